@@ -1,0 +1,81 @@
+"""Order-n solution of the Projection Equation: Bremer's Gaussian elimination (THEORY §6).
+
+Backward pass, leaves to root, with h_n = Q_n − G_n ẏ_n:
+
+    M̂_n = M_n + Σ_c T_cnᵀ M̄_c T_cn,        ĥ_n = h_n + Σ_c T_cnᵀ h̄_c
+    D_n = F_nᵀ M̂_n F_n
+    M̄_n = M̂_n − M̂_n F_n D_n⁻¹ F_nᵀ M̂_n,   h̄_n = (E − M̂_n F_n D_n⁻¹ F_nᵀ)(ĥ_n − M̂_n ζ_n)
+
+Forward pass, root to leaves (ÿ of the ground = 0):
+
+    s̈_n = D_n⁻¹ F_nᵀ (ĥ_n − M̂_n (T_np ÿ_p + ζ_n)),   ÿ_n = T_np ÿ_p + F_n s̈_n + ζ_n
+
+Both passes are written with the augmented matrices
+
+    Ã_n = [[M̂_n, −ĥ_n], [−ĥ_nᵀ, 0]],   T̃_np = [[T_np, ζ_n], [0, 1]],   F̃_n = [F_n; 0]
+
+for which the two lines of M̄_n and h̄_n are one Schur complement and one congruence,
+
+    Ā_n = Ã_n − Ã_n F̃_n D_n⁻¹ F̃_nᵀ Ã_n = [[M̄_n, ·], [·, ·]] with h̄ in the last column,
+    Ã_p += T̃_npᵀ Ā_n T̃_np,
+
+and the forward pass acts on (ÿ_n; 1) = T̃_np (ÿ_p; 1) + F̃_n s̈_n. The last column of
+T̃ᵀ Ā T̃ is −T_npᵀ h̄_n with h̄_n exactly as above (THEORY §6 expands this).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.assembly.linalg import mass_scale, solve_spd
+from projeq.kinematics import forward, gauss_terms
+
+
+class RecursiveEvaluator:
+    """Accelerations of one tree System in O(N). Counts calls in ``n_calls``."""
+
+    def __init__(self, system):
+        if system.coupled:
+            raise ValueError(
+                "method: 'recursive' needs a tree whose joints own their minimal velocities; "
+                "this system has coupled joints (shared ṡ): use method='dense'"
+            )
+        self.system = system
+        self.scale = mass_scale(system)
+        self.n_calls = 0
+
+    def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
+        """s̈ by the backward and forward passes of THEORY §6."""
+        self.n_calls += 1
+        system, scale = self.system, self.scale
+        kin = forward(system, q, s_dot, t)
+        M, h = gauss_terms(system, kin, q, s_dot, t)
+        A_hat = [_augmented(M_n, h_n) for M_n, h_n in zip(M, h)]
+        T_aug, F, parent, names = kin.T_aug, kin.F, system.parent, system.names
+        N = len(names)
+        gain = [None] * N
+        for n in range(N - 1, -1, -1):  # backward: leaves → root
+            A = A_hat[n]
+            AF = A[:, :-1] @ F[n]  # Ã_n F̃_n
+            gain[n] = solve_spd(F[n].T @ AF[:-1], AF.T, names[n], scale)  # D_n⁻¹ F̃_nᵀ Ã_n
+            A_bar = A - AF @ gain[n]  # Ā_n
+            A_hat[parent[n]] += T_aug[n].T @ A_bar @ T_aug[n]  # Ã_p += T̃ᵀ Ā T̃
+        s_ddot = [None] * N
+        y_aug = [None] * N + [np.ones(1)]  # (ÿ; 1), ground at rest
+        for n in range(N):  # forward: root → leaves
+            a = T_aug[n] @ y_aug[parent[n]]  # (T_np ÿ_p + ζ_n; 1)
+            s_ddot[n] = -gain[n] @ a  # D_n⁻¹ F_nᵀ (ĥ_n − M̂_n a)
+            a[:-1] += F[n] @ s_ddot[n]
+            y_aug[n] = a
+        return np.concatenate(s_ddot)
+
+
+def _augmented(M: NDArray, h: NDArray) -> NDArray:
+    """Ã = [[M, −h], [−hᵀ, 0]]."""
+    k = len(h)
+    A = np.zeros((k + 1, k + 1))
+    A[:k, :k] = M
+    A[:k, k] = A[k, :k] = -h
+    return A
+

@@ -1,0 +1,71 @@
+"""Input checks used where input enters projeq (constructors and ``simulate``).
+
+Each check raises ``ValueError`` whose message starts with the parameter's name and says
+what is wrong, so that bad input never reaches the numeric kernels.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+
+def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
+    """``value`` as a float array of the given shape with finite entries."""
+    try:
+        a = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
+    if shape is not None and a.shape != shape:
+        raise ValueError(f"{name}: expected shape {shape}, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        bad = np.flatnonzero(~np.isfinite(a.ravel()))
+        raise ValueError(f"{name}: non-finite entries (NaN or inf) at flat index {bad.tolist()}")
+    return a
+
+
+def positive(name: str, value) -> float:
+    """A finite, strictly positive float."""
+    x = float(finite_array(name, value, ()))
+    if x <= 0.0:
+        raise ValueError(f"{name}: must be positive, got {x}")
+    return x
+
+
+def non_negative(name: str, value) -> float:
+    """A finite float ≥ 0."""
+    x = float(finite_array(name, value, ()))
+    if x < 0.0:
+        raise ValueError(f"{name}: must not be negative, got {x}")
+    return x
+
+
+def state_vector(name: str, value, length: int) -> NDArray:
+    """A state (q or ṡ) of the right length with finite entries."""
+    a = finite_array(name, value)
+    if a.shape != (length,):
+        raise ValueError(f"{name}: expected {length} entries, got shape {a.shape}")
+    return a
+
+
+def inertia_tensor(name: str, I_c, allow_zero: bool = False) -> NDArray:
+    """A symmetric 3×3 inertia tensor: positive definite (semi-definite with ``allow_zero``)
+    with principal moments that satisfy the triangle inequality A + B ≥ C."""
+    I_c = finite_array(name, I_c, (3, 3))
+    scale = max(np.abs(I_c).max(), 1e-300)
+    if np.abs(I_c - I_c.T).max() > 1e-12 * scale:
+        raise ValueError(f"{name}: inertia tensor is not symmetric:\n{I_c}")
+    moments = np.linalg.eigvalsh(I_c)
+    tol = 1e-12 * scale
+    if allow_zero and np.all(np.abs(moments) <= tol):
+        return I_c
+    if moments[0] <= (-tol if allow_zero else 0.0):
+        raise ValueError(
+            f"{name}: inertia tensor is not positive definite (principal moments {moments})"
+        )
+    if moments[0] + moments[1] < moments[2] - tol:
+        raise ValueError(
+            f"{name}: principal moments {moments} violate the triangle inequality "
+            "A + B >= C (no mass distribution has them)"
+        )
+    return I_c

@@ -1,0 +1,203 @@
+"""Impressed forces beyond gravity: they add to h_n = Q_n − G_n ẏ_n of the subsystems.
+
+A force law is bound to a System by names (``bind``), then, at each evaluation, adds its
+wrenches to the subsystems' h_n given the kinematic state (``add_to``) and reports its
+potential energy (``potential``). Loads on a body enter as a wrench (f, M_O) about the
+body's origin in body coordinates, selected by the body's S. A generalized force τ on a
+joint's minimal velocities enters as an equal and opposite pair: h_n += w, h_p −= T_npᵀ w
+with F_nᵀ w = τ (w = F_n (F_nᵀF_n)⁻¹ τ), whose projection Σ J_nᵀ h_n is exactly τ on ṡ_n
+(B(14)); so the assemblers never special-case joint forces.
+
+Callables receive ``(t, q, s_dot)`` and return the load.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.checks import finite_array, non_negative
+from projeq.spatial import cross
+
+
+def _load(name: str, value, shape: tuple) -> Callable:
+    """A constant or a callable ``(t, q, s_dot) -> array`` as a checked callable."""
+    if callable(value):
+        def load(t, q, s_dot):
+            return finite_array(name, value(t, q, s_dot), shape)
+        return load
+    constant = finite_array(name, value, shape)
+    return lambda t, q, s_dot: constant
+
+
+def _frame(frame: str) -> str:
+    if frame not in ("world", "body"):
+        raise ValueError(f"frame: expected 'world' or 'body', got {frame!r}")
+    return frame
+
+
+class _BodyLoad:
+    """A wrench on one body, given as a force at a point and/or a torque."""
+
+    def __init__(self, body: str, frame: str):
+        self.body = body
+        self.frame = _frame(frame)
+
+    def bind(self, system) -> "_BodyLoad":
+        self.index = system.index(self.body)
+        self.S = system.subsystems[self.index].S
+        return self
+
+    def add_to(self, h, kin, t, q, s_dot) -> None:
+        n = self.index
+        wrench = self.wrench(kin.R[n], t, q, s_dot)
+        h[n] += wrench if self.S is None else self.S @ wrench
+
+    def potential(self, kin, q) -> float:
+        return 0.0
+
+
+class Force(_BodyLoad):
+    """A force on ``body`` acting at ``point`` (body coordinates, m).
+
+    ``force`` is a 3-vector (N) or a callable ``(t, q, s_dot) -> 3-vector``, in world
+    coordinates (``frame="world"``) or body coordinates (``frame="body"``).
+    """
+
+    def __init__(self, body: str, force, point=(0.0, 0.0, 0.0), frame: str = "world"):
+        super().__init__(body, frame)
+        self.force = _load("force", force, (3,))
+        self.point = finite_array("point", point, (3,))
+
+    def wrench(self, R, t, q, s_dot) -> NDArray:
+        f = self.force(t, q, s_dot)
+        f = R.T @ f if self.frame == "world" else f
+        return np.concatenate((f, cross(self.point, f)))
+
+
+class Torque(_BodyLoad):
+    """A torque (N m) on ``body``: a 3-vector or callable, world or body coordinates."""
+
+    def __init__(self, body: str, torque, frame: str = "world"):
+        super().__init__(body, frame)
+        self.torque = _load("torque", torque, (3,))
+
+    def wrench(self, R, t, q, s_dot) -> NDArray:
+        tau = self.torque(t, q, s_dot)
+        return np.concatenate((np.zeros(3), R.T @ tau if self.frame == "world" else tau))
+
+
+class JointForce:
+    """A generalized force τ on the minimal velocities ṡ_n of ``joint`` (a motor torque,
+    a drive force): a constant or a callable ``(t, q, s_dot) -> τ``."""
+
+    def __init__(self, joint: str, tau):
+        self.joint = joint
+        self.tau = tau
+
+    def bind(self, system) -> "JointForce":
+        self.index = n = system.index(self.joint)
+        self.parent = system.parent[n]
+        self.n_s = system.joints[n].n_s
+        self._tau = _load(f"tau of joint {self.joint!r}", self.tau, (self.n_s,))
+        return self
+
+    def generalized_force(self, t, q, s_dot) -> NDArray:
+        return self._tau(t, q, s_dot)
+
+    def add_to(self, h, kin, t, q, s_dot) -> None:
+        n, F = self.index, kin.F[self.index]
+        tau = self.generalized_force(t, q, s_dot)
+        w = F @ np.linalg.solve(F.T @ F, tau)  # F_nᵀ w = τ
+        h[n] += w
+        h[self.parent] -= kin.T_aug[n][:-1, :-1].T @ w  # reaction on p: −T_npᵀ w
+
+    def potential(self, kin, q) -> float:
+        return 0.0
+
+
+class JointSpring(JointForce):
+    """A linear spring-damper on a joint coordinate: τ = −k (q_n − q_ref) − d ṡ_n.
+
+    Only for joints with q̇_n = ṡ_n (revolute, prismatic). Potential ½ k (q_n − q_ref)².
+    """
+
+    def __init__(self, joint: str, stiffness: float, damping: float = 0.0, q_ref=0.0):
+        super().__init__(joint, None)
+        self.stiffness = non_negative("stiffness", stiffness)
+        self.damping = non_negative("damping", damping)
+        self.q_ref = q_ref
+
+    def bind(self, system) -> "JointSpring":
+        self.index = n = system.index(self.joint)
+        self.parent = system.parent[n]
+        joint = system.joints[n]
+        if joint.n_q != joint.n_s or not np.allclose(joint.K(joint.default_q(), 0.0), np.eye(joint.n_q)):
+            raise ValueError(f"joint: JointSpring needs q̇ = ṡ, which joint {self.joint!r} does not have")
+        self.n_s = joint.n_s
+        self._q_ref = finite_array("q_ref", np.broadcast_to(self.q_ref, (self.n_s,)), (self.n_s,))
+        self._q = system.joint_q_getter(n)
+        self._s = system.joint_s_dot_getter(n)
+        return self
+
+    def generalized_force(self, t, q, s_dot) -> NDArray:
+        return -self.stiffness * (self._q(q) - self._q_ref) - self.damping * self._s(s_dot)
+
+    def potential(self, kin, q) -> float:
+        dq = self._q(q) - self._q_ref
+        return 0.5 * self.stiffness * float(dq @ dq)
+
+
+class SpringDamper:
+    """A linear spring-damper between two points: force k (ℓ − ℓ₀) + d ℓ̇ along the line.
+
+    ``body_a`` / ``body_b`` are subsystem names or ``None`` for the ground; points are in
+    the body's coordinates (world coordinates for the ground). Potential ½ k (ℓ − ℓ₀)².
+    """
+
+    def __init__(self, body_a, point_a, body_b, point_b, stiffness: float, damping: float = 0.0, length: float = 0.0):
+        self.bodies = (body_a, body_b)
+        self.points = (finite_array("point_a", point_a, (3,)), finite_array("point_b", point_b, (3,)))
+        self.stiffness = non_negative("stiffness", stiffness)
+        self.damping = non_negative("damping", damping)
+        self.length = non_negative("length", length)
+
+    def bind(self, system) -> "SpringDamper":
+        self.index = tuple(-1 if b is None else system.index(b) for b in self.bodies)
+        self.S = tuple(system.subsystems[n].S if n >= 0 else None for n in self.index)
+        if self.index[0] == self.index[1]:
+            raise ValueError("body_b: a spring-damper needs two different bodies")
+        return self
+
+    def _ends(self, kin):
+        """World position and velocity of both attachment points."""
+        ends = []
+        for n, point in zip(self.index, self.points):
+            if n < 0:
+                ends.append((point, np.zeros(3)))
+                continue
+            v_O, omega = kin.twist[n][:3], kin.twist[n][3:]
+            R = kin.R[n]
+            ends.append((kin.r[n] + R @ point, R @ (v_O + cross(omega, point))))
+        return ends
+
+    def add_to(self, h, kin, t, q, s_dot) -> None:
+        (x_a, v_a), (x_b, v_b) = self._ends(kin)
+        d = x_b - x_a
+        length = np.linalg.norm(d)
+        if length < 1e-12:
+            raise ValueError(f"SpringDamper between {self.bodies}: the two points coincide, no direction")
+        e = d / length
+        tension = self.stiffness * (length - self.length) + self.damping * float(e @ (v_b - v_a))
+        for n, point, S, sign in zip(self.index, self.points, self.S, (1.0, -1.0)):
+            if n < 0:
+                continue
+            f = kin.R[n].T @ (sign * tension * e)  # pulls a towards b and b towards a
+            wrench = np.concatenate((f, cross(point, f)))
+            h[n] += wrench if S is None else S @ wrench
+
+    def potential(self, kin, q) -> float:
+        (x_a, _), (x_b, _) = self._ends(kin)
+        return 0.5 * self.stiffness * (np.linalg.norm(x_b - x_a) - self.length) ** 2

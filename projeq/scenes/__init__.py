@@ -1,0 +1,87 @@
+"""Ready-made named systems for scripts, the CLI, tests and docs.
+
+Every scene is a function returning a :class:`projeq.System` with sensible default initial
+conditions; its keyword parameters (SI units) are documented in its docstring. ``SCENES``
+maps the names the CLI knows to these functions.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from projeq import inertia
+from projeq.joints import Prismatic, Revolute
+from projeq.subsystems import PlanarBody, PointMass, RigidBody
+from projeq.system import System
+
+
+def chain(n: int = 5, planar: bool = False, q0=None) -> System:
+    """n identical links hanging from the origin, joined by revolute joints about y.
+
+    Each link: length 1 m, mass 1 kg, a solid cylinder of radius 0.01 m along the link, its
+    joint at the upper end and its mass centre in the middle; in q = 0 the links hang
+    along −z; gravity 9.81 m/s² along −z; q = relative joint angles (right-hand rule
+    about +y). ``planar=True`` builds the same system from planar bodies in the x–z
+    plane. Default initial state: first joint at 0.5 rad, the rest 0, at rest.
+    """
+    if int(n) != n or n < 1:
+        raise ValueError(f"n: number of links must be a positive integer, got {n!r}")
+    n = int(n)
+    I_c = inertia.cylinder(m=1.0, radius=0.01, length=1.0, axis="z")
+    link = PlanarBody(1.0, (0.0, 0.0, -0.5), I_c, plane="zx") if planar else RigidBody(1.0, (0.0, 0.0, -0.5), I_c)
+    names = [f"link{i + 1}" for i in range(n)]
+    joints = {
+        name: Revolute(parent=None if i == 0 else names[i - 1], axis="y", r_pn=(0.0, 0.0, 0.0 if i == 0 else -1.0))
+        for i, name in enumerate(names)
+    }
+    if q0 is None:
+        q0 = np.zeros(n)
+        q0[0] = 0.5
+    return System(dict.fromkeys(names, link), joints, gravity=(0.0, 0.0, -9.81), q0=q0)
+
+
+def double_pendulum(m1: float = 1.0, m2: float = 1.0, l1: float = 1.0, l2: float = 1.0, g: float = 9.81, q0=(np.pi / 2, 0.0)) -> System:
+    """Two point masses on massless rods, hinged about y, hanging along −z (Problem 8 of
+    the Lagrange problem book). q = (θ₁, θ₂), θ₂ relative to the first rod.
+    Default: released from rest with the first rod horizontal."""
+    return System(
+        {"bob1": PointMass(m1, (0.0, 0.0, -l1)), "bob2": PointMass(m2, (0.0, 0.0, -l2))},
+        {"bob1": Revolute(axis="y"), "bob2": Revolute(parent="bob1", axis="y", r_pn=(0.0, 0.0, -l1))},
+        gravity=(0.0, 0.0, -g),
+        q0=q0,
+    )
+
+
+def atwood(m1: float = 2.0, m2: float = 1.0, pulley_mass: float = 0.5, radius: float = 0.1, g: float = 9.81) -> System:
+    """Atwood machine: masses m1 (at x = −radius) and m2 (x = +radius) on a rope over a
+    pulley (a uniform disk about y at the origin, inertia ½ pulley_mass radius²).
+
+    One minimal coordinate: the pulley angle θ about +y. The rope does not slip, so mass 1
+    rises by radius·θ and mass 2 sinks by radius·θ: their prismatic joints are *coupled*
+    to the pulley (shared minimal velocity, evaluated by the dense Gauss form).
+    Reference: ẍ₁ = (m1 − m2) g / (m1 + m2 + I/a²) downwards for mass 1 (Problem 1).
+    """
+    a = radius
+    return System(
+        {
+            "pulley": RigidBody(pulley_mass, I_c=inertia.disk(pulley_mass, radius, axis="y")),
+            "mass1": PointMass(m1),
+            "mass2": PointMass(m2),
+        },
+        {
+            "pulley": Revolute(axis="y"),
+            "mass1": Prismatic(axis="z", r_pn=(-a, 0.0, -1.0), coupling={"pulley": a}),
+            "mass2": Prismatic(axis="z", r_pn=(a, 0.0, -1.0), coupling={"pulley": -a}),
+        },
+        gravity=(0.0, 0.0, -g),
+    )
+
+
+SCENES = {
+    "chain": (chain, "n links on revolute joints hanging from the origin (default n = 5)"),
+    "double_pendulum": (double_pendulum, "two point masses on massless rods, released horizontally"),
+    "atwood": (atwood, "two masses on a rope over a pulley with inertia (coupled joints)"),
+}
+DEFAULT_SCENE = "double_pendulum"
+
+__all__ = ["chain", "double_pendulum", "atwood", "SCENES", "DEFAULT_SCENE"]

@@ -1,0 +1,263 @@
+"""Simulation: integrate q̇ = K(q) ṡ + k, s̈ from the Projection Equation, with solve_ivp.
+
+The state is x = (q, ṡ). The run is split into segments (``n_segments``) so that a
+failure, a non-finite state or Ctrl-C keeps everything computed up to the last finished
+segment; each segment is one ``scipy.integrate.solve_ivp`` call with the user's method,
+tolerances and events. Quaternions are normalised where the pose is evaluated and in the
+output.
+"""
+
+from __future__ import annotations
+
+import json
+import time as _time
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.integrate import OdeSolution, solve_ivp
+
+from projeq.checks import finite_array, positive
+
+
+class SimulationError(RuntimeError):
+    """The integration failed; ``.result`` holds the trajectory up to ``.result.t[-1]``."""
+
+    def __init__(self, message: str, result: "Result"):
+        super().__init__(message)
+        self.result = result
+
+
+@dataclass(frozen=True)
+class Result:
+    """A simulated trajectory: one row per output time.
+
+    Attributes
+    ----------
+    t : (n,) times; q : (n, n_q) coordinates; s_dot : (n, n_s) minimal velocities
+    kinetic, potential : (n,) energies (``energy`` is their sum)
+    constraint_residual : (n, m) residuals of velocity constraints (m = 0 without any)
+    nfev : right-hand-side evaluations; wall_time : seconds
+    status : 0 finished, 1 stopped by a terminal event, -1 failed, 2 interrupted
+    message : the integrator's message; t_events : times of each event
+    names : subsystem names; sol : dense output ``sol(t) -> (q, s_dot)`` or None
+    """
+
+    t: NDArray
+    q: NDArray
+    s_dot: NDArray
+    kinetic: NDArray
+    potential: NDArray
+    constraint_residual: NDArray
+    nfev: int = 0
+    wall_time: float = 0.0
+    status: int = 0
+    message: str = ""
+    t_events: tuple = ()
+    names: tuple = ()
+    method: str = ""
+    sol: object = field(default=None, repr=False, compare=False)
+
+    @property
+    def energy(self) -> NDArray:
+        """Total mechanical energy kinetic + potential along the trajectory."""
+        return self.kinetic + self.potential
+
+    @property
+    def energy_drift(self) -> float:
+        """max |E(t) − E(t₀)| relative to the largest kinetic or potential energy of the run
+        (a scale that stays meaningful when E(t₀) = 0)."""
+        if len(self.t) == 0:
+            return 0.0
+        scale = max(np.abs(self.kinetic).max(), np.abs(self.potential).max(), 1e-300)
+        return float(np.abs(self.energy - self.energy[0]).max() / scale)
+
+    @property
+    def success(self) -> bool:
+        """True when the run reached its end or a terminal event."""
+        return self.status in (0, 1)
+
+    def save(self, path) -> None:
+        """Write the arrays and metadata to an ``.npz`` file (readable by numpy alone)."""
+        arrays = {f.name: getattr(self, f.name) for f in fields(self) if isinstance(getattr(self, f.name), np.ndarray)}
+        meta = {
+            "nfev": self.nfev, "wall_time": self.wall_time, "status": self.status,
+            "message": self.message, "names": list(self.names), "method": self.method,
+        }
+        events = {f"t_events_{i}": np.asarray(e) for i, e in enumerate(self.t_events)}
+        np.savez(path, **arrays, **events, meta=json.dumps(meta))
+
+    @classmethod
+    def load(cls, path) -> "Result":
+        """Read a Result written by :meth:`save` (without dense output)."""
+        with np.load(path) as data:
+            meta = json.loads(str(data["meta"]))
+            n_events = sum(1 for k in data.files if k.startswith("t_events_"))
+            arrays = {k: data[k] for k in data.files if k != "meta" and not k.startswith("t_events_")}
+            t_events = tuple(data[f"t_events_{i}"] for i in range(n_events))
+        meta["names"] = tuple(meta["names"])
+        return cls(**arrays, **meta, t_events=t_events)
+
+
+def _event_wrapper(event, n_q):
+    def wrapped(t, x):
+        return event(t, x[:n_q], x[n_q:])
+
+    for attr in ("terminal", "direction"):
+        if hasattr(event, attr):
+            setattr(wrapped, attr, getattr(event, attr))
+    return wrapped
+
+
+def simulate(
+    system,
+    t_end: float,
+    q0=None,
+    s_dot0=None,
+    method="RK45",
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    events=None,
+    *,
+    t_start: float = 0.0,
+    t_eval=None,
+    n_points: int = 501,
+    dense_output: bool = False,
+    evaluator: str | object | None = None,
+    n_segments: int = 20,
+    progress=None,
+    **options,
+) -> Result:
+    """Integrate the equations of motion of ``system`` from ``t_start`` to ``t_end``.
+
+    Parameters
+    ----------
+    system : System
+    t_end : float
+        End time (s), > t_start.
+    q0, s_dot0 : arrays, optional
+        Initial coordinates and minimal velocities (default: the system's q0, ṡ0).
+    method : str or scipy OdeSolver class
+        Any method of ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...).
+    rtol, atol : float
+        Tolerances passed to the integrator.
+    events : callable or list of callables ``event(t, q, s_dot)``
+        Zero crossings; ``terminal`` and ``direction`` attributes as in solve_ivp.
+    t_eval : array, optional
+        Output times (default ``n_points`` equally spaced).
+    dense_output : bool
+        Keep a continuous solution ``result.sol(t) -> (q, s_dot)``.
+    evaluator : "recursive", "dense" or an object with ``accelerations(q, s_dot, t)``
+        Right-hand side (default: recursive for trees, dense for coupled joints).
+    progress : callable ``progress(t)``, optional
+        Called after each segment with the time reached.
+    **options
+        Further options for the integrator (max_step, first_step, ...).
+
+    Returns
+    -------
+    Result
+        On failure of the integrator or a non-finite state, :class:`SimulationError` is
+        raised with ``.result`` holding the trajectory computed so far; Ctrl-C returns the
+        partial trajectory with ``status = 2``.
+    """
+    q0 = system.q0 if q0 is None else q0
+    s_dot0 = system.s_dot0 if s_dot0 is None else s_dot0
+    q0, s_dot0 = system.check_state(q0, s_dot0)
+    q0 = system.normalized(q0)
+    t_start = float(finite_array("t_start", t_start, ()))
+    if not float(finite_array("t_end", t_end, ())) > t_start:
+        raise ValueError(f"t_end: must be after t_start = {t_start}, got {t_end}")
+    positive("rtol", rtol)
+    positive("atol", atol)
+    t_eval = _output_times(t_start, float(t_end), t_eval, n_points)
+    ev = evaluator if hasattr(evaluator, "accelerations") else system.evaluator(evaluator)
+    n_q = system.n_q
+
+    def rhs(t, x):
+        q, s_dot = x[:n_q], x[n_q:]
+        x_dot = np.concatenate((system.q_dot(q, s_dot, t), ev.accelerations(q, s_dot, t)))
+        if not np.all(np.isfinite(x_dot)):
+            raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
+        return x_dot
+
+    events = [] if events is None else (list(events) if isinstance(events, (list, tuple)) else [events])
+    wrapped_events = [_event_wrapper(e, n_q) for e in events] or None
+    bounds = np.linspace(t_start, float(t_end), max(1, int(n_segments)) + 1)
+    pieces, nfev, status, message = [], 0, 0, "The solver successfully reached the end of the integration interval."
+    t_events = [[] for _ in events]
+    x = np.concatenate((q0, s_dot0))
+    started = _time.perf_counter()
+    try:
+        for a, b in zip(bounds[:-1], bounds[1:]):
+            inside = t_eval[(t_eval > a) & (t_eval <= b)] if pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
+            sol = solve_ivp(
+                rhs, (a, b), x, method=method, t_eval=inside, rtol=rtol, atol=atol,
+                events=wrapped_events, dense_output=True, **options,
+            )
+            nfev += sol.nfev
+            pieces.append(sol)
+            for i, te in enumerate(sol.t_events or []):
+                t_events[i].extend(te)
+            if sol.status != 0:
+                status, message = sol.status, sol.message
+                break
+            x = sol.y[:, -1].copy()
+            x[:n_q] = system.normalized(x[:n_q])
+            if progress is not None:
+                progress(b)
+    except KeyboardInterrupt:
+        status, message = 2, "interrupted (Ctrl-C): the trajectory up to the last finished segment is kept"
+    except (FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
+        status, message = -1, str(exc)
+    result = _assemble(system, pieces, nfev, status, message, t_events, _time.perf_counter() - started, method, dense_output)
+    if status == -1:
+        reached = result.t[-1] if len(result.t) else t_start
+        raise SimulationError(
+            f"integration failed at t = {reached:.6g} s of {t_end}: {message} "
+            "(the trajectory computed so far is in .result)",
+            result,
+        )
+    return result
+
+
+def _output_times(t_start, t_end, t_eval, n_points) -> NDArray:
+    if t_eval is None:
+        return np.linspace(t_start, t_end, max(2, int(n_points)))
+    t_eval = finite_array("t_eval", t_eval)
+    if t_eval.ndim != 1 or np.any(np.diff(t_eval) <= 0) or t_eval[0] < t_start or t_eval[-1] > t_end:
+        raise ValueError(f"t_eval: must increase strictly within [{t_start}, {t_end}]")
+    return t_eval
+
+
+def _assemble(system, pieces, nfev, status, message, t_events, wall_time, method, dense_output) -> Result:
+    """One Result from the segments' solutions: normalised q, energies along the path."""
+    n_q = system.n_q
+    if pieces:
+        t = np.concatenate([p.t for p in pieces])
+        x = np.concatenate([p.y for p in pieces], axis=1).T
+    else:
+        t, x = np.zeros(0), np.zeros((0, n_q + system.n_s))
+    q = np.array([system.normalized(row) for row in x[:, :n_q]]).reshape(len(t), n_q)
+    s_dot = x[:, n_q:]
+    energies = np.array([system.energy(qi, si, ti) for ti, qi, si in zip(t, q, s_dot)]).reshape(len(t), 2)
+    sol = _dense_solution(pieces, n_q) if dense_output and pieces else None
+    return Result(
+        t=t, q=q, s_dot=s_dot, kinetic=energies[:, 0], potential=energies[:, 1],
+        constraint_residual=np.zeros((len(t), 0)), nfev=int(nfev), wall_time=wall_time,
+        status=int(status), message=str(message), t_events=tuple(np.array(e) for e in t_events),
+        names=system.names, method=getattr(method, "__name__", str(method)), sol=sol,
+    )
+
+
+def _dense_solution(pieces, n_q):
+    """Join the segments' dense outputs into one ``sol(t) -> (q, s_dot)``."""
+    ts = np.concatenate([p.sol.ts[:-1] for p in pieces] + [pieces[-1].sol.ts[-1:]])
+    interpolants = [f for p in pieces for f in p.sol.interpolants]
+    joined = OdeSolution(ts, interpolants)
+
+    def sol(t):
+        x = joined(t)
+        return x[:n_q], x[n_q:]
+
+    return sol

@@ -1,0 +1,146 @@
+"""Compiling user-defined joints (:class:`projeq.joints.UserJoint`).
+
+From sympy: F, A, r, K (and the rheonomic f, k) are checked for unknown symbols,
+Ḟ ṡ + ḟ is derived by differentiating along q̇ = K ṡ + k, and everything is lambdified
+once with common subexpressions. From callables: Ḟ ṡ + ḟ by complex-step
+differentiation, exact to round-off. Either way the pose is checked against F and K.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from projeq.checks import finite_array
+from projeq.joints import Relative, pose_twist_mismatch
+
+_COMPLEX_STEP = 1e-30
+_POSE_TOLERANCE = 1e-5  # central differences of step 1e-7 in pose_twist_mismatch: error ~1e-9
+
+
+def _matrix(name: str, value, shape: tuple) -> sp.Matrix:
+    M = sp.Matrix(value)
+    if shape[1] == 1 and M.shape == (1, shape[0]):
+        M = M.T
+    if M.shape != shape:
+        raise ValueError(f"{name}: expected shape {shape}, got {M.shape}")
+    return M
+
+
+def _check_symbols(name: str, expr: sp.Matrix, allowed: set, q, t) -> None:
+    extra = expr.free_symbols - allowed
+    if extra:
+        raise ValueError(
+            f"{name}: depends on {sorted(map(str, extra))}, which are not coordinates "
+            f"{[str(x) for x in q]}, time {t} or declared parameters"
+        )
+
+
+def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0, r_pn, orientation):
+    """A :class:`UserJoint` from sympy expressions (see ``UserJoint.from_sympy``)."""
+    q, s = list(q), list(s)
+    t = t if t is not None else sp.Symbol("t")
+    n_q, n_s = len(q), len(s)
+    exprs = {
+        "A": _matrix("A", A, (3, 3)),
+        "r": _matrix("r", r, (3, 1)),
+        "F": _matrix("F", F, (6, n_s)),
+        "K": _matrix("K", K, (n_q, n_s)),
+        "f": _matrix("f", sp.zeros(6, 1) if f is None else f, (6, 1)),
+        "k": _matrix("k", sp.zeros(n_q, 1) if k is None else k, (n_q, 1)),
+    }
+    values = {sym: float(finite_array(f"parameters[{sym}]", val, ())) for sym, val in parameters.items()}
+    allowed = set(q) | {t} | set(values)
+    for name, expr in exprs.items():
+        _check_symbols(name, expr, allowed, q, t)
+    A, r, F, K, f, k = (e.xreplace(values) for e in exprs.values())
+
+    s_vec = sp.Matrix(s)
+    q_dot = K * s_vec + k
+
+    def d_dt(M: sp.Matrix) -> sp.Matrix:
+        return sum((M.diff(qi) * q_dot[i] for i, qi in enumerate(q)), M.diff(t))
+
+    zeta = d_dt(F) * s_vec + d_dt(f)
+    rel = sp.lambdify([q, s, t], [A, r, F, F * s_vec + f, zeta], modules="numpy", cse=True)
+    K_fun = sp.lambdify([q, t], K, modules="numpy", cse=True)
+    q_dot_fun = sp.lambdify([q, s, t], q_dot, modules="numpy", cse=True)
+
+    def relative(q_n, s_dot_n, time):
+        A_, r_, F_, w_, z_ = rel(q_n, s_dot_n, time)
+        return Relative(
+            np.asarray(A_, dtype=float),
+            np.asarray(r_, dtype=float).ravel(),
+            np.asarray(F_, dtype=float),
+            np.asarray(w_, dtype=float).ravel(),
+            np.asarray(z_, dtype=float).ravel(),
+        )
+
+    joint = cls(
+        parent, n_q, n_s, relative,
+        lambda q_n, time: np.asarray(K_fun(q_n, time), dtype=float),
+        lambda q_n, s_dot_n, time: np.asarray(q_dot_fun(q_n, s_dot_n, time), dtype=float).ravel(),
+        q0=q0, r_pn=r_pn, orientation=orientation,
+    )
+    joint.symbols = {"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k}
+    _check_pose(joint)
+    return joint
+
+
+def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, orientation):
+    """A :class:`UserJoint` from callables (see ``UserJoint.from_functions``)."""
+    zero6, zero_q = np.zeros(6), np.zeros(n_q)
+    f = f if f is not None else (lambda q_n, time: zero6)
+    k = k if k is not None else (lambda q_n, time: zero_q)
+
+    def q_dot(q_n, s_dot_n, time):
+        return K(q_n, time) @ s_dot_n + k(q_n, time)
+
+    def relative(q_n, s_dot_n, time):
+        A, r = pose(q_n, time)
+        F_n = np.asarray(F(q_n, time), dtype=float)
+        # complex step along (q̇, 1): Im F(q + iε q̇, t + iε)/ε = Ḟ exactly to round-off
+        q_c = q_n + 1j * _COMPLEX_STEP * q_dot(q_n, s_dot_n, time)
+        t_c = time + 1j * _COMPLEX_STEP
+        F_dot = np.imag(F(q_c, t_c)) / _COMPLEX_STEP
+        f_dot = np.imag(f(q_c, t_c)) / _COMPLEX_STEP
+        w = F_n @ s_dot_n + np.real(f(q_n, time))
+        return Relative(np.asarray(A, dtype=float), np.asarray(r, dtype=float), F_n, w, F_dot @ s_dot_n + f_dot)
+
+    joint = cls(parent, n_q, n_s, relative, K, q_dot, q0=q0, r_pn=r_pn, orientation=orientation)
+    _check_shapes(joint)
+    _check_pose(joint)
+    return joint
+
+
+def _check_shapes(joint) -> None:
+    q0, s0 = joint.default_q(), np.ones(joint.n_s)
+    try:
+        rel = joint.relative(q0, s0, 0.0)
+    except TypeError as exc:
+        raise ValueError(
+            "F: the callables must accept complex arguments for complex-step "
+            f"differentiation (use numpy functions): {exc}"
+        ) from exc
+    for name, value, shape in (
+        ("pose A", rel.A, (3, 3)),
+        ("pose r", rel.r, (3,)),
+        ("F", rel.F, (6, joint.n_s)),
+        ("K", joint.K(q0, 0.0), (joint.n_q, joint.n_s)),
+    ):
+        finite_array(name, value, shape)
+
+
+def _check_pose(joint) -> None:
+    """The pose's time derivative must be the twist F ṡ + f (at q0 and a nearby point)."""
+    rng = np.random.default_rng(0)
+    for q_n in (joint.default_q(), joint.default_q() + 0.1 * rng.standard_normal(joint.n_q)):
+        s_dot = rng.standard_normal(joint.n_s)
+        error = pose_twist_mismatch(joint, q_n, s_dot, 0.3)
+        scale = 1.0 + np.abs(joint.relative(q_n, s_dot, 0.3).w).max()
+        if not error <= _POSE_TOLERANCE * scale:
+            raise ValueError(
+                f"F: the relative twist F ṡ + f differs by {error:.3g} from the time derivative "
+                f"of the pose (A, r) along q̇ = K ṡ + k at q = {np.round(q_n, 4).tolist()}; "
+                "F, K and the pose must describe the same motion"
+            )

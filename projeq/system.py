@@ -1,0 +1,310 @@
+"""The System: a validated, immutable tree of subsystems, joints and forces.
+
+Subsystems are numbered in topological order (``parent[n] < n``; ``GROUND = -1``). Each
+joint owns a slice of the coordinates q and of the minimal velocities ṡ (``q_slice[n]``,
+``s_slice[n]``) unless it is *coupled* (gears, ropes), in which case its coordinate is a
+linear combination of other joints' coordinates and ∂ẏ/∂ṡ is no longer block-triangular
+(THEORY §4): such systems are evaluated by the dense Gauss form.
+
+All validation happens here, where input enters; the kernels trust what they get.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.checks import finite_array, state_vector
+from projeq.joints import Joint
+
+GROUND = -1
+_GROUND_S = np.zeros((0, 6))
+
+
+class System:
+    """A multibody system for the Projection Equation Σ J_nᵀ (M_n ÿ_n + G_n ẏ_n − Q_n) = 0.
+
+    Parameters
+    ----------
+    subsystems : dict[str, Subsystem]
+        The bodies by name (any object with ``n_y``, ``S`` and ``gauss_terms``).
+    joints : dict[str, Joint]
+        For each subsystem name the joint that attaches it to its ``parent``.
+    gravity : 3-vector
+        Gravitational acceleration in inertial coordinates (m/s²).
+    forces : sequence
+        Force laws (:mod:`projeq.forces`).
+    q0, s_dot0 : arrays, optional
+        Default initial state used by :func:`projeq.simulate` (zero configuration and rest).
+
+    Examples
+    --------
+    >>> import numpy as np, projeq as pq
+    >>> rod = pq.RigidBody(m=1.0, r_c=(0, 0, -0.5), I_c=np.diag([1/12, 1/12, 1e-4]))
+    >>> system = pq.System(
+    ...     subsystems={"upper": rod, "lower": rod},
+    ...     joints={"upper": pq.Revolute(parent=None, axis="y"),
+    ...             "lower": pq.Revolute(parent="upper", axis="y", r_pn=(0, 0, -1))},
+    ...     gravity=(0, 0, -9.81))
+    >>> s_ddot = system.accelerations(q=[0.3, -0.2], s_dot=[0.0, 0.0])
+    >>> bool(np.allclose(s_ddot, system.accelerations([0.3, -0.2], [0, 0], method="dense")))
+    True
+    """
+
+    def __init__(self, subsystems: dict, joints: dict, gravity=(0.0, 0.0, 0.0), forces=(), q0=None, s_dot0=None):
+        _check_names(subsystems, joints)
+        order = _topological_order(joints)
+        self.names = tuple(order)
+        self._index = {name: n for n, name in enumerate(order)}
+        self.subsystems = tuple(subsystems[name] for name in order)
+        self.joints = tuple(joints[name] for name in order)
+        self.parent = tuple(GROUND if j.parent is None else self._index[j.parent] for j in self.joints)
+        self.S = tuple(s.S for s in self.subsystems) + (_GROUND_S,)
+        self.gravity = finite_array("gravity", gravity, (3,))
+        self._layout_coordinates()
+        self.coupled = any(j.coupling for j in self.joints)
+        self.forces = tuple(copy.copy(f).bind(self) for f in forces)
+        self.q0 = self.normalized(state_vector("q0", self._default_q() if q0 is None else q0, self.n_q))
+        self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
+        for a in (self.gravity, self.q0, self.s_dot0):
+            a.flags.writeable = False
+        self._check_planar()
+        self._evaluators: dict = {}  # the one cache: an evaluator per method (not thread-safe)
+
+    # -- names and indexing -------------------------------------------------------------
+    def index(self, name: str) -> int:
+        """Position of the subsystem ``name`` in the topological order."""
+        if name not in self._index:
+            raise ValueError(f"unknown subsystem {name!r}; the system has {list(self.names)}")
+        return self._index[name]
+
+    def subsystem(self, name: str):
+        """The subsystem added under ``name``."""
+        return self.subsystems[self.index(name)]
+
+    def joint(self, name: str) -> Joint:
+        """The joint that attaches subsystem ``name``."""
+        return self.joints[self.index(name)]
+
+    def _layout_coordinates(self) -> None:
+        q_slice, s_slice, n_q, n_s = [], [], 0, 0
+        for joint in self.joints:
+            own_q, own_s = (0, 0) if joint.coupling else (joint.n_q, joint.n_s)
+            q_slice.append(slice(n_q, n_q + own_q))
+            s_slice.append(slice(n_s, n_s + own_s))
+            n_q, n_s = n_q + own_q, n_s + own_s
+        self.q_slice, self.s_slice, self.n_q, self.n_s = tuple(q_slice), tuple(s_slice), n_q, n_s
+        self._q_get = tuple(self.joint_q_getter(n) for n in range(len(self.joints)))
+        self._s_get = tuple(self.joint_s_dot_getter(n) for n in range(len(self.joints)))
+
+    def _coupling_rows(self, n: int, slices) -> tuple[NDArray, NDArray]:
+        """Indices into the global vector and weights for coupled joint n."""
+        joint = self.joints[n]
+        if joint.n_q != 1 or joint.n_s != 1:
+            raise ValueError(f"coupling: joint of {self.names[n]!r} must have one dof")
+        idx, weights = [], []
+        for other, ratio in joint.coupling.items():
+            m = self.index(other)
+            if self.joints[m].coupling or self.joints[m].n_s != 1 or self.joints[m].n_q != 1:
+                raise ValueError(f"coupling: {self.names[n]!r} may follow only uncoupled one-dof joints, not {other!r}")
+            idx.append(slices[m].start)
+            weights.append(ratio)
+        return np.array(idx), np.array(weights)
+
+    def joint_q_getter(self, n: int):
+        """A function q ↦ q_n (the joint's coordinates, coupled ones computed)."""
+        if not self.joints[n].coupling:
+            sl = self.q_slice[n]
+            return lambda q: q[sl]
+        idx, w = self._coupling_rows(n, self.q_slice)
+        return lambda q: np.array([w @ q[idx]])
+
+    def joint_s_dot_getter(self, n: int):
+        """A function ṡ ↦ ṡ_n (the joint's minimal velocities, coupled ones computed)."""
+        if not self.joints[n].coupling:
+            sl = self.s_slice[n]
+            return lambda s_dot: s_dot[sl]
+        idx, w = self._coupling_rows(n, self.s_slice)
+        return lambda s_dot: np.array([w @ s_dot[idx]])
+
+    def joint_s_columns(self, n: int) -> tuple[NDArray, NDArray]:
+        """(columns of ṡ, weights P) with ṡ_n = P ṡ[columns]: the joint's place in ∂ẏ/∂ṡ."""
+        if not self.joints[n].coupling:
+            cols = np.arange(self.n_s)[self.s_slice[n]]
+            return cols, np.eye(len(cols))
+        idx, w = self._coupling_rows(n, self.s_slice)
+        return idx, w[None, :]
+
+    # -- states ---------------------------------------------------------------------------
+    def _default_q(self) -> NDArray:
+        return np.concatenate([j.default_q() for j in self.joints if not j.coupling] or [np.zeros(0)])
+
+    def normalized(self, q: NDArray) -> NDArray:
+        """q with every joint's coordinates projected onto their manifold (unit quaternions)."""
+        q = np.array(q, dtype=float)
+        for joint, sl in zip(self.joints, self.q_slice):
+            if sl.stop > sl.start:
+                q[sl] = joint.normalized(q[sl])
+        return q
+
+    def check_state(self, q, s_dot) -> tuple[NDArray, NDArray]:
+        """q and ṡ as float arrays of the right lengths with finite entries."""
+        return state_vector("q", q, self.n_q), state_vector("s_dot", s_dot, self.n_s)
+
+    def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
+        """q̇ = K(q) ṡ + k(q, t), joint by joint."""
+        parts = [
+            j.q_dot(self._q_get[n](q), self._s_get[n](s_dot), t)
+            for n, j in enumerate(self.joints)
+            if not j.coupling
+        ]
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+    def K(self, q: NDArray, t: float = 0.0) -> NDArray:
+        """K(q) of q̇ = K ṡ + k (block-diagonal over the joints)."""
+        K = np.zeros((self.n_q, self.n_s))
+        for n, j in enumerate(self.joints):
+            if not j.coupling:
+                K[self.q_slice[n], self.s_slice[n]] = j.K(self._q_get[n](q), t)
+        return K
+
+    # -- evaluation -----------------------------------------------------------------------
+    def evaluator(self, method: str | None = None):
+        """The cached evaluator ``"recursive"`` or ``"dense"`` (``None``: recursive, or
+        dense when minimal velocities are shared by coupled joints)."""
+        from projeq.assembly import EVALUATORS
+
+        if method is None:
+            method = "dense" if self.coupled else "recursive"
+        if method not in EVALUATORS:
+            raise ValueError(f"method: unknown evaluator {method!r}; use one of {sorted(EVALUATORS)}")
+        if method not in self._evaluators:
+            self._evaluators[method] = EVALUATORS[method](self)
+        return self._evaluators[method]
+
+    def accelerations(self, q, s_dot, t: float = 0.0, method: str | None = None) -> NDArray:
+        """Minimal accelerations s̈ from the Projection Equation at (q, ṡ, t).
+
+        ``method="recursive"`` (order n, THEORY §6) or ``"dense"`` (Gauss form, §5).
+        """
+        q, s_dot = self.check_state(q, s_dot)
+        return self.evaluator(method).accelerations(q, s_dot, float(t))
+
+    def gauss_form(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
+        """M(q) and b(q, ṡ, t) of the Gauss form M s̈ + b = 0 (THEORY §5)."""
+        q, s_dot = self.check_state(q, s_dot)
+        return self.evaluator("dense").gauss_form(q, s_dot, float(t))
+
+    def mass_matrix(self, q, t: float = 0.0) -> NDArray:
+        """M(q) = Σ J_nᵀ M_n J_n (THEORY §5)."""
+        return self.gauss_form(q, np.zeros(self.n_s), t)[0]
+
+    def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:
+        """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and gravity plus springs."""
+        from projeq.kinematics import forward
+
+        q, s_dot = self.check_state(q, s_dot)
+        kin = forward(self, q, s_dot, float(t))
+        kinetic = sum(sub.kinetic_energy(kin.y_dot[n]) for n, sub in enumerate(self.subsystems))
+        potential = sum(
+            sub.potential_energy(kin.R[n], kin.r[n], self.gravity) for n, sub in enumerate(self.subsystems)
+        ) + sum(f.potential(kin, q) for f in self.forces)
+        return float(kinetic), float(potential)
+
+    def _check_planar(self) -> None:
+        """A subsystem with a selection S must not be driven out of its plane by its joint
+        (F⁶ and T⁶_np Sₚᵀ must lie in the span of Sₙᵀ), checked at q0 and a perturbed q."""
+        from projeq.kinematics import forward
+
+        rng = np.random.default_rng(1)
+        for q in (self.q0, self.normalized(self.q0 + 0.3 * rng.standard_normal(self.n_q))):
+            kin = forward(self, q, rng.standard_normal(self.n_s), 0.0)
+            for n, sub in enumerate(self.subsystems):
+                if sub.S is None:
+                    continue
+                out_of_plane = np.eye(6) - sub.S.T @ sub.S
+                p = self.parent[n]
+                if np.abs(out_of_plane @ kin.twist[n]).max() > 1e-9 * (1 + np.abs(kin.twist[n]).max()):
+                    parent = "the ground" if p == GROUND else repr(self.names[p])
+                    raise ValueError(
+                        f"joints[{self.names[n]!r}]: the planar body {self.names[n]!r} (plane "
+                        f"{getattr(sub, 'plane', '?')}) would move out of its plane: its joint axis "
+                        f"or its parent {parent} is not in the same plane"
+                    )
+
+    def __repr__(self) -> str:
+        return f"System({len(self.names)} subsystems, n_q={self.n_q}, n_s={self.n_s})"
+
+
+def _check_names(subsystems, joints) -> None:
+    if not isinstance(subsystems, dict) or not subsystems:
+        raise ValueError("subsystems: expected a non-empty dict {name: subsystem}")
+    if not isinstance(joints, dict):
+        raise ValueError("joints: expected a dict {subsystem name: joint}")
+    missing, extra = set(subsystems) - set(joints), set(joints) - set(subsystems)
+    if missing:
+        raise ValueError(f"joints: no joint for subsystem(s) {sorted(missing)}")
+    if extra:
+        raise ValueError(f"joints: joint(s) for unknown subsystem(s) {sorted(extra)}")
+    for name, sub in subsystems.items():
+        if not all(hasattr(sub, a) for a in ("n_y", "S", "gauss_terms", "kinetic_energy", "potential_energy")):
+            raise ValueError(f"subsystems[{name!r}]: {sub!r} is not a subsystem (needs n_y, S, gauss_terms, ...)")
+    for name, joint in joints.items():
+        if not isinstance(joint, Joint):
+            raise ValueError(f"joints[{name!r}]: {joint!r} is not a Joint")
+        if joint.parent is not None and joint.parent not in subsystems:
+            raise ValueError(
+                f"joints[{name!r}]: parent {joint.parent!r} is not in the system; "
+                f"known subsystems are {list(subsystems)}"
+            )
+        if joint.parent == name:
+            raise ValueError(f"joints[{name!r}]: a subsystem cannot be its own parent")
+
+
+def _topological_order(joints: dict) -> list[str]:
+    """Names ordered so that every parent precedes its children (stable); cycles raise."""
+    order, placed, pending = [], set(), list(joints)
+    while pending:
+        ready = [n for n in pending if joints[n].parent is None or joints[n].parent in placed]
+        if not ready:
+            raise ValueError(f"joints: the parents of {pending} form a cycle; a system must be a tree")
+        for name in ready:
+            order.append(name)
+            placed.add(name)
+        pending = [n for n in pending if n not in placed]
+    return order
+
+
+class SystemBuilder:
+    """Builds a :class:`System` one subsystem at a time; ``build()`` returns it frozen.
+
+    >>> import projeq as pq
+    >>> b = pq.SystemBuilder(gravity=(0, 0, -9.81))
+    >>> b.add("bob", pq.PointMass(1.0, r_c=(0, 0, -1)), pq.Revolute(axis="y"))
+    >>> b.build().n_s
+    1
+    """
+
+    def __init__(self, gravity=(0.0, 0.0, 0.0)):
+        self.gravity = gravity
+        self._subsystems: dict = {}
+        self._joints: dict = {}
+        self._forces: list = []
+
+    def add(self, name: str, subsystem, joint: Joint) -> None:
+        """Attach ``subsystem`` under ``name`` by ``joint``."""
+        if name in self._subsystems:
+            raise ValueError(f"name: a subsystem {name!r} is attached already; each is attached once")
+        self._subsystems[name] = subsystem
+        self._joints[name] = joint
+
+    def add_force(self, force) -> None:
+        """Add a force law (:mod:`projeq.forces`)."""
+        self._forces.append(force)
+
+    def build(self, q0=None, s_dot0=None) -> System:
+        """The validated System."""
+        return System(self._subsystems, self._joints, self.gravity, self._forces, q0, s_dot0)
+
