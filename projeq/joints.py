@@ -66,6 +66,7 @@ class Joint:
 
     n_q = 0
     n_s = 0
+    n_c = 0  # number of velocity constraints whose residual the joint reports
 
     def __init__(self, parent=None, r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
         if parent is not None and not isinstance(parent, str):
@@ -90,6 +91,11 @@ class Joint:
     def default_q(self) -> NDArray:
         """Coordinates of the reference configuration (zero unless a joint says otherwise)."""
         return np.zeros(self.n_q)
+
+    def constraint_residual(self, q_n: NDArray, q_dot_n: NDArray, t: float) -> NDArray:
+        """Residuals of the velocity constraints the minimal velocities are meant to
+        satisfy, evaluated on (q, q̇) (none for the built-in joints)."""
+        return np.zeros(0)
 
     def normalized(self, q_n: NDArray) -> NDArray:
         """q_n projected back onto its manifold (unit quaternions); identity otherwise."""
@@ -288,10 +294,12 @@ class UserJoint(Joint):
     Build with :meth:`from_sympy` or :meth:`from_functions`.
     """
 
-    def __init__(self, parent, n_q, n_s, relative, K, q_dot, q0=None, r_pn=(0, 0, 0), orientation=None):
+    def __init__(self, parent, n_q, n_s, relative, K, q_dot, q0=None, r_pn=(0, 0, 0), orientation=None,
+                 constraints=None, n_c=0):
         super().__init__(parent, r_pn, orientation)
-        self.n_q, self.n_s = n_q, n_s
+        self.n_q, self.n_s, self.n_c = n_q, n_s, n_c
         self._relative, self._K, self._q_dot = relative, K, q_dot
+        self._constraints = constraints
         self._q0 = np.zeros(n_q) if q0 is None else finite_array("q0", q0, (n_q,))
 
     def relative(self, q_n, s_dot_n, t):
@@ -305,6 +313,11 @@ class UserJoint(Joint):
 
     def default_q(self):
         return self._q0.copy()
+
+    def constraint_residual(self, q_n, q_dot_n, t):
+        if self._constraints is None:
+            return np.zeros(0)
+        return np.asarray(self._constraints(q_n, q_dot_n, t), dtype=float).ravel()
 
     @classmethod
     def from_sympy(
@@ -320,6 +333,8 @@ class UserJoint(Joint):
         k=None,
         t: sp.Symbol | None = None,
         parameters: dict | None = None,
+        constraints=None,
+        q_dot: Sequence[sp.Symbol] | None = None,
         parent=None,
         q0=None,
         r_pn=(0.0, 0.0, 0.0),
@@ -331,12 +346,15 @@ class UserJoint(Joint):
         ``A`` (3×3) and ``r`` (3) give the pose, ``F`` (6×n_s) and ``f`` (6) the relative
         twist F ṡ + f in child coordinates, ``K`` (n_q×n_s) and ``k`` (n_q) give q̇.
         Ḟ ṡ + ḟ = (∂F/∂q q̇ + ∂F/∂t) ṡ + ∂f/∂q q̇ + ∂f/∂t is derived and compiled once.
+        ``constraints`` lists the original velocity constraints (expressions in q, the
+        symbols ``q_dot`` for q̇, and t) whose residuals every Result reports.
         """
         from projeq.symbolic_joint import compile_user_joint
 
         return compile_user_joint(
             cls, q, s, A, r, F, K, f=f, k=k, t=t, parameters=parameters or {},
             parent=parent, q0=q0, r_pn=r_pn, orientation=orientation,
+            constraints=constraints, q_dot=q_dot,
         )
 
     @classmethod
@@ -350,6 +368,8 @@ class UserJoint(Joint):
         *,
         f: Callable | None = None,
         k: Callable | None = None,
+        constraints: Callable | None = None,
+        n_c: int = 0,
         parent=None,
         q0=None,
         r_pn=(0.0, 0.0, 0.0),
@@ -360,12 +380,14 @@ class UserJoint(Joint):
 
         Ḟ ṡ + ḟ is taken by complex-step differentiation along (q̇, 1), exact to
         round-off, so the callables must accept complex arguments (numpy ufuncs do).
+        ``constraints(q, q_dot, t)`` returns the ``n_c`` residuals of the original velocity
+        constraints, reported along every simulated trajectory.
         """
         from projeq.symbolic_joint import wrap_user_functions
 
         return wrap_user_functions(
             cls, n_q, n_s, pose, F, K, f=f, k=k, parent=parent, q0=q0, r_pn=r_pn,
-            orientation=orientation,
+            orientation=orientation, constraints=constraints, n_c=n_c,
         )
 
 

@@ -241,10 +241,13 @@ def _assemble(system, pieces, nfev, status, message, t_events, wall_time, method
     q = np.array([system.normalized(row) for row in x[:, :n_q]]).reshape(len(t), n_q)
     s_dot = x[:, n_q:]
     energies = np.array([system.energy(qi, si, ti) for ti, qi, si in zip(t, q, s_dot)]).reshape(len(t), 2)
+    residual = np.array(
+        [system.constraint_residual(qi, system.q_dot(qi, si, ti), ti) for ti, qi, si in zip(t, q, s_dot)]
+    ).reshape(len(t), system.n_c)
     sol = _dense_solution(pieces, n_q) if dense_output and pieces else None
     return Result(
         t=t, q=q, s_dot=s_dot, kinetic=energies[:, 0], potential=energies[:, 1],
-        constraint_residual=np.zeros((len(t), 0)), nfev=int(nfev), wall_time=wall_time,
+        constraint_residual=residual, nfev=int(nfev), wall_time=wall_time,
         status=int(status), message=str(message), t_events=tuple(np.array(e) for e in t_events),
         names=system.names, method=getattr(method, "__name__", str(method)), sol=sol,
     )

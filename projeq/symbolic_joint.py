@@ -36,7 +36,8 @@ def _check_symbols(name: str, expr: sp.Matrix, allowed: set, q, t) -> None:
         )
 
 
-def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0, r_pn, orientation):
+def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0, r_pn, orientation,
+                       constraints=None, q_dot=None):
     """A :class:`UserJoint` from sympy expressions (see ``UserJoint.from_sympy``)."""
     q, s = list(q), list(s)
     t = t if t is not None else sp.Symbol("t")
@@ -56,15 +57,15 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
     A, r, F, K, f, k = (e.xreplace(values) for e in exprs.values())
 
     s_vec = sp.Matrix(s)
-    q_dot = K * s_vec + k
+    rates = K * s_vec + k  # q̇
 
     def d_dt(M: sp.Matrix) -> sp.Matrix:
-        return sum((M.diff(qi) * q_dot[i] for i, qi in enumerate(q)), M.diff(t))
+        return sum((M.diff(qi) * rates[i] for i, qi in enumerate(q)), M.diff(t))
 
     zeta = d_dt(F) * s_vec + d_dt(f)
     rel = sp.lambdify([q, s, t], [A, r, F, F * s_vec + f, zeta], modules="numpy", cse=True)
     K_fun = sp.lambdify([q, t], K, modules="numpy", cse=True)
-    q_dot_fun = sp.lambdify([q, s, t], q_dot, modules="numpy", cse=True)
+    q_dot_fun = sp.lambdify([q, s, t], rates, modules="numpy", cse=True)
 
     def relative(q_n, s_dot_n, time):
         A_, r_, F_, w_, z_ = rel(q_n, s_dot_n, time)
@@ -76,18 +77,32 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
             np.asarray(z_, dtype=float).ravel(),
         )
 
+    residual, n_c = _compile_constraints(constraints, q, q_dot, t, values)
     joint = cls(
         parent, n_q, n_s, relative,
         lambda q_n, time: np.asarray(K_fun(q_n, time), dtype=float),
         lambda q_n, s_dot_n, time: np.asarray(q_dot_fun(q_n, s_dot_n, time), dtype=float).ravel(),
-        q0=q0, r_pn=r_pn, orientation=orientation,
+        q0=q0, r_pn=r_pn, orientation=orientation, constraints=residual, n_c=n_c,
     )
     joint.symbols = {"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k}
     _check_pose(joint)
     return joint
 
 
-def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, orientation):
+def _compile_constraints(constraints, q, q_dot, t, values):
+    """Residual function of the original velocity constraints (expressions in q, q̇, t)."""
+    if constraints is None:
+        return None, 0
+    if q_dot is None or len(q_dot) != len(q):
+        raise ValueError("q_dot: give one symbol for each coordinate's rate to state constraints")
+    C = sp.Matrix(list(constraints))
+    _check_symbols("constraints", C, set(q) | set(q_dot) | {t} | set(values), q, t)
+    fun = sp.lambdify([q, list(q_dot), t], list(C.xreplace(values)), modules="numpy", cse=True)
+    return (lambda q_n, q_dot_n, time: np.asarray(fun(q_n, q_dot_n, time), dtype=float)), len(C)
+
+
+def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, orientation,
+                        constraints=None, n_c=0):
     """A :class:`UserJoint` from callables (see ``UserJoint.from_functions``)."""
     zero6, zero_q = np.zeros(6), np.zeros(n_q)
     f = f if f is not None else (lambda q_n, time: zero6)
@@ -107,7 +122,8 @@ def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, or
         w = F_n @ s_dot_n + np.real(f(q_n, time))
         return Relative(np.asarray(A, dtype=float), np.asarray(r, dtype=float), F_n, w, F_dot @ s_dot_n + f_dot)
 
-    joint = cls(parent, n_q, n_s, relative, K, q_dot, q0=q0, r_pn=r_pn, orientation=orientation)
+    joint = cls(parent, n_q, n_s, relative, K, q_dot, q0=q0, r_pn=r_pn, orientation=orientation,
+                constraints=constraints, n_c=n_c)
     _check_shapes(joint)
     _check_pose(joint)
     return joint

@@ -162,6 +162,20 @@ class System:
         ]
         return np.concatenate(parts) if parts else np.zeros(0)
 
+    @property
+    def n_c(self) -> int:
+        """Number of velocity constraints whose residuals are reported."""
+        return sum(j.n_c for j in self.joints)
+
+    def constraint_residual(self, q: NDArray, q_dot: NDArray, t: float = 0.0) -> NDArray:
+        """Residuals of the joints' original velocity constraints at (q, q̇, t)."""
+        parts = [
+            j.constraint_residual(q[self.q_slice[n]], q_dot[self.q_slice[n]], t)
+            for n, j in enumerate(self.joints)
+            if j.n_c
+        ]
+        return np.concatenate(parts) if parts else np.zeros(0)
+
     def K(self, q: NDArray, t: float = 0.0) -> NDArray:
         """K(q) of q̇ = K ṡ + k (block-diagonal over the joints)."""
         K = np.zeros((self.n_q, self.n_s))
