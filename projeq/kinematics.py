@@ -10,6 +10,11 @@ For each subsystem n with predecessor p and joint frame J (fixed in p):
 where u × w is the motion cross product (``spatial.cross_motion``): it is Ṫ_np ẏ_p, since
 Ȧ_np = −ω̃_rel A_np and ṙ_pn = A_pn v_rel. The lists have one extra entry at index −1 for
 the ground (n_y = 0, at rest in the inertial frame), so ``parent = -1`` needs no branch.
+
+Only poses and twists need the root-to-leaves loop; T_np, ζ_n and the Gauss terms of
+rigid bodies are then computed for all subsystems at once on stacked arrays (the
+formulas are the same functions, applied row-wise), which is what makes a pass cheap in
+numpy. A :class:`Plan` holds what this needs and is built once per System.
 """
 
 from __future__ import annotations
@@ -19,7 +24,55 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.spatial import chain_matrix, cross_motion
+from projeq.spatial import chain_matrix, cross, cross_motion
+
+
+class Plan:
+    """Per-System preparation of the forward pass (built once, cached on the System).
+
+    - ``groups``: subsystems that share a batch implementation (``type(sub).group``), as
+      (indices, group object); ``singles``: the others, evaluated one by one;
+    - ``S_aug[n]`` = blockdiag(S_n, 1), and [0 … 0 1] for the ground, so that
+      T̃_np = S̃_n T̃⁶_np S̃_pᵀ; ``plain[n]`` marks the common case S̃ = E on both sides.
+    """
+
+    def __init__(self, system):
+        N = len(system.joints)
+        by_key: dict = {}
+        self.singles = []
+        for n, sub in enumerate(system.subsystems):
+            key = getattr(sub, "group_key", None)
+            if key is None:
+                self.singles.append(n)
+            else:
+                by_key.setdefault((type(sub).group, key), []).append(n)
+        self.groups = [
+            (np.array(idx), group([system.subsystems[n] for n in idx])) for (group, _), idx in by_key.items()
+        ]
+        ground = np.zeros((1, 7))
+        ground[0, 6] = 1.0
+        self.S_aug = [_augmented_selection(system.S[n]) for n in range(N)] + [ground]
+        self.plain = [
+            system.S[n] is None and system.parent[n] >= 0 and system.S[system.parent[n]] is None for n in range(N)
+        ]
+
+
+def _augmented_selection(S: NDArray | None) -> NDArray:
+    """S̃ = blockdiag(S, 1) (E₇ for S = None)."""
+    if S is None:
+        return np.eye(7)
+    S_aug = np.zeros((S.shape[0] + 1, 7))
+    S_aug[:-1, :6] = S
+    S_aug[-1, 6] = 1.0
+    return S_aug
+
+
+def plan(system) -> Plan:
+    """The System's :class:`Plan`, built on first use (kept in the System's evaluator cache)."""
+    cache = system._evaluators
+    if "_plan" not in cache:
+        cache["_plan"] = Plan(system)
+    return cache["_plan"]
 
 
 @dataclass
@@ -49,52 +102,57 @@ class Kinematics:
 
 
 def forward(system, q: NDArray, s_dot: NDArray, t: float) -> Kinematics:
-    """Poses, ẏ_n, T̃_np (T_np and ζ_n) and F_n of every subsystem at (q, ṡ, t), root to leaves."""
+    """Poses, ẏ_n, T̃_np (T_np and ζ_n) and F_n of every subsystem at (q, ṡ, t)."""
     N = len(system.joints)
-    ground = (np.eye(3), np.zeros(3), np.zeros(6), np.zeros(0), np.ones((1, 1)), None)
-    R, r, twist, y_dot, T_aug, F = ([None] * N + [g] for g in ground)
-    for n, joint in enumerate(system.joints):
-        p = system.parent[n]
-        rel = joint.relative(system._q_get[n](q), system._s_get[n](s_dot), t)
+    parent, joints = system.parent, system.joints
+    R, r, twist = [None] * N + [np.eye(3)], [None] * N + [np.zeros(3)], [None] * N + [np.zeros(6)]
+    rels, A_np, r_pn, u = [None] * N, [None] * N, [None] * N, [None] * N
+    for n, joint in enumerate(joints):  # root → leaves: poses and twists
+        p = parent[n]
+        rels[n] = rel = joint.relative(system._q_get[n](q), system._s_get[n](s_dot), t)
         A_pn = joint.orientation @ rel.A
-        r_pn = joint.r_pn + joint.orientation @ rel.r
-        T6 = chain_matrix(A_pn.T, r_pn)
-        u = T6 @ twist[p]
-        R[n], r[n] = R[p] @ A_pn, r[p] + R[p] @ r_pn
-        twist[n] = u + rel.w
-        zeta6 = cross_motion(u, rel.w) + rel.zeta
-        S_n, S_p = system.S[n], system.S[p]
-        T6 = T6 if S_p is None else T6 @ S_p.T
-        if S_n is None:
-            y_dot[n], F[n] = twist[n], rel.F
-        else:
-            y_dot[n], F[n], T6, zeta6 = S_n @ twist[n], S_n @ rel.F, S_n @ T6, S_n @ zeta6
-        T_aug[n] = _augmented_chain(T6, zeta6)
+        r_pn[n] = joint.r_pn + joint.orientation @ rel.r
+        A_np[n] = A = A_pn.T
+        v_p, omega_p = twist[p][:3], twist[p][3:]
+        u[n] = np.concatenate((A @ (v_p + cross(omega_p, r_pn[n])), A @ omega_p))  # T⁶_np twist_p
+        R[n], r[n] = R[p] @ A_pn, r[p] + R[p] @ r_pn[n]
+        twist[n] = u[n] + rel.w
+    w = np.array([rel.w for rel in rels])
+    zeta6 = cross_motion(np.array(u), w) + np.array([rel.zeta for rel in rels])  # Ṫ ẏ_p + Ḟ ṡ + ḟ
+    T_aug6 = np.zeros((N, 7, 7))
+    T_aug6[:, :6, :6] = chain_matrix(np.array(A_np), np.array(r_pn))
+    T_aug6[:, :6, 6] = zeta6
+    T_aug6[:, 6, 6] = 1.0
+    return _select(system, plan(system), R, r, twist, rels, T_aug6)
+
+
+def _select(system, prep: Plan, R, r, twist, rels, T_aug6) -> Kinematics:
+    """Apply the selections S_n: ẏ_n = S_n twist, F_n = S_n F⁶, T̃_np = S̃_n T̃⁶ S̃_pᵀ."""
+    N = len(rels)
+    y_dot, T_aug, F = [None] * N + [np.zeros(0)], [None] * N + [np.ones((1, 1))], [None] * N
+    for n in range(N):
+        S = system.S[n]
+        y_dot[n] = twist[n] if S is None else S @ twist[n]
+        F[n] = rels[n].F if S is None else S @ rels[n].F
+        T_aug[n] = T_aug6[n] if prep.plain[n] else prep.S_aug[n] @ T_aug6[n] @ prep.S_aug[system.parent[n]].T
     return Kinematics(R, r, twist, y_dot, T_aug, F)
-
-
-def _augmented_chain(T: NDArray, zeta: NDArray) -> NDArray:
-    """T̃ = [[T, ζ], [0, 1]]."""
-    rows, cols = T.shape
-    T_aug = np.zeros((rows + 1, cols + 1))
-    T_aug[:rows, :cols] = T
-    T_aug[:rows, cols] = zeta
-    T_aug[rows, cols] = 1.0
-    return T_aug
 
 
 def gauss_terms(system, kin: Kinematics, q: NDArray, s_dot: NDArray, t: float) -> tuple[list, list]:
     """M_n and h_n = Q_n − G_n ẏ_n of every subsystem, forces included (B(14)).
 
+    Grouped subsystems are evaluated together (``Plan.groups``), the others one by one.
     The lists have a ground entry at −1 (empty), where joint forces on the ground land.
     """
-    M, h = [], []
-    for n, sub in enumerate(system.subsystems):
-        M_n, h_n = sub.gauss_terms(kin.y_dot[n], kin.R[n], system.gravity)
-        M.append(M_n)
-        h.append(h_n)
-    M.append(np.zeros((0, 0)))
-    h.append(np.zeros(0))
+    N = len(system.subsystems)
+    M, h = [None] * N + [np.zeros((0, 0))], [None] * N + [np.zeros(0)]
+    prep = plan(system)
+    for idx, group in prep.groups:
+        H = group.h(np.array([kin.y_dot[n] for n in idx]), np.array([kin.R[n] for n in idx]), system.gravity)
+        for k, n in enumerate(idx):
+            M[n], h[n] = group.M[k], H[k]
+    for n in prep.singles:
+        M[n], h[n] = system.subsystems[n].gauss_terms(kin.y_dot[n], kin.R[n], system.gravity)
     for force in system.forces:
         force.add_to(h, kin, t, q, s_dot)
     return M, h

@@ -24,10 +24,18 @@ def skew(a) -> NDArray:
 
 
 def cross(a, b) -> NDArray:
-    """a × b for 3-vectors (a plain formula: ten times faster than ``np.cross`` here)."""
-    return np.array(
-        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-    )
+    """a × b for 3-vectors, or row-wise for stacks of shape (..., 3).
+
+    A plain formula: for 3-vectors ten times faster than ``np.cross``; stacks are written
+    into one preallocated array.
+    """
+    if a.ndim == 1 and b.ndim == 1:
+        return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
 
 
 def unit_axis(axis, name: str = "axis") -> NDArray:
@@ -77,27 +85,36 @@ def quaternion_rate_matrix(quat: NDArray) -> NDArray:
 
 
 def chain_matrix(A_np: NDArray, r_pn: NDArray) -> NDArray:
-    """Rigid T_np = [[A_np, −A_np r̃_pn], [0, A_np]] (THEORY §4).
+    """Rigid T_np = [[A_np, −A_np r̃_pn], [0, A_np]] (THEORY §4), or a stack of them for
+    stacks A_np (..., 3, 3) and r_pn (..., 3).
 
     ``r_pn`` is O_p → O_n in p-coordinates; ẏ_n = T_np ẏ_p is the twist of a frame n
     rigidly attached to p.
     """
-    T = np.zeros((6, 6))
-    T[:3, :3] = A_np
-    T[3:, 3:] = A_np
-    T[:3, 3:] = -A_np @ skew(r_pn)
+    T = np.zeros(A_np.shape[:-2] + (6, 6))
+    T[..., :3, :3] = A_np
+    T[..., 3:, 3:] = A_np
+    T[..., :3, 3:] = -A_np @ skew_stack(r_pn)
     return T
 
 
+def skew_stack(a: NDArray) -> NDArray:
+    """Spin matrices of a stack of 3-vectors (..., 3) → (..., 3, 3)."""
+    S = np.zeros(a.shape[:-1] + (3, 3))
+    S[..., 0, 1], S[..., 0, 2], S[..., 1, 2] = -a[..., 2], a[..., 1], -a[..., 0]
+    S[..., 1, 0], S[..., 2, 0], S[..., 2, 1] = a[..., 2], -a[..., 1], a[..., 0]
+    return S
+
+
 def cross_motion(u: NDArray, w: NDArray) -> NDArray:
-    """Motion cross product u × w = (u_ω × w_v + u_v × w_ω, u_ω × w_ω) of two twists.
+    """Motion cross product u × w = (u_ω × w_v + u_v × w_ω, u_ω × w_ω) of two twists
+    (row-wise for stacks of shape (..., 6)).
 
     With u = T_np ẏ_p and w the joint's relative twist, it is the part Ṫ_np ẏ_p of
     ζ_n that stems from the joint's rotation and translation (THEORY §4).
     """
-    return np.concatenate(
-        (cross(u[3:], w[:3]) + cross(u[:3], w[3:]), cross(u[3:], w[3:]))
-    )
+    u_v, u_w, w_v, w_w = u[..., :3], u[..., 3:], w[..., :3], w[..., 3:]
+    return np.concatenate((cross(u_w, w_v) + cross(u_v, w_w), cross(u_w, w_w)), axis=-1)
 
 
 def vee(W: NDArray) -> NDArray:

@@ -33,7 +33,11 @@ from projeq.kinematics import forward, gauss_terms
 
 
 class RecursiveEvaluator:
-    """Accelerations of one tree System in O(N). Counts calls in ``n_calls``."""
+    """Accelerations of one tree System in O(N). Counts calls in ``n_calls``.
+
+    Its workspace is one augmented matrix Ã_n per subsystem (and the ground), allocated
+    once and overwritten by every call.
+    """
 
     def __init__(self, system):
         if system.coupled:
@@ -43,15 +47,22 @@ class RecursiveEvaluator:
             )
         self.system = system
         self.scale = mass_scale(system)
+        self._fill_groups, self._A_hat = _workspace(system)
         self.n_calls = 0
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """s̈ by the backward and forward passes of THEORY §6."""
         self.n_calls += 1
-        system, scale = self.system, self.scale
+        system, scale, A_hat = self.system, self.scale, self._A_hat
         kin = forward(system, q, s_dot, t)
         M, h = gauss_terms(system, kin, q, s_dot, t)
-        A_hat = [_augmented(M_n, h_n) for M_n, h_n in zip(M, h)]
+        for idx, A in self._fill_groups:  # Ã_n = [[M_n, −h_n], [−h_nᵀ, 0]], a stack per n_y
+            k = A.shape[1] - 1
+            A[:, :k, :k] = [M[n] for n in idx]
+            A[:, :k, k] = [h[n] for n in idx]
+            np.negative(A[:, :k, k], out=A[:, :k, k])
+            A[:, k, :k] = A[:, :k, k]
+            A[:, k, k] = 0.0
         T_aug, F, parent, names = kin.T_aug, kin.F, system.parent, system.names
         N = len(names)
         gain = [None] * N
@@ -59,23 +70,28 @@ class RecursiveEvaluator:
             A = A_hat[n]
             AF = A[:, :-1] @ F[n]  # Ã_n F̃_n
             gain[n] = solve_spd(F[n].T @ AF[:-1], AF.T, names[n], scale)  # D_n⁻¹ F̃_nᵀ Ã_n
-            A_bar = A - AF @ gain[n]  # Ā_n
-            A_hat[parent[n]] += T_aug[n].T @ A_bar @ T_aug[n]  # Ã_p += T̃ᵀ Ā T̃
-        s_ddot = [None] * N
+            A -= AF @ gain[n]  # Ā_n
+            A_hat[parent[n]] += T_aug[n].T @ A @ T_aug[n]  # Ã_p += T̃ᵀ Ā T̃
+        minus_s_ddot = [None] * N
         y_aug = [None] * N + [np.ones(1)]  # (ÿ; 1), ground at rest
         for n in range(N):  # forward: root → leaves
             a = T_aug[n] @ y_aug[parent[n]]  # (T_np ÿ_p + ζ_n; 1)
-            s_ddot[n] = -gain[n] @ a  # D_n⁻¹ F_nᵀ (ĥ_n − M̂_n a)
-            a[:-1] += F[n] @ s_ddot[n]
+            minus_s_ddot[n] = gain[n] @ a  # −s̈_n = −D_n⁻¹ F_nᵀ (ĥ_n − M̂_n a)
+            a[:-1] -= F[n] @ minus_s_ddot[n]  # ÿ_n = a + F_n s̈_n
             y_aug[n] = a
-        return np.concatenate(s_ddot)
+        return -np.concatenate(minus_s_ddot)
 
 
-def _augmented(M: NDArray, h: NDArray) -> NDArray:
-    """Ã = [[M, −h], [−hᵀ, 0]]."""
-    k = len(h)
-    A = np.zeros((k + 1, k + 1))
-    A[:k, :k] = M
-    A[:k, k] = A[k, :k] = -h
-    return A
-
+def _workspace(system) -> tuple[list, list]:
+    """The augmented matrices Ã_n, stacked by n_y so that one call fills each stack, and
+    per-subsystem views into them (the ground's 1×1 Ã last)."""
+    by_size: dict = {}
+    for n, sub in enumerate(system.subsystems):
+        by_size.setdefault(sub.n_y, []).append(n)
+    groups, A_hat = [], [None] * len(system.subsystems) + [np.zeros((1, 1))]
+    for k, idx in by_size.items():
+        stack = np.zeros((len(idx), k + 1, k + 1))
+        groups.append((idx, stack))
+        for j, n in enumerate(idx):
+            A_hat[n] = stack[j]
+    return groups, A_hat

@@ -33,15 +33,41 @@ def rigid_mass_matrix(m: float, r_c: NDArray, I_c: NDArray) -> NDArray:
     return M
 
 
-def rigid_h(m: float, r_c: NDArray, I_c: NDArray, twist: NDArray, g_body: NDArray) -> NDArray:
+def rigid_h(m, r_c: NDArray, I_c: NDArray, twist: NDArray, g_body: NDArray) -> NDArray:
     """h = Q − G ẏ of a rigid body with gravity g (body coordinates), THEORY §3.
 
     With the momentum p = m v_c: h = [m g − ω̃ p ; r̃_c (m g − ω̃ p) − ω̃ I_c ω].
+    Works on one body or row-wise on stacks: m (...), r_c (..., 3), I_c (..., 3, 3),
+    twist (..., 6), g_body (..., 3).
     """
-    v, omega = twist[:3], twist[3:]
+    m = np.asarray(m)[..., None]
+    v, omega = twist[..., :3], twist[..., 3:]
     p_c = m * (v + cross(omega, r_c))
     force = m * g_body - cross(omega, p_c)
-    return np.concatenate((force, cross(r_c, force) - cross(omega, I_c @ omega)))
+    L_c = (I_c @ omega[..., None])[..., 0]
+    return np.concatenate((force, cross(r_c, force) - cross(omega, L_c)), axis=-1)
+
+
+class RigidGroup:
+    """Rigid bodies of one kind (same S) evaluated together: :func:`rigid_h` on stacks.
+
+    ``M[k]`` and the rows of ``h(...)`` belong to ``bodies[k]``; equal to calling each
+    body's ``gauss_terms`` (tests/subsystems/test_rigid.py), several times faster.
+    """
+
+    def __init__(self, bodies):
+        self.m = np.array([b.m for b in bodies])
+        self.r_c = np.array([b.r_c for b in bodies])
+        self.I_c = np.array([b.I_c for b in bodies])
+        self.M = [b.gauss_terms(np.zeros(b.n_y), np.eye(3), np.zeros(3))[0] for b in bodies]
+        self.S = bodies[0].S
+
+    def h(self, y_dot: NDArray, R: NDArray, gravity: NDArray) -> NDArray:
+        """h_n of every body: rows of y_dot (N, n_y) with rotations R (N, 3, 3)."""
+        twist = y_dot if self.S is None else y_dot @ self.S
+        g_body = gravity @ R  # rows Rᵀ g
+        h6 = rigid_h(self.m, self.r_c, self.I_c, twist, g_body)
+        return h6 if self.S is None else h6 @ self.S.T
 
 
 class RigidBody:
@@ -68,6 +94,12 @@ class RigidBody:
 
     n_y = 6
     S: NDArray | None = None
+    group = RigidGroup  # how several bodies of this kind are evaluated at once
+
+    @property
+    def group_key(self) -> tuple:
+        """Bodies with equal keys can share one :class:`RigidGroup`."""
+        return ("rigid",) if self.S is None else ("rigid", tuple(np.flatnonzero(self.S)))
 
     def __init__(self, m: float, r_c=(0.0, 0.0, 0.0), I_c=None):
         self.m = positive("m (mass)", m)
