@@ -33,7 +33,9 @@ class Plan:
     - ``groups``: subsystems that share a batch implementation (``type(sub).group``), as
       (indices, group object); ``singles``: the others, evaluated one by one;
     - ``S_aug[n]`` = blockdiag(S_n, 1), and [0 … 0 1] for the ground, so that
-      T̃_np = S̃_n T̃⁶_np S̃_pᵀ; ``plain[n]`` marks the common case S̃ = E on both sides.
+      T̃_np = S̃_n T̃⁶_np S̃_pᵀ; ``plain[n]`` marks the common case S̃ = E on both sides;
+    - ``internal``: subsystems with internal coordinates q_e (ṡ_e = q̇_e), whose last n_e
+      rows of ẏ_n are ṡ_e (S_n has zero rows there).
     """
 
     def __init__(self, system):
@@ -55,6 +57,7 @@ class Plan:
         self.plain = [
             system.S[n] is None and system.parent[n] >= 0 and system.S[system.parent[n]] is None for n in range(N)
         ]
+        self.internal = [n for n in range(N) if getattr(system.subsystems[n], "n_e", 0)]
 
 
 def _augmented_selection(S: NDArray | None) -> NDArray:
@@ -123,11 +126,12 @@ def forward(system, q: NDArray, s_dot: NDArray, t: float) -> Kinematics:
     T_aug6[:, :6, :6] = chain_matrix(np.array(A_np), np.array(r_pn))
     T_aug6[:, :6, 6] = zeta6
     T_aug6[:, 6, 6] = 1.0
-    return _select(system, plan(system), R, r, twist, rels, T_aug6)
+    return _select(system, plan(system), R, r, twist, rels, T_aug6, s_dot)
 
 
-def _select(system, prep: Plan, R, r, twist, rels, T_aug6) -> Kinematics:
-    """Apply the selections S_n: ẏ_n = S_n twist, F_n = S_n F⁶, T̃_np = S̃_n T̃⁶ S̃_pᵀ."""
+def _select(system, prep: Plan, R, r, twist, rels, T_aug6, s_dot) -> Kinematics:
+    """Apply the selections S_n: ẏ_n = S_n twist, F_n = S_n F⁶, T̃_np = S̃_n T̃⁶ S̃_pᵀ, and
+    add the internal velocities ṡ_e of subsystems that have them (their last n_e rows)."""
     N = len(rels)
     y_dot, T_aug, F = [None] * N + [np.zeros(0)], [None] * N + [np.ones((1, 1))], [None] * N
     for n in range(N):
@@ -135,6 +139,11 @@ def _select(system, prep: Plan, R, r, twist, rels, T_aug6) -> Kinematics:
         y_dot[n] = twist[n] if S is None else S @ twist[n]
         F[n] = rels[n].F if S is None else S @ rels[n].F
         T_aug[n] = T_aug6[n] if prep.plain[n] else prep.S_aug[n] @ T_aug6[n] @ prep.S_aug[system.parent[n]].T
+    for n in prep.internal:  # ẏ_n = S twist + [0; ṡ_e],  F_n = [S F⁶, [0; E]]
+        n_e = system.e_s_slice[n].stop - system.e_s_slice[n].start
+        y_dot[n] = y_dot[n].copy()
+        y_dot[n][-n_e:] += s_dot[system.e_s_slice[n]]
+        F[n] = np.hstack((F[n], np.eye(len(y_dot[n]))[:, -n_e:]))
     return Kinematics(R, r, twist, y_dot, T_aug, F)
 
 
@@ -152,7 +161,8 @@ def gauss_terms(system, kin: Kinematics, q: NDArray, s_dot: NDArray, t: float) -
         for k, n in enumerate(idx):
             M[n], h[n] = group.M[k], H[k]
     for n in prep.singles:
-        M[n], h[n] = system.subsystems[n].gauss_terms(kin.y_dot[n], kin.R[n], system.gravity)
+        q_e = q[system.e_q_slice[n]]
+        M[n], h[n] = system.subsystems[n].gauss_terms(kin.y_dot[n], kin.R[n], system.gravity, q_e)
     for force in system.forces:
         force.add_to(h, kin, t, q, s_dot)
     return M, h

@@ -70,8 +70,8 @@ class System:
         self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
         for a in (self.gravity, self.q0, self.s_dot0):
             a.flags.writeable = False
-        self._check_planar()
         self._evaluators: dict = {}  # the one cache: an evaluator per method (not thread-safe)
+        self._check_planar()
 
     # -- names and indexing -------------------------------------------------------------
     def index(self, name: str) -> int:
@@ -89,13 +89,19 @@ class System:
         return self.joints[self.index(name)]
 
     def _layout_coordinates(self) -> None:
-        q_slice, s_slice, n_q, n_s = [], [], 0, 0
-        for joint in self.joints:
+        """Each subsystem owns q_n = (joint coordinates, internal coordinates q_e) and
+        ṡ_n = (joint velocities, ṡ_e = q̇_e); coupled joints own none of their own."""
+        q_slice, s_slice, e_q, e_s, n_q, n_s = [], [], [], [], 0, 0
+        for joint, sub in zip(self.joints, self.subsystems):
             own_q, own_s = (0, 0) if joint.coupling else (joint.n_q, joint.n_s)
-            q_slice.append(slice(n_q, n_q + own_q))
-            s_slice.append(slice(n_s, n_s + own_s))
-            n_q, n_s = n_q + own_q, n_s + own_s
+            n_e = getattr(sub, "n_e", 0)
+            q_slice.append(slice(n_q, n_q + own_q + n_e))
+            s_slice.append(slice(n_s, n_s + own_s + n_e))
+            e_q.append(slice(n_q + own_q, n_q + own_q + n_e))
+            e_s.append(slice(n_s + own_s, n_s + own_s + n_e))
+            n_q, n_s = n_q + own_q + n_e, n_s + own_s + n_e
         self.q_slice, self.s_slice, self.n_q, self.n_s = tuple(q_slice), tuple(s_slice), n_q, n_s
+        self.e_q_slice, self.e_s_slice = tuple(e_q), tuple(e_s)
         self._q_get = tuple(self.joint_q_getter(n) for n in range(len(self.joints)))
         self._s_get = tuple(self.joint_s_dot_getter(n) for n in range(len(self.joints)))
 
@@ -116,7 +122,7 @@ class System:
     def joint_q_getter(self, n: int):
         """A function q ↦ q_n (the joint's coordinates, coupled ones computed)."""
         if not self.joints[n].coupling:
-            sl = self.q_slice[n]
+            sl = slice(self.q_slice[n].start, self.e_q_slice[n].start)
             return lambda q: q[sl]
         idx, w = self._coupling_rows(n, self.q_slice)
         return lambda q: np.array([w @ q[idx]])
@@ -124,27 +130,36 @@ class System:
     def joint_s_dot_getter(self, n: int):
         """A function ṡ ↦ ṡ_n (the joint's minimal velocities, coupled ones computed)."""
         if not self.joints[n].coupling:
-            sl = self.s_slice[n]
+            sl = slice(self.s_slice[n].start, self.e_s_slice[n].start)
             return lambda s_dot: s_dot[sl]
         idx, w = self._coupling_rows(n, self.s_slice)
         return lambda s_dot: np.array([w @ s_dot[idx]])
 
     def joint_s_columns(self, n: int) -> tuple[NDArray, NDArray]:
         """(columns of ṡ, weights P) with ṡ_n = P ṡ[columns]: the joint's place in ∂ẏ/∂ṡ."""
+        internal = np.arange(self.n_s)[self.e_s_slice[n]]
         if not self.joints[n].coupling:
             cols = np.arange(self.n_s)[self.s_slice[n]]
             return cols, np.eye(len(cols))
         idx, w = self._coupling_rows(n, self.s_slice)
-        return idx, w[None, :]
+        P = np.zeros((1 + len(internal), len(idx) + len(internal)))
+        P[0, : len(idx)] = w
+        P[1:, len(idx):] = np.eye(len(internal))
+        return np.concatenate((idx, internal)), P
 
     # -- states ---------------------------------------------------------------------------
     def _default_q(self) -> NDArray:
-        return np.concatenate([j.default_q() for j in self.joints if not j.coupling] or [np.zeros(0)])
+        parts = [
+            np.concatenate(([] if j.coupling else j.default_q(), np.zeros(getattr(sub, "n_e", 0))))
+            for j, sub in zip(self.joints, self.subsystems)
+        ]
+        return np.concatenate(parts) if parts else np.zeros(0)
 
     def normalized(self, q: NDArray) -> NDArray:
         """q with every joint's coordinates projected onto their manifold (unit quaternions)."""
         q = np.array(q, dtype=float)
-        for joint, sl in zip(self.joints, self.q_slice):
+        for n, joint in enumerate(self.joints):
+            sl = slice(self.q_slice[n].start, self.e_q_slice[n].start)
             if sl.stop > sl.start:
                 q[sl] = joint.normalized(q[sl])
         return q
@@ -155,12 +170,12 @@ class System:
 
     def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
         """q̇ = K(q) ṡ + k(q, t), joint by joint."""
-        parts = [
-            j.q_dot(self._q_get[n](q), self._s_get[n](s_dot), t)
-            for n, j in enumerate(self.joints)
-            if not j.coupling
-        ]
-        return np.concatenate(parts) if parts else np.zeros(0)
+        q_dot = np.empty(self.n_q)
+        for n, j in enumerate(self.joints):
+            if not j.coupling:
+                q_dot[self.q_slice[n].start : self.e_q_slice[n].start] = j.q_dot(self._q_get[n](q), self._s_get[n](s_dot), t)
+            q_dot[self.e_q_slice[n]] = s_dot[self.e_s_slice[n]]  # q̇_e = ṡ_e
+        return q_dot
 
     @property
     def n_c(self) -> int:
@@ -170,7 +185,7 @@ class System:
     def constraint_residual(self, q: NDArray, q_dot: NDArray, t: float = 0.0) -> NDArray:
         """Residuals of the joints' original velocity constraints at (q, q̇, t)."""
         parts = [
-            j.constraint_residual(q[self.q_slice[n]], q_dot[self.q_slice[n]], t)
+            j.constraint_residual(self._q_get[n](q), self._q_get[n](q_dot), t)
             for n, j in enumerate(self.joints)
             if j.n_c
         ]
@@ -181,7 +196,10 @@ class System:
         K = np.zeros((self.n_q, self.n_s))
         for n, j in enumerate(self.joints):
             if not j.coupling:
-                K[self.q_slice[n], self.s_slice[n]] = j.K(self._q_get[n](q), t)
+                rows = slice(self.q_slice[n].start, self.e_q_slice[n].start)
+                cols = slice(self.s_slice[n].start, self.e_s_slice[n].start)
+                K[rows, cols] = j.K(self._q_get[n](q), t)
+            K[self.e_q_slice[n], self.e_s_slice[n]] = np.eye(self.e_q_slice[n].stop - self.e_q_slice[n].start)
         return K
 
     # -- evaluation -----------------------------------------------------------------------
@@ -221,9 +239,10 @@ class System:
 
         q, s_dot = self.check_state(q, s_dot)
         kin = forward(self, q, s_dot, float(t))
-        kinetic = sum(sub.kinetic_energy(kin.y_dot[n]) for n, sub in enumerate(self.subsystems))
+        q_e = [q[sl] for sl in self.e_q_slice]
+        kinetic = sum(sub.kinetic_energy(kin.y_dot[n], q_e[n]) for n, sub in enumerate(self.subsystems))
         potential = sum(
-            sub.potential_energy(kin.R[n], kin.r[n], self.gravity) for n, sub in enumerate(self.subsystems)
+            sub.potential_energy(kin.R[n], kin.r[n], self.gravity, q_e[n]) for n, sub in enumerate(self.subsystems)
         ) + sum(f.potential(kin, q) for f in self.forces)
         return float(kinetic), float(potential)
 

@@ -58,11 +58,14 @@ class RecursiveEvaluator:
         M, h = gauss_terms(system, kin, q, s_dot, t)
         for idx, A in self._fill_groups:  # Ã_n = [[M_n, −h_n], [−h_nᵀ, 0]], a stack per n_y
             k = A.shape[1] - 1
+            # not np.negative(..., out=view): numpy 2.4 mis-reads such strided views when the
+            # stack has one member (tests/assembly/test_recursive_vs_dense.py covers both)
+            minus_h = np.negative([h[n] for n in idx])
             A[:, :k, :k] = [M[n] for n in idx]
-            A[:, :k, k] = [h[n] for n in idx]
-            np.negative(A[:, :k, k], out=A[:, :k, k])
-            A[:, k, :k] = A[:, :k, k]
+            A[:, :k, k] = minus_h
+            A[:, k, :k] = minus_h
             A[:, k, k] = 0.0
+        A_hat[-1][0, 0] = 0.0  # the ground's Ã only collects, nothing reads it
         T_aug, F, parent, names = kin.T_aug, kin.F, system.parent, system.names
         N = len(names)
         gain = [None] * N

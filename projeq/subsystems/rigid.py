@@ -112,15 +112,16 @@ class RigidBody:
     def _check_inertia(I_c) -> NDArray:
         return inertia_tensor("I_c", I_c)
 
-    def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray):
-        """(M_n, h_n) of THEORY §3; ``R`` body → inertial, ``gravity`` inertial."""
+    def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e=None):
+        """(M_n, h_n) of THEORY §3; ``R`` body → inertial, ``gravity`` inertial (a rigid
+        body has no internal coordinates q_e)."""
         return self.M6, rigid_h(self.m, self.r_c, self.I_c, y_dot, R.T @ gravity)
 
-    def kinetic_energy(self, y_dot: NDArray) -> float:
+    def kinetic_energy(self, y_dot: NDArray, q_e=None) -> float:
         """½ ẏᵀ M ẏ."""
         return 0.5 * float(y_dot @ self.M6 @ y_dot)
 
-    def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray) -> float:
+    def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray, q_e=None) -> float:
         """−m g · r_c(inertial)."""
         return -self.m * float(gravity @ (r + R @ self.r_c))
 
@@ -171,10 +172,10 @@ class PlanarBody(RigidBody):
         self.S = np.eye(6)[self.rows]
         self.M = self.M6[np.ix_(self.rows, self.rows)]
 
-    def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray):
+    def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e=None):
         """(S M⁶ Sᵀ, S h⁶(Sᵀ ẏ)): the spatial terms restricted to the plane."""
         return self.M, rigid_h(self.m, self.r_c, self.I_c, self.S.T @ y_dot, R.T @ gravity)[self.rows]
 
-    def kinetic_energy(self, y_dot: NDArray) -> float:
+    def kinetic_energy(self, y_dot: NDArray, q_e=None) -> float:
         """½ ẏᵀ M ẏ."""
         return 0.5 * float(y_dot @ self.M @ y_dot)
