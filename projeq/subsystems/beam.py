@@ -43,8 +43,8 @@ def _per_length(name: str, value, x: NDArray, allow_zero: bool = False) -> NDArr
 def _family(name: str, family, table: dict, n: int, L: float):
     if n == 0:
         return None
-    if callable(family) and family not in table.values():
-        return family
+    if callable(family):
+        return family(n, L)
     if family not in table:
         raise ValueError(f"{name}: unknown Ritz family {family!r}; use one of {sorted(table)} or a callable")
     return table[family](n, L)
@@ -197,9 +197,12 @@ class RitzBeam:
             P, sl = self.Phi[key][0], slice(cols.start - 6, cols.stop - 6)
             gram[sl, sl] = (P * self.weights) @ P.T
         eigenvalues, vectors = np.linalg.eigh(gram)
-        if eigenvalues[0] <= 1e-10 * eigenvalues[-1]:
+        if eigenvalues[0] <= 1e-14 * eigenvalues[-1]:  # numerically singular (monomials up to x¹³ pass)
             involved = np.flatnonzero(np.abs(vectors[:, 0]) > 1e-3).tolist()
-            raise ValueError(f"family: the Ritz functions {involved} are linearly dependent (singular mass matrix)")
+            raise ValueError(
+                f"family: the Ritz functions {involved} are linearly dependent to machine precision "
+                "(singular mass matrix); for many functions use family='clamped_free'"
+            )
 
     # -- slice kinematics ------------------------------------------------------------------
     def _slices(self, q_e: NDArray, x: NDArray | None = None, data=None):
