@@ -35,7 +35,9 @@ class Plan:
     - ``S_aug[n]`` = blockdiag(S_n, 1), and [0 … 0 1] for the ground, so that
       T̃_np = S̃_n T̃⁶_np S̃_pᵀ; ``plain[n]`` marks the common case S̃ = E on both sides;
     - ``internal``: subsystems with internal coordinates q_e (ṡ_e = q̇_e), whose last n_e
-      rows of ẏ_n are ṡ_e (S_n has zero rows there).
+      rows of ẏ_n are ṡ_e (S_n has zero rows there);
+    - ``port[n]``: joint n sits on a deforming parent (one with a ``port`` method, a beam),
+      at the station its ``r_pn`` names.
     """
 
     def __init__(self, system):
@@ -58,6 +60,8 @@ class Plan:
             system.S[n] is None and system.parent[n] >= 0 and system.S[system.parent[n]] is None for n in range(N)
         ]
         self.internal = [n for n in range(N) if getattr(system.subsystems[n], "n_e", 0)]
+        self.port = [system.parent[n] >= 0 and hasattr(system.subsystems[system.parent[n]], "port") for n in range(N)]
+        self.plain = [plain and not port for plain, port in zip(self.plain, self.port)]
 
 
 def _augmented_selection(S: NDArray | None) -> NDArray:
@@ -110,15 +114,21 @@ def forward(system, q: NDArray, s_dot: NDArray, t: float) -> Kinematics:
     parent, joints = system.parent, system.joints
     R, r, twist = [None] * N + [np.eye(3)], [None] * N + [np.zeros(3)], [None] * N + [np.zeros(6)]
     rels, A_np, r_pn, u = [None] * N, [None] * N, [None] * N, [None] * N
+    prep = plan(system)
+    P_aug = [None] * N
     for n, joint in enumerate(joints):  # root → leaves: poses and twists
         p = parent[n]
         rels[n] = rel = joint.relative(system._q_get[n](q), system._s_get[n](s_dot), t)
+        if prep.port[n]:  # the joint sits at a station of a deforming parent
+            base_R, base_r, base_twist, offset, P_aug[n] = _port(system, n, p, q, s_dot, R, r, twist)
+        else:
+            base_R, base_r, base_twist, offset = R[p], r[p], twist[p], joint.r_pn
         A_pn = joint.orientation @ rel.A
-        r_pn[n] = joint.r_pn + joint.orientation @ rel.r
+        r_pn[n] = offset + joint.orientation @ rel.r
         A_np[n] = A = A_pn.T
-        v_p, omega_p = twist[p][:3], twist[p][3:]
+        v_p, omega_p = base_twist[:3], base_twist[3:]
         u[n] = np.concatenate((A @ (v_p + cross(omega_p, r_pn[n])), A @ omega_p))  # T⁶_np twist_p
-        R[n], r[n] = R[p] @ A_pn, r[p] + R[p] @ r_pn[n]
+        R[n], r[n] = base_R @ A_pn, base_r + base_R @ r_pn[n]
         twist[n] = u[n] + rel.w
     w = np.array([rel.w for rel in rels])
     zeta6 = cross_motion(np.array(u), w) + np.array([rel.zeta for rel in rels])  # Ṫ ẏ_p + Ḟ ṡ + ḟ
@@ -126,10 +136,27 @@ def forward(system, q: NDArray, s_dot: NDArray, t: float) -> Kinematics:
     T_aug6[:, :6, :6] = chain_matrix(np.array(A_np), np.array(r_pn))
     T_aug6[:, :6, 6] = zeta6
     T_aug6[:, 6, 6] = 1.0
-    return _select(system, plan(system), R, r, twist, rels, T_aug6, s_dot)
+    return _select(system, prep, R, r, twist, rels, T_aug6, s_dot, P_aug)
 
 
-def _select(system, prep: Plan, R, r, twist, rels, T_aug6, s_dot) -> Kinematics:
+def _port(system, n, p, q, s_dot, R, r, twist):
+    """The frame at joint n's station on its deforming parent p (``parent.port``): its
+    pose, its twist, and P̃ = [[T⁶_port Sₚᵀ + F_port Eₑᵀ, ζ_port], [0, 1]], the map
+    (ÿ_p; 1) ↦ (port acceleration; 1) that T̃_np composes with (THEORY §10, last line)."""
+    port = system.subsystems[p].port(system.joints[n].r_pn, q[system.e_q_slice[p]], s_dot[system.e_s_slice[p]])
+    T6 = chain_matrix(port.A.T, port.r)
+    u = T6 @ twist[p]
+    n_y = system.subsystems[p].n_y
+    n_e = port.F.shape[1]
+    P_aug = np.zeros((7, n_y + 1))
+    P_aug[:6, :n_y] = T6 @ system.S[p].T
+    P_aug[:6, n_y - n_e : n_y] += port.F
+    P_aug[:6, -1] = cross_motion(u, port.w) + port.zeta
+    P_aug[6, -1] = 1.0
+    return R[p] @ port.A, r[p] + R[p] @ port.r, u + port.w, np.zeros(3), P_aug
+
+
+def _select(system, prep: Plan, R, r, twist, rels, T_aug6, s_dot, P_aug) -> Kinematics:
     """Apply the selections S_n: ẏ_n = S_n twist, F_n = S_n F⁶, T̃_np = S̃_n T̃⁶ S̃_pᵀ, and
     add the internal velocities ṡ_e of subsystems that have them (their last n_e rows)."""
     N = len(rels)
@@ -138,7 +165,12 @@ def _select(system, prep: Plan, R, r, twist, rels, T_aug6, s_dot) -> Kinematics:
         S = system.S[n]
         y_dot[n] = twist[n] if S is None else S @ twist[n]
         F[n] = rels[n].F if S is None else S @ rels[n].F
-        T_aug[n] = T_aug6[n] if prep.plain[n] else prep.S_aug[n] @ T_aug6[n] @ prep.S_aug[system.parent[n]].T
+        if prep.plain[n]:
+            T_aug[n] = T_aug6[n]
+        elif prep.port[n]:
+            T_aug[n] = prep.S_aug[n] @ T_aug6[n] @ P_aug[n]
+        else:
+            T_aug[n] = prep.S_aug[n] @ T_aug6[n] @ prep.S_aug[system.parent[n]].T
     for n in prep.internal:  # ẏ_n = S twist + [0; ṡ_e],  F_n = [S F⁶, [0; E]]
         n_e = system.e_s_slice[n].stop - system.e_s_slice[n].start
         y_dot[n] = y_dot[n].copy()

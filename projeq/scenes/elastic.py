@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from projeq.joints import Prescribed, Revolute
+from projeq import inertia
+from projeq.joints import Fixed, Prescribed, Revolute
 from projeq.subsystems.beam import RitzBeam
+from projeq.subsystems.rigid import PointMass, RigidBody
 from projeq.system import System
 
 
@@ -57,3 +59,46 @@ def spin_up_beam(
     )
     hub = Prescribed(Revolute(axis="z"), spin_up_motion(omega_s, t_s))
     return System({"beam": beam}, {"beam": hub}, gravity=(0.0, 0.0, -gravity))
+
+
+def elastic_arm(
+    l1: float = 0.5,
+    m1: float = 1.0,
+    length: float = 1.0,
+    rho_A: float = 2.0,
+    EI: float = 50.0,
+    tip_mass: float = 0.5,
+    n_shapes: int = 3,
+    stiffening: bool = True,
+    gravity: float = 0.0,
+    omega0: float = 2.0,
+) -> System:
+    """A two-link arm turning about z: a rigid first link (length l1, mass m1, a slender
+    rod) and an elastic second link (a RitzBeam of ``length``, ρA, EI, ``n_shapes``
+    functions per plane) carrying a tip mass at its end. The tip mass hangs on a station
+    of the beam (``Fixed(parent="beam", r_pn=(length, 0, 0))``), so its chain matrix T
+    depends on the beam's elastic coordinates (THEORY §10). Units SI; ``gravity`` along −z
+    is off by default. Initial state: the first joint spinning at ``omega0`` rad/s, the
+    beam slightly bent (1 cm tip deflection in the plane)."""
+    beam = RitzBeam(length, rho_A, EI, n_v=n_shapes, n_w=n_shapes, stiffening=stiffening)
+    system = System(
+        {
+            "link1": RigidBody(m1, (0.5 * l1, 0.0, 0.0), inertia.cylinder(m1, 0.01, l1, axis="x")),
+            "beam": beam,
+            "tip": PointMass(tip_mass),
+        },
+        {
+            "link1": Revolute(axis="z"),
+            "beam": Revolute(parent="link1", axis="z", r_pn=(l1, 0.0, 0.0)),
+            "tip": Fixed(parent="beam", r_pn=(length, 0.0, 0.0)),
+        },
+        gravity=(0.0, 0.0, -gravity),
+    )
+    q0 = np.zeros(system.n_q)
+    q0[system.e_q_slice[system.index("beam")].start] = 0.01  # first v function: v(L) = 1 cm
+    s_dot0 = np.zeros(system.n_s)
+    s_dot0[0] = omega0
+    return System(
+        dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints)),
+        gravity=system.gravity, q0=q0, s_dot0=s_dot0,
+    )

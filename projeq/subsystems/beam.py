@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.checks import non_negative, positive
+from projeq.joints import Relative
 from projeq.spatial import cross, skew_stack
 from projeq.subsystems import shapes
 
@@ -119,6 +120,7 @@ class RitzBeam:
         self._stiffness(EI_z, EI_y if EI_y is not None else EI_z, EA)
         self._rotary(rho_I)
         self._check_independent()
+        self._ports: dict = {}  # station data of joints attached to the beam, by station
 
     # -- precomputation ------------------------------------------------------------------
     def _shapes(self, family, L) -> None:
@@ -211,11 +213,12 @@ class RitzBeam:
         x, (Phi, H) = (self.x, (self.Phi, self.H)) if x is None else (x, data)
         e = lambda cols: slice(cols.start - 6, cols.stop - 6)  # noqa: E731  (columns within q_e)
         q_u, q_v, q_w = q_e[e(self.u_cols)], q_e[e(self.v_cols)], q_e[e(self.w_cols)]
-        r = np.zeros((len(x), 3))
+        dtype = np.result_type(q_e, float)  # complex for the complex-step derivative of ports
+        r = np.zeros((len(x), 3), dtype=dtype)
         r[:, 0] = x + q_u @ Phi["u"][0]
         r[:, 1] = q_v @ Phi["v"][0]
         r[:, 2] = q_w @ Phi["w"][0]
-        Phi_r = np.zeros((len(x), 3, self.n_e))
+        Phi_r = np.zeros((len(x), 3, self.n_e), dtype=dtype)
         Phi_r[:, 0, e(self.u_cols)] = Phi["u"][0].T
         Phi_r[:, 1, e(self.v_cols)] = Phi["v"][0].T
         Phi_r[:, 2, e(self.w_cols)] = Phi["w"][0].T
@@ -267,6 +270,50 @@ class RitzBeam:
         """Gravity −∫ g·r_slice dm plus the strain energy ½ q_eᵀ K_e q_e."""
         r_x, _ = self._slices(q_e)
         return float(-self.mass_weights @ (r_x @ R.T + r) @ gravity + 0.5 * q_e @ self.K_e @ q_e)
+
+    def port(self, point: NDArray, q_e: NDArray, q_e_dot: NDArray) -> Relative:
+        """Kinematics of a frame attached at ``point`` of the undeformed beam (station
+        x = point[0], cross-section offset c = (0, point[1], point[2])), relative to the
+        beam's reference frame, as a joint would give them (THEORY §10, last line):
+
+        pose A = R_z(v′) R_y(−w′) (Bremer's Cardan sequence, B(17)), r = r(x) + A c;
+        relative twist F q̇_e in port coordinates with F = [[Aᵀ Φ_r − c̃ Φ_ω], [Φ_ω]],
+        Φ_ω q̇_e = v̇′ (−sin(−w′), 0, cos(−w′)) − ẇ′ e_y; and Ḟ q̇_e by complex step.
+        """
+        x = float(point[0])
+        if not 0.0 <= x <= self.length:
+            raise ValueError(f"r_pn: a joint on a beam must sit at a station 0 ≤ x ≤ {self.length}, got x = {x}")
+        offset = np.array([0.0, point[1], point[2]])
+        data = self._port_data(x)
+        A, r, F = self._port_terms(q_e, data, offset)
+        step = 1e-30
+        F_dot = np.imag(self._port_terms(q_e + 1j * step * q_e_dot, data, offset)[2]) / step
+        return Relative(A, r, F, F @ q_e_dot, F_dot @ q_e_dot)
+
+    def _port_data(self, x: float):
+        """Station data at x, kept per station (ports sit at fixed stations)."""
+        if x not in self._ports:
+            self._ports[x] = (np.array([x]), self.station_data(np.array([x])))
+        return self._ports[x]
+
+    def _port_terms(self, q_e, data, offset):
+        """(A, r, F) of a port; complex-safe, for the complex-step Ḟ."""
+        x, (Phi, H) = data
+        r_x, Phi_r = self._slices(q_e, x, (Phi, H))
+        e = lambda cols: slice(cols.start - 6, cols.stop - 6)  # noqa: E731
+        a = Phi["v"][1][:, 0] @ q_e[e(self.v_cols)]  # v′
+        b = -(Phi["w"][1][:, 0] @ q_e[e(self.w_cols)])  # −w′
+        ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
+        R_z = np.array([[ca, -sa, 0 * ca], [sa, ca, 0 * ca], [0 * ca, 0 * ca, 1 + 0 * ca]])
+        R_y = np.array([[cb, 0 * cb, sb], [0 * cb, 1 + 0 * cb, 0 * cb], [-sb, 0 * cb, cb]])
+        A = R_z @ R_y
+        Phi_omega = np.zeros((3, self.n_e), dtype=A.dtype)
+        Phi_omega[0, e(self.v_cols)] = -sb * Phi["v"][1][:, 0]
+        Phi_omega[2, e(self.v_cols)] = cb * Phi["v"][1][:, 0]
+        Phi_omega[1, e(self.w_cols)] = -Phi["w"][1][:, 0]
+        C = np.array([[0, -offset[2], offset[1]], [offset[2], 0, -offset[0]], [-offset[1], offset[0], 0]])
+        F = np.vstack((A.T @ Phi_r[0] - C @ Phi_omega, Phi_omega))
+        return A, r_x[0] + A @ offset, F
 
     def displacement(self, q_e, x) -> NDArray:
         """(u + u₂, v, w) at stations x in the beam's reference frame: for one q_e a
