@@ -202,7 +202,7 @@ def simulate(
             if sol.status != 0:
                 status, message = sol.status, sol.message
                 break
-            x = sol.y[:, -1].copy()
+            x = sol.sol(b).copy()  # the state at the segment's end, not at its last output time
             x[:n_q] = system.normalized(x[:n_q])
             if progress is not None:
                 progress(b)
@@ -235,7 +235,8 @@ def _assemble(system, pieces, nfev, status, message, t_events, wall_time, method
     n_q = system.n_q
     if pieces:
         t = np.concatenate([p.t for p in pieces])
-        x = np.concatenate([p.y for p in pieces], axis=1).T
+        n_x = n_q + system.n_s  # a segment without output times has y = []
+        x = np.concatenate([np.reshape(p.y, (n_x, len(p.t))) for p in pieces], axis=1).T
     else:
         t, x = np.zeros(0), np.zeros((0, n_q + system.n_s))
     q = np.array([system.normalized(row) for row in x[:, :n_q]]).reshape(len(t), n_q)
