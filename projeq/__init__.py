@@ -8,16 +8,16 @@ from projeq import inertia
 from projeq.assembly import SingularMassError
 from projeq.forces import Force, JointForce, JointSpring, SpringDamper, Torque
 from projeq.joints import Fixed, Free, Joint, Planar, Prescribed, Prismatic, Revolute, UserJoint
-from projeq.subsystems import PlanarBody, PointMass, RigidBody, Subsystem
+from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, RitzBeam, Subsystem
 from projeq.system import GROUND, System, SystemBuilder
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "GROUND", "System", "SystemBuilder", "Subsystem", "RigidBody", "PlanarBody", "PointMass",
+    "GROUND", "System", "SystemBuilder", "Subsystem", "RigidBody", "PlanarBody", "PointMass", "Frame", "RitzBeam",
     "Joint", "Revolute", "Prismatic", "Fixed", "Planar", "Free", "Prescribed", "UserJoint",
     "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
-    "inertia", "simulate", "Result", "SimulationError", "scenes",
+    "inertia", "simulate", "Result", "SimulationError", "scenes", "linearize",
 ]
 
 
@@ -27,6 +27,10 @@ def __getattr__(name):
         from projeq import simulation
 
         return getattr(simulation, name)
+    if name == "linearize":
+        from projeq.linearize import linearize
+
+        return linearize
     if name == "scenes":
         import projeq.scenes as scenes
 

@@ -2,6 +2,6 @@
 
 from projeq.subsystems.base import Subsystem
 from projeq.subsystems.beam import RitzBeam
-from projeq.subsystems.rigid import PlanarBody, PointMass, RigidBody
+from projeq.subsystems.rigid import Frame, PlanarBody, PointMass, RigidBody
 
-__all__ = ["Subsystem", "RigidBody", "PlanarBody", "PointMass", "RitzBeam"]
+__all__ = ["Subsystem", "RigidBody", "PlanarBody", "PointMass", "Frame", "RitzBeam"]

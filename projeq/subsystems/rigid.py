@@ -179,3 +179,27 @@ class PlanarBody(RigidBody):
     def kinetic_energy(self, y_dot: NDArray, q_e=None) -> float:
         """½ ẏᵀ M ẏ."""
         return 0.5 * float(y_dot @ self.M @ y_dot)
+
+
+class Frame:
+    """A massless frame: a place to chain joints (a universal joint as two revolutes).
+
+    M_n = 0 and h_n = 0; the system stays regular as long as every joint moves some mass
+    further out (else the evaluators raise :class:`projeq.SingularMassError`).
+    """
+
+    n_y = 6
+    S = None
+
+    def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e=None):
+        """(0, 0): no mass, no load."""
+        return np.zeros((6, 6)), np.zeros(6)
+
+    def kinetic_energy(self, y_dot: NDArray, q_e=None) -> float:
+        return 0.0
+
+    def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray, q_e=None) -> float:
+        return 0.0
+
+    def __repr__(self) -> str:
+        return "Frame()"
