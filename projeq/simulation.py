@@ -57,6 +57,7 @@ class Result:
     names: tuple = ()
     method: str = ""
     sol: object = field(default=None, repr=False, compare=False)
+    system: object = field(default=None, repr=False, compare=False)  # in memory only, not saved
 
     @property
     def energy(self) -> NDArray:
@@ -250,7 +251,7 @@ def _assemble(system, pieces, nfev, status, message, t_events, wall_time, method
         t=t, q=q, s_dot=s_dot, kinetic=energies[:, 0], potential=energies[:, 1],
         constraint_residual=residual, nfev=int(nfev), wall_time=wall_time,
         status=int(status), message=str(message), t_events=tuple(np.array(e) for e in t_events),
-        names=system.names, method=getattr(method, "__name__", str(method)), sol=sol,
+        names=system.names, method=getattr(method, "__name__", str(method)), sol=sol, system=system,
     )
 
 

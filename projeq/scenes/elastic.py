@@ -102,3 +102,24 @@ def elastic_arm(
         dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints)),
         gravity=system.gravity, q0=q0, s_dot0=s_dot0,
     )
+
+
+def spinning_beam(
+    omega: float = 2.0,
+    length: float = 1.0,
+    EI: float = 1.0,
+    rho_A: float = 1.0,
+    rho_I: float | None = None,
+    n_shapes: int = 4,
+    family: str = "clamped_free",
+) -> System:
+    """A cantilever spinning about its own axis x at the constant rate ``omega`` (the
+    beam of B(16)–(23), THEORY §9): the root turns by α = Ω t (prescribed); v, w bend in
+    the co-rotating frame with ``n_shapes`` functions each; ``rho_I`` (per length, kg m)
+    adds the rotary inertia ρI of both bending axes (polar 2ρI, circular section)."""
+    beam = RitzBeam(
+        length, rho_A, EI, n_v=n_shapes, n_w=n_shapes, family=family,
+        rho_I=None if rho_I is None else (rho_I, rho_I),
+    )
+    spin = Prescribed(Revolute(axis="x"), lambda t: (omega * t, omega, 0.0))
+    return System({"beam": beam}, {"beam": spin})

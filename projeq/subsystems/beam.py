@@ -117,7 +117,8 @@ class RitzBeam:
         self.weights = 0.5 * L * w
         self.mass_weights = self.weights * _per_length("rho_A", rho_A, x)
         self._shapes(family, L)
-        self._stiffness(EI_z, EI_y if EI_y is not None else EI_z, EA)
+        self._EI = {"z": EI_z, "y": EI_y if EI_y is not None else EI_z}
+        self._stiffness(EI_z, self._EI["y"], EA)
         self._rotary(rho_I)
         self._check_independent()
         self._ports: dict = {}  # station data of joints attached to the beam, by station
@@ -325,6 +326,41 @@ class RitzBeam:
         q_e = np.asarray(q_e, dtype=float)
         rows = [self._slices(q, x, data)[0] - np.outer(x, (1.0, 0.0, 0.0)) for q in np.atleast_2d(q_e)]
         return np.array(rows) if q_e.ndim == 2 else rows[0]
+
+    def _coordinates(self, result) -> NDArray:
+        """This beam's q_e along a trajectory (rows), found in ``result.system``."""
+        system = getattr(result, "system", None)
+        if system is None:
+            raise ValueError("result: has no system (loaded from a file?); probe a Result from simulate()")
+        places = [n for n, sub in enumerate(system.subsystems) if sub is self]
+        if len(places) != 1:
+            raise ValueError(f"result: this beam appears {len(places)} times in the system; probe it by q_e")
+        return result.q[:, system.e_q_slice[places[0]]]
+
+    def deflection(self, result, x: float) -> NDArray:
+        """(u, v, w) at station x in the beam's reference frame along a simulated
+        trajectory: one row per time point (u includes the foreshortening u₂)."""
+        return self.displacement(self._coordinates(result), [x])[:, 0, :]
+
+    def slope(self, result, x: float) -> NDArray:
+        """(v′, w′) at station x, one row per time point."""
+        return self._derivative(result, x, 1)
+
+    def bending_moment(self, result, x: float) -> NDArray:
+        """Bending moments (EI_z v″, EI_y w″) at station x (N m), one row per time point."""
+        curvature = self._derivative(result, x, 2)
+        return curvature * np.array([self._EI_at(x, "z"), self._EI_at(x, "y")])
+
+    def _derivative(self, result, x: float, order: int) -> NDArray:
+        q_e = self._coordinates(result)
+        Phi, _ = self.station_data(np.array([float(x)]))
+        v = q_e[:, self.v_cols.start - 6 : self.v_cols.stop - 6] @ Phi["v"][order][:, 0]
+        w = q_e[:, self.w_cols.start - 6 : self.w_cols.stop - 6] @ Phi["w"][order][:, 0]
+        return np.column_stack((v, w))
+
+    def _EI_at(self, x: float, axis: str) -> float:
+        EI = self._EI[axis]
+        return float(EI(np.array([x]))[0]) if callable(EI) else float(EI)
 
     def __repr__(self) -> str:
         return f"RitzBeam(L={self.length}, n_u={self.n_u}, n_v={self.n_v}, n_w={self.n_w}, stiffening={self.stiffening})"

@@ -227,3 +227,37 @@ def test_elastic_arm_conserves_energy():
     system = elastic_arm()
     result = pq.simulate(system, 0.5, method="DOP853", rtol=1e-10, atol=1e-12)
     assert result.energy_drift < 1e-9
+
+
+@pytest.mark.parametrize("omega", [0.5, 2.0, 7.0])
+def test_spinning_shaft_frequencies_split_by_the_spin(omega):
+    """An isotropic shaft spinning about its own axis, without rotary inertia, vibrates in
+    the co-rotating frame at ω_k ± Ω (VALIDATION.md "spinning shaft"; with z = v + i w the
+    equations ρA(z̈ + 2iΩż − Ω²z) + EI z'''' = 0 of B(23) give λ = i(−Ω ± ω_k)). ω_k from
+    the same discretisation at rest, so only round-off and the linearisation's central
+    differences remain: 1e-7 relative."""
+    from projeq.scenes.elastic import spinning_beam
+
+    A, _ = linearize(spinning_beam(omega=omega, n_shapes=3))
+    eigenvalues = np.linalg.eigvals(A)
+    found = np.sort(np.abs(eigenvalues.imag[eigenvalues.imag > 1e-9]))
+    at_rest = _frequencies_at_rest(RitzBeam(1.0, 1.0, 1.0, n_v=3, n_w=0, family="clamped_free"))
+    expected = np.sort(np.abs(np.concatenate((at_rest + omega, at_rest - omega))))
+    assert np.allclose(found, expected, rtol=1e-7)
+
+
+def test_probes_along_a_trajectory():
+    """deflection, slope and bending moment at a station, one row per time point; at the
+    clamped root all vanish except the moment, and the tip moment of a cantilever vanishes
+    only for exact eigenfunctions (Ritz moments are approximate): check root and shape."""
+    system = spin_up_beam(n_shapes=3, t_s=2.0)
+    result = pq.simulate(system, 1.0, method="RK45", rtol=1e-6, atol=1e-8, n_points=11)
+    beam = system.subsystem("beam")
+    tip = beam.deflection(result, L)
+    assert tip.shape == (11, 3)
+    assert np.allclose(beam.deflection(result, 0.0), 0.0)
+    assert np.allclose(beam.slope(result, 0.0), 0.0)
+    assert beam.bending_moment(result, 0.5 * L).shape == (11, 2)
+    # the deflection agrees with displacement() on the raw coordinates
+    q_e = result.q[:, system.e_q_slice[system.index("beam")]]
+    assert np.array_equal(tip, beam.displacement(q_e, [L])[:, 0, :])
