@@ -232,7 +232,7 @@ class RitzBeam:
 
     def _jacobian(self, r: NDArray, Phi_r: NDArray) -> NDArray:
         """J(x) = [E, −r̃(x), Φ_r(x)], stacked over the stations."""
-        J = np.empty((len(self.x), 3, self.n_y))
+        J = np.empty((len(r), 3, self.n_y))
         J[:, :, :3] = np.eye(3)
         J[:, :, 3:6] = -skew_stack(r)
         J[:, :, 6:] = Phi_r
@@ -326,6 +326,13 @@ class RitzBeam:
         q_e = np.asarray(q_e, dtype=float)
         rows = [self._slices(q, x, data)[0] - np.outer(x, (1.0, 0.0, 0.0)) for q in np.atleast_2d(q_e)]
         return np.array(rows) if q_e.ndim == 2 else rows[0]
+
+    def centre_line(self, q_e: NDArray, y_dot: NDArray, stations: int = 21) -> tuple[NDArray, NDArray]:
+        """Positions r(x) and velocities J(x) ẏ of ``stations`` equally spaced points of the
+        centre line, in the beam's reference frame (for drawing and export)."""
+        x = np.linspace(0.0, self.length, int(stations))
+        r, Phi_r = self._slices(q_e, x, self.station_data(x))
+        return r, self._jacobian(r, Phi_r) @ y_dot
 
     def _coordinates(self, result) -> NDArray:
         """This beam's q_e along a trajectory (rows), found in ``result.system``."""
