@@ -15,9 +15,20 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.integrate import OdeSolution, solve_ivp
+from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
 from projeq.checks import finite_array, positive
+
+
+INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # the methods of solve_ivp
+
+
+def _check_method(method) -> None:
+    if isinstance(method, str) and method in INTEGRATORS:
+        return
+    if isinstance(method, type) and issubclass(method, OdeSolver):
+        return
+    raise ValueError(f"method: unknown integrator {method!r}; use one of {list(INTEGRATORS)} or an OdeSolver class")
 
 
 class SimulationError(RuntimeError):
@@ -171,6 +182,7 @@ def simulate(
         raise ValueError(f"t_end: must be after t_start = {t_start}, got {t_end}")
     positive("rtol", rtol)
     positive("atol", atol)
+    _check_method(method)
     t_eval = _output_times(t_start, float(t_end), t_eval, n_points)
     ev = evaluator if hasattr(evaluator, "accelerations") else system.evaluator(evaluator)
     n_q = system.n_q
