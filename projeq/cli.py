@@ -1,7 +1,8 @@
 """The ``projeq`` command: argparse to library calls, no logic of its own.
 
-``projeq run [SCENE]`` simulates a scene (default: the package's default scene), prints a
-summary and writes the result (NPZ and CSV) to ``--out``. ``projeq list`` names the scenes.
+``projeq run [SCENE]`` simulates a scene (default: the spin-up beam), prints a summary and
+writes the result (NPZ, CSV and a ParaView VTU series) to ``--out``. ``projeq list`` names
+the scenes.
 Exit codes: 0 success, 1 failed run (partial results written), 2 bad arguments.
 """
 
@@ -22,7 +23,7 @@ def _parser() -> argparse.ArgumentParser:
     sub.add_parser("list", help="list the scenes")
     run = sub.add_parser("run", help="simulate a scene and write the results")
     run.add_argument("scene", nargs="?", default=DEFAULT_SCENE, help=f"scene name (default {DEFAULT_SCENE})")
-    run.add_argument("--t-end", type=float, default=10.0, help="end time in s (default 10)")
+    run.add_argument("--t-end", type=float, default=None, help="end time in s (default: the scene's)")
     run.add_argument("--method", default="DOP853", help="solve_ivp method (default DOP853)")
     run.add_argument("--rtol", type=float, default=1e-9, help="relative tolerance (default 1e-9)")
     run.add_argument("--atol", type=float, default=1e-11, help="absolute tolerance (default 1e-11)")
@@ -48,9 +49,11 @@ def _run(args) -> int:
     if args.scene not in SCENES:
         print(f"projeq: unknown scene {args.scene!r}; known scenes: {', '.join(SCENES)}", file=sys.stderr)
         return 2
-    system = SCENES[args.scene][0]()
+    scene = SCENES[args.scene]
+    system = scene.build()
+    t_end = scene.t_end if args.t_end is None else args.t_end
     try:
-        result, code = simulate(system, args.t_end, method=args.method, rtol=args.rtol, atol=args.atol), 0
+        result, code = simulate(system, t_end, method=args.method, rtol=args.rtol, atol=args.atol, n_points=201), 0
     except SimulationError as exc:
         print(f"projeq: {exc}", file=sys.stderr)
         result, code = exc.result, 1
@@ -58,12 +61,24 @@ def _run(args) -> int:
         print(f"projeq: {exc}", file=sys.stderr)
         return 2
     files = _write(result, Path(args.out), args.scene)
+    if len(result.t):
+        from projeq.export import write_vtu_series
+
+        files.append(write_vtu_series(result, Path(args.out) / "paraview", name=args.scene))
     if not args.quiet:
         print(f"scene {args.scene}: {len(system.names)} subsystems, n_q = {system.n_q}, n_s = {system.n_s}")
         print(f"t = {result.t[-1]:.6g} s, {result.nfev} evaluations, {result.wall_time:.3g} s CPU ({result.method})")
         print(f"final q     = {np.array2string(result.q[-1], precision=6)}")
         print(f"final s_dot = {np.array2string(result.s_dot[-1], precision=6)}")
-        print(f"energy {result.energy[0]:.10g} J -> {result.energy[-1]:.10g} J, relative drift {result.energy_drift:.2e}")
+        change = result.energy[-1] - result.energy[0]
+        print(f"energy {result.energy[0]:.10g} J -> {result.energy[-1]:.10g} J (change {change:.3g} J, "
+              f"{result.energy_drift:.2e} of the energy scale; not conserved where a motion is prescribed)")
+        for name, sub in zip(system.names, system.subsystems):
+            if hasattr(sub, "deflection"):
+                tip = sub.deflection(result, sub.length)[-1]
+                print(f"{name}: tip displacement (u, v, w) = {np.array2string(tip, precision=5)} m at t = {result.t[-1]:.6g} s")
+        if system.n_c:
+            print(f"largest constraint residual {np.abs(result.constraint_residual).max():.2e}")
         print("wrote " + ", ".join(str(f) for f in files))
     return code
 
@@ -74,7 +89,7 @@ def main(argv=None) -> int:
     if args.command == "list":
         from projeq.scenes import SCENES
 
-        for name, (_, description) in SCENES.items():
-            print(f"{name:18s} {description}")
+        for name, scene in SCENES.items():
+            print(f"{name:18s} {scene.description}")
         return 0
     return _run(args)

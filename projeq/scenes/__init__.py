@@ -7,11 +7,14 @@ maps the names the CLI knows to these functions.
 
 from __future__ import annotations
 
+from typing import Callable, NamedTuple
+
 import numpy as np
 
 from projeq import inertia
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
+from projeq.scenes.elastic import elastic_arm, spin_up_beam, spinning_beam
 from projeq.system import System
 
 
@@ -77,11 +80,25 @@ def atwood(m1: float = 2.0, m2: float = 1.0, pulley_mass: float = 0.5, radius: f
     )
 
 
-SCENES = {
-    "chain": (chain, "n links on revolute joints hanging from the origin (default n = 5)"),
-    "double_pendulum": (double_pendulum, "two point masses on massless rods, released horizontally"),
-    "atwood": (atwood, "two masses on a rope over a pulley with inertia (coupled joints)"),
-}
-DEFAULT_SCENE = "double_pendulum"
+class Scene(NamedTuple):
+    """A named scene for the CLI: how to build it, what it is, how long to run it (s)."""
 
-__all__ = ["chain", "double_pendulum", "atwood", "SCENES", "DEFAULT_SCENE"]
+    build: Callable[..., System]
+    description: str
+    t_end: float
+
+
+SCENES = {
+    "spin_up_beam": Scene(spin_up_beam, "a cantilever spun up to Ωs = 6 rad/s, with dynamic stiffening", 20.0),
+    "spinning_beam": Scene(spinning_beam, "a cantilever spinning about its own axis (B(16)-(23))", 10.0),
+    "elastic_arm": Scene(elastic_arm, "rigid link + elastic link with a tip mass, turning freely", 5.0),
+    "chain": Scene(chain, "n links on revolute joints hanging from the origin (default n = 5)", 10.0),
+    "double_pendulum": Scene(double_pendulum, "two point masses on massless rods, released horizontally", 10.0),
+    "atwood": Scene(atwood, "two masses on a rope over a pulley with inertia (coupled joints)", 2.0),
+}
+DEFAULT_SCENE = "spin_up_beam"
+
+__all__ = [
+    "chain", "double_pendulum", "atwood", "spin_up_beam", "spinning_beam", "elastic_arm",
+    "Scene", "SCENES", "DEFAULT_SCENE",
+]
