@@ -226,8 +226,11 @@ def simulate(
     result = _assemble(system, pieces, nfev, status, message, t_events, _time.perf_counter() - started, method, dense_output)
     if status == -1:
         reached = result.t[-1] if len(result.t) else t_start
+        hint = ""
+        if method in ("RK45", "RK23", "DOP853") and "step size" in message:
+            hint = "; an explicit method stalls on stiff systems (a very stiff beam): try method='Radau' or 'BDF'"
         raise SimulationError(
-            f"integration failed at t = {reached:.6g} s of {t_end}: {message} "
+            f"integration failed at t = {reached:.6g} s of {t_end}: {message}{hint} "
             "(the trajectory computed so far is in .result)",
             result,
         )

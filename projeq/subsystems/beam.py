@@ -122,6 +122,8 @@ class RitzBeam:
         self._rotary(rho_I)
         self._check_independent()
         self._ports: dict = {}  # station data of joints attached to the beam, by station
+        self._warned = False  # the unstiffened-spin warning is given once per beam
+        self.first_frequency = self._first_frequency()
 
     # -- precomputation ------------------------------------------------------------------
     def _shapes(self, family, L) -> None:
@@ -207,6 +209,30 @@ class RitzBeam:
                 "(singular mass matrix); for many functions use family='clamped_free'"
             )
 
+    def _first_frequency(self) -> float:
+        """Lowest bending frequency of the clamped beam at rest (rad/s), from M_ee and K_e."""
+        from scipy.linalg import eigh
+
+        M, _ = self.gauss_terms(np.zeros(self.n_y), np.eye(3), np.zeros(3), np.zeros(self.n_e))
+        return float(np.sqrt(max(eigh(self.K_e, M[6:, 6:], eigvals_only=True)[0], 0.0)))
+
+    def _warn_unstiffened_spin(self, omega: NDArray) -> None:
+        """Without stiffening a spin about an axis across the beam faster than its first
+        bending frequency makes the model unstable (ω_lag² = ω₁² − Ω² < 0): allowed, but
+        said once."""
+        spin = float(np.hypot(omega[1], omega[2]))
+        if spin > self.first_frequency:
+            import warnings
+
+            self._warned = True
+            warnings.warn(
+                f"RitzBeam without stiffening spins at {spin:.3g} rad/s, above its first bending "
+                f"frequency {self.first_frequency:.3g} rad/s: the unstiffened model is unstable there "
+                "(use stiffening=True)",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+
     # -- slice kinematics ------------------------------------------------------------------
     def _slices(self, q_e: NDArray, x: NDArray | None = None, data=None):
         """r(x) and Φ_r(x, q_e) at the quadrature stations (or at ``x`` with its
@@ -244,6 +270,8 @@ class RitzBeam:
         r, Phi_r = self._slices(q_e)
         J = self._jacobian(r, Phi_r)
         v_R, omega, q_e_dot = y_dot[:3], y_dot[3:6], y_dot[6:]
+        if not (self.stiffening or self._warned) and hasattr(self, "first_frequency"):
+            self._warn_unstiffened_spin(omega)
         r_dot = Phi_r @ q_e_dot
         v_c = v_R + cross(omega, r) + r_dot
         c = cross(omega, r_dot) + cross(omega, v_c) - R.T @ gravity  # J̇ẏ + ω̃ v_c − g
