@@ -7,6 +7,7 @@ recursively in order n. See docs/ and shared/design/THEORY.md.
 from projeq import inertia
 from projeq.assembly import SingularMassError
 from projeq.forces import Force, JointForce, JointSpring, SpringDamper, Torque
+from projeq.linearization import linearize
 from projeq.joints import Fixed, Free, Joint, Planar, Prescribed, Prismatic, Revolute, UserJoint
 from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, RitzBeam, Subsystem
 from projeq.system import GROUND, System, SystemBuilder
@@ -27,10 +28,6 @@ def __getattr__(name):
         from projeq import simulation
 
         return getattr(simulation, name)
-    if name == "linearize":
-        from projeq.linearize import linearize
-
-        return linearize
     if name == "scenes":
         import projeq.scenes as scenes
 

@@ -40,6 +40,13 @@ def non_negative(name: str, value) -> float:
     return x
 
 
+def count(name: str, value, minimum: int = 1) -> int:
+    """An integer ≥ ``minimum`` (a number of points, segments, ...)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
 def state_vector(name: str, value, length: int) -> NDArray:
     """A state (q or ṡ) of the right length with finite entries."""
     a = finite_array(name, value)

@@ -32,6 +32,13 @@ def _load(name: str, value, shape: tuple) -> Callable:
     return lambda t, q, s_dot: constant
 
 
+def _index(system, name, parameter: str) -> int:
+    """Position of subsystem ``name`` in ``system``; an unknown name is an error naming ``parameter``."""
+    if name not in system.names:
+        raise ValueError(f"{parameter}: unknown subsystem {name!r}; the system has {list(system.names)}")
+    return system.index(name)
+
+
 def _frame(frame: str) -> str:
     if frame not in ("world", "body"):
         raise ValueError(f"frame: expected 'world' or 'body', got {frame!r}")
@@ -46,7 +53,7 @@ class _BodyLoad:
         self.frame = _frame(frame)
 
     def bind(self, system) -> "_BodyLoad":
-        self.index = system.index(self.body)
+        self.index = _index(system, self.body, "body")
         self.S = system.subsystems[self.index].S
         return self
 
@@ -98,7 +105,7 @@ class JointForce:
         self.tau = tau
 
     def bind(self, system) -> "JointForce":
-        self.index = n = system.index(self.joint)
+        self.index = n = _index(system, self.joint, "joint")
         self.parent = system.parent[n]
         self.n_s = system.joints[n].n_s
         self._tau = _load(f"tau of joint {self.joint!r}", self.tau, (self.n_s,))
@@ -131,7 +138,7 @@ class JointSpring(JointForce):
         self.q_ref = q_ref
 
     def bind(self, system) -> "JointSpring":
-        self.index = n = system.index(self.joint)
+        self.index = n = _index(system, self.joint, "joint")
         self.parent = system.parent[n]
         joint = system.joints[n]
         if joint.n_q != joint.n_s or not np.allclose(joint.K(joint.default_q(), 0.0), np.eye(joint.n_q)):
@@ -165,10 +172,11 @@ class SpringDamper:
         self.length = non_negative("length", length)
 
     def bind(self, system) -> "SpringDamper":
-        self.index = tuple(-1 if b is None else system.index(b) for b in self.bodies)
+        names = ("body_a", "body_b")
+        self.index = tuple(-1 if b is None else _index(system, b, p) for b, p in zip(self.bodies, names))
         self.S = tuple(system.subsystems[n].S if n >= 0 else None for n in self.index)
         if self.index[0] == self.index[1]:
-            raise ValueError("body_b: a spring-damper needs two different bodies")
+            raise ValueError(f"body_b: a spring-damper needs two distinct bodies, not {self.bodies[1]!r} twice")
         return self
 
     def _ends(self, kin):

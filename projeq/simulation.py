@@ -17,7 +17,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
-from projeq.checks import finite_array, positive
+from projeq.assembly import EVALUATORS
+from projeq.checks import count, finite_array, positive, state_vector
+from projeq.constraints import check_configuration
 
 
 INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # the methods of solve_ivp
@@ -170,35 +172,47 @@ def simulate(
     -------
     Result
         On failure of the integrator or a non-finite state, :class:`SimulationError` is
-        raised with ``.result`` holding the trajectory computed so far; Ctrl-C returns the
-        partial trajectory with ``status = 2``.
+        raised with ``.result`` holding the trajectory computed so far and a message giving
+        the time reached; Ctrl-C returns the partial trajectory with ``status = 2``. Bad
+        arguments raise ``ValueError`` naming the argument before the run starts, and a
+        model that cannot be evaluated at the initial state raises its own error there
+        (:class:`projeq.SingularMassError`, a force law's ``ValueError``).
     """
-    q0 = system.q0 if q0 is None else q0
-    s_dot0 = system.s_dot0 if s_dot0 is None else s_dot0
-    q0, s_dot0 = system.check_state(q0, s_dot0)
-    q0 = system.normalized(q0)
+    q0 = system.normalized(system.check_q("q0", system.q0 if q0 is None else q0))
+    s_dot0 = state_vector("s_dot0", system.s_dot0 if s_dot0 is None else s_dot0, system.n_s)
     t_start = float(finite_array("t_start", t_start, ()))
     if not float(finite_array("t_end", t_end, ())) > t_start:
         raise ValueError(f"t_end: must be after t_start = {t_start}, got {t_end}")
     positive("rtol", rtol)
     positive("atol", atol)
     _check_method(method)
-    t_eval = _output_times(t_start, float(t_end), t_eval, n_points)
-    ev = evaluator if hasattr(evaluator, "accelerations") else system.evaluator(evaluator)
+    t_eval = _output_times(t_start, float(t_end), t_eval, count("n_points", n_points, 2))
+    n_segments = count("n_segments", n_segments)
+    if progress is not None and not callable(progress):
+        raise ValueError(f"progress: expected a callable progress(t), got {progress!r}")
+    events = [] if events is None else (list(events) if isinstance(events, (list, tuple)) else [events])
+    for i, e in enumerate(events):
+        if not callable(e):
+            raise ValueError(f"events[{i}]: expected a callable event(t, q, s_dot), got {e!r}")
+    ev = _evaluator(system, evaluator)
+    check_configuration(system, q0, t_start)  # a coordinate singularity at the start, by name
+    ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
     n_q = system.n_q
+    reached = [t_start]  # time of the latest right-hand side evaluation, for error messages
 
     def rhs(t, x):
+        reached[0] = t
         q, s_dot = x[:n_q], x[n_q:]
         x_dot = np.concatenate((system.q_dot(q, s_dot, t), ev.accelerations(q, s_dot, t)))
         if not np.all(np.isfinite(x_dot)):
             raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
         return x_dot
 
-    events = [] if events is None else (list(events) if isinstance(events, (list, tuple)) else [events])
     wrapped_events = [_event_wrapper(e, n_q) for e in events] or None
-    bounds = np.linspace(t_start, float(t_end), max(1, int(n_segments)) + 1)
+    bounds = np.linspace(t_start, float(t_end), n_segments + 1)
     pieces, nfev, status, message = [], 0, 0, "The solver successfully reached the end of the integration interval."
     t_events = [[] for _ in events]
+    cause = None  # the exception that stopped the run, if any
     x = np.concatenate((q0, s_dot0))
     started = _time.perf_counter()
     try:
@@ -222,24 +236,41 @@ def simulate(
     except KeyboardInterrupt:
         status, message = 2, "interrupted (Ctrl-C): the trajectory up to the last finished segment is kept"
     except (FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
-        status, message = -1, str(exc)
+        status, message, cause = -1, str(exc), exc
+    except Exception as exc:  # noqa: BLE001 - a user's force law or event failed: keep the trajectory
+        status, message, cause = -1, f"{type(exc).__name__}: {exc}", exc
     result = _assemble(system, pieces, nfev, status, message, t_events, _time.perf_counter() - started, method, dense_output)
     if status == -1:
-        reached = result.t[-1] if len(result.t) else t_start
+        kept = result.t[-1] if len(result.t) else t_start
         hint = ""
         if method in ("RK45", "RK23", "DOP853") and "step size" in message:
-            hint = "; an explicit method stalls on stiff systems (a very stiff beam): try method='Radau' or 'BDF'"
+            hint = (
+                "; the solution may blow up here, or the system is stiff for an explicit method "
+                "(a very stiff beam): then try method='Radau' or 'BDF'"
+            )
         raise SimulationError(
-            f"integration failed at t = {reached:.6g} s of {t_end}: {message}{hint} "
-            "(the trajectory computed so far is in .result)",
+            f"integration failed at t = {reached[0]:.6g} s (t_end = {t_end}): {message}{hint}; "
+            f"the trajectory up to t = {kept:.6g} s is in .result",
             result,
-        )
+        ) from cause
     return result
+
+
+def _evaluator(system, evaluator):
+    """The right-hand side's evaluator: a user object, or the system's cached one by name."""
+    if hasattr(evaluator, "accelerations"):
+        return evaluator
+    if evaluator is None or (isinstance(evaluator, str) and evaluator in EVALUATORS):
+        return system.evaluator(evaluator)
+    raise ValueError(
+        f"evaluator: unknown evaluator {evaluator!r}; use one of {sorted(EVALUATORS)} "
+        "or an object with accelerations(q, s_dot, t)"
+    )
 
 
 def _output_times(t_start, t_end, t_eval, n_points) -> NDArray:
     if t_eval is None:
-        return np.linspace(t_start, t_end, max(2, int(n_points)))
+        return np.linspace(t_start, t_end, n_points)
     t_eval = finite_array("t_eval", t_eval)
     if t_eval.ndim != 1 or np.any(np.diff(t_eval) <= 0) or t_eval[0] < t_start or t_eval[-1] > t_end:
         raise ValueError(f"t_eval: must increase strictly within [{t_start}, {t_end}]")

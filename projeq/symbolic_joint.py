@@ -15,6 +15,7 @@ from projeq.checks import finite_array
 from projeq.joints import Relative, pose_twist_mismatch
 
 _COMPLEX_STEP = 1e-30
+_SINGULAR_CONDITION = 1e10  # condition number of K(q0) treated as singular
 _POSE_TOLERANCE = 1e-5  # central differences of step 1e-7 in pose_twist_mismatch: error ~1e-9
 
 
@@ -27,12 +28,20 @@ def _matrix(name: str, value, shape: tuple) -> sp.Matrix:
     return M
 
 
-def _check_symbols(name: str, expr: sp.Matrix, allowed: set, q, t) -> None:
+def _check_symbols(name: str, expr: sp.Matrix, allowed: set, q, t, s=()) -> None:
     extra = expr.free_symbols - allowed
+    speeds = sorted(map(str, extra & set(s)))
+    if speeds:
+        raise ValueError(
+            f"{name}: depends on the minimal velocities {speeds}; it may depend only on the "
+            f"coordinates {[str(x) for x in q]}, time {t} and declared parameters (the twist "
+            "F ṡ + f and the rates K ṡ + k are linear in ṡ)"
+        )
     if extra:
         raise ValueError(
             f"{name}: depends on {sorted(map(str, extra))}, which are not coordinates "
-            f"{[str(x) for x in q]}, time {t} or declared parameters"
+            f"{[str(x) for x in q]}, time {t} or declared parameters; declare them with "
+            "parameters={symbol: value}"
         )
 
 
@@ -53,7 +62,7 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
     values = {sym: float(finite_array(f"parameters[{sym}]", val, ())) for sym, val in parameters.items()}
     allowed = set(q) | {t} | set(values)
     for name, expr in exprs.items():
-        _check_symbols(name, expr, allowed, q, t)
+        _check_symbols(name, expr, allowed, q, t, s)
     A, r, F, K, f, k = (e.xreplace(values) for e in exprs.values())
 
     s_vec = sp.Matrix(s)
@@ -124,9 +133,28 @@ def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, or
 
     joint = cls(parent, n_q, n_s, relative, K, q_dot, q0=q0, r_pn=r_pn, orientation=orientation,
                 constraints=constraints, n_c=n_c)
+    _check_callables(joint, pose, F, f, k)
     _check_shapes(joint)
     _check_pose(joint)
     return joint
+
+
+def _check_callables(joint, pose, F, f, k) -> None:
+    """Shapes of the user's callables at q0, before anything is combined from them."""
+    q0 = joint.default_q()
+    try:
+        A, r = pose(q0, 0.0)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"pose: must return (A, r) = (3×3 rotation, 3-vector) at (q, t): {exc}") from exc
+    for name, value, shape in (
+        ("pose A", A, (3, 3)),
+        ("pose r", r, (3,)),
+        ("F", F(q0, 0.0), (6, joint.n_s)),
+        ("K", joint.K(q0, 0.0), (joint.n_q, joint.n_s)),
+        ("f", f(q0, 0.0), (6,)),
+        ("k", k(q0, 0.0), (joint.n_q,)),
+    ):
+        finite_array(name, value, shape)
 
 
 def _check_shapes(joint) -> None:
@@ -147,8 +175,25 @@ def _check_shapes(joint) -> None:
         finite_array(name, value, shape)
 
 
+def _check_K(joint, q_n) -> None:
+    """K(q) must be finite and of full column rank: else the minimal velocities do not
+    parametrise the rates (a coordinate singularity, e.g. Euler angles at 90° tilt)."""
+    if joint.n_s == 0:
+        return
+    with np.errstate(all="ignore"):
+        K = np.asarray(joint.K(q_n, 0.0), dtype=float)
+    cond = np.linalg.cond(K) if np.all(np.isfinite(K)) else np.inf
+    if not cond < _SINGULAR_CONDITION:
+        raise ValueError(
+            f"K: q̇ = K(q) ṡ is singular at q0 = {np.round(q_n, 6).tolist()} (condition number "
+            f"{cond:.3g}): a coordinate singularity of the chosen coordinates; start away from "
+            "it or use other coordinates (another Euler sequence, quaternions)"
+        )
+
+
 def _check_pose(joint) -> None:
     """The pose's time derivative must be the twist F ṡ + f (at q0 and a nearby point)."""
+    _check_K(joint, joint.default_q())
     rng = np.random.default_rng(0)
     for q_n in (joint.default_q(), joint.default_q() + 0.1 * rng.standard_normal(joint.n_q)):
         s_dot = rng.standard_normal(joint.n_s)

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.checks import finite_array, state_vector
+from projeq.constraints import check_configuration
 from projeq.joints import Joint
 
 GROUND = -1
@@ -65,19 +66,20 @@ class System:
         self.gravity = finite_array("gravity", gravity, (3,))
         self._layout_coordinates()
         self.coupled = any(j.coupling for j in self.joints)
-        self.forces = tuple(copy.copy(f).bind(self) for f in forces)
-        self.q0 = self.normalized(state_vector("q0", self._default_q() if q0 is None else q0, self.n_q))
+        self.forces = tuple(copy.copy(f).bind(self) for f in _check_forces(forces))
+        self.q0 = self.normalized(self.check_q("q0", self._default_q() if q0 is None else q0))
         self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
         for a in (self.gravity, self.q0, self.s_dot0):
             a.flags.writeable = False
         self._evaluators: dict = {}  # the one cache: an evaluator per method (not thread-safe)
         self._check_planar()
+        check_configuration(self, self.q0)  # K(q0), F(q0) regular: no coordinate singularity at the start
 
     # -- names and indexing -------------------------------------------------------------
     def index(self, name: str) -> int:
         """Position of the subsystem ``name`` in the topological order."""
         if name not in self._index:
-            raise ValueError(f"unknown subsystem {name!r}; the system has {list(self.names)}")
+            raise ValueError(f"name: unknown subsystem {name!r}; the system has {list(self.names)}")
         return self._index[name]
 
     def subsystem(self, name: str):
@@ -104,6 +106,10 @@ class System:
         self.e_q_slice, self.e_s_slice = tuple(e_q), tuple(e_s)
         self._q_get = tuple(self.joint_q_getter(n) for n in range(len(self.joints)))
         self._s_get = tuple(self.joint_s_dot_getter(n) for n in range(len(self.joints)))
+        self._normalizing = tuple(  # joints whose coordinates live on a manifold (quaternions)
+            n for n, j in enumerate(self.joints)
+            if type(j).normalized is not Joint.normalized and not j.coupling
+        )
 
     def _coupling_rows(self, n: int, slices) -> tuple[NDArray, NDArray]:
         """Indices into the global vector and weights for coupled joint n."""
@@ -164,9 +170,26 @@ class System:
                 q[sl] = joint.normalized(q[sl])
         return q
 
-    def check_state(self, q, s_dot) -> tuple[NDArray, NDArray]:
-        """q and ṡ as float arrays of the right lengths with finite entries."""
-        return state_vector("q", q, self.n_q), state_vector("s_dot", s_dot, self.n_s)
+    def check_q(self, name: str, q) -> NDArray:
+        """q as a float array of the right length with finite entries that every joint can
+        normalise (no zero quaternion)."""
+        q = state_vector(name, q, self.n_q)
+        for n in self._normalizing:
+            sl = slice(self.q_slice[n].start, self.e_q_slice[n].start)
+            with np.errstate(all="ignore"):
+                ok = np.all(np.isfinite(self.joints[n].normalized(q[sl])))
+            if not ok:
+                raise ValueError(
+                    f"{name}: the coordinates {q[sl].tolist()} of joint {self.names[n]!r} (entries "
+                    f"{sl.start}..{sl.stop - 1}) cannot be normalised (a zero quaternion?)"
+                )
+        return q
+
+    def check_state(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
+        """q and ṡ as float arrays of the right lengths with finite entries (q normalisable),
+        and a finite time t."""
+        finite_array("t", t, ())
+        return self.check_q("q", q), state_vector("s_dot", s_dot, self.n_s)
 
     def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
         """q̇ = K(q) ṡ + k(q, t), joint by joint."""
@@ -221,12 +244,12 @@ class System:
 
         ``method="recursive"`` (order n, THEORY §6) or ``"dense"`` (Gauss form, §5).
         """
-        q, s_dot = self.check_state(q, s_dot)
+        q, s_dot = self.check_state(q, s_dot, t)
         return self.evaluator(method).accelerations(q, s_dot, float(t))
 
     def gauss_form(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """M(q) and b(q, ṡ, t) of the Gauss form M s̈ + b = 0 (THEORY §5)."""
-        q, s_dot = self.check_state(q, s_dot)
+        q, s_dot = self.check_state(q, s_dot, t)
         return self.evaluator("dense").gauss_form(q, s_dot, float(t))
 
     def mass_matrix(self, q, t: float = 0.0) -> NDArray:
@@ -237,7 +260,7 @@ class System:
         """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and gravity plus springs."""
         from projeq.kinematics import forward
 
-        q, s_dot = self.check_state(q, s_dot)
+        q, s_dot = self.check_state(q, s_dot, t)
         kin = forward(self, q, s_dot, float(t))
         q_e = [q[sl] for sl in self.e_q_slice]
         kinetic = sum(sub.kinetic_energy(kin.y_dot[n], q_e[n]) for n, sub in enumerate(self.subsystems))
@@ -296,13 +319,37 @@ def _check_names(subsystems, joints) -> None:
             raise ValueError(f"joints[{name!r}]: a subsystem cannot be its own parent")
 
 
+def _check_forces(forces) -> tuple:
+    try:
+        forces = tuple(forces)
+    except TypeError:
+        raise ValueError(f"forces: expected a list of force laws, got {forces!r}") from None
+    for i, f in enumerate(forces):
+        if not all(hasattr(f, a) for a in ("bind", "add_to", "potential")):
+            raise ValueError(f"forces[{i}]: {f!r} is not a force law (needs bind, add_to, potential)")
+    return forces
+
+
+def _cycle(joints: dict, start: str) -> list[str]:
+    """The loop reached by following parents from ``start`` (which does not reach the ground)."""
+    path = [start]
+    while joints[path[-1]].parent not in path:
+        path.append(joints[path[-1]].parent)
+    loop = path[path.index(joints[path[-1]].parent):]
+    return loop + loop[:1]
+
+
 def _topological_order(joints: dict) -> list[str]:
     """Names ordered so that every parent precedes its children (stable); cycles raise."""
     order, placed, pending = [], set(), list(joints)
     while pending:
         ready = [n for n in pending if joints[n].parent is None or joints[n].parent in placed]
         if not ready:
-            raise ValueError(f"joints: the parents of {pending} form a cycle; a system must be a tree")
+            loop = " -> ".join(repr(n) for n in _cycle(joints, pending[0]))
+            raise ValueError(
+                f"joints: the parents form a cycle (following parents: {loop}); "
+                "a system must be a tree"
+            )
         for name in ready:
             order.append(name)
             placed.add(name)

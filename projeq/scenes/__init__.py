@@ -15,6 +15,10 @@ from projeq import inertia
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
 from projeq.scenes.elastic import elastic_arm, spin_up_beam, spinning_beam
+from projeq.scenes.nonholonomic import (
+    barhorst_particle, car, knife_edge_circle, knife_edge_disc, nonholonomic_particle, rolling_disk,
+    rolling_disk_critical_speed,
+)
 from projeq.system import System
 
 
@@ -95,10 +99,17 @@ SCENES = {
     "chain": Scene(chain, "n links on revolute joints hanging from the origin (default n = 5)", 10.0),
     "double_pendulum": Scene(double_pendulum, "two point masses on massless rods, released horizontally", 10.0),
     "atwood": Scene(atwood, "two masses on a rope over a pulley with inertia (coupled joints)", 2.0),
+    "car": Scene(car, "Bremer's car: a planar body whose rear axle cannot slide (B(5)-(12))", 10.0),
+    "knife_edge_disc": Scene(knife_edge_disc, "a knife-edge disc rolling without slip (lecture 001, slides 28-37)", 20.0),
+    "rolling_disk": Scene(rolling_disk, "Barhorst's rolling disk with an eccentric mass (seed 000, 3.2)", 10.0),
+    "barhorst_particle": Scene(barhorst_particle, "a particle with the constraint y' - y^2 x' = 0 (seed 000, 3.1)", 10.0),
+    "nonholonomic_particle": Scene(nonholonomic_particle, "a particle in space with y' + z x' = 0 (seed 000, 3.1)", 2.0),
 }
 DEFAULT_SCENE = "spin_up_beam"
 
 __all__ = [
     "chain", "double_pendulum", "atwood", "spin_up_beam", "spinning_beam", "elastic_arm",
+    "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed",
+    "barhorst_particle", "nonholonomic_particle",
     "Scene", "SCENES", "DEFAULT_SCENE",
 ]

@@ -5,7 +5,7 @@ import pytest
 from scipy.linalg import eigh
 
 import projeq as pq
-from projeq.linearize import linearize
+from projeq.linearization import linearize
 from projeq.scenes.elastic import elastic_arm, spin_up_beam
 from projeq.subsystems import RitzBeam
 from projeq.subsystems.shapes import clamped_free_roots

@@ -4,6 +4,11 @@ The state is x = (q, ṡ) with ẋ = (K(q) ṡ + k, s̈(q, ṡ, t)). A and B are
 Jacobians (relative step 1e-6, so their entries carry about ten correct digits). This is
 the first version: perturbations of all of q and ṡ (for non-holonomic systems the ṡ are
 already minimal, so the linearisation is in minimal velocities by construction).
+
+Caution: with body-fixed quasi-velocities a steady motion is often not an equilibrium of
+(q, ṡ) (the speeds rotate with the configuration, as Barhorst's u1, u3 of the rolling disk
+do with its roll angle); linearise in speeds for which the steady motion is one (the
+knife-edge disc's Euler rates), or the eigenvalues mislead.
 """
 
 from __future__ import annotations

@@ -1,0 +1,83 @@
+"""Bad input for non-holonomic systems (the issue's "Bad input" list).
+
+- a user-defined joint whose F has the wrong shape, or depends on symbols that are not
+  coordinates, time or declared parameters (named in the message), or on the speeds;
+- K(q) singular at the start: Barhorst's Euler angles at tilt q2 = π/2
+  (``seeds/000_…`` §3.2, eq. 96, "the singularity near q2 = π/2"); the knife-edge disc's
+  F at ϕ = π/2 (lecture ``seeds/001_…`` slide 31: the 1/cos²ϕ of the Hamiltonian);
+- initial rates q̇₀ that violate the constraints they are meant to satisfy.
+"""
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import projeq as pq
+from projeq.constraints import check_configuration, initial_speeds
+
+x, y, k, u = sp.symbols("x y k u")
+
+
+def particle_joint(F, K=None, **kw):
+    K = sp.Matrix([[1], [y**2]]) if K is None else K
+    return pq.UserJoint.from_sympy([x, y], [u], sp.eye(3), [x, y, 0], F, K, **kw)
+
+
+def test_F_of_the_wrong_shape():
+    with pytest.raises(ValueError, match=r"^F: expected shape \(6, 1\), got \(5, 1\)"):
+        particle_joint(sp.Matrix([1, y**2, 0, 0, 0]))
+    with pytest.raises(ValueError, match=r"^F: .*shape \(6, 1\)"):
+        pq.UserJoint.from_functions(
+            2, 1, lambda q, t: (np.eye(3), np.array([q[0], q[1], 0.0])),
+            lambda q, t: np.ones((5, 1)), lambda q, t: np.array([[1.0], [q[1] ** 2]]),
+        )
+
+
+def test_F_with_unknown_symbols_names_them():
+    with pytest.raises(ValueError, match=r"^F: depends on \['k'\], which are not coordinates \['x', 'y'\]"):
+        particle_joint(sp.Matrix([1, k * y**2, 0, 0, 0, 0]))
+    particle_joint(sp.Matrix([1, k * y**2, 0, 0, 0, 0]), K=sp.Matrix([[1], [k * y**2]]), parameters={k: 1.0})
+    with pytest.raises(ValueError, match=r"^F: depends on the minimal velocities \['u'\]"):
+        particle_joint(sp.Matrix([1, u * y, 0, 0, 0, 0]))
+    with pytest.raises(ValueError, match=r"^constraints: depends on \['k'\]"):
+        xd, yd = sp.symbols("xd yd")
+        particle_joint(sp.Matrix([1, y**2, 0, 0, 0, 0]), constraints=[yd - k * xd], q_dot=[xd, yd])
+
+
+def test_F_inconsistent_with_K_is_refused():
+    """The pose (x, y) and F must describe the same motion as q̇ = K ṡ."""
+    with pytest.raises(ValueError, match="^F: the relative twist"):
+        particle_joint(sp.Matrix([1, y, 0, 0, 0, 0]))
+
+
+def test_singular_K_of_barhorsts_euler_angles():
+    """Eq. (96): K has sec q2, singular at the tilt q2 = π/2 (disk flat on the plane)."""
+    with pytest.raises(ValueError, match=r"^K: q̇ = K\(q\) ṡ is singular at q0 = \[0.0, 1.570796"):
+        pq.scenes.rolling_disk(q0=(0.0, np.pi / 2, 0.0, 0.0, 0.0))
+    system = pq.scenes.rolling_disk()
+    with pytest.raises(ValueError, match=r"K\(q\) .*'disk' at q = \[0.0, -1.570796"):
+        check_configuration(system, [0.0, -np.pi / 2, 0.0, 0.0, 0.0])
+    check_configuration(system, [0.0, 1.5, 0.0, 0.0, 0.0])  # 86°: regular
+
+
+def test_singular_F_of_the_knife_edge_disc_at_flat_tilt():
+    """Slides 29–31: at ϕ = ±π/2 the ψ̇- and θ̇-directions of ω coincide (n̂z = ê2), F loses
+    rank and the mass matrix is singular; the scene refuses to start there."""
+    with pytest.raises(ValueError, match=r"F\(q\) loses rank .*'disc' at q = \[0.0, 0.0, 0.0, 1.570796"):
+        pq.scenes.knife_edge_disc(q0=(0.0, 0.0, 0.0, np.pi / 2, 0.0))
+
+
+def test_initial_rates_violating_the_constraints():
+    """Slide 30's rolling constraints and Barhorst's ẏ − y² ẋ = 0: rates that violate them
+    are refused with the residual; rates that satisfy them give the minimal velocities."""
+    with pytest.raises(ValueError, match=r"^q_dot: the initial rates violate the velocity constraints: residual \[1\. 0\.\]"):
+        pq.scenes.knife_edge_disc(q_dot0=(1.0, 0.0, 0.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match=r"residual \[-4\.\]"):
+        pq.scenes.barhorst_particle(q_dot0=(1.0, 0.0))  # ẏ − y² ẋ = 0 − 4·1 at (2, 2)
+    system = pq.scenes.knife_edge_disc()
+    s_dot = np.array([0.3, -0.2, 1.1])
+    q_dot = system.q_dot(system.q0, s_dot)
+    assert np.allclose(initial_speeds(system, system.q0, q_dot), s_dot, rtol=1e-14)
+    built = pq.scenes.knife_edge_disc(q_dot0=q_dot)
+    assert np.allclose(built.s_dot0, s_dot, rtol=1e-14)
+    assert np.allclose(pq.scenes.barhorst_particle(q_dot0=(1.0, 4.0)).s_dot0, [1.0])

@@ -1,0 +1,441 @@
+"""Bad input gets a clear error naming the parameter, raised where the input enters.
+
+One test per kind of bad input (STYLE §4.8 item 11), its variants as parametrized cases;
+every message is matched from its start, so that it begins with the parameter's name.
+"""
+
+import numpy as np
+import pytest
+
+import projeq as pq
+
+ROD = {"m": 1.0, "r_c": (0, 0, -0.5), "I_c": np.diag([0.1, 0.1, 0.01])}
+
+
+def _pendulum(**kwargs):
+    """One rod on a revolute joint about y under gravity: n_q = n_s = 1."""
+    return pq.System(
+        {"bob": pq.RigidBody(**ROD)}, {"bob": pq.Revolute(axis="y")}, gravity=(0, 0, -9.81), **kwargs
+    )
+
+
+# -- subsystems and joints ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "build",
+    [
+        lambda m: pq.RigidBody(m, ROD["r_c"], ROD["I_c"]),
+        lambda m: pq.PointMass(m),
+        lambda m: pq.PlanarBody(m, I_c=0.1),
+    ],
+    ids=["RigidBody", "PointMass", "PlanarBody"],
+)
+@pytest.mark.parametrize(
+    "m, problem",
+    [
+        (0.0, "must be positive"),
+        (-1.0, "must be positive"),
+        (np.nan, "non-finite"),
+        (np.inf, "non-finite"),
+        ("heavy", "expected numbers"),
+    ],
+    ids=["zero", "negative", "nan", "inf", "text"],
+)
+def test_mass_must_be_positive_and_finite(build, m, problem):
+    with pytest.raises(ValueError, match=rf"^m \(mass\): {problem}"):
+        build(m)
+
+
+@pytest.mark.parametrize(
+    "I_c, problem",
+    [
+        (np.array([[1.0, 0.2, 0], [0.0, 1, 0], [0, 0, 1]]), "inertia tensor is not symmetric"),
+        (np.diag([1.0, 1.0, -0.5]), "inertia tensor is not positive definite"),
+        (np.zeros((3, 3)), "inertia tensor is not positive definite"),
+        (np.diag([1.0, 1.0, 3.0]), r"principal moments \[1. 1. 3.\] violate the triangle inequality"),
+        (np.diag([1.0, np.nan, 1.0]), "non-finite"),
+        (np.eye(2), r"expected shape \(3, 3\)"),
+    ],
+    ids=["asymmetric", "indefinite", "zero", "triangle", "nan", "shape"],
+)
+def test_inertia_must_be_a_mass_distribution(I_c, problem):
+    with pytest.raises(ValueError, match=f"^I_c: {problem}"):
+        pq.RigidBody(1.0, (0, 0, 0), I_c)
+
+
+@pytest.mark.parametrize(
+    "axis, problem",
+    [
+        ((0, 0, 0), "zero axis"),
+        ((1e-14, 0, 0), "zero axis"),
+        ((np.nan, 0, 1), "axis has non-finite entries"),
+        ((0, 0, np.inf), "axis has non-finite entries"),
+        ((1, 0), "expected a 3-vector"),
+        ("w", "unknown axis 'w'"),
+    ],
+    ids=["zero", "tiny", "nan", "inf", "shape", "name"],
+)
+@pytest.mark.parametrize("joint", [pq.Revolute, pq.Prismatic])
+def test_joint_axis_must_have_a_direction(joint, axis, problem):
+    with pytest.raises(ValueError, match=f"^axis: {problem}"):
+        joint(axis=axis)
+
+
+# -- the tree -------------------------------------------------------------------------------
+
+
+def test_a_body_is_attached_once():
+    builder = pq.SystemBuilder()
+    builder.add("link", pq.RigidBody(**ROD), pq.Revolute(axis="y"))
+    with pytest.raises(ValueError, match="^name: a subsystem 'link' is attached already"):
+        builder.add("link", pq.RigidBody(**ROD), pq.Revolute(axis="y"))
+
+
+@pytest.mark.parametrize(
+    "parents, loop",
+    [
+        ({"a": "b", "b": "a"}, "'a' -> 'b' -> 'a'"),
+        ({"root": None, "a": "c", "b": "a", "c": "b", "leaf": "c"}, "'a' -> 'c' -> 'b' -> 'a'"),
+    ],
+    ids=["two", "three-with-root-and-leaf"],
+)
+def test_a_cycle_is_not_a_tree(parents, loop):
+    """The message names the loop itself, not the bodies merely hanging from it."""
+    body = pq.RigidBody(**ROD)
+    joints = {name: pq.Revolute(parent, "y") for name, parent in parents.items()}
+    with pytest.raises(ValueError, match=rf"^joints: the parents form a cycle \(following parents: {loop}\)"):
+        pq.System(dict.fromkeys(parents, body), joints)
+
+
+def test_a_subsystem_cannot_be_its_own_parent():
+    with pytest.raises(ValueError, match=r"^joints\['a'\]: a subsystem cannot be its own parent"):
+        pq.System({"a": pq.RigidBody(**ROD)}, {"a": pq.Revolute("a", "y")})
+
+
+def test_parent_must_be_in_the_system():
+    with pytest.raises(
+        ValueError, match=r"^joints\['a'\]: parent 'ghost' is not in the system; known subsystems are \['a'\]"
+    ):
+        pq.System({"a": pq.RigidBody(**ROD)}, {"a": pq.Revolute("ghost", "y")})
+
+
+BODY, JOINT = pq.RigidBody(**ROD), pq.Revolute(axis="y")
+
+
+@pytest.mark.parametrize(
+    "subsystems, joints, message",
+    [
+        ({"a": BODY, "b": BODY}, {"a": JOINT}, r"^joints: no joint for subsystem\(s\) \['b'\]"),
+        ({"a": BODY}, {"a": JOINT, "c": JOINT}, r"^joints: joint\(s\) for unknown subsystem\(s\) \['c'\]"),
+        ({"a": 1.0}, {"a": JOINT}, r"^subsystems\['a'\]: 1.0 is not a subsystem"),
+        ({"a": BODY}, {"a": "revolute"}, r"^joints\['a'\]: 'revolute' is not a Joint"),
+        ({}, {}, "^subsystems: expected a non-empty dict"),
+    ],
+    ids=["joint-missing", "joint-extra", "not-a-subsystem", "not-a-joint", "empty"],
+)
+def test_subsystems_and_joints_must_match(subsystems, joints, message):
+    with pytest.raises(ValueError, match=message):
+        pq.System(subsystems, joints)
+
+
+# -- states ---------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda s: s.accelerations([0.1, 0.2], [0.0]), "q"),
+        (lambda s: s.accelerations([0.1], [0.0, 1.0]), "s_dot"),
+        (lambda s: s.mass_matrix([0.1, 0.2]), "q"),
+        (lambda s: s.gauss_form([0.1], []), "s_dot"),
+        (lambda s: s.energy([[0.1]], [0.0]), "q"),
+        (lambda s: s.energy([0.1], [0.0, 1.0]), "s_dot"),
+        (lambda s: pq.simulate(s, 1.0, q0=[0.1, 0.2]), "q0"),
+        (lambda s: pq.simulate(s, 1.0, s_dot0=[]), "s_dot0"),
+        (lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, q0=[0.1, 0.2]), "q0"),
+        (
+            lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, s_dot0=[0, 1]),
+            "s_dot0",
+        ),
+    ],
+    ids=[
+        "accelerations-q",
+        "accelerations-s_dot",
+        "mass_matrix-q",
+        "gauss_form-s_dot",
+        "energy-q",
+        "energy-s_dot",
+        "simulate-q0",
+        "simulate-s_dot0",
+        "System-q0",
+        "System-s_dot0",
+    ],
+)
+def test_state_of_the_wrong_length(call, name):
+    with pytest.raises(ValueError, match=rf"^{name}: expected 1 entries, got shape"):
+        call(_pendulum())
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda s: s.accelerations([np.nan], [0.0]), "q"),
+        (lambda s: s.accelerations([0.1], [np.inf]), "s_dot"),
+        (lambda s: s.accelerations([0.1], [0.0], t=np.nan), "t"),
+        (lambda s: s.mass_matrix([np.inf]), "q"),
+        (lambda s: s.energy([0.1], [np.nan]), "s_dot"),
+        (lambda s: pq.simulate(s, 1.0, q0=[np.nan]), "q0"),
+        (lambda s: pq.simulate(s, 1.0, s_dot0=[-np.inf]), "s_dot0"),
+        (lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, q0=[np.nan]), "q0"),
+        (
+            lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, s_dot0=[np.nan]),
+            "s_dot0",
+        ),
+    ],
+    ids=[
+        "accelerations-q",
+        "accelerations-s_dot",
+        "accelerations-t",
+        "mass_matrix-q",
+        "energy-s_dot",
+        "simulate-q0",
+        "simulate-s_dot0",
+        "System-q0",
+        "System-s_dot0",
+    ],
+)
+def test_non_finite_state(call, name):
+    with pytest.raises(ValueError, match=rf"^{name}: non-finite entries \(NaN or inf\) at flat index \[0\]"):
+        call(_pendulum())
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Free()}, q0=np.zeros(7)), "q0"),
+        (lambda s: pq.simulate(s, 1.0, q0=np.zeros(7)), "q0"),
+        (lambda s: s.accelerations(np.zeros(7), np.zeros(6)), "q"),
+    ],
+    ids=["System", "simulate", "accelerations"],
+)
+def test_a_zero_quaternion_cannot_be_normalised(call, name):
+    """A free joint's orientation (w, x, y, z) = 0 is no rotation: an error, not NaN poses."""
+    system = pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Free()})
+    with pytest.raises(ValueError, match=rf"^{name}: the coordinates .* of joint 'b' .*cannot be normalised"):
+        call(system)
+
+
+# -- parameters and forces ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "build, name",
+    [
+        (
+            lambda: pq.System(
+                {"a": pq.RigidBody(**ROD)}, {"a": pq.Revolute(axis="y")}, gravity=(0, np.nan, 0)
+            ),
+            "gravity",
+        ),
+        (lambda: pq.RigidBody(1.0, (0, np.inf, 0), ROD["I_c"]), "r_c"),
+        (lambda: pq.PointMass(1.0, (np.nan, 0, 0)), "r_c"),
+        (lambda: pq.Revolute(axis="y", r_pn=(0, 0, np.nan)), "r_pn"),
+        (lambda: pq.Prismatic(axis="x", r_pn=(np.inf, 0, 0)), "r_pn"),
+        (lambda: pq.Force("bob", (1.0, np.nan, 0)), "force"),
+        (lambda: pq.Force("bob", (1.0, 0, 0), point=(np.nan, 0, 0)), "point"),
+        (lambda: pq.Torque("bob", (0, 0, np.inf)), "torque"),
+        (lambda: _pendulum(forces=[pq.JointForce("bob", [np.nan])]), "tau of joint 'bob'"),
+        (lambda: _pendulum(forces=[pq.JointSpring("bob", 1.0, q_ref=np.nan)]), "q_ref"),
+        (lambda: pq.JointSpring("bob", stiffness=np.nan), "stiffness"),
+        (lambda: pq.SpringDamper("bob", (0, 0, 0), None, (0, 0, 1), 1.0, length=np.inf), "length"),
+    ],
+    ids=[
+        "gravity",
+        "r_c",
+        "r_c-point-mass",
+        "r_pn",
+        "r_pn-prismatic",
+        "force",
+        "point",
+        "torque",
+        "tau",
+        "q_ref",
+        "stiffness",
+        "length",
+    ],
+)
+def test_non_finite_parameter(build, name):
+    with pytest.raises(ValueError, match=rf"^{name}: non-finite entries \(NaN or inf\)"):
+        build()
+
+
+@pytest.mark.parametrize(
+    "force, name",
+    [
+        (pq.Force("ghost", (1.0, 0, 0)), "body"),
+        (pq.Torque("ghost", (0, 0, 1.0)), "body"),
+        (pq.JointForce("ghost", 1.0), "joint"),
+        (pq.JointSpring("ghost", 1.0), "joint"),
+        (pq.SpringDamper("bob", (0, 0, 0), "ghost", (0, 0, 0), 1.0), "body_b"),
+        (pq.SpringDamper("ghost", (0, 0, 0), None, (0, 0, 0), 1.0), "body_a"),
+    ],
+    ids=["Force", "Torque", "JointForce", "JointSpring", "SpringDamper-b", "SpringDamper-a"],
+)
+def test_a_force_on_an_unknown_body_lists_the_known_ones(force, name):
+    with pytest.raises(ValueError, match=rf"^{name}: unknown subsystem 'ghost'; the system has \['bob'\]"):
+        _pendulum(forces=[force])
+
+
+def test_a_force_law_must_be_a_force_law():
+    with pytest.raises(ValueError, match=r"^forces\[1\]: 3 is not a force law"):
+        _pendulum(forces=[pq.Force("bob", (1.0, 0, 0)), 3])
+
+
+def test_a_spring_damper_needs_two_bodies():
+    with pytest.raises(
+        ValueError, match="^body_b: a spring-damper needs two distinct bodies, not 'bob' twice"
+    ):
+        _pendulum(forces=[pq.SpringDamper("bob", (0, 0, 0), "bob", (0, 0, -1), stiffness=10.0)])
+
+
+@pytest.mark.parametrize("method", ["recursive", "simulate"])
+def test_a_joint_that_moves_no_mass_is_singular(method):
+    """A point mass on the axis of its revolute joint: D_n = F_nᵀ M̂_n F_n = 0. The error
+    names the joint, also from simulate, which evaluates the initial state before the run."""
+    system = pq.System({"p": pq.PointMass(1.0, (0, 0, 0))}, {"p": pq.Revolute(axis="z")})
+    with pytest.raises(pq.SingularMassError, match=r"^D_n = F_nᵀ M̂_n F_n of joint 'p' is singular"):
+        system.accelerations([0.0], [0.0]) if method == "recursive" else pq.simulate(system, 1.0)
+
+
+def test_the_dense_evaluator_reports_a_singular_mass_matrix():
+    """The Gauss form cannot tell which joint: it names the system mass matrix M(q)."""
+    system = pq.System({"p": pq.PointMass(1.0, (0, 0, 0))}, {"p": pq.Revolute(axis="z")})
+    with pytest.raises(pq.SingularMassError, match=r"^system mass matrix M\(q\) is singular"):
+        system.accelerations([0.0], [0.0], method="dense")
+
+
+# -- failures during a simulation -----------------------------------------------------------
+
+
+def test_a_force_that_turns_nan_fails_the_run_and_keeps_the_trajectory():
+    """A force law that returns NaN after t = 0.5 s: SimulationError naming the force and
+    the time reached; ``.result`` keeps the finished segments (of 0.1 s each), all finite."""
+    force = pq.Force("bob", lambda t, q, s_dot: np.array([np.nan if t > 0.5 else 0.0, 0.0, 0.0]))
+    with pytest.raises(
+        pq.SimulationError,
+        match=r"^integration failed at t = 0\.5\d* s \(t_end = 1\.0\): force: non-finite entries .*; "
+        r"the trajectory up to t = 0\.5 s is in \.result",
+    ) as info:
+        pq.simulate(_pendulum(forces=[force]), 1.0, [0.3], [0.0], n_segments=10, n_points=11)
+    result = info.value.result
+    assert result.status == -1 and not result.success
+    assert np.allclose(result.t, np.linspace(0.0, 0.5, 6))  # every output time up to the failure
+    assert np.all(np.isfinite(result.q)) and np.all(np.isfinite(result.energy))
+    assert isinstance(info.value.__cause__, ValueError)  # the original error is chained
+
+
+def test_a_force_law_that_raises_fails_the_run_and_keeps_the_trajectory():
+    """Any exception of a user's force law mid-run: the same SimulationError, with the
+    exception's type in the message and the exception as ``__cause__``."""
+
+    def torque(t, q, s_dot):
+        if t > 0.25:
+            raise ZeroDivisionError("float division by zero")
+        return np.zeros(3)
+
+    with pytest.raises(
+        pq.SimulationError, match=r"^integration failed at t = 0\.25\d* s .*ZeroDivisionError"
+    ) as info:
+        pq.simulate(_pendulum(forces=[pq.Torque("bob", torque)]), 1.0, [0.3], [0.0], n_segments=4, n_points=5)
+    assert np.allclose(info.value.result.t, [0.0, 0.25])
+    assert isinstance(info.value.__cause__, ZeroDivisionError)
+
+
+def test_an_integrator_that_fails_reports_its_message_and_keeps_the_trajectory():
+    """A drive torque τ = 1/(1 − t)³ makes θ̇ blow up at t = 1 s: solve_ivp's step size
+    underflows (status −1). The message gives solve_ivp's own reason and the time reached
+    (t → 1), ``.result`` the outputs before it. Loose tolerances only make the step size
+    collapse in fewer steps; the failure is the same at any tolerance."""
+    drive = pq.JointForce("bob", lambda t, q, s_dot: np.array([1.0 / (1.0 - t) ** 3]))
+    with pytest.raises(
+        pq.SimulationError,
+        match=r"^integration failed at t = (1|0\.9999\d*) s \(t_end = 2\.0\): "
+        r"Required step size is less than spacing between numbers\..*the solution may blow up here",
+    ) as info:
+        pq.simulate(
+            _pendulum(forces=[drive]),
+            2.0,
+            [0.0],
+            [0.0],
+            method="RK45",
+            rtol=1e-3,
+            atol=1e-6,
+            n_segments=2,
+            n_points=21,
+        )
+    result = info.value.result
+    assert result.status == -1 and "step size" in result.message
+    assert np.allclose(result.t, np.linspace(0.0, 0.9, 10))  # the outputs before the blow-up
+    assert np.all(np.diff(result.s_dot[:, 0]) > 0)  # spun up by the drive, never NaN
+
+
+# -- arguments of simulate ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"t_end": 0.0}, "^t_end: must be after t_start = 0.0, got 0.0"),
+        ({"t_end": -1.0}, "^t_end: must be after t_start = 0.0, got -1.0"),
+        ({"t_end": 1.0, "t_start": 2.0}, "^t_end: must be after t_start = 2.0, got 1.0"),
+        ({"t_end": np.nan}, r"^t_end: non-finite entries"),
+        ({"t_start": np.inf}, r"^t_start: non-finite entries"),
+        ({"method": "Euler42"}, r"^method: unknown integrator 'Euler42'; use one of \['RK45', "),
+        ({"method": len}, "^method: unknown integrator"),
+        ({"evaluator": "fast"}, r"^evaluator: unknown evaluator 'fast'; use one of \['dense', 'recursive'\]"),
+        ({"rtol": 0.0}, "^rtol: must be positive, got 0.0"),
+        ({"atol": -1e-9}, "^atol: must be positive"),
+        ({"t_eval": [0.0, 2.0]}, r"^t_eval: must increase strictly within \[0.0, 1.0\]"),
+        ({"t_eval": [0.5, 0.2]}, "^t_eval: must increase strictly"),
+        ({"n_points": 1}, "^n_points: expected an integer >= 2, got 1"),
+        ({"n_segments": 0}, "^n_segments: expected an integer >= 1, got 0"),
+        ({"n_segments": 2.5}, "^n_segments: expected an integer >= 1, got 2.5"),
+        (
+            {"events": [lambda t, q, s_dot: q[0], "bottom"]},
+            r"^events\[1\]: expected a callable event\(t, q, s_dot\)",
+        ),
+        ({"progress": True}, r"^progress: expected a callable progress\(t\), got True"),
+    ],
+    ids=[
+        "t_end-equal",
+        "t_end-before",
+        "t_end-before-start",
+        "t_end-nan",
+        "t_start-inf",
+        "method-name",
+        "method-function",
+        "evaluator",
+        "rtol",
+        "atol",
+        "t_eval-outside",
+        "t_eval-decreasing",
+        "n_points",
+        "n_segments",
+        "n_segments-float",
+        "events",
+        "progress",
+    ],
+)
+def test_simulate_arguments(kwargs, message):
+    kwargs = {"t_end": 1.0, **kwargs}
+    with pytest.raises(ValueError, match=message):
+        pq.simulate(_pendulum(), **kwargs)
+
+
+@pytest.mark.parametrize("method", ["newton", 3])
+def test_unknown_evaluator(method):
+    with pytest.raises(
+        ValueError, match=r"^method: unknown evaluator .*; use one of \['dense', 'recursive'\]"
+    ):
+        _pendulum().accelerations([0.0], [0.0], method=method)
