@@ -29,7 +29,6 @@ inequality by construction.
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field
 from functools import cache
 
 import numpy as np
@@ -293,20 +292,15 @@ def _force(kind, names, kinds, rng, planar: bool, damped: bool):
 
 
 # -- the tree ------------------------------------------------------------------------------
-@dataclass
 class Tree:
-    """A random system and a state (q, ṡ, t) at which to evaluate it."""
+    """A random system and a state (q, ṡ, t) at which to evaluate it; ``rng`` continues the
+    generator that built it (for further random numbers in a test). Its repr names the
+    structure and the seed, which is all a failing example needs to be rebuilt."""
 
-    system: pq.System
-    q: np.ndarray
-    s_dot: np.ndarray
-    t: float
-    kinds: list
-    parents: list
-    force_kinds: list
-    seed: int
-    planar: bool
-    rng: np.random.Generator = field(repr=False)
+    def __init__(self, system, q, s_dot, t, kinds, parents, force_kinds, seed, planar, rng):
+        self.system, self.q, self.s_dot, self.t = system, q, s_dot, t
+        self.kinds, self.parents, self.force_kinds = kinds, parents, force_kinds
+        self.seed, self.planar, self.rng = seed, planar, rng
 
     def __repr__(self) -> str:
         return (
