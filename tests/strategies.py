@@ -39,8 +39,16 @@ import projeq as pq
 from projeq.spatial import rotation, skew
 
 SPATIAL_KINDS = (
-    "revolute", "prismatic", "planar", "free", "fixed", "prescribed",
-    "spherical", "screw", "car", "turntable",
+    "revolute",
+    "prismatic",
+    "planar",
+    "free",
+    "fixed",
+    "prescribed",
+    "spherical",
+    "screw",
+    "car",
+    "turntable",
 )
 PLANAR_KINDS = ("revolute", "prismatic", "planar", "fixed", "prescribed", "car", "car_sympy")
 RHEONOMIC_KINDS = ("prescribed", "turntable")  # joints with f ≠ 0: the system is rheonomic
@@ -95,7 +103,7 @@ def spherical_joint(parent=None, r_pn=(0.0, 0.0, 0.0)) -> pq.UserJoint:
         return Rz @ Ry @ Rx, np.zeros(3)
 
     def F(q, t):
-        a, b, c = q
+        _, b, c = q
         cb, sb, cc, sc = np.cos(b), np.sin(b), np.cos(c), np.sin(c)
         F6 = np.zeros((6, 3), dtype=np.result_type(q, float))
         F6[3:, 0] = (-sb, cb * sc, cb * cc)
@@ -135,7 +143,9 @@ def car_joint(parent=None, r_pn=(0.0, 0.0, 0.0), orientation=None) -> pq.UserJoi
         c, s = np.cos(q[2]), np.sin(q[2])
         return np.array([[c, 0 * c], [s, 0 * c], [0 * c, 1 + 0 * c]])
 
-    return pq.UserJoint.from_functions(3, 2, pose, lambda q, t: F6, K, parent=parent, r_pn=r_pn, orientation=orientation)
+    return pq.UserJoint.from_functions(
+        3, 2, pose, lambda q, t: F6, K, parent=parent, r_pn=r_pn, orientation=orientation
+    )
 
 
 @cache
@@ -174,7 +184,15 @@ def turntable_joint(spin: float, parent=None, r_pn=(0.0, 0.0, 0.0), orientation=
         return np.array([z, spin * q[0] + 0 * t, z, z, z, spin + z])
 
     return pq.UserJoint.from_functions(
-        1, 1, pose, lambda q, t: F6, lambda q, t: np.eye(1), f=f, parent=parent, r_pn=r_pn, orientation=orientation
+        1,
+        1,
+        pose,
+        lambda q, t: F6,
+        lambda q, t: np.eye(1),
+        f=f,
+        parent=parent,
+        r_pn=r_pn,
+        orientation=orientation,
     )
 
 
@@ -233,7 +251,11 @@ def planar_joint(kind: str, parent, rng) -> pq.Joint:
     if kind == "fixed":
         return pq.Fixed(parent, r_pn, _rz(angle))
     if kind == "prescribed":
-        inner = pq.Revolute(parent, "z", r_pn, orientation) if rng.random() < 0.5 else pq.Prismatic(parent, in_plane, r_pn)
+        inner = (
+            pq.Revolute(parent, "z", r_pn, orientation)
+            if rng.random() < 0.5
+            else pq.Prismatic(parent, in_plane, r_pn)
+        )
         return _prescribed(inner, rng)
     if kind == "car":
         return car_joint(parent, r_pn, orientation)
@@ -256,7 +278,12 @@ def _force(kind, names, kinds, rng, planar: bool, damped: bool):
         if rng.random() < 0.5:
             return pq.Force(body, f0, point, frame="world" if planar or rng.random() < 0.5 else "body")
         # a load that depends on time and state (s_dot in it makes it non-conservative)
-        return pq.Force(body, lambda t, q, s_dot: f0 * np.cos(t + np.sum(q)) + 0.1 * f0 * np.sum(s_dot), point, frame="world")
+        return pq.Force(
+            body,
+            lambda t, q, s_dot: f0 * np.cos(t + np.sum(q)) + 0.1 * f0 * np.sum(s_dot),
+            point,
+            frame="world",
+        )
     if kind == "torque":
         tau = rng.uniform(-3, 3, 3)
         if planar:
@@ -274,7 +301,9 @@ def _force(kind, names, kinds, rng, planar: bool, damped: bool):
         if not candidates:
             return None
         joint = candidates[rng.integers(len(candidates))]
-        n_s = {"planar": 3, "free": 6, "spherical": 3, "car": 2, "car_sympy": 2}.get(kinds[names.index(joint)], 1)
+        n_s = {"planar": 3, "free": 6, "spherical": 3, "car": 2, "car_sympy": 2}.get(
+            kinds[names.index(joint)], 1
+        )
         tau = rng.uniform(-3, 3, n_s)
         if rng.random() < 0.5:
             return pq.JointForce(joint, tau)
@@ -285,9 +314,15 @@ def _force(kind, names, kinds, rng, planar: bool, damped: bool):
         b = others[rng.integers(len(others))] if others else None
         if a is None and b is None:
             return None
-        return pq.SpringDamper(a, point if a is not None else rng.uniform(-1, 1, 3) * (1, 1, 0 if planar else 1),
-                               b, rng.uniform(-0.5, 0.5, 3) * (1, 1, 0 if planar else 1),
-                               stiffness=rng.uniform(0.5, 20.0), damping=damping, length=rng.uniform(0.0, 1.0))
+        return pq.SpringDamper(
+            a,
+            point if a is not None else rng.uniform(-1, 1, 3) * (1, 1, 0 if planar else 1),
+            b,
+            rng.uniform(-0.5, 0.5, 3) * (1, 1, 0 if planar else 1),
+            stiffness=rng.uniform(0.5, 20.0),
+            damping=damping,
+            length=rng.uniform(0.0, 1.0),
+        )
     raise ValueError(f"kind: unknown force kind {kind!r}")
 
 
@@ -361,7 +396,9 @@ def trees(
         m = random_mass(rng)
         r_c = rng.uniform(-0.5, 0.5, 3)
         if planar:
-            subsystems[name] = pq.PlanarBody(m, r_c, random_inertia(rng, m, _rz(rng.uniform(-np.pi, np.pi))), "xy")
+            subsystems[name] = pq.PlanarBody(
+                m, r_c, random_inertia(rng, m, _rz(rng.uniform(-np.pi, np.pi))), "xy"
+            )
             joints[name] = planar_joint(joint_kinds[i], parent, rng)
         else:
             subsystems[name] = pq.RigidBody(m, r_c, random_inertia(rng, m))

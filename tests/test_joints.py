@@ -16,6 +16,7 @@ Every joint kind of ``tests/strategies.py`` is covered, one test case each.
 
 import numpy as np
 import pytest
+import strategies as S
 import sympy as sp
 from hypothesis import given
 from hypothesis import strategies as st
@@ -24,8 +25,6 @@ import projeq as pq
 from projeq.joints import pose_twist_mismatch
 from projeq.kinematics import forward
 from projeq.spatial import chain_matrix
-
-import strategies as S
 
 seeds = st.integers(0, 2**32 - 1)
 KINDS = sorted(set(S.SPATIAL_KINDS) | {"car_sympy", "prescribed_prismatic", "planar_xz"})
@@ -147,12 +146,17 @@ def _sympy_screw(pitch=0.3):
     """A screw about z: R_z(θ), r = (0, 0, pitch θ), F⁶ = (0, 0, pitch, 0, 0, 1)."""
     (th,) = q = [sp.Symbol("theta")]
     F = sp.Matrix([0, 0, pitch, 0, 0, 1])
-    return pq.UserJoint.from_sympy(q, [sp.Symbol("w")], _rot_sym("z", th), [0, 0, pitch * th], F, sp.eye(1)), S.screw_joint(
-        (0.0, 0.0, 1.0), pitch
-    )
+    return pq.UserJoint.from_sympy(
+        q, [sp.Symbol("w")], _rot_sym("z", th), [0, 0, pitch * th], F, sp.eye(1)
+    ), S.screw_joint((0.0, 0.0, 1.0), pitch)
 
 
-PAIRS = {"car": _sympy_car, "spherical": _sympy_spherical, "turntable": _sympy_turntable, "screw": _sympy_screw}
+PAIRS = {
+    "car": _sympy_car,
+    "spherical": _sympy_spherical,
+    "turntable": _sympy_turntable,
+    "screw": _sympy_screw,
+}
 
 
 @pytest.fixture(scope="module", params=sorted(PAIRS))
@@ -165,7 +169,7 @@ def test_from_sympy_equals_from_functions(joint_pair, seed):
     """The same joint written as sympy expressions and as numpy callables gives the same
     (A, r, F, w, ζ), K and q̇ at random states: both are exact formulas (ζ symbolic vs
     complex step, exact to round-off), so they agree to 1e-12 relative."""
-    name, (symbolic, numeric) = joint_pair
+    _, (symbolic, numeric) = joint_pair
     rng = np.random.default_rng(seed)
     q, s_dot, t = _state(symbolic, rng)
     a, b = symbolic.relative(q, s_dot, t), numeric.relative(q, s_dot, t)
@@ -174,7 +178,9 @@ def test_from_sympy_equals_from_functions(joint_pair, seed):
         assert np.shape(x) == np.shape(y), field
         assert np.abs(x - y).max(initial=0.0) <= 1e-12 * max(1.0, np.abs(y).max(initial=0.0)), field
     assert np.abs(symbolic.K(q, t) - numeric.K(q, t)).max() <= 1e-12
-    assert np.abs(symbolic.q_dot(q, s_dot, t) - numeric.q_dot(q, s_dot, t)).max() <= 1e-12 * max(1.0, np.abs(s_dot).max())
+    assert np.abs(symbolic.q_dot(q, s_dot, t) - numeric.q_dot(q, s_dot, t)).max() <= 1e-12 * max(
+        1.0, np.abs(s_dot).max()
+    )
 
 
 def test_car_joint_is_bremers_functional_matrix():
@@ -226,4 +232,6 @@ def test_chain_matrices_equal_those_of_the_absolute_poses(planar, data):
         joint = system.joints[n]
         f = joint.relative(system._q_get[n](tree.q), np.zeros(joint.n_s), tree.t).w
         chain = kin.T[n] @ kin.y_dot[p] + kin.F[n] @ system._s_get[n](tree.s_dot) + S_n @ f
-        assert np.abs(kin.y_dot[n] - chain).max() <= 1e-12 * max(1.0, np.abs(kin.y_dot[n]).max()), system.names[n]
+        assert np.abs(kin.y_dot[n] - chain).max() <= 1e-12 * max(1.0, np.abs(kin.y_dot[n]).max()), (
+            system.names[n]
+        )

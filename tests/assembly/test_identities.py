@@ -19,18 +19,19 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from strategies import random_state, trees
 
 import projeq as pq
 from projeq.assembly import EVALUATORS
 from projeq.kinematics import forward, gauss_terms
 
-from strategies import random_state, trees
-
 any_plane = st.booleans()
 
 
 def _scleronomic_trees(max_n=10, forces=True):
-    return any_plane.flatmap(lambda planar: trees(max_n=max_n, planar=planar, scleronomic=True, forces=forces))
+    return any_plane.flatmap(
+        lambda planar: trees(max_n=max_n, planar=planar, scleronomic=True, forces=forces)
+    )
 
 
 def _chain_J(system, kin):
@@ -153,7 +154,7 @@ def _nonconservative_power(system, kin, q, s_dot, t):
             length_rate = d @ (ends[1][1] - ends[0][1]) / np.linalg.norm(d)
             power -= law.damping * length_rate**2
         else:
-            raise AssertionError(f"no power formula for {law!r}")
+            pytest.fail(f"no power formula for {law!r}")
     return power
 
 
@@ -205,7 +206,9 @@ def test_power_balance_with_nonconservative_loads(tree):
     """d(T + V)/dt = ṡᵀ Q_nc: the power of body forces and torques, joint forces and the
     dampers (``_nonconservative_power``) is the rate of the mechanical energy."""
     rate, power, tol = _power_balance(tree)
-    assert abs(rate - power) <= tol, f"d(T + V)/dt = {rate:.6g} but the loads deliver {power:.6g} (tol {tol:.3g})"
+    assert abs(rate - power) <= tol, (
+        f"d(T + V)/dt = {rate:.6g} but the loads deliver {power:.6g} (tol {tol:.3g})"
+    )
 
 
 # -- evaluator reuse ------------------------------------------------------------------------

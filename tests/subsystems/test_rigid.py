@@ -19,11 +19,10 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from strategies import random_inertia, random_mass, random_rotation
 
 import projeq as pq
 from projeq.subsystems.rigid import RigidGroup
-
-from strategies import random_inertia, random_mass, random_rotation
 
 RTOL = 1e-10  # algebraic identity; round-off ~1e-14 (module docstring)
 PLANES = ("xy", "yz", "zx", "xz")
@@ -102,7 +101,9 @@ def test_mass_matrix_is_the_projection_of_the_mass_centre_momenta(seed):
     rng = np.random.default_rng(seed)
     body = _body(rng)
     J = np.eye(6)
-    J[:3, 3:] = -np.array([[0, -body.r_c[2], body.r_c[1]], [body.r_c[2], 0, -body.r_c[0]], [-body.r_c[1], body.r_c[0], 0]])
+    J[:3, 3:] = -np.array(
+        [[0, -body.r_c[2], body.r_c[1]], [body.r_c[2], 0, -body.r_c[0]], [-body.r_c[1], body.r_c[0], 0]]
+    )
     D = np.zeros((6, 6))
     D[:3, :3], D[3:, 3:] = body.m * np.eye(3), body.I_c
     M, _ = body.gauss_terms(np.zeros(6), np.eye(3), np.zeros(3))
@@ -208,4 +209,6 @@ def test_kinetic_and_potential_energy(seed):
     T = 0.5 * body.m * v_c @ v_c + 0.5 * twist[3:] @ body.I_c @ twist[3:]
     assert body.kinetic_energy(twist) == pytest.approx(T, rel=RTOL)
     R, r = random_rotation(rng), rng.uniform(-2, 2, 3)
-    assert body.potential_energy(R, r, gravity) == pytest.approx(-body.m * gravity @ (r + R @ body.r_c), rel=RTOL, abs=RTOL * body.m * 100)
+    assert body.potential_energy(R, r, gravity) == pytest.approx(
+        -body.m * gravity @ (r + R @ body.r_c), rel=RTOL, abs=RTOL * body.m * 100
+    )
