@@ -7,7 +7,7 @@ recursively in order n. See docs/ and shared/design/THEORY.md.
 from projeq import inertia
 from projeq.assembly import SingularMassError
 from projeq.forces import Force, JointForce, JointSpring, SpringDamper, Torque
-from projeq.linearization import linearize
+from projeq.linearization import Linearization, NotSteadyError, eigenvalue_sweep, linearize
 from projeq.joints import Fixed, Free, Joint, Planar, Prescribed, Prismatic, Revolute, UserJoint
 from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, RitzBeam, Subsystem
 from projeq.system import GROUND, System, SystemBuilder
@@ -18,18 +18,29 @@ __all__ = [
     "GROUND", "System", "SystemBuilder", "Subsystem", "RigidBody", "PlanarBody", "PointMass", "Frame", "RitzBeam",
     "Joint", "Revolute", "Prismatic", "Fixed", "Planar", "Free", "Prescribed", "UserJoint",
     "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
-    "inertia", "simulate", "Result", "SimulationError", "scenes", "linearize",
+    "inertia", "simulate", "Result", "SimulationError", "scenes", "linearize", "Linearization", "NotSteadyError",
+    "eigenvalue_sweep", "compare", "ComparisonTable", "ConstrainedSystem", "reactions", "joint_reactions",
+    "contact_event", "plots", "sweep", "SweepTable", "symbolic",
 ]
 
 
+# names loaded on first use (they import scipy, matplotlib or tqdm): keeps `import projeq` light
+_LAZY = {
+    "simulate": "projeq.simulation", "Result": "projeq.simulation", "SimulationError": "projeq.simulation",
+    "compare": "projeq.comparison", "ComparisonTable": "projeq.comparison",
+    "ConstrainedSystem": "projeq.constrained",
+    "reactions": "projeq.reaction_forces", "joint_reactions": "projeq.reaction_forces",
+    "contact_event": "projeq.reaction_forces",
+    "sweep": "projeq.sweeps", "SweepTable": "projeq.sweeps",
+}
+_LAZY_MODULES = ("scenes", "plots", "symbolic")
+
+
 def __getattr__(name):
-    # simulate and scenes import scipy; load them on first use to keep `import projeq` light
-    if name in ("simulate", "Result", "SimulationError"):
-        from projeq import simulation
+    import importlib
 
-        return getattr(simulation, name)
-    if name == "scenes":
-        import projeq.scenes as scenes
-
-        return scenes
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    if name in _LAZY_MODULES:
+        return importlib.import_module(f"projeq.{name}")
     raise AttributeError(f"module 'projeq' has no attribute {name!r}")

@@ -20,7 +20,12 @@ from projeq.spatial import cross
 
 
 def _draw(system, q, s_dot, t, stations: int, frame_size: float):
-    """Points, velocities (inertial) and line cells of the system at one state."""
+    """Points, velocities (inertial) and line cells of the system at one state.
+
+    A constrained system (one with a ``tree``) is drawn as its tree moving with the tree
+    velocities F ṡ."""
+    if hasattr(system, "tree"):
+        system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
     kin = forward(system, q, s_dot, t)
     points, velocities, lines = [], [], []
     for n, sub in enumerate(system.subsystems):

@@ -195,7 +195,8 @@ def simulate(
         if not callable(e):
             raise ValueError(f"events[{i}]: expected a callable event(t, q, s_dot), got {e!r}")
     ev = _evaluator(system, evaluator)
-    check_configuration(system, q0, t_start)  # a coordinate singularity at the start, by name
+    # a coordinate singularity (or a degenerate partition of a ConstrainedSystem) at the start, by name
+    getattr(system, "check_configuration", lambda q, t: check_configuration(system, q, t))(q0, t_start)
     ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
     n_q = system.n_q
     reached = [t_start]  # time of the latest right-hand side evaluation, for error messages

@@ -227,7 +227,8 @@ class System:
 
     # -- evaluation -----------------------------------------------------------------------
     def evaluator(self, method: str | None = None):
-        """The cached evaluator ``"recursive"`` or ``"dense"`` (``None``: recursive, or
+        """The cached evaluator ``"recursive"``, ``"dense"`` or ``"fast"`` (compiled order n,
+        :mod:`projeq.assembly.fast`) (``None``: recursive, or
         dense when minimal velocities are shared by coupled joints)."""
         from projeq.assembly import EVALUATORS
 
@@ -242,7 +243,8 @@ class System:
     def accelerations(self, q, s_dot, t: float = 0.0, method: str | None = None) -> NDArray:
         """Minimal accelerations s̈ from the Projection Equation at (q, ṡ, t).
 
-        ``method="recursive"`` (order n, THEORY §6) or ``"dense"`` (Gauss form, §5).
+        ``method="recursive"`` (order n, THEORY §6), ``"dense"`` (Gauss form, §5) or
+        ``"fast"`` (§6 compiled, :mod:`projeq.assembly.fast`).
         """
         q, s_dot = self.check_state(q, s_dot, t)
         return self.evaluator(method).accelerations(q, s_dot, float(t))

@@ -47,3 +47,44 @@ def test_planar_chain_is_built_from_planar_bodies():
     system = pq.scenes.chain(3, planar=True)
     assert all(isinstance(sub, pq.PlanarBody) for sub in system.subsystems)
     assert all(isinstance(sub, pq.RigidBody) and not isinstance(sub, pq.PlanarBody) for sub in pq.scenes.chain(3).subsystems)
+
+
+def test_every_scene_parameter_has_a_documented_unit():
+    """Scenes as data: every keyword parameter of every registered scene has a unit entry
+    ("-" marks a dimensionless number or a switch), so ``projeq list SCENE`` is complete."""
+    from projeq.scenes.parameters import UNITS
+
+    for name, scene in pq.scenes.SCENES.items():
+        for parameter in pq.scenes.scene_parameters(scene):
+            assert parameter.name in {**UNITS, **(scene.units or {})}, (name, parameter.name)
+
+
+def test_build_scene_overrides_reach_the_model():
+    """atwood with m1 = 3 kg: θ̈ = −ẍ/a, ẍ = (m1 − m2) g / (m1 + m2 + I/a²), I = ½ M a²
+    (Problem 1, eq. (4) of ../shared/seeds/003_13b1ca6faae9f37e.txt); one linear solve:
+    1e-12 relative is a few hundred ulps."""
+    system = pq.scenes.build_scene("atwood", m1=3.0)
+    x_ddot = (3.0 - 1.0) * 9.81 / (3.0 + 1.0 + 0.5 * 0.5)
+    assert system.accelerations([0.0], [0.0])[0] == pytest.approx(-x_ddot / 0.1, rel=1e-12)
+
+
+def test_settings_parse_to_the_type_of_the_default():
+    scene = pq.scenes.SCENES["car"]
+    parsed = pq.scenes.parse_settings(scene, ["m=900", "q0=1, 2, 0.5", "s_dot0=(5.0, 0.0)"])
+    assert parsed == {"m": 900.0, "q0": (1, 2, 0.5), "s_dot0": (5.0, 0.0)} and type(parsed["m"]) is float
+    assert pq.scenes.parse_settings(pq.scenes.SCENES["chain"], ["planar=yes", "n=3"]) == {"planar": True, "n": 3}
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda: pq.scenes.get_scene("chan"), "scene: unknown scene 'chan' \\(did you mean 'chain'\\?\\)"),
+        (lambda: pq.scenes.build_scene("chain", links=3), "links: unknown parameter"),
+        (lambda: pq.scenes.parse_settings(pq.scenes.SCENES["car"], ["q0=(1,"]), "q0: expected a number, a tuple"),
+        (lambda: pq.scenes.parse_settings(pq.scenes.SCENES["car"], ["=1"]), "--set: expected name=value"),
+    ],
+    ids=["scene", "parameter", "literal", "setting"],
+)
+def test_bad_scene_input(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()

@@ -14,7 +14,10 @@ import numpy as np
 from projeq import inertia
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
+from projeq.scenes.bicycle import whipple_bicycle, whipple_eigenvalues
 from projeq.scenes.elastic import elastic_arm, spin_up_beam, spinning_beam
+from projeq.scenes.mechanisms import bar_on_wall, four_bar, quick_return, slider_pendulum, sphere_on_sphere
+from projeq.scenes.parameters import Parameter, check_names, closest, parse_settings, scene_parameters
 from projeq.scenes.nonholonomic import (
     barhorst_particle, car, knife_edge_circle, knife_edge_disc, nonholonomic_particle, rolling_disk,
     rolling_disk_critical_speed,
@@ -85,11 +88,19 @@ def atwood(m1: float = 2.0, m2: float = 1.0, pulley_mass: float = 0.5, radius: f
 
 
 class Scene(NamedTuple):
-    """A named scene for the CLI: how to build it, what it is, how long to run it (s)."""
+    """A named scene: how to build it, what it is, how long to run it (s).
+
+    ``units`` maps parameter names to SI units where they differ from or are missing in
+    :data:`projeq.scenes.parameters.UNITS`; ``plane`` = the indices (i, j) of q that are a
+    position in the ground plane, for a trajectory plot. Registering a scene is one entry in
+    ``SCENES``.
+    """
 
     build: Callable[..., System]
     description: str
     t_end: float
+    units: dict | None = None
+    plane: tuple | None = None
 
 
 SCENES = {
@@ -99,17 +110,40 @@ SCENES = {
     "chain": Scene(chain, "n links on revolute joints hanging from the origin (default n = 5)", 10.0),
     "double_pendulum": Scene(double_pendulum, "two point masses on massless rods, released horizontally", 10.0),
     "atwood": Scene(atwood, "two masses on a rope over a pulley with inertia (coupled joints)", 2.0),
-    "car": Scene(car, "Bremer's car: a planar body whose rear axle cannot slide (B(5)-(12))", 10.0),
-    "knife_edge_disc": Scene(knife_edge_disc, "a knife-edge disc rolling without slip (lecture 001, slides 28-37)", 20.0),
-    "rolling_disk": Scene(rolling_disk, "Barhorst's rolling disk with an eccentric mass (seed 000, 3.2)", 10.0),
+    "car": Scene(car, "Bremer's car: a planar body whose rear axle cannot slide (B(5)-(12))", 10.0, plane=(0, 1)),
+    "knife_edge_disc": Scene(knife_edge_disc, "a knife-edge disc rolling without slip (lecture 001, slides 28-37)", 20.0, plane=(0, 1)),
+    "rolling_disk": Scene(rolling_disk, "Barhorst's rolling disk with an eccentric mass (seed 000, 3.2)", 10.0, plane=(3, 4)),
     "barhorst_particle": Scene(barhorst_particle, "a particle with the constraint y' - y^2 x' = 0 (seed 000, 3.1)", 10.0),
     "nonholonomic_particle": Scene(nonholonomic_particle, "a particle in space with y' + z x' = 0 (seed 000, 3.1)", 2.0),
+    "whipple_bicycle": Scene(whipple_bicycle, "the Whipple bicycle of Meijaard et al. (2007), constraint equations", 5.0,
+                             plane=(0, 1)),
+    "quick_return": Scene(quick_return, "Barhorst's quick-return mechanism, a closed loop (seed 000, 3.3)", 5.0),
+    "four_bar": Scene(four_bar, "a four-bar linkage closed by a constraint equation", 5.0),
 }
 DEFAULT_SCENE = "spin_up_beam"
+
+
+def get_scene(name: str) -> Scene:
+    """The registered scene ``name``; ValueError listing the scenes and the closest name."""
+    if name not in SCENES:
+        raise ValueError(f"scene: unknown scene {name!r}{closest(name, SCENES)}; known scenes: {', '.join(SCENES)}")
+    return SCENES[name]
+
+
+def build_scene(name: str, **overrides) -> System:
+    """Build the registered scene ``name`` with parameters overridden by keyword.
+
+    >>> build_scene("chain", n=2).n_q
+    2
+    """
+    scene = get_scene(name)
+    check_names(scene, overrides)
+    return scene.build(**overrides)
 
 __all__ = [
     "chain", "double_pendulum", "atwood", "spin_up_beam", "spinning_beam", "elastic_arm",
     "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed",
-    "barhorst_particle", "nonholonomic_particle",
-    "Scene", "SCENES", "DEFAULT_SCENE",
+    "barhorst_particle", "nonholonomic_particle", "whipple_bicycle", "whipple_eigenvalues",
+    "quick_return", "four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",
+    "Scene", "SCENES", "DEFAULT_SCENE", "get_scene", "build_scene", "scene_parameters", "parse_settings", "Parameter",
 ]

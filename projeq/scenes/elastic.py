@@ -41,6 +41,7 @@ def spin_up_beam(
     family: str = "polynomial",
     stiffening: bool = True,
     gravity: float = 0.0,
+    precomputed_integrals: bool = False,
 ) -> System:
     """A uniform cantilever clamped on the rotation axis (hub radius 0), spun up in the
     horizontal plane by the prescribed hub angle of :func:`spin_up_motion`.
@@ -51,11 +52,12 @@ def spin_up_beam(
     Units: m, N m², N, kg/m, rad/s, s. ``gravity`` (m/s², along −z) is off by default.
     The first bending frequency at rest is 3.516 √(EI/(ρA L⁴)) = 3.80 rad/s for the
     defaults, below Ωs = 6 rad/s: without ``stiffening`` the in-plane deflection then
-    grows without bound.
+    grows without bound. ``precomputed_integrals`` selects the beam's small-deformation
+    mode (shape integrals computed once, :mod:`projeq.subsystems.beam_integrals`).
     """
     beam = RitzBeam(
         length, rho_A, EI, EA=EA if n_axial else None, n_v=n_shapes, n_w=n_shapes, n_u=n_axial,
-        family=family, stiffening=stiffening,
+        family=family, stiffening=stiffening, precomputed_integrals=precomputed_integrals,
     )
     hub = Prescribed(Revolute(axis="z"), spin_up_motion(omega_s, t_s))
     return System({"beam": beam}, {"beam": hub}, gravity=(0.0, 0.0, -gravity))

@@ -10,7 +10,8 @@ the Projection Equation B(19)–(25) for the slices gives
     M_n = ∫ Jᵀ J dm,   h_n = −∫ Jᵀ (ω̃ ṙ + ω̃ v_c − (q̇_vᵀH_v q̇_v + q̇_wᵀH_w q̇_w) e_x − g_R) dm − K_e q_e
 
 (the bracket is J̇ ẏ + ω̃ v_c − g, the acceleration not proportional to ÿ), plus the rotary
-inertia of the slices (Rayleigh) with ω_c = ω + Φ_θᵀ q̇_e, Φ_θ = (0, −Φ_w′, Φ_v′). Because
+inertia of the slices (Rayleigh) with ω_c = (E − θ̃) ω + Φ_θᵀ q̇_e in the slice's frame,
+small rotation θ = Φ_θᵀ q_e, Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (torsion β, THEORY §10). Because
 u₂ is part of the kinematics, the projection of the slices' axial inertia loads on
 ∂u₂/∂q gives the geometric stiffness ∫ N(x) Φ′Φ′ᵀ dx with N(x) = ∫ₓᴸ f_x: dynamic
 stiffening from spin, angular and frame acceleration and gravity alike, and the model
@@ -29,6 +30,8 @@ from projeq.checks import non_negative, positive
 from projeq.joints import Relative
 from projeq.spatial import cross, skew_stack
 from projeq.subsystems import shapes
+from projeq.subsystems.beam_integrals import ShapeIntegrals
+from projeq.subsystems.beam_probes import BeamProbes
 
 
 def _per_length(name: str, value, x: NDArray, allow_zero: bool = False) -> NDArray:
@@ -51,9 +54,9 @@ def _family(name: str, family, table: dict, n: int, L: float):
     return table[family](n, L)
 
 
-class RitzBeam:
-    """A beam subsystem: Euler–Bernoulli bending in two planes, optional axial deformation
-    and rotary inertia, dynamic stiffening, stiffness-proportional damping.
+class RitzBeam(BeamProbes):
+    """A beam subsystem: Euler–Bernoulli bending in two planes, optional axial and torsional
+    deformation and rotary inertia, dynamic stiffening, stiffness-proportional damping.
 
     Parameters
     ----------
@@ -67,16 +70,30 @@ class RitzBeam:
         Axial stiffness (N), needed when ``n_u > 0``.
     rho_I : (float, float), optional
         Rotary inertia per length (ρI_y, ρI_z) in kg m; polar ρ(I_y + I_z). None: none.
-    n_v, n_w, n_u : int
-        Number of Ritz functions for v, w and u (the accuracy knob).
-    family : "polynomial", "clamped_free" or a callable ``(n, L) -> shapes``
-        Bending family (clamped root); the axial family is chosen alike.
+    n_v, n_w, n_u, n_beta : int
+        Number of Ritz functions for v, w, u and the torsion angle β (the accuracy knob).
+    GI_t : float or callable, optional
+        Torsional stiffness (N m²), needed when ``n_beta > 0``.
+    rho_I_p : float, optional
+        Polar mass moment per length ρI_p (kg m) of the torsion, needed when ``n_beta > 0``
+        unless ``rho_I`` gives it as ρ(I_y + I_z).
+    family : "polynomial", "clamped_free", "pinned_free" or a callable ``(n, L) -> shapes``
+        Bending family; the axial and torsional families are chosen alike ("polynomial" or
+        "clamped_free": the fixed–free bar's sines; "pinned_free" uses the latter).
+    support : "clamped" or "pinned"
+        Geometric boundary conditions the bending functions must meet at the root:
+        Φ(0) = Φ′(0) = 0 (clamped) or Φ(0) = 0 (pinned: the joint carries the rigid
+        rotation about the pin). A family violating them is refused.
     quadrature_order : int, optional
         Gauss points along the beam (default 2·max(n) + 6).
     stiffening : bool
         Include u₂ (dynamic stiffening); default True.
     damping : float
         β of the stiffness-proportional damping force −β K_e q̇_e (s).
+    precomputed_integrals : bool
+        Assemble M_n, h_n from shape integrals computed once (small deformations: errors
+        O(ε²) in q_e, q̇_e ~ ε, see :mod:`projeq.subsystems.beam_integrals`) instead of
+        quadrature per call; default False.
     """
 
     def __init__(
@@ -90,26 +107,38 @@ class RitzBeam:
         n_v: int = 4,
         n_w: int = 4,
         n_u: int = 0,
+        n_beta: int = 0,
+        GI_t=None,
+        rho_I_p=None,
         family="polynomial",
+        support: str = "clamped",
         quadrature_order: int | None = None,
         stiffening: bool = True,
         damping: float = 0.0,
+        precomputed_integrals: bool = False,
     ):
         self.length = L = positive("length", length)
-        for name, n in (("n_v", n_v), ("n_w", n_w), ("n_u", n_u)):
+        for name, n in (("n_v", n_v), ("n_w", n_w), ("n_u", n_u), ("n_beta", n_beta)):
             if int(n) != n or n < 0:
                 raise ValueError(f"{name}: number of Ritz functions must be a non-negative integer, got {n!r}")
-        self.n_u, self.n_v, self.n_w = int(n_u), int(n_v), int(n_w)
-        self.n_e = self.n_u + self.n_v + self.n_w
+        self.n_u, self.n_v, self.n_w, self.n_beta = int(n_u), int(n_v), int(n_w), int(n_beta)
+        self.n_e = self.n_u + self.n_v + self.n_w + self.n_beta
         if self.n_e == 0:
-            raise ValueError("n_v, n_w, n_u: a beam needs at least one Ritz function")
+            raise ValueError("n_v, n_w, n_u, n_beta: a beam needs at least one Ritz function")
         if self.n_u and EA is None:
             raise ValueError("EA: axial deformation (n_u > 0) needs the axial stiffness EA")
+        if self.n_beta and GI_t is None:
+            raise ValueError("GI_t: torsion (n_beta > 0) needs the torsional stiffness GI_t")
+        if self.n_beta and rho_I_p is None and rho_I is None:
+            raise ValueError("rho_I_p: torsion (n_beta > 0) needs the polar mass moment per length ρI_p")
+        if support not in ("clamped", "pinned"):
+            raise ValueError(f"support: must be 'clamped' or 'pinned', got {support!r}")
+        self.support = support
         self.n_y = 6 + self.n_e
         self.S = np.vstack((np.eye(6), np.zeros((self.n_e, 6))))
         self.stiffening = bool(stiffening)
         self.damping = non_negative("damping", damping)
-        self.order = order = int(quadrature_order or 2 * max(self.n_u, self.n_v, self.n_w) + 6)
+        self.order = order = int(quadrature_order or 2 * max(self.n_u, self.n_v, self.n_w, self.n_beta) + 6)
         if order < 1:
             raise ValueError(f"quadrature_order: must be at least 1, got {quadrature_order}")
         t, w = np.polynomial.legendre.leggauss(order)
@@ -118,26 +147,29 @@ class RitzBeam:
         self.mass_weights = self.weights * _per_length("rho_A", rho_A, x)
         self._shapes(family, L)
         self._EI = {"z": EI_z, "y": EI_y if EI_y is not None else EI_z}
-        self._stiffness(EI_z, self._EI["y"], EA)
-        self._rotary(rho_I)
+        self._stiffness(EI_z, self._EI["y"], EA, GI_t)
+        self._rotary(rho_I, rho_I_p)
         self._check_independent()
+        self.integrals = ShapeIntegrals(self) if precomputed_integrals else None
         self._ports: dict = {}  # station data of joints attached to the beam, by station
         self._warned = False  # the unstiffened-spin warning is given once per beam
         self.first_frequency = self._first_frequency()
 
     # -- precomputation ------------------------------------------------------------------
     def _shapes(self, family, L) -> None:
-        """The families, their clamped-root check, and Φ, Φ′, Φ″, H at the stations."""
-        self.u_cols = slice(6, 6 + self.n_u)
-        self.v_cols = slice(6 + self.n_u, 6 + self.n_u + self.n_v)
-        self.w_cols = slice(6 + self.n_u + self.n_v, self.n_y)
+        """The families, their root check (support), and Φ, Φ′, Φ″, H at the stations."""
+        ends = np.cumsum([6, self.n_u, self.n_v, self.n_w, self.n_beta])
+        self.u_cols, self.v_cols, self.w_cols, self.beta_cols = (slice(a, b) for a, b in zip(ends[:-1], ends[1:]))
+        bending = (0, 1) if self.support == "clamped" else (0,)
+        axial_family = "clamped_free" if family == "pinned_free" else family
         self.families = {}
-        for key, n, table, conditions in (
-            ("u", self.n_u, shapes.AXIAL, (0,)),
-            ("v", self.n_v, shapes.BENDING, (0, 1)),
-            ("w", self.n_w, shapes.BENDING, (0, 1)),
+        for key, n, fam_name, table, conditions in (
+            ("u", self.n_u, axial_family, shapes.AXIAL, (0,)),
+            ("v", self.n_v, family, shapes.BENDING, bending),
+            ("w", self.n_w, family, shapes.BENDING, bending),
+            ("beta", self.n_beta, axial_family, shapes.AXIAL, (0,)),
         ):
-            self.families[key] = fam = _family("family", family, table, n, L)
+            self.families[key] = fam = _family("family", fam_name, table, n, L)
             if fam is None:
                 continue
             at_root = fam(np.zeros(1))
@@ -146,7 +178,8 @@ class RitzBeam:
                 if bad.size:
                     what = "Φ(0)" if derivative == 0 else "Φ′(0)"
                     raise ValueError(
-                        f"family: Ritz functions {bad.tolist()} for {key} violate the clamped root ({what} ≠ 0)"
+                        f"family: Ritz functions {bad.tolist()} for {key} violate the geometric boundary "
+                        f"condition of the {self.support} root ({what} ≠ 0)"
                     )
         self.Phi, self.H = self.station_data(self.x)
 
@@ -155,7 +188,7 @@ class RitzBeam:
         (by Gauss quadrature of the beam's order on [0, x])."""
         sizes = {"u": self.n_u, "v": self.n_v, "w": self.n_w}
         Phi = {
-            key: tuple(np.asarray(p, dtype=float) for p in fam(x)) if fam else tuple(np.zeros((0, len(x))) for _ in range(3))
+            key: tuple(np.asarray(p, dtype=float) for p in fam(x)) if fam else tuple(np.zeros((0, len(x))) for _ in range(4))
             for key, fam in self.families.items()
         }
         t, w = np.polynomial.legendre.leggauss(self.order)
@@ -170,10 +203,16 @@ class RitzBeam:
             H[key] = np.einsum("igk,jgk,gk->gij", d1, d1, 0.5 * x[:, None] * w[None, :])
         return Phi, H
 
-    def _stiffness(self, EI_z, EI_y, EA) -> None:
-        """K_e = ∫ (EA Φ_u′Φ_u′ᵀ + EI_z Φ_v″Φ_v″ᵀ + EI_y Φ_w″Φ_w″ᵀ) dx (block diagonal)."""
+    def _stiffness(self, EI_z, EI_y, EA, GI_t) -> None:
+        """K_e = ∫ (EA Φ_u′Φ_u′ᵀ + EI_z Φ_v″Φ_v″ᵀ + EI_y Φ_w″Φ_w″ᵀ + GI_t Φ_β′Φ_β′ᵀ) dx
+        (block diagonal, THEORY §10)."""
         self.K_e = np.zeros((self.n_e, self.n_e))
-        blocks = (("u", 1, EA, "EA", self.u_cols), ("v", 2, EI_z, "EI_z", self.v_cols), ("w", 2, EI_y, "EI_y", self.w_cols))
+        blocks = (
+            ("u", 1, EA, "EA", self.u_cols),
+            ("v", 2, EI_z, "EI_z", self.v_cols),
+            ("w", 2, EI_y, "EI_y", self.w_cols),
+            ("beta", 1, GI_t, "GI_t", self.beta_cols),
+        )
         for key, derivative, stiffness, name, cols in blocks:
             if cols.stop == cols.start:
                 continue
@@ -182,39 +221,56 @@ class RitzBeam:
             sl = slice(cols.start - 6, cols.stop - 6)
             self.K_e[sl, sl] = (D * k) @ D.T
 
-    def _rotary(self, rho_I) -> None:
-        """Rotary inertia per station diag(ρ(I_y + I_z), ρI_y, ρI_z) and J_ω(x) = [0, E, Φ_θ]."""
-        if rho_I is None:
+    def _rotary(self, rho_I, rho_I_p) -> None:
+        """Rotary inertia per station diag(ρI_p, ρI_y, ρI_z) (ρI_p = ρ(I_y + I_z) unless
+        given) and J_ω(x) = [0, E, Φ_θ], Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (THEORY §10)."""
+        if rho_I is None and rho_I_p is None:
             self.rotary = None
             return
-        rho_I = np.broadcast_to(np.asarray(rho_I, dtype=float), (2,))
-        I_y, I_z = (positive(f"rho_I[{i}]", v) for i, v in enumerate(rho_I))
-        self.rotary = self.weights[:, None] * np.array([I_y + I_z, I_y, I_z])[None, :]
+        I_y, I_z = 0.0, 0.0
+        if rho_I is not None:
+            rho_I = np.broadcast_to(np.asarray(rho_I, dtype=float), (2,))
+            I_y, I_z = (positive(f"rho_I[{i}]", v) for i, v in enumerate(rho_I))
+        I_p = I_y + I_z if rho_I_p is None else positive("rho_I_p", rho_I_p)
+        self.rotary = self.weights[:, None] * np.array([I_p, I_y, I_z])[None, :]
         J = np.zeros((len(self.x), 3, self.n_y))
         J[:, :, 3:6] = np.eye(3)
+        J[:, 0, self.beta_cols] = self.Phi["beta"][0].T  # twist about x: β
         J[:, 1, self.w_cols] = -self.Phi["w"][1].T  # rotation about y: −w′
         J[:, 2, self.v_cols] = self.Phi["v"][1].T  # rotation about z: +v′
         self.J_omega = J
 
     def _check_independent(self) -> None:
         gram = np.zeros((self.n_e, self.n_e))
-        for key, cols in (("u", self.u_cols), ("v", self.v_cols), ("w", self.w_cols)):
+        for key, cols in (("u", self.u_cols), ("v", self.v_cols), ("w", self.w_cols), ("beta", self.beta_cols)):
             P, sl = self.Phi[key][0], slice(cols.start - 6, cols.stop - 6)
             gram[sl, sl] = (P * self.weights) @ P.T
         eigenvalues, vectors = np.linalg.eigh(gram)
         if eigenvalues[0] <= 1e-14 * eigenvalues[-1]:  # numerically singular (monomials up to x¹³ pass)
-            involved = np.flatnonzero(np.abs(vectors[:, 0]) > 1e-3).tolist()
+            involved = [self._name(k) for k in np.flatnonzero(np.abs(vectors[:, 0]) > 1e-3)]
             raise ValueError(
                 f"family: the Ritz functions {involved} are linearly dependent to machine precision "
                 "(singular mass matrix); for many functions use family='clamped_free'"
             )
 
+    def _name(self, k: int) -> str:
+        """Name of elastic coordinate k: the deformation and the function's index in it."""
+        for key, cols in (("u", self.u_cols), ("v", self.v_cols), ("w", self.w_cols), ("beta", self.beta_cols)):
+            if cols.start - 6 <= k < cols.stop - 6:
+                return f"{key}[{k - cols.start + 6}]"
+        raise IndexError(k)
+
     def _first_frequency(self) -> float:
-        """Lowest bending frequency of the clamped beam at rest (rad/s), from M_ee and K_e."""
+        """Lowest bending frequency of the beam at rest on its support (rad/s), from the
+        bending blocks of M_ee and K_e."""
         from scipy.linalg import eigh
 
         M, _ = self.gauss_terms(np.zeros(self.n_y), np.eye(3), np.zeros(3), np.zeros(self.n_e))
-        return float(np.sqrt(max(eigh(self.K_e, M[6:, 6:], eigvals_only=True)[0], 0.0)))
+        bending = np.r_[self.v_cols, self.w_cols] - 6
+        if bending.size == 0:
+            return np.inf
+        M_b, K_b = M[6:, 6:][np.ix_(bending, bending)], self.K_e[np.ix_(bending, bending)]
+        return float(np.sqrt(max(eigh(K_b, M_b, eigvals_only=True)[0], 0.0)))
 
     def _warn_unstiffened_spin(self, omega: NDArray) -> None:
         """Without stiffening a spin about an axis across the beam faster than its first
@@ -238,7 +294,7 @@ class RitzBeam:
         """r(x) and Φ_r(x, q_e) at the quadrature stations (or at ``x`` with its
         ``station_data``)."""
         x, (Phi, H) = (self.x, (self.Phi, self.H)) if x is None else (x, data)
-        e = lambda cols: slice(cols.start - 6, cols.stop - 6)  # noqa: E731  (columns within q_e)
+        e = self._local  # columns of ẏ → positions within q_e
         q_u, q_v, q_w = q_e[e(self.u_cols)], q_e[e(self.v_cols)], q_e[e(self.w_cols)]
         dtype = np.result_type(q_e, float)  # complex for the complex-step derivative of ports
         r = np.zeros((len(x), 3), dtype=dtype)
@@ -266,29 +322,48 @@ class RitzBeam:
 
     # -- the subsystem interface -------------------------------------------------------------
     def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray):
-        """(M_n, h_n) of B(25) by quadrature (see the module docstring)."""
+        """(M_n, h_n) of B(25) by quadrature (see the module docstring) or, with
+        ``precomputed_integrals``, from the shape integrals."""
+        omega, q_e_dot = y_dot[3:6], y_dot[6:]
+        if not (self.stiffening or self._warned) and hasattr(self, "first_frequency"):
+            self._warn_unstiffened_spin(omega)
+        if getattr(self, "integrals", None) is None:
+            M, h = self._translation_terms(y_dot, R, gravity, q_e)
+        else:
+            M, h = self.integrals.terms(y_dot, R, gravity, q_e)
+        if self.rotary is not None:
+            Jw, omega_c, c_w = self._slice_rotation(omega, q_e, q_e_dot, y_dot)
+            Jw_flat = (Jw * np.sqrt(self.rotary)[:, :, None]).reshape(-1, self.n_y)
+            M += Jw_flat.T @ Jw_flat
+            h -= Jw.reshape(-1, self.n_y).T @ (self.rotary * c_w + cross(omega_c, self.rotary * omega_c)).ravel()
+        h[6:] -= self.K_e @ (q_e + self.damping * q_e_dot)
+        return M, h
+
+    def _translation_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray):
+        """∫Jᵀ J dm and −∫Jᵀ c dm of the slices' translation by quadrature."""
         r, Phi_r = self._slices(q_e)
         J = self._jacobian(r, Phi_r)
         v_R, omega, q_e_dot = y_dot[:3], y_dot[3:6], y_dot[6:]
-        if not (self.stiffening or self._warned) and hasattr(self, "first_frequency"):
-            self._warn_unstiffened_spin(omega)
         r_dot = Phi_r @ q_e_dot
         v_c = v_R + cross(omega, r) + r_dot
         c = cross(omega, r_dot) + cross(omega, v_c) - R.T @ gravity  # J̇ẏ + ω̃ v_c − g
         if self.stiffening:
-            qd_v, qd_w = q_e_dot[self.v_cols.start - 6 : self.v_cols.stop - 6], q_e_dot[self.w_cols.start - 6 : self.w_cols.stop - 6]
+            qd_v, qd_w = q_e_dot[self._local(self.v_cols)], q_e_dot[self._local(self.w_cols)]
             c[:, 0] -= (self.H["v"] @ qd_v) @ qd_v + (self.H["w"] @ qd_w) @ qd_w  # d/dt(∂u₂/∂q) q̇
         J_flat = (J * np.sqrt(self.mass_weights)[:, None, None]).reshape(-1, self.n_y)
         M = J_flat.T @ J_flat
         h = -J.reshape(-1, self.n_y).T @ (c * self.mass_weights[:, None]).ravel()
-        if self.rotary is not None:
-            Jw = self.J_omega
-            Jw_flat = (Jw * np.sqrt(self.rotary)[:, :, None]).reshape(-1, self.n_y)
-            M += Jw_flat.T @ Jw_flat
-            omega_c = Jw @ y_dot
-            h -= Jw.reshape(-1, self.n_y).T @ cross(omega, self.rotary * omega_c).ravel()
-        h[6:] -= self.K_e @ (q_e + self.damping * q_e_dot)
         return M, h
+
+    def _slice_rotation(self, omega, q_e, q_e_dot, y_dot):
+        """Angular velocity of the slices in their own (slightly turned) frames,
+        ω_c = (E − θ̃) ω + Φ_θᵀ q̇_e with the small rotation θ(x) = Φ_θᵀ q_e = (β, −w′, v′):
+        its Jacobian J_ω(x, q_e), ω_c, and J̇_ω ẏ = ω̃ θ̇ (the rotary-inertia terms of the
+        Rayleigh beam; with Euler's ω̃_c I ω_c the power is exactly d/dt ½ ω_cᵀ I ω_c)."""
+        J = self.J_omega.copy()
+        theta = J[:, :, 6:] @ q_e
+        J[:, :, 3:6] -= skew_stack(theta)
+        return J, J @ y_dot, cross(omega, J[:, :, 6:] @ q_e_dot)
 
     def kinetic_energy(self, y_dot: NDArray, q_e: NDArray) -> float:
         """½ ẏᵀ M ẏ (exact for the slice kinematics)."""
@@ -305,9 +380,9 @@ class RitzBeam:
         x = point[0], cross-section offset c = (0, point[1], point[2])), relative to the
         beam's reference frame, as a joint would give them (THEORY §10, last line):
 
-        pose A = R_z(v′) R_y(−w′) (Bremer's Cardan sequence, B(17)), r = r(x) + A c;
+        pose A = R_z(v′) R_y(−w′) R_x(β) (Bremer's Cardan sequence, B(17)), r = r(x) + A c;
         relative twist F q̇_e in port coordinates with F = [[Aᵀ Φ_r − c̃ Φ_ω], [Φ_ω]],
-        Φ_ω q̇_e = v̇′ (−sin(−w′), 0, cos(−w′)) − ẇ′ e_y; and Ḟ q̇_e by complex step.
+        Φ_ω q̇_e = R_xᵀ(v̇′ (−sin(−w′), 0, cos(−w′)) − ẇ′ e_y) + β̇ e_x; Ḟ q̇_e by complex step.
         """
         x = float(point[0])
         if not 0.0 <= x <= self.length:
@@ -329,73 +404,26 @@ class RitzBeam:
         """(A, r, F) of a port; complex-safe, for the complex-step Ḟ."""
         x, (Phi, H) = data
         r_x, Phi_r = self._slices(q_e, x, (Phi, H))
-        e = lambda cols: slice(cols.start - 6, cols.stop - 6)  # noqa: E731
+        e = self._local
         a = Phi["v"][1][:, 0] @ q_e[e(self.v_cols)]  # v′
         b = -(Phi["w"][1][:, 0] @ q_e[e(self.w_cols)])  # −w′
         ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
         R_z = np.array([[ca, -sa, 0 * ca], [sa, ca, 0 * ca], [0 * ca, 0 * ca, 1 + 0 * ca]])
         R_y = np.array([[cb, 0 * cb, sb], [0 * cb, 1 + 0 * cb, 0 * cb], [-sb, 0 * cb, cb]])
-        A = R_z @ R_y
+        beta = Phi["beta"][0][:, 0] @ q_e[e(self.beta_cols)]
+        cg, sg = np.cos(beta), np.sin(beta)
+        R_x = np.array([[1 + 0 * cg, 0 * cg, 0 * cg], [0 * cg, cg, -sg], [0 * cg, sg, cg]])
+        A = R_z @ R_y @ R_x
         Phi_omega = np.zeros((3, self.n_e), dtype=A.dtype)
         Phi_omega[0, e(self.v_cols)] = -sb * Phi["v"][1][:, 0]
         Phi_omega[2, e(self.v_cols)] = cb * Phi["v"][1][:, 0]
         Phi_omega[1, e(self.w_cols)] = -Phi["w"][1][:, 0]
+        Phi_omega = R_x.T @ Phi_omega
+        Phi_omega[0, e(self.beta_cols)] += Phi["beta"][0][:, 0]
         C = np.array([[0, -offset[2], offset[1]], [offset[2], 0, -offset[0]], [-offset[1], offset[0], 0]])
         F = np.vstack((A.T @ Phi_r[0] - C @ Phi_omega, Phi_omega))
         return A, r_x[0] + A @ offset, F
 
-    def displacement(self, q_e, x) -> NDArray:
-        """(u + u₂, v, w) at stations x in the beam's reference frame: for one q_e a
-        (len(x), 3) array, for a trajectory of q_e (rows) a (n_t, len(x), 3) array."""
-        x = np.atleast_1d(np.asarray(x, dtype=float))
-        if np.any(x < 0) or np.any(x > self.length):
-            raise ValueError(f"x: stations must lie on the beam, 0 ≤ x ≤ {self.length}")
-        data = self.station_data(x)
-        q_e = np.asarray(q_e, dtype=float)
-        rows = [self._slices(q, x, data)[0] - np.outer(x, (1.0, 0.0, 0.0)) for q in np.atleast_2d(q_e)]
-        return np.array(rows) if q_e.ndim == 2 else rows[0]
-
-    def centre_line(self, q_e: NDArray, y_dot: NDArray, stations: int = 21) -> tuple[NDArray, NDArray]:
-        """Positions r(x) and velocities J(x) ẏ of ``stations`` equally spaced points of the
-        centre line, in the beam's reference frame (for drawing and export)."""
-        x = np.linspace(0.0, self.length, int(stations))
-        r, Phi_r = self._slices(q_e, x, self.station_data(x))
-        return r, self._jacobian(r, Phi_r) @ y_dot
-
-    def _coordinates(self, result) -> NDArray:
-        """This beam's q_e along a trajectory (rows), found in ``result.system``."""
-        system = getattr(result, "system", None)
-        if system is None:
-            raise ValueError("result: has no system (loaded from a file?); probe a Result from simulate()")
-        places = [n for n, sub in enumerate(system.subsystems) if sub is self]
-        if len(places) != 1:
-            raise ValueError(f"result: this beam appears {len(places)} times in the system; probe it by q_e")
-        return result.q[:, system.e_q_slice[places[0]]]
-
-    def deflection(self, result, x: float) -> NDArray:
-        """(u, v, w) at station x in the beam's reference frame along a simulated
-        trajectory: one row per time point (u includes the foreshortening u₂)."""
-        return self.displacement(self._coordinates(result), [x])[:, 0, :]
-
-    def slope(self, result, x: float) -> NDArray:
-        """(v′, w′) at station x, one row per time point."""
-        return self._derivative(result, x, 1)
-
-    def bending_moment(self, result, x: float) -> NDArray:
-        """Bending moments (EI_z v″, EI_y w″) at station x (N m), one row per time point."""
-        curvature = self._derivative(result, x, 2)
-        return curvature * np.array([self._EI_at(x, "z"), self._EI_at(x, "y")])
-
-    def _derivative(self, result, x: float, order: int) -> NDArray:
-        q_e = self._coordinates(result)
-        Phi, _ = self.station_data(np.array([float(x)]))
-        v = q_e[:, self.v_cols.start - 6 : self.v_cols.stop - 6] @ Phi["v"][order][:, 0]
-        w = q_e[:, self.w_cols.start - 6 : self.w_cols.stop - 6] @ Phi["w"][order][:, 0]
-        return np.column_stack((v, w))
-
-    def _EI_at(self, x: float, axis: str) -> float:
-        EI = self._EI[axis]
-        return float(EI(np.array([x]))[0]) if callable(EI) else float(EI)
-
     def __repr__(self) -> str:
-        return f"RitzBeam(L={self.length}, n_u={self.n_u}, n_v={self.n_v}, n_w={self.n_w}, stiffening={self.stiffening})"
+        counts = f"n_u={self.n_u}, n_v={self.n_v}, n_w={self.n_w}, n_beta={self.n_beta}"
+        return f"RitzBeam(L={self.length}, {counts}, support={self.support!r}, stiffening={self.stiffening})"

@@ -1,8 +1,9 @@
 """Ritz shape-function families for beams: Φ, Φ′, Φ″ at stations x (THEORY §10).
 
-A family is a callable ``family(n, L)`` returning ``shapes(x) -> (Φ, Φ′, Φ″)``, each of
-shape (n, len(x)). Bending families of a clamped root satisfy Φ(0) = Φ′(0) = 0; axial ones
-Φ(0) = 0. ``n`` (the number of functions) is the accuracy knob.
+A family is a callable ``family(n, L)`` returning ``shapes(x) -> (Φ, Φ′, Φ″[, Φ‴])``, each
+of shape (n, len(x)); Φ‴ (for shear forces) is optional in user families. Bending families
+of a clamped root satisfy Φ(0) = Φ′(0) = 0, of a pinned root Φ(0) = 0; axial and torsional
+ones Φ(0) = 0. ``n`` (the number of functions) is the accuracy knob.
 """
 
 from __future__ import annotations
@@ -21,7 +22,8 @@ def polynomial(n: int, L: float):
 
     def shapes(x):
         xi = np.asarray(x, dtype=float)[None, :] / L
-        return xi**k, k * xi ** (k - 1) / L, k * (k - 1) * xi ** (k - 2) / L**2
+        third = k * (k - 1) * (k - 2) * xi ** np.maximum(k - 3, 0) / L**3
+        return xi**k, k * xi ** (k - 1) / L, k * (k - 1) * xi ** (k - 2) / L**2, third
 
     return shapes
 
@@ -32,7 +34,8 @@ def axial_polynomial(n: int, L: float):
 
     def shapes(x):
         xi = np.asarray(x, dtype=float)[None, :] / L
-        return xi**k, k * xi ** (k - 1) / L, k * (k - 1) * xi ** np.maximum(k - 2, 0) / L**2
+        second = k * (k - 1) * xi ** np.maximum(k - 2, 0) / L**2
+        return xi**k, k * xi ** (k - 1) / L, second, k * (k - 1) * (k - 2) * xi ** np.maximum(k - 3, 0) / L**3
 
     return shapes
 
@@ -58,6 +61,7 @@ def clamped_free(n: int, L: float):
             ch - c - sigma * (sh - s),
             beta * (sh + s - sigma * (ch - c)),
             beta**2 * (ch + c - sigma * (sh + s)),
+            beta**3 * (sh - s - sigma * (ch + c)),
         )
 
     return shapes
@@ -69,10 +73,33 @@ def axial_clamped_free(n: int, L: float):
 
     def shapes(x):
         ax = a * np.asarray(x, dtype=float)[None, :]
-        return np.sin(ax), a * np.cos(ax), -(a**2) * np.sin(ax)
+        return np.sin(ax), a * np.cos(ax), -(a**2) * np.sin(ax), -(a**3) * np.cos(ax)
 
     return shapes
 
 
-BENDING = {"polynomial": polynomial, "clamped_free": clamped_free}
+def pinned_free_roots(n: int) -> NDArray:
+    """β_k L of tan βL = tanh βL, k = 1 … n (3.9266023, 7.0685835, 10.2101761, …; the
+    root βL = 0, the rigid rotation about the pin, is left to the hub joint)."""
+    f = lambda b: np.sin(b) * np.cosh(b) - np.cos(b) * np.sinh(b)  # noqa: E731  (tan = tanh)
+    guesses = (4 * np.arange(1, n + 1) + 1) * np.pi / 4
+    return np.array([brentq(f, g - 0.3, g + 0.3) for g in guesses])
+
+
+def pinned_free(n: int, L: float):
+    """Elastic eigenfunctions of the pinned–free Euler–Bernoulli beam (Φ(0) = Φ″(0) = 0,
+    Φ″(L) = Φ‴(L) = 0): Φ_k = sin βx + σ_k sinh βx, σ_k = sin βL / sinh βL."""
+    beta = pinned_free_roots(n)[:, None] / L
+    bL = beta * L
+    sigma = np.sin(bL) / np.sinh(bL)
+
+    def shapes(x):
+        bx = beta * np.asarray(x, dtype=float)[None, :]
+        ch, c, sh, s = np.cosh(bx), np.cos(bx), np.sinh(bx), np.sin(bx)
+        return s + sigma * sh, beta * (c + sigma * ch), beta**2 * (sigma * sh - s), beta**3 * (sigma * ch - c)
+
+    return shapes
+
+
+BENDING = {"polynomial": polynomial, "clamped_free": clamped_free, "pinned_free": pinned_free}
 AXIAL = {"polynomial": axial_polynomial, "clamped_free": axial_clamped_free}

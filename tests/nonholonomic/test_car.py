@@ -9,6 +9,7 @@ import numpy as np
 import sympy as sp
 
 import projeq as pq
+from projeq.symbolic import hamel_coefficients, hamel_equations
 
 # random parameters and states drawn from this generator in every test
 RNG_SEED = 20240607
@@ -70,54 +71,30 @@ def test_gauss_form_is_B9_and_B12_at_random_states():
 
 
 def test_hamel_route_B3_B8_needs_v_y_until_the_end():
-    """B(3)–(8) and THEORY §8: with ṡ = H(q) q̇ of B(6), Hamel's coefficients give
-    β₂^{3,1} = −1 (and β₁^{1,3} = 0, B(7)); Hamel's equations with all three velocities,
-    after inserting v_y = 0, are B(9). Inserting v_y = 0 into T first loses the
-    −m c ω_z² term (B(2.1) text: "not allowed to set v_y = 0 in advance")."""
-    _x, _y, g = q = sp.symbols("x y gamma")
-    s = sp.symbols("v_x v_y omega_z")
-    s_dd = sp.symbols("a_x a_y a_z")
-    m, c, C0, f_x, f_y, M_z = sp.symbols("m c C0 f_x f_y M_z")
+    """B(3)–(8) and THEORY §8 with ``projeq.symbolic.hamel``: with ṡ = H(q) q̇ of B(6),
+    β₂^{3,1} = −1 and β₁^{1,3} = 0 (B(7)); Hamel's equations with all three velocities,
+    after inserting v_y = 0, are B(9) with f_y at the mass centre (the load of
+    ``scenes.car``). Inserting v_y = 0 into T first loses the −m c ω_z² term (B(2.1) text:
+    "not allowed to set v_y = 0 in advance")."""
+    q = sp.symbols("x y gamma")
+    vx, vy, wz = s = sp.symbols("v_x v_y omega_z")
+    a_x, a_y, a_z = s_dd = sp.symbols("a_x a_y a_z")
+    m, c, C0, f_x, f_y, M_z = parameters = sp.symbols("m c C0 f_x f_y M_z")
+    g = q[2]
     H = sp.Matrix([[sp.cos(g), sp.sin(g), 0], [-sp.sin(g), sp.cos(g), 0], [0, 0, 1]])
-    K = H.inv().applyfunc(sp.simplify)
-
-    def beta(nu, mu, n):
-        return sp.simplify(sum(
-            K[k, mu] * K[i, n] * (H[nu, i].diff(q[k]) - H[nu, k].diff(q[i])) for i in range(3) for k in range(3)
-        ))
-
-    assert beta(1, 2, 0) == -1  # β₂^{3,1} (1-based) = −1
-    assert beta(0, 0, 2) == 0  # β₁^{1,3} = 0, B(7)
-
-    def hamel(T, speeds, Q):
-        """Hamel's explicit equations B(3) for the speeds present in T."""
-        eqs = []
-        for n, sn in enumerate(speeds):
-            dT = T.diff(sn)
-            d_dt = sum(dT.diff(sv) * s_dd[v] for v, sv in enumerate(speeds))  # T does not depend on q
-            coupling = sum(
-                T.diff(speeds[nu]) * speeds[mu] * beta(nu, mu, n) for nu in range(len(speeds)) for mu in range(len(speeds))
-            )
-            eqs.append(sp.expand(d_dt - Q[n] + coupling))
-        return eqs
-
-    vx, vy, wz = s
+    beta = hamel_coefficients(H, q)
+    assert beta[1, 2, 0] == -1  # β₂^{3,1} (1-based) = −1
+    assert beta[0, 0, 2] == 0  # β₁^{1,3} = 0, B(7)
     T = m / 2 * (vx**2 + (vy + c * wz) ** 2) + (C0 - m * c**2) / 2 * wz**2  # v_c = (v_x, v_y + c ω_z)
     Q = [f_x, f_y, M_z + c * f_y]  # f at the mass centre, M_z: virtual power f·v_c + M_z ω_z
-    full = [e.subs(vy, 0).subs(s_dd[1], 0) for e in hamel(T, s, Q)]
-    B9 = [m * s_dd[0] - m * c * wz**2 - f_x, C0 * s_dd[2] + m * c * vx * wz - M_z - c * f_y]
-    assert sp.simplify(full[0] - B9[0]) == 0
-    assert sp.simplify(full[2] - B9[1]) == 0
-    # the wrong route: v_y = 0 in T before Hamel's equations (only ν, μ over v_x, ω_z)
-    T0 = T.subs(vy, 0)
-    speeds0 = (vx, wz)
-    wrong = []
-    for n_full, sn in ((0, vx), (2, wz)):
-        dT = T0.diff(sn)
-        d_dt = dT.diff(vx) * s_dd[0] + dT.diff(wz) * s_dd[2]
-        idx = {vx: 0, wz: 2}
-        coupling = sum(T0.diff(a) * b * beta(idx[a], idx[b], n_full) for a in speeds0 for b in speeds0)
-        wrong.append(sp.expand(d_dt - Q[n_full] + coupling))
+
+    def after_v_y_0(T):
+        eqs = hamel_equations(T, q, s, H, Q, s_dd, parameters=parameters)
+        return [eqs[n].subs({vy: 0, a_y: 0}) for n in (0, 2)]
+
+    B9 = [m * a_x - m * c * wz**2 - f_x, C0 * a_z + m * c * vx * wz - M_z - c * f_y]
+    assert all(sp.simplify(e - b) == 0 for e, b in zip(after_v_y_0(T), B9))
+    wrong = after_v_y_0(T.subs(vy, 0))  # the wrong route: v_y = 0 in T before Hamel's equations
     assert sp.simplify(wrong[0] - B9[0]) == m * c * wz**2  # the centripetal term is lost
 
 

@@ -173,12 +173,13 @@ def test_family_violating_the_clamped_root_is_refused():
 
 
 def test_dependent_ritz_functions_are_named():
-    """Two identical shape functions make M_ee singular: both are named."""
+    """Two identical shape functions make M_ee singular: both are named (deformation and
+    index within it)."""
 
     def family(n, length):
         return lambda x: (np.array([x**2, x**2]), np.array([2 * x, 2 * x]), np.array([2 + 0 * x, 2 + 0 * x]))
 
-    with pytest.raises(ValueError, match=r"\[0, 1\].*linearly dependent"):
+    with pytest.raises(ValueError, match=r"'v\[0\]', 'v\[1\]'.*linearly dependent"):
         RitzBeam(2.0, 1.0, 1.0, n_v=2, n_w=0, family=family)
 
 
@@ -204,12 +205,16 @@ def test_body_on_a_beam_station_recursive_equals_dense():
     _assert_recursive_equals_dense(_arm_with_offset_tip_body(), seed=1, q_range=0.1)
 
 
-def test_port_pose_and_twist_agree():
-    """The port's relative twist F q̇_e is the time derivative of its pose (A, r), and its
-    ζ = Ḟ q̇_e the derivative of F (central differences of step 1e-6: 1e-8)."""
+@pytest.mark.parametrize(
+    "torsion", [{}, {"n_beta": 2, "GI_t": 1.0, "rho_I_p": 1e-3}], ids=["bending-axial", "with-torsion"]
+)
+def test_port_pose_and_twist_agree(torsion):
+    """The port's relative twist F q̇_e is the time derivative of its pose (A, r) — with
+    torsion A = R_z(v′)R_y(−w′)R_x(β) — and its ζ = Ḟ q̇_e the derivative of F (central
+    differences of step 1e-6: 1e-8)."""
     from projeq.spatial import vee
 
-    beam = RitzBeam(2.0, 1.0, 1.0, n_v=3, n_w=2, n_u=1, EA=10.0)
+    beam = RitzBeam(2.0, 1.0, 1.0, n_v=3, n_w=2, n_u=1, EA=10.0, **torsion)
     rng = np.random.default_rng(0)
     q, q_dot, point = 0.1 * rng.standard_normal(beam.n_e), rng.standard_normal(beam.n_e), np.array([1.3, 0.1, -0.2])
     now = beam.port(point, q, q_dot)

@@ -1,0 +1,112 @@
+"""Integration cost, energy drift and constraint drift of the formulations side by side, as Barhorst
+compares them (``seeds/000_…`` §3): the knife-edge disc of the lecture (``seeds/001_…`` slides 28–37).
+
+Formulations, all from the same initial state (tilt ϕ = 0.2, θ̇ = −3, ψ̇ = 0.4, m = g = r = 1, μ = ¼, ν = ½):
+
+* ``PE``: projeq's numeric Projection Equation (scene ``knife_edge_disc``, 5 coordinates, ṡ = (ψ̇, ϕ̇, θ̇));
+* ``Lagrange+λ``: lecture K(7), 6 coordinates, constraint differentiated once (index 1), no stabilisation;
+* ``Lagrange+λ, Baumgarte``: the same with A q̈ + Ȧq̇ = −α A q̇, α = 1 and 10 per time unit;
+* ``Hamilton+λ``: lecture K(23)–(24), state (q, p), same index reduction;
+* ``Barhorst Lagrangian`` and ``Barhorst projective``: canonical momentum forms (eqs. 45–52, 28–37).
+
+Columns: setup (derivation + lambdify + first call, s, sympy's cache cleared before each),
+integration wall time (s), right-hand-side evaluations, max |E − E₀| (energy), max |A q̇| (velocity constraints; for the PE and the canonical
+forms zero by construction), max |z + r cos ϕ| (the integrable constraint, only position-level drift
+for the 6-coordinate forms). DOP853 at the given rtol, atol = rtol/100. Times are this machine's only.
+
+    python benchmarks/formulations.py            # t_end = 100, rtol 1e-6 and 1e-10
+    python benchmarks/formulations.py --quick    # t_end = 10, rtol 1e-8
+
+Not yet covered: Barhorst's rolling disk with eccentric mass (scene ``rolling_disk``), which needs its
+Lagrangian and constraint matrix written in the lecture's input form.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+import sympy as sp
+
+import projeq as pq
+from projeq.scenes.nonholonomic import knife_edge_disc
+from projeq.symbolic.canonical import lagrangian_canonical
+from projeq.symbolic.formulation_examples import lecture_disc, lecture_disc_state, projective_disc
+
+# fresh (uncached) builds, so that the setup column measures derivation and compilation
+build_lecture_disc, build_projective_disc = lecture_disc.__wrapped__, projective_disc.__wrapped__
+
+
+def _row(name, setup, wall, nfev, q, q_dot, disc):
+    """Drifts of one run: energy H = ½ pᵀq̇ − m g z (T homogeneous quadratic), |A q̇|, |z + r cos ϕ|."""
+    energy = [0.5 * disc.momenta(0.0, qi, ui) @ ui - qi[2] for qi, ui in zip(q.T, q_dot.T)]
+    residual = max(np.abs(disc.velocity_residual(0.0, qi, ui)).max() for qi, ui in zip(q.T, q_dot.T))
+    return (name, setup, wall, nfev, np.abs(np.array(energy) - energy[0]).max(),
+            residual, np.abs(q[2] + np.cos(q[4])).max())
+
+
+def run(t_end: float, rtol: float):
+    system = knife_edge_disc(s_dot0=(0.4, 0.0, -3.0))
+    q0, q_dot0 = lecture_disc_state(system)
+    t_eval, rows = np.linspace(0, t_end, 201), []
+    disc = build_lecture_disc()
+    disc._compiled  # noqa: B018  (compile once for the drift evaluation)
+
+    pe = pq.simulate(system, t_end, t_eval=t_eval, rtol=rtol, atol=rtol / 100, method="DOP853")
+    z = -np.cos(pe.q[:, 3])
+    q6 = np.vstack([pe.q[:, 0], pe.q[:, 1], z, pe.q[:, 2], pe.q[:, 3], pe.q[:, 4]])
+    q_dot6 = np.array([system.q_dot(qi, si) for qi, si in zip(pe.q, pe.s_dot)]).T
+    q_dot6 = np.vstack([q_dot6[:2], np.sin(pe.q[:, 3]) * q_dot6[3], q_dot6[2:]])
+    rows.append(_row("PE (numeric, projeq)", 0.0, pe.wall_time, pe.nfev, q6, q_dot6, disc))
+
+    multiplier_runs = (("Lagrange+λ", 0.0, "lagrange"), ("Lagrange+λ, Baumgarte α=1", 1.0, "lagrange"),
+                       ("Lagrange+λ, Baumgarte α=10", 10.0, "lagrange"), ("Hamilton+λ", 0.0, "hamilton"))
+    for name, alpha, form in multiplier_runs:
+        sp.core.cache.clear_cache()
+        start = time.perf_counter()
+        candidate = build_lecture_disc()
+        candidate.simulate(q0, q_dot0, (0, 1e-3))
+        setup = time.perf_counter() - start
+        start = time.perf_counter()
+        sol = candidate.simulate(q0, q_dot0, (0, t_end), form=form, alpha=alpha, t_eval=t_eval, rtol=rtol,
+                                 atol=rtol / 100)
+        rows.append(_row(name, setup, time.perf_counter() - start, sol.nfev, sol.q, sol.q_dot, disc))
+
+    for name, build in (("Barhorst Lagrangian", lambda: lagrangian_canonical(build_lecture_disc())),
+                        ("Barhorst projective", build_projective_disc)):
+        sp.core.cache.clear_cache()
+        start = time.perf_counter()
+        canonical = build()
+        canonical.simulate(q0, q_dot0[3:], (0, 1e-3))
+        setup = time.perf_counter() - start
+        start = time.perf_counter()
+        sol = canonical.simulate(q0, q_dot0[3:], (0, t_end), t_eval=t_eval, rtol=rtol, atol=rtol / 100)
+        wall = time.perf_counter() - start
+        rows.append(_row(name, setup, wall, sol.nfev, sol.q, _q_dot(canonical, sol), disc))
+    return rows
+
+
+def _q_dot(canonical, sol):
+    """q̇ = K u along a canonical-form run."""
+    K = sp.lambdify([canonical.q], canonical.K.subs(canonical.parameters), modules="numpy")
+    return np.array([np.asarray(K(qi), float) @ ui for qi, ui in zip(sol.q.T, sol.u.T)]).T
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args()
+    cases = [(10.0, 1e-8)] if args.quick else [(100.0, 1e-6), (100.0, 1e-10)]
+    for t_end, rtol in cases:
+        print(f"\nknife-edge disc, t_end = {t_end}, rtol = {rtol:g}, atol = {rtol / 100:g}")
+        print(f"{'formulation':28s} {'setup s':>8s} {'run s':>7s} {'nfev':>6s} {'|ΔE|':>9s} {'|Aq̇|':>9s} "
+              f"{'|z+rcϕ|':>9s} {'run/PE':>7s}")
+        rows = run(t_end, rtol)
+        for name, setup, wall, nfev, dE, dA, dz in rows:
+            print(f"{name:28s} {setup:8.2f} {wall:7.2f} {nfev:6d} {dE:9.2e} {dA:9.2e} {dz:9.2e} "
+                  f"{wall / rows[0][2]:7.2f}")
+
+
+if __name__ == "__main__":
+    main()

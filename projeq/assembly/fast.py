@@ -1,0 +1,124 @@
+"""The order-n passes of THEORY §6 in one compiled loop over flat arrays ("fast").
+
+The System stays frozen; :class:`FastEvaluator` packs its tree once into arrays (parents,
+joint kinds, axes, joint frames, masses, r_c, I_c, M_n) and each call runs
+:func:`projeq.assembly._kernels.chain_terms` (T_np, ζ_n, F_n, h_n; THEORY §3–4) and
+:func:`projeq.assembly._kernels.passes` (Bremer's backward and forward passes, §6).
+With numba installed (``pip install 'projeq[fast]'``) both are compiled on first use
+(cached on disk); without it the same source runs interpreted — correct, but slower than
+``method="recursive"``.
+
+Supported: trees of :class:`~projeq.RigidBody` / :class:`~projeq.PointMass` on
+:class:`~projeq.Revolute`, :class:`~projeq.Prismatic` and :class:`~projeq.Fixed` joints
+(no coupling), under gravity, without force laws. Any other system (beams, planar bodies,
+free, prescribed or user — e.g. non-holonomic — joints, couplings, forces) is evaluated
+by the general path (recursive, or dense for coupled joints); then ``fast`` is False and
+``reason`` says why.
+
+>>> import numpy as np, projeq as pq
+>>> system = pq.scenes.chain(3)
+>>> ev = FastEvaluator(system, compiled=False)
+>>> ev.fast, ev.compiled
+(True, False)
+>>> q, s_dot = np.array([0.5, -0.2, 0.1]), np.array([0.3, 0.0, -1.0])
+>>> bool(np.allclose(ev.accelerations(q, s_dot, 0.0), system.accelerations(q, s_dot, method="dense"), atol=1e-12))
+True
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.assembly import _kernels
+from projeq.assembly.linalg import _SINGULAR, SingularMassError, mass_scale
+from projeq.joints import Fixed, Prismatic, Revolute
+from projeq.subsystems import PointMass, RigidBody
+
+_KINDS = {Fixed: _kernels.FIXED, Revolute: _kernels.REVOLUTE, Prismatic: _kernels.PRISMATIC}
+
+
+class FastEvaluator:
+    """s̈ of one System by the compiled order-n kernel, or by the general path.
+
+    Parameters
+    ----------
+    system : System
+    compiled : bool or None
+        True: numba (ValueError if it is missing); False: the interpreted kernel (the
+        pure-numpy fallback); None: numba when installed, unless the environment variable
+        ``PROJEQ_FAST_KERNEL=python``.
+
+    Attributes: ``fast`` (the kernel is used), ``reason`` (why not, else None),
+    ``compiled`` (numba), ``n_calls``. The workspace (T_np, ζ_n, f_n, M̂_n, ĥ_n) is
+    allocated once and overwritten by every call.
+    """
+
+    def __init__(self, system, compiled: bool | None = None):
+        self.system = system
+        self.n_calls = 0
+        self.reason = unsupported(system)
+        self.fast = self.reason is None
+        self.compiled = False
+        if not self.fast:
+            self._general = system.evaluator("dense" if system.coupled else "recursive")
+            return
+        self._chain_terms, self._passes, self.compiled = _kernels.kernel(compiled)
+        self._pack(system)
+
+    def _pack(self, system) -> None:
+        """Flat arrays of the tree (built once) and the workspace."""
+        N = len(system.joints)
+        joints, bodies = system.joints, system.subsystems
+        self._kind = np.array([_KINDS[type(j)] for j in joints], dtype=np.int64)
+        self._parent = np.array(system.parent, dtype=np.int64)
+        self._axis = np.array([getattr(j, "axis", np.zeros(3)) for j in joints])
+        self._orientation = np.array([j.orientation for j in joints])
+        self._offset = np.array([j.r_pn for j in joints])
+        self._q_index = np.array([system.q_slice[n].start for n in range(N)], dtype=np.int64)
+        self._m = np.array([b.m for b in bodies])
+        self._r_c = np.array([b.r_c for b in bodies])
+        self._I_c = np.array([b.I_c for b in bodies])
+        self._M6 = np.array([b.M6 for b in bodies])
+        self._gravity = np.asarray(system.gravity, dtype=float)
+        self._pivot_min = _SINGULAR * mass_scale(system)
+        self._T, self._zeta = np.zeros((N, 6, 6)), np.zeros((N, 6))
+        self._f, self._M_hat, self._h_hat = np.zeros((N, 6)), np.zeros((N, 6, 6)), np.zeros((N, 6))
+
+    def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
+        """s̈ at (q, ṡ, t) (THEORY §6); raises SingularMassError for a zero pivot D_n."""
+        self.n_calls += 1
+        if not self.fast:
+            return self._general.accelerations(q, s_dot, t)
+        q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
+        self._chain_terms(
+            self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index,
+            self._m, self._r_c, self._I_c, self._gravity, q, s_dot,
+            self._T, self._zeta, self._f, self._h_hat,
+        )
+        self._M_hat[:] = self._M6
+        s_ddot = np.empty(self.system.n_s)
+        failed = self._passes(
+            self._kind, self._parent, self._q_index, self._T, self._zeta, self._f,
+            self._M_hat, self._h_hat, self._pivot_min, s_ddot,
+        )
+        if failed >= 0:
+            raise SingularMassError(
+                f"D_n = F_nᵀ M̂_n F_n of joint {self.system.names[failed]!r} is singular: "
+                "it moves no mass or inertia"
+            )
+        return s_ddot
+
+
+def unsupported(system) -> str | None:
+    """Why the fast kernel cannot evaluate ``system`` (None if it can)."""
+    for name, joint, body in zip(system.names, system.joints, system.subsystems):
+        if type(joint) not in _KINDS:
+            return f"joint {name!r} is a {type(joint).__name__} (the kernel knows Revolute, Prismatic, Fixed)"
+        if joint.coupling:
+            return f"joint {name!r} is coupled (shared minimal velocities)"
+        if type(body) not in (RigidBody, PointMass) or body.S is not None:
+            return f"subsystem {name!r} is a {type(body).__name__} (the kernel knows spatial rigid bodies)"
+    if system.forces:
+        return "the system has force laws (the kernel knows gravity only)"
+    return None

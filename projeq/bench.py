@@ -1,0 +1,217 @@
+"""Quick benchmarks (``projeq bench``): cost of s̈ for ``scenes.chain(n)`` against peers,
+and the quick versions of the scripts in ``benchmarks/`` when they are present.
+
+Every evaluator is timed alternately with the others in one run and each entry is the
+minimum CPU time over repetitions, so ratios are robust on a noisy machine; absolute times hold for
+this machine only. The peers, when installed (``pip install 'projeq[bench]'``), are
+Pinocchio's ABA (``pin.aba``) and MuJoCo's ``mj_forward`` on the same chain, built here
+from the same parameters; their s̈ is compared with the dense evaluator, which checks
+that the peer models are the same chain.
+
+    python -m projeq.bench            # chain n = 10, 30, 100 (+ scripts' --quick)
+    python -m projeq.bench --json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from projeq import inertia, scenes
+
+QUICK_SIZES = (10, 30, 100)
+OURS = ("recursive", "fast", "dense")
+DENSE_UP_TO = 300  # the dense evaluator is O(N³): skipped above this n
+PINOCCHIO_UP_TO = 300  # pin 4.1's Data needs 1.9 GB at n = 300, growing as n²: skipped above
+_LINK_I_C = inertia.cylinder(m=1.0, radius=0.01, length=1.0, axis="z")  # the links of scenes.chain
+
+
+def pinocchio_chain(n: int):
+    """s̈ function of ``scenes.chain(n)`` by Pinocchio's ABA, or None without ``pin``."""
+    try:
+        import pinocchio as pin
+    except ImportError:
+        return None
+    model = pin.Model()
+    parent = 0
+    for i in range(n):
+        placement = pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.0 if i == 0 else -1.0]))
+        parent = model.addJoint(parent, pin.JointModelRY(), placement, f"j{i}")
+        model.appendBodyToJoint(parent, pin.Inertia(1.0, np.array([0.0, 0.0, -0.5]), _LINK_I_C), pin.SE3.Identity())
+    model.gravity.linear = np.array([0.0, 0.0, -9.81])
+    data, tau = model.createData(), np.zeros(n)
+    return lambda q, s_dot: pin.aba(model, data, q, s_dot, tau)
+
+
+def mujoco_chain(n: int):
+    """s̈ function of ``scenes.chain(n)`` by MuJoCo's ``mj_forward`` (built with MjSpec —
+    a nested MJCF string needs gigabytes to parse at n = 1000 —, no geoms, contacts off),
+    or None without ``mujoco``."""
+    try:
+        import mujoco
+    except ImportError:
+        return None
+    spec = mujoco.MjSpec()
+    spec.option.gravity = [0.0, 0.0, -9.81]
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+    body = spec.worldbody
+    for i in range(n):
+        body = body.add_body(pos=[0.0, 0.0, 0.0 if i == 0 else -1.0], mass=1.0, ipos=[0.0, 0.0, -0.5],
+                             inertia=np.diagonal(_LINK_I_C), explicitinertial=True)
+        body.add_joint(type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0.0, 1.0, 0.0])
+    model = spec.compile()
+    data = mujoco.MjData(model)
+
+    def s_ddot(q, s_dot):
+        data.qpos[:], data.qvel[:] = q, s_dot
+        mujoco.mj_forward(model, data)
+        return data.qacc.copy()
+
+    return s_ddot
+
+
+def evaluators(n: int, peers: bool = True) -> dict:
+    """Name → function (q, ṡ) ↦ s̈ for projeq's evaluators and the installed peers."""
+    system = scenes.chain(n)
+    names = [m for m in OURS if m != "dense" or n <= DENSE_UP_TO]
+    funcs = {m: (lambda ev: lambda q, s_dot: ev.accelerations(q, s_dot, 0.0))(system.evaluator(m)) for m in names}
+    if peers:
+        builders = [("pinocchio", pinocchio_chain)] * (n <= PINOCCHIO_UP_TO) + [("mujoco", mujoco_chain)]
+        for name, build in builders:
+            f = build(n)
+            if f is not None:
+                funcs[name] = f
+    return funcs
+
+
+def time_per_call(funcs: dict, q, s_dot, budget: float, clock=time.process_time, batch: float = 2e-3) -> dict:
+    """Minimum CPU time of one call per function, alternating them until ``budget``
+    seconds are spent (at least 3 rounds, after one warm-up call each).
+
+    Each function is timed in batches of repeated calls lasting about ``batch`` seconds, so
+    that the clock's granularity (a CPU-time clock may tick in coarse steps on virtual
+    machines) cannot round a short call to zero; the result is the fastest batch's mean.
+
+    By default CPU time of this process (``time.process_time``), not wall time: on a loaded
+    machine a call that is preempted would otherwise count the other processes' time
+    slices, which hits long calls more often than short ones and biases the slopes
+    upwards. CPU time counts every thread, though, so calls into multithreaded BLAS (the
+    dense evaluator at n ≳ 100) are better timed with ``clock=time.perf_counter``.
+    """
+    best = dict.fromkeys(funcs, np.inf)
+    repeats = {name: _repeats(f, q, s_dot, batch) for name, f in funcs.items()}
+    started, rounds = time.perf_counter(), 0
+    while rounds < 3 or time.perf_counter() - started < budget:
+        for name, f in funcs.items():
+            t0 = clock()
+            for _ in range(repeats[name]):
+                f(q, s_dot)
+            best[name] = min(best[name], (clock() - t0) / repeats[name])
+        rounds += 1
+    return best
+
+
+def _repeats(f, q, s_dot, batch: float) -> int:
+    """How many calls of f (after a warm-up call) take about ``batch`` seconds of wall time."""
+    f(q, s_dot)
+    t0 = time.perf_counter()
+    f(q, s_dot)
+    return max(1, int(batch / max(time.perf_counter() - t0, 1e-9)))
+
+
+def measure(sizes, budget: float = 1.0, peers: bool = True) -> list[dict]:
+    """One row per chain length: seconds per call of every evaluator, and each one's
+    largest deviation from the reference s̈ (dense up to n = 300, else recursive),
+    relative to max(1, |s̈|∞)."""
+    rng = np.random.default_rng(0)
+    rows = []
+    for n in sizes:
+        q, s_dot = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
+        funcs = evaluators(n, peers)
+        seconds = time_per_call(funcs, q, s_dot, budget)
+        reference = funcs["dense" if "dense" in funcs else "recursive"](q, s_dot)
+        scale = max(1.0, np.abs(reference).max())
+        rows.append({
+            "n": n,
+            "seconds": seconds,
+            "deviation": {k: float(np.abs(f(q, s_dot) - reference).max() / scale) for k, f in funcs.items()},
+        })
+    return rows
+
+
+def slopes(rows) -> dict:
+    """Least-squares slope of log(time) against log(n) for every evaluator timed at
+    every size."""
+    names = set.intersection(*(set(r["seconds"]) for r in rows))
+    n = np.log([r["n"] for r in rows])
+    return {k: float(np.polyfit(n, np.log([r["seconds"][k] for r in rows]), 1)[0]) for k in sorted(names)}
+
+
+def print_table(rows, slope: dict) -> None:
+    """µs per call, fast/peer time ratios, the fast evaluator's and the largest deviation
+    from the reference s̈ (see :func:`measure`)."""
+    names = list(rows[-1]["seconds"]) + [k for k in rows[0]["seconds"] if k not in rows[-1]["seconds"]]
+    print(f"{'n':>6} " + " ".join(f"{k + ' µs':>14}" for k in names) + f" {'fast/pin':>9} {'fast/mujoco':>12} {'fast dev':>9} {'max dev':>9}")
+    for r in rows:
+        s = r["seconds"]
+        cells = " ".join(f"{s[k] * 1e6:>14.1f}" if k in s else f"{'-':>14}" for k in names)
+        ratio = {p: f"{s['fast'] / s[p]:.2f}" if p in s else "-" for p in ("pinocchio", "mujoco")}
+        print(f"{r['n']:>6} {cells} {ratio['pinocchio']:>9} {ratio['mujoco']:>12} "
+              f"{r['deviation']['fast']:>9.1e} {max(r['deviation'].values()):>9.1e}")
+    print("log-log slope: " + ", ".join(f"{k} {v:.3f}" for k, v in slope.items()))
+
+
+def chain_scaling(sizes, budget: float, as_json: bool, peers: bool = True) -> dict:
+    """Measure, print (table or JSON) and return the chain-scaling report."""
+    rows = measure(sizes, budget, peers)
+    report = {"benchmark": "chain_scaling", "rows": rows, "slopes": slopes(rows)}
+    if as_json:
+        print(json.dumps(report, indent=2))
+    else:
+        print_table(rows, report["slopes"])
+    return report
+
+
+QUICK_SCRIPTS = {"beam_convergence.py": ["--quick"], "derivation.py": ["2", "4"]}  # their quick arguments
+
+
+def _run_script(name: str, as_json: bool, timeout: float) -> int:
+    """``benchmarks/<name>`` of a source checkout with its quick arguments, if it exists;
+    its exit code."""
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / name
+    if not script.exists():
+        print(f"{name}: not available (benchmarks/ is part of the source checkout)")
+        return 0
+    args = QUICK_SCRIPTS[name] + ["--json"] * as_json
+    print(f"\n$ python benchmarks/{name} {' '.join(args)}", flush=True)
+    try:
+        return subprocess.run([sys.executable, str(script), *args], timeout=timeout).returncode
+    except subprocess.TimeoutExpired:
+        print(f"{name}: stopped after {timeout:.0f} s")
+        return 1
+
+
+def main(argv=None) -> int:
+    """``projeq bench``: quick chain scaling, then the quick beam and derivation scripts."""
+    parser = argparse.ArgumentParser(prog="projeq bench", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
+    parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per chain length")
+    parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
+    parser.add_argument("--chain-only", action="store_true", help="skip the scripts in benchmarks/")
+    args = parser.parse_args(argv)
+    chain_scaling(QUICK_SIZES, args.budget, args.json, not args.no_peers)
+    if args.chain_only:
+        return 0
+    codes = [_run_script(name, args.json, 50.0) for name in QUICK_SCRIPTS]
+    return max(codes)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

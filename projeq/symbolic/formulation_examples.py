@@ -1,0 +1,75 @@
+"""The knife-edge disc and Barhorst's particle in the input forms of the Lagrange/Hamilton and
+canonical modules (for the tests, the formulation benchmark and comparisons).
+
+Same bodies as projeq's scenes ``knife_edge_disc`` (lecture ``seeds/001_…`` slides 28–37) and
+``barhorst_particle`` (``seeds/000_…`` §3.1), written as L, A for :func:`multiplier_system` and as
+bodies for :func:`projective_canonical`.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+import sympy as sp
+from sympy.physics.mechanics import dynamicsymbols
+
+from .canonical import CanonicalForm, projective_canonical
+from .lagrange import MultiplierSystem, multiplier_system
+from .projection import Body, t
+
+__all__ = ["DISC_UNITS", "lecture_disc", "lecture_disc_state", "projective_disc", "particle"]
+
+m, g, r, I, J = sp.symbols("m g r I J", positive=True)
+DISC_UNITS = {m: 1.0, g: 1.0, r: 1.0, I: 0.25, J: 0.5}  # the scene's defaults: μ = 1/4, ν = 1/2
+
+
+def _disc_K(q) -> sp.Matrix:
+    """q̇ = K u for q = (x, y, z, ψ, ϕ, θ), u = (ψ̇, ϕ̇, θ̇): slide 30's A q̇ = 0 solved for ẋ, ẏ, ż."""
+    s, c, psi, phi = sp.sin, sp.cos, q[3], q[4]
+    return sp.Matrix([[-r * c(psi) * s(phi), -r * c(phi) * s(psi), -r * c(psi)],
+                      [-r * s(psi) * s(phi), r * c(psi) * c(phi), -r * s(psi)],
+                      [0, r * s(phi), 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+
+
+@cache
+def lecture_disc() -> MultiplierSystem:
+    """Slides 29–31: q = (x, y, z, ψ, ϕ, θ) of the centre G and the angles, n̂z down, L = T + m g z,
+    rolling constraints A q̇ = 0 (slide 30, including the integrable ż − r ϕ̇ sϕ = 0)."""
+    x, y, z, psi, phi, th = q = dynamicsymbols("x y z psi phi theta")
+    d, s, c = (lambda f: f.diff(t)), sp.sin, sp.cos
+    L = (m * (d(x) ** 2 + d(y) ** 2 + d(z) ** 2) + I * d(psi) ** 2 * c(phi) ** 2 + I * d(phi) ** 2
+         + J * (d(th) + d(psi) * s(phi)) ** 2) / 2 + m * g * z
+    A = [[1, 0, 0, r * c(psi) * s(phi), r * c(phi) * s(psi), r * c(psi)],
+         [0, 1, 0, r * s(psi) * s(phi), -r * c(psi) * c(phi), r * s(psi)],
+         [0, 0, 1, 0, -r * s(phi), 0]]
+    return multiplier_system(L, q, t, A=A, parameters=DISC_UNITS)
+
+
+def lecture_disc_state(system) -> tuple[np.ndarray, np.ndarray]:
+    """(q, q̇) in the lecture's six coordinates from the scene's initial state (z = −r cos ϕ, r = 1)."""
+    q, q_dot = system.q0, system.q_dot(system.q0, system.s_dot0)
+    return (np.array([q[0], q[1], -np.cos(q[3]), q[2], q[3], q[4]]),
+            np.array([q_dot[0], q_dot[1], np.sin(q[3]) * q_dot[3], q_dot[2], q_dot[3], q_dot[4]]))
+
+
+@cache
+def projective_disc() -> CanonicalForm:
+    """The disc as one body in E = R_z(ψ) R_x(ϕ) (slide 29): v_G and gravity turned into E, ω and the
+    inertia diag(I, J, I) in E, E turning with ω_E = ω − θ̇ ê2."""
+    q = sp.symbols("x y z psi phi theta")
+    u = sp.symbols("u1:4")
+    s, c, psi, phi = sp.sin, sp.cos, q[3], q[4]
+    K = _disc_K(q)
+    R_E = sp.rot_axis3(-psi) * sp.rot_axis1(-phi)  # E's axes in N (sympy's rot_axis turns frames, hence −)
+    body = Body(v_c=R_E.T * (K * sp.Matrix(u))[:3, :], omega=[u[1], u[2] + s(phi) * u[0], c(phi) * u[0]],
+                m=m, I_c=sp.diag(I, J, I), f=R_E.T * sp.Matrix([0, 0, m * g]),
+                omega_IR=[u[1], s(phi) * u[0], c(phi) * u[0]])
+    return projective_canonical([body], q, u, K, t, DISC_UNITS)
+
+
+@cache
+def particle() -> MultiplierSystem:
+    """Barhorst's particle (seed 000 §3.1): L = m(ẋ² + ẏ²)/2 − m g y with ẏ − y² ẋ = 0, m = 1, g = 10."""
+    x, y = q = dynamicsymbols("x y")
+    return multiplier_system((x.diff(t) ** 2 + y.diff(t) ** 2) / 2 - 10 * y, q, t, A=[[-y**2, 1]])

@@ -1,0 +1,307 @@
+"""The spinning beam of B(16)–(23): Hamilton's principle versus the Projection Equation.
+
+A beam along x spins with the prescribed angle α(t) about its own axis; v(x, t), w(x, t)
+are its bending deflections in the co-rotating frame R (ω_IR = (α̇, 0, 0)); the section is
+circular (polar ρI_x = 2ρI). Both sets of field equations are derived here with sympy and
+linearised in (v, w):
+
+* :func:`hamilton_field_equations` — Hamilton's principle with the Cardan rates
+  (α̇, −ẇ′, v̇′) of B(17); reproduces B(18) (THEORY §9).
+* :func:`projection_field_equations` — Newton–Euler residuals of a slice in R projected
+  with the operator D̄ of B(22) and its adjoint D (B(21)); reproduces B(23) as corrected in
+  THEORY §9.
+
+They differ only in the ρI α̈ coupling of the v equation (:func:`field_difference`): the
+Cardan axes (x, y′, z″) are not orthogonal, so Hamilton's v equation is the directional
+derivative along the Cardan v′ axis, which picks up the torsional balance ρI_x α̈ times w′
+(the x component of that axis). :func:`ritz_models` discretises both with the clamped
+polynomial functions (x/L)^(k+1) of ``RitzBeam(family="polynomial")``.
+
+Interpretation. B(23) is the slice's Newton–Euler balance in the co-rotating frame R,
+projected on R's y and z directions: its ρI α̈ coupling is skew (circulatory, like the ρA
+part). B(18) is the same balance projected on the Cardan axes; its v equation contains
+the torsional balance ρI_x α̈ weighted by w′, so the ρI α̈ coupling is symmetric (the
+derivative of a time-dependent potential −½α̈ aᵀC_sym a at the Ritz level). At constant
+spin both coincide (and conserve the energy relative to R, the Jacobi integral); under
+spin-up each obeys its own work balance and the motions differ at first order in ρI.
+projeq's numeric ``RitzBeam`` projects the slice's Euler equations in the slice frame: its
+v rows coincide with Hamilton's, its coupling is skew (tests/symbolic/test_spinning_beam.py).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import NamedTuple
+
+import numpy as np
+import sympy as sp
+
+x, t, L = sp.symbols("x t L", positive=True)
+rho_A, rho_I, EI = sp.symbols("rho_A rho_I EI", positive=True)
+alpha = sp.Function("alpha")(t)
+v = sp.Function("v")(x, t)
+w = sp.Function("w")(x, t)
+_eps = sp.Symbol("epsilon")
+
+
+def _d(f, *args):
+    return sp.diff(f, *args) if args else f
+
+
+def _order(expr, k: int, fields=None):
+    """The part of ``expr`` of order k in the deflections (default (v, w))."""
+    fields = (v, w) if fields is None else fields
+    scaled = expr.subs({f: _eps * f for f in fields}, simultaneous=True).doit()
+    return sp.expand(sp.diff(scaled, _eps, k).subs(_eps, 0) / sp.factorial(k))
+
+
+def _linear(expr):
+    """First-order part in the deflections (v, w) of ``expr``."""
+    return _order(expr, 1)
+
+
+def cardan_angular_velocity() -> sp.Matrix:
+    """ω_c of a slice in its own frame, B(17): Cardan rates (α̇, −ẇ′, v̇′), second order."""
+    vp, wp = _d(v, x), _d(w, x)
+    A = sp.Matrix([[1 - vp**2 / 2 - wp**2 / 2, vp, 0], [-vp, 1 - vp**2 / 2, 0], [-wp, 0, 1]])
+    return A * sp.Matrix([_d(alpha, t), -_d(wp, t), _d(vp, t)])
+
+
+def slice_velocity() -> sp.Matrix:
+    """v_c of the slice centre in R, B(17): ṙ + ω̃_IR r with r = (x, v, w)."""
+    r = sp.Matrix([x, v, w])
+    omega_IR = sp.Matrix([_d(alpha, t), 0, 0])
+    return _d(r, t) + omega_IR.cross(r)
+
+
+def _variational_derivative(density, f):
+    """δ/δf of ∫∫ density dx dt: Σ (−1)^(i+j) ∂ₓⁱ∂ₜʲ ∂density/∂(∂ₓⁱ∂ₜʲ f)."""
+    result = sp.diff(density, f)
+    for d in density.atoms(sp.Derivative):
+        if d.expr != f:
+            continue
+        orders = dict(d.variable_count)
+        i, j = orders.get(x, 0), orders.get(t, 0)
+        result += (-1) ** (i + j) * _d(sp.diff(density, d), *([x] * i + [t] * j))
+    return result
+
+
+@lru_cache(maxsize=None)
+def hamilton_field_equations() -> tuple[sp.Expr, sp.Expr]:
+    """The v and w field equations from Hamilton's principle, B(16)–(18), linear in (v, w).
+
+    Lagrangian density ½ρA v_cᵀv_c + ½ω_cᵀ ρ diag(2I, I, I) ω_c − ½EI(v″² + w″²); sign
+    chosen so that the ρA v̈ (ρA ẅ) term is positive.
+    """
+    density = _quadratic_density()
+    return tuple(_linear(-_variational_derivative(density, f)) for f in (v, w))
+
+
+@lru_cache(maxsize=None)
+def _quadratic_density() -> sp.Expr:
+    """The part of T − V per length, B(16)–(17), quadratic in (v, w) — all that linear
+    equations need: ½ρA v_cᵀv_c + ½ω_cᵀ ρ diag(2I, I, I) ω_c − ½EI(v″² + w″²)."""
+    v_c, omega_c = slice_velocity(), cardan_angular_velocity()
+    T = rho_A * v_c.dot(v_c) / 2 + (omega_c.T * rho_I * sp.diag(2, 1, 1) * omega_c)[0] / 2
+    return _order(T - EI * (_d(v, x, 2) ** 2 + _d(w, x, 2) ** 2) / 2, 2)
+
+
+def _newton_euler_residuals() -> sp.Matrix:
+    """dṗ + ω̃_IR dp and dL̇ + ω̃_IR dL of a slice in R, per length, linear (B(19))."""
+    omega_IR = sp.Matrix([_d(alpha, t), 0, 0])
+    theta = sp.Matrix([0, -_d(w, x), _d(v, x)])  # small Cardan angles (−w′, v′)
+    A_Rc = sp.eye(3) + _skew(theta)
+    J_R = A_Rc * rho_I * sp.diag(2, 1, 1) * A_Rc.T
+    p = rho_A * slice_velocity()
+    L_c = J_R * (omega_IR + _d(theta, t))
+    f = _d(p, t) + omega_IR.cross(p)
+    m = _d(L_c, t) + omega_IR.cross(L_c)
+    return sp.Matrix([_linear(e) for e in list(f) + list(m)])
+
+
+def _slice_residual() -> list:
+    """B(23)'s middle factor dMÿ + dGẏ − dQ on the rows of D_BAR: (f_y, f_z, m_y, m_z, EIv″, EIw″)."""
+    f_m = _newton_euler_residuals()
+    return [f_m[1], f_m[2], f_m[4], f_m[5], EI * _d(v, x, 2), EI * _d(w, x, 2)]
+
+
+def _skew(a):
+    return sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+
+
+# D̄ of B(22), the rows of ẏ = (v̇_y, v̇_z, −ẇ′, v̇′, v̇″, ẇ″) that depend on (v̇, ẇ):
+# entry -> (field, coefficient, order of ∂/∂x). The α̇ row only enters the α equation.
+D_BAR = ((v, 1, 0), (w, 1, 0), (w, -1, 1), (v, 1, 1), (v, 1, 2), (w, 1, 2))
+
+
+@lru_cache(maxsize=None)
+def projection_field_equations() -> tuple[sp.Expr, sp.Expr]:
+    """The v and w field equations of the Projection Equation, B(19)–(23), linear in (v, w).
+
+    The slice residual r = (f_y, f_z, m_y, m_z, EIv″, EIw″) (B(23)'s middle factor) is
+    projected with D = adjoint of D̄ (B(21)): odd derivatives change sign.
+    """
+    r = _slice_residual()
+    equations = []
+    for field in (v, w):
+        terms = [c * (-1) ** k * _d(r_i, *([x] * k)) for r_i, (f, c, k) in zip(r, D_BAR) if f == field]
+        equations.append(sp.expand(sum(terms)))
+    return tuple(equations)
+
+
+def _field_expected(rho_I_coupling: tuple[int, int]):
+    """The two field equations of THEORY §9 with signs (s_v, s_w) of the ρI α̈ terms."""
+    ad, add = _d(alpha, t), _d(alpha, t, 2)
+    sv, sw = rho_I_coupling
+    eq_v = (rho_A * (_d(v, t, 2) - 2 * ad * _d(w, t) - add * w - ad**2 * v)
+            - rho_I * (_d(v, x, 2, t, 2) + ad**2 * _d(v, x, 2) + sv * add * _d(w, x, 2)) + EI * _d(v, x, 4))
+    eq_w = (rho_A * (_d(w, t, 2) + 2 * ad * _d(v, t) + add * v - ad**2 * w)
+            - rho_I * (_d(w, x, 2, t, 2) + ad**2 * _d(w, x, 2) + sw * add * _d(v, x, 2)) + EI * _d(w, x, 4))
+    return sp.expand(eq_v), sp.expand(eq_w)
+
+
+def expected_B18():
+    """B(18) as printed (circular section, EI constant), with ρA α̈ v (not α̈ v/2, a typo of
+    the seed's transcription): ρI α̈ coupling −ρI(… − α̈w″), −ρI(… − α̈v″), symmetric."""
+    return _field_expected((-1, -1))
+
+
+def expected_B23():
+    """B(23) as corrected in THEORY §9: −ρI(… + α̈w″), −ρI(… − α̈v″), skew-symmetric."""
+    return _field_expected((1, -1))
+
+
+def field_difference() -> tuple[sp.Expr, sp.Expr]:
+    """Hamilton minus Projection Equation, per equation: (2ρI α̈ w″, 0).
+
+    2ρI α̈ w″ = ∂ₓ(w′ · ρI_x α̈) with ρI_x = 2ρI: the torsional balance of the slice
+    projected by the x component (−w′ in R) of the Cardan v′ axis and moved to v by
+    integration by parts — the directional derivative along a non-orthogonal axis.
+    """
+    return tuple(sp.expand(h - p) for h, p in zip(hamilton_field_equations(), projection_field_equations()))
+
+
+class RitzModel(NamedTuple):
+    """Linear Ritz model M ä + α̇ G ȧ + (K − α̇² K_c + α̈ C) a = 0, a = (a_v, a_w)."""
+
+    M: np.ndarray
+    G: np.ndarray
+    K: np.ndarray
+    K_c: np.ndarray
+    C: np.ndarray
+
+    def accelerations(self, a, a_dot, alpha_dot: float, alpha_ddot: float) -> np.ndarray:
+        """ä of the model at (a, ȧ) for the spin rate α̇ and spin acceleration α̈."""
+        stiffness = self.K - alpha_dot**2 * self.K_c + alpha_ddot * self.C
+        return np.linalg.solve(self.M, -(alpha_dot * self.G @ a_dot + stiffness @ a))
+
+    def energy(self, a, a_dot, alpha_dot: float) -> float:
+        """E = ½ȧᵀMȧ + ½aᵀ(K − α̇²K_c)a, the energy relative to R (Jacobi integral at α̈ = 0)."""
+        return 0.5 * a_dot @ self.M @ a_dot + 0.5 * a @ (self.K - alpha_dot**2 * self.K_c) @ a
+
+    def drive_power(self, a, a_dot, alpha_dot: float, alpha_ddot: float) -> float:
+        """dE/dt along the motion: −α̈ ȧᵀCa − α̇α̈ aᵀK_c a (G is skew and does no work)."""
+        return -alpha_ddot * a_dot @ self.C @ a - alpha_dot * alpha_ddot * a @ self.K_c @ a
+
+
+def _ritz_coordinates(n: int):
+    """a_v, a_w (functions of t) and the substitution v = Σ φ_k a_v,k, w = Σ φ_k a_w,k."""
+    a_v = [sp.Function(f"a_v{k}")(t) for k in range(1, n + 1)]
+    a_w = [sp.Function(f"a_w{k}")(t) for k in range(1, n + 1)]
+    phi = [(x / L) ** (k + 1) for k in range(1, n + 1)]
+    fields = {v: sum(p * a for p, a in zip(phi, a_v)), w: sum(p * a for p, a in zip(phi, a_w))}
+    return a_v + a_w, phi, fields
+
+
+_Om, _Om_dot = sp.symbols("Omega Omega_dot")
+
+
+def _state_symbols(a):
+    """Plain symbols (q, q̇, q̈) for a, ȧ, ä and (Ω, Ω̇) for (α̇, α̈), and the substitution."""
+    q, q_dot, q_ddot = (sp.symbols(f"{name}0:{len(a)}") for name in ("q", "qd", "qdd"))
+    rates = {_d(alpha, t, 2): _Om_dot, _d(alpha, t): _Om}
+    rates.update({_d(ai, t, 2): s for ai, s in zip(a, q_ddot)})
+    rates.update({_d(ai, t): s for ai, s in zip(a, q_dot)})
+    rates.update(dict(zip(a, q)))
+    return (q, q_dot, q_ddot), rates
+
+
+def _matrices(E: sp.Matrix, q, q_dot, q_ddot) -> RitzModel:
+    """Split linear equations E (in q, q̇, q̈; polynomial in Ω, Ω̇) into M, G, K, K_c, C."""
+    K_all = E.jacobian(q)
+    return RitzModel(
+        M=E.jacobian(q_ddot), G=E.jacobian(q_dot).diff(_Om), K=K_all.subs({_Om: 0, _Om_dot: 0}),
+        K_c=-K_all.diff(_Om, 2) / 2, C=K_all.diff(_Om_dot),
+    )
+
+
+@lru_cache(maxsize=None)
+def _hamilton_ritz(n: int) -> RitzModel:
+    """Lagrange's equations d/dt ∂L/∂ȧ − ∂L/∂a = 0 of the discretised Lagrangian ∫(T − V)dx
+    (Hamilton's principle, B(16)); α̇ is prescribed, so d/dt also acts through α̈."""
+    a, phi, fields = _ritz_coordinates(n)
+    (q, q_dot, q_ddot), rates = _state_symbols(a)
+    Lagrangian = sp.integrate(sp.expand(_quadratic_density().subs(fields).doit().subs(rates)), (x, 0, L))
+    p = sp.Matrix([Lagrangian]).jacobian(q_dot).T
+    p_dot = p.jacobian(q) * sp.Matrix(q_dot) + p.jacobian(q_dot) * sp.Matrix(q_ddot) + p.diff(_Om) * _Om_dot
+    return _matrices(p_dot - sp.Matrix([Lagrangian]).jacobian(q).T, q, q_dot, q_ddot)
+
+
+@lru_cache(maxsize=None)
+def _projection_ritz(n: int) -> RitzModel:
+    """∫ Ψᵀ r dx = 0 with Ψ = D̄ ∘ φ (B(20), B(22)): no boundary terms needed."""
+    a, phi, fields = _ritz_coordinates(n)
+    r = [sp.expand(r_i.subs(fields).doit()) for r_i in _slice_residual()]
+    (q, q_dot, q_ddot), rates = _state_symbols(a)
+    equations = []
+    for field in (v, w):
+        for phi_i in phi:
+            integrand = sum(c * _d(phi_i, *([x] * k)) * r_i for r_i, (f, c, k) in zip(r, D_BAR) if f == field)
+            equations.append(sp.integrate(sp.expand(integrand.subs(rates)), (x, 0, L)))
+    return _matrices(sp.Matrix(equations), q, q_dot, q_ddot)
+
+
+def ritz_models(n: int = 2, length: float = 1.0, rho_A_value: float = 1.0, rho_I_value: float = 0.01,
+                EI_value: float = 1.0) -> dict[str, RitzModel]:
+    """Numeric Ritz models ``{"hamilton": …, "projection": …}`` with n functions per plane.
+
+    Coordinates a = (a_v1 … a_vn, a_w1 … a_wn), shapes (x/L)^(k+1) as in
+    ``RitzBeam(family="polynomial")``. They differ only in C (the ρI α̈ coupling):
+    symmetric for Hamilton, skew-symmetric for the Projection Equation.
+    """
+    if int(n) != n or n < 1:
+        raise ValueError(f"n: number of Ritz functions per plane must be a positive integer, got {n!r}")
+    values = {L: length, rho_A: rho_A_value, rho_I: rho_I_value, EI: EI_value}
+    for symbol, value in values.items():
+        if not value > 0:
+            raise ValueError(f"{symbol}: must be positive, got {value!r}")
+    models = {"hamilton": _hamilton_ritz(int(n)), "projection": _projection_ritz(int(n))}
+    return {
+        name: RitzModel(*(np.array(m.subs(values), dtype=float) for m in model))
+        for name, model in models.items()
+    }
+
+
+def simulate_ritz(model: RitzModel, motion, a0, a_dot0, t_end: float, rtol: float = 1e-9, atol: float = 1e-12):
+    """Integrate a :class:`RitzModel` under the prescribed spin ``motion(t) -> (α, α̇, α̈)``.
+
+    Returns ``(t, a, a_dot, E, W)``: E the energy relative to R (:meth:`RitzModel.energy`),
+    W the drive work ∫ dE/dt dt (:meth:`RitzModel.drive_power`) integrated alongside, so
+    that E − E(0) = W is the work balance of the model.
+    """
+    from scipy.integrate import solve_ivp
+
+    n = len(model.M)
+
+    def rhs(time, state):
+        a, a_dot = state[:n], state[n:2 * n]
+        _, alpha_dot, alpha_ddot = motion(time)
+        a_ddot = model.accelerations(a, a_dot, alpha_dot, alpha_ddot)
+        return np.concatenate([a_dot, a_ddot, [model.drive_power(a, a_dot, alpha_dot, alpha_ddot)]])
+
+    state0 = np.concatenate([np.asarray(a0, float), np.asarray(a_dot0, float), [0.0]])
+    times = np.linspace(0.0, t_end, 201)
+    sol = solve_ivp(rhs, (0.0, t_end), state0, t_eval=times, rtol=rtol, atol=atol, method="DOP853")
+    a, a_dot, W = sol.y[:n].T, sol.y[n:2 * n].T, sol.y[2 * n]
+    E = np.array([model.energy(ai, adi, motion(ti)[1]) for ti, ai, adi in zip(sol.t, a, a_dot)])
+    return sol.t, a, a_dot, E, W

@@ -1,0 +1,103 @@
+"""Bad input to constraints given as equations: one test per kind (issue 4, bad input)."""
+
+import numpy as np
+import pytest
+
+import projeq as pq
+from projeq.constrained import ConstrainedSystem
+from projeq.reaction_forces import contact_event, reactions
+from projeq.scenes.mechanisms import slider_pendulum
+
+
+@pytest.fixture(scope="module")
+def tree():
+    """A point mass on x and z sliders: q = ṡ-integral = (x, z)."""
+    return pq.System({"x": pq.Frame(), "bob": pq.PointMass(1.0)},
+                     {"x": pq.Prismatic(axis="x"), "bob": pq.Prismatic(parent="x", axis="z")},
+                     gravity=(0, 0, -9.81), q0=(0.6, -0.8))
+
+
+def circle(q, t):
+    return [np.hypot(q[0], q[1]) - 1.0]
+
+
+def test_no_constraint(tree):
+    with pytest.raises(ValueError, match="phi: give"):
+        ConstrainedSystem(tree)
+
+
+def test_constraint_not_callable(tree):
+    with pytest.raises(ValueError, match="A: expected a callable"):
+        ConstrainedSystem(tree, A=np.ones((1, 2)))
+
+
+def test_pfaffian_matrix_of_wrong_shape(tree):
+    with pytest.raises(ValueError, match=r"A: returns an array of shape \(1, 3\), expected \(m, n_q = 2\)"):
+        ConstrainedSystem(tree, A=lambda q, t: np.ones((1, 3)))
+
+
+def test_right_hand_side_of_wrong_length(tree):
+    with pytest.raises(ValueError, match=r"b: returns an array of shape \(2,\), expected \(1,\)"):
+        ConstrainedSystem(tree, A=lambda q, t: [[1.0, 0.0]], b=lambda q, t: [0.0, 0.0])
+
+
+def test_b_without_A(tree):
+    with pytest.raises(ValueError, match="b: given without A"):
+        ConstrainedSystem(tree, phi=circle, b=lambda q, t: [0.0])
+
+
+def test_rank_deficient_rows_are_named(tree):
+    """The Pfaffian row 1, 2x ẋ + 2z ż = 0, repeats the circle's velocity constraint (row 0)."""
+    match = r"rank-deficient at q0 \(rank 1 of 2\): rows \[1\] depend on rows \[0\]"
+    with pytest.raises(ValueError, match=match):
+        ConstrainedSystem(tree, phi=circle, A=lambda q, t: [[2 * q[0], 2 * q[1]]])
+
+
+def test_wrong_number_of_independent_velocities(tree):
+    with pytest.raises(ValueError, match="independent: expected 1 distinct indices"):
+        ConstrainedSystem(tree, phi=circle, independent=[0, 1])
+
+
+def test_partition_with_a_singular_dependent_block(tree):
+    """At (1, 0) the circle's normal is x: ż cannot be the dependent velocity."""
+    match = r"independent: the dependent velocities \[1\] cannot be solved for at q = \[1.0, 0.0\]"
+    with pytest.raises(ValueError, match=match):
+        ConstrainedSystem(tree, phi=circle, independent=[0], q0=[1.0, 0.0])
+
+
+def test_automatic_partition_picks_the_regular_block(tree):
+    """Same configuration without a user choice: pivoted QR makes ẋ dependent, ż independent."""
+    system = ConstrainedSystem(tree, phi=circle, q0=[1.0, 0.0])
+    assert system.dependent.tolist() == [0] and system.independent.tolist() == [1]
+
+
+def test_initial_coordinates_off_the_constraints(tree):
+    with pytest.raises(ValueError, match=r"q0: violates the loop closures Φ\(q0\) = \[0.1"):
+        ConstrainedSystem(tree, phi=circle, q0=[0.66, -0.88])
+
+
+def test_initial_coordinates_projected_on_request(tree):
+    system = ConstrainedSystem(tree, phi=circle, q0=[0.66, -0.88], project_q0=True)
+    assert abs(np.hypot(*system.q0) - 1.0) < 1e-12  # POSITION_TOLERANCE
+    assert np.allclose(system.q0, [0.6, -0.8])  # the minimum-norm step keeps the direction
+
+
+def test_unknown_correction(tree):
+    with pytest.raises(ValueError, match="correction: unknown method 'stabilize'"):
+        ConstrainedSystem(tree, phi=circle, correction="stabilize")
+
+
+def test_time_dependent_loop_with_projection(tree):
+    with pytest.raises(ValueError, match="correction: 'projection' needs Φ independent of t"):
+        ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0 - 0.1 * np.sin(t)])
+
+
+def test_reactions_of_a_tree(tree):
+    r = pq.simulate(tree, 0.1, n_points=3)
+    with pytest.raises(ValueError, match="system: reactions need a ConstrainedSystem"):
+        reactions(tree, r)
+
+
+def test_contact_event_row_out_of_range():
+    with pytest.raises(ValueError, match="row: expected a constraint row in 0..0"):
+        contact_event(slider_pendulum(), 1)

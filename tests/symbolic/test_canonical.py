@@ -1,0 +1,109 @@
+"""Barhorst's canonical momentum forms (``seeds/000_3d4483f33eada135.txt`` eqs. 28–37 and 45–52) against
+projeq's numeric Projection-Equation simulation, for the knife-edge disc and Barhorst's particle."""
+
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from projeq.scenes.nonholonomic import barhorst_particle
+from projeq.simulation import simulate
+from projeq.symbolic.canonical import lagrangian_canonical, projective_canonical
+from projeq.symbolic.formulation_examples import lecture_disc, particle, projective_disc
+from projeq.symbolic.projection import Body, t
+
+from .test_lagrange import ATOL, RTOL, disc_reference
+
+Q_DISC, U_DISC = sp.symbols("x y z psi phi theta"), sp.symbols("u1:4")  # as in projective_disc()
+
+
+@pytest.mark.parametrize("form", ["lagrangian", "projective"])
+def test_disc_canonical_forms_follow_the_projection_equation(form):
+    """Same initial state as projeq's PE run; (x, y, ψ, ϕ, θ) agree to 1000 × rtol over 1 time unit
+    (both at rtol = 1e-11; measured ~6e-12); the speeds u(p) reproduce the PE's ṡ = (ψ̇, ϕ̇, θ̇) likewise."""
+    reference, q0, q_dot0 = disc_reference()
+    canonical = lagrangian_canonical(lecture_disc()) if form == "lagrangian" else projective_disc()
+    sol = canonical.simulate(q0, q_dot0[3:], (0, reference.t[-1]), t_eval=reference.t,
+                             rtol=RTOL, atol=ATOL)
+    assert sol.success
+    assert np.abs(sol.q[[0, 1, 3, 4, 5]].T - reference.q).max() < 1000 * RTOL
+    assert np.abs(sol.u.T - reference.s_dot).max() < 1000 * RTOL
+
+
+def test_both_momenta_are_dT_du_and_agree_at_random_states():
+    """Barhorst's projective momenta (28) and Lagrangian momenta (45) both equal ∂T/∂u (the projected
+    momenta); checked numerically at 5 random states (round-off tolerance 1e-12 relative)."""
+    lagrangian, projective = lagrangian_canonical(lecture_disc()), projective_disc()
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        q, u = rng.uniform(-1, 1, 6), rng.uniform(-2, 2, 3)
+        p_l, p_p = lagrangian.momenta(0.0, q, u), projective.momenta(0.0, q, u)
+        assert np.allclose(p_l, p_p, rtol=1e-12, atol=1e-12)
+
+
+def test_lagrangian_kinematics_come_from_the_constraint_matrix():
+    """K from A (slide 30): the dependent rows are −A_ρ⁻¹ A_λ, the same K as the projective input."""
+    assert sp.simplify(lagrangian_canonical(lecture_disc()).K.subs(
+        dict(zip(sp.symbols("psi_dot phi_dot theta_dot"), U_DISC))) - projective_disc().K) == sp.zeros(6, 3)
+
+
+@pytest.mark.parametrize("form", ["lagrangian", "projective"])
+def test_barhorst_particle_canonical_forms_follow_the_projection_equation(form):
+    """Barhorst §3.1 particle from (2, 2), ẋ = 0.5: matches projeq's scene to 1000 × rtol over 0.3 s and
+    conserves E = ½(ẋ² + ẏ²) + 10 y to 1000 × rtol (relative)."""
+    system = barhorst_particle(s_dot0=(0.5,))
+    reference = simulate(system, 0.3, t_eval=np.linspace(0, 0.3, 16), rtol=RTOL, atol=ATOL, method="DOP853")
+    if form == "lagrangian":
+        canonical = lagrangian_canonical(particle(), independent=particle().q[:1])
+    else:
+        qx, qy, u = sp.symbols("x y u")
+        body = Body(v_c=(u, qy**2 * u, 0), omega=(0, 0, 0), m=1, I_c=sp.zeros(3, 3), f=(0, -10, 0))
+        canonical = projective_canonical([body], (qx, qy), (u,), [[1], [qy**2]], t)
+    sol = canonical.simulate(system.q0, system.s_dot0, (0, 0.3), t_eval=reference.t, rtol=RTOL, atol=ATOL)
+    assert np.abs(sol.q.T - reference.q).max() < 1000 * RTOL
+    energy = 0.5 * sol.u[0] ** 2 * (1 + sol.q[1] ** 4) + 10 * sol.q[1]
+    assert np.abs(energy - energy[0]).max() < 1000 * RTOL * abs(energy[0])
+
+
+def test_mismatched_K_is_refused():
+    with pytest.raises(ValueError, match="K: expected a 6 × 3 matrix"):
+        projective_canonical([], Q_DISC, U_DISC, sp.zeros(6, 2), t)
+
+
+def test_body_vectors_must_be_3_vectors():
+    with pytest.raises(ValueError, match=r"bodies\[0\].v_c: expected a 3-vector"):
+        projective_canonical([Body((1, 0), (0, 0, 0), 1, sp.eye(3))], Q_DISC, U_DISC, sp.zeros(6, 3), t)
+
+
+def test_undeclared_symbols_are_named():
+    k = sp.Symbol("k")
+    with pytest.raises(ValueError, match="bodies: undeclared symbols k"):
+        projective_canonical([Body((0, 0, 0), (0, 0, 0), k, sp.eye(3))], Q_DISC, U_DISC, sp.zeros(6, 3), t)
+
+
+def test_inhomogeneous_constraints_are_refused():
+    from projeq.symbolic.lagrange import multiplier_system
+    from sympy.physics.mechanics import dynamicsymbols
+    qx, qy = dynamicsymbols("x y")
+    system = multiplier_system(qx.diff(t) ** 2 + qy.diff(t) ** 2, [qx, qy], t, A=[[1, 1]], b=[1])
+    with pytest.raises(ValueError, match="b: the canonical forms need homogeneous"):
+        lagrangian_canonical(system)
+
+
+def test_initial_state_sizes_are_checked():
+    with pytest.raises(ValueError, match="q0, u0: expected 6 coordinates and 3 speeds"):
+        projective_disc().simulate(np.zeros(6), np.zeros(2), (0, 1))
+
+
+def test_barhorst_particle_projective_equations_are_his_74_to_77():
+    """Barhorst's own choice u = ẏ (A12 = 1/y², seed 000 §3.1.3): p₂ = m u₂ (1 + 1/y⁴) (74), Q₂ = −m g (76),
+    P₂ = L · d/dt(n̂₂ + n̂₁/y²) = −2 m u₂²/y⁵ (77); the Lagrangian form (45) gives the same p₂ and ṗ₂."""
+    qx, qy, u2, mass, grav = sp.symbols("x y u_2 m g")
+    body = Body(v_c=(u2 / qy**2, u2, 0), omega=(0, 0, 0), m=mass, I_c=sp.zeros(3, 3), f=(0, -mass * grav, 0))
+    projective = projective_canonical([body], (qx, qy), (u2,), [[1 / qy**2], [1]], t, {mass: 1, grav: 10})
+    assert sp.simplify(projective.p[0] - mass * u2 * (1 + 1 / qy**4)) == 0
+    assert sp.simplify(projective.p_dot[0] - (-mass * grav - 2 * mass * u2**2 / qy**5)) == 0
+    lagrangian = lagrangian_canonical(particle(), independent=particle().q[1:])
+    on_u = {lagrangian.u[0]: u2, mass: 1, grav: 10}
+    assert sp.simplify((lagrangian.p[0] - projective.p[0]).subs(on_u)) == 0
+    assert sp.simplify((lagrangian.p_dot[0] - projective.p_dot[0]).subs(on_u)) == 0

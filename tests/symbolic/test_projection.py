@@ -1,0 +1,160 @@
+"""The symbolic Projection Equation B(10)–(12) of seed ``004_e8c95cc2ec0226a1.txt`` (THEORY §2)."""
+
+import numpy as np
+import pytest
+import sympy as sp
+from sympy.physics import mechanics as me
+
+import projeq as pq
+from projeq import inertia
+from projeq.symbolic import Body, projection_equation
+from projeq.symbolic.examples import n_link_pendulum
+
+RNG_SEED = 20261123
+# two evaluations of the same equations in double precision, O(10²) operations on numbers
+# of order 10²: round-off ≲ 1e-13 relative; 1e-11 leaves two orders of margin
+RTOL = 1e-11
+
+x, y, gamma = Q_CAR = sp.symbols("x y gamma")
+v_x, omega_z = S_CAR = sp.symbols("v_x omega_z")
+m, c, C0, f_x, f_y, M_z = CAR_PARAMETERS = sp.symbols("m c C0 f_x f_y M_z")
+K_CAR = sp.Matrix([[sp.cos(gamma), 0], [sp.sin(gamma), 0], [0, 1]])  # B(6) without v_y
+
+
+def car_gauss_form():
+    """B(11)–(12): body-fixed R (ω_IR = ω), v_c = (v_x, c ω_z), C^c = C° − m c²; f_x at O
+    along x, f_y lateral at the mass centre, M_z about z (the loads of ``scenes.car``)."""
+    car = Body(v_c=(v_x, c * omega_z, 0), omega=(0, 0, omega_z), m=m, I_c=sp.diag(0, 0, C0 - m * c**2),
+               f=(f_x, f_y, 0), M=(0, 0, M_z), omega_IR=(0, 0, omega_z))
+    return projection_equation({"car": car}, Q_CAR, S_CAR, K_CAR, CAR_PARAMETERS)
+
+
+def test_car_is_B9():
+    """B(9) (with f_y at the mass centre adding c f_y to the ω_z row, B(12)): M = diag(m, C°),
+    rhs = −[[0, −m c ω_z], [m c ω_z, 0]] ṡ + (f_x, M_z + c f_y) — symbolically identical."""
+    gauss = car_gauss_form()
+    assert gauss.M == sp.diag(m, C0)
+    G = sp.Matrix([[0, -m * c * omega_z], [m * c * omega_z, 0]])
+    expected = -G * sp.Matrix(S_CAR) + sp.Matrix([f_x, M_z + c * f_y])
+    assert sp.simplify(gauss.rhs - expected) == sp.zeros(2, 1)
+    assert gauss.q == Q_CAR and gauss.s == S_CAR and gauss.t == sp.Symbol("t")
+    assert r"\ddot{\omega_{z}}" in gauss.latex()
+
+
+def test_compiled_car_equals_scenes_car_dense_and_recursive():
+    """The compiled evaluator (lambdify, cse=True) gives the accelerations of projeq's dense
+    and recursive evaluators of ``scenes.car`` at random parameters and states."""
+    rng = np.random.default_rng(RNG_SEED)
+    gauss = car_gauss_form()
+    for _ in range(5):
+        p = dict(zip(("m", "c", "f_x", "f_y", "M_z"), (rng.uniform(500, 2000), rng.uniform(0.2, 2.0), *rng.uniform(-3000, 3000, 3))))
+        p["C0"] = p["m"] * p["c"] ** 2 + rng.uniform(200, 3000)
+        system = pq.scenes.car(**p)
+        evaluator = gauss.evaluator({sp.Symbol(k): v for k, v in p.items()})
+        for _ in range(5):
+            q, s_dot = rng.uniform(-5, 5, 3), np.array([rng.uniform(-20, 20), rng.uniform(-2, 2)])
+            s_ddot = evaluator.accelerations(q, s_dot, 0.0)
+            for method in ("recursive", "dense"):
+                reference = system.accelerations(q, s_dot, method=method)
+                assert np.allclose(s_ddot, reference, rtol=RTOL, atol=RTOL * np.abs(reference).max())
+
+
+def chain_values():
+    """The numbers of ``scenes.chain``: 1 kg, 1 m cylinders of radius 0.01 m, g = 9.81."""
+    I_c = inertia.cylinder(m=1.0, radius=0.01, length=1.0, axis="z")
+    return dict(zip(sp.symbols("m l J J_a g", positive=True), (1.0, 1.0, I_c[0, 0], I_c[2, 2], 9.81)))
+
+
+def test_n_link_pendulum_equals_scenes_chain_dense_and_recursive():
+    """Symbolic == numeric: the 4-link pendulum from mass-centre velocities (inertial frame,
+    q-dependent I_c) equals ``scenes.chain(4)`` (joint chain T_np, F_n, THEORY §4) in M and s̈
+    at random states, for both numeric evaluators."""
+    rng = np.random.default_rng(RNG_SEED)
+    bodies, q, s, parameters = n_link_pendulum(4)
+    evaluator = projection_equation(bodies, q, s, parameters=parameters).evaluator(chain_values())
+    system = pq.scenes.chain(4)
+    for _ in range(10):
+        q_n, s_n = rng.uniform(-np.pi, np.pi, 4), rng.uniform(-3, 3, 4)
+        M, _ = evaluator.gauss_form(q_n, s_n)
+        M_ref, _ = system.gauss_form(q_n, s_n)
+        assert np.allclose(M, M_ref, rtol=0, atol=RTOL * np.abs(M_ref).max())
+        s_ddot = evaluator.accelerations(q_n, s_n)
+        for method in ("recursive", "dense"):
+            reference = system.accelerations(q_n, s_n, method=method)
+            assert np.allclose(s_ddot, reference, rtol=0, atol=RTOL * (1 + np.abs(reference).max()))
+
+
+def kane_pendulum(n):
+    """sympy.physics.mechanics KanesMethod for the same n-link pendulum (VALIDATION.md):
+    frames rotated about N.y, rigid links with central inertia (J, J, J_a), gravity −g N.z."""
+    q, u = me.dynamicsymbols(f"q1:{n + 1}"), me.dynamicsymbols(f"u1:{n + 1}")
+    m, l, J, J_a, g = sp.symbols("m l J J_a g", positive=True)
+    N = me.ReferenceFrame("N")
+    joint = me.Point("O")
+    joint.set_vel(N, 0)
+    frame, links, loads = N, [], []
+    for k in range(n):
+        frame = frame.orientnew(f"A{k}", "Axis", (q[k], frame.y))
+        frame.set_ang_vel(N, sum((u_j * N.y for u_j in u[: k + 1]), 0 * N.y))
+        centre = joint.locatenew(f"C{k}", -l / 2 * frame.z)
+        centre.v2pt_theory(joint, N, frame)
+        links.append(me.RigidBody(f"B{k}", centre, frame, m, (me.inertia(frame, J, J, J_a), centre)))
+        loads.append((centre, -m * g * N.z))
+        joint = joint.locatenew(f"P{k}", -l * frame.z)
+        joint.v2pt_theory(centre, N, frame)
+    kane = me.KanesMethod(N, q_ind=q, u_ind=u, kd_eqs=[q_k.diff() - u_k for q_k, u_k in zip(q, u)])
+    kane.kanes_equations(links, loads)
+    return q, u, kane.mass_matrix, kane.forcing
+
+
+def test_n_link_pendulum_equals_kanes_method():
+    """Projection Equation == KanesMethod (VALIDATION.md, N-link pendulum, N = 3): M and
+    rhs (M u̇ = forcing) agree at random states and random parameters."""
+    rng = np.random.default_rng(RNG_SEED)
+    bodies, q, s, parameters = n_link_pendulum(3)
+    gauss = projection_equation(bodies, q, s, parameters=parameters)
+    q_k, u_k, M_k, forcing = kane_pendulum(3)
+    kane = sp.lambdify([q_k, u_k, parameters], [M_k, forcing], cse=True)
+    ours = sp.lambdify([q, s, parameters], [gauss.M, gauss.rhs], cse=True)
+    for _ in range(10):
+        state = rng.uniform(-np.pi, np.pi, 3), rng.uniform(-3, 3, 3), rng.uniform(0.5, 3.0, 5)
+        (M, rhs), (M_ref, rhs_ref) = ours(*state), kane(*state)
+        assert np.allclose(M, M_ref, rtol=0, atol=RTOL * np.abs(M_ref).max())
+        assert np.allclose(rhs, rhs_ref, rtol=0, atol=RTOL * (np.abs(rhs_ref).max() + np.abs(M_ref).max()))
+
+
+def test_simulate_with_the_compiled_evaluator_equals_the_recursive_one():
+    """``projeq.simulate(system, evaluator=compiled)`` reproduces the recursive run of the
+    3-link chain: same right-hand side to round-off, so the trajectories differ by the
+    integrator's error control only; at rtol = 1e-10 over 1 s, ≲ 1e-8 rad."""
+    bodies, q, s, parameters = n_link_pendulum(3)
+    evaluator = projection_equation(bodies, q, s, parameters=parameters).evaluator(chain_values())
+    system = pq.scenes.chain(3)
+    ours = pq.simulate(system, 1.0, evaluator=evaluator, rtol=1e-10, atol=1e-12, n_points=21)
+    reference = pq.simulate(system, 1.0, evaluator="recursive", rtol=1e-10, atol=1e-12, n_points=21)
+    assert np.abs(ours.q - reference.q).max() < 1e-8
+
+
+def test_undeclared_symbols_are_named():
+    k = sp.Symbol("k")
+    body = Body(v_c=(v_x, c * omega_z, 0), omega=(0, 0, omega_z), m=m, I_c=sp.zeros(3), f=(k * x, 0, 0))
+    with pytest.raises(ValueError, match="^car.f: depends on undeclared symbols k"):
+        projection_equation({"car": body}, Q_CAR, S_CAR, K_CAR, (m, c))
+
+
+def test_mismatched_dimensions_are_refused_by_name():
+    body = Body(v_c=(v_x, 0), omega=(0, 0, omega_z), m=m, I_c=sp.zeros(3))
+    with pytest.raises(ValueError, match=r"^car.v_c: expected a 3-vector, got shape \(2, 1\)"):
+        projection_equation({"car": body}, Q_CAR, S_CAR, K_CAR, (m,))
+    body = Body(v_c=(v_x, 0, 0), omega=(0, 0, omega_z), m=m, I_c=sp.zeros(2))
+    with pytest.raises(ValueError, match="^car.I_c: expected a 3×3"):
+        projection_equation({"car": body}, Q_CAR, S_CAR, K_CAR, (m,))
+    with pytest.raises(ValueError, match=r"^K: expected shape \(3, 2\)"):
+        projection_equation({"car": body}, Q_CAR, S_CAR, K_CAR.T, (m,))
+    with pytest.raises(ValueError, match="^K: required"):
+        projection_equation({"car": body}, Q_CAR, S_CAR, parameters=(m,))
+
+
+def test_evaluator_needs_every_parameter_value():
+    with pytest.raises(ValueError, match="^values: no number given for the parameters C0"):
+        car_gauss_form().evaluator({m: 1.0, c: 1.0, f_x: 0.0, f_y: 0.0, M_z: 0.0})
