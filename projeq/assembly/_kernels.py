@@ -177,6 +177,14 @@ def _add_congruence(T, M, c, MT, M_p, h_p):
         h_p[a] += total
 
 
+def missing_compiler(compiled: bool | None) -> str | None:
+    """Why the default kernel choice (``compiled=None``) falls back to the general path:
+    numba is missing and the interpreted kernel was not asked for; else None."""
+    if compiled is None and _numba() is None and os.environ.get("PROJEQ_FAST_KERNEL", "") != "python":
+        return "numba is not installed (pip install 'projeq[fast]'): the recursive evaluator is used"
+    return None
+
+
 def kernel(compiled: bool | None = None):
     """(chain_terms, passes), compiled by numba when ``compiled`` is true, or when it is
     None, numba is installed and the environment variable ``PROJEQ_FAST_KERNEL`` is not

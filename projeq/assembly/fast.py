@@ -5,8 +5,9 @@ joint kinds, axes, joint frames, masses, r_c, I_c, M_n) and each call runs
 :func:`projeq.assembly._kernels.chain_terms` (T_np, ζ_n, F_n, h_n; THEORY §3–4) and
 :func:`projeq.assembly._kernels.passes` (Bremer's backward and forward passes, §6).
 With numba installed (``pip install 'projeq[fast]'``) both are compiled on first use
-(cached on disk); without it the same source runs interpreted — correct, but slower than
-``method="recursive"``.
+(cached on disk). Without it ``method="fast"`` is the recursive evaluator (``reason``
+says so): the same kernel source runs interpreted only on request (``compiled=False`` or
+``PROJEQ_FAST_KERNEL=python``, for testing) — correct, but slower than the recursive one.
 
 Supported: trees of :class:`~projeq.RigidBody` / :class:`~projeq.PointMass` on
 :class:`~projeq.Revolute`, :class:`~projeq.Prismatic` and :class:`~projeq.Fixed` joints
@@ -46,8 +47,8 @@ class FastEvaluator:
     system : System
     compiled : bool or None
         True: numba (ValueError if it is missing); False: the interpreted kernel (the
-        pure-numpy fallback); None: numba when installed, unless the environment variable
-        ``PROJEQ_FAST_KERNEL=python``.
+        pure-numpy fallback); None: numba when installed, the interpreted kernel if the
+        environment variable ``PROJEQ_FAST_KERNEL=python``, else the general path.
 
     Attributes: ``fast`` (the kernel is used), ``reason`` (why not, else None),
     ``compiled`` (numba), ``n_calls``. The workspace (T_np, ζ_n, f_n, M̂_n, ĥ_n) is
@@ -57,7 +58,7 @@ class FastEvaluator:
     def __init__(self, system, compiled: bool | None = None):
         self.system = system
         self.n_calls = 0
-        self.reason = unsupported(system)
+        self.reason = unsupported(system) or _kernels.missing_compiler(compiled)
         self.fast = self.reason is None
         self.compiled = False
         if not self.fast:

@@ -25,8 +25,9 @@ HAS_NUMBA = _kernels._numba() is not None
 @given(trees(max_n=30, kinds=KERNEL_KINDS, forces=False))
 def test_fast_equals_dense_on_random_trees(tree):
     """Trees of 1–30 rigid bodies on revolute, prismatic and fixed joints about random axes,
-    random joint frames, masses over four decades: fast s̈ = dense s̈."""
-    assert tree.system.evaluator("fast").fast
+    random joint frames, masses over four decades: fast s̈ = dense s̈ (without numba
+    method="fast" is the recursive evaluator; the interpreted kernel is tested below)."""
+    assert tree.system.evaluator("fast").fast is HAS_NUMBA
     _agree(tree, "fast", "dense")
 
 
@@ -46,6 +47,17 @@ def test_environment_switch_selects_the_interpreted_kernel(monkeypatch):
     assert FastEvaluator(system).compiled is HAS_NUMBA
     monkeypatch.setenv("PROJEQ_FAST_KERNEL", "python")
     assert FastEvaluator(system).compiled is False
+
+
+def test_without_numba_the_default_is_the_recursive_evaluator(monkeypatch):
+    """The interpreted kernel is slower than the recursive evaluator, so without numba
+    method="fast" does not use it unless asked (PROJEQ_FAST_KERNEL=python)."""
+    monkeypatch.setattr(_kernels, "_numba", lambda: None)
+    monkeypatch.delenv("PROJEQ_FAST_KERNEL", raising=False)
+    ev = FastEvaluator(pq.scenes.chain(2))
+    assert ev.fast is False and "numba is not installed" in ev.reason
+    monkeypatch.setenv("PROJEQ_FAST_KERNEL", "python")
+    assert FastEvaluator(pq.scenes.chain(2)).fast is True
 
 
 def test_compiled_without_numba_is_refused(monkeypatch):
