@@ -1,9 +1,10 @@
-"""Comparing derivations: the recursive order-n evaluator against the dense Gauss form.
+"""Comparing derivations: recursive order-n, compiled order-n ("fast"), dense Gauss form, sympy.
 
-Both evaluate the Projection Equation Σ (∂ẏ_n/∂ṡ)ᵀ(M_n ÿ_n + G_n ẏ_n − Q_n) = 0 for the
-same chain, one by the O(n) recursion (THEORY §6), one by assembling M(q) and solving
-(THEORY §5). Two formulations of the same equations must give the same accelerations to
-round-off, and trajectories that agree to the integration tolerance.
+All evaluate the Projection Equation Σ (∂ẏ_n/∂ṡ)ᵀ(M_n ÿ_n + G_n ẏ_n − Q_n) = 0 for the
+same chain: by the O(n) recursion (THEORY §6) in numpy and compiled, by assembling M(q)
+and solving (THEORY §5), and symbolically (``projeq.symbolic.gauss_form``: M(q) s̈ = rhs
+in sympy, lambdified). Formulations of the same equations must give the same
+accelerations to round-off, and trajectories that agree to the integration tolerance.
 
 Run: python examples/derivations.py
 """
@@ -13,6 +14,7 @@ import os
 import numpy as np
 
 import projeq as pq
+from projeq.symbolic import gauss_form
 
 system = pq.scenes.chain(4)
 rng = np.random.default_rng(1)
@@ -22,6 +24,11 @@ dense = system.accelerations(q, s_dot, method="dense")
 difference = np.abs(recursive - dense).max() / np.abs(dense).max()
 print(f"accelerations at a random state: relative difference {difference:.1e}")
 assert difference < 1e-12  # a 4x4 solve: round-off is ~1e-15; 1e-12 leaves a factor 1000
+fast = system.accelerations(q, s_dot, method="fast")  # numba-compiled when installed, else numpy
+symbolic = gauss_form(system).evaluator().accelerations(q, s_dot)
+for name, value in (("fast", fast), ("symbolic", symbolic)):
+    print(f"{name}: relative difference to dense {np.abs(value - dense).max() / np.abs(dense).max():.1e}")
+    assert np.abs(value - dense).max() < 1e-12 * np.abs(dense).max()  # the same round-off argument
 
 t_end = 0.2 if os.environ.get("PROJEQ_QUICK") else 5.0
 runs = {name: pq.simulate(system, t_end, rtol=1e-10, atol=1e-12, evaluator=name) for name in ("recursive", "dense")}

@@ -19,8 +19,8 @@ __all__ = [
     "Joint", "Revolute", "Prismatic", "Fixed", "Planar", "Free", "Prescribed", "UserJoint",
     "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
     "inertia", "simulate", "Result", "SimulationError", "scenes", "linearize", "Linearization", "NotSteadyError",
-    "eigenvalue_sweep", "compare", "ComparisonTable", "ConstrainedSystem", "reactions", "joint_reactions",
-    "contact_event", "plots", "sweep", "SweepTable", "symbolic",
+    "eigenvalue_sweep", "compare", "ComparisonTable", "ConstrainedSystem", "reactions", "joint_reactions", "PinClosure",
+    "contact_event", "StiffnessWarning", "plots", "sweep", "SweepTable", "symbolic",
 ]
 
 
@@ -29,9 +29,11 @@ _LAZY = {
     "simulate": "projeq.simulation", "Result": "projeq.simulation", "SimulationError": "projeq.simulation",
     "compare": "projeq.comparison", "ComparisonTable": "projeq.comparison",
     "ConstrainedSystem": "projeq.constrained",
+    "PinClosure": "projeq.cut_joints",
     "reactions": "projeq.reaction_forces", "joint_reactions": "projeq.reaction_forces",
     "contact_event": "projeq.reaction_forces",
     "sweep": "projeq.sweeps", "SweepTable": "projeq.sweeps",
+    "StiffnessWarning": "projeq.integrators",
 }
 _LAZY_MODULES = ("scenes", "plots", "symbolic")
 

@@ -8,8 +8,9 @@ Pinocchio's ABA (``pin.aba``) and MuJoCo's ``mj_forward`` on the same chain, bui
 from the same parameters; their s̈ is compared with the dense evaluator, which checks
 that the peer models are the same chain.
 
-    python -m projeq.bench            # chain n = 10, 30, 100 (+ scripts' --quick)
-    python -m projeq.bench --json
+    projeq bench                 # chain n = 10, 30, 100, then the scripts' quick modes
+    projeq bench --json          # one JSON document with every report
+    projeq bench --chain-only --no-peers --sizes 10,30
 """
 
 from __future__ import annotations
@@ -147,7 +148,9 @@ def measure(sizes, budget: float = 1.0, peers: bool = True) -> list[dict]:
 
 def slopes(rows) -> dict:
     """Least-squares slope of log(time) against log(n) for every evaluator timed at
-    every size."""
+    every size (none for fewer than two sizes)."""
+    if len({r["n"] for r in rows}) < 2:
+        return {}
     names = set.intersection(*(set(r["seconds"]) for r in rows))
     n = np.log([r["n"] for r in rows])
     return {k: float(np.polyfit(n, np.log([r["seconds"][k] for r in rows]), 1)[0]) for k in sorted(names)}
@@ -164,53 +167,117 @@ def print_table(rows, slope: dict) -> None:
         ratio = {p: f"{s['fast'] / s[p]:.2f}" if p in s else "-" for p in ("pinocchio", "mujoco")}
         print(f"{r['n']:>6} {cells} {ratio['pinocchio']:>9} {ratio['mujoco']:>12} "
               f"{r['deviation']['fast']:>9.1e} {max(r['deviation'].values()):>9.1e}")
-    print("log-log slope: " + ", ".join(f"{k} {v:.3f}" for k, v in slope.items()))
+    if slope:
+        print("log-log slope: " + ", ".join(f"{k} {v:.3f}" for k, v in slope.items()))
+
+
+def chain_report(sizes, budget: float, peers: bool = True) -> dict:
+    """The chain-scaling report: :func:`measure` rows and their :func:`slopes`."""
+    rows = measure(sizes, budget, peers)
+    return {"benchmark": "chain_scaling", "rows": rows, "slopes": slopes(rows)}
 
 
 def chain_scaling(sizes, budget: float, as_json: bool, peers: bool = True) -> dict:
     """Measure, print (table or JSON) and return the chain-scaling report."""
-    rows = measure(sizes, budget, peers)
-    report = {"benchmark": "chain_scaling", "rows": rows, "slopes": slopes(rows)}
+    report = chain_report(sizes, budget, peers)
     if as_json:
         print(json.dumps(report, indent=2))
     else:
-        print_table(rows, report["slopes"])
+        print_table(report["rows"], report["slopes"])
     return report
 
 
-QUICK_SCRIPTS = {"beam_convergence.py": ["--quick"], "derivation.py": ["2", "4"]}  # their quick arguments
+QUICK_SCRIPTS = {"derivation.py": ["2", "4"], "beam_convergence.py": ["--quick"]}  # quick arguments, cheapest first
+TOTAL_BUDGET = 120.0  # s of wall time for all of projeq bench (issue 7, item 2: "under two minutes")
 
 
-def _run_script(name: str, as_json: bool, timeout: float) -> int:
-    """``benchmarks/<name>`` of a source checkout with its quick arguments, if it exists;
-    its exit code."""
+def run_script(name: str, as_json: bool, timeout: float) -> dict:
+    """Run ``benchmarks/<name>`` of a source checkout with its quick arguments.
+
+    Its output goes to this process's stdout, or with ``as_json`` is parsed as its JSON
+    report. Returns ``{"benchmark", "status", "seconds"}`` (+ ``"report"`` with
+    ``as_json``); status is "ok", "failed (exit code k)", "stopped after T s" or
+    "not available" (an installed package has no ``benchmarks/``).
+    """
     script = Path(__file__).resolve().parents[1] / "benchmarks" / name
+    entry = {"benchmark": name.removesuffix(".py"), "status": "not available", "seconds": 0.0}
     if not script.exists():
-        print(f"{name}: not available (benchmarks/ is part of the source checkout)")
-        return 0
+        return entry
     args = QUICK_SCRIPTS[name] + ["--json"] * as_json
-    print(f"\n$ python benchmarks/{name} {' '.join(args)}", flush=True)
+    if not as_json:
+        print(f"\n$ python benchmarks/{name} {' '.join(args)}", flush=True)
+    started = time.perf_counter()
     try:
-        return subprocess.run([sys.executable, str(script), *args], timeout=timeout).returncode
+        done = subprocess.run([sys.executable, str(script), *args], timeout=timeout, text=True,
+                              stdout=subprocess.PIPE if as_json else None)
+        entry["status"] = "ok" if done.returncode == 0 else f"failed (exit code {done.returncode})"
     except subprocess.TimeoutExpired:
-        print(f"{name}: stopped after {timeout:.0f} s")
-        return 1
+        done, entry["status"] = None, f"stopped after {timeout:.0f} s"
+    entry["seconds"] = time.perf_counter() - started
+    if as_json:
+        entry["report"] = _parse_json(done.stdout if done is not None else "")
+    return entry
+
+
+def _parse_json(text: str):
+    """A script's JSON report, or its raw output when that is not JSON."""
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError:
+        return {"output": text}
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="projeq bench", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
+    parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per chain length (default 0.5)")
+    parser.add_argument("--sizes", type=_sizes, default=QUICK_SIZES, metavar="N,N,...",
+                        help="chain lengths (default %s)" % ",".join(map(str, QUICK_SIZES)))
+    parser.add_argument("--total", type=float, default=TOTAL_BUDGET,
+                        help=f"wall-time budget in s for everything; the scripts share what the chain part "
+                             f"leaves and are stopped when it is spent (default {TOTAL_BUDGET:g})")
+    parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
+    parser.add_argument("--chain-only", action="store_true", help="skip the scripts in benchmarks/")
+    return parser
+
+
+def _sizes(text: str) -> tuple:
+    """``"10,30"`` -> (10, 30); argparse prints the error as a bad --sizes (exit code 2)."""
+    try:
+        sizes = tuple(int(n) for n in text.split(","))
+        if min(sizes) < 1:
+            raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected chain lengths >= 1 separated by commas, got {text!r}") from None
+    return sizes
 
 
 def main(argv=None) -> int:
-    """``projeq bench``: quick chain scaling, then the quick beam and derivation scripts."""
-    parser = argparse.ArgumentParser(prog="projeq bench", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
-    parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per chain length")
-    parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
-    parser.add_argument("--chain-only", action="store_true", help="skip the scripts in benchmarks/")
-    args = parser.parse_args(argv)
-    chain_scaling(QUICK_SIZES, args.budget, args.json, not args.no_peers)
-    if args.chain_only:
-        return 0
-    codes = [_run_script(name, args.json, 50.0) for name in QUICK_SCRIPTS]
-    return max(codes)
+    """``projeq bench``: quick chain scaling, then the quick beam and derivation scripts
+    within the total budget; a summary of the wall times. Exit code 1 when a script failed
+    or was stopped."""
+    args = _parser().parse_args(argv)
+    started = time.perf_counter()
+    chain = chain_report(args.sizes, args.budget, not args.no_peers)
+    if not args.json:
+        print_table(chain["rows"], chain["slopes"])
+    parts = [{"benchmark": "chain_scaling", "status": "ok", "seconds": time.perf_counter() - started}]
+    scripts = [] if args.chain_only else list(QUICK_SCRIPTS)
+    for i, name in enumerate(scripts):
+        share = (args.total - (time.perf_counter() - started)) / (len(scripts) - i)
+        parts.append(run_script(name, args.json, max(share, 1.0)))
+    total = time.perf_counter() - started
+    if args.json:
+        reports = {p["benchmark"]: p.pop("report") for p in parts[1:]}
+        print(json.dumps({"chain_scaling": chain, **reports, "parts": parts, "total_seconds": total,
+                          "budget_seconds": args.total}, indent=2))
+    else:
+        print(f"\n{'benchmark':>18} {'wall s':>8}  status")
+        for p in parts:
+            print(f"{p['benchmark']:>18} {p['seconds']:>8.1f}  {p['status']}")
+        print(f"{'total':>18} {total:>8.1f}  = {total / args.total:.2f} of the {args.total:g} s budget")
+    return int(any(p["status"] not in ("ok", "not available") for p in parts))
 
 
 if __name__ == "__main__":

@@ -46,7 +46,7 @@ def _parser() -> argparse.ArgumentParser:
     sweep.add_argument("--grid", action="append", default=[], metavar="NAME=A:B:N", required=True,
                        help="N values from A to B (linspace) for parameter NAME; repeat for a product grid")
     sweep.add_argument("--outputs", default="energy_drift,t_reached",
-                       help="comma-separated outputs: energy_drift, constraint_residual, t_reached, cpu, nfev, q<i>, s_dot<i>")
+                       help="comma-separated outputs: energy_drift, constraint_residual, t_reached, wall_time, nfev, q<i>, s_dot<i>")
     sweep.add_argument("--scheduler", help="address of a Dask scheduler, e.g. tcp://host:8786 (default: local processes)")
     sweep.add_argument("--scheduler-timeout", type=float, default=10.0, help="seconds to wait for the scheduler (default 10)")
     sweep.add_argument("--workers", type=int, default=None, help="local worker processes (default: one per CPU)")
@@ -125,8 +125,10 @@ def _run(args) -> int:
     cpu = time.process_time()
     with _progress_bar(0.0, t_end, args.quiet) as bar:
         try:
+            # 100 segments: Ctrl-C loses at most the current 1 % of the run; each segment restarts the
+            # step size (measured: +3 % evaluations for chain(5) over 10 s, +10 % for spin_up_beam over 2 s)
             result, code = simulate(system, t_end, method=args.method, rtol=args.rtol, atol=args.atol, n_points=201,
-                                    progress=lambda t: bar.update(t - bar.n)), 0
+                                    n_segments=100, progress=lambda t: bar.update(t - bar.n)), 0
         except SimulationError as exc:
             print(f"projeq: {exc}", file=sys.stderr)
             result, code = exc.result, 1
@@ -181,7 +183,7 @@ def _grid_axis(text: str) -> tuple[str, np.ndarray]:
 
 def _sweep(args) -> int:
     from projeq.scenes import check_names, get_scene, parse_settings, scene_parameters
-    from projeq.sweeps import sweep
+    from projeq.sweeps import interruptible_worker, sweep
 
     scene = get_scene(args.scene)
     fixed = parse_settings(scene, args.set)
@@ -193,20 +195,22 @@ def _sweep(args) -> int:
         grid.update({name: [value] for name, value in fixed.items()})
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers: expected a positive count, got {args.workers}")
-    executor = _dask_client(args.scheduler, args.scheduler_timeout) if args.scheduler else ProcessPoolExecutor(args.workers)
-    out = _output_directory(args.out)
+    executor = (_dask_client(args.scheduler, args.scheduler_timeout) if args.scheduler
+                else ProcessPoolExecutor(args.workers, initializer=interruptible_worker))
     options = {"method": args.method, "rtol": args.rtol}
-    with executor:
+    with executor:  # closed (a Dask client disconnected) also when --out is refused
+        out = _output_directory(args.out)
         table = sweep(scene, grid=grid, outputs=args.outputs.split(","), executor=executor, t_end=args.t_end,
                       progress=not args.quiet, **options)
     files = table.save(out / f"sweep_{args.scene}")
-    failed = int((table["status"] == -1).sum())
+    failed, partial = int((table["status"] == -1).sum()), int((table["status"] == 2).sum())
     if not args.quiet:
-        print(f"{len(table['status'])} points, {failed} failed; wrote " + ", ".join(str(f) for f in files))
+        print(f"{len(table['status'])} points, {failed} failed or not run, {partial} interrupted with partial results; "
+              "wrote " + ", ".join(str(f) for f in files))
     for i in np.flatnonzero(table["status"] == -1):
         point = ", ".join(f"{k}={table[k][i]}" for k in grid)
         print(f"projeq: point {point} failed: {table['error'][i]}", file=sys.stderr)
-    return 1 if failed else 0
+    return 1 if failed or partial else 0
 
 
 def _dask_client(address: str, timeout: float):
@@ -242,8 +246,10 @@ def _list(args) -> int:
         return 0
     scene = get_scene(args.scene)
     print(f"{args.scene}: {scene.description} (default t_end = {scene.t_end:g} s)")
-    for parameter in scene_parameters(scene):
-        print(f"  {parameter.name:14s} {parameter.default!r:24s} {parameter.unit}")
+    parameters = scene_parameters(scene)
+    width = max((len(p.name) for p in parameters), default=0)
+    for parameter in parameters:
+        print(f"  {parameter.name:{width}s}  {parameter.default!r:24s} {parameter.unit}")
     return 0
 
 

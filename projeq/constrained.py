@@ -22,9 +22,26 @@ Gauss–Newton projection of q onto Φ = 0 wherever :func:`projeq.simulate` norm
 (segment ends and outputs; ``correction="projection"``, the default) or by Baumgarte's
 first-order stabilisation q̇ += −β C_Φ⁺ Φ (``correction="baumgarte"``), or not at all
 (``"none"``). ``Result.constraint_residual`` holds (Φ, A q̇ − b) along the run.
+
+Re-pivoting. A partition good at q0 may degenerate later (a four-bar's rocker angle as the
+independent coordinate at the rocker's extreme positions, where dq_rocker/dq_crank = 0).
+With ``repivot`` (the default when the partition is chosen automatically) the partition
+carries a limit on its condition number κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ (≥ cond(A_dep); unlike
+cond(A_dep) it also sees a 1 × 1 block shrink to zero), max(REPIVOT_CONDITION, 10 κ at its
+start), and :func:`projeq.simulate` stops the integration by a terminal event where κ rises
+through it, re-partitions by pivoted QR at the current q (:meth:`~ConstrainedSystem.repartitioned`,
+ṡ_new = (F_old ṡ_old + f_old)[independent_new], the same tree velocities) and continues.
+``Result.partitions`` lists (t_k, independent_k): the ``s_dot`` rows at times t with
+t_k < t ≤ t_k+1 are the tree velocities independent_k (the first partition also holds at
+t_start); energies and constraint residuals are computed in each row's own partition.
+A user-fixed partition (``repivot=False``) stops the run at the same event with a
+ValueError naming (q, t): integrated on, the solver could step across the degeneracy
+(where ṡ_tree = F ṡ is ∞ · 0) and lose accuracy silently.
 """
 
 from __future__ import annotations
+
+import copy
 
 import numpy as np
 import scipy.linalg
@@ -34,8 +51,12 @@ from projeq.assembly.linalg import solve_spd
 from projeq.checks import positive, state_vector
 
 CORRECTIONS = ("projection", "baumgarte", "none")
-# condition number of the dependent block A_dep above which the partition is degenerate
+# condition number κ = ‖A_s‖ ‖A_dep⁻¹‖ above which the partition is degenerate
 PARTITION_CONDITION = 1e8
+# re-pivot when κ exceeds this (or 10 × its value where the partition was chosen): up to
+# there ‖F‖ ≤ κ amplifies the differences' ~1e-11 errors at most ~κ-fold, and the integrator
+# has not met the ∞ · 0 of ṡ_tree = F ṡ at the degeneracy
+REPIVOT_CONDITION = 1e2
 # |Φ| (relative to the largest coordinate, at least 1) accepted as on the manifold: 1e4 × round-off
 POSITION_TOLERANCE = 1e-12
 _H1, _H2 = 1e-3, 3e-3  # steps of the 1st/2nd differences: truncation ~h⁴, round-off ~1e-16/h, 1e-16/h²
@@ -73,6 +94,11 @@ class ConstrainedSystem:
     correction : "projection", "baumgarte" or "none"
         Position-drift correction of Φ = 0 (see the module docstring); ``beta`` (1/s) is
         Baumgarte's rate.
+    repivot : bool, optional
+        Re-choose the partition during a run when it degenerates (module docstring);
+        default: True for the automatic partition, False for a user-fixed ``independent``
+        (then a run stops with an error naming the configuration where κ reaches
+        the limit, rather than lose accuracy silently).
 
     Examples
     --------
@@ -93,7 +119,8 @@ class ConstrainedSystem:
     """
 
     def __init__(self, system, phi=None, A=None, b=None, independent=None, q0=None, s_dot0=None,
-                 project_q0: bool = False, correction: str = "projection", beta: float = 10.0):
+                 project_q0: bool = False, correction: str = "projection", beta: float = 10.0,
+                 repivot: bool | None = None):
         if phi is None and A is None:
             raise ValueError("phi: give holonomic constraints phi(q, t) and/or Pfaffian ones A(q, t)")
         for name, f in (("phi", phi), ("A", A), ("b", b)):
@@ -119,6 +146,8 @@ class ConstrainedSystem:
         self._check_rank(q0)
         self.independent, self.dependent = self._partition(q0, independent)
         self.n_s = len(self.independent)
+        self.repivot = independent is None if repivot is None else _check_repivot(repivot)
+        self.limit = max(REPIVOT_CONDITION, 10 * self.condition(q0))
         self.q0 = self._initial_q(q0, project_q0)
         self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
 
@@ -188,8 +217,7 @@ class ConstrainedSystem:
         n_s = self.tree.n_s
         A_s = self.constraint_matrix(q0)[0]
         if independent is None:
-            _, _, columns = scipy.linalg.qr(A_s, pivoting=True)
-            dependent = np.sort(columns[: self.n_c])
+            dependent = _pivoted_dependent(A_s, self.n_c)
         else:
             chosen = np.asarray(independent)
             integers = chosen.ndim == 1 and np.issubdtype(chosen.dtype, np.integer)
@@ -208,16 +236,75 @@ class ConstrainedSystem:
     def check_configuration(self, q: NDArray, t: float = 0.0) -> None:
         """Raise ValueError if the dependent block A_dep is singular at q (the partition
         degenerates: choose another ``independent`` set)."""
-        self._check_dependent(self.constraint_matrix(q, t)[0][:, self.dependent], q, t)
+        self._check_dependent(self.constraint_matrix(q, t)[0], q, t)
 
-    def _check_dependent(self, A_dep, q, t) -> None:
-        cond = np.linalg.cond(A_dep) if A_dep.size else 1.0
+    def condition(self, q: NDArray, t: float = 0.0) -> float:
+        """κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ at (q, t), the condition number of the partition (1 without
+        constraints, ∞ for a singular A_dep): ‖F‖ ≤ κ bounds the gain from ṡ to ṡ_tree."""
+        return _partition_condition(self.constraint_matrix(q, t)[0], self.dependent)
+
+    def partition_event(self):
+        """The terminal event ``event(t, q, s_dot) = κ − limit`` (rising) at which
+        :func:`projeq.simulate` calls :meth:`repartitioned` (None without constraints)."""
+        if not self.n_c:
+            return None
+
+        def degenerates(t, q, s_dot):
+            return self.condition(q, t) - self.limit
+
+        degenerates.terminal, degenerates.direction = True, 1
+        return degenerates
+
+    def repartitioned(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple["ConstrainedSystem", NDArray]:
+        """(system, s_dot) in the partition pivoted QR picks at (q, t): the same tree, the
+        same tree velocities ṡ_tree = F_old ṡ_old + f_old, ṡ_new = ṡ_tree[independent_new];
+        the new system starts at (q, ṡ_new). Without ``repivot``: ValueError naming (q, t)."""
+        if not self.repivot:
+            raise self._degenerate(q, t, self.condition(q, t), self.limit)
+        dependent = _pivoted_dependent(self.constraint_matrix(q, t)[0], self.n_c)
+        new = self._in_partition(np.setdiff1d(np.arange(self.tree.n_s), dependent), q, t)
+        new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
+        return new, new.s_dot0.copy()
+
+    def with_independent(self, independent, repivot: bool | None = None) -> "ConstrainedSystem":
+        """This system (same tree, constraints and initial motion q0, ṡ_tree0) with the tree
+        velocities ``independent`` as its minimal velocities; ``repivot`` as in the
+        constructor (default: this system's). ValueError if A_dep is singular at q0."""
+        free, dependent = copy.copy(self)._partition(self.q0, independent)  # checks, at q0
+        new = self._in_partition(free, self.q0)
+        new.s_dot0 = self.tree_velocities(self.q0, self.s_dot0)[free]
+        new.repivot = self.repivot if repivot is None else _check_repivot(repivot)
+        return new
+
+    def row_systems(self, result) -> list:
+        """This system in the partition of each row of ``result`` (``Result.partitions``:
+        (t_k, independent_k) holds for t_k < t ≤ t_k+1, the first one from the start)."""
+        if not result.partitions:
+            return [self] * len(result.t)
+        starts = [t for t, _ in result.partitions]
+        systems = [self._in_partition(np.asarray(independent), self.q0) for _, independent in result.partitions]
+        return [systems[max(k - 1, 0)] for k in np.searchsorted(starts, result.t, side="left")]
+
+    def _in_partition(self, independent, q, t=0.0) -> "ConstrainedSystem":
+        """A copy with the partition ``independent`` (unchecked), starting at q."""
+        new = copy.copy(self)
+        new.independent, new.dependent = independent, np.setdiff1d(np.arange(self.tree.n_s), independent)
+        new.q0 = np.array(q, dtype=float)
+        new.limit = max(REPIVOT_CONDITION, 10 * new.condition(q, t))
+        return new
+
+    def _check_dependent(self, A_s, q, t) -> None:
+        cond = _partition_condition(A_s, self.dependent)
         if not cond < PARTITION_CONDITION:
-            raise ValueError(
-                f"independent: the dependent velocities {self.dependent.tolist()} cannot be solved for at "
-                f"q = {np.round(q, 6).tolist()}, t = {t:.6g} (condition number of A_dep {cond:.3g}); "
-                "choose other independent velocities (default: pivoted QR picks them at q0)"
-            )
+            raise self._degenerate(q, t, cond, PARTITION_CONDITION)
+
+    def _degenerate(self, q, t, cond, limit) -> ValueError:
+        return ValueError(
+            f"independent: the dependent velocities {self.dependent.tolist()} cannot be solved for at "
+            f"q = {np.round(q, 6).tolist()}, t = {t:.6g} (condition number of the partition {cond:.3g}, limit "
+            f"{limit:.3g}); choose other independent velocities (default: pivoted QR picks them at q0), "
+            "or pass repivot=True"
+        )
 
     def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:
         """(F, f) of ṡ_tree = F ṡ + f: F = [E; −A_dep⁻¹ A_ind], f = [0; A_dep⁻¹ b_s]
@@ -227,7 +314,7 @@ class ConstrainedSystem:
         F[self.independent] = np.eye(self.n_s)
         f = np.zeros(self.tree.n_s)
         if self.n_c:
-            self._check_dependent(A_s[:, self.dependent], q, t)  # the partition degenerates during a run
+            self._check_dependent(A_s, q, t)  # the partition degenerates during a run
             solved = np.linalg.solve(A_s[:, self.dependent], np.column_stack((A_s[:, self.independent], b_s)))
             F[self.dependent], f[self.dependent] = -solved[:, :-1], solved[:, -1]
         return F, f
@@ -337,6 +424,26 @@ class ConstrainedSystem:
 
     def __repr__(self) -> str:
         return f"ConstrainedSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian)"
+
+
+def _check_repivot(repivot) -> bool:
+    if repivot not in (True, False):
+        raise ValueError(f"repivot: expected True, False or None (automatic), got {repivot!r}")
+    return bool(repivot)
+
+
+def _partition_condition(A_s: NDArray, dependent: NDArray) -> float:
+    """κ = ‖A_s‖₂ / σ_min(A_dep) = ‖A_s‖₂ ‖A_dep⁻¹‖₂ (1 for no rows, ∞ for a singular A_dep)."""
+    if not A_s.size:
+        return 1.0
+    sigma = np.linalg.svd(A_s[:, dependent], compute_uv=False)
+    return float(np.linalg.norm(A_s, 2) / sigma[-1]) if sigma[-1] > 0 else np.inf
+
+
+def _pivoted_dependent(A_s: NDArray, n_c: int) -> NDArray:
+    """The n_c columns of A_s that column-pivoted QR takes first (sorted): the dependent
+    velocities with the best-conditioned block A_dep."""
+    return np.sort(scipy.linalg.qr(A_s, pivoting=True)[2][:n_c])
 
 
 def _pfaffian_residual(system: ConstrainedSystem, q_t, q_dot) -> NDArray:

@@ -20,12 +20,14 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from projeq.checks import state_vector
 from projeq.kinematics import forward, gauss_terms
 
 
 def reactions(system, result) -> NDArray:
     """λ (n_t × n_c) along a trajectory of a :class:`~projeq.constrained.ConstrainedSystem`
-    (rows: Φ first, then the Pfaffian rows), from ``M s̈_tree + b = A_sᵀ λ``."""
+    (rows: Φ first, then the Pfaffian rows), from ``M s̈_tree + b = A_sᵀ λ``; each row in
+    its own partition if the run re-pivoted (``result.partitions``)."""
     if not hasattr(system, "accelerations_tree"):
         raise ValueError(f"system: reactions need a ConstrainedSystem, got {system!r}")
     if result.q.shape[1:] != (system.n_q,) or result.s_dot.shape[1:] != (system.n_s,):
@@ -33,8 +35,10 @@ def reactions(system, result) -> NDArray:
             f"result: its states (q {result.q.shape[1:]}, s_dot {result.s_dot.shape[1:]}) are not "
             f"those of the system (n_q = {system.n_q}, n_s = {system.n_s})"
         )
-    rows = [system.accelerations_tree(q, s, t)[1] for t, q, s in zip(result.t, result.q, result.s_dot)]
+    rows = [row_system.accelerations_tree(q, s, t)[1]
+            for row_system, t, q, s in zip(system.row_systems(result), result.t, result.q, result.s_dot)]
     return np.array(rows).reshape(len(result.t), system.n_c)
+
 
 
 def contact_event(system, row: int, terminal: bool = True):
@@ -51,22 +55,62 @@ def contact_event(system, row: int, terminal: bool = True):
     return event
 
 
-def joint_reactions(system, q, s_dot, t: float = 0.0) -> dict:
-    """{name: W_n}: the wrench each joint of a tree System transmits to its subsystem (and
-    the subtree beyond), in the subsystem's ẏ coordinates (a rigid body's [force; moment
-    about O_n] in body axes), from W_n = r_n + Σ_c T_cnᵀ W_c with r_n = M_n ÿ_n − h_n and
-    ÿ_n = T_np ÿ_p + F_n s̈_n + ζ_n (B(14); THEORY §7)."""
-    q, s_dot = system.check_state(q, s_dot, t)
-    s_ddot = system.accelerations(q, s_dot, t)
-    kin = forward(system, q, s_dot, float(t))
-    M, h = gauss_terms(system, kin, q, s_dot, float(t))
-    N = len(system.joints)
+def joint_reactions(system, q, s_dot, t: float = 0.0, cuts=None) -> dict:
+    """{name: W_n}: the wrench each joint transmits to its subsystem (and the subtree
+    beyond), in the subsystem's ẏ coordinates (a rigid body's [force; moment about O_n] in
+    body axes), from W_n = r_n + Σ_c T_cnᵀ W_c with r_n = M_n ÿ_n − h_n − w_n and
+    ÿ_n = T_np ÿ_p + F_n s̈_n + ζ_n (B(14); THEORY §7).
+
+    For a :class:`~projeq.constrained.ConstrainedSystem`, ``cuts`` is a dict
+    {name: :class:`~projeq.cut_joints.PinClosure`} of the cut joints whose closures make up
+    its Φ, in the order of Φ's rows; their multipliers λ are the cut joints' forces, applied
+    as the wrenches w_n, and the result also holds, under each cut's name, the wrench of the
+    cut joint on its subsystem a. For a tree System ``cuts`` is not used (w_n = 0).
+    """
+    if not hasattr(system, "accelerations_tree"):
+        q, s_dot = system.check_state(q, s_dot, t)
+        return _transmitted(system, q, s_dot, system.accelerations(q, s_dot, t), t, {})
+    tree, cuts = system.tree, _check_cuts(system, cuts)
+    q, s_dot = tree.check_q("q", q), state_vector("s_dot", s_dot, system.n_s)
+    s_ddot_tree, lam = system.accelerations_tree(q, s_dot, t)
+    s_dot_tree = system.tree_velocities(q, s_dot, t)
+    kin = forward(tree, q, s_dot_tree, float(t))
+    applied, cut_wrenches, row = {}, {}, 0
+    for name, closure in cuts.items():
+        loads = closure.wrenches(kin, lam[row: row + len(closure.rows)])
+        row += len(closure.rows)
+        cut_wrenches[name] = loads[closure.a]
+        for n, w in loads.items():
+            applied[n] = applied.get(n, 0.0) + w
+    return _transmitted(tree, q, s_dot_tree, s_ddot_tree, t, applied, kin) | cut_wrenches
+
+
+def _check_cuts(system, cuts) -> dict:
+    if not isinstance(cuts, dict) or not all(callable(getattr(c, "wrenches", None)) for c in cuts.values()):
+        raise ValueError(f"cuts: expected a dict {{name: PinClosure}} of the cut joints, got {cuts!r}")
+    rows = sum(len(c.rows) for c in cuts.values())
+    if rows != system.m_h or system.m_p:
+        raise ValueError(
+            f"cuts: the cut joints give {rows} closure rows, the system has {system.m_h} holonomic and "
+            f"{system.m_p} Pfaffian constraints; every constraint must be a cut joint's closure"
+        )
+    clash = set(cuts) & set(system.names)
+    if clash:
+        raise ValueError(f"cuts: names {sorted(clash)} are subsystem names already")
+    return cuts
+
+
+def _transmitted(tree, q, s_dot, s_ddot, t, applied: dict, kin=None) -> dict:
+    """W_n of every tree joint, leaves → root, with the loads ``applied`` {n: w_n} (B(14))."""
+    kin = forward(tree, q, s_dot, float(t)) if kin is None else kin
+    M, h = gauss_terms(tree, kin, q, s_dot, float(t))
+    N = len(tree.joints)
     y_ddot = [None] * N + [np.zeros(0)]
     for n in range(N):  # root → leaves: accelerations ÿ_n
-        cols, P = system.joint_s_columns(n)
-        y_ddot[n] = kin.T[n] @ y_ddot[system.parent[n]] + kin.F[n] @ (P @ s_ddot[cols]) + kin.zeta[n]
-    W = [M[n] @ y_ddot[n] - h[n] for n in range(N)]
+        cols, P = tree.joint_s_columns(n)
+        y_ddot[n] = kin.T[n] @ y_ddot[tree.parent[n]] + kin.F[n] @ (P @ s_ddot[cols]) + kin.zeta[n]
+    W = [M[n] @ y_ddot[n] - h[n] - applied.get(n, 0.0) for n in range(N)]
     for n in reversed(range(N)):  # leaves → root: pass each wrench on to the parent
-        if system.parent[n] >= 0:
-            W[system.parent[n]] = W[system.parent[n]] + kin.T[n].T @ W[n]
-    return dict(zip(system.names, W))
+        if tree.parent[n] >= 0:
+            W[tree.parent[n]] = W[tree.parent[n]] + kin.T[n].T @ W[n]
+    return dict(zip(tree.names, W))

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import time as _time
+from collections import deque
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -20,17 +21,20 @@ from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 from projeq.assembly import EVALUATORS
 from projeq.checks import count, finite_array, positive, state_vector
 from projeq.constraints import check_configuration
+from projeq.integrators import EXPLICIT, PROJECTED, projected_solver, warn_if_stiff
 
 
 INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # the methods of solve_ivp
 
 
 def _check_method(method) -> None:
-    if isinstance(method, str) and method in INTEGRATORS:
+    if isinstance(method, str) and (method in INTEGRATORS or method in PROJECTED):
         return
     if isinstance(method, type) and issubclass(method, OdeSolver):
         return
-    raise ValueError(f"method: unknown integrator {method!r}; use one of {list(INTEGRATORS)} or an OdeSolver class")
+    raise ValueError(
+        f"method: unknown integrator {method!r}; use one of {list(INTEGRATORS) + list(PROJECTED)} or an OdeSolver class"
+    )
 
 
 class SimulationError(RuntimeError):
@@ -54,6 +58,9 @@ class Result:
     status : 0 finished, 1 stopped by a terminal event, -1 failed, 2 interrupted
     message : the integrator's message; t_events : times of each event
     names : subsystem names; sol : dense output ``sol(t) -> (q, s_dot)`` or None
+    partitions : ((t_k, independent_k), ...) of a ConstrainedSystem, one per partition used
+    (more than one if it re-pivoted): rows (and ``sol(t)``) with t_k < t ≤ t_k+1 hold the
+    tree velocities independent_k in ``s_dot`` (:mod:`projeq.constrained`); empty for other systems
     """
 
     t: NDArray
@@ -69,6 +76,7 @@ class Result:
     t_events: tuple = ()
     names: tuple = ()
     method: str = ""
+    partitions: tuple = ()
     sol: object = field(default=None, repr=False, compare=False)
     system: object = field(default=None, repr=False, compare=False)  # in memory only, not saved
 
@@ -97,6 +105,7 @@ class Result:
         meta = {
             "nfev": self.nfev, "wall_time": self.wall_time, "status": self.status,
             "message": self.message, "names": list(self.names), "method": self.method,
+            "partitions": [[t, list(independent)] for t, independent in self.partitions],
         }
         events = {f"t_events_{i}": np.asarray(e) for i, e in enumerate(self.t_events)}
         np.savez(path, **arrays, **events, meta=json.dumps(meta))
@@ -110,6 +119,7 @@ class Result:
             arrays = {k: data[k] for k in data.files if k != "meta" and not k.startswith("t_events_")}
             t_events = tuple(data[f"t_events_{i}"] for i in range(n_events))
         meta["names"] = tuple(meta["names"])
+        meta["partitions"] = tuple((t, tuple(independent)) for t, independent in meta.get("partitions", ()))
         return cls(**arrays, **meta, t_events=t_events)
 
 
@@ -152,7 +162,13 @@ def simulate(
     q0, s_dot0 : arrays, optional
         Initial coordinates and minimal velocities (default: the system's q0, ṡ0).
     method : str or scipy OdeSolver class
-        Any method of ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...).
+        Any method of ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...),
+        or ``"RK45-projected"`` / ``"DOP853-projected"``: that method with each step projected
+        onto the initial energy, so that a conservative scleronomic system's energy error
+        stays at round-off over long runs (:mod:`projeq.integrators`; ValueError for a
+        system whose energy is not conserved). An explicit method whose steps crawl at its
+        stability limit (a stiff model) gets a :class:`projeq.integrators.StiffnessWarning`
+        suggesting Radau or BDF.
     rtol, atol : float
         Tolerances passed to the integrator.
     events : callable or list of callables ``event(t, q, s_dot)``
@@ -198,6 +214,7 @@ def simulate(
     # a coordinate singularity (or a degenerate partition of a ConstrainedSystem) at the start, by name
     getattr(system, "check_configuration", lambda q, t: check_configuration(system, q, t))(q0, t_start)
     ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
+    solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
     n_q = system.n_q
     reached = [t_start]  # time of the latest right-hand side evaluation, for error messages
 
@@ -214,23 +231,38 @@ def simulate(
     pieces, nfev, status, message = [], 0, 0, "The solver successfully reached the end of the integration interval."
     t_events = [[] for _ in events]
     cause = None  # the exception that stopped the run, if any
+    stiff_warned = False  # one StiffnessWarning per run at most
     x = np.concatenate((q0, s_dot0))
     started = _time.perf_counter()
     try:
-        for a, b in zip(bounds[:-1], bounds[1:]):
+        segments = deque(zip(bounds[:-1], bounds[1:]))  # a re-partition splits one (below)
+        while segments:
+            a, b = segments.popleft()
             inside = t_eval[(t_eval > a) & (t_eval <= b)] if pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
             sol = solve_ivp(
-                rhs, (a, b), x, method=method, t_eval=inside, rtol=rtol, atol=atol,
-                events=wrapped_events, dense_output=True, **options,
+                rhs, (a, b), x, method=solver, t_eval=inside, rtol=rtol, atol=atol,
+                events=_with_partition_event(wrapped_events, system, n_q), dense_output=True, **options,
             )
             nfev += sol.nfev
+            sol.system = system  # the partition of a ConstrainedSystem its s_dot rows are in
             pieces.append(sol)
-            for i, te in enumerate(sol.t_events or []):
-                t_events[i].extend(te)
+            for collected, te in zip(t_events, sol.t_events or []):
+                collected.extend(te)
+            if sol.status == 1 and len(sol.t_events) > len(events) and len(sol.t_events[-1]):
+                # a ConstrainedSystem's partition degenerates: go on in a new one (or its ValueError)
+                x, a = sol.y_events[-1][0], sol.t_events[-1][0]
+                system, s_dot = system.repartitioned(x[:n_q], x[n_q:], a)
+                x, ev = np.concatenate((x[:n_q], s_dot)), _evaluator(system, evaluator)
+                if method in PROJECTED:  # the same energy, now in the new partition's s_dot
+                    solver = projected_solver(method, system, x[:n_q], s_dot, a)
+                if a < b:
+                    segments.appendleft((a, b))
+                continue
             if sol.status != 0:
                 status, message = sol.status, sol.message
                 break
             x = sol.sol(b).copy()  # the state at the segment's end, not at its last output time
+            stiff_warned = stiff_warned or warn_if_stiff(rhs, sol, method, rtol)
             x[:n_q] = system.normalized(x[:n_q])
             if progress is not None:
                 progress(b)
@@ -244,7 +276,7 @@ def simulate(
     if status == -1:
         kept = result.t[-1] if len(result.t) else t_start
         hint = ""
-        if method in ("RK45", "RK23", "DOP853") and "step size" in message:
+        if method in EXPLICIT and "step size" in message:
             hint = (
                 "; the solution may blow up here, or the system is stiff for an explicit method "
                 "(a very stiff beam): then try method='Radau' or 'BDF'"
@@ -255,6 +287,14 @@ def simulate(
             result,
         ) from cause
     return result
+
+
+def _with_partition_event(wrapped_events, system, n_q):
+    """The user's events plus, last, a ConstrainedSystem's partition event (κ reaches its limit)."""
+    partition_event = getattr(system, "partition_event", lambda: None)()
+    if partition_event is None:
+        return wrapped_events
+    return (wrapped_events or []) + [_event_wrapper(partition_event, n_q)]
 
 
 def _evaluator(system, evaluator):
@@ -289,16 +329,23 @@ def _assemble(system, pieces, nfev, status, message, t_events, wall_time, method
         t, x = np.zeros(0), np.zeros((0, n_q + system.n_s))
     q = np.array([system.normalized(row) for row in x[:, :n_q]]).reshape(len(t), n_q)
     s_dot = x[:, n_q:]
-    energies = np.array([system.energy(qi, si, ti) for ti, qi, si in zip(t, q, s_dot)]).reshape(len(t), 2)
+    rows = [(p.system, ti) for p in pieces for ti in p.t]  # each row in its piece's partition
+    energies = np.array([s.energy(qi, si, ti) for (s, ti), qi, si in zip(rows, q, s_dot)]).reshape(len(t), 2)
     residual = np.array(
-        [system.constraint_residual(qi, system.q_dot(qi, si, ti), ti) for ti, qi, si in zip(t, q, s_dot)]
+        [s.constraint_residual(qi, s.q_dot(qi, si, ti), ti) for (s, ti), qi, si in zip(rows, q, s_dot)]
     ).reshape(len(t), system.n_c)
+    partitions = tuple(
+        (float(p.sol.ts[0]), tuple(p.system.independent.tolist())) for i, p in enumerate(pieces)
+        if hasattr(p.system, "independent") and (i == 0 or p.system is not pieces[i - 1].system)
+    )
+    system = pieces[0].system if pieces else system  # the user's, before any re-partition
     sol = _dense_solution(pieces, n_q) if dense_output and pieces else None
     return Result(
         t=t, q=q, s_dot=s_dot, kinetic=energies[:, 0], potential=energies[:, 1],
         constraint_residual=residual, nfev=int(nfev), wall_time=wall_time,
         status=int(status), message=str(message), t_events=tuple(np.array(e) for e in t_events),
-        names=system.names, method=getattr(method, "__name__", str(method)), sol=sol, system=system,
+        names=system.names, method=getattr(method, "__name__", str(method)), partitions=partitions,
+        sol=sol, system=system,
     )
 
 

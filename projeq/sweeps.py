@@ -6,12 +6,18 @@
 fails is kept in the table with ``status = -1`` and its error message, never dropped.
 Nothing is written to disk here; :meth:`SweepTable.save` writes CSV + NPZ once the table
 is complete, so an unreachable scheduler or Ctrl-C leaves no half-written files.
+
+Ctrl-C on a terminal reaches the whole process group: the pool's workers are started with
+:func:`interruptible_worker`, so a point being simulated stops and returns what it has
+(``status`` 2, outputs at the time reached, see :func:`projeq.simulate`) while idle workers
+stay quiet, and :func:`sweep` gathers those partial points before it returns.
 """
 
 from __future__ import annotations
 
 import concurrent.futures as cf
 import itertools
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +29,7 @@ BUILTIN_OUTPUTS = {
     "t_reached": lambda r: r.t[-1],
     "energy_drift": lambda r: r.energy_drift,
     "constraint_residual": lambda r: np.abs(r.constraint_residual).max() if r.constraint_residual.size else 0.0,
-    "cpu": lambda r: r.wall_time,
+    "wall_time": lambda r: r.wall_time,
     "nfev": lambda r: r.nfev,
 }
 
@@ -40,22 +46,45 @@ def _column(name: str):
 
 def output_value(result, name: str) -> float:
     """A named output of a Result: a :data:`BUILTIN_OUTPUTS` key, or ``q<i>`` / ``s_dot<i>``
-    for the final value of coordinate / minimal velocity i."""
+    for the final value of coordinate / minimal velocity i; NaN when no time step was
+    completed (a run interrupted or failed in its first segment)."""
+    if not len(result.t):
+        return np.nan
     column = _column(name)
     if column is None:
         return float(BUILTIN_OUTPUTS[name](result))
     return float(getattr(result, column[0])[-1, column[1]])
 
 
+INTERRUPT_GRACE = 10.0  # s to wait, after Ctrl-C, for the running points to return their partial results
+_simulating = False  # in a pool worker: True while run_point simulates
+
+
+def _interrupt_a_running_point(signum, frame):
+    if _simulating:
+        raise KeyboardInterrupt
+
+
+def interruptible_worker() -> None:
+    """Initializer of a process-pool worker: SIGINT (Ctrl-C) stops the point it simulates
+    (which :func:`projeq.simulate` turns into a partial result, status 2) and is ignored
+    while the worker waits for work, so no worker dies with a traceback."""
+    signal.signal(signal.SIGINT, _interrupt_a_running_point)
+
+
 def run_point(scene: Scene, parameters: dict, outputs, t_end: float, options: dict):
     """Simulate one point; returns (status, output values, error message). Runs on a worker."""
     from projeq.simulation import simulate
 
+    global _simulating
     try:
+        _simulating = True
         result = simulate(scene.build(**parameters), t_end, **options)
         return result.status, [output_value(result, o) for o in outputs], ""
     except Exception as exc:  # noqa: BLE001 - a failed point is reported in the table, never dropped
         return -1, [np.nan] * len(outputs), f"{type(exc).__name__}: {exc}"
+    finally:
+        _simulating = False
 
 
 class SweepTable(dict):
@@ -94,7 +123,7 @@ def _points(grid, samples) -> list[dict]:
 def _executor(executor):
     """(executor, owned): a Dask Client becomes its concurrent.futures view."""
     if executor is None:
-        return cf.ProcessPoolExecutor(), True
+        return cf.ProcessPoolExecutor(initializer=interruptible_worker), True
     if hasattr(executor, "get_executor"):  # dask.distributed.Client
         if getattr(executor, "status", "running") != "running":
             raise ValueError(f"executor: the Dask client is not connected (status {executor.status!r})")
@@ -131,8 +160,9 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     Returns
     -------
     SweepTable
-        A dict of columns. On Ctrl-C the points finished so far are returned with the others
-        marked status −1, error "interrupted".
+        A dict of columns. On Ctrl-C the points finished so far are returned, the points that
+        were running with their partial results (status 2), the others marked status −1,
+        error "interrupted".
 
     >>> table = sweep("chain", grid={"n": [1, 2]}, outputs=["q0"], executor=cf.ThreadPoolExecutor(2),
     ...               t_end=0.1, progress=False)
@@ -159,12 +189,22 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
                 rows[futures[future]] = future.result()
                 bar.update()
     except KeyboardInterrupt:
-        for future in futures:
-            future.cancel()
+        _gather_interrupted(futures, rows)
     finally:
         if owned:
             pool.shutdown(wait=False, cancel_futures=True)
     return _table(points, outputs, rows)
+
+
+def _gather_interrupted(futures: dict, rows: list) -> None:
+    """After Ctrl-C: cancel the points not started, and keep the running points' partial
+    results (status 2) when they return within :data:`INTERRUPT_GRACE` seconds."""
+    for future in futures:
+        future.cancel()
+    done, _ = cf.wait(futures, timeout=INTERRUPT_GRACE)
+    for future in done:
+        if not future.cancelled() and future.exception() is None:
+            rows[futures[future]] = future.result()
 
 
 def _table(points, outputs, rows) -> SweepTable:

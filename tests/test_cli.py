@@ -1,7 +1,10 @@
 """The projeq command: list, run, sweep, delegated subcommands, exit codes, bad input."""
 
 import io
+import os
 import runpy
+import signal
+import subprocess
 import sys
 import types
 
@@ -27,8 +30,24 @@ def test_list_names_every_scene(capsys):
 
 def test_list_scene_shows_parameters_with_units_and_defaults(capsys):
     assert main(["list", "atwood"]) == 0
-    out = capsys.readouterr().out
-    assert "m1             2.0" in out and "kg" in out and "radius" in out and "m/s²" in out
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:]]
+    assert ["m1", "2.0", "kg"] in rows and ["radius", "0.1", "m"] in rows and ["g", "9.81", "m/s²"] in rows
+
+
+def test_list_a_constrained_scene(capsys):
+    """The Whipple bicycle (a ConstrainedSystem) lists its initial speed and angles with units."""
+    assert main(["list", "whipple_bicycle"]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:]]
+    assert ["speed", "4.0", "m/s"] in rows and ["roll", "0.0", "rad"] in rows and ["steer_rate", "0.0", "rad/s"] in rows
+
+
+@pytest.mark.parametrize("name", list(pq.scenes.SCENES))
+def test_every_real_valued_parameter_has_a_unit(name):
+    """Scenes as data (issue 8, item 7): a parameter with a float or tuple default is a
+    physical quantity, so its unit must be known (counts and switches are dimensionless)."""
+    missing = [p.name for p in pq.scenes.scene_parameters(pq.scenes.SCENES[name])
+               if isinstance(p.default, (float, tuple)) and p.unit == "-"]
+    assert missing == []
 
 
 def test_run_writes_results_that_load_back(tmp_path, capsys):
@@ -86,6 +105,63 @@ def test_ctrl_c_exits_1_and_keeps_the_trajectory(tmp_path, capsys, monkeypatch):
     assert saved.status == 2 and 0.1 < saved.t[-1] < 1.0
 
 
+# Child processes for the Ctrl-C tests: Python's own SIGINT handler (a shell may start
+# background jobs with SIGINT ignored), and a line on stdout once there is something to keep.
+_CHILD = """
+import signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
+import projeq.simulation, projeq.sweeps
+from projeq.cli import main
+simulate, as_completed = projeq.simulation.simulate, projeq.sweeps.cf.as_completed
+
+def reporting_simulate(system, t_end, progress=None, **options):  # projeq run passes a progress bar
+    def report(t):
+        progress(t)
+        print("segment done", flush=True)
+    return simulate(system, t_end, progress=progress and report, **options)
+
+def reporting_as_completed(futures):
+    for future in as_completed(futures):
+        yield future
+        print("point done", flush=True)
+
+projeq.simulation.simulate, projeq.sweeps.cf.as_completed = reporting_simulate, reporting_as_completed
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def ctrl_c(argv):
+    """Run ``projeq argv`` in a new process group, press Ctrl-C (SIGINT to the group, as a
+    terminal does) once it reports progress; its exit code and stderr."""
+    child = subprocess.Popen([sys.executable, "-c", _CHILD, *argv], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, start_new_session=True)
+    assert child.stdout.readline().endswith("done\n")
+    os.killpg(child.pid, signal.SIGINT)
+    _, err = child.communicate(timeout=120)
+    return child.returncode, err
+
+
+def test_a_real_ctrl_c_during_run_writes_the_trajectory_so_far(tmp_path):
+    """SIGINT arrives anywhere in the integrator: exit 1, and the results up to the last
+    finished segment (1 % of the run) are written and load back."""
+    code, err = ctrl_c(["run", "chain", "--set", "n=1", "--t-end", "1000", "--out", str(tmp_path), "--quiet"])
+    assert code == 1 and "interrupted at t = " in err and "Traceback" not in err
+    saved = pq.Result.load(tmp_path / "chain.npz")
+    assert saved.status == 2 and 10.0 <= saved.t[-1] < 1000.0
+
+
+def test_a_real_ctrl_c_during_sweep_keeps_finished_and_partial_points(tmp_path):
+    """Ctrl-C reaches the main process and the pool's workers: the finished point (n = 1) is
+    kept, the running one (n = 60) returns as interrupted (status 2), nothing dies with a
+    traceback, and the table is written; exit 1."""
+    code, err = ctrl_c(["sweep", "chain", "--grid", "n=1:60:2", "--t-end", "5", "--rtol", "1e-6", "--workers", "2",
+                        "--outputs", "q0", "--out", str(tmp_path), "--quiet"])
+    assert code == 1 and "Traceback" not in err
+    table = np.load(tmp_path / "sweep_chain.npz", allow_pickle=True)
+    assert table["n"].tolist() == [1, 60] and table["status"].tolist() == [0, 2]
+    assert np.isfinite(table["q0"][0])
+
+
 @pytest.mark.parametrize(
     "argv, message",
     [
@@ -111,9 +187,10 @@ def test_bad_arguments_exit_2_with_the_reason(argv, message, capsys, monkeypatch
     assert message in capsys.readouterr().err
 
 
-def test_an_output_directory_that_cannot_be_written(tmp_path, capsys):
+@pytest.mark.parametrize("command", [["run", "chain"], ["sweep", "atwood", "--grid", "m1=1:2:2", "--workers", "1"]])
+def test_an_output_directory_that_cannot_be_written(command, tmp_path, capsys):
     (tmp_path / "file").write_text("")
-    assert main(["run", "chain", "--out", str(tmp_path / "file" / "out")]) == 2
+    assert main(command + ["--out", str(tmp_path / "file" / "out")]) == 2
     assert "--out: cannot write to directory" in capsys.readouterr().err
 
 

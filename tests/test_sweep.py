@@ -2,6 +2,8 @@
 
 import concurrent.futures as cf
 import sys
+import time
+import types
 
 import numpy as np
 import pytest
@@ -74,21 +76,28 @@ def test_samples_and_saved_table(tmp_path):
     assert np.array_equal(np.load(npz)["q1"], table["q1"])
 
 
-def test_ctrl_c_keeps_the_finished_points(monkeypatch):
-    """A KeyboardInterrupt after the first finished point: that point is kept, the others
-    are marked interrupted."""
-    real = cf.as_completed
+def test_ctrl_c_keeps_the_running_point_and_cancels_the_others(monkeypatch):
+    """A KeyboardInterrupt while the first of three points runs on a one-thread pool: the
+    running point is waited for and kept, the two not started are marked interrupted."""
 
     def interrupted(futures):
-        for i, future in enumerate(real(futures)):
-            if i == 1:
-                raise KeyboardInterrupt
-            yield future
+        first = next(iter(futures))
+        while not (first.running() or first.done()):
+            time.sleep(1e-3)
+        raise KeyboardInterrupt
+        yield  # a generator, like cf.as_completed
 
     monkeypatch.setattr(sweep_module.cf, "as_completed", interrupted)
     with cf.ThreadPoolExecutor(1) as pool:
         table = sweep("chain", grid={"n": [1, 2, 3]}, outputs=["q0"], executor=pool, t_end=0.05, progress=False)
-    assert (table["status"] == 0).sum() == 1 and table["error"].count("interrupted") == 2
+    assert table["status"].tolist() == [0, -1, -1] and table["error"] == ["", "interrupted", "interrupted"]
+    assert np.isfinite(table["q0"][0])
+
+
+def test_outputs_of_a_run_without_a_completed_step_are_nan():
+    """A run interrupted in its first segment has no time points: its outputs are NaN."""
+    empty = types.SimpleNamespace(t=np.empty(0), q=np.empty((0, 1)))
+    assert np.isnan(sweep_module.output_value(empty, "q0")) and np.isnan(sweep_module.output_value(empty, "t_reached"))
 
 
 @pytest.mark.parametrize(

@@ -11,10 +11,12 @@ says so): the same kernel source runs interpreted only on request (``compiled=Fa
 
 Supported: trees of :class:`~projeq.RigidBody` / :class:`~projeq.PointMass` on
 :class:`~projeq.Revolute`, :class:`~projeq.Prismatic` and :class:`~projeq.Fixed` joints
-(no coupling), under gravity, without force laws. Any other system (beams, planar bodies,
-free, prescribed or user — e.g. non-holonomic — joints, couplings, forces) is evaluated
-by the general path (recursive, or dense for coupled joints); then ``fast`` is False and
-``reason`` says why.
+(no coupling), under gravity, without force laws; and one :class:`~projeq.RitzBeam` on a
+prescribed or fixed hub (the spin-up beam), by :mod:`projeq.assembly.beam_fast` (pure
+numpy; with ``precomputed_integrals`` its cost per call does not grow with the number of
+quadrature stations). Any other system (beams in chains, planar bodies, free or user —
+e.g. non-holonomic — joints, couplings, forces) is evaluated by the general path
+(recursive, or dense for coupled joints); then ``fast`` is False and ``reason`` says why.
 
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.chain(3)
@@ -32,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.assembly import _kernels
+from projeq.assembly.beam_fast import HubBeamEvaluator, hub_beam_unsupported
 from projeq.assembly.linalg import _SINGULAR, SingularMassError, mass_scale
 from projeq.joints import Fixed, Prismatic, Revolute
 from projeq.subsystems import PointMass, RigidBody
@@ -50,7 +53,7 @@ class FastEvaluator:
         pure-numpy fallback); None: numba when installed, the interpreted kernel if the
         environment variable ``PROJEQ_FAST_KERNEL=python``, else the general path.
 
-    Attributes: ``fast`` (the kernel is used), ``reason`` (why not, else None),
+    Attributes: ``fast`` (a fast path is used), ``reason`` (why not, else None),
     ``compiled`` (numba), ``n_calls``. The workspace (T_np, ζ_n, f_n, M̂_n, ĥ_n) is
     allocated once and overwritten by every call.
     """
@@ -61,6 +64,10 @@ class FastEvaluator:
         self.reason = unsupported(system) or _kernels.missing_compiler(compiled)
         self.fast = self.reason is None
         self.compiled = False
+        if not self.fast and hub_beam_unsupported(system) is None:
+            self.reason, self.fast = None, True
+            self._general = HubBeamEvaluator(system)  # not the kernel: the beam's own path
+            return
         if not self.fast:
             self._general = system.evaluator("dense" if system.coupled else "recursive")
             return
@@ -89,7 +96,7 @@ class FastEvaluator:
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """s̈ at (q, ṡ, t) (THEORY §6); raises SingularMassError for a zero pivot D_n."""
         self.n_calls += 1
-        if not self.fast:
+        if hasattr(self, "_general"):
             return self._general.accelerations(q, s_dot, t)
         q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
         self._chain_terms(

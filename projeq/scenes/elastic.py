@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from projeq import inertia
+from projeq.checks import count, finite_array, positive
 from projeq.joints import Fixed, Prescribed, Revolute
 from projeq.subsystems.beam import RitzBeam
 from projeq.subsystems.rigid import PointMass, RigidBody
@@ -15,6 +16,7 @@ def spin_up_motion(omega_s: float, t_s: float):
     """Hub angle θ(t) of the spin-up manoeuvre and its first two derivatives:
     θ = (Ωs/Ts)[t²/2 + (Ts/2π)²(cos(2πt/Ts) − 1)] for t ≤ Ts, Ωs (t − Ts/2) afterwards
     (smooth: θ̈ = (Ωs/Ts)(1 − cos 2πt/Ts) rises from and returns to zero)."""
+    omega_s, t_s = float(finite_array("omega_s", omega_s, ())), positive("t_s", t_s)
     a, k = omega_s / t_s, 2.0 * np.pi / t_s
 
     def motion(t: float):
@@ -52,9 +54,11 @@ def spin_up_beam(
     Units: m, N m², N, kg/m, rad/s, s. ``gravity`` (m/s², along −z) is off by default.
     The first bending frequency at rest is 3.516 √(EI/(ρA L⁴)) = 3.80 rad/s for the
     defaults, below Ωs = 6 rad/s: without ``stiffening`` the in-plane deflection then
-    grows without bound. ``precomputed_integrals`` selects the beam's small-deformation
-    mode (shape integrals computed once, :mod:`projeq.subsystems.beam_integrals`).
+    grows without bound. ``precomputed_integrals`` selects the precomputed-moment mode
+    (:mod:`projeq.subsystems.beam_integrals`: exact for this model, since the slice position
+    is quadratic in q; faster per call up to ~5 functions per plane).
     """
+    n_shapes, n_axial = count("n_shapes", n_shapes), count("n_axial", n_axial, minimum=0)
     beam = RitzBeam(
         length, rho_A, EI, EA=EA if n_axial else None, n_v=n_shapes, n_w=n_shapes, n_u=n_axial,
         family=family, stiffening=stiffening, precomputed_integrals=precomputed_integrals,
@@ -82,6 +86,7 @@ def elastic_arm(
     depends on the beam's elastic coordinates (THEORY §10). Units SI; ``gravity`` along −z
     is off by default. Initial state: the first joint spinning at ``omega0`` rad/s, the
     beam slightly bent (1 cm tip deflection in the plane)."""
+    n_shapes = count("n_shapes", n_shapes)
     beam = RitzBeam(length, rho_A, EI, n_v=n_shapes, n_w=n_shapes, stiffening=stiffening)
     system = System(
         {
@@ -119,6 +124,7 @@ def spinning_beam(
     beam of B(16)–(23), THEORY §9): the root turns by α = Ω t (prescribed); v, w bend in
     the co-rotating frame with ``n_shapes`` functions each; ``rho_I`` (per length, kg m)
     adds the rotary inertia ρI of both bending axes (polar 2ρI, circular section)."""
+    n_shapes, omega = count("n_shapes", n_shapes), float(finite_array("omega", omega, ()))
     beam = RitzBeam(
         length, rho_A, EI, n_v=n_shapes, n_w=n_shapes, family=family,
         rho_I=None if rho_I is None else (rho_I, rho_I),

@@ -70,7 +70,9 @@ def four_bar(a: float = 0.3, b: float = 1.0, c: float = 0.8, d: float = 1.0, m=(
     b at the crank pin (q2, relative), rocker c about D = (d, 0) (q3, absolute), uniform
     rods of masses ``m``; the loop coupler tip = rocker tip is cut and given as Φ = 0.
     The tree orders its coordinates q = (q1, q3, q2) (``system.tree.names``).
-    Initial state: crank at ``theta1`` turning at ``omega1`` (the independent velocity ṡ = q̇1).
+    Initial state: crank at ``theta1`` turning at ``omega1`` (the independent velocity ṡ = q̇1;
+    ``four_bar().with_independent([1], repivot=True)`` starts the same motion in the rocker's
+    rate q̇3, which degenerates at the rocker's extreme positions).
     """
     tree = System(
         {"crank": _rod(m[0], a), "coupler": _rod(m[1], b), "rocker": _rod(m[2], c)},

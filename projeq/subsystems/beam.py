@@ -26,32 +26,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.checks import non_negative, positive
+from projeq.checks import count, finite_array, non_negative, positive
 from projeq.joints import Relative
 from projeq.spatial import cross, skew_stack
 from projeq.subsystems import shapes
+from projeq.subsystems.beam_checks import family_shapes, per_length
 from projeq.subsystems.beam_integrals import ShapeIntegrals
 from projeq.subsystems.beam_probes import BeamProbes
-
-
-def _per_length(name: str, value, x: NDArray, allow_zero: bool = False) -> NDArray:
-    """A per-length property (constant or function of x) at the stations, checked."""
-    values = np.asarray(value(x) if callable(value) else np.full_like(x, float(value)), dtype=float)
-    if values.shape != x.shape or not np.all(np.isfinite(values)):
-        raise ValueError(f"{name}: must give a finite value at each station x")
-    if np.any(values < 0) or (not allow_zero and np.any(values <= 0)):
-        raise ValueError(f"{name}: must be positive along the beam, got min {values.min():.3g}")
-    return values
-
-
-def _family(name: str, family, table: dict, n: int, L: float):
-    if n == 0:
-        return None
-    if callable(family):
-        return family(n, L)
-    if family not in table:
-        raise ValueError(f"{name}: unknown Ritz family {family!r}; use one of {sorted(table)} or a callable")
-    return table[family](n, L)
 
 
 class RitzBeam(BeamProbes):
@@ -79,7 +60,9 @@ class RitzBeam(BeamProbes):
         unless ``rho_I`` gives it as ρ(I_y + I_z).
     family : "polynomial", "clamped_free", "pinned_free" or a callable ``(n, L) -> shapes``
         Bending family; the axial and torsional families are chosen alike ("polynomial" or
-        "clamped_free": the fixed–free bar's sines; "pinned_free" uses the latter).
+        "clamped_free": the fixed–free bar's sines; "pinned_free" uses the latter; a
+        callable serves all deformations). A callable's output is checked by
+        :func:`projeq.subsystems.beam_checks.family_shapes`.
     support : "clamped" or "pinned"
         Geometric boundary conditions the bending functions must meet at the root:
         Φ(0) = Φ′(0) = 0 (clamped) or Φ(0) = 0 (pinned: the joint carries the rigid
@@ -91,8 +74,8 @@ class RitzBeam(BeamProbes):
     damping : float
         β of the stiffness-proportional damping force −β K_e q̇_e (s).
     precomputed_integrals : bool
-        Assemble M_n, h_n from shape integrals computed once (small deformations: errors
-        O(ε²) in q_e, q̇_e ~ ε, see :mod:`projeq.subsystems.beam_integrals`) instead of
+        Assemble M_n, h_n from moments of the shape functions computed once (exact for
+        this model at any deformation, see :mod:`projeq.subsystems.beam_integrals`) instead of
         quadrature per call; default False.
     """
 
@@ -138,13 +121,13 @@ class RitzBeam(BeamProbes):
         self.S = np.vstack((np.eye(6), np.zeros((self.n_e, 6))))
         self.stiffening = bool(stiffening)
         self.damping = non_negative("damping", damping)
-        self.order = order = int(quadrature_order or 2 * max(self.n_u, self.n_v, self.n_w, self.n_beta) + 6)
-        if order < 1:
-            raise ValueError(f"quadrature_order: must be at least 1, got {quadrature_order}")
+        default_order = 2 * max(self.n_u, self.n_v, self.n_w, self.n_beta) + 6
+        order = default_order if quadrature_order is None else quadrature_order
+        self.order = order = count("quadrature_order", order)
         t, w = np.polynomial.legendre.leggauss(order)
         self.x = x = 0.5 * L * (t + 1.0)
         self.weights = 0.5 * L * w
-        self.mass_weights = self.weights * _per_length("rho_A", rho_A, x)
+        self.mass_weights = self.weights * per_length("rho_A", rho_A, x)
         self._shapes(family, L)
         self._EI = {"z": EI_z, "y": EI_y if EI_y is not None else EI_z}
         self._stiffness(EI_z, self._EI["y"], EA, GI_t)
@@ -169,7 +152,7 @@ class RitzBeam(BeamProbes):
             ("w", self.n_w, family, shapes.BENDING, bending),
             ("beta", self.n_beta, axial_family, shapes.AXIAL, (0,)),
         ):
-            self.families[key] = fam = _family("family", fam_name, table, n, L)
+            self.families[key] = fam = family_shapes(fam_name, table, n, L, key)
             if fam is None:
                 continue
             at_root = fam(np.zeros(1))
@@ -217,7 +200,7 @@ class RitzBeam(BeamProbes):
             if cols.stop == cols.start:
                 continue
             D = self.Phi[key][derivative]
-            k = self.weights * _per_length(name, stiffness, self.x)
+            k = self.weights * per_length(name, stiffness, self.x)
             sl = slice(cols.start - 6, cols.stop - 6)
             self.K_e[sl, sl] = (D * k) @ D.T
 
@@ -229,7 +212,10 @@ class RitzBeam(BeamProbes):
             return
         I_y, I_z = 0.0, 0.0
         if rho_I is not None:
-            rho_I = np.broadcast_to(np.asarray(rho_I, dtype=float), (2,))
+            rho_I = finite_array("rho_I", rho_I)
+            if rho_I.size not in (1, 2):
+                raise ValueError(f"rho_I: expected ρI or (ρI_y, ρI_z), got {rho_I.size} values")
+            rho_I = np.broadcast_to(rho_I.ravel(), (2,))
             I_y, I_z = (positive(f"rho_I[{i}]", v) for i, v in enumerate(rho_I))
         I_p = I_y + I_z if rho_I_p is None else positive("rho_I_p", rho_I_p)
         self.rotary = self.weights[:, None] * np.array([I_p, I_y, I_z])[None, :]
@@ -246,7 +232,7 @@ class RitzBeam(BeamProbes):
             P, sl = self.Phi[key][0], slice(cols.start - 6, cols.stop - 6)
             gram[sl, sl] = (P * self.weights) @ P.T
         eigenvalues, vectors = np.linalg.eigh(gram)
-        if eigenvalues[0] <= 1e-14 * eigenvalues[-1]:  # numerically singular (monomials up to x¹³ pass)
+        if eigenvalues[0] <= 1e-14 * eigenvalues[-1]:  # numerically singular (polynomials: n ≤ 9 pass, n = 10 not)
             involved = [self._name(k) for k in np.flatnonzero(np.abs(vectors[:, 0]) > 1e-3)]
             raise ValueError(
                 f"family: the Ritz functions {involved} are linearly dependent to machine precision "

@@ -1,18 +1,29 @@
-"""Precomputed shape integrals of a RitzBeam: M_n and h_n of B(25) for small deformations
-without quadrature per call (THEORY §10, "a speed/accuracy knob").
+"""Precomputed shape integrals of a RitzBeam: M_n and h_n of B(25) without quadrature per
+call, exact for the beam's model (THEORY §10, "a speed/accuracy knob").
 
-The slice Jacobian J(x, q_e) = [E, −r̃(x), Φ_r(x)] is a polynomial in q_e (affine plus the
-quadratic u₂), so J = J₀(x) + Σ_k q_k J₁ₖ(x) + O(q²) with J₁ₖ the exact central difference
-of step 1. The slice acceleration not proportional to ÿ is
+The slice position is a polynomial of degree two in the elastic coordinates,
 
-    c(x) = a + ω̃ω̃ r(x) + 2 ω̃ Φ_r(x) q̇_e − (q̇_vᵀH_v q̇_v + q̇_wᵀH_w q̇_w) e_x,  a = ω̃ v_R − g_R,
+    r(x, q) = R(x) z(q),   z = (1, q, q_v ⊗ q_v, q_w ⊗ q_w),
 
-linear in the station fields r, Φ_r and H. With q_e and q̇_e of order ε (rigid motion of
-order one) the integrals ∫J₀ᵀJ₀ dm, ∫J₁ₖᵀJ₀ dm, ∫J dm, ∫J_aᵀ r_b dm, ∫J₀_aᵀ Φ_r,b dm and
-the stiffening integrals ∫J₀,xᵀ H dm are computed once, and M_n, h_n follow to first order
-in ε (errors O(ε²); exact at q_e = 0 for any ẏ). The geometric stiffness is kept: it comes
-from ∫J₁ᵀ ω̃ω̃ (x e_x) dm = −(ω_y² + ω_z²) ∫ x H dm q (THEORY §10, N = ρAΩ²(L² − x²)/2).
-Rotary inertia and the stiffness stay with the beam (shared with the quadrature mode).
+with the columns of R: x e_x, the Ritz functions Ψ(x) = Φ_r(x, 0), and −½ H_ij(x) e_x for
+the products q_i q_j of the second-order axial field u₂ = −½ (q_vᵀH_v q_v + q_wᵀH_w q_w).
+Then Φ_r = ∂r/∂q = R Z with Z = ∂z/∂q, ṙ = R Z q̇, the part of r̈ not proportional to q̈
+is R Ż q̇ (the stiffening term −(q̇ᵀH q̇) e_x), and every integral of B(25) is bilinear in
+the station fields, so with the moments
+
+    G_ab = ∫ R_aᵀ R_b dm  (rows a, b of R; n_z × n_z),   R̄ = ∫ R dm,   m = ∫ dm,
+
+computed once by the beam's quadrature, J = [E, −r̃, Φ_r] and the acceleration
+c = a + ω̃ω̃ r + 2 ω̃ ṙ + R Ż q̇ (a = ω̃ v_R − g_R) give
+
+    ∫ r dm = R̄ z,   ∫ r_a r_b dm = zᵀ G_ab z,   ∫ r_a Φ_r,b dm = zᵀ G_ab Z,
+    ∫ Φ_rᵀ Φ_r dm = Zᵀ (Σ_a G_aa) Z,   ∫ Φ_r,aᵀ ṙ_b dm = Zᵀ G_ab Z q̇,
+
+and M_n = ∫ Jᵀ J dm, h_n = −∫ Jᵀ c dm follow from them without approximation: equal to
+the quadrature mode to round-off, for any deformation (tests/subsystems/test_beam_integrals.py).
+The cost per call is O(n_z²) with n_z = 1 + n_e + n_v² + n_w², independent of the number
+of stations. Rotary inertia and the stiffness stay with the beam (shared with the
+quadrature mode).
 """
 
 from __future__ import annotations
@@ -23,47 +34,96 @@ from numpy.typing import NDArray
 from projeq.spatial import cross, skew
 
 
+def _axial(C: NDArray) -> NDArray:
+    """Σ_bc ε_abc C_bc: the vector of the antisymmetric part of C (∫ r × x dm from C = ∫ r xᵀ dm;
+    C may carry further trailing axes)."""
+    return np.array([C[1, 2] - C[2, 1], C[2, 0] - C[0, 2], C[0, 1] - C[1, 0]])
+
+
 class ShapeIntegrals:
-    """The shape integrals of ``beam`` (a RitzBeam), by its quadrature, once."""
+    """The moments G_ab, R̄, m of ``beam`` (a RitzBeam), by its quadrature, once."""
 
     def __init__(self, beam):
-        m = beam.mass_weights
-        zero = np.zeros(beam.n_e)
-        r0, Phi0 = beam._slices(zero)
-        J0 = beam._jacobian(r0, Phi0)
-        J1 = np.array([self._linear_part(beam, unit) for unit in np.eye(beam.n_e)])
-        n_y, n_e = beam.n_y, beam.n_e
-        self.M0 = np.einsum("sai,saj,s->ij", J0, J0, m)
-        M1 = np.einsum("ksai,saj,s->kij", J1, J0, m)
-        self.M1 = (M1 + M1.transpose(0, 2, 1)).reshape(n_e, n_y * n_y)
-        # ∫J dm (zero and first order), flattened for matrix products
-        self.J_int = np.einsum("sai,s->ai", J0, m), np.einsum("ksai,s->kai", J1, m).reshape(n_e, 3 * n_y)
-        # ∫J_aᵀ r_b dm, indices (ab, i)
-        J_r1 = np.einsum("ksai,sb,s->kabi", J1, r0, m) + np.einsum("sai,sbk,s->kabi", J0, Phi0, m)
-        self.J_r = np.einsum("sai,sb,s->abi", J0, r0, m).reshape(9, n_y), J_r1.reshape(n_e, 9 * n_y)
-        self.J_Phi = np.einsum("sai,sbk,s->abik", J0, Phi0, m).reshape(9, n_y * n_e)  # ∫J₀_aᵀ Φ_r,b dm
-        self.J_H = {key: np.einsum("si,sjk,s->ijk", J0[:, 0, :], beam.H[key], m) for key in ("v", "w")}
         self.beam = beam
+        n_e = beam.n_e
+        # bending planes carrying u₂: positions in q_e and their H(x) at the stations
+        self.planes = [
+            (np.arange(cols.start - 6, cols.stop - 6), beam.H[key])
+            for key, cols in (("v", beam.v_cols), ("w", beam.w_cols))
+            if beam.stiffening and cols.stop > cols.start
+        ]
+        quadratic = [-0.5 * H.reshape(len(beam.x), -1) for _, H in self.planes]
+        self.n_z = 1 + n_e + sum(block.shape[1] for block in quadratic)
+        R = np.zeros((len(beam.x), 3, self.n_z))
+        R[:, 0, 0] = beam.x
+        R[:, :, 1 : 1 + n_e] = beam._slices(np.zeros(n_e))[1]  # Ψ(x) = Φ_r(x, 0)
+        if quadratic:
+            R[:, 0, 1 + n_e :] = np.hstack(quadratic)
+        m = beam.mass_weights
+        self.mass = float(m.sum())
+        self.R_bar = np.einsum("sak,s->ak", R, m)
+        self.G = np.einsum("sak,sbl,s->abkl", R, R, m)
+        self.G_trace = np.einsum("aakl->kl", self.G)
+        self._G_rows = self.G.reshape(9 * self.n_z, self.n_z)  # for one matrix–vector product
+        # the products q_i q_j in z (row-major within each plane), and ∂(q_i q_j)/∂q_l =
+        # δ_il q_j + q_i δ_jl as a constant tensor D with Z_quadratic = D q
+        pairs = [(i, j) for cols, _ in self.planes for i in cols for j in cols]
+        self._i, self._j = (np.array([p[k] for p in pairs], dtype=int) for k in (0, 1))
+        E = np.eye(n_e)
+        self._D = E[self._i][:, :, None] * E[self._j][:, None, :] + E[self._j][:, :, None] * E[self._i][:, None, :]
+        self._Z_linear = np.vstack((np.zeros((1, n_e)), E))
 
-    @staticmethod
-    def _linear_part(beam, unit: NDArray) -> NDArray:
-        """∂J/∂q_k at q = 0: central difference of step 1 (exact, J is quadratic in q)."""
-        ahead, behind = beam._slices(unit), beam._slices(-unit)
-        return 0.5 * (beam._jacobian(*ahead) - beam._jacobian(*behind))
+    def monomials(self, q_e: NDArray, q_e_dot: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+        """z(q), Z = ∂z/∂q and Ż q̇ (whose only non-zero entries are 2 q̇_i q̇_j)."""
+        z = np.concatenate(((1.0,), q_e, q_e[self._i] * q_e[self._j]))
+        Z = np.vstack((self._Z_linear, self._D @ q_e))
+        z_dd = np.concatenate((np.zeros(1 + len(q_e)), 2.0 * q_e_dot[self._i] * q_e_dot[self._j]))
+        return z, Z, z_dd
+
+    def _moments(self, q_e: NDArray, q_e_dot: NDArray, omega: NDArray, a: NDArray) -> dict:
+        """The integrals shared by all rows: ∫ r dm, ∫ Φ_r dm, ∫ R_aᵀ r_b dm, Y_ab = ∫ r_a Φ_r,b dm,
+        and the elastic rows M_e = ∫ Φ_rᵀ J dm, −h_e = ∫ Φ_rᵀ c dm (c of the module docstring)."""
+        z, Z, z_dd = self.monomials(q_e, q_e_dot)
+        n_z, n_e = self.n_z, len(q_e)
+        W = skew(omega)
+        WW = W @ W
+        Gz = (self._G_rows @ z).reshape(3, 3, n_z)  # Gz[a, b] = ∫ R_aᵀ r_b dm
+        Y = np.swapaxes(Gz @ Z, 0, 1)  # Y[a, b] = ∫ r_a Φ_r,b dm
+        r_bar, Phi_bar = self.R_bar @ z, self.R_bar @ Z
+        M_e = np.empty((n_e, 6 + n_e))
+        M_e[:, :3] = Phi_bar.T
+        M_e[:, 3:6] = _axial(Y).T  # (∫ r̃ Φ_r dm)ᵀ
+        M_e[:, 6:] = Z.T @ self.G_trace @ Z
+        Phi_c = (  # ∫ Φ_rᵀ c dm
+            Phi_bar.T @ a
+            + np.einsum("ab,bai->i", WW, Y)
+            + 2.0 * Z.T @ (W.ravel() @ (self._G_rows @ (Z @ q_e_dot)).reshape(9, n_z))
+            + Z.T @ (self.G_trace @ z_dd)
+        )
+        return {"z": z, "z_dd": z_dd, "W": W, "WW": WW, "Gz": Gz, "Y": Y, "r_bar": r_bar, "Phi_bar": Phi_bar,
+                "M_e": M_e, "h_e": -Phi_c}
+
+    def elastic_rows(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray) -> tuple[NDArray, NDArray]:
+        """The last n_e rows of (M_n, h_n) of the slices' translation: all a beam on a
+        prescribed hub needs (:mod:`projeq.assembly.beam_fast`)."""
+        omega = y_dot[3:6]
+        moments = self._moments(q_e, y_dot[6:], omega, cross(omega, y_dot[:3]) - R.T @ gravity)
+        return moments["M_e"], moments["h_e"]
 
     def terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray) -> tuple[NDArray, NDArray]:
-        """(M_n, h_n) of the slices' translation to first order in (q_e, q̇_e)."""
-        beam = self.beam
+        """(M_n, h_n) of the slices' translation, B(25), from the moments (module docstring)."""
         v_R, omega, q_e_dot = y_dot[:3], y_dot[3:6], y_dot[6:]
-        W = skew(omega)
         a = cross(omega, v_R) - R.T @ gravity
-        n_y, n_e = beam.n_y, beam.n_e
-        M = self.M0 + (q_e @ self.M1).reshape(n_y, n_y)
-        h = -a @ (self.J_int[0] + (q_e @ self.J_int[1]).reshape(3, n_y))
-        h -= (W @ W).ravel() @ (self.J_r[0] + (q_e @ self.J_r[1]).reshape(9, n_y))
-        h -= 2.0 * ((W.ravel() @ self.J_Phi).reshape(n_y, n_e) @ q_e_dot)
-        if beam.stiffening:
-            for key, cols in (("v", beam.v_cols), ("w", beam.w_cols)):
-                qd = q_e_dot[beam._local(cols)]
-                h += self.J_H[key] @ qd @ qd
-        return M, h
+        k = self._moments(q_e, q_e_dot, omega, a)
+        W, WW, Gz, Y, r_bar, Phi_bar = k["W"], k["WW"], k["Gz"], k["Y"], k["r_bar"], k["Phi_bar"]
+        S = Gz @ k["z"]  # ∫ r rᵀ dm
+        M = np.empty((6 + len(q_e), 6 + len(q_e)))
+        M[:3, :3] = self.mass * np.eye(3)
+        M[:3, 3:6] = -skew(r_bar)
+        M[3:6, :3] = skew(r_bar)
+        M[3:6, 3:6] = (S[0, 0] + S[1, 1] + S[2, 2]) * np.eye(3) - S
+        M[6:] = k["M_e"]
+        M[:6, 6:] = k["M_e"][:, :6].T
+        c_int = self.mass * a + WW @ r_bar + 2.0 * W @ (Phi_bar @ q_e_dot) + self.R_bar @ k["z_dd"]  # ∫ c dm
+        r_c = np.outer(r_bar, a) + S @ WW.T + 2.0 * (Y @ q_e_dot) @ W.T + (Gz @ k["z_dd"]).T  # ∫ r cᵀ dm
+        return M, np.concatenate((-c_int, -_axial(r_c), k["h_e"]))

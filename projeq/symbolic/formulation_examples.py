@@ -73,3 +73,29 @@ def particle() -> MultiplierSystem:
     """Barhorst's particle (seed 000 §3.1): L = m(ẋ² + ẏ²)/2 − m g y with ẏ − y² ẋ = 0, m = 1, g = 10."""
     x, y = q = dynamicsymbols("x y")
     return multiplier_system((x.diff(t) ** 2 + y.diff(t) ** 2) / 2 - 10 * y, q, t, A=[[-y**2, 1]])
+
+
+def hamel_disc():
+    """The disc by Hamel's equations B(3) (THEORY §8) in the scene's q = (x, y, ψ, ϕ, θ): speeds
+    ṡ = H q̇ = (ψ̇, ϕ̇, θ̇, c₁, c₂) with c₁, c₂ the rolling constraints of slide 30 (z = −r cos ϕ
+    eliminated), T and the weight's generalised forces Q = Kᵀ ∂(m g z)/∂q in these speeds; c₁ = c₂ = 0
+    inserted *after* the derivation. Returns the Gauss form in (ψ̇, ϕ̇, θ̇) with parameters m, g, r, I, J."""
+    from .hamel import hamel_equations
+    from .projection import GaussForm
+
+    q = sp.symbols("x y psi phi theta")
+    s = sp.symbols("psi_d phi_d theta_d c_1 c_2")
+    s_ddot = sp.symbols("psi_dd phi_dd theta_dd c_1_d c_2_d")
+    x, y, psi, phi, th = q
+    K_rolling = _disc_K([x, y, None, psi, phi, th])  # rows ẋ, ẏ, ż, ψ̇, ϕ̇, θ̇ from (ψ̇, ϕ̇, θ̇)
+    K = sp.Matrix.hstack(K_rolling.extract([0, 1, 3, 4, 5], [0, 1, 2]), sp.eye(5)[:, :2])  # ẋ, ẏ gain c₁, c₂
+    H = K.inv().applyfunc(sp.simplify)
+    q_dot = K * sp.Matrix(s)
+    z_dot = r * sp.sin(phi) * q_dot[3]
+    T = (m * (q_dot[0] ** 2 + q_dot[1] ** 2 + z_dot**2) + I * q_dot[2] ** 2 * sp.cos(phi) ** 2 + I * q_dot[3] ** 2
+         + J * (q_dot[4] + q_dot[2] * sp.sin(phi)) ** 2) / 2
+    Q = K.T * sp.Matrix([0, 0, 0, m * g * r * sp.sin(phi), 0])  # −∂V/∂q, V = −m g z = m g r cos ϕ
+    residual = hamel_equations(T, q, s, H, Q, s_ddot, parameters=(m, g, r, I, J))
+    residual = residual[:3, :].subs({s[3]: 0, s[4]: 0, s_ddot[3]: 0, s_ddot[4]: 0})
+    M, rhs = sp.linear_eq_to_matrix(list(residual), list(s_ddot[:3]))
+    return GaussForm(M, rhs, q, s[:3], K[:, :3], parameters=(I, J, g, m, r))

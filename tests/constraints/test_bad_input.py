@@ -5,8 +5,9 @@ import pytest
 
 import projeq as pq
 from projeq.constrained import ConstrainedSystem
-from projeq.reaction_forces import contact_event, reactions
-from projeq.scenes.mechanisms import slider_pendulum
+from projeq.cut_joints import PinClosure
+from projeq.reaction_forces import contact_event, joint_reactions, reactions
+from projeq.scenes.mechanisms import four_bar, slider_pendulum
 
 
 @pytest.fixture(scope="module")
@@ -29,6 +30,31 @@ def test_no_constraint(tree):
 def test_constraint_not_callable(tree):
     with pytest.raises(ValueError, match="A: expected a callable"):
         ConstrainedSystem(tree, A=np.ones((1, 2)))
+
+
+def test_loop_closures_of_wrong_shape(tree):
+    with pytest.raises(ValueError, match=r"phi: returns an array of shape \(1, 1\), expected \(m,\)"):
+        ConstrainedSystem(tree, phi=lambda q, t: [[np.hypot(q[0], q[1]) - 1.0]])
+
+
+def test_initial_minimal_velocities_of_wrong_length(tree):
+    with pytest.raises(ValueError, match="s_dot0: expected 1 entries"):
+        ConstrainedSystem(tree, phi=circle, s_dot0=[1.0, 2.0])
+
+
+def test_repivot_not_a_bool(tree):
+    with pytest.raises(ValueError, match="repivot: expected True, False or None"):
+        ConstrainedSystem(tree, phi=circle, repivot="yes")
+
+
+def test_other_partition_out_of_range():
+    with pytest.raises(ValueError, match=r"independent: expected 1 distinct indices of ṡ_tree in 0..2"):
+        four_bar().with_independent([3])
+
+
+def test_other_partition_with_a_bad_repivot():
+    with pytest.raises(ValueError, match="repivot: expected True, False or None"):
+        four_bar().with_independent([1], repivot="yes")
 
 
 def test_pfaffian_matrix_of_wrong_shape(tree):
@@ -63,6 +89,15 @@ def test_partition_with_a_singular_dependent_block(tree):
     match = r"independent: the dependent velocities \[1\] cannot be solved for at q = \[1.0, 0.0\]"
     with pytest.raises(ValueError, match=match):
         ConstrainedSystem(tree, phi=circle, independent=[0], q0=[1.0, 0.0])
+
+
+def test_fixed_partition_degenerating_during_a_run(tree):
+    """Started at (0.6, −0.8) with ẋ independent the pendulum swings up to x = 1, z = 0,
+    where ż cannot be solved for: the run stops with the configuration in the message
+    (no silent loss of accuracy; tests/constraints/test_repivot.py for the four-bar)."""
+    system = ConstrainedSystem(tree, phi=circle, independent=[0], s_dot0=[4.0])
+    with pytest.raises(pq.SimulationError, match=r"dependent velocities \[1\] cannot be solved for at q = \[0.9"):
+        pq.simulate(system, 0.5, n_points=3)
 
 
 def test_automatic_partition_picks_the_regular_block(tree):
@@ -101,3 +136,54 @@ def test_reactions_of_a_tree(tree):
 def test_contact_event_row_out_of_range():
     with pytest.raises(ValueError, match="row: expected a constraint row in 0..0"):
         contact_event(slider_pendulum(), 1)
+
+
+@pytest.fixture(scope="module")
+def four_bar_pin():
+    system = four_bar()
+    return system, PinClosure(system.tree, "coupler", (1.0, 0, 0), "rocker", (0.8, 0, 0), axes="xy")
+
+
+def test_cut_joint_on_one_subsystem(four_bar_pin):
+    with pytest.raises(ValueError, match="b: the cut joint must join two subsystems"):
+        PinClosure(four_bar_pin[0].tree, "rocker", (0, 0, 0), "rocker", (0.8, 0, 0))
+
+
+def test_cut_joint_on_an_unknown_subsystem(four_bar_pin):
+    with pytest.raises(ValueError, match="name: unknown subsystem 'slider'"):
+        PinClosure(four_bar_pin[0].tree, "slider", (0, 0, 0), "rocker", (0.8, 0, 0))
+
+
+def test_cut_joint_on_a_deforming_subsystem():
+    tree = pq.scenes.spin_up_beam()
+    with pytest.raises(ValueError, match="a: a cut joint needs a rigid subsystem"):
+        PinClosure(tree, tree.names[-1], (0, 0, 0), None, (0, 0, 0))
+
+
+def test_cut_joint_point_of_wrong_shape(four_bar_pin):
+    with pytest.raises(ValueError, match="rho_a"):
+        PinClosure(four_bar_pin[0].tree, "coupler", (1.0, 0), "rocker", (0.8, 0, 0))
+
+
+def test_cut_joint_with_unknown_axes(four_bar_pin):
+    with pytest.raises(ValueError, match="axes: expected distinct letters of 'xyz'"):
+        PinClosure(four_bar_pin[0].tree, "coupler", (1.0, 0, 0), "rocker", (0.8, 0, 0), axes="xw")
+
+
+def test_joint_reactions_of_a_loop_without_its_cuts(four_bar_pin):
+    system, _ = four_bar_pin
+    with pytest.raises(ValueError, match=r"cuts: expected a dict \{name: PinClosure\}"):
+        joint_reactions(system, system.q0, [1.0])
+
+
+def test_joint_reactions_with_cuts_missing_rows(four_bar_pin):
+    system, pin = four_bar_pin
+    half = PinClosure(system.tree, "coupler", (1.0, 0, 0), "rocker", (0.8, 0, 0), axes="x")
+    with pytest.raises(ValueError, match="cuts: the cut joints give 1 closure rows, the system has 2 holonomic"):
+        joint_reactions(system, system.q0, [1.0], cuts={"pin": half})
+
+
+def test_cut_named_like_a_subsystem(four_bar_pin):
+    system, pin = four_bar_pin
+    with pytest.raises(ValueError, match=r"cuts: names \['rocker'\] are subsystem names"):
+        joint_reactions(system, system.q0, [1.0], cuts={"rocker": pin})

@@ -3,12 +3,13 @@
 import numpy as np
 import pytest
 import sympy as sp
-from sympy.physics import mechanics as me
 
 import projeq as pq
 from projeq import inertia
-from projeq.symbolic import Body, projection_equation
-from projeq.symbolic.examples import n_link_pendulum
+from projeq.symbolic import Body, gauss_form, projection_equation
+from projeq.symbolic.examples import (
+    PENDULUM_PARAMETERS, chain_parameters, kane_pendulum, lagrange_pendulum, n_link_pendulum,
+)
 
 RNG_SEED = 20261123
 # two evaluations of the same equations in double precision, O(10²) operations on numbers
@@ -84,43 +85,31 @@ def test_n_link_pendulum_equals_scenes_chain_dense_and_recursive():
             assert np.allclose(s_ddot, reference, rtol=0, atol=RTOL * (1 + np.abs(reference).max()))
 
 
-def kane_pendulum(n):
-    """sympy.physics.mechanics KanesMethod for the same n-link pendulum (VALIDATION.md):
-    frames rotated about N.y, rigid links with central inertia (J, J, J_a), gravity −g N.z."""
-    q, u = me.dynamicsymbols(f"q1:{n + 1}"), me.dynamicsymbols(f"u1:{n + 1}")
-    m, l, J, J_a, g = sp.symbols("m l J J_a g", positive=True)
-    N = me.ReferenceFrame("N")
-    joint = me.Point("O")
-    joint.set_vel(N, 0)
-    frame, links, loads = N, [], []
-    for k in range(n):
-        frame = frame.orientnew(f"A{k}", "Axis", (q[k], frame.y))
-        frame.set_ang_vel(N, sum((u_j * N.y for u_j in u[: k + 1]), 0 * N.y))
-        centre = joint.locatenew(f"C{k}", -l / 2 * frame.z)
-        centre.v2pt_theory(joint, N, frame)
-        links.append(me.RigidBody(f"B{k}", centre, frame, m, (me.inertia(frame, J, J, J_a), centre)))
-        loads.append((centre, -m * g * N.z))
-        joint = joint.locatenew(f"P{k}", -l * frame.z)
-        joint.v2pt_theory(centre, N, frame)
-    kane = me.KanesMethod(N, q_ind=q, u_ind=u, kd_eqs=[q_k.diff() - u_k for q_k, u_k in zip(q, u)])
-    kane.kanes_equations(links, loads)
-    return q, u, kane.mass_matrix, kane.forcing
+def _pendulum_gauss_form(route: str, n: int):
+    """The n-link pendulum's Gauss form from its velocity expressions (B(10)) or from the
+    numeric ``scenes.chain(n)`` with symbolic parameters (the recursive chain, THEORY §6)."""
+    if route == "velocities":
+        bodies, q, s, parameters = n_link_pendulum(n)
+        return projection_equation(bodies, q, s, parameters=parameters)
+    return gauss_form(pq.scenes.chain(n), chain_parameters(n))
 
 
-def test_n_link_pendulum_equals_kanes_method():
-    """Projection Equation == KanesMethod (VALIDATION.md, N-link pendulum, N = 3): M and
-    rhs (M u̇ = forcing) agree at random states and random parameters."""
+@pytest.mark.parametrize("route, reference", [("velocities", "kane"), ("system", "kane"), ("system", "lagrange")])
+def test_n_link_pendulum_equals_kanes_and_lagranges_method(route, reference):
+    """Projection Equation == sympy.physics.mechanics KanesMethod and LagrangesMethod
+    (VALIDATION.md, N-link pendulum, N = 3): M and rhs (M u̇ = forcing) agree at random
+    states and random parameters, for both symbolic routes (Lagrange once: it is slow)."""
     rng = np.random.default_rng(RNG_SEED)
-    bodies, q, s, parameters = n_link_pendulum(3)
-    gauss = projection_equation(bodies, q, s, parameters=parameters)
-    q_k, u_k, M_k, forcing = kane_pendulum(3)
-    kane = sp.lambdify([q_k, u_k, parameters], [M_k, forcing], cse=True)
-    ours = sp.lambdify([q, s, parameters], [gauss.M, gauss.rhs], cse=True)
+    gauss = _pendulum_gauss_form(route, 3)
+    q_k, u_k, M_k, forcing = (kane_pendulum if reference == "kane" else lagrange_pendulum)(3)
+    theirs = sp.lambdify([q_k, u_k, PENDULUM_PARAMETERS], [M_k, forcing], cse=True)
+    ours = sp.lambdify([gauss.q, gauss.s, PENDULUM_PARAMETERS], [gauss.M, gauss.rhs], cse=True)
     for _ in range(10):
         state = rng.uniform(-np.pi, np.pi, 3), rng.uniform(-3, 3, 3), rng.uniform(0.5, 3.0, 5)
-        (M, rhs), (M_ref, rhs_ref) = ours(*state), kane(*state)
+        (M, rhs), (M_ref, rhs_ref) = ours(*state), theirs(*state)
         assert np.allclose(M, M_ref, rtol=0, atol=RTOL * np.abs(M_ref).max())
-        assert np.allclose(rhs, rhs_ref, rtol=0, atol=RTOL * (np.abs(rhs_ref).max() + np.abs(M_ref).max()))
+        assert np.allclose(np.ravel(rhs), np.ravel(rhs_ref), rtol=0,
+                           atol=RTOL * (np.abs(rhs_ref).max() + np.abs(M_ref).max()))
 
 
 def test_simulate_with_the_compiled_evaluator_equals_the_recursive_one():

@@ -1,0 +1,84 @@
+"""The fast path of a beam on a moving hub: one RitzBeam whose root follows a prescribed
+motion (a rheonomic hub, THEORY §4) or is fixed to the ground — the spin-up beam.
+
+Then the beam's reference frame moves as given, ẏ = (w(t), q̇_e) with the hub's twist w
+and ÿ = (ζ(t), q̈_e) with ζ = Ḟ⁶ θ̇ + F⁶ θ̈ (the parent is the ground at rest), and the
+Projection Equation B(14) projected on the only minimal velocities ṡ = q̇_e,
+
+    M_ee q̈_e = h_e − M_eR ζ,
+
+needs neither the kinematic chain nor the passes of THEORY §6: the beam's terms and one
+n_e × n_e solve. With precomputed shape integrals (:mod:`projeq.subsystems.beam_integrals`)
+and no rotary inertia only the elastic rows (M_ee, M_eR, h_e) are formed; otherwise the
+beam's ``gauss_terms``. M_ee = ∫ Φ_rᵀ Φ_r dm is positive definite for the independent
+Ritz functions a RitzBeam accepts, so a plain LU solve suffices. Equal to the general
+evaluators to round-off (tests/assembly/test_fast.py).
+
+>>> import numpy as np, projeq as pq
+>>> system = pq.scenes.spin_up_beam(omega_s=4.0, n_shapes=2, family="clamped_free")
+>>> ev = HubBeamEvaluator(system)
+>>> q, s_dot = np.array([0.01, 0.0, 0.002, 0.0]), np.array([0.1, 0.0, 0.0, 0.0])
+>>> bool(np.allclose(ev.accelerations(q, s_dot, 3.0), system.accelerations(q, s_dot, 3.0), rtol=1e-12, atol=1e-12))
+True
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.joints import Fixed, Prescribed
+from projeq.subsystems.beam import RitzBeam
+
+
+def hub_beam_unsupported(system) -> str | None:
+    """Why ``system`` is not one RitzBeam on a prescribed or fixed root joint (None if it is)."""
+    if len(system.subsystems) != 1:
+        return f"the system has {len(system.subsystems)} subsystems (the beam path takes one RitzBeam)"
+    name, beam, joint = system.names[0], system.subsystems[0], system.joints[0]
+    if not isinstance(beam, RitzBeam):
+        return f"subsystem {name!r} is a {type(beam).__name__}, not a RitzBeam"
+    if not isinstance(joint, (Prescribed, Fixed)):
+        return f"joint {name!r} is a {type(joint).__name__} (the beam path takes Prescribed or Fixed hubs)"
+    if system.forces:
+        return "the system has force laws (the beam path knows gravity only)"
+    return None
+
+
+class HubBeamEvaluator:
+    """q̈_e of one RitzBeam on a prescribed or fixed hub (module docstring).
+
+    Parameters
+    ----------
+    system : System
+        One RitzBeam on a :class:`~projeq.Prescribed` or :class:`~projeq.Fixed` joint to
+        the ground, without force laws; otherwise ValueError naming the reason.
+    """
+
+    def __init__(self, system):
+        reason = hub_beam_unsupported(system)
+        if reason is not None:
+            raise ValueError(f"system: {reason}")
+        self.system = system
+        self.beam, self.joint = system.subsystems[0], system.joints[0]
+        self._rows_only = self.beam.integrals is not None and self.beam.rotary is None
+        self._empty = np.zeros(0)
+        self.n_calls = 0
+
+    def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
+        """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) at (q, ṡ, t) = (q_e, q̇_e, t)."""
+        self.n_calls += 1
+        joint = self.joint
+        hub = joint.relative(self._empty, self._empty, t)
+        R = joint.orientation @ hub.A  # the ground is at rest: R_n = A_pn
+        y_dot = np.concatenate((hub.w, s_dot))
+        beam = self.beam
+        if self._rows_only:
+            if not (beam.stiffening or beam._warned):
+                beam._warn_unstiffened_spin(hub.w[3:])
+            M_e, h_e = beam.integrals.elastic_rows(y_dot, R, self.system.gravity, q)
+            h_e -= beam.K_e @ (q + beam.damping * s_dot)
+        else:
+            M, h = beam.gauss_terms(y_dot, R, self.system.gravity, q)
+            M_e, h_e = M[6:], h[6:]
+        return np.linalg.solve(M_e[:, 6:], h_e - M_e[:, :6] @ hub.zeta)
