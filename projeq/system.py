@@ -106,6 +106,7 @@ class System:
         self.e_q_slice, self.e_s_slice = tuple(e_q), tuple(e_s)
         self._q_get = tuple(self.joint_q_getter(n) for n in range(len(self.joints)))
         self._s_get = tuple(self.joint_s_dot_getter(n) for n in range(len(self.joints)))
+        self._identity_q, self._identity_s, self._general_kinematics = self._kinematics_split()
         self._normalizing = tuple(  # joints whose coordinates live on a manifold (quaternions)
             n for n, j in enumerate(self.joints)
             if type(j).normalized is not Joint.normalized and not j.coupling
@@ -191,13 +192,28 @@ class System:
         finite_array("t", t, ())
         return self.check_q("q", q), state_vector("s_dot", s_dot, self.n_s)
 
-    def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
-        """q̇ = K(q) ṡ + k(q, t), joint by joint."""
-        q_dot = np.empty(self.n_q)
+    def _kinematics_split(self) -> tuple[NDArray, NDArray, tuple]:
+        """(rows of q, rows of ṡ) where q̇ = ṡ — joints with the identity K of the Joint base
+        class (revolute, prismatic) and elastic coordinates — and the other uncoupled joints."""
+        q_rows, s_rows, general = [], [], []
         for n, j in enumerate(self.joints):
-            if not j.coupling:
-                q_dot[self.q_slice[n].start : self.e_q_slice[n].start] = j.q_dot(self._q_get[n](q), self._s_get[n](s_dot), t)
-            q_dot[self.e_q_slice[n]] = s_dot[self.e_s_slice[n]]  # q̇_e = ṡ_e
+            if not j.coupling and j.n_q == j.n_s and type(j).K is Joint.K and type(j).q_dot is Joint.q_dot:
+                q_rows += range(self.q_slice[n].start, self.e_q_slice[n].start)
+                s_rows += range(self.s_slice[n].start, self.e_s_slice[n].start)
+            elif not j.coupling:
+                general.append(n)
+            q_rows += range(self.e_q_slice[n].start, self.e_q_slice[n].stop)
+            s_rows += range(self.e_s_slice[n].start, self.e_s_slice[n].stop)
+        return np.array(q_rows, dtype=int), np.array(s_rows, dtype=int), tuple(general)
+
+    def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
+        """q̇ = K(q) ṡ + k(q, t): q̇ = ṡ in one step where K = E (revolute and prismatic
+        joints, elastic coordinates), joint by joint elsewhere."""
+        q_dot = np.empty(self.n_q)
+        q_dot[self._identity_q] = np.asarray(s_dot)[self._identity_s]
+        for n in self._general_kinematics:
+            j = self.joints[n]
+            q_dot[self.q_slice[n].start : self.e_q_slice[n].start] = j.q_dot(self._q_get[n](q), self._s_get[n](s_dot), t)
         return q_dot
 
     @property

@@ -254,3 +254,12 @@ def test_planar_chain_equals_spatial_chain(n, seed):
     for method in ("recursive", "dense"):
         a, b = planar.accelerations(q, s_dot, method=method), spatial.accelerations(q, s_dot, method=method)
         assert np.abs(a - b).max() <= 1e-12 * max(1.0, np.abs(b).max()), method
+
+
+@given(any_plane.flatmap(lambda planar: trees(max_n=10, planar=planar, forces=False)))
+def test_q_dot_is_K_s_dot(tree):
+    """System.q_dot (q̇ = ṡ in one step for the identity joints, joint by joint elsewhere)
+    equals the block-diagonal K(q) ṡ assembled joint by joint (THEORY §3), to round-off."""
+    system, q, s_dot, t = tree.system, tree.q, tree.s_dot, tree.t
+    expected = system.K(q, t) @ s_dot
+    np.testing.assert_allclose(system.q_dot(q, s_dot, t), expected, rtol=0, atol=1e-14 * max(1.0, *np.abs(expected)))
