@@ -262,4 +262,4 @@ def test_q_dot_is_K_s_dot(tree):
     equals the block-diagonal K(q) ṡ assembled joint by joint (THEORY §3), to round-off."""
     system, q, s_dot, t = tree.system, tree.q, tree.s_dot, tree.t
     expected = system.K(q, t) @ s_dot
-    np.testing.assert_allclose(system.q_dot(q, s_dot, t), expected, rtol=0, atol=1e-14 * max(1.0, *np.abs(expected)))
+    np.testing.assert_allclose(system.q_dot(q, s_dot, t), expected, rtol=0, atol=1e-14 * np.max(np.abs(expected), initial=1.0))
