@@ -20,7 +20,6 @@ from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
 from projeq.assembly import EVALUATORS
 from projeq.checks import count, finite_array, positive, state_vector
-from projeq.constraints import check_configuration
 from projeq.integrators import EXPLICIT, PROJECTED, projected_solver, warn_if_stiff
 
 
@@ -211,8 +210,7 @@ def simulate(
         if not callable(e):
             raise ValueError(f"events[{i}]: expected a callable event(t, q, s_dot), got {e!r}")
     ev = _evaluator(system, evaluator)
-    # a coordinate singularity (or a degenerate partition of a ConstrainedSystem) at the start, by name
-    getattr(system, "check_configuration", lambda q, t: check_configuration(system, q, t))(q0, t_start)
+    system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
     ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
     solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
     n_q = system.n_q

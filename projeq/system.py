@@ -73,7 +73,7 @@ class System:
             a.flags.writeable = False
         self._evaluators: dict = {}  # the one cache: an evaluator per method (not thread-safe)
         self._check_planar()
-        check_configuration(self, self.q0)  # K(q0), F(q0) regular: no coordinate singularity at the start
+        self.check_configuration(self.q0)  # K(q0), F(q0) regular: no coordinate singularity at the start
 
     # -- names and indexing -------------------------------------------------------------
     def index(self, name: str) -> int:
@@ -191,6 +191,11 @@ class System:
         and a finite time t."""
         finite_array("t", t, ())
         return self.check_q("q", q), state_vector("s_dot", s_dot, self.n_s)
+
+    def check_configuration(self, q: NDArray, t: float = 0.0) -> None:
+        """ValueError naming the joint whose K(q) or F(q) is singular or not finite at q
+        (:func:`projeq.constraints.check_configuration`)."""
+        check_configuration(self, q, t)
 
     def _kinematics_split(self) -> tuple[NDArray, NDArray, tuple]:
         """(rows of q, rows of ṡ) where q̇ = ṡ — joints with the identity K of the Joint base
