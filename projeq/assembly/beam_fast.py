@@ -9,10 +9,11 @@ Projection Equation B(14) projected on the only minimal velocities ṡ = q̇_e,
 
 needs neither the kinematic chain nor the passes of THEORY §6: the beam's terms and one
 n_e × n_e solve. With precomputed shape integrals (:mod:`projeq.subsystems.beam_integrals`)
-and no rotary inertia only the elastic rows (M_ee, M_eR, h_e) are formed; otherwise the
-beam's ``gauss_terms``. M_ee = ∫ Φ_rᵀ Φ_r dm is positive definite for the independent
-Ritz functions a RitzBeam accepts, so a plain LU solve suffices. Equal to the general
-evaluators to round-off (tests/assembly/test_fast.py).
+and no rotary inertia only the elastic rows (M_ee, M_eR, h_e) are formed
+(:meth:`~projeq.subsystems.beam.RitzBeam.elastic_terms`). M_ee = ∫ Φ_rᵀ Φ_r dm is
+positive definite for the independent Ritz functions a RitzBeam accepts, so a plain LU
+solve suffices. Equal to the general evaluators to round-off
+(tests/assembly/test_fast.py).
 
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.spin_up_beam(omega_s=4.0, n_shapes=2, family="clamped_free")
@@ -61,7 +62,6 @@ class HubBeamEvaluator:
             raise ValueError(f"system: {reason}")
         self.system = system
         self.beam, self.joint = system.subsystems[0], system.joints[0]
-        self._rows_only = self.beam.integrals is not None and self.beam.rotary is None
         self._empty = np.zeros(0)
         self.n_calls = 0
 
@@ -72,13 +72,5 @@ class HubBeamEvaluator:
         hub = joint.relative(self._empty, self._empty, t)
         R = joint.orientation @ hub.A  # the ground is at rest: R_n = A_pn
         y_dot = np.concatenate((hub.w, s_dot))
-        beam = self.beam
-        if self._rows_only:
-            if not (beam.stiffening or beam._warned):
-                beam._warn_unstiffened_spin(hub.w[3:])
-            M_e, h_e = beam.integrals.elastic_rows(y_dot, R, self.system.gravity, q)
-            h_e -= beam.K_e @ (q + beam.damping * s_dot)
-        else:
-            M, h = beam.gauss_terms(y_dot, R, self.system.gravity, q)
-            M_e, h_e = M[6:], h[6:]
+        M_e, h_e = self.beam.elastic_terms(y_dot, R, self.system.gravity, q)
         return np.linalg.solve(M_e[:, 6:], h_e - M_e[:, :6] @ hub.zeta)

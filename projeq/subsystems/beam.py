@@ -311,8 +311,7 @@ class RitzBeam(BeamProbes):
         """(M_n, h_n) of B(25) by quadrature (see the module docstring) or, with
         ``precomputed_integrals``, from the shape integrals."""
         omega, q_e_dot = y_dot[3:6], y_dot[6:]
-        if not (self.stiffening or self._warned) and hasattr(self, "first_frequency"):
-            self._warn_unstiffened_spin(omega)
+        self._check_spin(omega)
         if getattr(self, "integrals", None) is None:
             M, h = self._translation_terms(y_dot, R, gravity, q_e)
         else:
@@ -322,8 +321,28 @@ class RitzBeam(BeamProbes):
             Jw_flat = (Jw * np.sqrt(self.rotary)[:, :, None]).reshape(-1, self.n_y)
             M += Jw_flat.T @ Jw_flat
             h -= Jw.reshape(-1, self.n_y).T @ (self.rotary * c_w + cross(omega_c, self.rotary * omega_c)).ravel()
-        h[6:] -= self.K_e @ (q_e + self.damping * q_e_dot)
+        h[6:] -= self._restoring_force(q_e, q_e_dot)
         return M, h
+
+    def elastic_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray):
+        """The last n_e rows (M_e, h_e) of :meth:`gauss_terms`: all a beam on a prescribed
+        hub needs (:mod:`projeq.assembly.beam_fast`); with precomputed integrals and no
+        rotary inertia only these rows are formed."""
+        if getattr(self, "integrals", None) is None or self.rotary is not None:
+            M, h = self.gauss_terms(y_dot, R, gravity, q_e)
+            return M[6:], h[6:]
+        self._check_spin(y_dot[3:6])
+        M_e, h_e = self.integrals.elastic_rows(y_dot, R, gravity, q_e)
+        return M_e, h_e - self._restoring_force(q_e, y_dot[6:])
+
+    def _check_spin(self, omega: NDArray) -> None:
+        """Warn once if the unstiffened model spins above its first bending frequency."""
+        if not (self.stiffening or self._warned) and hasattr(self, "first_frequency"):
+            self._warn_unstiffened_spin(omega)
+
+    def _restoring_force(self, q_e: NDArray, q_e_dot: NDArray) -> NDArray:
+        """K_e (q_e + d q̇_e): elastic and stiffness-proportional damping forces."""
+        return self.K_e @ (q_e + self.damping * q_e_dot)
 
     def _translation_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray):
         """∫Jᵀ J dm and −∫Jᵀ c dm of the slices' translation by quadrature."""
