@@ -26,7 +26,7 @@ def _draw(system, q, s_dot, t, stations: int, frame_size: float):
     velocities F ṡ."""
     if hasattr(system, "tree"):
         system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
-    kin = forward(system, q, s_dot, t)
+    kin = forward(system, q, s_dot, t, chain_terms=False)
     points, velocities, lines = [], [], []
     for n, sub in enumerate(system.subsystems):
         if hasattr(sub, "centre_line"):

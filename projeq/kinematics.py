@@ -108,15 +108,35 @@ class Kinematics:
         return [T[:-1, -1] for T in self.T_aug[:-1]]
 
 
-def forward(system, q: NDArray, s_dot: NDArray, t: float) -> Kinematics:
-    """Poses, ẏ_n, T̃_np (T_np and ζ_n) and F_n of every subsystem at (q, ṡ, t)."""
+def forward(system, q: NDArray, s_dot: NDArray, t: float, chain_terms: bool = True) -> Kinematics:
+    """Poses, ẏ_n, T̃_np (T_np and ζ_n) and F_n of every subsystem at (q, ṡ, t).
+
+    With ``chain_terms=False`` only poses, twists and ẏ_n are computed (``T_aug`` and ``F``
+    are None): what energies, exports and constraint positions need, at about half the cost.
+    """
+    prep = plan(system)
+    R, r, twist, rels, A_np, r_pn, u, P_aug = _poses_and_twists(system, prep, q, s_dot, t)
+    y_dot = _describing_velocities(system, prep, twist, s_dot)
+    if not chain_terms:
+        return Kinematics(R, r, twist, y_dot, None, None)
+    w = np.array([rel.w for rel in rels])
+    zeta6 = cross_motion(np.array(u), w) + np.array([rel.zeta for rel in rels])  # Ṫ ẏ_p + Ḟ ṡ + ḟ
+    T_aug6 = np.zeros((len(rels), 7, 7))
+    T_aug6[:, :6, :6] = chain_matrix(np.array(A_np), np.array(r_pn))
+    T_aug6[:, :6, 6] = zeta6
+    T_aug6[:, 6, 6] = 1.0
+    T_aug, F = _chain_terms(system, prep, rels, T_aug6, P_aug)
+    return Kinematics(R, r, twist, y_dot, T_aug, F)
+
+
+def _poses_and_twists(system, prep: Plan, q: NDArray, s_dot: NDArray, t: float) -> tuple:
+    """Root → leaves: R_n, r_n, the twists, the joints' relative motions, A_np, r_pn,
+    u = T⁶_np twist_p and the port maps P̃ of joints on deforming parents."""
     N = len(system.joints)
     parent, joints = system.parent, system.joints
     R, r, twist = [None] * N + [np.eye(3)], [None] * N + [np.zeros(3)], [None] * N + [np.zeros(6)]
-    rels, A_np, r_pn, u = [None] * N, [None] * N, [None] * N, [None] * N
-    prep = plan(system)
-    P_aug = [None] * N
-    for n, joint in enumerate(joints):  # root → leaves: poses and twists
+    rels, A_np, r_pn, u, P_aug = [None] * N, [None] * N, [None] * N, [None] * N, [None] * N
+    for n, joint in enumerate(joints):
         p = parent[n]
         rels[n] = rel = joint.relative(system._q_get[n](q), system._s_get[n](s_dot), t)
         if prep.port[n]:  # the joint sits at a station of a deforming parent
@@ -130,13 +150,7 @@ def forward(system, q: NDArray, s_dot: NDArray, t: float) -> Kinematics:
         u[n] = np.concatenate((A @ (v_p + cross(omega_p, r_pn[n])), A @ omega_p))  # T⁶_np twist_p
         R[n], r[n] = base_R @ A_pn, base_r + base_R @ r_pn[n]
         twist[n] = u[n] + rel.w
-    w = np.array([rel.w for rel in rels])
-    zeta6 = cross_motion(np.array(u), w) + np.array([rel.zeta for rel in rels])  # Ṫ ẏ_p + Ḟ ṡ + ḟ
-    T_aug6 = np.zeros((N, 7, 7))
-    T_aug6[:, :6, :6] = chain_matrix(np.array(A_np), np.array(r_pn))
-    T_aug6[:, :6, 6] = zeta6
-    T_aug6[:, 6, 6] = 1.0
-    return _select(system, prep, R, r, twist, rels, T_aug6, s_dot, P_aug)
+    return R, r, twist, rels, A_np, r_pn, u, P_aug
 
 
 def _port(system, n, p, q, s_dot, R, r, twist):
@@ -156,14 +170,25 @@ def _port(system, n, p, q, s_dot, R, r, twist):
     return R[p] @ port.A, r[p] + R[p] @ port.r, u + port.w, np.zeros(3), P_aug
 
 
-def _select(system, prep: Plan, R, r, twist, rels, T_aug6, s_dot, P_aug) -> Kinematics:
-    """Apply the selections S_n: ẏ_n = S_n twist, F_n = S_n F⁶, T̃_np = S̃_n T̃⁶ S̃_pᵀ, and
-    add the internal velocities ṡ_e of subsystems that have them (their last n_e rows)."""
+def _describing_velocities(system, prep: Plan, twist, s_dot: NDArray) -> list:
+    """ẏ_n = S_n twist_n, plus the internal velocities ṡ_e in the last n_e rows of the
+    subsystems that have them; the ground's entry (−1) is empty."""
+    N = len(system.joints)
+    y_dot = [twist[n] if system.S[n] is None else system.S[n] @ twist[n] for n in range(N)] + [np.zeros(0)]
+    for n in prep.internal:
+        n_e = system.e_s_slice[n].stop - system.e_s_slice[n].start
+        y_dot[n] = y_dot[n].copy()
+        y_dot[n][-n_e:] += s_dot[system.e_s_slice[n]]
+    return y_dot
+
+
+def _chain_terms(system, prep: Plan, rels, T_aug6, P_aug) -> tuple[list, list]:
+    """Apply the selections S_n: F_n = S_n F⁶ (with [0; E] columns for internal
+    velocities) and T̃_np = S̃_n T̃⁶ S̃_pᵀ (composed with P̃ for joints on a deforming parent)."""
     N = len(rels)
-    y_dot, T_aug, F = [None] * N + [np.zeros(0)], [None] * N + [np.ones((1, 1))], [None] * N
+    T_aug, F = [None] * N + [np.ones((1, 1))], [None] * N
     for n in range(N):
         S = system.S[n]
-        y_dot[n] = twist[n] if S is None else S @ twist[n]
         F[n] = rels[n].F if S is None else S @ rels[n].F
         if prep.plain[n]:
             T_aug[n] = T_aug6[n]
@@ -171,12 +196,10 @@ def _select(system, prep: Plan, R, r, twist, rels, T_aug6, s_dot, P_aug) -> Kine
             T_aug[n] = prep.S_aug[n] @ T_aug6[n] @ P_aug[n]
         else:
             T_aug[n] = prep.S_aug[n] @ T_aug6[n] @ prep.S_aug[system.parent[n]].T
-    for n in prep.internal:  # ẏ_n = S twist + [0; ṡ_e],  F_n = [S F⁶, [0; E]]
+    for n in prep.internal:  # F_n = [S F⁶, [0; E]]
         n_e = system.e_s_slice[n].stop - system.e_s_slice[n].start
-        y_dot[n] = y_dot[n].copy()
-        y_dot[n][-n_e:] += s_dot[system.e_s_slice[n]]
-        F[n] = np.hstack((F[n], np.eye(len(y_dot[n]))[:, -n_e:]))
-    return Kinematics(R, r, twist, y_dot, T_aug, F)
+        F[n] = np.hstack((F[n], np.eye(F[n].shape[0])[:, -n_e:]))
+    return T_aug, F
 
 
 def gauss_terms(system, kin: Kinematics, q: NDArray, s_dot: NDArray, t: float) -> tuple[list, list]:

@@ -284,7 +284,7 @@ class System:
         from projeq.kinematics import forward
 
         q, s_dot = self.check_state(q, s_dot, t)
-        kin = forward(self, q, s_dot, float(t))
+        kin = forward(self, q, s_dot, float(t), chain_terms=False)
         q_e = [q[sl] for sl in self.e_q_slice]
         kinetic = sum(sub.kinetic_energy(kin.y_dot[n], q_e[n]) for n, sub in enumerate(self.subsystems))
         potential = sum(
