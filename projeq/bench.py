@@ -8,6 +8,11 @@ Pinocchio's ABA (``pin.aba``) and MuJoCo's ``mj_forward`` on the same chain, bui
 from the same parameters; their s̈ is compared with the dense evaluator, which checks
 that the peer models are the same chain.
 
+Every s̈ is also compared with the exact one, :func:`projeq.bench_exact.chain_s_ddot`
+(Lagrange's equations in absolute angles at 40 digits; up to n = 300, ``--exact-up-to``):
+the deviation from the dense s̈ includes the dense evaluator's own error, about κ(M) ε
+(κ(M) ≈ 2e7 at n = 100), the deviation from the exact s̈ is each evaluator's own.
+
     projeq bench                 # chain n = 10, 30, 100, then the scripts' quick modes
     projeq bench --json          # one JSON document with every report
     projeq bench --chain-only --no-peers --sizes 10,30
@@ -25,10 +30,12 @@ from pathlib import Path
 import numpy as np
 
 from projeq import inertia, scenes
+from projeq.bench_exact import chain_s_ddot
 
 QUICK_SIZES = (10, 30, 100)
 OURS = ("recursive", "fast", "dense")
 DENSE_UP_TO = 300  # the dense evaluator is O(N³): skipped above this n
+EXACT_UP_TO = 300  # the exact s̈ costs O(n²) mpmath operations: 0.5 s at n = 100, 4 s at n = 300
 PINOCCHIO_UP_TO = 300  # pin 4.1's Data needs 1.9 GB at n = 300, growing as n²: skipped above
 _LINK_I_C = inertia.cylinder(m=1.0, radius=0.01, length=1.0, axis="z")  # the links of scenes.chain
 
@@ -81,7 +88,7 @@ def evaluators(n: int, peers: bool = True) -> dict:
     """Name → function (q, ṡ) ↦ s̈ for projeq's evaluators and the installed peers."""
     system = scenes.chain(n)
     names = [m for m in OURS if m != "dense" or n <= DENSE_UP_TO]
-    funcs = {m: (lambda ev: lambda q, s_dot: ev.accelerations(q, s_dot, 0.0))(system.evaluator(m)) for m in names}
+    funcs = {m: _s_ddot(system.evaluator(m)) for m in names}
     if peers:
         builders = [("pinocchio", pinocchio_chain)] * (n <= PINOCCHIO_UP_TO) + [("mujoco", mujoco_chain)]
         for name, build in builders:
@@ -89,6 +96,11 @@ def evaluators(n: int, peers: bool = True) -> dict:
             if f is not None:
                 funcs[name] = f
     return funcs
+
+
+def _s_ddot(evaluator):
+    """(q, ṡ) ↦ s̈ of one of projeq's evaluators, at t = 0."""
+    return lambda q, s_dot: evaluator.accelerations(q, s_dot, 0.0)
 
 
 def time_per_call(funcs: dict, q, s_dot, budget: float, clock=time.process_time, batch: float = 2e-3) -> dict:
@@ -126,24 +138,34 @@ def _repeats(f, q, s_dot, batch: float) -> int:
     return max(1, int(batch / max(time.perf_counter() - t0, 1e-9)))
 
 
-def measure(sizes, budget: float = 1.0, peers: bool = True) -> list[dict]:
-    """One row per chain length: seconds per call of every evaluator, and each one's
-    largest deviation from the reference s̈ (dense up to n = 300, else recursive),
-    relative to max(1, |s̈|∞)."""
+def measure(sizes, budget: float = 1.0, peers: bool = True, exact_up_to: int = EXACT_UP_TO) -> list[dict]:
+    """One row per chain length: seconds per call of every evaluator (``"seconds"``), and
+    each one's largest deviation, relative to max(1, |s̈|∞), from the reference s̈ (dense
+    up to n = 300, else recursive; ``"deviation"``) and for n ≤ ``exact_up_to`` from the
+    exact s̈ (:func:`projeq.bench_exact.chain_s_ddot`; ``"exact_deviation"``, and the
+    reference's CPU time ``"exact_seconds"``)."""
     rng = np.random.default_rng(0)
     rows = []
     for n in sizes:
         q, s_dot = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
         funcs = evaluators(n, peers)
         seconds = time_per_call(funcs, q, s_dot, budget)
-        reference = funcs["dense" if "dense" in funcs else "recursive"](q, s_dot)
-        scale = max(1.0, np.abs(reference).max())
-        rows.append({
-            "n": n,
-            "seconds": seconds,
-            "deviation": {k: float(np.abs(f(q, s_dot) - reference).max() / scale) for k, f in funcs.items()},
-        })
+        s_ddot = {k: f(q, s_dot) for k, f in funcs.items()}
+        reference = s_ddot["dense" if "dense" in funcs else "recursive"]
+        row = {"n": n, "seconds": seconds, "deviation": _deviations(s_ddot, reference)}
+        if n <= exact_up_to:
+            started = time.process_time()
+            exact = chain_s_ddot(q, s_dot)
+            row["exact_seconds"] = time.process_time() - started
+            row["exact_deviation"] = _deviations(s_ddot, exact)
+        rows.append(row)
     return rows
+
+
+def _deviations(s_ddot: dict, reference) -> dict:
+    """Name → |s̈ − reference|∞ / max(1, |reference|∞)."""
+    scale = max(1.0, np.abs(reference).max())
+    return {k: float(np.abs(x - reference).max() / scale) for k, x in s_ddot.items()}
 
 
 def slopes(rows) -> dict:
@@ -158,28 +180,31 @@ def slopes(rows) -> dict:
 
 def print_table(rows, slope: dict) -> None:
     """µs per call, fast/peer time ratios, the fast evaluator's and the largest deviation
-    from the reference s̈ (see :func:`measure`)."""
+    from the reference s̈, the fast and the dense evaluator's deviation from the exact s̈
+    ("-" where not computed; see :func:`measure`)."""
     names = list(rows[-1]["seconds"]) + [k for k in rows[0]["seconds"] if k not in rows[-1]["seconds"]]
-    print(f"{'n':>6} " + " ".join(f"{k + ' µs':>14}" for k in names) + f" {'fast/pin':>9} {'fast/mujoco':>12} {'fast dev':>9} {'max dev':>9}")
+    print(f"{'n':>6} " + " ".join(f"{k + ' µs':>14}" for k in names) + f" {'fast/pin':>9} {'fast/mujoco':>12} "
+          f"{'fast dev':>9} {'max dev':>9} {'fast vs exact':>14} {'dense vs exact':>15}")
     for r in rows:
         s = r["seconds"]
         cells = " ".join(f"{s[k] * 1e6:>14.1f}" if k in s else f"{'-':>14}" for k in names)
         ratio = {p: f"{s['fast'] / s[p]:.2f}" if p in s else "-" for p in ("pinocchio", "mujoco")}
+        exact = {k: f"{r['exact_deviation'][k]:.1e}" if k in r.get("exact_deviation", {}) else "-" for k in ("fast", "dense")}
         print(f"{r['n']:>6} {cells} {ratio['pinocchio']:>9} {ratio['mujoco']:>12} "
-              f"{r['deviation']['fast']:>9.1e} {max(r['deviation'].values()):>9.1e}")
+              f"{r['deviation']['fast']:>9.1e} {max(r['deviation'].values()):>9.1e} {exact['fast']:>14} {exact['dense']:>15}")
     if slope:
         print("log-log slope: " + ", ".join(f"{k} {v:.3f}" for k, v in slope.items()))
 
 
-def chain_report(sizes, budget: float, peers: bool = True) -> dict:
+def chain_report(sizes, budget: float, peers: bool = True, exact_up_to: int = EXACT_UP_TO) -> dict:
     """The chain-scaling report: :func:`measure` rows and their :func:`slopes`."""
-    rows = measure(sizes, budget, peers)
+    rows = measure(sizes, budget, peers, exact_up_to)
     return {"benchmark": "chain_scaling", "rows": rows, "slopes": slopes(rows)}
 
 
-def chain_scaling(sizes, budget: float, as_json: bool, peers: bool = True) -> dict:
+def chain_scaling(sizes, budget: float, as_json: bool, peers: bool = True, exact_up_to: int = EXACT_UP_TO) -> dict:
     """Measure, print (table or JSON) and return the chain-scaling report."""
-    report = chain_report(sizes, budget, peers)
+    report = chain_report(sizes, budget, peers, exact_up_to)
     if as_json:
         print(json.dumps(report, indent=2))
     else:
@@ -208,7 +233,7 @@ def run_script(name: str, as_json: bool, timeout: float) -> dict:
         print(f"\n$ python benchmarks/{name} {' '.join(args)}", flush=True)
     started = time.perf_counter()
     try:
-        done = subprocess.run([sys.executable, str(script), *args], timeout=timeout, text=True,
+        done = subprocess.run([sys.executable, str(script), *args], check=False, timeout=timeout, text=True,
                               stdout=subprocess.PIPE if as_json else None)
         entry["status"] = "ok" if done.returncode == 0 else f"failed (exit code {done.returncode})"
     except subprocess.TimeoutExpired:
@@ -233,13 +258,21 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
     parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per chain length (default 0.5)")
     parser.add_argument("--sizes", type=_sizes, default=QUICK_SIZES, metavar="N,N,...",
-                        help="chain lengths (default %s)" % ",".join(map(str, QUICK_SIZES)))
+                        help=f"chain lengths (default {','.join(map(str, QUICK_SIZES))})")
     parser.add_argument("--total", type=float, default=TOTAL_BUDGET,
                         help=f"wall-time budget in s for everything; the scripts share what the chain part "
                              f"leaves and are stopped when it is spent (default {TOTAL_BUDGET:g})")
     parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
+    add_exact_option(parser)
     parser.add_argument("--chain-only", action="store_true", help="skip the scripts in benchmarks/")
     return parser
+
+
+def add_exact_option(parser: argparse.ArgumentParser) -> None:
+    """``--exact-up-to N`` (for ``projeq bench`` and ``benchmarks/chain_scaling.py``)."""
+    parser.add_argument("--exact-up-to", type=int, default=EXACT_UP_TO, metavar="N",
+                        help=f"compare with the exact s̈ (projeq.bench_exact) for n <= N (default {EXACT_UP_TO}; "
+                             f"it costs about 0.5 s at n = 100, 4 s at n = 300)")
 
 
 def _sizes(text: str) -> tuple:
@@ -259,7 +292,7 @@ def main(argv=None) -> int:
     or was stopped."""
     args = _parser().parse_args(argv)
     started = time.perf_counter()
-    chain = chain_report(args.sizes, args.budget, not args.no_peers)
+    chain = chain_report(args.sizes, args.budget, not args.no_peers, args.exact_up_to)
     if not args.json:
         print_table(chain["rows"], chain["slopes"])
     parts = [{"benchmark": "chain_scaling", "status": "ok", "seconds": time.perf_counter() - started}]
