@@ -105,12 +105,19 @@ def plot(table: dict):
     fig = plots.work_precision(rows)
     ax = fig.axes[0]
     methods, knobs = (list(dict.fromkeys(table[name][ok])) for name in ("method", "knob"))
+    color = {method: f"C{i % 10}" for i, method in enumerate(methods)}
+    style = {knob: dict(linestyle=("-", "--", ":", "-.")[k % 4], marker="os^vDP"[k % 6]) for k, knob in enumerate(knobs)}
     for line in ax.lines:  # colour by integrator, line style and marker by knob
         method, knob = line.get_label().split(" [", 1)
-        k = knobs.index(knob[:-1])
-        line.set(color=f"C{methods.index(method) % 10}", linestyle=("-", "--", ":", "-.")[k % 4],
-                 marker="os^vDP"[k % 6])
-    ax.legend(fontsize="x-small", loc="center left", bbox_to_anchor=(1.01, 0.5))
+        line.set(color=color[method], **style[knob[:-1]])
+    # two legends, integrators (colours) and knobs (styles): m + k entries instead of m · k
+    from matplotlib.lines import Line2D
+
+    ax.get_legend().remove()
+    fig.legend([Line2D([], [], color=c) for c in color.values()], list(color), fontsize="x-small",
+               title="integrator", title_fontsize="x-small", loc="outside right upper")
+    fig.legend([Line2D([], [], color="0.3", **s) for s in style.values()], list(style), fontsize="x-small",
+               title="knob", title_fontsize="x-small", loc="outside right lower")
     ax.set_title(f"{table['scene'][0] if len(table['scene']) else ''}: {table.get('measure', 'error')}", fontsize="small")
     return fig
 
