@@ -10,8 +10,9 @@ that the peer models are the same chain.
 
 Every s̈ is also compared with the exact one, :func:`projeq.bench_exact.chain_s_ddot`
 (Lagrange's equations in absolute angles at 40 digits; up to n = 300, ``--exact-up-to``):
-the deviation from the dense s̈ includes the dense evaluator's own error, about κ(M) ε
-(κ(M) ≈ 2e7 at n = 100), the deviation from the exact s̈ is each evaluator's own.
+the deviation from the dense s̈ includes the dense evaluator's own error, up to κ(M) ε
+(κ(M) ≈ 1.3e8 at n = 100 at the benchmark's state), the deviation from the exact s̈ is each
+evaluator's own.
 
     projeq bench                 # chain n = 10, 30, 100, then the scripts' quick modes
     projeq bench --json          # one JSON document with every report
