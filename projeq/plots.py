@@ -75,10 +75,11 @@ def tip_deflection(result, beam, x=None):
     return fig
 
 
-def work_precision(rows):
+def work_precision(rows, legend: bool = True):
     """Work-precision diagram: CPU time over error, one line per label.
 
-    ``rows``: iterable of ``(label, error, cpu_seconds)``, e.g. one per tolerance and method.
+    ``rows``: iterable of ``(label, error, cpu_seconds)``, e.g. one per tolerance and method;
+    ``legend=False`` leaves the legend to the caller.
     """
     fig, (ax,) = _figure(1)
     series = {}
@@ -90,5 +91,6 @@ def work_precision(rows):
     ax.set_xlabel("error")
     ax.set_ylabel("CPU time (s)")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize="small")
+    if legend:
+        ax.legend(fontsize="small")
     return fig

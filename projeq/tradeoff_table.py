@@ -102,7 +102,7 @@ def plot(table: dict):
 
     ok = np.flatnonzero((table["failure"] == "") & np.isfinite(table["error"]))
     rows = [(f"{table['method'][i]} [{table['knob'][i]}]", max(table["error"][i], 1e-16), table["cpu"][i]) for i in ok]
-    fig = plots.work_precision(rows)
+    fig = plots.work_precision(rows, legend=False)
     ax = fig.axes[0]
     methods, knobs = (list(dict.fromkeys(table[name][ok])) for name in ("method", "knob"))
     color = {method: f"C{i % 10}" for i, method in enumerate(methods)}
@@ -113,7 +113,6 @@ def plot(table: dict):
     # two legends, integrators (colours) and knobs (styles): m + k entries instead of m · k
     from matplotlib.lines import Line2D
 
-    ax.get_legend().remove()
     fig.legend([Line2D([], [], color=c) for c in color.values()], list(color), fontsize="x-small",
                title="integrator", title_fontsize="x-small", loc="outside right upper")
     fig.legend([Line2D([], [], color="0.3", **s) for s in style.values()], list(style), fontsize="x-small",
