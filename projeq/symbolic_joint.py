@@ -19,6 +19,11 @@ _SINGULAR_CONDITION = 1e10  # condition number of K(q0) treated as singular
 _POSE_TOLERANCE = 1e-5  # central differences of step 1e-7 in pose_twist_mismatch: error ~1e-9
 
 
+def skew(a) -> sp.Matrix:
+    """Spin matrix ã of a 3-vector of sympy expressions (ã b = a × b)."""
+    return sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+
+
 def _matrix(name: str, value, shape: tuple) -> sp.Matrix:
     M = sp.Matrix(value)
     if shape[1] == 1 and M.shape == (1, shape[0]):

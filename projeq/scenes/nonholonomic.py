@@ -27,6 +27,7 @@ import sympy as sp
 from projeq.constraints import check_configuration, initial_speeds
 from projeq.forces import Force, Torque
 from projeq.joints import Fixed, UserJoint
+from projeq.symbolic_joint import skew
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
 from projeq.system import System
 
@@ -214,13 +215,9 @@ def _rolling_disk_joint():
     A = A_B * _rot(1, q3)
     pos = sp.Matrix([q[3], q[4], 0]) + R * A_B[:, 2]
     b3_C = _rot(1, q3).T * sp.Matrix([0, 0, 1])
-    F = sp.Matrix.vstack(-R * _skew(b3_C), sp.eye(3))  # v = ω × R b̂3, ω = u
+    F = sp.Matrix.vstack(-R * skew(b3_C), sp.eye(3))  # v = ω × R b̂3, ω = u
     constraints = [qd[3] - R * sp.cos(q1) * qd[2], qd[4] - R * sp.sin(q1) * qd[2]]  # eq. (97)
     return q, s, A, pos, F, K, constraints, qd, R
-
-
-def _skew(a) -> sp.Matrix:
-    return sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
 
 
 def rolling_disk(m_disk: float = 0.030, R: float = 0.015, m_ecc: float = 0.001, ecc=None,

@@ -18,6 +18,7 @@ import numpy as np
 import sympy as sp
 
 from ..joints import Fixed, Free, Planar, Prescribed, Prismatic, Revolute, UserJoint
+from ..symbolic_joint import skew
 
 __all__ = ["SymbolicRelative", "relative", "exact", "skew", "cross", "mul"]
 
@@ -41,11 +42,6 @@ def exact(value) -> sp.Matrix | sp.Expr:
     convert = np.vectorize(lambda x: sp.Integer(int(x)) if float(x).is_integer() else sp.Float(x),
                            otypes=[object])
     return convert(array).item() if array.ndim == 0 else sp.Matrix(convert(array))
-
-
-def skew(a) -> sp.Matrix:
-    """Spin matrix ã of a 3-vector (ã b = a × b)."""
-    return sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
 
 
 def _times(x, y):

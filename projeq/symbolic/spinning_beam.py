@@ -36,6 +36,8 @@ from typing import NamedTuple
 import numpy as np
 import sympy as sp
 
+from projeq.symbolic_joint import skew
+
 x, t, L = sp.symbols("x t L", positive=True)
 rho_A, rho_I, EI = sp.symbols("rho_A rho_I EI", positive=True)
 alpha = sp.Function("alpha")(t)
@@ -110,7 +112,7 @@ def _newton_euler_residuals() -> sp.Matrix:
     """dṗ + ω̃_IR dp and dL̇ + ω̃_IR dL of a slice in R, per length, linear (B(19))."""
     omega_IR = sp.Matrix([_d(alpha, t), 0, 0])
     theta = sp.Matrix([0, -_d(w, x), _d(v, x)])  # small Cardan angles (−w′, v′)
-    A_Rc = sp.eye(3) + _skew(theta)
+    A_Rc = sp.eye(3) + skew(theta)
     J_R = A_Rc * rho_I * sp.diag(2, 1, 1) * A_Rc.T
     p = rho_A * slice_velocity()
     L_c = J_R * (omega_IR + _d(theta, t))
@@ -123,10 +125,6 @@ def _slice_residual() -> list:
     """B(23)'s middle factor dMÿ + dGẏ − dQ on the rows of D_BAR: (f_y, f_z, m_y, m_z, EIv″, EIw″)."""
     f_m = _newton_euler_residuals()
     return [f_m[1], f_m[2], f_m[4], f_m[5], EI * _d(v, x, 2), EI * _d(w, x, 2)]
-
-
-def _skew(a):
-    return sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
 
 
 # D̄ of B(22), the rows of ẏ = (v̇_y, v̇_z, −ẇ′, v̇′, v̇″, ẇ″) that depend on (v̇, ẇ):
