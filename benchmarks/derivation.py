@@ -23,30 +23,22 @@ dominates the run time from N ≈ 7).
 
 import json
 import sys
-import time
 
 import numpy as np
 import sympy as sp
 
 import projeq as pq
+from projeq.comparison import _cse_ops, _timed
 from projeq.symbolic import gauss_form, projection_equation
 from projeq.symbolic.examples import (
     PENDULUM_PARAMETERS, chain_parameters, kane_pendulum, lagrange_pendulum, n_link_pendulum,
 )
 
 
-def ops_after_cse(expressions) -> int:
-    """``sympy.count_ops`` over the output of ``sympy.cse``."""
-    replacements, reduced = sp.cse(list(expressions))
-    return sum(sp.count_ops(e) for _, e in replacements) + sum(sp.count_ops(e) for e in reduced)
-
-
 def timed(derive):
     """(q, speeds, M, rhs) of ``derive()`` and its wall time (s), sympy's cache cleared first."""
     sp.core.cache.clear_cache()
-    start = time.perf_counter()
-    out = derive()
-    return out, time.perf_counter() - start
+    return _timed(derive)
 
 
 def projeq_system(n):
@@ -83,7 +75,7 @@ def row(n, methods, rng):
     for name in methods:
         results[name], out[f"{name}_s"] = timed(lambda: METHODS[name](n))
     for name, (_, _, M, rhs) in results.items():
-        out[f"{name}_ops"] = ops_after_cse([M, rhs])
+        out[f"{name}_ops"] = _cse_ops([M, rhs])
     out["kane/projeq"] = out["kane_s"] / out["projeq_s"]
     out["max_rel_diff"] = max_relative_difference(results, n, rng)
     return out

@@ -68,8 +68,9 @@ class Formulation:
 
 def _cse_ops(expressions) -> int:
     """sympy.count_ops over the output of sympy.cse (replacements and reduced expressions)."""
-    replacements, reduced = sp.cse(list(expressions))
-    return sum(sp.count_ops(e) for _, e in replacements) + sum(sp.count_ops(e) for e in reduced)
+    from projeq.symbolic.projection import operation_count
+
+    return operation_count(*sp.cse(list(expressions)))
 
 
 def _timed(fn):

@@ -89,6 +89,11 @@ class GaussForm:
         return SymbolicEvaluator(self, values)
 
 
+def operation_count(replacements, reduced) -> int:
+    """sympy.count_ops over the output of sympy.cse: its replacements and reduced expressions."""
+    return sum(sp.count_ops(e) for _, e in replacements) + sum(sp.count_ops(e) for e in reduced)
+
+
 class SymbolicEvaluator:
     """``accelerations(q, s_dot, t)`` from a compiled Gauss form, for :func:`projeq.simulate`.
 
@@ -98,7 +103,7 @@ class SymbolicEvaluator:
     def __init__(self, gauss: GaussForm, values: dict):
         M, rhs = (x.xreplace({k: sp.Float(v) for k, v in values.items()}) for x in (gauss.M, gauss.rhs))
         replacements, reduced = sp.cse([M, rhs])
-        self.n_ops = sum(sp.count_ops(e) for _, e in replacements) + sum(sp.count_ops(e) for e in reduced)
+        self.n_ops = operation_count(replacements, reduced)
         self._M_rhs = sp.lambdify([list(gauss.q), list(gauss.s), gauss.t], [M, rhs], modules="numpy",
                                   cse=lambda expressions: (replacements, reduced))  # the CSE counted above
         self.n_q, self.n_s = len(gauss.q), len(gauss.s)
