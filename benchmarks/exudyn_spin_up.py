@@ -100,7 +100,7 @@ def exudyn_tip_deflection(omega_s: float = OMEGA_S, n_elements: int = 16, h: flo
 
 
 def _projeq(knobs: dict) -> tuple[np.ndarray, float]:
-    v, cpu, _ = tip_deflection(OMEGA_S if "omega_s" not in knobs else knobs.pop("omega_s"), **knobs)
+    v, cpu, _ = tip_deflection(**knobs)
     return v, cpu
 
 

@@ -31,13 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.spatial import cross, skew
-
-
-def _axial(C: NDArray) -> NDArray:
-    """Σ_bc ε_abc C_bc: the vector of the antisymmetric part of C (∫ r × x dm from C = ∫ r xᵀ dm;
-    C may carry further trailing axes)."""
-    return np.array([C[1, 2] - C[2, 1], C[2, 0] - C[0, 2], C[0, 1] - C[1, 0]])
+from projeq.spatial import cross, skew, vee
 
 
 class ShapeIntegrals:
@@ -92,7 +86,7 @@ class ShapeIntegrals:
         r_bar, Phi_bar = self.R_bar @ z, self.R_bar @ Z
         M_e = np.empty((n_e, 6 + n_e))
         M_e[:, :3] = Phi_bar.T
-        M_e[:, 3:6] = _axial(Y).T  # (∫ r̃ Φ_r dm)ᵀ
+        M_e[:, 3:6] = -2.0 * vee(Y).T  # (∫ r̃ Φ_r dm)ᵀ: −2 vee(C) = Σ_bc ε_abc C_bc, C = ∫ r xᵀ dm
         M_e[:, 6:] = Z.T @ self.G_trace @ Z
         Phi_c = (  # ∫ Φ_rᵀ c dm
             Phi_bar.T @ a
@@ -126,4 +120,4 @@ class ShapeIntegrals:
         M[:6, 6:] = k["M_e"][:, :6].T
         c_int = self.mass * a + WW @ r_bar + 2.0 * W @ (Phi_bar @ q_e_dot) + self.R_bar @ k["z_dd"]  # ∫ c dm
         r_c = np.outer(r_bar, a) + S @ WW.T + 2.0 * (Y @ q_e_dot) @ W.T + (Gz @ k["z_dd"]).T  # ∫ r cᵀ dm
-        return M, np.concatenate((-c_int, -_axial(r_c), k["h_e"]))
+        return M, np.concatenate((-c_int, 2.0 * vee(r_c), k["h_e"]))
