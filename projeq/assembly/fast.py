@@ -61,18 +61,18 @@ class FastEvaluator:
     def __init__(self, system, compiled: bool | None = None):
         self.system = system
         self.n_calls = 0
-        self.reason = unsupported(system) or _kernels.missing_compiler(compiled)
-        self.fast = self.reason is None
         self.compiled = False
-        if not self.fast and hub_beam_unsupported(system) is None:
-            self.reason, self.fast = None, True
-            self._general = HubBeamEvaluator(system)  # not the kernel: the beam's own path
-            return
-        if not self.fast:
-            self._general = system.evaluator("dense" if system.coupled else "recursive")
-            return
-        self._chain_terms, self._passes, self.compiled = _kernels.kernel(compiled)
-        self._pack(system)
+        self._delegate = None  # another evaluator that answers instead of the kernel
+        if hub_beam_unsupported(system) is None:
+            self.reason, self._delegate = None, HubBeamEvaluator(system)  # the beam's own fast path
+        else:
+            self.reason = unsupported(system) or _kernels.missing_compiler(compiled)
+            if self.reason is not None:
+                self._delegate = system.evaluator("dense" if system.coupled else "recursive")
+        self.fast = self.reason is None
+        if self._delegate is None:
+            self._chain_terms, self._passes, self.compiled = _kernels.kernel(compiled)
+            self._pack(system)
 
     def _pack(self, system) -> None:
         """Flat arrays of the tree (built once) and the workspace."""
@@ -96,8 +96,8 @@ class FastEvaluator:
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """s̈ at (q, ṡ, t) (THEORY §6); raises SingularMassError for a zero pivot D_n."""
         self.n_calls += 1
-        if hasattr(self, "_general"):
-            return self._general.accelerations(q, s_dot, t)
+        if self._delegate is not None:
+            return self._delegate.accelerations(q, s_dot, t)
         q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
         self._chain_terms(
             self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index,
