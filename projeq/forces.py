@@ -29,7 +29,12 @@ def _load(name: str, value, shape: tuple) -> Callable:
             return finite_array(name, value(t, q, s_dot), shape)
         return load
     constant = finite_array(name, value, shape)
-    return lambda t, q, s_dot: constant
+
+    def load(t, q, s_dot):
+        return constant
+
+    load.constant = constant  # what the symbolic side (projeq.symbolic.loads) reads
+    return load
 
 
 def _index(system, name, parameter: str) -> int:

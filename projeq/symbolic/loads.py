@@ -18,12 +18,12 @@ __all__ = ["check_loads", "body_wrenches", "joint_forces"]
 
 def _load(i: int, law, attribute: str):
     """The constant of a load; a callable one is refused, naming ``forces[i]``
-    (:func:`projeq.forces._load` makes a constant into a closure over ``constant``)."""
-    load = getattr(law, attribute)
-    if load.__code__.co_freevars != ("constant",):
+    (:func:`projeq.forces._load` marks a constant load with its value, ``load.constant``)."""
+    constant = getattr(getattr(law, attribute), "constant", None)
+    if constant is None:
         raise ValueError(f"system: forces[{i}] ({type(law).__name__}) has a callable {attribute.strip('_')}, "
                          "which is not supported symbolically; give a constant or use projection_equation")
-    return exact(load(0.0, None, None))
+    return exact(constant)
 
 
 def check_loads(system) -> None:
