@@ -13,7 +13,6 @@ import argparse
 import importlib
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -183,7 +182,7 @@ def _grid_axis(text: str) -> tuple[str, np.ndarray]:
 
 def _sweep(args) -> int:
     from projeq.scenes import check_names, get_scene, parse_settings, scene_parameters
-    from projeq.sweeps import interruptible_worker, sweep
+    from projeq.sweeps import process_pool, sweep
 
     scene = get_scene(args.scene)
     fixed = parse_settings(scene, args.set)
@@ -196,7 +195,7 @@ def _sweep(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers: expected a positive count, got {args.workers}")
     executor = (_dask_client(args.scheduler, args.scheduler_timeout) if args.scheduler
-                else ProcessPoolExecutor(args.workers, initializer=interruptible_worker))
+                else process_pool(args.workers))
     options = {"method": args.method, "rtol": args.rtol}
     with executor:  # closed (a Dask client disconnected) also when --out is refused
         out = _output_directory(args.out)

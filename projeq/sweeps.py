@@ -120,10 +120,16 @@ def _points(grid, samples) -> list[dict]:
     return [dict(p) for p in samples]
 
 
+def process_pool(workers: int | None = None) -> cf.ProcessPoolExecutor:
+    """The default executor: local processes (``workers``, default one per core) whose
+    points stop on Ctrl-C and return what they have (:func:`interruptible_worker`)."""
+    return cf.ProcessPoolExecutor(workers, initializer=interruptible_worker)
+
+
 def _executor(executor):
     """(executor, owned): a Dask Client becomes its concurrent.futures view."""
     if executor is None:
-        return cf.ProcessPoolExecutor(initializer=interruptible_worker), True
+        return process_pool(), True
     if hasattr(executor, "get_executor"):  # dask.distributed.Client
         if getattr(executor, "status", "running") != "running":
             raise ValueError(f"executor: the Dask client is not connected (status {executor.status!r})")
