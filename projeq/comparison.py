@@ -31,10 +31,17 @@ class ComparisonTable:
     name: str
     rows: list = field(default_factory=list)
 
+    @property
+    def columns(self) -> tuple:
+        """``COLUMNS``, then any further keys the rows carry (in their order of appearance)."""
+        extra = dict.fromkeys(k for row in self.rows for k in row if k not in COLUMNS)
+        return COLUMNS + tuple(extra)
+
     def format(self) -> str:
         """Plain-text table (numbers to 3 significant digits)."""
-        cells = [list(COLUMNS)] + [[_cell(row.get(c)) for c in COLUMNS] for row in self.rows]
-        widths = [max(len(r[i]) for r in cells) for i in range(len(COLUMNS))]
+        columns = self.columns
+        cells = [list(columns)] + [[_cell(row.get(c)) for c in columns] for row in self.rows]
+        widths = [max(len(r[i]) for r in cells) for i in range(len(columns))]
         lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in cells]
         lines.insert(1, "  ".join("-" * w for w in widths))
         return f"compare {self.name}\n" + "\n".join(lines)
@@ -42,9 +49,9 @@ class ComparisonTable:
     def to_csv(self, path) -> None:
         """Write the rows to ``path`` as CSV with a header line."""
         with open(path, "w", newline="") as handle:
-            writer = csv.DictWriter(handle, fieldnames=COLUMNS)
+            writer = csv.DictWriter(handle, fieldnames=self.columns)
             writer.writeheader()
-            writer.writerows({c: row.get(c, "") for c in COLUMNS} for row in self.rows)
+            writer.writerows({c: row.get(c, "") for c in self.columns} for row in self.rows)
 
 
 def _cell(value) -> str:
@@ -324,6 +331,7 @@ COMPARISONS = {
     "n_link_pendulum": _pendulum,
 }
 DEFAULT_T_END = {"car": 2.0, "knife_edge_disc": 2.0, "spinning_beam": 3.0, "n_link_pendulum": 2.0}
+__import__("projeq.comparison_barhorst").comparison_barhorst.register(COMPARISONS, DEFAULT_T_END)  # Barhorst's study
 
 
 def compare(name: str, formulations=None, simulate: bool = True, t_end: float | None = None) -> ComparisonTable:

@@ -11,7 +11,7 @@
 - :mod:`.spinning_beam`: Hamilton vs Projection Equation for the spinning beam (B(16)–(23)).
 """
 
-from .canonical import CanonicalForm, lagrangian_canonical, projective_canonical
+from .canonical import CanonicalForm, energy_rate, lagrangian_canonical, projective_canonical
 from .hamiltonian import (Separation, constant_of_motion_rate, is_constant_of_motion, poisson_bracket,
                           separate_hamilton_jacobi)
 from .hamel import check_regular, hamel_coefficients, hamel_equations
@@ -23,7 +23,8 @@ from .system import gauss_form
 __all__ = [
     "Body", "GaussForm", "SymbolicEvaluator", "gauss_form", "projection_equation", "t",
     "check_regular", "hamel_coefficients", "hamel_equations",
-    "MultiplierSystem", "multiplier_system", "CanonicalForm", "lagrangian_canonical", "projective_canonical",
+    "MultiplierSystem", "multiplier_system", "CanonicalForm", "energy_rate", "lagrangian_canonical",
+    "projective_canonical",
     "ProgramEquations", "program_motion_equations",
     "poisson_bracket", "constant_of_motion_rate", "is_constant_of_motion", "Separation", "separate_hamilton_jacobi",
 ]

@@ -158,6 +158,63 @@ class MultiplierSystem:
             [self._velocities(ti, xi[:n], xi[n:]) for ti, xi in zip(sol.t, sol.y.T)]).T
         return sol
 
+    def hamilton_dae(self, phi=None):
+        """Hamilton's canonical equations with multipliers as a semi-explicit DAE in y = (q, p, λ),
+        K(23)–(26) and Barhorst's eq. 7 with 3, *not* index-reduced:
+
+            q̇ = ∂H/∂p,   ṗ = −∂H/∂q + Q + Aᵀλ,   0 = A ∂H/∂p − b   (index 2)
+
+        or, with ``phi`` (position constraints Φ(q(t)) = 0 whose Jacobian is A, b = 0), 0 = Φ(q)
+        (index 3). ∂H/∂p = M⁻¹(p − ∂L/∂q̇|_{q̇=0}) and −∂H/∂q = ∂L/∂q at q̇ = ∂H/∂p (Legendre
+        duality) are evaluated numerically, so H is never inverted symbolically.
+
+        Returns (f, mass, index): f(t, y) for M y′ = f, the diagonal of M, each component's index,
+        for :func:`projeq.integrators.radau_dae`.
+        """
+        n, c = len(self.q), len(self.lam)
+        position = None
+        if phi is not None:
+            phi = sp.Matrix(phi)
+            if phi.shape != (c, 1):
+                raise ValueError(f"phi: expected {c} position constraints (one per row of A), got {phi.shape}")
+            check_declared(list(phi), self.q, self.t, self.parameters, "phi")
+            plain = replace_derivatives(phi, self.q, self.t, [self.q_symbols]).subs(self.parameters)
+            position = sp.lambdify([self.t, self.q_symbols], plain, modules="numpy")
+
+        def f(t, y):
+            q, p, lam = y[:n], y[n:2 * n], y[2 * n:]
+            q_dot = self._velocities(t, q, p)
+            _, _, force, _, A, b, _ = self._compiled(t, q, q_dot)
+            A = np.asarray(A, dtype=float).reshape(c, n)
+            residual = (np.asarray(position(t, q), float).ravel() if position is not None
+                        else A @ q_dot - np.asarray(b, float).ravel())
+            return np.concatenate([q_dot, np.asarray(force, float).ravel() + A.T @ lam, residual])
+
+        mass = np.r_[np.ones(2 * n), np.zeros(c)]
+        index = np.r_[np.ones(n), np.full(n, 1 if phi is None else 2), np.full(c, 2 if phi is None else 3)]
+        return f, mass, index
+
+    def simulate_dae(self, q0, q_dot0, t_span, phi=None, t_eval=None, rtol: float = 1e-8, atol: float = 1e-10):
+        """Integrate :meth:`hamilton_dae` by Radau IIA (:func:`projeq.integrators.radau_dae`) from a
+        consistent state: p₀ = ∂L/∂q̇ at (q0, q̇0), λ₀ from the constraint differentiated once (only
+        the start value: the integration keeps the DAE as it stands). Returns the
+        :class:`~projeq.integrators.DAEResult` with ``q``, ``p``, ``lam`` and ``q_dot`` added."""
+        from projeq.integrators import radau_dae
+
+        n = len(self.q)
+        q0, q_dot0 = (np.asarray(v, dtype=float).ravel() for v in (q0, q_dot0))
+        if q0.size != n or q_dot0.size != n:
+            raise ValueError(f"q0, q_dot0: expected {n} values each, got {q0.size} and {q_dot0.size}")
+        _, _, _, constraint_force, _ = self._evaluate(t_span[0], q0, q_dot0, 0.0)
+        _, _, _, _, A, _, _ = self._compiled(t_span[0], q0, q_dot0)
+        lam0 = np.linalg.lstsq(np.asarray(A, float).reshape(-1, n).T, constraint_force, rcond=None)[0]
+        f, mass, index = self.hamilton_dae(phi)
+        y0 = np.concatenate([q0, self.momenta(t_span[0], q0, q_dot0), lam0])
+        sol = radau_dae(f, t_span, y0, mass=mass, index=index, rtol=rtol, atol=atol, t_eval=t_eval)
+        sol.q, sol.p, sol.lam = sol.y[:n], sol.y[n:2 * n], sol.y[2 * n:]
+        sol.q_dot = np.array([self._velocities(ti, qi, pi) for ti, qi, pi in zip(sol.t, sol.q.T, sol.p.T)]).T
+        return sol
+
     def _velocities(self, t, q, p):
         """q̇ = M⁻¹(p − ∂L/∂q̇|_{q̇=0}) = ∂H/∂p, K(23), numerically (M does not depend on q̇)."""
         M, p0, *_ = self._evaluate(t, q, np.zeros_like(q), 0.0)

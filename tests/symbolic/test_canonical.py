@@ -81,13 +81,18 @@ def test_undeclared_symbols_are_named():
         projective_canonical([Body((0, 0, 0), (0, 0, 0), k, sp.eye(3))], Q_DISC, U_DISC, sp.zeros(6, 3), t)
 
 
-def test_inhomogeneous_constraints_are_refused():
+def test_inhomogeneous_constraint_gives_an_offset_J():
+    """A q̇ = b with b ≠ 0 (Barhorst eqs. 10–11 with an affine term): a free unit mass with ẋ + ẏ = 1 and
+    u = ẋ independent has ẏ = 1 − u, so q̇ = K u + J with K = (1, −1), J = (0, 1), p = Kᵀ ∂L/∂q̇ = 2u − 1 and
+    ṗ = 0 (no force along the admissible direction (1, −1))."""
     from projeq.symbolic.lagrange import multiplier_system
     from sympy.physics.mechanics import dynamicsymbols
     qx, qy = dynamicsymbols("x y")
-    system = multiplier_system(qx.diff(t) ** 2 + qy.diff(t) ** 2, [qx, qy], t, A=[[1, 1]], b=[1])
-    with pytest.raises(ValueError, match="b: the canonical forms need homogeneous"):
-        lagrangian_canonical(system)
+    system = multiplier_system((qx.diff(t) ** 2 + qy.diff(t) ** 2) / 2, [qx, qy], t, A=[[1, 1]], b=[1])
+    canonical = lagrangian_canonical(system, independent=[qx])
+    (u,) = canonical.u
+    assert canonical.K == sp.Matrix([1, -1]) and canonical.J == sp.Matrix([0, 1])
+    assert sp.expand(canonical.p[0] - (2 * u - 1)) == 0 and canonical.p_dot == sp.zeros(1, 1)
 
 
 def test_initial_state_sizes_are_checked():
