@@ -168,8 +168,9 @@ def _cse_ops(derived) -> int | None:
 
 def study_rows(study: str, formulations, example, wanted, simulate: bool, t_end: float,
                n_points: int = 51) -> list[dict]:
-    """Derive (timed), integrate and measure each wanted formulation; compare motions with the
-    reference row (the projective/Kane form) on ``n_points`` common instants."""
+    """Derive and compile (``derivation_s``, from the example's shared kinematics, sympy's cache cleared
+    before each row), integrate (``integration_s``) and measure each wanted formulation; compare the
+    motions with the reference row (the projective/Kane form) on ``n_points`` common instants."""
     available = [f.name for f in formulations]
     wanted = available if wanted is None else wanted
     unknown = [w for w in wanted if w not in available]
@@ -180,8 +181,10 @@ def study_rows(study: str, formulations, example, wanted, simulate: bool, t_end:
     t_eval = np.linspace(0.0, t_end, n_points)
     rows, runs = [], {}
     for f in (f for f in formulations if f.name in wanted):
+        sp.core.cache.clear_cache()  # every derivation from the same (empty) sympy cache
         start = time.perf_counter()
         derived = f.derive()
+        getattr(derived, "_compiled", None)  # lambdify now: derivation_s = derivation + compilation
         row = {"formulation": f.name, "derivation_s": time.perf_counter() - start, "n_ops": _cse_ops(derived),
                "note": f.note}
         paper = PAPER[study].get(f.name, ("—", "—", "—"))
@@ -219,8 +222,9 @@ def _compare_motions(study: str, rows: list[dict], runs: dict) -> None:
             row.update(identical="not compared", check="reference row not run")
         else:
             gap = float(np.abs(runs[name].q - reference.q).max())
-            # 1e-5: both at rtol 1e-8 over motions of order 1–100; a modelling error is O(1)
-            row.update(identical="yes" if gap < 1e-5 else "no", check=f"same motion: max |Δq| {gap:.1e}")
+            # 1e-4: both at rtol 1e-8; the quick return's swing past its upper position amplifies
+            # integration errors to 2e-5 over 10 s (measured), a modelling error is O(1)
+            row.update(identical="yes" if gap < 1e-4 else "no", check=f"same motion: max |Δq| {gap:.1e}")
 
 
 # -- the three studies ------------------------------------------------------------------------

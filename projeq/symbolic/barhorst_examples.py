@@ -32,7 +32,9 @@ __all__ = ["Example", "PoseBody", "barhorst_particle", "rolling_disk", "quick_re
 class PoseBody:
     """A body by its mass centre r(q) and orientation R(q) (body → N; None: a point mass), mass ``m``,
     central inertia ``I_c`` in the body frame, a non-potential force ``f`` in N at the mass centre and
-    torque ``M`` in the body frame (expressions in q, q̇); gravity is the example's."""
+    torque ``M`` in the body frame (expressions in q, q̇); gravity is the example's. ``omega``: the
+    angular velocity in the body frame in q, q̇ (default: from ω̃ = RᵀṘ, simplified — slow for
+    three Euler angles, so the examples give Barhorst's own expressions)."""
 
     m: object
     r: sp.Matrix
@@ -40,6 +42,7 @@ class PoseBody:
     I_c: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 3))
     f: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
     M: sp.Matrix = field(default_factory=lambda: sp.zeros(3, 1))
+    omega: sp.Matrix | None = None
 
 
 @dataclass(frozen=True)
@@ -63,6 +66,8 @@ class Example:
         r_dot = body.r.jacobian(self.q) * sp.Matrix(self.q_dot)
         if body.R is None:
             return r_dot, sp.zeros(3, 1)
+        if body.omega is not None:
+            return r_dot, sp.Matrix(body.omega)
         R_dot = sum((body.R.diff(qi) * qd for qi, qd in zip(self.q, self.q_dot)), sp.zeros(3, 3))
         W = (body.R.T * R_dot).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
         return r_dot, sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
@@ -105,7 +110,7 @@ class Example:
         for body in self.bodies:
             r_dot, omega = self._rates(body)
             R = sp.eye(3) if body.R is None else body.R
-            out.append(Body(v_c=(R.T * r_dot).xreplace(on_u).applyfunc(sp.trigsimp), omega=omega.xreplace(on_u),
+            out.append(Body(v_c=(R.T * r_dot).xreplace(on_u), omega=omega.xreplace(on_u),
                             m=body.m, I_c=body.I_c, f=(R.T * (body.f + body.m * self.gravity)).xreplace(on_u), M=body.M.xreplace(on_u),
                             omega_IR=omega.xreplace(on_u)))
         return out
@@ -174,7 +179,7 @@ def rolling_disk(m_disk: float = 0.030, radius: float = 0.015, m_ecc: float = 0.
     r_s = r_G + C * sp.Matrix([ecc_h, ecc_e, ecc_r])
     omega_C = disk_speeds(q, q_dot)[:3, :]
     drag_torque = -T_f * omega_C.applyfunc(lambda w: w * sp.Abs(w))
-    disk = PoseBody(m_r, r_G, C, sp.diag(I_d, J_d, I_d), M=drag_torque)
+    disk = PoseBody(m_r, r_G, C, sp.diag(I_d, J_d, I_d), M=drag_torque, omega=omega_C)
     mass = PoseBody(m_s, r_s, None)
     A = sp.Matrix([[0, 0, -R_disk * sp.cos(q1), 1, 0], [0, 0, -R_disk * sp.sin(q1), 0, 1]])
     ecc = (0.0, 0.0, 0.95 * radius) if ecc is None else ecc
@@ -215,9 +220,11 @@ def quick_return(torques: bool = False) -> Example:
     q1, q2, q3 = q
     B_len = A_len + sp.Rational(3, 2) * H_len
     crank = PoseBody(m_a, H_len / 2 * sp.Matrix([sp.cos(q1), sp.sin(q1), 0]), _rot(2, q1),
-                     sp.diag(0, 0, m_a * H_len**2 / 12), M=sp.Matrix([0, 0, T_m if torques else 0]))
+                     sp.diag(0, 0, m_a * H_len**2 / 12), M=sp.Matrix([0, 0, T_m if torques else 0]),
+                     omega=sp.Matrix([0, 0, q_dot[0]]))
     follower = PoseBody(m_b, sp.Matrix([A_len, 0, 0]) + B_len / 2 * sp.Matrix([sp.cos(q2), sp.sin(q2), 0]),
-                        _rot(2, q2), sp.diag(0, 0, m_b * B_len**2 / 12), M=sp.Matrix([0, 0, T_d if torques else 0]))
+                        _rot(2, q2), sp.diag(0, 0, m_b * B_len**2 / 12), M=sp.Matrix([0, 0, T_d if torques else 0]),
+                        omega=sp.Matrix([0, 0, q_dot[1]]))
     phi = sp.Matrix([A_len - H_len * sp.cos(q1) + q3 * sp.cos(q2), q3 * sp.sin(q2) - H_len * sp.sin(q1)])
     values = {A_len: 1.0, H_len: 1.0 / 3.0, m_a: 0.5, m_b: 1.0, g: 9.81, **({T_m: 0.0, T_d: 0.0} if torques else {})}
     return Example("quick_return", q, q_dot, (crank, follower), sp.Matrix([0, -g, 0]), phi.jacobian(q), values, phi)

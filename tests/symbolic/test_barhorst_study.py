@@ -1,0 +1,193 @@
+"""Barhorst's formulation study (A. A. Barhorst, "Generalized momenta in constrained non-holonomic systems —
+another perspective on the canonical equations of motion", §2–3): general speeds u = Y q̇ + Z (eqs. 8–11, 93),
+the energy-conservation condition (eq. 38/55), Hamilton's canonical equations with multipliers integrated as a
+DAE, and ``compare`` on his three examples with the projective (Kane) form as the reference formulation."""
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from projeq.comparison import compare
+from projeq.integrators import radau_dae
+from projeq.symbolic import energy_rate, lagrangian_canonical, projective_canonical, t
+from projeq.symbolic import barhorst_examples as bx
+
+
+def _energy_in_u(example, form):
+    """E = T + V of the example in the form's (q, u): q̇ = K u + J."""
+    J = form.J if form.J is not None else sp.zeros(len(form.q), 1)
+    return (example.T + example.V).xreplace(dict(zip(example.q_dot, form.K * sp.Matrix(form.u) + J)))
+
+
+@pytest.fixture(scope="module")
+def disk_forms():
+    """The disk's Lagrangian canonical form in his general speeds (93) and the projective canonical form
+    in the same speeds."""
+    example = bx.rolling_disk(drag=0.0)
+    ms = example.multiplier_system()
+    lagrangian = lagrangian_canonical(ms, independent=[0, 1, 2], speeds=bx.disk_speeds(ms.q, [qi.diff(t) for qi in ms.q]))
+    u, K = bx.disk_kinematics("body")
+    projective = projective_canonical(example.bodies_in(u, K), example.q, u, K, t, example.values)
+    return example, lagrangian, projective
+
+
+def test_general_speeds_give_barhorsts_K_and_the_projective_momenta(disk_forms):
+    """Eq. 93 speeds u = Y q̇ (u1..u3 the disk's angular velocity in C, u4 = q̇4, u5 = q̇5) with u4, u5 dependent:
+    K̄ = K_I + K_D A_DI equals Barhorst's inverse map (95)–(96) with the rolling rows (97), and the Lagrangian
+    momenta (45) equal the projective momenta (28) — both are ∂T/∂u — and ṗ agrees (eqs. 36 vs 50) at
+    random states (round-off, 1e-12 relative)."""
+    example, lagrangian, projective = disk_forms
+    on_u = dict(zip(lagrangian.u, projective.u))
+    assert (lagrangian.K.xreplace(on_u) - projective.K).applyfunc(sp.simplify) == sp.zeros(5, 3)
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        q, u = rng.uniform(-0.6, 0.6, 5), rng.uniform(-3, 3, 3)
+        p_l, p_p = lagrangian.momenta(0.0, q, u), projective.momenta(0.0, q, u)
+        assert np.allclose(p_l, p_p, rtol=1e-12, atol=1e-18)
+        x = np.r_[q, p_l]
+        assert np.allclose(lagrangian.rhs(0.0, x), projective.rhs(0.0, x), rtol=1e-10, atol=1e-16)
+
+
+def test_speeds_that_are_not_linear_or_invertible_are_refused():
+    ms = bx.barhorst_particle().multiplier_system()
+    x, y = ms.q
+    with pytest.raises(ValueError, match="speeds: must be linear"):
+        lagrangian_canonical(ms, speeds=[x.diff(t) ** 2, y.diff(t)])
+    with pytest.raises(ValueError, match="speeds: Y = ∂u/∂q̇ is singular"):
+        lagrangian_canonical(ms, speeds=[x.diff(t) + y.diff(t), 2 * x.diff(t) + 2 * y.diff(t)])
+    with pytest.raises(ValueError, match="independent: expected positions"):
+        lagrangian_canonical(ms, independent=[x], speeds=[x.diff(t), y.diff(t)])
+
+
+def test_eq_38_quick_return_conserves_energy_without_drive():
+    """§3.3: "Conservation of energy can be confirmed as indicated in equation 38 … with the driving and load
+    torque set to zero": for the Lagrangian canonical form (112)–(116), dE/dt of eq. 38 is identically
+    T_m q̇1 + T_d q̇2 (the drive's power, q̇2 = H cos(q1 − q2)/q3 q̇1 by (109)), hence 0 for T_m = T_d = 0."""
+    example = bx.quick_return(torques=True)
+    form = lagrangian_canonical(example.multiplier_system(), independent=[0])
+    (u,) = form.u
+    rate = energy_rate(form, _energy_in_u(example, form))
+    q1, q2, q3 = example.q
+    power = bx.T_m * u + bx.T_d * bx.H_len * sp.cos(q1 - q2) / q3 * u
+    assert sp.simplify(rate - power) == 0
+    assert sp.simplify(rate.subs({bx.T_m: 0, bx.T_d: 0})) == 0
+
+
+@pytest.mark.parametrize("form", ["projective", "lagrangian"])
+def test_eq_38_particle_energy_is_conserved(form):
+    """§3.1 with u = ẏ (A12 = 1/y²): the projective canonical equations (79)–(80) and the Lagrangian ones
+    (86)–(87) satisfy eq. 38 identically for E = ½ m (ẋ² + ẏ²) + m g y; a wrong energy (without the
+    potential) does not."""
+    example = bx.barhorst_particle()
+    if form == "lagrangian":
+        canonical = lagrangian_canonical(example.multiplier_system(), independent=[1])
+    else:
+        u, K = sp.symbols("u2:3"), sp.Matrix([[1 / example.q[1] ** 2], [1]])
+        canonical = projective_canonical(example.bodies_in(u, K), example.q, u, K, t, example.values)
+    E = _energy_in_u(example, canonical)
+    assert sp.simplify(energy_rate(canonical, E)) == 0
+    assert sp.simplify(energy_rate(canonical, E - example.V)) != 0
+
+
+def test_eq_38_rolling_disk_with_and_without_drag(disk_forms):
+    """§3.2: without drag eq. 38 vanishes at random states (round-off); with his air-drag torque (104),
+    −T_f u_i |u_i| about C's axes, the rate equals its power −T_f Σ |u_i|³ (rtol 1e-9)."""
+    example = bx.rolling_disk(drag=2e-6)
+    ms = example.multiplier_system()
+    form = lagrangian_canonical(ms, independent=[0, 1, 2], speeds=bx.disk_speeds(ms.q, [qi.diff(t) for qi in ms.q]))
+    rate = energy_rate(form, _energy_in_u(example, form))
+    numbers = {k: sp.Float(v) for k, v in example.values.items() if k != bx.T_f}
+    f = sp.lambdify([form.q, form.u, bx.T_f], rate.xreplace(numbers), modules="numpy", cse=True)
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        q, u = rng.uniform(-0.6, 0.6, 5), rng.uniform(-20, 20, 3)
+        assert abs(f(q, u, 0.0)) < 1e-12 * 1e-3 * np.sum(u**2)  # T ~ 1e-6 u² J here, rate ~ T u
+        assert np.isclose(f(q, u, 2e-6), -2e-6 * np.sum(np.abs(u) ** 3), rtol=1e-9)
+
+
+def test_radau_dae_index_2_and_3_pendulum():
+    """Radau IIA on a pendulum in Cartesian coordinates (x, y, u, v, λ) as an index-3 (x² + y² = 1) and an
+    index-2 (x u + y v = 0) DAE against the angle ODE θ̈ = −g sin θ (DOP853, rtol 1e-12): x agrees to 1e-7
+    after 3 s and the energy drifts < 1e-8 (measured 2e-10 and 8e-10 at rtol 1e-8)."""
+    from scipy.integrate import solve_ivp
+
+    g, theta0 = 9.81, 0.5
+    reference = solve_ivp(lambda _, z: [z[1], -g * np.sin(z[0])], (0, 3), [theta0, 0], rtol=1e-12, atol=1e-12)
+
+    def f(_, z, position):
+        x, y, u, v, lam = z
+        return [u, v, -x * lam, -y * lam - g, x * x + y * y - 1 if position else x * u + y * v]
+
+    z0 = [np.sin(theta0), -np.cos(theta0), 0, 0, g * np.cos(theta0)]
+    for position, index in ((True, [1, 1, 2, 2, 3]), (False, [1, 1, 2, 2, 2])):
+        sol = radau_dae(lambda s, z: f(s, z, position), (0, 3), z0, mass=[1, 1, 1, 1, 0], index=index,
+                        rtol=1e-8, atol=1e-10)
+        assert sol.success
+        x, y, u, v, _ = sol.y
+        assert abs(x[-1] - np.sin(reference.y[0, -1])) < 1e-7
+        energy = 0.5 * (u * u + v * v) + g * y
+        assert np.abs(energy - energy[0]).max() < 1e-8
+
+
+def test_radau_dae_bad_input():
+    with pytest.raises(ValueError, match="mass, index: expected 2 values"):
+        radau_dae(lambda s, y: y, (0, 1), [1.0, 2.0], mass=[1.0])
+    with pytest.raises(ValueError, match="t_span: expected t_end > t0"):
+        radau_dae(lambda s, y: y, (1, 0), [1.0])
+
+
+def test_hamilton_dae_particle_follows_the_integral_curve():
+    """§3.1 as Barhorst's eq. 69, a DAE in (x, y, p1, p2, λ) integrated without index reduction, from (2, 2) at
+    rest: the constraint integrates to y = 1/(2.5 − x) (his footnote 6), which the motion follows to 1e-8 over
+    3 s, and E = ½(p1² + p2²) + 10 y stays 20 to 1e-8 (measured 3e-10, rtol 1e-9)."""
+    ms = bx.barhorst_particle().multiplier_system()
+    sol = ms.simulate_dae([2.0, 2.0], [0.0, 0.0], (0, 3), rtol=1e-9, atol=1e-11)
+    x, y = sol.q
+    assert x[-1] < -5  # it slid down the curve
+    assert np.abs(y - 1 / (2.5 - x)).max() < 1e-8
+    energy = 0.5 * (sol.p**2).sum(axis=0) + 10 * y
+    assert np.abs(energy - 20).max() < 1e-8
+    with pytest.raises(ValueError, match="phi: expected 1 position constraints"):
+        ms.hamilton_dae(phi=[ms.q[0], ms.q[1]])
+
+
+def _rows(table):
+    return {row["formulation"]: row for row in table.rows}
+
+
+def test_compare_barhorst_particle_four_formulations_agree():
+    """compare("barhorst_particle"): his four formulations, the Hamilton row a DAE; over 2 s all follow the
+    projective (Kane) reference to 1e-6 (measured ≤ 3e-9), conserve E to 1e-7 (measured ≤ 2e-8), and his
+    reported numbers stand beside projeq's."""
+    rows = _rows(compare("barhorst_particle", t_end=2.0))
+    assert len(rows) == 4
+    reference = rows["projective (Kane), u = ẏ"]
+    assert reference["identical"] == "reference" and reference["time / baseline"] > 0
+    for name, row in rows.items():
+        if row is not reference:
+            assert row["identical"] == "yes", row["check"]
+            assert float(row["check"].split()[-1]) < 1e-6
+        assert row["energy_drift"] < 1e-7
+        assert row["Barhorst (paper) time"]
+    hamilton = rows["hamilton + multipliers (DAE)"]
+    assert hamilton["time / baseline"] == 1.0 and "index 2" in hamilton["note"]
+    assert 0 < hamilton["constraint_drift"] < 1e-7  # a DAE keeps A q̇ = 0 only to its tolerance
+
+
+def test_compare_rolling_disk_and_quick_return():
+    """compare("rolling_disk") with his four formulations and the Hamilton DAE (0.1 s: the equations agree to
+    1e-6, measured ≤ 1e-8, energy to 1e-7), and compare("quick_return") with three formulations — the Hamilton
+    row is not available (massless slider: no Legendre transform) — whose loop residuals |Φ| stay < 1e-7
+    (measured 2e-9 over 1 s)."""
+    disk = _rows(compare("rolling_disk", t_end=0.1))
+    assert len(disk) == 5
+    for row in disk.values():
+        assert row["identical"] in ("reference", "yes"), row["check"]
+        assert row["energy_drift"] < 1e-7
+    assert disk["lagrangian canonical, eq. 93 speeds"]["Barhorst (paper) time"].startswith("0.19")
+    quick = _rows(compare("quick_return", t_end=1.0))
+    assert quick["hamilton + multipliers (DAE)"]["identical"] == "not available"
+    for name in ("projective (Kane), u = q̇1", "projective canonical, u = q̇1", "lagrangian canonical, u = q̇1"):
+        assert quick[name]["identical"] in ("reference", "yes")
+        assert quick[name]["constraint_drift"] < 1e-7
+        assert quick[name]["energy_drift"] < 1e-7
