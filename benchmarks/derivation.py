@@ -28,7 +28,7 @@ import numpy as np
 import sympy as sp
 
 import projeq as pq
-from projeq.comparison import _cse_ops, _timed
+from projeq.studies.compare import _cse_ops, _timed
 from projeq.symbolic import gauss_form, projection_equation
 from projeq.symbolic.examples import (
     PENDULUM_PARAMETERS, chain_parameters, kane_pendulum, lagrange_pendulum, n_link_pendulum,

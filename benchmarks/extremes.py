@@ -37,7 +37,7 @@ import numpy as np
 
 import projeq as pq
 from projeq.scenes.elastic import spin_up_motion
-from projeq.integrators import StiffnessWarning, _gradient, spectral_radius
+from projeq.simulation.integrators import StiffnessWarning, _gradient, spectral_radius
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from test_extremes import EA_STIFF, axially_stiff_beam, first_bending_frequency, mass_ratio_chain, pendulum  # noqa: E402
@@ -68,7 +68,7 @@ def spin_up(omegas=(2.0, 6.0, 10.0, 20.0)) -> list[dict]:
            "after the hub rate Ω(t) passed ω₁ (t_cross; below ω₁ the softened beam is still stable); "
            "unstiffened Ωs < ω₁: bounded. For information: the growth rate σ of |v_tip| over 0.01 L … L and "
            "the quasi-steady σ_ref = mean √(Ω(t)² − ω₁²) there (the forced response to the hub's angular "
-           "acceleration adds to σ; tests/test_extremes.py checks σ at constant Ω to 1e-3)")
+           "acceleration adds to σ; tests/simulation/test_extremes.py checks σ at constant Ω to 1e-3)")
     omega_1 = first_bending_frequency(1.4e4, 1.2, 10.0)
     rows = []
     print(f"{'Ωs':>5}{'stiffening':>11}{'max|v| m':>11}{'tail|v| m':>11}{'t_cross s':>10}{'diverged at s':>14}"

@@ -1,5 +1,5 @@
-"""``python -m projeq`` runs the command line (:mod:`projeq.cli`)."""
+"""``python -m projeq`` runs the command line (:mod:`projeq.cli.commands`)."""
 
-from projeq.cli import main
+from projeq.cli.commands import main
 
 raise SystemExit(main())

@@ -11,7 +11,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from projeq import inertia
+from projeq.subsystems import inertia
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
 from projeq.scenes.bicycle import whipple_bicycle, whipple_eigenvalues

@@ -5,7 +5,7 @@ Model and parameters of Meijaard, Papadopoulos, Ruina & Schwab (2007, Proc. R. S
 fork with handlebar H, front wheel F; axes x forward, z *down*, origin at the rear contact
 in the upright reference configuration (the table's coordinates are used as given).
 
-Design: a tree plus constraint equations (:class:`~projeq.constrained.ConstrainedSystem`,
+Design: a tree plus constraint equations (:class:`~projeq.constraints.partitioned.ConstrainedSystem`,
 THEORY §7). The rolling constraints couple the speeds of all four bodies (the yaw rate
 follows from steer, roll and the rear wheel's speed; the front wheel's spin from all of
 them), so no choice of minimal velocities fits the tree's one-joint-one-slice layout that
@@ -49,9 +49,9 @@ import sympy as sp
 from numpy.typing import NDArray
 
 from projeq.checks import finite_array
-from projeq.constrained import ConstrainedSystem
+from projeq.constraints.partitioned import ConstrainedSystem
 from projeq.joints import Revolute, UserJoint
-from projeq.linearization import linearize, sorted_eigenvalues
+from projeq.analysis.linearize import linearize, sorted_eigenvalues
 from projeq.scenes.nonholonomic import _rot
 from projeq.spatial import skew
 from projeq.subsystems import RigidBody
@@ -252,7 +252,7 @@ def whipple_bicycle(params: dict | None = None, speed: float = 4.0, roll: float 
     roll, steer, roll_rate, steer_rate : float
         Initial roll φ, steer δ (rad) and their rates (rad/s); the pitch is solved from Φ = 0.
     **options
-        Passed to :class:`~projeq.constrained.ConstrainedSystem` (``correction``, ``beta``).
+        Passed to :class:`~projeq.constraints.partitioned.ConstrainedSystem` (``correction``, ``beta``).
 
     Returns
     -------

@@ -24,10 +24,10 @@ from functools import cache
 import numpy as np
 import sympy as sp
 
-from projeq.constraints import check_configuration, initial_speeds
+from projeq.constraints.nonholonomic import check_configuration, initial_speeds
 from projeq.forces import Force, Torque
 from projeq.joints import Fixed, UserJoint
-from projeq.symbolic_joint import skew
+from projeq.joints.user_compiler import skew
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
 from projeq.system import System
 

@@ -18,7 +18,7 @@ import numpy as np
 import sympy as sp
 
 from ..joints import Fixed, Free, Planar, Prescribed, Prismatic, Revolute, UserJoint
-from ..symbolic_joint import skew
+from projeq.joints.user_compiler import skew
 
 __all__ = ["SymbolicRelative", "relative", "exact", "skew", "cross", "mul"]
 

@@ -16,14 +16,14 @@ from strategies import trees
 from test_recursive_vs_dense import _agree
 
 import projeq as pq
-from projeq.assembly import _kernels
+from projeq.assembly import kernels
 from projeq.assembly.beam_fast import HubBeamEvaluator
 from projeq.assembly.fast import FastEvaluator
 from projeq.assembly.linalg import SingularMassError
 from projeq.spatial import rotation
 
 KERNEL_KINDS = ("revolute", "prismatic", "fixed")
-HAS_NUMBA = _kernels._numba() is not None
+HAS_NUMBA = kernels._numba() is not None
 
 
 @given(trees(max_n=30, kinds=KERNEL_KINDS, forces=False))
@@ -56,7 +56,7 @@ def test_environment_switch_selects_the_interpreted_kernel(monkeypatch):
 def test_without_numba_the_default_is_the_recursive_evaluator(monkeypatch):
     """The interpreted kernel is slower than the recursive evaluator, so without numba
     method="fast" does not use it unless asked (PROJEQ_FAST_KERNEL=python)."""
-    monkeypatch.setattr(_kernels, "_numba", lambda: None)
+    monkeypatch.setattr(kernels, "_numba", lambda: None)
     monkeypatch.delenv("PROJEQ_FAST_KERNEL", raising=False)
     ev = FastEvaluator(pq.scenes.chain(2))
     assert ev.fast is False and "numba is not installed" in ev.reason
@@ -65,7 +65,7 @@ def test_without_numba_the_default_is_the_recursive_evaluator(monkeypatch):
 
 
 def test_compiled_without_numba_is_refused(monkeypatch):
-    monkeypatch.setattr(_kernels, "_numba", lambda: None)
+    monkeypatch.setattr(kernels, "_numba", lambda: None)
     with pytest.raises(ValueError, match="compiled: numba is not installed"):
         FastEvaluator(pq.scenes.chain(2), compiled=True)
 

@@ -13,7 +13,7 @@ import pytest
 import sympy as sp
 
 import projeq as pq
-from projeq.constraints import check_configuration, initial_speeds
+from projeq.constraints.nonholonomic import check_configuration, initial_speeds
 
 x, y, k, u = sp.symbols("x y k u")
 

@@ -1,0 +1,5 @@
+"""The ``projeq`` command (:mod:`.commands`)."""
+
+from projeq.cli.commands import main
+
+__all__ = ["main"]
