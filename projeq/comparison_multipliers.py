@@ -1,7 +1,8 @@
-"""The multiplier and canonical forms in a comparison table (:mod:`projeq.comparison`, issue 5).
+"""The multiplier and canonical forms in a comparison table (:mod:`projeq.comparison`).
 
-Lagrange's and Hamilton's equations with multipliers (seed 001, K(7), K(23)–(26)) and
-Barhorst's Lagrangian canonical form (seed 000, eqs. 45–52) live in the full coordinates of
+Lagrange's and Hamilton's equations with multipliers (the lecture on non-holonomic systems,
+K(7), K(23)–(26)) and Barhorst's Lagrangian canonical form (A. A. Barhorst, "Generalized
+momenta in constrained non-holonomic systems", eqs. 45–52) live in the full coordinates of
 a Pfaffian model, not in the scene's minimal velocities; each row is derived, counted, and
 compared with the scene's Projection Equation by the motion both produce from the same
 initial state (:class:`FullCoordinates` maps one onto the other).
@@ -15,7 +16,7 @@ from typing import Callable
 import numpy as np
 import sympy as sp
 
-from projeq.comparison import _cse_ops, _timed
+from projeq.comparison import _cse_ops, _derivation_timed, _timed
 
 __all__ = ["MULTIPLIER_FORMS", "FullCoordinates", "CAR_COORDINATES", "car_multiplier_system", "multiplier_rows",
            "without_multiplier_rows"]
@@ -87,11 +88,11 @@ def multiplier_row(form: str, name: str, build, system, coordinates: FullCoordin
         if form == "barhorst":  # an ODE in (q, p) with q̇ = K u, no multiplier
             independent = [qi for qi in ms.q if qi.func.__name__ in coordinates.independent]
             canonical = lagrangian_canonical(ms, independent=independent)
-            return (ms, canonical), canonical.p_dot
+            return (ms, canonical), [*canonical.p, *canonical.p_dot]
         return (ms, None), (ms.lagrange_equations() if form == "lagrange" else sp.Matrix([*ms.canonical_equations()]))
 
-    ((ms, canonical), equations), seconds = _timed(derive)
-    row = {"formulation": name, "derivation_s": seconds, "n_ops": _cse_ops(equations),
+    ((ms, canonical), equations), seconds = _derivation_timed(derive)
+    row = {"formulation": name, "derivation_s": seconds, "n_ops": _cse_ops(equations, ms.parameters),
            "note": "q̇ = K u, ṗ = Kᵀ(∂L/∂q + Q) + K̇ᵀ∂L/∂q̇: no multiplier" if canonical else
            "index-1 by differentiating the constraint once (λ solved), no Baumgarte"}
     if reference is None:
