@@ -200,8 +200,8 @@ def test_compare_hands_its_options_to_the_library(monkeypatch, capsys):
         return pq.ComparisonTable("car")
 
     monkeypatch.setattr(projeq.cli.studies, "compare", compare)
-    assert main(["compare", "car", "--no-simulate", "--t-end", "1.5", "--formulation", "hamel"]) == 0
-    assert seen == [(("car", ["hamel"]), {"simulate": False, "t_end": 1.5})]
+    assert main(["compare", "car", "--no-simulate", "--t-end", "1.5", "--formulation", "hamel", "--repeats", "3"]) == 0
+    assert seen == [(("car", ["hamel"]), {"simulate": False, "t_end": 1.5, "repeats": 3})]
     assert capsys.readouterr().out.startswith("compare car")
 
 
