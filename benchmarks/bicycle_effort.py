@@ -26,7 +26,7 @@ import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # for tests.bicycle
 
-from projeq.bench import time_per_call  # noqa: E402
+from projeq.studies.bench import time_per_call  # noqa: E402
 from projeq.scenes import bicycle  # noqa: E402
 from tests.bicycle import kane_whipple  # noqa: E402
 

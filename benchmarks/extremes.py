@@ -37,7 +37,8 @@ import numpy as np
 
 import projeq as pq
 from projeq.scenes.elastic import spin_up_motion
-from projeq.integrators import StiffnessWarning, _gradient, spectral_radius
+from projeq.analysis.differentiation import gradient
+from projeq.simulation.integrators import StiffnessWarning, spectral_radius
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from test_extremes import EA_STIFF, axially_stiff_beam, first_bending_frequency, mass_ratio_chain, pendulum  # noqa: E402
@@ -68,7 +69,7 @@ def spin_up(omegas=(2.0, 6.0, 10.0, 20.0)) -> list[dict]:
            "after the hub rate Ω(t) passed ω₁ (t_cross; below ω₁ the softened beam is still stable); "
            "unstiffened Ωs < ω₁: bounded. For information: the growth rate σ of |v_tip| over 0.01 L … L and "
            "the quasi-steady σ_ref = mean √(Ω(t)² − ω₁²) there (the forced response to the hub's angular "
-           "acceleration adds to σ; tests/test_extremes.py checks σ at constant Ω to 1e-3)")
+           "acceleration adds to σ; tests/simulation/test_extremes.py checks σ at constant Ω to 1e-3)")
     omega_1 = first_bending_frequency(1.4e4, 1.2, 10.0)
     rows = []
     print(f"{'Ωs':>5}{'stiffening':>11}{'max|v| m':>11}{'tail|v| m':>11}{'t_cross s':>10}{'diverged at s':>14}"
@@ -152,8 +153,8 @@ def energy_round_off(system, q, s_dot, t: float) -> float:
     and the eccentric mass makes E depend on it."""
     n_q = system.n_q
     x = np.concatenate((q, s_dot))
-    gradient = _gradient(lambda x, t: (sum(system.energy(x[:n_q], x[n_q:], t)), None), x, t)
-    return float(EPS * np.abs(gradient) @ np.abs(x))
+    grad = gradient(lambda x: sum(system.energy(x[:n_q], x[n_q:], t)), x)
+    return float(EPS * np.abs(grad) @ np.abs(x))
 
 
 LONG_RUN_METHODS = ("RK45", "RK45-projected", "DOP853", "DOP853-projected")

@@ -10,7 +10,7 @@ Run: python examples/sweep.py
 
 import numpy as np
 
-from projeq.sweeps import sweep
+from projeq.simulation.sweep import sweep
 
 if __name__ == "__main__":  # worker processes import this file: only the main process sweeps
     table = sweep("atwood", grid={"m1": np.linspace(0.5, 2.5, 5)}, outputs=["q0"], t_end=1.0,

@@ -1,8 +1,8 @@
-"""Work-precision: the cheapest integrator setting for an accuracy (``projeq.tradeoff``).
+"""Work-precision: the cheapest integrator setting for an accuracy (``projeq.studies.tradeoff``).
 
 The knife-edge disc (lecture 001, slides 28-37) integrated by DOP853 at two relative
 tolerances, each run's error measured against a converged reference (DOP853 at rtol 1e-13,
-``projeq.tradeoff``'s reference run). The checked fact: an error-controlled integrator
+``projeq.studies.tradeoff``'s reference run). The checked fact: an error-controlled integrator
 meets the request — the error at the end is within a small multiple of rtol times the
 solution's size (here O(1) m and rad) — and tightening rtol by 1e4 buys at least 1e3.
 
@@ -11,7 +11,7 @@ Run: python examples/tradeoff.py  (PROJEQ_QUICK=1: DOP853 over 1 s only, as the 
 
 import os
 
-from projeq.tradeoff import cheapest, format_table, plot, tradeoff
+from projeq.studies.tradeoff import cheapest, format_table, plot, tradeoff
 
 QUICK = bool(os.environ.get("PROJEQ_QUICK"))
 methods = ["DOP853"] if QUICK else ["RK45", "DOP853", "Radau", "LSODA"]

@@ -1,13 +1,13 @@
 """projeq: equations of motion of multibody systems by H. Bremer's Projection Equation.
 
 Σ_n (∂ẏ_n/∂ṡ)ᵀ (M_n ÿ_n + G_n ẏ_n − Q_n) = 0, assembled densely (Gauss form) or solved
-recursively in order n. See docs/ and shared/design/THEORY.md.
+recursively in order n. See docs/theory.md and docs/architecture.md.
 """
 
-from projeq import inertia
+from projeq.subsystems import inertia
 from projeq.assembly import SingularMassError
 from projeq.forces import Force, JointForce, JointSpring, SpringDamper, Torque
-from projeq.linearization import Linearization, NotSteadyError, eigenvalue_sweep, linearize
+from projeq.analysis.linearize import Linearization, NotSteadyError, eigenvalue_sweep, linearize
 from projeq.joints import Fixed, Free, Joint, Planar, Prescribed, Prismatic, Revolute, UserJoint
 from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, RitzBeam, Subsystem
 from projeq.system import GROUND, System, SystemBuilder
@@ -26,16 +26,16 @@ __all__ = [
 
 # names loaded on first use (they import scipy, matplotlib or tqdm): keeps `import projeq` light
 _LAZY = {
-    "simulate": "projeq.simulation", "Result": "projeq.simulation", "SimulationError": "projeq.simulation",
-    "compare": "projeq.comparison", "ComparisonTable": "projeq.comparison",
-    "ConstrainedSystem": "projeq.constrained",
-    "PinClosure": "projeq.cut_joints",
-    "reactions": "projeq.reaction_forces", "joint_reactions": "projeq.reaction_forces",
-    "contact_event": "projeq.reaction_forces",
-    "sweep": "projeq.sweeps", "SweepTable": "projeq.sweeps",
-    "StiffnessWarning": "projeq.integrators",
+    "simulate": "projeq.simulation.driver", "Result": "projeq.simulation.driver", "SimulationError": "projeq.simulation.driver",
+    "compare": "projeq.studies.compare", "ComparisonTable": "projeq.studies.compare",
+    "ConstrainedSystem": "projeq.constraints.partitioned",
+    "PinClosure": "projeq.constraints.cut_joints",
+    "reactions": "projeq.constraints.reactions", "joint_reactions": "projeq.constraints.reactions",
+    "contact_event": "projeq.constraints.reactions",
+    "sweep": "projeq.simulation.sweep", "SweepTable": "projeq.simulation.sweep",
+    "StiffnessWarning": "projeq.simulation.integrators",
 }
-_LAZY_MODULES = ("scenes", "plots", "symbolic")
+_LAZY_MODULES = {"scenes": "projeq.scenes", "plots": "projeq.simulation.plots", "symbolic": "projeq.symbolic"}
 
 
 def __getattr__(name):
@@ -44,5 +44,5 @@ def __getattr__(name):
     if name in _LAZY:
         return getattr(importlib.import_module(_LAZY[name]), name)
     if name in _LAZY_MODULES:
-        return importlib.import_module(f"projeq.{name}")
+        return importlib.import_module(_LAZY_MODULES[name])
     raise AttributeError(f"module 'projeq' has no attribute {name!r}")

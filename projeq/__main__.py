@@ -1,4 +1,4 @@
-"""``python -m projeq`` runs the command line (:mod:`projeq.cli`)."""
+"""``python -m projeq`` runs the command line (:func:`projeq.cli.main`)."""
 
 from projeq.cli import main
 

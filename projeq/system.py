@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.checks import finite_array, state_vector
-from projeq.constraints import check_configuration
+from projeq.constraints.nonholonomic import check_configuration
 from projeq.joints import Joint
 
 GROUND = -1
@@ -194,7 +194,7 @@ class System:
 
     def check_configuration(self, q: NDArray, t: float = 0.0) -> None:
         """ValueError naming the joint whose K(q) or F(q) is singular or not finite at q
-        (:func:`projeq.constraints.check_configuration`)."""
+        (:func:`projeq.constraints.nonholonomic.check_configuration`)."""
         check_configuration(self, q, t)
 
     def _kinematics_split(self) -> tuple[NDArray, NDArray, tuple]:
@@ -281,7 +281,7 @@ class System:
 
     def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:
         """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and gravity plus springs."""
-        from projeq.kinematics import forward
+        from projeq.assembly.kinematics import forward
 
         q, s_dot = self.check_state(q, s_dot, t)
         kin = forward(self, q, s_dot, float(t), chain_terms=False)
@@ -295,7 +295,7 @@ class System:
     def _check_planar(self) -> None:
         """A subsystem with a selection S must not be driven out of its plane by its joint
         (F⁶ and T⁶_np Sₚᵀ must lie in the span of Sₙᵀ), checked at q0 and a perturbed q."""
-        from projeq.kinematics import forward
+        from projeq.assembly.kinematics import forward
 
         rng = np.random.default_rng(1)
         for q in (self.q0, self.normalized(self.q0 + 0.3 * rng.standard_normal(self.n_q))):

@@ -8,9 +8,9 @@ Projection Equation B(14) projected on the only minimal velocities ṡ = q̇_e,
     M_ee q̈_e = h_e − M_eR ζ,
 
 needs neither the kinematic chain nor the passes of THEORY §6: the beam's terms and one
-n_e × n_e solve. With precomputed shape integrals (:mod:`projeq.subsystems.beam_integrals`)
+n_e × n_e solve. With precomputed shape integrals (:mod:`projeq.subsystems.beam.integrals`)
 and no rotary inertia only the elastic rows (M_ee, M_eR, h_e) are formed
-(:meth:`~projeq.subsystems.beam.RitzBeam.elastic_terms`). M_ee = ∫ Φ_rᵀ Φ_r dm is
+(:meth:`~projeq.subsystems.beam.beam.RitzBeam.elastic_terms`). M_ee = ∫ Φ_rᵀ Φ_r dm is
 positive definite for the independent Ritz functions a RitzBeam accepts, so a plain LU
 solve suffices. Equal to the general evaluators to round-off
 (tests/assembly/test_fast.py).
@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.joints import Fixed, Prescribed
-from projeq.subsystems.beam import RitzBeam
+from projeq.subsystems.beam.beam import RitzBeam
 
 
 def hub_beam_unsupported(system) -> str | None:

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.assembly.linalg import mass_scale, solve_spd
-from projeq.kinematics import forward, gauss_terms
+from projeq.assembly.kinematics import forward, gauss_terms
 
 
 class DenseEvaluator:

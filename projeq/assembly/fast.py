@@ -2,8 +2,8 @@
 
 The System stays frozen; :class:`FastEvaluator` packs its tree once into arrays (parents,
 joint kinds, axes, joint frames, masses, r_c, I_c, M_n) and each call runs
-:func:`projeq.assembly._kernels.chain_terms` (T_np, ζ_n, F_n, h_n; THEORY §3–4) and
-:func:`projeq.assembly._kernels.passes` (Bremer's backward and forward passes, §6).
+:func:`projeq.assembly.kernels.chain_terms` (T_np, ζ_n, F_n, h_n; THEORY §3–4) and
+:func:`projeq.assembly.kernels.passes` (Bremer's backward and forward passes, §6).
 With numba installed (``pip install 'projeq[fast]'``) both are compiled on first use
 (cached on disk). Without it ``method="fast"`` is the recursive evaluator (``reason``
 says so): the same kernel source runs interpreted only on request (``compiled=False`` or
@@ -33,13 +33,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.assembly import _kernels
+from projeq.assembly import kernels
 from projeq.assembly.beam_fast import HubBeamEvaluator, hub_beam_unsupported
-from projeq.assembly.linalg import _SINGULAR, SingularMassError, mass_scale
+from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.joints import Fixed, Prismatic, Revolute
 from projeq.subsystems import PointMass, RigidBody
 
-_KINDS = {Fixed: _kernels.FIXED, Revolute: _kernels.REVOLUTE, Prismatic: _kernels.PRISMATIC}
+_KINDS = {Fixed: kernels.FIXED, Revolute: kernels.REVOLUTE, Prismatic: kernels.PRISMATIC}
 
 
 class FastEvaluator:
@@ -66,12 +66,12 @@ class FastEvaluator:
         if hub_beam_unsupported(system) is None:
             self.reason, self._delegate = None, HubBeamEvaluator(system)  # the beam's own fast path
         else:
-            self.reason = unsupported(system) or _kernels.missing_compiler(compiled)
+            self.reason = unsupported(system) or kernels.missing_compiler(compiled)
             if self.reason is not None:
                 self._delegate = system.evaluator("dense" if system.coupled else "recursive")
         self.fast = self.reason is None
         if self._delegate is None:
-            self._chain_terms, self._passes, self.compiled = _kernels.kernel(compiled)
+            self._chain_terms, self._passes, self.compiled = kernels.kernel(compiled)
             self._pack(system)
 
     def _pack(self, system) -> None:
@@ -89,7 +89,7 @@ class FastEvaluator:
         self._I_c = np.array([b.I_c for b in bodies])
         self._M6 = np.array([b.M6 for b in bodies])
         self._gravity = np.asarray(system.gravity, dtype=float)
-        self._pivot_min = _SINGULAR * mass_scale(system)
+        self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
         self._T, self._zeta = np.zeros((N, 6, 6)), np.zeros((N, 6))
         self._f, self._M_hat, self._h_hat = np.zeros((N, 6)), np.zeros((N, 6, 6)), np.zeros((N, 6))
 

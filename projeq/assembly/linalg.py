@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-_SINGULAR = 1e-13  # pivots below this fraction of the system's mass scale count as zero
+SINGULAR_PIVOT = 1e-13  # pivots below this fraction of the system's mass scale count as zero
 
 
 class SingularMassError(ValueError):
@@ -31,7 +31,7 @@ def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
     """
     k = D.shape[0]
     if k == 1:
-        if D[0, 0] > _SINGULAR * scale:
+        if D[0, 0] > SINGULAR_PIVOT * scale:
             return B / D[0, 0]
         raise SingularMassError(f"{_name(what)} is singular (pivot {D[0, 0]:.3g}): it moves no mass or inertia")
     if k == 0:
@@ -40,7 +40,7 @@ def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
         L = np.linalg.cholesky(D)
     except np.linalg.LinAlgError as exc:
         raise SingularMassError(f"{_name(what)} is not positive definite: {exc}") from exc
-    if np.diagonal(L).min() ** 2 <= _SINGULAR * scale:
+    if np.diagonal(L).min() ** 2 <= SINGULAR_PIVOT * scale:
         raise SingularMassError(f"{_name(what)} is singular (smallest pivot {np.diagonal(L).min() ** 2:.3g})")
     return np.linalg.solve(L.T, np.linalg.solve(L, B))
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from projeq import inertia
+from projeq.subsystems import inertia
 from projeq.checks import count, finite_array, positive
 from projeq.joints import Fixed, Prescribed, Revolute
-from projeq.subsystems.beam import RitzBeam
+from projeq.subsystems.beam.beam import RitzBeam
 from projeq.subsystems.rigid import PointMass, RigidBody
 from projeq.system import System
 
@@ -55,7 +55,7 @@ def spin_up_beam(
     The first bending frequency at rest is 3.516 √(EI/(ρA L⁴)) = 3.80 rad/s for the
     defaults, below Ωs = 6 rad/s: without ``stiffening`` the in-plane deflection then
     grows without bound. ``precomputed_integrals`` selects the precomputed-moment mode
-    (:mod:`projeq.subsystems.beam_integrals`: exact for this model, since the slice position
+    (:mod:`projeq.subsystems.beam.integrals`: exact for this model, since the slice position
     is quadratic in q; faster per call up to ~5 functions per plane).
     """
     n_shapes, n_axial = count("n_shapes", n_shapes), count("n_axial", n_axial, minimum=0)

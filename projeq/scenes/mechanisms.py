@@ -1,6 +1,6 @@
 """Closed loops and contacts given as constraint equations on a tree (THEORY §7).
 
-Each scene returns a :class:`projeq.constrained.ConstrainedSystem`: a tree cut open at one
+Each scene returns a :class:`projeq.constraints.partitioned.ConstrainedSystem`: a tree cut open at one
 joint (or a free body on sliders) plus the constraint equations that close it.
 """
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from projeq.constrained import ConstrainedSystem
+from projeq.constraints.partitioned import ConstrainedSystem
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody
 from projeq.system import System
@@ -32,7 +32,7 @@ def quick_return(A: float = 1.0, H: float = 1.0 / 3.0, m_a: float = 0.5, m_b: fl
     uniform slender rods (centroidal moments m L²/12: the seed does not print A_i33, B_i33).
     Default q0: the seed's printed configuration (q1 = 9π/20, q2 = 2.80729, q3 = 1.0034,
     given to 5 digits), projected onto the loop closures; at rest, no drive (T_m = T_d = 0).
-    ``options`` go to :class:`~projeq.constrained.ConstrainedSystem` (``correction``, ``beta``).
+    ``options`` go to :class:`~projeq.constraints.partitioned.ConstrainedSystem` (``correction``, ``beta``).
     """
     B = A + 1.5 * H
     tree = System(

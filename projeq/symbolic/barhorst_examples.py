@@ -22,6 +22,7 @@ import numpy as np
 import sympy as sp
 from sympy.physics.mechanics import dynamicsymbols
 
+from .algebra import rotation_x, rotation_y, rotation_z
 from .lagrange import MultiplierSystem, multiplier_system
 from .projection import Body, t
 
@@ -129,13 +130,6 @@ class Example:
         return velocity, position
 
 
-def _rot(axis: int, angle) -> sp.Matrix:
-    """Active rotation about coordinate axis 0, 1, 2 (x, y, z): the frame turned by ``angle``."""
-    c, s = sp.cos(angle), sp.sin(angle)
-    return [sp.Matrix([[1, 0, 0], [0, c, -s], [0, s, c]]), sp.Matrix([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
-            sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])][axis]
-
-
 m, g = sp.symbols("m g", positive=True)
 
 
@@ -173,8 +167,8 @@ def rolling_disk(m_disk: float = 0.030, radius: float = 0.015, m_ecc: float = 0.
     q = sp.symbols("q1:6")
     q_dot = sp.symbols("q1_dot q2_dot q3_dot q4_dot q5_dot")
     q1, q2, q3, q4, q5 = q
-    B = _rot(2, q1) * _rot(0, q2)
-    C = B * _rot(1, q3)
+    B = rotation_z(q1) * rotation_x(q2)
+    C = B * rotation_y(q3)
     r_G = sp.Matrix([q4, q5, 0]) + R_disk * B[:, 2]
     r_s = r_G + C * sp.Matrix([ecc_h, ecc_e, ecc_r])
     omega_C = disk_speeds(q, q_dot)[:3, :]
@@ -219,11 +213,11 @@ def quick_return(torques: bool = False) -> Example:
     q_dot = sp.symbols("q1_dot q2_dot q3_dot")
     q1, q2, q3 = q
     B_len = A_len + sp.Rational(3, 2) * H_len
-    crank = PoseBody(m_a, H_len / 2 * sp.Matrix([sp.cos(q1), sp.sin(q1), 0]), _rot(2, q1),
+    crank = PoseBody(m_a, H_len / 2 * sp.Matrix([sp.cos(q1), sp.sin(q1), 0]), rotation_z(q1),
                      sp.diag(0, 0, m_a * H_len**2 / 12), M=sp.Matrix([0, 0, T_m if torques else 0]),
                      omega=sp.Matrix([0, 0, q_dot[0]]))
     follower = PoseBody(m_b, sp.Matrix([A_len, 0, 0]) + B_len / 2 * sp.Matrix([sp.cos(q2), sp.sin(q2), 0]),
-                        _rot(2, q2), sp.diag(0, 0, m_b * B_len**2 / 12), M=sp.Matrix([0, 0, T_d if torques else 0]),
+                        rotation_z(q2), sp.diag(0, 0, m_b * B_len**2 / 12), M=sp.Matrix([0, 0, T_d if torques else 0]),
                         omega=sp.Matrix([0, 0, q_dot[1]]))
     phi = sp.Matrix([A_len - H_len * sp.cos(q1) + q3 * sp.cos(q2), q3 * sp.sin(q2) - H_len * sp.sin(q1)])
     values = {A_len: 1.0, H_len: 1.0 / 3.0, m_a: 0.5, m_b: 1.0, g: 9.81, **({T_m: 0.0, T_d: 0.0} if torques else {})}

@@ -23,7 +23,7 @@ from strategies import random_state, trees
 
 import projeq as pq
 from projeq.assembly import EVALUATORS
-from projeq.kinematics import forward, gauss_terms
+from projeq.assembly.kinematics import forward, gauss_terms
 
 any_plane = st.booleans()
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import projeq as pq
-from projeq.kinematics import forward
+from projeq.assembly.kinematics import forward
 from projeq.subsystems.rigid import rigid_h, rigid_mass_matrix
 
 

@@ -21,7 +21,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from strategies import trees
 
-from projeq.kinematics import forward
+from projeq.assembly.kinematics import forward
 
 BACKWARD = 1e-14  # assumed backward error of either evaluator (module docstring)
 RELATIVE = 1e-10  # the agreement asked for when M is well conditioned

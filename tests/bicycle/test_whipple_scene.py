@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import projeq as pq
-from projeq.constrained import POSITION_TOLERANCE
+from projeq.constraints.partitioned import POSITION_TOLERANCE
 from projeq.scenes.bicycle import BENCHMARK, Contacts, bicycle_parameters, upright_pitch, whipple_bicycle
 from projeq.spatial import rotation
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 import projeq as pq
-from projeq.constrained import ConstrainedSystem
-from projeq.cut_joints import PinClosure
-from projeq.reaction_forces import contact_event, joint_reactions, reactions
+from projeq.constraints.partitioned import ConstrainedSystem
+from projeq.constraints.cut_joints import PinClosure
+from projeq.constraints.reactions import contact_event, joint_reactions, reactions
 from projeq.scenes.mechanisms import four_bar, slider_pendulum
 
 

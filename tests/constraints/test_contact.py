@@ -3,7 +3,7 @@
 import numpy as np
 
 import projeq as pq
-from projeq.reaction_forces import contact_event, reactions
+from projeq.constraints.reactions import contact_event, reactions
 from projeq.scenes.mechanisms import bar_on_wall, sphere_on_sphere
 
 RTOL, ATOL = 1e-9, 1e-11

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 import projeq as pq
-from projeq.constrained import ConstrainedSystem
-from projeq.cut_joints import PinClosure
-from projeq.kinematics import forward
-from projeq.reaction_forces import joint_reactions
+from projeq.constraints.partitioned import ConstrainedSystem
+from projeq.constraints.cut_joints import PinClosure
+from projeq.assembly.kinematics import forward
+from projeq.constraints.reactions import joint_reactions
 from projeq.scenes.mechanisms import four_bar
 
 M_ROD, L_ROD, G = 1.3, 0.9, 9.81

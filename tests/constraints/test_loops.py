@@ -5,8 +5,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import projeq as pq
-from projeq.constrained import POSITION_TOLERANCE, ConstrainedSystem
-from projeq.reaction_forces import reactions
+from projeq.constraints.partitioned import POSITION_TOLERANCE, ConstrainedSystem
+from projeq.constraints.reactions import reactions
 from projeq.scenes.mechanisms import four_bar, four_bar_angles, quick_return, slider_pendulum
 
 RTOL, ATOL = 1e-9, 1e-11
@@ -98,7 +98,7 @@ def test_pendulum_rod_tension_from_the_joint_reaction():
     rod along −z of the rod frame): the force the pivot exerts along the rod, W_z in the
     rod's axes, equals m (g cos θ + l θ̇²); the moment about the joint axis, F_nᵀ W_n, is
     zero (a free joint carries no torque about its axis)."""
-    from projeq.reaction_forces import joint_reactions
+    from projeq.constraints.reactions import joint_reactions
 
     l, m, g = 1.2, 0.7, 9.81
     tree = pq.System({"bob": pq.PointMass(m, r_c=(0, 0, -l))}, {"bob": pq.Revolute(axis="y")},
@@ -115,8 +115,8 @@ def test_joint_reactions_have_no_part_along_the_free_directions(planar):
     """The Projection Equation itself: projected on the joints' free directions the
     transmitted wrenches vanish, F_nᵀ W_n = 0 for every joint (no joint forces), for a
     3-link chain (spatial and planar bodies) in a moving state."""
-    from projeq.kinematics import forward
-    from projeq.reaction_forces import joint_reactions
+    from projeq.assembly.kinematics import forward
+    from projeq.constraints.reactions import joint_reactions
 
     system = pq.scenes.chain(3, planar=planar)
     q, s_dot = np.array([0.4, -0.7, 1.1]), np.array([1.5, -0.5, 2.0])

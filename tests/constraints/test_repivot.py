@@ -10,8 +10,8 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import projeq as pq
-from projeq.constrained import POSITION_TOLERANCE, ConstrainedSystem
-from projeq.reaction_forces import reactions
+from projeq.constraints.partitioned import POSITION_TOLERANCE, ConstrainedSystem
+from projeq.constraints.reactions import reactions
 from projeq.scenes.mechanisms import four_bar
 
 from .test_loops import _four_bar_reference
@@ -95,7 +95,7 @@ def test_partitions_are_saved(run, tmp_path):
 
 def test_energy_projection_follows_the_new_partition():
     """With ``method="RK45-projected"`` each step is projected onto the initial energy
-    (projeq.integrators); after a switch the projection must read ṡ in the new partition.
+    (projeq.simulation.integrators); after a switch the projection must read ṡ in the new partition.
     A point mass on x, z sliders kept on the unit circle, started at (0.6, −0.8) with ẋ = 4
     (speed 5, enough to pass the horizontal x = 1 where ẋ degenerates): the partition
     switches from ẋ to ż and the energy stays at the projection's round-off across it

@@ -13,7 +13,7 @@ import pytest
 import sympy as sp
 
 import projeq as pq
-from projeq.constraints import check_configuration, initial_speeds
+from projeq.constraints.nonholonomic import check_configuration, initial_speeds
 
 x, y, k, u = sp.symbols("x y k u")
 
@@ -58,6 +58,18 @@ def test_singular_K_of_barhorsts_euler_angles():
     with pytest.raises(ValueError, match=r"K\(q\) .*'disk' at q = \[0.0, -1.570796"):
         check_configuration(system, [0.0, -np.pi / 2, 0.0, 0.0, 0.0])
     check_configuration(system, [0.0, 1.5, 0.0, 0.0, 0.0])  # 86°: regular
+
+
+@pytest.mark.parametrize("inertia, match", [
+    ("ring", r"^inertia: expected 'disk', 'hoop' or a pair \(I, J\)"),
+    ((1e-6,), r"^inertia: expected 'disk', 'hoop' or a pair \(I, J\)"),
+    ((0.0, 1e-6), r"^inertia: I and J must be positive"),
+    ((1e-6, 3e-6), r"^inertia: J = 3e-06 exceeds 2 I = 2e-06"),
+])
+def test_rolling_disk_inertia_is_checked(inertia, match):
+    """The disk's moments: a known shape name or (I, J) with 0 < J ≤ 2 I (triangle inequality)."""
+    with pytest.raises(ValueError, match=match):
+        pq.scenes.rolling_disk(inertia=inertia)
 
 
 def test_singular_F_of_the_knife_edge_disc_at_flat_tilt():

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import projeq as pq
-from projeq.kinematics import forward
+from projeq.assembly.kinematics import forward
 from projeq.scenes import knife_edge_circle, knife_edge_disc
 
 RNG_SEED = 11

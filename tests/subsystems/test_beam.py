@@ -6,10 +6,10 @@ from scipy.linalg import eigh
 from scipy.optimize import brentq
 
 import projeq as pq
-from projeq.linearization import linearize
+from projeq.analysis.linearize import linearize
 from projeq.scenes.elastic import elastic_arm, spin_up_beam
 from projeq.subsystems import RitzBeam
-from projeq.subsystems.shapes import clamped_free_roots
+from projeq.subsystems.beam.shapes import clamped_free_roots
 
 L, EI, RHO_A = 10.0, 1.4e4, 1.2
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import projeq as pq
-from projeq.linearization import linearize
+from projeq.analysis.linearize import linearize
 from projeq.scenes.elastic import spin_up_beam
 from projeq.subsystems import RitzBeam
 

@@ -1,5 +1,5 @@
-"""Precomputed shape integrals (projeq/subsystems/beam_integrals.py) against the quadrature
-mode (projeq/subsystems/beam.py): a second evaluation of the same integrals of B(25), one
+"""Precomputed shape integrals (projeq/subsystems/beam/integrals.py) against the quadrature
+mode (projeq/subsystems/beam/beam.py): a second evaluation of the same integrals of B(25), one
 per call at the stations, one from moments computed once. The model is polynomial in q_e,
 so the two must agree to round-off at any deformation, not only to first order."""
 

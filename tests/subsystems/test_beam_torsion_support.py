@@ -6,10 +6,10 @@ import pytest
 from scipy.linalg import eigh
 
 import projeq as pq
-from projeq.linearization import linearize
+from projeq.analysis.linearize import linearize
 from projeq.scenes.elastic import spin_up_beam
 from projeq.subsystems import RitzBeam
-from projeq.subsystems.shapes import pinned_free_roots
+from projeq.subsystems.beam.shapes import pinned_free_roots
 
 L, EI, RHO_A, GI_T, RHO_I_P = 10.0, 1.4e4, 1.2, 3.0e3, 0.02
 

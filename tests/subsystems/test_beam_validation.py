@@ -10,7 +10,7 @@ from scipy.linalg import eigh
 from scipy.optimize import brentq
 from scipy.special import iv, jv
 
-from projeq.linearization import linearize
+from projeq.analysis.linearize import linearize
 from projeq.scenes.elastic import spinning_beam
 from projeq.subsystems import RitzBeam
 

@@ -1,14 +1,12 @@
-"""Barhorst's formulation study (A. A. Barhorst, "Generalized momenta in constrained non-holonomic systems —
-another perspective on the canonical equations of motion", §2–3): general speeds u = Y q̇ + Z (eqs. 8–11, 93),
-the energy-conservation condition (eq. 38/55), Hamilton's canonical equations with multipliers integrated as a
-DAE, and ``compare`` on his three examples with the projective (Kane) form as the reference formulation."""
+"""Barhorst's formulation study, its symbolic part (A. A. Barhorst, "Generalized momenta in constrained non-holonomic systems — another perspective on the
+canonical equations of motion", §2–3): general
+speeds u = Y q̇ + Z (eqs. 8–11, 93), the energy-conservation condition (eq. 38/55) on his three examples, and
+Hamilton's canonical equations with multipliers integrated as a DAE."""
 
 import numpy as np
 import pytest
 import sympy as sp
 
-from projeq.comparison import compare
-from projeq.integrators import radau_dae
 from projeq.symbolic import energy_rate, lagrangian_canonical, projective_canonical, t
 from projeq.symbolic import barhorst_examples as bx
 
@@ -105,37 +103,6 @@ def test_eq_38_rolling_disk_with_and_without_drag(disk_forms):
         assert np.isclose(f(q, u, 2e-6), -2e-6 * np.sum(np.abs(u) ** 3), rtol=1e-9)
 
 
-def test_radau_dae_index_2_and_3_pendulum():
-    """Radau IIA on a pendulum in Cartesian coordinates (x, y, u, v, λ) as an index-3 (x² + y² = 1) and an
-    index-2 (x u + y v = 0) DAE against the angle ODE θ̈ = −g sin θ (DOP853, rtol 1e-12): x agrees to 1e-7
-    after 3 s and the energy drifts < 1e-8 (measured 2e-10 and 8e-10 at rtol 1e-8)."""
-    from scipy.integrate import solve_ivp
-
-    g, theta0 = 9.81, 0.5
-    reference = solve_ivp(lambda _, z: [z[1], -g * np.sin(z[0])], (0, 3), [theta0, 0], rtol=1e-12, atol=1e-12)
-
-    def f(_, z, position):
-        x, y, u, v, lam = z
-        return [u, v, -x * lam, -y * lam - g, x * x + y * y - 1 if position else x * u + y * v]
-
-    z0 = [np.sin(theta0), -np.cos(theta0), 0, 0, g * np.cos(theta0)]
-    for position, index in ((True, [1, 1, 2, 2, 3]), (False, [1, 1, 2, 2, 2])):
-        sol = radau_dae(lambda s, z: f(s, z, position), (0, 3), z0, mass=[1, 1, 1, 1, 0], index=index,
-                        rtol=1e-8, atol=1e-10)
-        assert sol.success
-        x, y, u, v, _ = sol.y
-        assert abs(x[-1] - np.sin(reference.y[0, -1])) < 1e-7
-        energy = 0.5 * (u * u + v * v) + g * y
-        assert np.abs(energy - energy[0]).max() < 1e-8
-
-
-def test_radau_dae_bad_input():
-    with pytest.raises(ValueError, match="mass, index: expected 2 values"):
-        radau_dae(lambda s, y: y, (0, 1), [1.0, 2.0], mass=[1.0])
-    with pytest.raises(ValueError, match="t_span: expected t_end > t0"):
-        radau_dae(lambda s, y: y, (1, 0), [1.0])
-
-
 def test_hamilton_dae_particle_follows_the_integral_curve():
     """§3.1 as Barhorst's eq. 69, a DAE in (x, y, p1, p2, λ) integrated without index reduction, from (2, 2) at
     rest: the constraint integrates to y = 1/(2.5 − x) (his footnote 6), which the motion follows to 1e-8 over
@@ -149,45 +116,3 @@ def test_hamilton_dae_particle_follows_the_integral_curve():
     assert np.abs(energy - 20).max() < 1e-8
     with pytest.raises(ValueError, match="phi: expected 1 position constraints"):
         ms.hamilton_dae(phi=[ms.q[0], ms.q[1]])
-
-
-def _rows(table):
-    return {row["formulation"]: row for row in table.rows}
-
-
-def test_compare_barhorst_particle_four_formulations_agree():
-    """compare("barhorst_particle"): his four formulations, the Hamilton row a DAE; over 2 s all follow the
-    projective (Kane) reference to 1e-6 (measured ≤ 3e-9), conserve E to 1e-7 (measured ≤ 2e-8), and his
-    reported numbers stand beside projeq's."""
-    rows = _rows(compare("barhorst_particle", t_end=2.0))
-    assert len(rows) == 4
-    reference = rows["projective (Kane), u = ẏ"]
-    assert reference["identical"] == "reference" and reference["time / baseline"] > 0
-    for name, row in rows.items():
-        if row is not reference:
-            assert row["identical"] == "yes", row["check"]
-            assert float(row["check"].split()[-1]) < 1e-6
-        assert row["energy_drift"] < 1e-7
-        assert row["Barhorst (paper) time"]
-    hamilton = rows["hamilton + multipliers (DAE)"]
-    assert hamilton["time / baseline"] == 1.0 and "index 2" in hamilton["note"]
-    assert 0 < hamilton["constraint_drift"] < 1e-7  # a DAE keeps A q̇ = 0 only to its tolerance
-
-
-def test_compare_rolling_disk_and_quick_return():
-    """compare("rolling_disk") with his four formulations and the Hamilton DAE (0.1 s: the equations agree to
-    1e-6, measured ≤ 1e-8, energy to 1e-7), and compare("quick_return") with three formulations — the Hamilton
-    row is not available (massless slider: no Legendre transform) — whose loop residuals |Φ| stay < 1e-7
-    (measured 2e-9 over 1 s)."""
-    disk = _rows(compare("rolling_disk", t_end=0.1))
-    assert len(disk) == 5
-    for row in disk.values():
-        assert row["identical"] in ("reference", "yes"), row["check"]
-        assert row["energy_drift"] < 1e-7
-    assert disk["lagrangian canonical, eq. 93 speeds"]["Barhorst (paper) time"].startswith("0.19")
-    quick = _rows(compare("quick_return", t_end=1.0))
-    assert quick["hamilton + multipliers (DAE)"]["identical"] == "not available"
-    for name in ("projective (Kane), u = q̇1", "projective canonical, u = q̇1", "lagrangian canonical, u = q̇1"):
-        assert quick[name]["identical"] in ("reference", "yes")
-        assert quick[name]["constraint_drift"] < 1e-7
-        assert quick[name]["energy_drift"] < 1e-7

@@ -7,7 +7,7 @@ import pytest
 import sympy as sp
 
 from projeq.scenes.nonholonomic import barhorst_particle
-from projeq.simulation import simulate
+from projeq.simulation.driver import simulate
 from projeq.symbolic.canonical import lagrangian_canonical, projective_canonical
 from projeq.symbolic.formulation_examples import lecture_disc, particle, projective_disc
 from projeq.symbolic.projection import Body, t

@@ -9,7 +9,7 @@ import sympy as sp
 from sympy.physics.mechanics import dynamicsymbols
 
 from projeq.scenes.nonholonomic import barhorst_particle, knife_edge_disc
-from projeq.simulation import simulate
+from projeq.simulation.driver import simulate
 from projeq.symbolic.formulation_examples import I, J, g, lecture_disc, lecture_disc_state, m, particle, r
 from projeq.symbolic.lagrange import multiplier_system
 from projeq.symbolic.projection import t

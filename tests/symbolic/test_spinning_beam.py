@@ -10,8 +10,8 @@ import sympy as sp
 
 from projeq.joints import Prescribed, Revolute
 from projeq.scenes.elastic import spin_up_motion, spinning_beam
-from projeq.simulation import simulate
-from projeq.subsystems.beam import RitzBeam
+from projeq.simulation.driver import simulate
+from projeq.subsystems.beam.beam import RitzBeam
 from projeq.symbolic import spinning_beam as sb
 from projeq.system import System
 

@@ -1,0 +1,1 @@
+"""Analysis of a model: linearisation about equilibria and steady motions, eigenvalues."""

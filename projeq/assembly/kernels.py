@@ -1,0 +1,221 @@
+"""The loops of the fast evaluator on flat arrays: THEORY §4 (kinematics) and §6 (passes).
+
+Plain Python on scalars and small arrays, written so that numba can compile it
+(:func:`kernel` applies ``numba.njit(cache=True)`` when numba is installed); the same
+source runs interpreted as the fallback, so both are the same algorithm.
+
+Joint kinds: ``FIXED`` (no dof), ``REVOLUTE`` (F⁶ = [0; e]), ``PRISMATIC`` (F⁶ = [e; 0]),
+about a unit axis e in joint-frame coordinates; subsystems: rigid bodies (M_n = M6,
+h_n of THEORY §3). Twists are (v_O, ω) in body coordinates; index −1 is the ground.
+
+Compiled twins. numba compiles scalar loops, not the array functions of
+:mod:`projeq.spatial`, so four formulas have a second, scalar form here and only here:
+:func:`_relative_rotation` (Rodrigues, :func:`projeq.spatial.rodrigues`), :func:`_chain_matrix`
+(:func:`projeq.spatial.chain_matrix`), :func:`_cross3` (:func:`projeq.spatial.cross`) and
+:func:`_rigid_h` (:func:`projeq.subsystems.rigid.rigid_h`); tests/assembly/test_fast.py
+checks each against its twin.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
+
+
+def _numba():
+    try:
+        import numba
+    except ImportError:
+        return None
+    return numba
+
+
+def chain_terms(kind, parent, axis, orientation, offset, q_index, m, r_c, I_c, gravity, q, s_dot,
+                T, zeta, f, h):
+    """T_np, ζ_n, F_n (as a 6-vector f_n) and h_n = Q_n − G_n ẏ_n of every body (THEORY §3–4).
+
+    A_pn = A_pJ A_Jn, r_pn = r_pJ + A_pJ r_Jn, T_np = [[A_np, −A_np r̃_pn], [0, A_np]],
+    u = T_np ẏ_p, w = f_n ṡ_n, ẏ_n = u + w, ζ_n = u × w (motion cross product).
+    Scalar loops only (no temporaries per body), which is what numba compiles best.
+    """
+    N = kind.shape[0]
+    twist = np.zeros((N + 1, 6))  # row N: the ground, at rest
+    g_body = np.zeros((N + 1, 3))
+    g_body[N] = gravity
+    A_rel, A_np, r, u, w = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty(6), np.empty(6)
+    for n in range(N):
+        e, k, p = axis[n], kind[n], parent[n] if parent[n] >= 0 else N
+        x = q[q_index[n]] if k != FIXED else 0.0
+        _relative_rotation(k, e, x, A_rel)
+        for a in range(3):  # A_np = (A_pJ A_Jn)ᵀ, r_pn = r_pJ + A_pJ e x
+            r[a] = offset[n, a]
+            for b in range(3):
+                A_np[b, a] = orientation[n, a, 0] * A_rel[0, b] + orientation[n, a, 1] * A_rel[1, b] + orientation[n, a, 2] * A_rel[2, b]
+                if k == PRISMATIC:
+                    r[a] += orientation[n, a, b] * e[b] * x
+        v_p, w_p = twist[p, :3] + _cross3(twist[p, 3:], r), twist[p, 3:]
+        for a in range(3):  # u = T_np ẏ_p, g_n = A_np g_p
+            u[a] = A_np[a, 0] * v_p[0] + A_np[a, 1] * v_p[1] + A_np[a, 2] * v_p[2]
+            u[a + 3] = A_np[a, 0] * w_p[0] + A_np[a, 1] * w_p[1] + A_np[a, 2] * w_p[2]
+            g_body[n, a] = A_np[a, 0] * g_body[p, 0] + A_np[a, 1] * g_body[p, 1] + A_np[a, 2] * g_body[p, 2]
+        f[n] = 0.0
+        if k == REVOLUTE:
+            f[n, 3:] = e
+        elif k == PRISMATIC:
+            f[n, :3] = e
+        sd = s_dot[q_index[n]] if k != FIXED else 0.0
+        for a in range(6):
+            w[a] = f[n, a] * sd
+            twist[n, a] = u[a] + w[a]
+        zeta[n, :3] = _cross3(u[3:], w[:3]) + _cross3(u[:3], w[3:])
+        zeta[n, 3:] = _cross3(u[3:], w[3:])
+        _chain_matrix(A_np, r, T[n])
+        _rigid_h(m[n], r_c[n], I_c[n], twist[n], g_body[n], h[n])
+
+
+def _relative_rotation(kind, e, x, A):
+    """A_Jn: cos θ E + sin θ ẽ + (1 − cos θ) e eᵀ for a revolute joint, else E (Rodrigues'
+    E + sin θ ẽ + (1 − cos θ) ẽ² with ẽ² = e eᵀ − E; compiled twin of :func:`projeq.spatial.rodrigues`)."""
+    c, s = (np.cos(x), np.sin(x)) if kind == REVOLUTE else (1.0, 0.0)
+    for a in range(3):
+        for b in range(3):
+            A[a, b] = (1.0 - c) * e[a] * e[b] + (c if a == b else 0.0)
+    A[0, 1] -= s * e[2]
+    A[1, 0] += s * e[2]
+    A[0, 2] += s * e[1]
+    A[2, 0] -= s * e[1]
+    A[1, 2] -= s * e[0]
+    A[2, 1] += s * e[0]
+
+
+def _chain_matrix(A_np, r, T):
+    """T = [[A_np, −A_np r̃], [0, A_np]] written into T (the columns of −A_np r̃ are A_np (e_j × r));
+    compiled twin of :func:`projeq.spatial.chain_matrix`."""
+    T[:, :] = 0.0
+    for a in range(3):
+        for b in range(3):
+            T[a, b] = T[a + 3, b + 3] = A_np[a, b]
+        T[a, 3] = A_np[a, 2] * r[1] - A_np[a, 1] * r[2]  # −A r̃ e_x = A (e_x × r)
+        T[a, 4] = A_np[a, 0] * r[2] - A_np[a, 2] * r[0]
+        T[a, 5] = A_np[a, 1] * r[0] - A_np[a, 0] * r[1]
+
+
+def _cross3(a, b):
+    """a × b of two 3-vectors (compiled twin of :func:`projeq.spatial.cross`)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def _rigid_h(m, r_c, I_c, twist, g_body, out):
+    """h = [m g − ω̃ p ; r̃_c (m g − ω̃ p) − ω̃ I_c ω], p = m (v + ω × r_c) (THEORY §3), written
+    into ``out``; compiled twin of :func:`projeq.subsystems.rigid.rigid_h`."""
+    omega = twist[3:]
+    p_c = m * (twist[:3] + _cross3(omega, r_c))
+    force = m * g_body - _cross3(omega, p_c)
+    L_c = np.array([I_c[a, 0] * omega[0] + I_c[a, 1] * omega[1] + I_c[a, 2] * omega[2] for a in range(3)])
+    out[:3] = force
+    out[3:] = _cross3(r_c, force) - _cross3(omega, L_c)
+
+
+def passes(kind, parent, q_index, T, zeta, f, M_hat, h_hat, pivot_min, s_ddot):
+    """Backward and forward pass of THEORY §6 for one-dof and fixed joints; writes s̈.
+
+    Backward: U = M̂_n f_n, D_n = f_nᵀ U, M̄_n = M̂_n − U Uᵀ / D_n,
+    h̄_n = c − U (f_nᵀ c) / D_n with c = ĥ_n − M̂_n ζ_n; M̂_p += T_npᵀ M̄_n T_np, ĥ_p += T_npᵀ h̄_n.
+    Forward: a = T_np ÿ_p + ζ_n, s̈_n = (f_nᵀ ĥ_n − Uᵀ a) / D_n, ÿ_n = a + f_n s̈_n.
+    ``M_hat`` and ``h_hat`` enter as M_n and h_n and are overwritten. Returns −1, or the
+    index of the first body whose pivot D_n is not above ``pivot_min``.
+    """
+    N = kind.shape[0]
+    U, D, f_h = np.zeros((N, 6)), np.ones(N), np.zeros(N)
+    c, MT = np.empty(6), np.empty((6, 6))
+    for n in range(N - 1, -1, -1):  # backward: leaves → root
+        M = M_hat[n]
+        for a in range(6):
+            c[a] = h_hat[n, a] - _dot6(M[a], zeta[n])
+        if kind[n] != FIXED:
+            for a in range(6):
+                U[n, a] = _dot6(M[a], f[n])
+            D[n] = _dot6(f[n], U[n])
+            if not D[n] > pivot_min:
+                return n
+            f_h[n] = _dot6(f[n], h_hat[n])
+            f_c = _dot6(f[n], c) / D[n]
+            for a in range(6):
+                c[a] -= U[n, a] * f_c
+                for b in range(6):
+                    M[a, b] -= U[n, a] * U[n, b] / D[n]
+        p = parent[n]
+        if p >= 0:
+            _add_congruence(T[n], M, c, MT, M_hat[p], h_hat[p])
+    y_ddot = np.zeros((N, 6))
+    for n in range(N):  # forward: root → leaves
+        p = parent[n]
+        a = y_ddot[n]
+        for i in range(6):
+            a[i] = zeta[n, i] + (_dot6(T[n, i], y_ddot[p]) if p >= 0 else 0.0)
+        if kind[n] != FIXED:
+            x = (f_h[n] - _dot6(U[n], a)) / D[n]
+            s_ddot[q_index[n]] = x
+            for i in range(6):
+                a[i] += f[n, i] * x
+    return -1
+
+
+def _dot6(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
+
+
+def _add_congruence(T, M, c, MT, M_p, h_p):
+    """M_p += Tᵀ M T and h_p += Tᵀ c (T's lower-left block is zero)."""
+    for a in range(6):
+        for b in range(6):
+            MT[a, b] = M[a, 0] * T[0, b] + M[a, 1] * T[1, b] + M[a, 2] * T[2, b] + (
+                M[a, 3] * T[3, b] + M[a, 4] * T[4, b] + M[a, 5] * T[5, b])
+    for a in range(6):
+        rows = 3 if a < 3 else 6  # column a < 3 of T is zero below row 3
+        for b in range(6):
+            total = 0.0
+            for i in range(rows):
+                total += T[i, a] * MT[i, b]
+            M_p[a, b] += total
+        total = 0.0
+        for i in range(6):
+            total += T[i, a] * c[i]
+        h_p[a] += total
+
+
+def missing_compiler(compiled: bool | None) -> str | None:
+    """Why the default kernel choice (``compiled=None``) falls back to the general path:
+    numba is missing and the interpreted kernel was not asked for; else None."""
+    if compiled is None and _numba() is None and os.environ.get("PROJEQ_FAST_KERNEL", "") != "python":
+        return "numba is not installed (pip install 'projeq[fast]'): the recursive evaluator is used"
+    return None
+
+
+def kernel(compiled: bool | None = None):
+    """(chain_terms, passes), compiled by numba when ``compiled`` is true, or when it is
+    None, numba is installed and the environment variable ``PROJEQ_FAST_KERNEL`` is not
+    ``"python"``. Returns the functions and whether they are compiled."""
+    if compiled is None:
+        compiled = os.environ.get("PROJEQ_FAST_KERNEL", "") != "python" and _numba() is not None
+    if not compiled:
+        return chain_terms, passes, False
+    numba = _numba()
+    if numba is None:
+        raise ValueError("compiled: numba is not installed (pip install 'projeq[fast]')")
+    if "compiled" not in _CACHE:
+        global _relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _add_congruence
+        # callees of compiled code (still plain Python when called from Python)
+        _relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _add_congruence = (
+            numba.extending.register_jitable(g)
+            for g in (_relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _add_congruence)
+        )
+        jit = numba.njit(cache=True)
+        _CACHE["compiled"] = (jit(chain_terms), jit(passes))
+    return (*_CACHE["compiled"], True)
+
+
+_CACHE: dict = {}

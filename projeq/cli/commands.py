@@ -1,0 +1,65 @@
+"""The ``projeq`` command: one parser for every subcommand and one exit-code convention.
+
+Each subcommand lives in a module of :mod:`projeq.cli` that adds its arguments to its
+parser and names the function that runs it (``parser.set_defaults(execute=...)``); the
+functions call the library and hold no logic of their own. Exit codes, for every
+subcommand alike:
+
+- 0: success;
+- 2: bad arguments — refused by argparse, or a ValueError (the library's way of refusing an
+  input, naming it: a scene, a parameter, a value, ``--out``) — nothing is run;
+- 1: a failed or interrupted run (a RuntimeError such as a failed simulation, Ctrl-C, or a
+  command's own report of failed points, settings or benchmarks); what was computed is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from projeq.cli import bench, run, studies, sweep
+
+OK, FAILED, BAD_ARGUMENTS = 0, 1, 2
+
+#: name → (function adding the subcommand's arguments, one-line help)
+COMMANDS = {
+    "list": (run.list_arguments, "list the scenes, or one scene's parameters"),
+    "run": (run.run_arguments, "simulate a scene and write the results"),
+    "sweep": (sweep.sweep_arguments, "simulate a scene on a parameter grid, in parallel"),
+    "compare": (studies.compare_arguments, "compare derivations of one system (Projection Equation, Lagrange, Kane ...)"),
+    "bench": (bench.bench_arguments, "run the performance benchmarks"),
+    "tradeoff": (studies.tradeoff_arguments, "work-precision trade-off of integrators for a scene"),
+}
+
+
+def parser() -> argparse.ArgumentParser:
+    """The parser of ``projeq`` with every subcommand."""
+    from projeq import __version__
+
+    top = argparse.ArgumentParser(prog="projeq", description="Multibody dynamics by Bremer's Projection Equation.")
+    top.add_argument("--version", action="version", version=f"projeq {__version__}")
+    sub = top.add_subparsers(dest="command", required=True)
+    for name, (arguments, text) in COMMANDS.items():
+        arguments(sub.add_parser(name, help=text, description=text))
+    return top
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``projeq`` command (and ``python -m projeq``): runs one subcommand
+    and returns its exit code (module docstring); never raises SystemExit."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        args = parser().parse_args(argv)
+    except SystemExit as exit_:  # --help (0) or a usage error (2), printed by argparse
+        return OK if exit_.code is None else int(exit_.code)
+    try:
+        return int(args.execute(args) or OK)
+    except ValueError as exc:
+        print(f"projeq {args.command}: {exc}", file=sys.stderr)
+        return BAD_ARGUMENTS
+    except RuntimeError as exc:
+        print(f"projeq {args.command}: {exc}", file=sys.stderr)
+        return FAILED
+    except KeyboardInterrupt:
+        print(f"projeq {args.command}: interrupted", file=sys.stderr)
+        return FAILED

@@ -1,0 +1,7 @@
+"""Constraints (THEORY §7): closed loops and Pfaffian constraints given as equations on a tree.
+
+- :mod:`.partitioned`: :class:`ConstrainedSystem`, the partitioned model with minimal velocities;
+- :mod:`.cut_joints`: cut joints of closed loops (:class:`PinClosure`);
+- :mod:`.reactions`: reaction forces and the contact event;
+- :mod:`.nonholonomic`: checks of non-holonomic quasi-velocities (singular K, constraint drift).
+"""

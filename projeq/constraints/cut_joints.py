@@ -1,0 +1,84 @@
+"""Cut joints of closed loops: a point of one body held on a point of another (THEORY §7).
+
+A loop is cut open at a joint that pins point P_a of subsystem a to point P_b of subsystem
+b (or of the ground): a revolute joint of a planar loop, a spherical joint in space. Its
+closure, given to :class:`~projeq.constraints.partitioned.ConstrainedSystem` as ``phi``, is
+
+    Φ(q) = (r_a + R_a ρ_a − r_b − R_b ρ_b)[axes]
+
+(r_n, R_n: origin O_n and orientation of frame n; ρ: the point in body axes). With the
+constraint inserted before the projection, M s̈_tree + b = A_sᵀ λ = (J_a − J_b)ᵀ λ, where
+J is the Jacobian of the point's inertial velocity by ṡ_tree: the multipliers λ are the
+joint's force on a at P_a (and −λ on b at P_b), in inertial axes, one per row of ``axes``.
+In the coordinates ẏ_n of a rigid subsystem (velocity of O_n and angular velocity, body
+axes, selected by S_n) a force f at ρ is the wrench w_n = S_n (R_nᵀ f; ρ × R_nᵀ f), so that
+w_nᵀ ẏ_n is its power.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.checks import finite_array
+from projeq.assembly.kinematics import forward
+from projeq.spatial import cross
+
+_AXES = "xyz"
+
+
+class PinClosure:
+    """Φ(q, t) of a cut joint that keeps point ``rho_a`` of subsystem ``a`` on point
+    ``rho_b`` of subsystem ``b`` (``b=None``: the inertial point ``rho_b``), along ``axes``.
+
+    Examples
+    --------
+    A rod on x and y sliders pinned at its end to the origin is a physical pendulum:
+
+    >>> import numpy as np, projeq as pq
+    >>> from projeq.constraints.partitioned import ConstrainedSystem
+    >>> tree = pq.System({"x": pq.Frame(), "y": pq.Frame(), "rod": pq.PlanarBody(1.0, (0.5, 0, 0), 1 / 12)},
+    ...     {"x": pq.Prismatic(axis="x"), "y": pq.Prismatic(parent="x", axis="y"),
+    ...      "rod": pq.Revolute(parent="y", axis="z")}, gravity=(0, -9.81, 0))
+    >>> pin = PinClosure(tree, "rod", (0, 0, 0), None, (0, 0, 0), axes="xy")
+    >>> pin([0.0, 0.0, -np.pi / 2]).tolist()
+    [0.0, 0.0]
+    >>> ConstrainedSystem(tree, phi=pin, q0=[0.0, 0.0, -np.pi / 2]).independent.tolist()
+    [2]
+    """
+
+    def __init__(self, tree, a: str, rho_a, b: str | None, rho_b, axes: str = "xyz"):
+        self.tree = tree
+        self.a, self.b = tree.index(a), None if b is None else tree.index(b)
+        if self.a == self.b:
+            raise ValueError(f"b: the cut joint must join two subsystems, got a = b = {a!r}")
+        for name, n in (("a", self.a), ("b", self.b)):
+            if n is not None and tree.e_s_slice[n].stop > tree.e_s_slice[n].start:
+                raise ValueError(f"{name}: a cut joint needs a rigid subsystem, {tree.names[n]!r} deforms")
+        self.rho_a, self.rho_b = finite_array("rho_a", rho_a, (3,)), finite_array("rho_b", rho_b, (3,))
+        if not axes or len(set(axes)) != len(axes) or set(axes) - set(_AXES):
+            raise ValueError(f"axes: expected distinct letters of 'xyz' (the inertial directions held), got {axes!r}")
+        self.rows = [_AXES.index(axis) for axis in axes]
+        self.names = (tree.names[self.a], None if b is None else tree.names[self.b])
+
+    def _point(self, kin, n, rho) -> NDArray:
+        return rho if n is None else kin.r[n] + kin.R[n] @ rho
+
+    def __call__(self, q, t: float = 0.0) -> NDArray:
+        """Φ = (P_a − P_b)[axes] in inertial coordinates."""
+        kin = forward(self.tree, np.asarray(q, dtype=float), np.zeros(self.tree.n_s), float(t), chain_terms=False)
+        return (self._point(kin, self.a, self.rho_a) - self._point(kin, self.b, self.rho_b))[self.rows]
+
+    def wrenches(self, kin, lam: NDArray) -> dict:
+        """{n: w_n}: the joint's force λ (inertial, rows of ``axes``) on a at P_a and −λ on b
+        at P_b as wrenches in the subsystems' ẏ coordinates (``kin``: the tree's kinematics)."""
+        f = np.zeros(3)
+        f[self.rows] = lam
+        loads = {self.a: (f, self.rho_a)} | ({} if self.b is None else {self.b: (-f, self.rho_b)})
+        return {n: self._wrench(kin, n, force, rho) for n, (force, rho) in loads.items()}
+
+    def _wrench(self, kin, n, force, rho) -> NDArray:
+        f_body = kin.R[n].T @ force
+        w = np.concatenate((f_body, cross(rho, f_body)))  # force and moment about O_n, body axes
+        S = self.tree.S[n]
+        return w if S is None else S @ w

@@ -1,0 +1,97 @@
+"""Checks for systems whose minimal velocities are non-holonomic quasi-velocities.
+
+With q̇ = K(q) ṡ + k the velocity constraints hold by construction for any ṡ; what can go
+wrong is *input*:
+
+- :func:`initial_speeds` turns given rates q̇₀ into ṡ₀ and refuses q̇₀ that violate the
+  constraints they are meant to satisfy (ValueError with the residuals);
+- :func:`check_configuration` refuses a configuration where a joint's K(q) is not finite
+  or not of full column rank (coordinate singularities such as Euler angles at 90° tilt),
+  or where F(q) loses rank (minimal velocities no longer independent).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.checks import state_vector
+
+# relative size of a residual (to the rates' size) above which q̇ violates the constraints:
+# far above round-off (1e-16) and far below any physical violation
+CONSTRAINT_TOLERANCE = 1e-8
+# condition number of K or F above which the configuration is treated as singular
+SINGULAR_CONDITION = 1e10
+
+
+def _joint_rows(system, n):
+    return slice(system.q_slice[n].start, system.e_q_slice[n].start), slice(
+        system.s_slice[n].start, system.e_s_slice[n].start
+    )
+
+
+def initial_speeds(system, q, q_dot, t: float = 0.0, tol: float = CONSTRAINT_TOLERANCE) -> NDArray:
+    """The minimal velocities ṡ with K(q) ṡ + k = q̇, for rates q̇ that satisfy the
+    constraints.
+
+    Raises ValueError when q̇ violates the system's declared velocity constraints (the
+    residuals are named) or is not of the form K ṡ + k (no ṡ reproduces it).
+    """
+    q = state_vector("q", q, system.n_q)
+    q_dot = state_vector("q_dot", q_dot, system.n_q)
+    check_configuration(system, q, t)
+    scale = 1.0 + np.abs(q_dot).max()
+    residual = system.constraint_residual(q, q_dot, t)
+    if residual.size and np.abs(residual).max() > tol * scale:
+        raise ValueError(
+            f"q_dot: the initial rates violate the velocity constraints: residual "
+            f"{np.array2string(residual, precision=4)} (tolerance {tol * scale:.2g}); "
+            "give rates that satisfy them, or give the minimal velocities s_dot directly"
+        )
+    K = system.K(q, t)
+    k = system.q_dot(q, np.zeros(system.n_s), t)
+    s_dot, *_ = np.linalg.lstsq(K, q_dot - k, rcond=None)
+    mismatch = K @ s_dot + k - q_dot
+    if np.abs(mismatch).max() > tol * scale:
+        raise ValueError(
+            f"q_dot: no minimal velocities reproduce the given rates (q̇ − K ṡ − k = "
+            f"{np.array2string(mismatch, precision=4)}); they violate the constraints built into K"
+        )
+    return s_dot
+
+
+def check_configuration(system, q, t: float = 0.0, max_condition: float = SINGULAR_CONDITION) -> None:
+    """Raise ValueError if some joint's K(q) or F(q) is singular at q (non-finite entries,
+    or condition number above ``max_condition``), naming the joint and the coordinates."""
+    from projeq.assembly.kinematics import forward
+
+    q = state_vector("q", q, system.n_q)
+    with np.errstate(all="ignore"):
+        K = system.K(q, t)
+        try:
+            kin = forward(system, q, np.zeros(system.n_s), t)
+            F_all = kin.F
+        except (FloatingPointError, ZeroDivisionError, ValueError):
+            F_all = [None] * len(system.joints)
+    for n, joint in enumerate(system.joints):
+        if joint.coupling or joint.n_s == 0:
+            continue
+        rows, cols = _joint_rows(system, n)
+        where = f"joint of {system.names[n]!r} at q = {np.round(q[rows], 6).tolist()}"
+        for label, M in (("K(q) of q̇ = K ṡ", K[rows, cols]), ("F(q)", F_all[n])):
+            if M is None:
+                continue
+            if not np.all(np.isfinite(M)):
+                bad = sorted({int(i) for i in np.argwhere(~np.isfinite(M))[:, 0]})
+                raise ValueError(
+                    f"{label} is singular (not finite in rows {bad}) for the {where}: a coordinate "
+                    "singularity of the chosen coordinates; use other coordinates (another Euler "
+                    "sequence or quaternions) or a configuration away from it"
+                )
+            cond = np.linalg.cond(M) if M.size else 1.0
+            if not cond < max_condition:
+                raise ValueError(
+                    f"{label} loses rank (condition number {cond:.3g}) for the {where}: the minimal "
+                    "velocities are not independent there (a coordinate singularity); use other "
+                    "coordinates or a configuration away from it"
+                )

@@ -1,0 +1,442 @@
+"""Constraints given as equations: closed loops and Pfaffian constraints on a tree (THEORY §7).
+
+A tree :class:`~projeq.System` keeps its own (now redundant) coordinates q and velocities
+ṡ_tree; the user adds holonomic constraints Φ(q, t) = 0 and/or Pfaffian ones
+A(q, t) q̇ = b(q, t). With q̇ = K ṡ_tree + k they read, at velocity level,
+
+    C K ṡ_tree = c − C k,    C = [∂Φ/∂q; A],  c = [−∂Φ/∂t; b]         (A_s ṡ_tree = b_s)
+
+and, differentiated once more with s̈_tree = 0 frozen, A_s s̈_tree = −γ. Coordinate
+partitioning into independent and dependent velocities gives the minimal velocities ṡ:
+
+    ṡ_tree = F ṡ + f,  F = [E; −A_dep⁻¹ A_ind] (rows permuted),  f = [0; A_dep⁻¹ b_s]
+    s̈_tree = F s̈ + f̄,  f̄ = [0; −A_dep⁻¹ γ]
+
+and the Projection Equation with the constraint inserted before the projection is
+
+    Fᵀ (M_tree (F s̈ + f̄) + b_tree) = 0.
+
+Derivatives of Φ, A and b are taken by fourth-order central differences (no user
+Jacobians needed). Position drift of the loop closures Φ = 0 is corrected either by a
+Gauss–Newton projection of q onto Φ = 0 wherever :func:`projeq.simulate` normalises q
+(segment ends and outputs; ``correction="projection"``, the default) or by Baumgarte's
+first-order stabilisation q̇ += −β C_Φ⁺ Φ (``correction="baumgarte"``), or not at all
+(``"none"``). ``Result.constraint_residual`` holds (Φ, A q̇ − b) along the run.
+
+Re-pivoting. A partition good at q0 may degenerate later (a four-bar's rocker angle as the
+independent coordinate at the rocker's extreme positions, where dq_rocker/dq_crank = 0).
+With ``repivot`` (the default when the partition is chosen automatically) the partition
+carries a limit on its condition number κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ (≥ cond(A_dep); unlike
+cond(A_dep) it also sees a 1 × 1 block shrink to zero), max(REPIVOT_CONDITION, 10 κ at its
+start), and :func:`projeq.simulate` stops the integration by a terminal event where κ rises
+through it, re-partitions by pivoted QR at the current q (:meth:`~ConstrainedSystem.repartitioned`,
+ṡ_new = (F_old ṡ_old + f_old)[independent_new], the same tree velocities) and continues.
+``Result.partitions`` lists (t_k, independent_k): the ``s_dot`` rows at times t with
+t_k < t ≤ t_k+1 are the tree velocities independent_k (the first partition also holds at
+t_start); energies and constraint residuals are computed in each row's own partition.
+A user-fixed partition (``repivot=False``) stops the run at the same event with a
+ValueError naming (q, t): integrated on, the solver could step across the degeneracy
+(where ṡ_tree = F ṡ is ∞ · 0) and lose accuracy silently.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import NDArray
+
+from projeq.assembly.linalg import solve_spd
+from projeq.checks import positive, state_vector
+from projeq.analysis.differentiation import richardson, second
+
+CORRECTIONS = ("projection", "baumgarte", "none")
+# condition number κ = ‖A_s‖ ‖A_dep⁻¹‖ above which the partition is degenerate
+PARTITION_CONDITION = 1e8
+# re-pivot when κ exceeds this (or 10 × its value where the partition was chosen): up to
+# there ‖F‖ ≤ κ amplifies the differences' ~1e-11 errors at most ~κ-fold, and the integrator
+# has not met the ∞ · 0 of ṡ_tree = F ṡ at the degeneracy
+REPIVOT_CONDITION = 1e2
+# |Φ| (relative to the largest coordinate, at least 1) accepted as on the manifold: 1e4 × round-off
+POSITION_TOLERANCE = 1e-12
+_H1, _H2 = 1e-3, 3e-3  # steps of the 1st/2nd differences: truncation ~h⁴, round-off ~1e-16/h, 1e-16/h²
+
+
+class ConstrainedSystem:
+    """A tree System with constraint equations, in minimal velocities by coordinate partitioning.
+
+    Parameters
+    ----------
+    system : System
+        The tree (cut the loops open: each closing joint becomes a constraint).
+    phi : callable ``phi(q, t) -> (m_h,)``, optional
+        Holonomic constraints Φ(q, t) = 0 (loop closures).
+    A, b : callables ``A(q, t) -> (m_p, n_q)``, ``b(q, t) -> (m_p,)``, optional
+        Pfaffian constraints A q̇ = b (b defaults to 0).
+    independent : sequence of int, optional
+        Indices of ṡ_tree kept as minimal velocities ṡ; default: chosen by column-pivoted
+        QR of A_s at q0 (the best-conditioned dependent block).
+    q0 : array, optional
+        Initial coordinates (default: the tree's q0); must satisfy Φ(q0) = 0 unless
+        ``project_q0`` is set, which moves it onto Φ = 0 by Gauss–Newton.
+    s_dot0 : array, optional
+        Initial minimal velocities (default zero); consistent by construction.
+    correction : "projection", "baumgarte" or "none"
+        Position-drift correction of Φ = 0 (see the module docstring); ``beta`` (1/s) is
+        Baumgarte's rate.
+    repivot : bool, optional
+        Re-choose the partition during a run when it degenerates (module docstring);
+        default: True for the automatic partition, False for a user-fixed ``independent``
+        (then a run stops with an error naming the configuration where κ reaches
+        the limit, rather than lose accuracy silently).
+
+    Examples
+    --------
+    A point mass on two sliders kept on a circle of radius 1 (a pendulum):
+
+    >>> import numpy as np, projeq as pq
+    >>> from projeq.constraints.partitioned import ConstrainedSystem
+    >>> tree = pq.System({"x": pq.Frame(), "bob": pq.PointMass(1.0)},
+    ...     {"x": pq.Prismatic(axis="x"), "bob": pq.Prismatic(parent="x", axis="z")},
+    ...     gravity=(0, 0, -9.81))
+    >>> pendulum = ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0],
+    ...                              q0=[0.6, -0.8], independent=[0])
+    >>> pendulum.n_s
+    1
+    >>> r = pq.simulate(pendulum, 0.2, n_points=5, n_segments=2)
+    >>> bool(np.abs(r.constraint_residual).max() < 1e-10)
+    True
+    """
+
+    def __init__(self, system, phi=None, A=None, b=None, independent=None, q0=None, s_dot0=None,
+                 project_q0: bool = False, correction: str = "projection", beta: float = 10.0,
+                 repivot: bool | None = None):
+        if phi is None and A is None:
+            raise ValueError("phi: give holonomic constraints phi(q, t) and/or Pfaffian ones A(q, t)")
+        for name, f in (("phi", phi), ("A", A), ("b", b)):
+            if f is not None and not callable(f):
+                raise ValueError(f"{name}: expected a callable {name}(q, t), got {f!r}")
+        if b is not None and A is None:
+            raise ValueError("b: given without A (Pfaffian constraints are A(q, t) q̇ = b(q, t))")
+        if correction not in CORRECTIONS:
+            raise ValueError(f"correction: unknown method {correction!r}; use one of {list(CORRECTIONS)}")
+        self.tree, self._phi, self._A, self._b = system, phi, A, b
+        self.correction, self.beta = correction, positive("beta", beta)
+        self.names, self.subsystems, self.n_q = system.names, system.subsystems, system.n_q
+        q0 = system.check_q("q0", system.q0 if q0 is None else q0)
+        self.m_h = self._constraint_rows("phi", phi, (q0, 0.0), 1)
+        self.m_p = self._constraint_rows("A", A, (q0, 0.0), 2)
+        if b is not None:
+            self._constraint_rows("b", b, (q0, 0.0), 1, self.m_p)
+        self.n_c = self.m_h + self.m_p
+        if correction == "projection" and self.m_h and any(  # simulate normalises q without the time
+                not np.allclose(self.phi(q0, t), self.phi(q0, 0.0), rtol=0, atol=1e-14) for t in (0.37, 1.9)):
+            raise ValueError("correction: 'projection' needs Φ independent of t (q is normalised without the "
+                             "time); use correction='baumgarte' for rheonomic constraints")
+        self._check_rank(q0)
+        self.independent, self.dependent = self._partition(q0, independent)
+        self.n_s = len(self.independent)
+        self.repivot = independent is None if repivot is None else _check_repivot(repivot)
+        self.limit = max(REPIVOT_CONDITION, 10 * self.condition(q0))
+        self.q0 = self._initial_q(q0, project_q0)
+        self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
+
+    # -- the constraint functions -----------------------------------------------------------
+    def _constraint_rows(self, name, f, args, ndim, n_cols=None) -> int:
+        if f is None:
+            return 0
+        value = np.asarray(f(*args), dtype=float)
+        expected = (n_cols,) if n_cols is not None else ((None, self.n_q) if ndim == 2 else (None,))
+        if value.ndim != ndim or (ndim == 2 and value.shape[1] != self.n_q) or (
+            n_cols is not None and value.shape != expected
+        ):
+            want = {1: "(m,)", 2: f"(m, n_q = {self.n_q})"}[ndim] if n_cols is None else f"({n_cols},)"
+            raise ValueError(f"{name}: returns an array of shape {value.shape}, expected {want}")
+        if not np.all(np.isfinite(value)):
+            raise ValueError(f"{name}: returns non-finite values {value.tolist()} at q0")
+        return value.shape[0]
+
+    def phi(self, q: NDArray, t: float = 0.0) -> NDArray:
+        """Φ(q, t), the holonomic constraints (empty without any)."""
+        return np.asarray(self._phi(q, t), dtype=float) if self.m_h else np.zeros(0)
+
+    def _pfaffian(self, q, t) -> tuple[NDArray, NDArray]:
+        if not self.m_p:
+            return np.zeros((0, self.n_q)), np.zeros(0)
+        b = np.zeros(self.m_p) if self._b is None else np.asarray(self._b(q, t), dtype=float)
+        return np.asarray(self._A(q, t), dtype=float), b
+
+    def phi_q(self, q: NDArray, t: float = 0.0) -> NDArray:
+        """∂Φ/∂q (m_h × n_q) by central differences."""
+        unit = np.eye(self.n_q)
+        columns = [richardson(lambda e, i=i: self.phi(q + e * unit[i], t), _H1) for i in range(self.n_q)]
+        return np.array(columns).T.reshape(self.m_h, self.n_q)
+
+    def velocity_constraints(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
+        """(C, c) of C q̇ = c: C = [∂Φ/∂q; A], c = [−∂Φ/∂t; b]."""
+        A, b = self._pfaffian(q, t)
+        phi_t = richardson(lambda e: self.phi(q, t + e), _H1) if self.m_h else np.zeros(0)
+        return np.vstack((self.phi_q(q, t), A)), np.concatenate((-phi_t, b))
+
+    def constraint_residual(self, q: NDArray, q_dot: NDArray, t: float = 0.0) -> NDArray:
+        """(Φ(q, t), A q̇ − b): loop closures at position level, Pfaffian ones at velocity level."""
+        A, b = self._pfaffian(q, t)
+        return np.concatenate((self.phi(q, t), A @ q_dot - b))
+
+    # -- partition --------------------------------------------------------------------------
+    def constraint_matrix(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
+        """(A_s, b_s) of A_s ṡ_tree = b_s: A_s = C K, b_s = c − C k."""
+        C, c = self.velocity_constraints(q, t)
+        return C @ self.tree.K(q, t), c - C @ self.tree.q_dot(q, np.zeros(self.tree.n_s), t)
+
+    def _check_rank(self, q0) -> None:
+        A_s = self.constraint_matrix(q0)[0]
+        if self.n_c > self.tree.n_s:
+            raise ValueError(f"phi: {self.n_c} constraints on only {self.tree.n_s} tree velocities")
+        tol = 1e-9 * max(np.abs(A_s).max(initial=0.0), 1.0)  # far above round-off, far below a real row
+        kept, redundant = [], []
+        for i in range(self.n_c):  # a row is redundant if it lies in the span of the rows kept before it
+            (kept if np.linalg.matrix_rank(A_s[kept + [i]], tol) > len(kept) else redundant).append(i)
+        if redundant:
+            raise ValueError(
+                f"phi: the constraint rows are rank-deficient at q0 (rank {len(kept)} of {self.n_c}): rows "
+                f"{redundant} depend on rows {kept} (rows count Φ first, then A); remove the redundant ones"
+            )
+
+    def _partition(self, q0, independent) -> tuple[NDArray, NDArray]:
+        n_s = self.tree.n_s
+        A_s = self.constraint_matrix(q0)[0]
+        if independent is None:
+            dependent = _pivoted_dependent(A_s, self.n_c)
+        else:
+            chosen = np.asarray(independent)
+            integers = chosen.ndim == 1 and np.issubdtype(chosen.dtype, np.integer)
+            if not integers or len(chosen) != n_s - self.n_c or len(set(chosen.tolist())) != len(chosen) \
+                    or np.any((chosen < 0) | (chosen >= n_s)):
+                raise ValueError(
+                    f"independent: expected {n_s - self.n_c} distinct indices of ṡ_tree in 0..{n_s - 1} "
+                    f"(n_s = {n_s} minus {self.n_c} constraints), got {independent!r}"
+                )
+            dependent = np.setdiff1d(np.arange(n_s), chosen)
+        free = np.setdiff1d(np.arange(n_s), dependent)
+        self.independent, self.dependent = free, dependent
+        self.check_configuration(q0, 0.0)
+        return free, dependent
+
+    def check_configuration(self, q: NDArray, t: float = 0.0) -> None:
+        """Raise ValueError if the dependent block A_dep is singular at q (the partition
+        degenerates: choose another ``independent`` set)."""
+        self._check_dependent(self.constraint_matrix(q, t)[0], q, t)
+
+    def condition(self, q: NDArray, t: float = 0.0) -> float:
+        """κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ at (q, t), the condition number of the partition (1 without
+        constraints, ∞ for a singular A_dep): ‖F‖ ≤ κ bounds the gain from ṡ to ṡ_tree."""
+        return _partition_condition(self.constraint_matrix(q, t)[0], self.dependent)
+
+    def partition_event(self):
+        """The terminal event ``event(t, q, s_dot) = κ − limit`` (rising) at which
+        :func:`projeq.simulate` calls :meth:`repartitioned` (None without constraints)."""
+        if not self.n_c:
+            return None
+
+        def degenerates(t, q, s_dot):
+            return self.condition(q, t) - self.limit
+
+        degenerates.terminal, degenerates.direction = True, 1
+        return degenerates
+
+    def repartitioned(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple["ConstrainedSystem", NDArray]:
+        """(system, s_dot) in the partition pivoted QR picks at (q, t): the same tree, the
+        same tree velocities ṡ_tree = F_old ṡ_old + f_old, ṡ_new = ṡ_tree[independent_new];
+        the new system starts at (q, ṡ_new). Without ``repivot``: ValueError naming (q, t)."""
+        if not self.repivot:
+            raise self._degenerate(q, t, self.condition(q, t), self.limit)
+        dependent = _pivoted_dependent(self.constraint_matrix(q, t)[0], self.n_c)
+        new = self._in_partition(np.setdiff1d(np.arange(self.tree.n_s), dependent), q, t)
+        new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
+        return new, new.s_dot0.copy()
+
+    def with_independent(self, independent, repivot: bool | None = None) -> "ConstrainedSystem":
+        """This system (same tree, constraints and initial motion q0, ṡ_tree0) with the tree
+        velocities ``independent`` as its minimal velocities; ``repivot`` as in the
+        constructor (default: this system's). ValueError if A_dep is singular at q0."""
+        free, dependent = copy.copy(self)._partition(self.q0, independent)  # checks, at q0
+        new = self._in_partition(free, self.q0)
+        new.s_dot0 = self.tree_velocities(self.q0, self.s_dot0)[free]
+        new.repivot = self.repivot if repivot is None else _check_repivot(repivot)
+        return new
+
+    def row_systems(self, result) -> list:
+        """This system in the partition of each row of ``result`` (``Result.partitions``:
+        (t_k, independent_k) holds for t_k < t ≤ t_k+1, the first one from the start)."""
+        if not result.partitions:
+            return [self] * len(result.t)
+        starts = [t for t, _ in result.partitions]
+        systems = [self._in_partition(np.asarray(independent), self.q0) for _, independent in result.partitions]
+        return [systems[max(k - 1, 0)] for k in np.searchsorted(starts, result.t, side="left")]
+
+    def _in_partition(self, independent, q, t=0.0) -> "ConstrainedSystem":
+        """A copy with the partition ``independent`` (unchecked), starting at q."""
+        new = copy.copy(self)
+        new.independent, new.dependent = independent, np.setdiff1d(np.arange(self.tree.n_s), independent)
+        new.q0 = np.array(q, dtype=float)
+        new.limit = max(REPIVOT_CONDITION, 10 * new.condition(q, t))
+        return new
+
+    def _check_dependent(self, A_s, q, t) -> None:
+        cond = _partition_condition(A_s, self.dependent)
+        if not cond < PARTITION_CONDITION:
+            raise self._degenerate(q, t, cond, PARTITION_CONDITION)
+
+    def _degenerate(self, q, t, cond, limit) -> ValueError:
+        return ValueError(
+            f"independent: the dependent velocities {self.dependent.tolist()} cannot be solved for at "
+            f"q = {np.round(q, 6).tolist()}, t = {t:.6g} (condition number of the partition {cond:.3g}, limit "
+            f"{limit:.3g}); choose other independent velocities (default: pivoted QR picks them at q0), "
+            "or pass repivot=True"
+        )
+
+    def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:
+        """(F, f) of ṡ_tree = F ṡ + f: F = [E; −A_dep⁻¹ A_ind], f = [0; A_dep⁻¹ b_s]
+        (``constraint_matrix``: (A_s, b_s) at (q, t) if known)."""
+        A_s, b_s = self.constraint_matrix(q, t) if constraint_matrix is None else constraint_matrix
+        F = np.zeros((self.tree.n_s, self.n_s))
+        F[self.independent] = np.eye(self.n_s)
+        f = np.zeros(self.tree.n_s)
+        if self.n_c:
+            self._check_dependent(A_s, q, t)  # the partition degenerates during a run
+            solved = np.linalg.solve(A_s[:, self.dependent], np.column_stack((A_s[:, self.independent], b_s)))
+            F[self.dependent], f[self.dependent] = -solved[:, :-1], solved[:, -1]
+        return F, f
+
+    def tree_velocities(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
+        """ṡ_tree = F ṡ + f."""
+        F, f = self.F(q, t)
+        return F @ s_dot + f
+
+    # -- the System interface used by projeq.simulate --------------------------------------------
+    def check_q(self, name: str, q) -> NDArray:
+        """q as the tree checks it."""
+        return self.tree.check_q(name, q)
+
+    def K(self, q: NDArray, t: float = 0.0) -> NDArray:
+        """K of q̇ = K ṡ + k in the minimal velocities: K_tree F."""
+        return self.tree.K(q, t) @ self.F(q, t)[0]
+
+    def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
+        """q̇ = K_tree (F ṡ + f) + k, minus β C_Φ⁺ Φ with Baumgarte's correction."""
+        q_dot = self.tree.q_dot(q, self.tree_velocities(q, s_dot, t), t)
+        if self.correction == "baumgarte" and self.m_h:
+            q_dot -= self.beta * np.linalg.lstsq(self.phi_q(q, t), self.phi(q, t), rcond=None)[0]
+        return q_dot
+
+    def normalized(self, q: NDArray, t: float = 0.0) -> NDArray:
+        """The tree's normalisation, then (``correction="projection"``) Gauss–Newton steps
+        q ← q − C_Φ⁺ Φ onto Φ = 0."""
+        q = self.tree.normalized(q)
+        return self.project(q, t) if self.correction == "projection" else q
+
+    def project(self, q: NDArray, t: float = 0.0, max_iter: int = 20) -> NDArray:
+        """q moved onto Φ(q, t) = 0 by minimum-norm Gauss–Newton steps; ValueError if it fails."""
+        q = np.array(q, dtype=float)
+        tol = POSITION_TOLERANCE * max(1.0, np.abs(q).max())
+        for _ in range(max_iter):
+            residual = self.phi(q, t)
+            if not residual.size or np.abs(residual).max() <= tol:
+                return q
+            q = self.tree.normalized(q - np.linalg.lstsq(self.phi_q(q, t), residual, rcond=None)[0])
+        raise ValueError(
+            f"q: cannot be projected onto the constraints Φ(q, t) = 0 (residual "
+            f"{np.array2string(self.phi(q, t), precision=3)} after {max_iter} Gauss–Newton steps)"
+        )
+
+    def _initial_q(self, q0, project_q0) -> NDArray:
+        residual = self.phi(q0, 0.0)
+        if residual.size and np.abs(residual).max() > POSITION_TOLERANCE * 1e3 * max(1.0, np.abs(q0).max()):
+            if not project_q0:
+                raise ValueError(
+                    f"q0: violates the loop closures Φ(q0) = {np.array2string(residual, precision=4)}; "
+                    "give a consistent q0 or pass project_q0=True to project it onto Φ = 0"
+                )
+        return self.project(q0) if self.m_h else q0
+
+    def evaluator(self, method=None):
+        """This system itself: its accelerations use the tree's dense Gauss form."""
+        return self
+
+    def energy(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple[float, float]:
+        """(kinetic, potential) of the tree at ṡ_tree = F ṡ + f."""
+        return self.tree.energy(q, self.tree_velocities(q, s_dot, t), t)
+
+    # -- dynamics ---------------------------------------------------------------------------
+    def gamma(self, q: NDArray, s_dot_tree: NDArray, t: float = 0.0, C=None) -> NDArray:
+        """γ of A_s s̈_tree = −γ: d/dt (C q̇ − c) along the motion with s̈_tree = 0
+        (``C``: the velocity constraint matrix at (q, t) if known)."""
+        tree = self.tree
+        q_dot = tree.q_dot(q, s_dot_tree, t)
+        moving = np.concatenate((q_dot, [1.0]))
+        step = 1.0 / np.linalg.norm(moving)  # differences along the unit direction (q̇, 1)
+
+        def at(e):
+            return q + e * step * q_dot, t + e * step
+
+        q_ddot = richardson(lambda e: tree.q_dot(at(e)[0], s_dot_tree, at(e)[1]), _H1) / step  # K̇ ṡ + k̇
+        C = self.velocity_constraints(q, t)[0] if C is None else C
+        parts = []
+        if self.m_h:
+            parts.append(second(lambda e: self.phi(*at(e)), _H2) / step**2)
+        if self.m_p:
+            parts.append(richardson(lambda e: _pfaffian_residual(self, at(e), q_dot), _H1) / step)
+        return np.concatenate(parts) + C @ q_ddot
+
+    def accelerations_tree(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
+        """(s̈_tree, λ): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0, and the
+        multipliers λ of M s̈_tree + b = A_sᵀ λ (the constraint forces)."""
+        C, c = self.velocity_constraints(q, t)
+        K, k = self.tree.K(q, t), self.tree.q_dot(q, np.zeros(self.tree.n_s), t)
+        A_s = C @ K
+        F, f = self.F(q, t, (A_s, c - C @ k))
+        s_dot_tree = F @ s_dot + f
+        M, b = self.tree.evaluator("dense").gauss_form(q, s_dot_tree, t)
+        f_bar = np.zeros(self.tree.n_s)
+        if self.n_c:
+            f_bar[self.dependent] = -np.linalg.solve(A_s[:, self.dependent], self.gamma(q, s_dot_tree, t, C))
+        M_min = F.T @ M @ F
+        s_ddot = -solve_spd(M_min, (F.T @ (M @ f_bar + b))[:, None], "constrained mass matrix FᵀMF",
+                            max(np.abs(np.diag(M_min)).max(initial=0.0), 1e-300))[:, 0]
+        s_ddot_tree = F @ s_ddot + f_bar
+        lam = np.linalg.lstsq(A_s.T, M @ s_ddot_tree + b, rcond=None)[0] if self.n_c else np.zeros(0)
+        return s_ddot_tree, lam
+
+    def accelerations(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
+        """Minimal accelerations s̈ (the independent entries of s̈_tree)."""
+        return self.accelerations_tree(q, s_dot, t)[0][self.independent]
+
+    def __repr__(self) -> str:
+        return f"ConstrainedSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian)"
+
+
+def _check_repivot(repivot) -> bool:
+    if repivot not in (True, False):
+        raise ValueError(f"repivot: expected True, False or None (automatic), got {repivot!r}")
+    return bool(repivot)
+
+
+def _partition_condition(A_s: NDArray, dependent: NDArray) -> float:
+    """κ = ‖A_s‖₂ / σ_min(A_dep) = ‖A_s‖₂ ‖A_dep⁻¹‖₂ (1 for no rows, ∞ for a singular A_dep)."""
+    if not A_s.size:
+        return 1.0
+    sigma = np.linalg.svd(A_s[:, dependent], compute_uv=False)
+    return float(np.linalg.norm(A_s, 2) / sigma[-1]) if sigma[-1] > 0 else np.inf
+
+
+def _pivoted_dependent(A_s: NDArray, n_c: int) -> NDArray:
+    """The n_c columns of A_s that column-pivoted QR takes first (sorted): the dependent
+    velocities with the best-conditioned block A_dep."""
+    return np.sort(scipy.linalg.qr(A_s, pivoting=True)[2][:n_c])
+
+
+def _pfaffian_residual(system: ConstrainedSystem, q_t, q_dot) -> NDArray:
+    A, b = system._pfaffian(*q_t)
+    return A @ q_dot - b

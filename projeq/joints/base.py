@@ -1,0 +1,132 @@
+"""How subsystems connect: the kinematic chain ẏ_n = T_np ẏ_p + F_n ṡ_n (THEORY §4).
+
+A joint describes the motion of the child frame n relative to a *joint frame* J fixed in
+the parent p (placed at ``r_pn`` with ``orientation`` J → p). Every joint returns, at
+(q_n, ṡ_n, t), a :class:`Relative`:
+
+- ``A``: child → joint-frame rotation; ``r``: J → O_n in joint-frame coordinates;
+- ``F``: F⁶_n, the relative twist (v, ω) of n per unit ṡ_n, in child coordinates;
+- ``w``: the relative twist F⁶ ṡ_n + f⁶(t) (f⁶ ≠ 0 for prescribed, rheonomic motion);
+- ``zeta``: Ḟ⁶ ṡ_n + ḟ⁶, the joint's own part of ζ_n.
+
+The chain matrix T_np follows from (A, r) once, in :mod:`projeq.assembly.kinematics`, for every
+joint alike; positions follow q̇_n = K_n(q) ṡ_n + k_n(q, t).
+
+Letters: ``K`` is q̇ = K ṡ (never a stiffness); ``A`` a rotation; ``t`` time.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.analysis.differentiation import central
+from projeq.checks import finite_array
+from projeq.spatial import vee
+
+
+class Relative(NamedTuple):
+    """Relative kinematics of a joint at one instant (see the module docstring)."""
+
+    A: NDArray
+    r: NDArray
+    F: NDArray
+    w: NDArray
+    zeta: NDArray
+
+
+class Joint:
+    """Base class: placement on the parent and the bookkeeping shared by all joints.
+
+    Parameters
+    ----------
+    parent : str or None
+        Name of the parent subsystem; ``None`` is the inertial ground.
+    r_pn : 3-vector
+        Origin of the joint frame in parent coordinates (m).
+    orientation : 3×3 rotation, optional
+        Joint-frame → parent coordinates (default: aligned).
+    coupling : dict, optional
+        ``{joint_name: ratio}``: the joint has no coordinate of its own; its coordinate is
+        Σ ratio · (that joint's coordinate) — gears, pulleys and ropes. Only for one-dof
+        joints with q̇ = ṡ. Shared minimal velocities make ∂ẏ/∂ṡ non-triangular, so such
+        systems are evaluated by the dense Gauss form (THEORY §4).
+    """
+
+    n_q = 0
+    n_s = 0
+    n_c = 0  # number of velocity constraints whose residual the joint reports
+
+    def __init__(self, parent=None, r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
+        if parent is not None and not isinstance(parent, str):
+            raise ValueError(f"parent: expected a subsystem name or None, got {parent!r}")
+        self.parent = parent
+        self.r_pn = finite_array("r_pn", r_pn, (3,))
+        self.orientation = _rotation_matrix("orientation", orientation)
+        self.coupling = _coupling(coupling, self)
+
+    def relative(self, q_n: NDArray, s_dot_n: NDArray, t: float) -> Relative:
+        """Relative kinematics (A, r, F⁶, w, ζ) at (q_n, ṡ_n, t)."""
+        raise NotImplementedError
+
+    def K(self, q_n: NDArray, t: float) -> NDArray:
+        """K_n(q) of q̇_n = K_n ṡ_n + k_n (identity for q̇ = ṡ)."""
+        return np.eye(self.n_q, self.n_s)
+
+    def q_dot(self, q_n: NDArray, s_dot_n: NDArray, t: float) -> NDArray:
+        """q̇_n = K_n(q) ṡ_n + k_n(q, t)."""
+        return self.K(q_n, t) @ s_dot_n
+
+    def default_q(self) -> NDArray:
+        """Coordinates of the reference configuration (zero unless a joint says otherwise)."""
+        return np.zeros(self.n_q)
+
+    def constraint_residual(self, q_n: NDArray, q_dot_n: NDArray, t: float) -> NDArray:
+        """Residuals of the velocity constraints the minimal velocities are meant to
+        satisfy, evaluated on (q, q̇) (none for the built-in joints)."""
+        return np.zeros(0)
+
+    def normalized(self, q_n: NDArray) -> NDArray:
+        """q_n projected back onto its manifold (unit quaternions); identity otherwise."""
+        return q_n
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(parent={self.parent!r})"
+
+
+def _rotation_matrix(name: str, value) -> NDArray:
+    if value is None:
+        return np.eye(3)
+    A = finite_array(name, value, (3, 3))
+    if np.abs(A.T @ A - np.eye(3)).max() > 1e-9 or np.linalg.det(A) < 0:
+        raise ValueError(f"{name}: not a proper rotation matrix (AᵀA ≠ E or det < 0):\n{A}")
+    return A
+
+
+def _coupling(coupling, joint) -> dict:
+    if not coupling:
+        return {}
+    if not isinstance(coupling, dict):
+        raise ValueError(f"coupling: expected {{joint_name: ratio}}, got {coupling!r}")
+    return {name: float(finite_array(f"coupling[{name!r}]", ratio, ())) for name, ratio in coupling.items()}
+
+
+def pose_twist_mismatch(joint: Joint, q_n: NDArray, s_dot_n: NDArray, t: float, h: float = 1e-7) -> float:
+    """Largest difference between F⁶ ṡ + f⁶ and the relative twist obtained by
+    differentiating the pose (A, r) along q̇ = K ṡ + k (central differences, step h).
+
+    Used to validate user joints; for the built-in joints it is a test of their K.
+    """
+    q_dot = joint.q_dot(q_n, s_dot_n, t)
+
+    def pose(eps):  # (A, r) at (q + ε q̇, t + ε), flattened
+        rel = joint.relative(joint.normalized(q_n + eps * q_dot), s_dot_n, t + eps)
+        return np.concatenate((rel.A.ravel(), rel.r))
+
+    rates = central(pose, h)
+    A_dot, r_dot = rates[:9].reshape(3, 3), rates[9:]
+    now = joint.relative(q_n, s_dot_n, t)
+    twist = np.concatenate((now.A.T @ r_dot, vee(now.A.T @ A_dot)))
+    return float(np.abs(twist - now.w).max())

@@ -1,0 +1,173 @@
+"""The standard joints: Revolute, Prismatic, Fixed, Planar, Free and Prescribed (THEORY §4).
+
+Each states its relative kinematics (A, r, F⁶, w, ζ) once in ``relative``; see
+:mod:`projeq.joints.base` for the contract.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+import sympy as sp
+
+from projeq.joints.base import Joint, Relative
+from projeq.spatial import axis_spin, quaternion_matrix, quaternion_rate_matrix, rodrigues, unit_axis
+
+_ZERO6 = np.zeros(6)
+_ZERO6.flags.writeable = False
+
+class _OneAxis(Joint):
+    """Shared part of the one-dof joints along or about a unit axis e (joint-frame coordinates)."""
+
+    n_q = 1
+    n_s = 1
+
+    def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
+        super().__init__(parent, r_pn, orientation, coupling)
+        self.axis = unit_axis(axis, "axis")
+
+
+class Revolute(_OneAxis):
+    """Rotation θ about the unit axis e through O_n: F⁶ = [0; e] (THEORY §4).
+
+    θ is positive by the right-hand rule about e; q = ṡ-integral = (θ,).
+    """
+
+    def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
+        super().__init__(parent, axis, r_pn, orientation, coupling)
+        self._spin = axis_spin(self.axis)
+        self._F = np.concatenate((np.zeros(3), self.axis))[:, None]
+
+    def relative(self, q_n, s_dot_n, t):
+        A = rodrigues(self._spin, q_n[0])
+        return Relative(A, _ZERO6[:3], self._F, self._F[:, 0] * s_dot_n[0], _ZERO6)
+
+
+class Prismatic(_OneAxis):
+    """Translation x along the unit axis e: F⁶ = [e; 0], r = e x (THEORY §4)."""
+
+    def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
+        super().__init__(parent, axis, r_pn, orientation, coupling)
+        self._F = np.concatenate((self.axis, np.zeros(3)))[:, None]
+
+    def relative(self, q_n, s_dot_n, t):
+        return Relative(np.eye(3), self.axis * q_n[0], self._F, self._F[:, 0] * s_dot_n[0], _ZERO6)
+
+
+class Fixed(Joint):
+    """A rigid connection: no coordinates; the child is the joint frame."""
+
+    _F = np.zeros((6, 0))
+
+    def relative(self, q_n, s_dot_n, t):
+        return Relative(np.eye(3), _ZERO6[:3], self._F, _ZERO6, _ZERO6)
+
+
+class Planar(Joint):
+    """Three dof in a plane of the joint frame: q = (a, b, θ), ṡ = (v_a, v_b, ω).
+
+    (a, b) locate O_n along the plane's first and second axis, θ turns about its normal.
+    The minimal velocities are the relative velocity of O_n and the spin in *child*
+    coordinates, so F⁶ is constant and K(q) rotates (v_a, v_b) into the joint frame —
+    Bremer's car (B(11)) is this joint with the lateral velocity v_b = 0 removed.
+    """
+
+    n_q = 3
+    n_s = 3
+    _AXES = {"xy": (0, 1, 2), "yz": (1, 2, 0), "zx": (2, 0, 1), "xz": (0, 2, 1)}
+
+    def __init__(self, parent=None, plane="xy", r_pn=(0.0, 0.0, 0.0), orientation=None):
+        super().__init__(parent, r_pn, orientation)
+        if plane not in self._AXES:
+            raise ValueError(f"plane: unknown plane {plane!r}; use one of {sorted(self._AXES)}")
+        self.plane = plane
+        a, b, n = (np.eye(3)[i] for i in self._AXES[plane])
+        self._P = np.array([a, b])
+        self.normal = n
+        self._spin = axis_spin(n)
+        self._F = np.zeros((6, 3))
+        self._F[:3, 0], self._F[:3, 1], self._F[3:, 2] = a, b, n
+
+    def _A(self, theta):
+        return rodrigues(self._spin, theta)
+
+    def relative(self, q_n, s_dot_n, t):
+        r = self._P.T @ q_n[:2]
+        return Relative(self._A(q_n[2]), r, self._F, self._F @ s_dot_n, _ZERO6)
+
+    def K(self, q_n, t):
+        K = np.zeros((3, 3))
+        K[:2, :2] = self._P @ self._A(q_n[2]) @ self._P.T
+        K[2, 2] = 1.0
+        return K
+
+
+class Free(Joint):
+    """Six dof: q = (r, quaternion (w, x, y, z)), ṡ = (v, ω) of the child in child coordinates.
+
+    F⁶ = E₆; ṙ = A v and q̇_quat = ½ quat ⊗ (0, ω) (no Euler-angle singularity). The
+    quaternion is normalised wherever the pose is evaluated and in simulation output.
+    """
+
+    n_q = 7
+    n_s = 6
+    _F = np.eye(6)
+
+    def relative(self, q_n, s_dot_n, t):
+        A = quaternion_matrix(q_n[3:] / np.linalg.norm(q_n[3:]))
+        return Relative(A, q_n[:3], self._F, s_dot_n, _ZERO6)
+
+    def K(self, q_n, t):
+        quat = q_n[3:] / np.linalg.norm(q_n[3:])
+        K = np.zeros((7, 6))
+        K[:3, :3] = quaternion_matrix(quat)
+        K[3:, 3:] = quaternion_rate_matrix(quat)
+        return K
+
+    def default_q(self):
+        return np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+
+    def normalized(self, q_n):
+        out = np.array(q_n, dtype=float)
+        out[3:] /= np.linalg.norm(out[3:])
+        return out
+
+
+class Prescribed(Joint):
+    """A one-dof joint whose coordinate is a given function of time (rheonomic).
+
+    ẏ_n = T_np ẏ_p + f⁶(t) with f⁶ = F⁶ θ̇(t), and ζ_n gains F⁶ θ̈(t) (THEORY §4). The
+    joint adds no coordinate and no minimal velocity.
+
+    Parameters
+    ----------
+    joint : Revolute or Prismatic
+        The joint whose coordinate θ is prescribed (its parent and placement are used).
+    motion : sympy expression in ``t`` or callable
+        θ(t) as an expression in the symbol ``t`` (θ̇, θ̈ by differentiation), or a callable
+        ``t -> (θ, θ̇, θ̈)``.
+    """
+
+    def __init__(self, joint: Joint, motion):
+        if not isinstance(joint, _OneAxis) or joint.coupling:
+            raise ValueError("joint: Prescribed needs an uncoupled Revolute or Prismatic joint")
+        super().__init__(joint.parent, joint.r_pn, joint.orientation)
+        self.joint = joint
+        self.motion = motion if callable(motion) else _time_function(motion)
+
+    def relative(self, q_n, s_dot_n, t):
+        theta, theta_dot, theta_ddot = self.motion(t)
+        inner = self.joint.relative(np.array([theta]), np.array([theta_dot]), t)
+        zeta = inner.zeta + inner.F[:, 0] * theta_ddot
+        return Relative(inner.A, inner.r, Fixed._F, inner.w, zeta)
+
+
+def _time_function(expr) -> Callable:
+    t = sp.Symbol("t")
+    expr = sp.sympify(expr)
+    extra = expr.free_symbols - {t}
+    if extra:
+        raise ValueError(f"motion: depends on {sorted(map(str, extra))}; only t is allowed")
+    f = sp.lambdify(t, [expr, expr.diff(t), expr.diff(t, 2)], modules="numpy")
+    return lambda time: tuple(float(v) for v in f(time))

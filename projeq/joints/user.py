@@ -1,0 +1,128 @@
+"""User-defined joints: the door for non-holonomic minimal velocities (THEORY §4).
+
+The pose, F, K (and the rheonomic f, k) are given as sympy expressions or as callables and
+compiled once by :mod:`projeq.joints.user_compiler`.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Callable, Sequence
+
+import numpy as np
+
+from projeq.checks import finite_array
+from projeq.joints.base import Joint
+
+if TYPE_CHECKING:
+    import sympy as sp
+
+
+class UserJoint(Joint):
+    """A joint defined by its pose and minimal velocities: the door for non-holonomic ṡ.
+
+    The child's pose relative to the joint frame is (A(q, t), r(q, t)); its relative twist
+    (v, ω) in child coordinates is F⁶(q, t) ṡ + f⁶(q, t); positions follow
+    q̇ = K(q, t) ṡ + k(q, t). The minimal velocities ṡ may be quasi-velocities, and a
+    velocity constraint goes in *before* the derivation by leaving its direction out of F
+    (Bremer's car: ṡ = (v_x, ω_z), B(11)). Ḟ ṡ + ḟ is obtained by differentiation along
+    q̇ (symbolically, or by complex-step for callables), and the pose is checked against
+    F and K at construction.
+
+    Build with :meth:`from_sympy` or :meth:`from_functions`.
+    """
+
+    def __init__(self, parent, n_q, n_s, relative, K, q_dot, q0=None, r_pn=(0, 0, 0), orientation=None,
+                 constraints=None, n_c=0):
+        super().__init__(parent, r_pn, orientation)
+        self.n_q, self.n_s, self.n_c = n_q, n_s, n_c
+        self._relative, self._K, self._q_dot = relative, K, q_dot
+        self._constraints = constraints
+        self._q0 = np.zeros(n_q) if q0 is None else finite_array("q0", q0, (n_q,))
+
+    def relative(self, q_n, s_dot_n, t):
+        return self._relative(q_n, s_dot_n, t)
+
+    def K(self, q_n, t):
+        return self._K(q_n, t)
+
+    def q_dot(self, q_n, s_dot_n, t):
+        return self._q_dot(q_n, s_dot_n, t)
+
+    def default_q(self):
+        return self._q0.copy()
+
+    def constraint_residual(self, q_n, q_dot_n, t):
+        if self._constraints is None:
+            return np.zeros(0)
+        return np.asarray(self._constraints(q_n, q_dot_n, t), dtype=float).ravel()
+
+    @classmethod
+    def from_sympy(
+        cls,
+        q: Sequence[sp.Symbol],
+        s: Sequence[sp.Symbol],
+        A,
+        r,
+        F,
+        K,
+        *,
+        f=None,
+        k=None,
+        t: sp.Symbol | None = None,
+        parameters: dict | None = None,
+        constraints=None,
+        q_dot: Sequence[sp.Symbol] | None = None,
+        parent=None,
+        q0=None,
+        r_pn=(0.0, 0.0, 0.0),
+        orientation=None,
+    ) -> "UserJoint":
+        """A user joint from sympy expressions in the coordinates ``q``, the minimal
+        velocities ``s`` (ṡ), time ``t`` and ``parameters`` ({symbol: value}).
+
+        ``A`` (3×3) and ``r`` (3) give the pose, ``F`` (6×n_s) and ``f`` (6) the relative
+        twist F ṡ + f in child coordinates, ``K`` (n_q×n_s) and ``k`` (n_q) give q̇.
+        Ḟ ṡ + ḟ = (∂F/∂q q̇ + ∂F/∂t) ṡ + ∂f/∂q q̇ + ∂f/∂t is derived and compiled once.
+        ``constraints`` lists the original velocity constraints (expressions in q, the
+        symbols ``q_dot`` for q̇, and t) whose residuals every Result reports.
+        """
+        from projeq.joints.user_compiler import compile_user_joint
+
+        return compile_user_joint(
+            cls, q, s, A, r, F, K, f=f, k=k, t=t, parameters=parameters or {},
+            parent=parent, q0=q0, r_pn=r_pn, orientation=orientation,
+            constraints=constraints, q_dot=q_dot,
+        )
+
+    @classmethod
+    def from_functions(
+        cls,
+        n_q: int,
+        n_s: int,
+        pose: Callable,
+        F: Callable,
+        K: Callable,
+        *,
+        f: Callable | None = None,
+        k: Callable | None = None,
+        constraints: Callable | None = None,
+        n_c: int = 0,
+        parent=None,
+        q0=None,
+        r_pn=(0.0, 0.0, 0.0),
+        orientation=None,
+    ) -> "UserJoint":
+        """A user joint from callables ``pose(q, t) -> (A, r)``, ``F(q, t)``, ``K(q, t)``
+        (and optionally ``f(q, t)``, ``k(q, t)``).
+
+        Ḟ ṡ + ḟ is taken by complex-step differentiation along (q̇, 1), exact to
+        round-off, so the callables must accept complex arguments (numpy ufuncs do).
+        ``constraints(q, q_dot, t)`` returns the ``n_c`` residuals of the original velocity
+        constraints, reported along every simulated trajectory.
+        """
+        from projeq.joints.user_compiler import wrap_user_functions
+
+        return wrap_user_functions(
+            cls, n_q, n_s, pose, F, K, f=f, k=k, parent=parent, q0=q0, r_pn=r_pn,
+            orientation=orientation, constraints=constraints, n_c=n_c,
+        )

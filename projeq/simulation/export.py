@@ -1,0 +1,72 @@
+"""Results for other tools: a VTU time series for ParaView (via meshio).
+
+Each output time becomes one ``.vtu`` file with the system drawn in inertial coordinates:
+beam centre lines as polylines (subsystems with a ``centre_line`` method) and every other
+subsystem as a small frame glyph (three line segments along its axes). Point data:
+``displacement`` (from the first time) and ``velocity`` (exact, from the kinematics);
+a ``.pvd`` collection file ties the steps together with their times.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import meshio
+import numpy as np
+
+from projeq.assembly.kinematics import forward
+from projeq.spatial import cross
+
+
+def _draw(system, q, s_dot, t, stations: int, frame_size: float):
+    """Points, velocities (inertial) and line cells of the system at one state.
+
+    A constrained system (one with a ``tree``) is drawn as its tree moving with the tree
+    velocities F ṡ."""
+    if hasattr(system, "tree"):
+        system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
+    kin = forward(system, q, s_dot, t, chain_terms=False)
+    points, velocities, lines = [], [], []
+    for n, sub in enumerate(system.subsystems):
+        if hasattr(sub, "centre_line"):
+            local, local_velocity = sub.centre_line(q[system.e_q_slice[n]], kin.y_dot[n], stations)
+            chain = [(i, i + 1) for i in range(len(local) - 1)]
+        else:
+            local = np.vstack((np.zeros(3), frame_size * np.eye(3)))
+            v_O, omega = kin.twist[n][:3], kin.twist[n][3:]
+            local_velocity = v_O + cross(omega, local)
+            chain = [(0, 1), (0, 2), (0, 3)]
+        start = sum(len(p) for p in points)
+        points.append(kin.r[n] + local @ kin.R[n].T)
+        velocities.append(local_velocity @ kin.R[n].T)
+        lines.extend((start + a, start + b) for a, b in chain)
+    return np.vstack(points), np.vstack(velocities), np.array(lines)
+
+
+def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21, frame_size: float = 0.1) -> Path:
+    """Write ``result`` as ``directory/name_####.vtu`` files and ``directory/name.pvd``.
+
+    Needs ``result.system`` (a Result returned by :func:`projeq.simulate`). Returns the
+    path of the ``.pvd`` file, which ParaView opens as a time series.
+    """
+    system = getattr(result, "system", None)
+    if system is None:
+        raise ValueError("result: has no system (loaded from a file?); export a Result from simulate()")
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    entries, reference = [], None
+    for k, (t, q, s_dot) in enumerate(zip(result.t, result.q, result.s_dot)):
+        points, velocity, lines = _draw(system, q, s_dot, t, stations, frame_size)
+        reference = points if reference is None else reference
+        path = directory / f"{name}_{k:04d}.vtu"
+        mesh = meshio.Mesh(points, [("line", lines)], point_data={"displacement": points - reference, "velocity": velocity})
+        mesh.write(path)
+        entries.append(f'    <DataSet timestep="{t:.12g}" part="0" file={quoteattr(path.name)}/>')
+    pvd = directory / f"{name}.pvd"
+    pvd.write_text(
+        '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+        + "\n".join(entries)
+        + "\n  </Collection>\n</VTKFile>\n"
+    )
+    return pvd

@@ -1,0 +1,384 @@
+"""Integrators for long runs and stiff models, beside the methods of ``solve_ivp``.
+
+Two concerns of the numerics at the extremes (issue 7, item 4):
+
+* **Drift over long runs.** An explicit Runge–Kutta method lets the energy of a
+  conservative scleronomic system random-walk and drift: its error grows with the number
+  of steps. The *projection methods* ``"RK45-projected"`` and ``"DOP853-projected"`` take
+  the base method's step and then project the state x = (q, ṡ) back onto the invariant
+  manifold E(q, ṡ) = E₀ (Hairer, Lubich, Wanner, *Geometric Numerical Integration*,
+  2nd ed., §IV.4, Algorithm 4.2: standard projection), with Newton steps along ∇E, and
+  normalise q (unit quaternions, :meth:`projeq.System.normalized`). Velocity constraints
+  need no projection: with minimal velocities q̇ = K(q)ṡ satisfies them identically. The
+  energy error then stays at round-off over any number of steps; the phase error still
+  grows linearly, as for the base method.
+* **Stiffness.** An explicit method on a stiff model (a beam whose axial modes are 10³
+  times faster than its bending modes) does not fail: it crawls at the step its stability
+  region allows. :func:`warn_if_stiff` recognises such a crawl after a segment of
+  :func:`projeq.simulate` and warns (:class:`StiffnessWarning`) with the suggestion of an
+  implicit method.
+
+``PROJECTED`` maps the method names :func:`projeq.simulate` accepts to their base method.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.integrate import DOP853, RK45, DenseOutput, OdeSolver
+
+from projeq.analysis.differentiation import central, forward, gradient
+
+PROJECTED = {"RK45-projected": RK45, "DOP853-projected": DOP853}
+EXPLICIT = ("RK45", "RK23", "DOP853", *PROJECTED)
+
+
+class StiffnessWarning(UserWarning):
+    """An explicit integrator's steps are limited by stability, not accuracy."""
+
+
+def energy_manifold(system, q0, s_dot0, t0: float = 0.0):
+    """The projection x ↦ x* onto {E(x) = E₀} of a conservative scleronomic ``system``.
+
+    E(x) = T + V = ½ṡᵀMṡ + V(q) (:meth:`projeq.System.energy`), E₀ = E(q0, ṡ0). The map
+    does simplified Newton steps x ← x − (E(x) − E₀) ∇E/|∇E|² (HLW §IV.4, Algorithm 4.2,
+    with one invariant; ∇E once, at the first iterate, by forward differences) until
+    |E − E₀| is at round-off (≤ 4 ε (|T| + |V|)), at most 4 steps, then normalises q.
+    After a step of an integrator one or two Newton steps suffice: 2 + n_x (+1) energy
+    evaluations for a state of n_x entries.
+    ValueError if E changes along the flow at the initial state (a driven joint or a
+    non-conservative force): its energy is not an invariant to project on.
+
+    >>> import projeq as pq
+    >>> system = pq.scenes.double_pendulum()
+    >>> project = energy_manifold(system, system.q0, [0.0, 0.0])
+    >>> x = project(0.0, [1.5, 0.1, 0.01, -0.02])  # a state near the manifold
+    >>> bool(abs(sum(system.energy(x[:2], x[2:])) - sum(system.energy(system.q0, [0.0, 0.0]))) < 1e-14)
+    True
+    """
+    n_q = system.n_q
+
+    def energy(x: NDArray, t: float) -> tuple[float, float]:
+        T, V = system.energy(system.normalized(x[:n_q]), x[n_q:], t)
+        return T + V, abs(T) + abs(V)
+
+    x0 = np.concatenate((np.asarray(q0, dtype=float), np.asarray(s_dot0, dtype=float)))
+    E0 = energy(x0, t0)[0]
+    _check_conservative(system, x0, t0, energy)
+
+    def project(t: float, x) -> NDArray:
+        x = np.array(x, dtype=float)
+        E, scale = energy(x, t)
+        grad = None
+        for _ in range(4):
+            if abs(E - E0) <= 4 * np.finfo(float).eps * max(scale, abs(E0)):
+                break
+            if grad is None:  # simplified Newton: ∇E at the first iterate serves all
+                # forward differences (given E): O(h) error, ample for Newton steps, whose
+                # error shrinks by that factor per step
+                grad = gradient(lambda x_: energy(x_, t)[0], x, E)
+            x -= (E - E0) * grad / (grad @ grad)
+            E, scale = energy(x, t)
+        x[:n_q] = system.normalized(x[:n_q])
+        return x
+
+    return project
+
+
+def _check_conservative(system, x0: NDArray, t0: float, energy) -> None:
+    """ValueError unless dE/dt = ∇E · ẋ + ∂E/∂t ≈ 0, relative to the size of its terms
+    |∇E| |ẋ| + |∂E/∂t| (central differences are good to ~1e-10 of it), at the initial
+    state and at probes: later times (a prescribed motion may start from rest, with zero
+    drive power at t0) and perturbed velocities (a damper does no work at rest)."""
+    n_q = system.n_q
+    rng = np.random.default_rng(0)
+    s_dot_probe = x0[n_q:] + 0.1 * (1.0 + np.abs(x0[n_q:])) * rng.standard_normal(len(x0) - n_q)
+    for t in (t0, t0 + 0.37, t0 + 1.9):
+        for x in (x0, np.concatenate((x0[:n_q], s_dot_probe))):
+            E_dot = _energy_rate(system, x, t, energy)
+            if E_dot is not None:
+                raise ValueError(
+                    f"method: the projected integrators keep the energy constant, but this system's energy "
+                    f"changes along its motion (dE/dt = {E_dot:.3g} at t = {t:.3g}); it is not conservative "
+                    "and scleronomic (a driven or prescribed joint, a damper or a time-dependent load): use a "
+                    "method of solve_ivp"
+                )
+
+
+def _energy_rate(system, x: NDArray, t: float, energy) -> float | None:
+    """dE/dt at (t, x) if it is distinguishable from zero, else None."""
+    n_q = system.n_q
+    q, s_dot = system.normalized(x[:n_q]), x[n_q:]
+    x_dot = np.concatenate((system.q_dot(q, s_dot, t), system.accelerations(q, s_dot, t)))
+    E_t = central(lambda eps: energy(x, t + eps)[0], 1e-6 * (1.0 + abs(t)))
+    grad = gradient(lambda x_: energy(x_, t)[0], x)
+    E_dot = grad @ x_dot + E_t
+    return E_dot if abs(E_dot) > 1e-6 * (np.linalg.norm(grad) * np.linalg.norm(x_dot) + abs(E_t)) else None
+
+
+def projected_solver(name: str, system, q0, s_dot0, t0: float = 0.0) -> type[OdeSolver]:
+    """The OdeSolver class for ``simulate(..., method=name)``, name in :data:`PROJECTED`:
+    the base method's steps followed by the projection of :func:`energy_manifold`."""
+    project = energy_manifold(system, q0, s_dot0, t0)
+    return type(name, (_ProjectedSolver,), {"base": PROJECTED[name], "project": staticmethod(project)})
+
+
+class _ProjectedSolver(OdeSolver):
+    """Steps of ``base`` (an explicit RK class), each followed by ``project(t, y)``.
+
+    The base keeps its own step-size control; after the projection its state y and its
+    first-same-as-last derivative f are replaced (one extra evaluation per step). Dense
+    output is the base's interpolant, projected at each requested time.
+    """
+
+    base: type[OdeSolver]
+    project = None
+
+    def __init__(self, fun, t0, y0, t_bound, vectorized=False, **options):
+        options.pop("jac", None)  # explicit bases take no Jacobian
+        self._inner = self.base(fun, t0, y0, t_bound, **options)
+        super().__init__(fun, t0, y0, t_bound, vectorized)
+        self.nfev = self._inner.nfev
+
+    def _step_impl(self):
+        inner = self._inner
+        inner.step()
+        self.nfev = inner.nfev
+        if inner.status == "failed":
+            return False, "the base method failed: step size too small"
+        inner.y = self.project(inner.t, inner.y)
+        inner.f = inner.fun(inner.t, inner.y)
+        self.nfev = inner.nfev
+        self.t, self.y = inner.t, inner.y.copy()
+        return True, None
+
+    def _dense_output_impl(self):
+        return _ProjectedDenseOutput(self.t_old, self.t, self._inner.dense_output(), self.project)
+
+
+class _ProjectedDenseOutput(DenseOutput):
+    def __init__(self, t_old, t, interpolant, project):
+        super().__init__(t_old, t)
+        self._interpolant, self._project = interpolant, project
+
+    def _call_impl(self, t):
+        y = self._interpolant(t)
+        if y.ndim == 1:
+            return self._project(t, y)
+        return np.column_stack([self._project(ti, yi) for ti, yi in zip(np.atleast_1d(t), y.T)])
+
+
+def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32) -> float:
+    """ρ(∂f/∂x) at (t, x) by power iteration on finite-difference products
+    Jv ≈ (f(x + εv) − f(x))/ε: the geometric mean growth ‖J v_k‖ over an even number of
+    the last iterations (for an undamped mode, a pair ±iω, the growth alternates between
+    ω²|a|/|b| and |b|/|a| for a vector (a, b) of coordinate and rate: a pair's mean is ω).
+    Costs ``iterations`` + 1 evaluations of f."""
+    x = np.asarray(x, dtype=float)
+    f0 = fun(t, x)
+    v = np.cos(np.arange(len(x)) + 1.0)  # a fixed start with components along every axis
+    v /= np.linalg.norm(v)
+    logs = []
+    for _ in range(iterations):
+        eps = np.sqrt(np.finfo(float).eps) * (1.0 + np.linalg.norm(x))
+        w = forward(lambda e: fun(t, x + e * v), eps, f0)
+        norm = np.linalg.norm(w)
+        if not norm > 0:
+            return 0.0
+        logs.append(np.log(norm))
+        v = w / norm
+    return float(np.exp(np.mean(logs[-2 * (iterations // 4):])))
+
+
+def warn_if_stiff(fun, segment, method, rtol: float) -> bool:
+    """Warn (:class:`StiffnessWarning`) if an explicit ``method``'s steps in ``segment``
+    (a solve_ivp result with dense output) sit at its stability limit; True if it warned.
+
+    The criterion: mean step h with ρ h ≥ 1 (ρ = :func:`spectral_radius` at the segment's
+    end), over at least 50 steps, at rtol ≤ 1e-5. At such tolerances a mode with ρ h ≥ 1
+    would be integrated with a local error of order (ρh)⁵ ≫ rtol, so the error control can
+    only accept these steps because the fast mode is hardly excited: the step is set by
+    stability, the definition of stiffness, and an implicit method could take far larger
+    ones.
+    """
+    if method not in EXPLICIT or rtol > 1e-5:
+        return False
+    n_steps = len(segment.sol.ts) - 1
+    if n_steps < 50:
+        return False
+    h = (segment.sol.ts[-1] - segment.sol.ts[0]) / n_steps
+    rho = spectral_radius(fun, segment.sol.ts[-1], segment.sol(segment.sol.ts[-1]))
+    if rho * h < 1.0:
+        return False
+    warnings.warn(
+        f"method: {method!r} is explicit and crawls at its stability limit (mean step {h:.3g} s, "
+        f"fastest mode {rho:.3g} 1/s, ρh = {rho * h:.2g}): the model is stiff (a very stiff beam, or a "
+        "pose near a coordinate singularity); try method='Radau' or 'BDF'",
+        StiffnessWarning,
+        stacklevel=3,
+    )
+    return True
+
+
+# -- Radau IIA for differential-algebraic equations ----------------------------------------
+_S6 = np.sqrt(6.0)
+RADAU_C = np.array([(4 - _S6) / 10, (4 + _S6) / 10, 1.0])
+RADAU_A = np.array([[(88 - 7 * _S6) / 360, (296 - 169 * _S6) / 1800, (-2 + 3 * _S6) / 225],
+                    [(296 + 169 * _S6) / 1800, (88 + 7 * _S6) / 360, (-2 - 3 * _S6) / 225],
+                    [(16 - _S6) / 36, (16 + _S6) / 36, 1 / 9]])
+_GAMMA0_INV = 3 + 3 ** (2 / 3) - 3 ** (1 / 3)  # the real eigenvalue of A⁻¹
+_E = np.array([-13 - 7 * _S6, -13 + 7 * _S6, -1.0]) / 3  # embedded error estimate (Hairer–Wanner IV.8)
+_NODES = np.concatenate(([0.0], RADAU_C))
+
+
+class DAEResult:
+    """The output of :func:`radau_dae`: ``t``, ``y`` (n × len(t)), ``success``, ``message`` and the cost
+    ``nfev`` (right-hand-side calls, Jacobian differences included), ``njev``, ``nlu``, ``n_steps``,
+    ``n_rejected``."""
+
+    def __init__(self, **fields):
+        self.__dict__.update(fields)
+
+
+def _collocation(y0: NDArray, Z: NDArray, theta) -> NDArray:
+    """y0 + P(θ), P the collocation polynomial with P(0) = 0, P(c_i) = Z_i (θ = (t − t0)/h, may exceed 1)."""
+    theta = np.atleast_1d(theta)
+    values = np.vstack([np.zeros_like(Z[0]), Z])  # at the nodes 0, c1, c2, 1
+    basis = np.ones((4, theta.size))
+    for i in range(4):
+        for j in range(4):
+            if j != i:
+                basis[i] *= (theta - _NODES[j]) / (_NODES[i] - _NODES[j])
+    return y0[:, None] + values.T @ basis
+
+
+def radau_dae(fun, t_span, y0, mass=None, index=None, rtol: float = 1e-6, atol: float = 1e-8, t_eval=None,
+              first_step: float | None = None, max_step: float = np.inf, max_steps: int = 200_000) -> DAEResult:
+    """Integrate M y′ = f(t, y) with a diagonal, possibly singular M by the 3-stage Radau IIA method
+    (order 5; Hairer & Wanner, *Solving Ordinary Differential Equations II*, 2nd ed., §IV.8 and §VII.4,
+    the scheme of their RADAU5 code).
+
+    ``mass``: the diagonal of M (1 for differential, 0 for algebraic components; default all 1, an ODE).
+    ``index``: the differentiation index of each component's variable (1, 2 or 3; default 1): as in
+    RADAU5 the error of index-2 (index-3) variables is scaled by h (h²). Semi-explicit index-2 DAEs
+    (velocity constraints with their multipliers) and index-3 DAEs (position constraints) are
+    integrated as they stand, without index reduction; the initial state must satisfy the constraints.
+
+    Each step solves the 3n stage equations (I₃ ⊗ M) Z = h (A ⊗ I) F(Z) by simplified Newton
+    iterations with one dense LU of I₃ ⊗ M − h A ⊗ ∂f/∂y (∂f/∂y by forward differences, once per step),
+    started from the previous step's collocation polynomial; the step size follows the embedded error
+    estimate (M/(γ₀h) − ∂f/∂y)⁻¹ (f(t₀, y₀) + M Σ e_i Z_i / h). ``t_eval`` values come from the
+    collocation polynomial (stage order 3).
+    """
+    from scipy.linalg import lu_factor, lu_solve
+
+    t0, t_end = map(float, t_span)
+    y = np.asarray(y0, dtype=float).copy()
+    n = y.size
+    m_diag = np.ones(n) if mass is None else np.asarray(mass, dtype=float).ravel()
+    idx = np.ones(n) if index is None else np.asarray(index, dtype=float).ravel()
+    if m_diag.size != n or idx.size != n:
+        raise ValueError(f"mass, index: expected {n} values each (one per component of y0), got "
+                         f"{m_diag.size} and {idx.size}")
+    if not t_end > t0:
+        raise ValueError(f"t_span: expected t_end > t0, got {t_span}")
+    if not (0 < rtol < 1 and atol > 0):
+        raise ValueError(f"rtol, atol: expected 0 < rtol < 1 and atol > 0, got {rtol}, {atol}")
+    t_eval = None if t_eval is None else np.asarray(t_eval, dtype=float)
+    M = np.diag(m_diag)
+    counts = dict(nfev=0, njev=0, nlu=0, n_steps=0, n_rejected=0)
+
+    def f(t, x):
+        counts["nfev"] += 1
+        return np.asarray(fun(t, x), dtype=float)
+
+    newton_tol = max(10 * np.finfo(float).eps / rtol, min(0.03, rtol**0.5))
+    h = min(first_step or 1e-3 * (t_end - t0) * rtol ** 0.25, max_step, t_end - t0)
+    t, f0 = t0, f(t0, y)
+    ts, ys = ([t0], [y.copy()]) if t_eval is None else ([], [])
+    if t_eval is not None and t_eval.size and t_eval[0] <= t0:
+        ts, ys = [t0], [y.copy()]
+    next_eval = 0 if t_eval is None else int(np.searchsorted(t_eval, t0, side="right"))
+    previous = None  # (t, h, y, Z) of the last accepted step, for the starting guess
+    first, rejected, message = True, False, "success"
+    while t < t_end:
+        if counts["n_steps"] >= max_steps:
+            message = f"max_steps = {max_steps} reached at t = {t}"
+            break
+        h = min(h, max_step, t_end - t)
+        counts["njev"] += 1
+        step = np.sqrt(np.finfo(float).eps) * np.maximum(1.0, np.abs(y))
+        J = np.empty((n, n))
+        for j in range(n):
+            yj = y.copy()
+            yj[j] += step[j]
+            J[:, j] = (f(t, yj) - f0) / step[j]
+        while True:
+            if h < 1e-14 * max(1.0, abs(t)):
+                message = f"step size underflow at t = {t}"
+                break
+            counts["nlu"] += 1
+            lu = lu_factor(np.kron(np.eye(3), M) - h * np.kron(RADAU_A, J))
+            if previous is None:
+                Z = np.zeros((3, n))
+            else:
+                tp, hp, yp, Zp = previous
+                Z = (_collocation(yp, Zp, (t + RADAU_C * h - tp) / hp) - y[:, None]).T
+            scale = atol + rtol * np.abs(y)
+            converged, rate, norm_old = False, None, None
+            for _ in range(7):
+                F = np.array([f(t + c * h, y + Zi) for c, Zi in zip(RADAU_C, Z)])
+                G = (Z @ M) - h * RADAU_A @ F
+                dZ = -lu_solve(lu, G.ravel()).reshape(3, n)
+                Z += dZ
+                norm = np.sqrt(np.mean((dZ / scale) ** 2))
+                if norm_old is not None:
+                    rate = norm / norm_old
+                    if rate >= 1:
+                        break
+                if norm == 0 or (rate is not None and rate / (1 - rate) * norm < newton_tol):
+                    converged = True
+                    break
+                norm_old = norm
+            if not converged:
+                h *= 0.5
+                previous = None
+                continue
+            y_new = y + Z[-1]
+            lu_err = lu_factor(_GAMMA0_INV / h * M - J)
+            ZE = M @ (Z.T @ _E) / h
+            error = lu_solve(lu_err, f0 + ZE)
+            scale = atol + rtol * np.maximum(np.abs(y), np.abs(y_new))
+            weight = h ** (idx - 1)
+            err = np.sqrt(np.mean((weight * error / scale) ** 2))
+            if err > 1 and (first or rejected):
+                error = lu_solve(lu_err, f(t, y + error) + ZE)
+                err = np.sqrt(np.mean((weight * error / scale) ** 2))
+            factor = min(10.0, max(0.2, 0.9 * (err + 1e-10) ** -0.25))
+            if err > 1:
+                counts["n_rejected"] += 1
+                rejected, h = True, h * min(factor, 0.9)
+                continue
+            break
+        if message != "success":
+            break
+        if t_eval is not None:
+            stop = int(np.searchsorted(t_eval, t + h, side="right"))
+            if stop > next_eval:
+                inside = t_eval[next_eval:stop]
+                ts.extend(inside)
+                ys.extend(_collocation(y, Z, (inside - t) / h).T)
+                next_eval = stop
+        previous = (t, h, y.copy(), Z.copy())
+        t, y = t + h, y_new
+        f0 = f(t, y)
+        counts["n_steps"] += 1
+        if t_eval is None:
+            ts.append(t)
+            ys.append(y.copy())
+        first, rejected = False, False
+        h *= factor
+    return DAEResult(t=np.array(ts), y=np.array(ys).T.reshape(n, -1), success=message == "success",
+                     message=message, **counts)

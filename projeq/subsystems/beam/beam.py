@@ -1,0 +1,429 @@
+"""An Euler–Bernoulli beam by a direct Ritz approach (B(19)–(25), THEORY §10).
+
+The beam hangs in a floating reference frame R (its root, axis x) with describing
+velocities ẏ = (v_R, ω_R, q̇_e). A slice at x sits at r(x) = (x + u + u₂, v, w) with
+u = Φ_uᵀ q_u, v = Φ_vᵀ q_v, w = Φ_wᵀ q_w and, when ``stiffening`` is on, the second-order
+axial displacement u₂(x) = −½ ∫₀ˣ (v′² + w′²) dξ = −½ (q_vᵀ H_v(x) q_v + q_wᵀ H_w(x) q_w),
+H(x) = ∫₀ˣ Φ′Φ′ᵀ dξ. Its velocity is v_c(x) = J(x) ẏ with J = [E, −r̃(x), Φ_r(x, q_e)], and
+the Projection Equation B(19)–(25) for the slices gives
+
+    M_n = ∫ Jᵀ J dm,   h_n = −∫ Jᵀ (ω̃ ṙ + ω̃ v_c − (q̇_vᵀH_v q̇_v + q̇_wᵀH_w q̇_w) e_x − g_R) dm − K_e q_e
+
+(the bracket is J̇ ẏ + ω̃ v_c − g, the acceleration not proportional to ÿ), plus the rotary
+inertia of the slices (Rayleigh) with ω_c = (E − θ̃) ω + Φ_θᵀ q̇_e in the slice's frame,
+small rotation θ = Φ_θᵀ q_e, Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (torsion β, THEORY §10). Because
+u₂ is part of the kinematics, the projection of the slices' axial inertia loads on
+∂u₂/∂q gives the geometric stiffness ∫ N(x) Φ′Φ′ᵀ dx with N(x) = ∫ₓᴸ f_x: dynamic
+stiffening from spin, angular and frame acceleration and gravity alike, and the model
+stays conservative (tests/subsystems/test_beam.py checks energy). Integrals by
+Gauss–Legendre quadrature at stations fixed at construction.
+
+Letters: ``K_e`` is the stiffness matrix (``K`` is kept for q̇ = K ṡ).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.analysis.differentiation import complex_step
+from projeq.checks import count, finite_array, non_negative, positive
+from projeq.joints import Relative
+from projeq.spatial import cross, rotation_x, rotation_y, rotation_z, skew, skew_stack
+from projeq.subsystems.beam import shapes
+from projeq.subsystems.beam.checks import family_shapes, per_length
+from projeq.subsystems.beam.integrals import ShapeIntegrals
+from projeq.subsystems.beam.probes import BeamProbes
+
+
+class RitzBeam(BeamProbes):
+    """A beam subsystem: Euler–Bernoulli bending in two planes, optional axial and torsional
+    deformation and rotary inertia, dynamic stiffening, stiffness-proportional damping.
+
+    Parameters
+    ----------
+    length : float
+        L in m; the beam runs along the reference frame's x axis from its origin.
+    rho_A : float or callable
+        Mass per length ρA (kg/m), constant or a function of x.
+    EI_z, EI_y : float or callable
+        Bending stiffness for v (x–y plane) and w (x–z plane), N m²; EI_y defaults to EI_z.
+    EA : float or callable, optional
+        Axial stiffness (N), needed when ``n_u > 0``.
+    rho_I : (float, float), optional
+        Rotary inertia per length (ρI_y, ρI_z) in kg m; polar ρ(I_y + I_z). None: none.
+    n_v, n_w, n_u, n_beta : int
+        Number of Ritz functions for v, w, u and the torsion angle β (the accuracy knob).
+    GI_t : float or callable, optional
+        Torsional stiffness (N m²), needed when ``n_beta > 0``.
+    rho_I_p : float, optional
+        Polar mass moment per length ρI_p (kg m) of the torsion, needed when ``n_beta > 0``
+        unless ``rho_I`` gives it as ρ(I_y + I_z).
+    family : "polynomial", "clamped_free", "pinned_free" or a callable ``(n, L) -> shapes``
+        Bending family; the axial and torsional families are chosen alike ("polynomial" or
+        "clamped_free": the fixed–free bar's sines; "pinned_free" uses the latter; a
+        callable serves all deformations). A callable's output is checked by
+        :func:`projeq.subsystems.beam.checks.family_shapes`.
+    support : "clamped" or "pinned"
+        Geometric boundary conditions the bending functions must meet at the root:
+        Φ(0) = Φ′(0) = 0 (clamped) or Φ(0) = 0 (pinned: the joint carries the rigid
+        rotation about the pin). A family violating them is refused.
+    quadrature_order : int, optional
+        Gauss points along the beam (default 2·max(n) + 6).
+    stiffening : bool
+        Include u₂ (dynamic stiffening); default True.
+    damping : float
+        β of the stiffness-proportional damping force −β K_e q̇_e (s).
+    precomputed_integrals : bool
+        Assemble M_n, h_n from moments of the shape functions computed once (exact for
+        this model at any deformation, see :mod:`projeq.subsystems.beam.integrals`) instead of
+        quadrature per call; default False.
+    """
+
+    def __init__(
+        self,
+        length: float,
+        rho_A,
+        EI_z,
+        EI_y=None,
+        EA=None,
+        rho_I=None,
+        n_v: int = 4,
+        n_w: int = 4,
+        n_u: int = 0,
+        n_beta: int = 0,
+        GI_t=None,
+        rho_I_p=None,
+        family="polynomial",
+        support: str = "clamped",
+        quadrature_order: int | None = None,
+        stiffening: bool = True,
+        damping: float = 0.0,
+        precomputed_integrals: bool = False,
+    ):
+        self.length = L = positive("length", length)
+        for name, n in (("n_v", n_v), ("n_w", n_w), ("n_u", n_u), ("n_beta", n_beta)):
+            if int(n) != n or n < 0:
+                raise ValueError(f"{name}: number of Ritz functions must be a non-negative integer, got {n!r}")
+        self.n_u, self.n_v, self.n_w, self.n_beta = int(n_u), int(n_v), int(n_w), int(n_beta)
+        self.n_e = self.n_u + self.n_v + self.n_w + self.n_beta
+        if self.n_e == 0:
+            raise ValueError("n_v, n_w, n_u, n_beta: a beam needs at least one Ritz function")
+        if self.n_u and EA is None:
+            raise ValueError("EA: axial deformation (n_u > 0) needs the axial stiffness EA")
+        if self.n_beta and GI_t is None:
+            raise ValueError("GI_t: torsion (n_beta > 0) needs the torsional stiffness GI_t")
+        if self.n_beta and rho_I_p is None and rho_I is None:
+            raise ValueError("rho_I_p: torsion (n_beta > 0) needs the polar mass moment per length ρI_p")
+        if support not in ("clamped", "pinned"):
+            raise ValueError(f"support: must be 'clamped' or 'pinned', got {support!r}")
+        self.support = support
+        self.n_y = 6 + self.n_e
+        self.S = np.vstack((np.eye(6), np.zeros((self.n_e, 6))))
+        self.stiffening = bool(stiffening)
+        self.damping = non_negative("damping", damping)
+        default_order = 2 * max(self.n_u, self.n_v, self.n_w, self.n_beta) + 6
+        order = default_order if quadrature_order is None else quadrature_order
+        self.order = order = count("quadrature_order", order)
+        t, w = np.polynomial.legendre.leggauss(order)
+        self.x = x = 0.5 * L * (t + 1.0)
+        self.weights = 0.5 * L * w
+        self.mass_weights = self.weights * per_length("rho_A", rho_A, x)
+        self._shapes(family, L)
+        self._EI = {"z": EI_z, "y": EI_y if EI_y is not None else EI_z}
+        self._stiffness(EI_z, self._EI["y"], EA, GI_t)
+        self._rotary(rho_I, rho_I_p)
+        self._check_independent()
+        self.integrals = ShapeIntegrals(self) if precomputed_integrals else None
+        self._ports: dict = {}  # station data of joints attached to the beam, by station
+        self._warned = False  # the unstiffened-spin warning is given once per beam
+        self.first_frequency = self._first_frequency()
+
+    # -- precomputation ------------------------------------------------------------------
+    def _shapes(self, family, L) -> None:
+        """The families, their root check (support), and Φ, Φ′, Φ″, H at the stations."""
+        ends = np.cumsum([6, self.n_u, self.n_v, self.n_w, self.n_beta])
+        self.u_cols, self.v_cols, self.w_cols, self.beta_cols = (slice(a, b) for a, b in zip(ends[:-1], ends[1:]))
+        bending = (0, 1) if self.support == "clamped" else (0,)
+        axial_family = "clamped_free" if family == "pinned_free" else family
+        self.families = {}
+        for key, n, fam_name, table, conditions in (
+            ("u", self.n_u, axial_family, shapes.AXIAL, (0,)),
+            ("v", self.n_v, family, shapes.BENDING, bending),
+            ("w", self.n_w, family, shapes.BENDING, bending),
+            ("beta", self.n_beta, axial_family, shapes.AXIAL, (0,)),
+        ):
+            self.families[key] = fam = family_shapes(fam_name, table, n, L, key)
+            if fam is None:
+                continue
+            at_root = fam(np.zeros(1))
+            for derivative in conditions:
+                bad = np.flatnonzero(np.abs(at_root[derivative][:, 0]) > 1e-12)
+                if bad.size:
+                    what = "Φ(0)" if derivative == 0 else "Φ′(0)"
+                    raise ValueError(
+                        f"family: Ritz functions {bad.tolist()} for {key} violate the geometric boundary "
+                        f"condition of the {self.support} root ({what} ≠ 0)"
+                    )
+        self.Phi, self.H = self.station_data(self.x)
+
+    def station_data(self, x: NDArray) -> tuple[dict, dict]:
+        """Φ, Φ′, Φ″ of u, v, w at stations x, and H(x) = ∫₀ˣ Φ′Φ′ᵀ dξ of v and w
+        (by Gauss quadrature of the beam's order on [0, x])."""
+        sizes = {"u": self.n_u, "v": self.n_v, "w": self.n_w}
+        Phi = {
+            key: tuple(np.asarray(p, dtype=float) for p in fam(x)) if fam else tuple(np.zeros((0, len(x))) for _ in range(4))
+            for key, fam in self.families.items()
+        }
+        t, w = np.polynomial.legendre.leggauss(self.order)
+        xi = 0.5 * x[:, None] * (t[None, :] + 1.0)  # quadrature points in [0, x]
+        H = {}
+        for key in ("v", "w"):
+            n, fam = sizes[key], self.families[key]
+            if fam is None:
+                H[key] = np.zeros((len(x), 0, 0))
+                continue
+            d1 = np.asarray(fam(xi.ravel())[1]).reshape(n, len(x), len(t))
+            H[key] = np.einsum("igk,jgk,gk->gij", d1, d1, 0.5 * x[:, None] * w[None, :])
+        return Phi, H
+
+    def _stiffness(self, EI_z, EI_y, EA, GI_t) -> None:
+        """K_e = ∫ (EA Φ_u′Φ_u′ᵀ + EI_z Φ_v″Φ_v″ᵀ + EI_y Φ_w″Φ_w″ᵀ + GI_t Φ_β′Φ_β′ᵀ) dx
+        (block diagonal, THEORY §10)."""
+        self.K_e = np.zeros((self.n_e, self.n_e))
+        blocks = (
+            ("u", 1, EA, "EA", self.u_cols),
+            ("v", 2, EI_z, "EI_z", self.v_cols),
+            ("w", 2, EI_y, "EI_y", self.w_cols),
+            ("beta", 1, GI_t, "GI_t", self.beta_cols),
+        )
+        for key, derivative, stiffness, name, cols in blocks:
+            if cols.stop == cols.start:
+                continue
+            D = self.Phi[key][derivative]
+            k = self.weights * per_length(name, stiffness, self.x)
+            sl = slice(cols.start - 6, cols.stop - 6)
+            self.K_e[sl, sl] = (D * k) @ D.T
+
+    def _rotary(self, rho_I, rho_I_p) -> None:
+        """Rotary inertia per station diag(ρI_p, ρI_y, ρI_z) (ρI_p = ρ(I_y + I_z) unless
+        given) and J_ω(x) = [0, E, Φ_θ], Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (THEORY §10)."""
+        if rho_I is None and rho_I_p is None:
+            self.rotary = None
+            return
+        I_y, I_z = 0.0, 0.0
+        if rho_I is not None:
+            rho_I = finite_array("rho_I", rho_I)
+            if rho_I.size not in (1, 2):
+                raise ValueError(f"rho_I: expected ρI or (ρI_y, ρI_z), got {rho_I.size} values")
+            rho_I = np.broadcast_to(rho_I.ravel(), (2,))
+            I_y, I_z = (positive(f"rho_I[{i}]", v) for i, v in enumerate(rho_I))
+        I_p = I_y + I_z if rho_I_p is None else positive("rho_I_p", rho_I_p)
+        self.rotary = self.weights[:, None] * np.array([I_p, I_y, I_z])[None, :]
+        J = np.zeros((len(self.x), 3, self.n_y))
+        J[:, :, 3:6] = np.eye(3)
+        J[:, 0, self.beta_cols] = self.Phi["beta"][0].T  # twist about x: β
+        J[:, 1, self.w_cols] = -self.Phi["w"][1].T  # rotation about y: −w′
+        J[:, 2, self.v_cols] = self.Phi["v"][1].T  # rotation about z: +v′
+        self.J_omega = J
+
+    def _check_independent(self) -> None:
+        gram = np.zeros((self.n_e, self.n_e))
+        for key, cols in (("u", self.u_cols), ("v", self.v_cols), ("w", self.w_cols), ("beta", self.beta_cols)):
+            P, sl = self.Phi[key][0], slice(cols.start - 6, cols.stop - 6)
+            gram[sl, sl] = (P * self.weights) @ P.T
+        eigenvalues, vectors = np.linalg.eigh(gram)
+        if eigenvalues[0] <= 1e-14 * eigenvalues[-1]:  # numerically singular (polynomials: n ≤ 9 pass, n = 10 not)
+            involved = [self._name(k) for k in np.flatnonzero(np.abs(vectors[:, 0]) > 1e-3)]
+            raise ValueError(
+                f"family: the Ritz functions {involved} are linearly dependent to machine precision "
+                "(singular mass matrix); for many functions use family='clamped_free'"
+            )
+
+    def _name(self, k: int) -> str:
+        """Name of elastic coordinate k: the deformation and the function's index in it."""
+        for key, cols in (("u", self.u_cols), ("v", self.v_cols), ("w", self.w_cols), ("beta", self.beta_cols)):
+            if cols.start - 6 <= k < cols.stop - 6:
+                return f"{key}[{k - cols.start + 6}]"
+        raise IndexError(k)
+
+    def _first_frequency(self) -> float:
+        """Lowest bending frequency of the beam at rest on its support (rad/s), from the
+        bending blocks of M_ee and K_e."""
+        from scipy.linalg import eigh
+
+        M, _ = self.gauss_terms(np.zeros(self.n_y), np.eye(3), np.zeros(3), np.zeros(self.n_e))
+        bending = np.r_[self.v_cols, self.w_cols] - 6
+        if bending.size == 0:
+            return np.inf
+        M_b, K_b = M[6:, 6:][np.ix_(bending, bending)], self.K_e[np.ix_(bending, bending)]
+        return float(np.sqrt(max(eigh(K_b, M_b, eigvals_only=True)[0], 0.0)))
+
+    def _warn_unstiffened_spin(self, omega: NDArray) -> None:
+        """Without stiffening a spin about an axis across the beam faster than its first
+        bending frequency makes the model unstable (ω_lag² = ω₁² − Ω² < 0): allowed, but
+        said once."""
+        spin = float(np.hypot(omega[1], omega[2]))
+        if spin > self.first_frequency:
+            import warnings
+
+            self._warned = True
+            warnings.warn(
+                f"RitzBeam without stiffening spins at {spin:.3g} rad/s, above its first bending "
+                f"frequency {self.first_frequency:.3g} rad/s: the unstiffened model is unstable there "
+                "(use stiffening=True)",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+
+    # -- slice kinematics ------------------------------------------------------------------
+    def _slices(self, q_e: NDArray, x: NDArray | None = None, data=None):
+        """r(x) and Φ_r(x, q_e) at the quadrature stations (or at ``x`` with its
+        ``station_data``)."""
+        x, (Phi, H) = (self.x, (self.Phi, self.H)) if x is None else (x, data)
+        e = self._local  # columns of ẏ → positions within q_e
+        q_u, q_v, q_w = q_e[e(self.u_cols)], q_e[e(self.v_cols)], q_e[e(self.w_cols)]
+        dtype = np.result_type(q_e, float)  # complex for the complex-step derivative of ports
+        r = np.zeros((len(x), 3), dtype=dtype)
+        r[:, 0] = x + q_u @ Phi["u"][0]
+        r[:, 1] = q_v @ Phi["v"][0]
+        r[:, 2] = q_w @ Phi["w"][0]
+        Phi_r = np.zeros((len(x), 3, self.n_e), dtype=dtype)
+        Phi_r[:, 0, e(self.u_cols)] = Phi["u"][0].T
+        Phi_r[:, 1, e(self.v_cols)] = Phi["v"][0].T
+        Phi_r[:, 2, e(self.w_cols)] = Phi["w"][0].T
+        if self.stiffening:
+            Hq_v, Hq_w = H["v"] @ q_v, H["w"] @ q_w
+            r[:, 0] -= 0.5 * (Hq_v @ q_v + Hq_w @ q_w)  # u₂
+            Phi_r[:, 0, e(self.v_cols)] = -Hq_v  # ∂u₂/∂q_v
+            Phi_r[:, 0, e(self.w_cols)] = -Hq_w
+        return r, Phi_r
+
+    def _jacobian(self, r: NDArray, Phi_r: NDArray) -> NDArray:
+        """J(x) = [E, −r̃(x), Φ_r(x)], stacked over the stations."""
+        J = np.empty((len(r), 3, self.n_y))
+        J[:, :, :3] = np.eye(3)
+        J[:, :, 3:6] = -skew_stack(r)
+        J[:, :, 6:] = Phi_r
+        return J
+
+    # -- the subsystem interface -------------------------------------------------------------
+    def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray):
+        """(M_n, h_n) of B(25) by quadrature (see the module docstring) or, with
+        ``precomputed_integrals``, from the shape integrals."""
+        omega, q_e_dot = y_dot[3:6], y_dot[6:]
+        self._check_spin(omega)
+        if getattr(self, "integrals", None) is None:
+            M, h = self._translation_terms(y_dot, R, gravity, q_e)
+        else:
+            M, h = self.integrals.terms(y_dot, R, gravity, q_e)
+        if self.rotary is not None:
+            Jw, omega_c, c_w = self._slice_rotation(omega, q_e, q_e_dot, y_dot)
+            Jw_flat = (Jw * np.sqrt(self.rotary)[:, :, None]).reshape(-1, self.n_y)
+            M += Jw_flat.T @ Jw_flat
+            h -= Jw.reshape(-1, self.n_y).T @ (self.rotary * c_w + cross(omega_c, self.rotary * omega_c)).ravel()
+        h[6:] -= self._restoring_force(q_e, q_e_dot)
+        return M, h
+
+    def elastic_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray):
+        """The last n_e rows (M_e, h_e) of :meth:`gauss_terms`: all a beam on a prescribed
+        hub needs (:mod:`projeq.assembly.beam_fast`); with precomputed integrals and no
+        rotary inertia only these rows are formed."""
+        if getattr(self, "integrals", None) is None or self.rotary is not None:
+            M, h = self.gauss_terms(y_dot, R, gravity, q_e)
+            return M[6:], h[6:]
+        self._check_spin(y_dot[3:6])
+        M_e, h_e = self.integrals.elastic_rows(y_dot, R, gravity, q_e)
+        return M_e, h_e - self._restoring_force(q_e, y_dot[6:])
+
+    def _check_spin(self, omega: NDArray) -> None:
+        """Warn once if the unstiffened model spins above its first bending frequency."""
+        if not (self.stiffening or self._warned) and hasattr(self, "first_frequency"):
+            self._warn_unstiffened_spin(omega)
+
+    def _restoring_force(self, q_e: NDArray, q_e_dot: NDArray) -> NDArray:
+        """K_e (q_e + d q̇_e): elastic and stiffness-proportional damping forces."""
+        return self.K_e @ (q_e + self.damping * q_e_dot)
+
+    def _translation_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray):
+        """∫Jᵀ J dm and −∫Jᵀ c dm of the slices' translation by quadrature."""
+        r, Phi_r = self._slices(q_e)
+        J = self._jacobian(r, Phi_r)
+        v_R, omega, q_e_dot = y_dot[:3], y_dot[3:6], y_dot[6:]
+        r_dot = Phi_r @ q_e_dot
+        v_c = v_R + cross(omega, r) + r_dot
+        c = cross(omega, r_dot) + cross(omega, v_c) - R.T @ gravity  # J̇ẏ + ω̃ v_c − g
+        if self.stiffening:
+            qd_v, qd_w = q_e_dot[self._local(self.v_cols)], q_e_dot[self._local(self.w_cols)]
+            c[:, 0] -= (self.H["v"] @ qd_v) @ qd_v + (self.H["w"] @ qd_w) @ qd_w  # d/dt(∂u₂/∂q) q̇
+        J_flat = (J * np.sqrt(self.mass_weights)[:, None, None]).reshape(-1, self.n_y)
+        M = J_flat.T @ J_flat
+        h = -J.reshape(-1, self.n_y).T @ (c * self.mass_weights[:, None]).ravel()
+        return M, h
+
+    def _slice_rotation(self, omega, q_e, q_e_dot, y_dot):
+        """Angular velocity of the slices in their own (slightly turned) frames,
+        ω_c = (E − θ̃) ω + Φ_θᵀ q̇_e with the small rotation θ(x) = Φ_θᵀ q_e = (β, −w′, v′):
+        its Jacobian J_ω(x, q_e), ω_c, and J̇_ω ẏ = ω̃ θ̇ (the rotary-inertia terms of the
+        Rayleigh beam; with Euler's ω̃_c I ω_c the power is exactly d/dt ½ ω_cᵀ I ω_c)."""
+        J = self.J_omega.copy()
+        theta = J[:, :, 6:] @ q_e
+        J[:, :, 3:6] -= skew_stack(theta)
+        return J, J @ y_dot, cross(omega, J[:, :, 6:] @ q_e_dot)
+
+    def kinetic_energy(self, y_dot: NDArray, q_e: NDArray) -> float:
+        """½ ẏᵀ M ẏ (exact for the slice kinematics)."""
+        M, _ = self.gauss_terms(y_dot, np.eye(3), np.zeros(3), q_e)
+        return 0.5 * float(y_dot @ M @ y_dot)
+
+    def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray, q_e: NDArray) -> float:
+        """Gravity −∫ g·r_slice dm plus the strain energy ½ q_eᵀ K_e q_e."""
+        r_x, _ = self._slices(q_e)
+        return float(-self.mass_weights @ (r_x @ R.T + r) @ gravity + 0.5 * q_e @ self.K_e @ q_e)
+
+    def port(self, point: NDArray, q_e: NDArray, q_e_dot: NDArray) -> Relative:
+        """Kinematics of a frame attached at ``point`` of the undeformed beam (station
+        x = point[0], cross-section offset c = (0, point[1], point[2])), relative to the
+        beam's reference frame, as a joint would give them (THEORY §10, last line):
+
+        pose A = R_z(v′) R_y(−w′) R_x(β) (Bremer's Cardan sequence, B(17)), r = r(x) + A c;
+        relative twist F q̇_e in port coordinates with F = [[Aᵀ Φ_r − c̃ Φ_ω], [Φ_ω]],
+        Φ_ω q̇_e = R_xᵀ(v̇′ (−sin(−w′), 0, cos(−w′)) − ẇ′ e_y) + β̇ e_x; Ḟ q̇_e by complex step.
+        """
+        x = float(point[0])
+        if not 0.0 <= x <= self.length:
+            raise ValueError(f"r_pn: a joint on a beam must sit at a station 0 ≤ x ≤ {self.length}, got x = {x}")
+        offset = np.array([0.0, point[1], point[2]])
+        data = self._port_data(x)
+        A, r, F = self._port_terms(q_e, data, offset)
+        F_dot = complex_step(lambda eps: self._port_terms(q_e + eps * q_e_dot, data, offset)[2])
+        return Relative(A, r, F, F @ q_e_dot, F_dot @ q_e_dot)
+
+    def _port_data(self, x: float):
+        """Station data at x, kept per station (ports sit at fixed stations)."""
+        if x not in self._ports:
+            self._ports[x] = (np.array([x]), self.station_data(np.array([x])))
+        return self._ports[x]
+
+    def _port_terms(self, q_e, data, offset):
+        """(A, r, F) of a port; complex-safe, for the complex-step Ḟ."""
+        x, (Phi, H) = data
+        r_x, Phi_r = self._slices(q_e, x, (Phi, H))
+        e = self._local
+        a = Phi["v"][1][:, 0] @ q_e[e(self.v_cols)]  # v′
+        b = -(Phi["w"][1][:, 0] @ q_e[e(self.w_cols)])  # −w′
+        beta = Phi["beta"][0][:, 0] @ q_e[e(self.beta_cols)]
+        R_x = rotation_x(beta)
+        A = rotation_z(a) @ rotation_y(b) @ R_x
+        Phi_omega = np.zeros((3, self.n_e), dtype=A.dtype)
+        Phi_omega[0, e(self.v_cols)] = -np.sin(b) * Phi["v"][1][:, 0]
+        Phi_omega[2, e(self.v_cols)] = np.cos(b) * Phi["v"][1][:, 0]
+        Phi_omega[1, e(self.w_cols)] = -Phi["w"][1][:, 0]
+        Phi_omega = R_x.T @ Phi_omega
+        Phi_omega[0, e(self.beta_cols)] += Phi["beta"][0][:, 0]
+        F = np.vstack((A.T @ Phi_r[0] - skew(offset) @ Phi_omega, Phi_omega))
+        return A, r_x[0] + A @ offset, F
+
+    def __repr__(self) -> str:
+        counts = f"n_u={self.n_u}, n_v={self.n_v}, n_w={self.n_w}, n_beta={self.n_beta}"
+        return f"RitzBeam(L={self.length}, {counts}, support={self.support!r}, stiffening={self.stiffening})"

@@ -1,0 +1,106 @@
+"""Probes of a :class:`~projeq.subsystems.beam.beam.RitzBeam` along a simulated trajectory:
+displacement, slopes and section forces at a station x (issue 6, "Beam probes").
+
+Section forces follow Euler–Bernoulli beam theory: bending moments M = EI Φ″ᵀq and shear
+forces Q = −(EI Φ″ᵀq)′, the force that the part of the beam beyond x exerts on the part
+before x, in the beam's reference frame (a tip load P gives Q = P along the beam).
+Ritz section forces converge more slowly than displacements (two and three derivatives).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+
+class BeamProbes:
+    """Mixin of RitzBeam: probes at stations (needs ``station_data``, ``_slices`` and the
+    column slices of the beam)."""
+
+    def displacement(self, q_e, x) -> NDArray:
+        """(u + u₂, v, w) at stations x in the beam's reference frame: for one q_e a
+        (len(x), 3) array, for a trajectory of q_e (rows) a (n_t, len(x), 3) array."""
+        x = self._stations(x)
+        data = self.station_data(x)
+        q_e = np.asarray(q_e, dtype=float)
+        rows = [self._slices(q, x, data)[0] - np.outer(x, (1.0, 0.0, 0.0)) for q in np.atleast_2d(q_e)]
+        return np.array(rows) if q_e.ndim == 2 else rows[0]
+
+    def _stations(self, x) -> NDArray:
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        if np.any(x < 0) or np.any(x > self.length):
+            raise ValueError(f"x: stations must lie on the beam, 0 ≤ x ≤ {self.length}")
+        return x
+
+    def centre_line(self, q_e: NDArray, y_dot: NDArray, stations: int = 21) -> tuple[NDArray, NDArray]:
+        """Positions r(x) and velocities J(x) ẏ of ``stations`` equally spaced points of the
+        centre line, in the beam's reference frame (for drawing and export)."""
+        x = np.linspace(0.0, self.length, int(stations))
+        r, Phi_r = self._slices(q_e, x, self.station_data(x))
+        return r, self._jacobian(r, Phi_r) @ y_dot
+
+    def _coordinates(self, result) -> NDArray:
+        """This beam's q_e along a trajectory (rows), found in ``result.system``; a plain
+        array of q_e rows is taken as is."""
+        if isinstance(result, np.ndarray):
+            return np.atleast_2d(result)
+        system = getattr(result, "system", None)
+        if system is None:
+            raise ValueError("result: has no system (loaded from a file?); probe a Result from simulate()")
+        places = [n for n, sub in enumerate(system.subsystems) if sub is self]
+        if len(places) != 1:
+            raise ValueError(f"result: this beam appears {len(places)} times in the system; probe it by q_e")
+        return result.q[:, system.e_q_slice[places[0]]]
+
+    def deflection(self, result, x: float) -> NDArray:
+        """(u, v, w) at station x in the beam's reference frame along a simulated
+        trajectory: one row per time point (u includes the foreshortening u₂)."""
+        return self.displacement(self._coordinates(result), [x])[:, 0, :]
+
+    def slope(self, result, x: float) -> NDArray:
+        """(v′, w′) at station x, one row per time point."""
+        return self._derivative(result, x, 1)
+
+    def twist(self, result, x: float) -> NDArray:
+        """Torsion angle β at station x (rad), one value per time point (zeros without
+        torsional functions)."""
+        q_e = self._coordinates(result)
+        Phi, _ = self.station_data(self._stations(x))
+        return q_e[:, self._local(self.beta_cols)] @ Phi["beta"][0][:, 0]
+
+    def bending_moment(self, result, x: float) -> NDArray:
+        """Bending moments (EI_z v″, EI_y w″) at station x (N m), one row per time point."""
+        return self._derivative(result, x, 2) * np.array([self._EI_at(x, "z"), self._EI_at(x, "y")])
+
+    def shear_force(self, result, x: float) -> NDArray:
+        """Shear forces (Q_y, Q_z) = −((EI_z v″)′, (EI_y w″)′) at station x (N), one row per
+        time point: the force of the part beyond x on the part before x. For x-dependent
+        EI its slope comes from central differences (relative error ~1e-10)."""
+        EI = np.array([self._EI_at(x, "z"), self._EI_at(x, "y")])
+        h = 1e-6 * self.length
+        ahead, behind = min(x + h, self.length), max(x - h, 0.0)
+        EI_ahead, EI_behind = ([self._EI_at(at, axis) for axis in "zy"] for at in (ahead, behind))
+        EI_slope = (np.array(EI_ahead) - EI_behind) / (ahead - behind)
+        return -(EI_slope * self._derivative(result, x, 2) + EI * self._derivative(result, x, 3))
+
+    def _derivative(self, result, x: float, order: int) -> NDArray:
+        """(v, w) derivatives of the given order at station x, one row per time point."""
+        q_e = self._coordinates(result)
+        Phi, _ = self.station_data(self._stations(x))
+        if any(len(Phi[key]) <= order for key in ("v", "w")):
+            raise ValueError(
+                f"family: derivative {order} of the Ritz functions is needed here; the user family "
+                f"gives only {len(Phi['v'])} arrays (Φ, Φ′, Φ″[, Φ‴])"
+            )
+        v = q_e[:, self._local(self.v_cols)] @ Phi["v"][order][:, 0]
+        w = q_e[:, self._local(self.w_cols)] @ Phi["w"][order][:, 0]
+        return np.column_stack((v, w))
+
+    def _EI_at(self, x: float, axis: str) -> float:
+        EI = self._EI[axis]
+        return float(EI(np.array([x]))[0]) if callable(EI) else float(EI)
+
+    @staticmethod
+    def _local(cols: slice) -> slice:
+        """Columns of ẏ → positions within q_e."""
+        return slice(cols.start - 6, cols.stop - 6)

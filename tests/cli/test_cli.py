@@ -1,0 +1,278 @@
+"""The projeq command: list, run, sweep, compare, one exit-code convention, bad input."""
+
+import io
+import os
+import runpy
+import signal
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import projeq as pq
+import projeq.cli.studies
+import projeq.simulation.driver
+from projeq.cli.commands import main
+
+
+def atwood_angle(m1, t, m2=1.0, pulley_mass=0.5, a=0.1, g=9.81):
+    """Pulley angle of ``atwood`` from rest: θ = −½ ẍ t²/a, ẍ = (m1 − m2) g / (m1 + m2 + I/a²),
+    I = ½ M a² (Problem 1, eq. (4) of ../shared/seeds/003_13b1ca6faae9f37e.txt)."""
+    return -0.5 * (m1 - m2) * g / (m1 + m2 + 0.5 * pulley_mass) * t**2 / a
+
+
+def test_list_names_every_scene(capsys):
+    assert main(["list"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split()[0] for line in lines] == list(pq.scenes.SCENES)
+
+
+def test_list_scene_shows_parameters_with_units_and_defaults(capsys):
+    assert main(["list", "atwood"]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:]]
+    assert ["m1", "2.0", "kg"] in rows and ["radius", "0.1", "m"] in rows and ["g", "9.81", "m/s²"] in rows
+
+
+def test_list_a_constrained_scene(capsys):
+    """The Whipple bicycle (a ConstrainedSystem) lists its initial speed and angles with units."""
+    assert main(["list", "whipple_bicycle"]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:]]
+    assert ["speed", "4.0", "m/s"] in rows and ["roll", "0.0", "rad"] in rows and ["steer_rate", "0.0", "rad/s"] in rows
+
+
+@pytest.mark.parametrize("name", list(pq.scenes.SCENES))
+def test_every_real_valued_parameter_has_a_unit(name):
+    """Scenes as data (issue 8, item 7): a parameter with a float or tuple default is a
+    physical quantity, so its unit must be known (counts and switches are dimensionless)."""
+    missing = [p.name for p in pq.scenes.scene_parameters(pq.scenes.SCENES[name])
+               if isinstance(p.default, (float, tuple)) and p.unit == "-"]
+    assert missing == []
+
+
+def test_run_writes_results_that_load_back(tmp_path, capsys):
+    """A short run of the default scene: exit 0, summary printed, NPZ equal to CSV, plots and
+    the ParaView series written."""
+    assert main(["run", "--t-end", "0.2", "--out", str(tmp_path), "--quiet"]) == 0
+    assert capsys.readouterr().out == ""
+    result = pq.Result.load(tmp_path / "spin_up_beam.npz")
+    table = np.loadtxt(tmp_path / "spin_up_beam.csv", delimiter=",", skiprows=1)
+    assert np.allclose(table[:, 0], result.t) and (tmp_path / "paraview" / "spin_up_beam.pvd").exists()
+    assert {p.name for p in tmp_path.glob("*.png")} == {
+        "spin_up_beam_history.png", "spin_up_beam_drift.png", "spin_up_beam_tip_beam.png"}
+
+
+def test_set_overrides_a_parameter(tmp_path, capsys):
+    """--set m1=3 reaches the model: the final pulley angle is the closed form's for m1 = 3 kg
+    (constant acceleration; rtol 1e-10 gives ~1e-10, checked to 1e-8 relative)."""
+    assert main(["run", "atwood", "--set", "m1=3", "--t-end", "0.5", "--rtol", "1e-10", "--out", str(tmp_path)]) == 0
+    assert "energy" in capsys.readouterr().out
+    result = pq.Result.load(tmp_path / "atwood.npz")
+    assert result.q[-1, 0] == pytest.approx(atwood_angle(3.0, 0.5), rel=1e-8)
+
+
+def test_failed_run_exits_1_with_partial_results(tmp_path, capsys, monkeypatch):
+    """A run that fails half way writes what it computed and says how far it got."""
+    real = projeq.simulation.driver.simulate
+
+    def failing(system, t_end, **options):
+        partial = real(system, t_end / 2, **options)
+        raise projeq.simulation.driver.SimulationError(f"integration failed at t = {t_end / 2} s", partial)
+
+    monkeypatch.setattr(projeq.simulation.driver, "simulate", failing)
+    assert main(["run", "chain", "--t-end", "0.2", "--out", str(tmp_path), "--quiet"]) == 1
+    assert "failed at t = 0.1" in capsys.readouterr().err
+    assert pq.Result.load(tmp_path / "chain.npz").t[-1] == pytest.approx(0.1)
+
+
+def test_ctrl_c_exits_1_and_keeps_the_trajectory(tmp_path, capsys, monkeypatch):
+    """A KeyboardInterrupt during the run (raised from the progress callback after the
+    simulated time passes 0.1 s): the finished segments are written."""
+    real = projeq.simulation.driver.simulate
+
+    def interrupted(system, t_end, progress=None, **options):
+        def progress_then_ctrl_c(t):
+            progress(t)
+            if t > 0.1:
+                raise KeyboardInterrupt
+
+        return real(system, t_end, progress=progress_then_ctrl_c, **options)
+
+    monkeypatch.setattr(projeq.simulation.driver, "simulate", interrupted)
+    assert main(["run", "chain", "--t-end", "1", "--out", str(tmp_path), "--quiet"]) == 1
+    assert "interrupted at t = " in capsys.readouterr().err
+    saved = pq.Result.load(tmp_path / "chain.npz")
+    assert saved.status == 2 and 0.1 < saved.t[-1] < 1.0
+
+
+# Child processes for the Ctrl-C tests: Python's own SIGINT handler (a shell may start
+# background jobs with SIGINT ignored), and a line on stdout once there is something to keep.
+_CHILD = """
+import signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
+import projeq.simulation.driver, projeq.simulation.sweep
+from projeq.cli.commands import main
+simulate, as_completed = projeq.simulation.driver.simulate, projeq.simulation.sweep.cf.as_completed
+
+def reporting_simulate(system, t_end, progress=None, **options):  # projeq run passes a progress bar
+    def report(t):
+        progress(t)
+        print("segment done", flush=True)
+    return simulate(system, t_end, progress=progress and report, **options)
+
+def reporting_as_completed(futures):
+    for future in as_completed(futures):
+        yield future
+        print("point done", flush=True)
+
+projeq.simulation.driver.simulate, projeq.simulation.sweep.cf.as_completed = reporting_simulate, reporting_as_completed
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def ctrl_c(argv):
+    """Run ``projeq argv`` in a new process group, press Ctrl-C (SIGINT to the group, as a
+    terminal does) once it reports progress; its exit code and stderr."""
+    child = subprocess.Popen([sys.executable, "-c", _CHILD, *argv], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, start_new_session=True)
+    assert child.stdout.readline().endswith("done\n")
+    os.killpg(child.pid, signal.SIGINT)
+    _, err = child.communicate(timeout=120)
+    return child.returncode, err
+
+
+def test_a_real_ctrl_c_during_run_writes_the_trajectory_so_far(tmp_path):
+    """SIGINT arrives anywhere in the integrator: exit 1, and the results up to the last
+    finished segment (1 % of the run) are written and load back."""
+    code, err = ctrl_c(["run", "chain", "--set", "n=1", "--t-end", "1000", "--out", str(tmp_path), "--quiet"])
+    assert code == 1 and "interrupted at t = " in err and "Traceback" not in err
+    saved = pq.Result.load(tmp_path / "chain.npz")
+    assert saved.status == 2 and 10.0 <= saved.t[-1] < 1000.0
+
+
+def test_a_real_ctrl_c_during_sweep_keeps_finished_and_partial_points(tmp_path):
+    """Ctrl-C reaches the main process and the pool's workers: the finished point (n = 1) is
+    kept, the running one (n = 60) returns as interrupted (status 2), nothing dies with a
+    traceback, and the table is written; exit 1."""
+    code, err = ctrl_c(["sweep", "chain", "--grid", "n=1:60:2", "--t-end", "5", "--rtol", "1e-6", "--workers", "2",
+                        "--outputs", "q0", "--out", str(tmp_path), "--quiet"])
+    assert code == 1 and "Traceback" not in err
+    table = np.load(tmp_path / "sweep_chain.npz", allow_pickle=True)
+    assert table["n"].tolist() == [1, 60] and table["status"].tolist() == [0, 2]
+    assert np.isfinite(table["q0"][0])
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["run", "chian"], "did you mean 'chain'"),
+        (["run", "chain", "--set", "nn=3"], "nn: unknown parameter (did you mean 'n'?)"),
+        (["run", "chain", "--set", "n=three"], "n: expected an integer, got 'three'"),
+        (["run", "chain", "--set", "n"], "--set: expected name=value"),
+        (["run", "atwood", "--set", "m1=heavy"], "m1: expected a number"),
+        (["run", "chain", "--set", "planar=maybe"], "planar: expected a bool"),
+        (["run", "chain", "--set", "n=0"], "n: number of links"),
+        (["list", "nope"], "unknown scene 'nope'"),
+        (["sweep", "chain", "--grid", "n=1:3"], "--grid: expected NAME=A:B:N"),
+        (["sweep", "chain", "--grid", "links=1:3:3"], "links: unknown parameter"),
+        (["sweep", "chain", "--grid", "n=1:2:2", "--workers", "0"], "--workers: expected a positive count"),
+    ],
+    ids=["scene", "parameter", "int", "setting", "float", "bool", "scene-check", "list", "grid", "grid-name",
+         "workers"],
+)
+def test_bad_arguments_exit_2_with_the_reason(argv, message, capsys, tmp_path):
+    assert main(argv + (["--out", str(tmp_path)] if argv[0] in ("run", "sweep") else [])) == 2
+    assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", [["run", "chain"], ["sweep", "atwood", "--grid", "m1=1:2:2", "--workers", "1"]])
+def test_an_output_directory_that_cannot_be_written(command, tmp_path, capsys):
+    (tmp_path / "file").write_text("")
+    assert main(command + ["--out", str(tmp_path / "file" / "out")]) == 2
+    assert "--out: cannot write to directory" in capsys.readouterr().err
+
+
+def test_compare_hands_its_options_to_the_library(monkeypatch, capsys):
+    seen = []
+
+    def compare(*args, **options):
+        seen.append((args, options))
+        return pq.ComparisonTable("car")
+
+    monkeypatch.setattr(projeq.cli.studies, "compare", compare)
+    assert main(["compare", "car", "--no-simulate", "--t-end", "1.5", "--formulation", "hamel", "--repeats", "3"]) == 0
+    assert seen == [(("car", ["hamel"]), {"simulate": False, "t_end": 1.5, "repeats": 3})]
+    assert capsys.readouterr().out.startswith("compare car")
+
+
+@pytest.mark.parametrize("error, code", [(ValueError("t_end: must be positive"), 2),
+                                         (RuntimeError("reference: the run failed"), 1),
+                                         (KeyboardInterrupt(), 1)])
+def test_one_exit_code_convention_for_every_subcommand(error, code, monkeypatch, capsys):
+    """A ValueError (a refused input) is exit code 2, a RuntimeError (a failed run) or Ctrl-C
+    exit code 1, each with a one-line message naming the subcommand and no traceback."""
+    def failing(*args, **options):
+        raise error
+
+    monkeypatch.setattr(projeq.cli.studies, "compare", failing)
+    assert main(["compare", "car"]) == code
+    err = capsys.readouterr().err
+    assert err.startswith("projeq compare: ") and (str(error) or "interrupted") in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("command", [[], ["list"], ["run"], ["sweep"], ["compare"], ["bench"], ["tradeoff"]])
+def test_help_everywhere(command, capsys):
+    assert main(command + ["--help"]) == 0
+    assert "usage: projeq" in capsys.readouterr().out
+
+
+def test_usage_errors_exit_2_without_raising(capsys):
+    assert main(["no-such-command"]) == 2 and main(["run", "--rtol", "tight"]) == 2
+    assert "invalid choice: 'no-such-command'" in capsys.readouterr().err
+
+
+def test_sweep_writes_one_table(tmp_path, capsys):
+    """projeq sweep: a 3-point grid of the Atwood machine, final angles = closed form."""
+    argv = ["sweep", "atwood", "--grid", "m1=1:3:3", "--t-end", "0.5", "--rtol", "1e-10", "--outputs", "q0",
+            "--workers", "2", "--out", str(tmp_path), "--quiet"]
+    assert main(argv) == 0
+    table = np.genfromtxt(tmp_path / "sweep_atwood.csv", delimiter=",", names=True, usecols=(0, 1, 2))
+    assert np.allclose(table["q0"], [atwood_angle(m, 0.5) for m in (1.0, 2.0, 3.0)], rtol=1e-8, atol=1e-12)
+
+
+def test_unreachable_scheduler_writes_nothing(tmp_path, capsys):
+    pytest.importorskip("dask.distributed")
+    argv = ["sweep", "atwood", "--grid", "m1=1:3:3", "--scheduler", "tcp://127.0.0.1:9",
+            "--scheduler-timeout", "0.5", "--out", str(tmp_path)]
+    assert main(argv) == 2
+    assert "cannot reach the Dask scheduler" in capsys.readouterr().err and not list(tmp_path.iterdir())
+
+
+def test_python_dash_m_is_the_same_command(capsys, monkeypatch):
+    monkeypatch.setattr(sys, "argv", ["projeq", "list"])
+    monkeypatch.delitem(sys.modules, "projeq.__main__", raising=False)
+    with pytest.raises(SystemExit) as exit_:
+        runpy.run_module("projeq", run_name="__main__")
+    assert exit_.value.code == 0 and capsys.readouterr().out.split()[0] == next(iter(pq.scenes.SCENES))
+
+
+class Terminal(io.StringIO):
+    """A stand-in for a terminal on stderr."""
+
+    def isatty(self):
+        return True
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_progress_bar_on_a_terminal_unless_quiet(quiet, tmp_path, monkeypatch):
+    terminal = Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    argv = ["run", "atwood", "--t-end", "0.2", "--out", str(tmp_path)] + (["--quiet"] if quiet else [])
+    assert main(argv) == 0
+    assert ("100%|" in terminal.getvalue() and "t = 0.2/0.2 s" in terminal.getvalue()) is not quiet
+
+
+def test_version(capsys):
+    """``projeq --version`` prints the one version source, ``projeq.__version__``, and exits 0."""
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"projeq {pq.__version__}"

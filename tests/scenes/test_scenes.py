@@ -1,0 +1,94 @@
+"""The scenes' public contract (core issue): geometry, conventions, defaults."""
+
+import numpy as np
+import pytest
+
+import projeq as pq
+
+
+@pytest.mark.parametrize("planar", [False, True])
+def test_chain_hangs_along_minus_z_from_the_origin(planar):
+    """Links of 1 m and 1 kg with the mass centre in the middle hang along −z at q = 0:
+    the potential is −Σ m g (i + ½) for link i (0-based), g = 9.81."""
+    system = pq.scenes.chain(4, planar=planar)
+    _, potential = system.energy(np.zeros(4), np.zeros(4))
+    assert potential == pytest.approx(-9.81 * sum(i + 0.5 for i in range(4)), rel=1e-14)
+
+
+def test_chain_angles_follow_the_right_hand_rule_about_y():
+    """Right-hand rule about +y: rotating −z about +y by θ > 0 gives (−sin θ, 0, −cos θ), so
+    the link's centre moves towards −x, and gravity pulls it back (θ̈ < 0)."""
+    system = pq.scenes.chain(1)
+    from projeq.assembly.kinematics import forward
+
+    kin = forward(system, np.array([0.3]), np.zeros(1), 0.0)
+    centre = kin.r[0] + kin.R[0] @ system.subsystem("link1").r_c
+    assert np.allclose(centre, 0.5 * np.array([-np.sin(0.3), 0.0, -np.cos(0.3)]))
+    assert system.accelerations([0.3], [0.0])[0] < 0
+
+
+def test_one_link_is_a_compound_pendulum():
+    """Small oscillations of one link: ω² = m g d / I_O with d = 0.5 m and
+    I_O = m (3 r² + ℓ²)/12 + m d² for the solid cylinder (r = 0.01 m, ℓ = 1 m)."""
+    system = pq.scenes.chain(1)
+    A, _ = pq.linearize(system, q=[0.0], s_dot=[0.0])
+    omega2 = -A[1, 0]
+    I_O = (3 * 0.01**2 + 1.0) / 12 + 0.25
+    assert omega2 == pytest.approx(9.81 * 0.5 / I_O, rel=1e-8)
+
+
+def test_scenes_come_with_default_initial_states():
+    for name, scene in pq.scenes.SCENES.items():
+        system = scene.build()
+        assert system.q0.shape == (system.n_q,) and system.s_dot0.shape == (system.n_s,), name
+
+
+def test_planar_chain_is_built_from_planar_bodies():
+    system = pq.scenes.chain(3, planar=True)
+    assert all(isinstance(sub, pq.PlanarBody) for sub in system.subsystems)
+    assert all(isinstance(sub, pq.RigidBody) and not isinstance(sub, pq.PlanarBody) for sub in pq.scenes.chain(3).subsystems)
+
+
+def test_every_scene_parameter_has_a_documented_unit():
+    """Scenes as data: every keyword parameter of every registered scene has a unit entry
+    ("-" marks a dimensionless number or a switch), so ``projeq list SCENE`` is complete."""
+    from projeq.scenes.parameters import UNITS
+
+    for name, scene in pq.scenes.SCENES.items():
+        for parameter in pq.scenes.scene_parameters(scene):
+            assert parameter.name in {**UNITS, **(scene.units or {})}, (name, parameter.name)
+
+
+def test_build_scene_overrides_reach_the_model():
+    """atwood with m1 = 3 kg: θ̈ = −ẍ/a, ẍ = (m1 − m2) g / (m1 + m2 + I/a²), I = ½ M a²
+    (Problem 1, eq. (4) of ../shared/seeds/003_13b1ca6faae9f37e.txt); one linear solve:
+    1e-12 relative is a few hundred ulps."""
+    system = pq.scenes.build_scene("atwood", m1=3.0)
+    x_ddot = (3.0 - 1.0) * 9.81 / (3.0 + 1.0 + 0.5 * 0.5)
+    assert system.accelerations([0.0], [0.0])[0] == pytest.approx(-x_ddot / 0.1, rel=1e-12)
+
+
+def test_settings_parse_to_the_type_of_the_default():
+    scene = pq.scenes.SCENES["car"]
+    parsed = pq.scenes.parse_settings(scene, ["m=900", "q0=1, 2, 0.5", "s_dot0=(5.0, 0.0)"])
+    assert parsed == {"m": 900.0, "q0": (1, 2, 0.5), "s_dot0": (5.0, 0.0)} and type(parsed["m"]) is float
+    assert pq.scenes.parse_settings(pq.scenes.SCENES["chain"], ["planar=yes", "n=3"]) == {"planar": True, "n": 3}
+    # a str parameter that also takes numbers: a name stays text, a tuple literal becomes the tuple
+    disk = pq.scenes.SCENES["rolling_disk"]
+    assert pq.scenes.parse_settings(disk, ["inertia=hoop"]) == {"inertia": "hoop"}
+    assert pq.scenes.parse_settings(disk, ["inertia=(2e-6, 3e-6)"]) == {"inertia": (2e-6, 3e-6)}
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda: pq.scenes.get_scene("chan"), "scene: unknown scene 'chan' \\(did you mean 'chain'\\?\\)"),
+        (lambda: pq.scenes.build_scene("chain", links=3), "links: unknown parameter"),
+        (lambda: pq.scenes.parse_settings(pq.scenes.SCENES["car"], ["q0=(1,"]), "q0: expected a number, a tuple"),
+        (lambda: pq.scenes.parse_settings(pq.scenes.SCENES["car"], ["=1"]), "--set: expected name=value"),
+    ],
+    ids=["scene", "parameter", "literal", "setting"],
+)
+def test_bad_scene_input(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()

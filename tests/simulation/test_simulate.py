@@ -1,0 +1,285 @@
+"""simulate(): integrators, tolerances, events, dense output, NPZ files, quaternions,
+energies, prescribed motion, default states, progress and interruption.
+
+The reference motion is a mathematical pendulum (point mass 1 kg on a 1 m massless rod,
+g = 9.81 m/s²) released from rest at θ₀ = 1 rad, whose period is
+T = 4 √(ℓ/g) K(sin²(θ₀/2)) with K the complete elliptic integral of the first kind
+(parameter m = k²), e.g. Landau & Lifshitz, Mechanics, §11, problem 1.
+"""
+
+import numpy as np
+import pytest
+from scipy.integrate import RK45
+from scipy.special import ellipk
+
+import projeq as pq
+from projeq.assembly.kinematics import forward
+from projeq.spatial import quaternion_matrix, rotation
+
+THETA0 = 1.0
+PERIOD = 4.0 * np.sqrt(1.0 / 9.81) * ellipk(np.sin(THETA0 / 2) ** 2)
+
+
+def _pendulum():
+    return pq.System(
+        {"bob": pq.PointMass(1.0, (0, 0, -1.0))}, {"bob": pq.Revolute(axis="y")}, gravity=(0, 0, -9.81)
+    )
+
+
+@pytest.fixture(scope="module")
+def reference():
+    """One period at rtol = atol = 1e-13 (DOP853): errors 1e-13 relative, far below what
+    the tests below resolve (≥ 1e-5 · 1e-8)."""
+    return pq.simulate(
+        _pendulum(), PERIOD, [THETA0], [0.0], method="DOP853", rtol=1e-13, atol=1e-13, n_points=21
+    )
+
+
+def test_the_reference_returns_after_one_period(reference):
+    """The closed-form period closes the orbit: θ(T) = θ₀, θ̇(T) = 0 to 1e-12."""
+    assert reference.q[-1, 0] == pytest.approx(THETA0, abs=1e-12)
+    assert reference.s_dot[-1, 0] == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("rtol", [1e-5, 1e-8])
+@pytest.mark.parametrize(
+    "method",
+    ["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA", RK45],
+    ids=["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA", "OdeSolver-class"],
+)
+def test_every_solve_ivp_method_follows_the_reference_to_its_tolerance(reference, method, rtol):
+    """Error over one period in units of rtol × amplitude (per component of (θ, θ̇)),
+    atol = rtol/100 so that rtol governs. solve_ivp bounds each step's *local* error by the
+    tolerance; over a period these add up (as phase error), so the global error may be a
+    few tens of units: measured (max over both rtol) 4e-4 (DOP853), 2e-3 (Radau), 1 (RK45),
+    2 (LSODA), 5 (RK23) and 31 (BDF at 1e-8, a multistep method whose error estimate is the
+    least sharp). The same bound of 50 units at two tolerances 1000 apart shows that rtol
+    reaches the integrator and that the error is proportional to it for every method."""
+    result = pq.simulate(
+        _pendulum(), PERIOD, [THETA0], [0.0], method=method, rtol=rtol, atol=rtol / 100, n_points=21
+    )
+    x, x_ref = np.hstack((result.q, result.s_dot)), np.hstack((reference.q, reference.s_dot))
+    units = np.abs(x - x_ref) / (rtol * np.abs(x_ref).max(axis=0))
+    assert units.max() < 50
+    assert result.method == getattr(method, "__name__", method)
+
+
+def _bottom(t, q, s_dot):
+    """θ = 0: the bob passes the lowest point."""
+    return q[0]
+
+
+def test_a_terminal_event_stops_the_run():
+    """The first passage through θ = 0 ends the run at T/4: status 1, the event time in
+    t_events (DOP853 at rtol 1e-10 locates it to 1e-9 s: the root is found on the dense
+    output, accurate to the tolerance); the outputs stop at the last requested time
+    before it (solve_ivp adds no output row at an event)."""
+
+    def bottom(t, q, s_dot):
+        return _bottom(t, q, s_dot)
+
+    bottom.terminal = True
+    result = pq.simulate(
+        _pendulum(),
+        5.0,
+        [THETA0],
+        [0.0],
+        events=bottom,
+        method="DOP853",
+        rtol=1e-10,
+        atol=1e-12,
+        n_points=501,
+    )
+    assert result.status == 1 and result.success
+    assert result.t_events[0] == pytest.approx([PERIOD / 4], abs=1e-9)
+    assert PERIOD / 4 - 0.01 < result.t[-1] <= PERIOD / 4  # output spacing 5 s / 500
+    assert np.all(result.q[:, 0] > 0)
+
+
+@pytest.mark.parametrize(
+    "direction, crossings", [(-1, [0.25]), (1, [0.75]), (0, [0.25, 0.75])], ids=["falling", "rising", "both"]
+)
+def test_the_direction_of_an_event_selects_its_crossings(direction, crossings):
+    """Released at θ₀ > 0, θ falls through 0 at T/4 and rises through it at 3T/4; a
+    non-terminal event with ``direction`` records only the matching crossings (1e-9 s as
+    above) and the run goes on to the end."""
+
+    def bottom(t, q, s_dot):
+        return _bottom(t, q, s_dot)
+
+    bottom.direction = direction
+    result = pq.simulate(
+        _pendulum(), PERIOD, [THETA0], [0.0], events=[bottom], method="DOP853", rtol=1e-10, atol=1e-12
+    )
+    assert result.status == 0 and result.t[-1] == PERIOD
+    assert result.t_events[0] == pytest.approx(np.array(crossings) * PERIOD, abs=1e-9)
+
+
+def test_dense_output_matches_the_output_times_and_t_eval():
+    """``sol(t)`` is the integrator's own interpolant, the one that produced the outputs:
+    at the output times it gives ``q`` and ``s_dot`` to round-off, and between them it
+    gives what a run asking for those times returns (t_eval changes no step, only where
+    the interpolant is read)."""
+    system = _pendulum()
+    result = pq.simulate(system, 1.0, [THETA0], [0.0], dense_output=True, n_points=41)
+    q, s_dot = result.sol(result.t)
+    assert np.abs(q.T - result.q).max() < 1e-14 and np.abs(s_dot.T - result.s_dot).max() < 1e-14
+    between = (result.t[:-1] + result.t[1:]) / 2
+    other = pq.simulate(system, 1.0, [THETA0], [0.0], t_eval=between)
+    assert np.abs(result.sol(between)[0].T - other.q).max() < 1e-14
+
+
+def test_t_eval_sets_the_output_times(reference):
+    """Exactly the requested times, starting after t_start if asked; the values agree
+    with the reference at the shared times to 50 rtol units (as for RK45 above)."""
+    t_eval = reference.t[[2, 5, 13, 20]]
+    result = pq.simulate(_pendulum(), PERIOD, [THETA0], [0.0], t_eval=t_eval, rtol=1e-8, atol=1e-10)
+    assert np.array_equal(result.t, t_eval)
+    assert np.abs(result.q - reference.q[[2, 5, 13, 20]]).max() < 50 * 1e-8 * THETA0
+    assert result.q.shape == (4, 1) and result.s_dot.shape == (4, 1) and result.kinetic.shape == (4,)
+
+
+def test_save_and_load_round_trip(tmp_path):
+    """Every array and every piece of metadata survives the NPZ file bit for bit; the
+    dense output and the System stay in memory only."""
+
+    def bottom(t, q, s_dot):
+        return _bottom(t, q, s_dot)
+
+    result = pq.simulate(
+        pq.scenes.chain(2), 1.0, events=bottom, dense_output=True, n_points=11, method="DOP853"
+    )
+    result.save(tmp_path / "run.npz")
+    loaded = pq.Result.load(tmp_path / "run.npz")
+    for name in ("t", "q", "s_dot", "kinetic", "potential", "constraint_residual"):
+        assert np.array_equal(getattr(loaded, name), getattr(result, name)), name
+    assert len(loaded.t_events) == 1 and np.array_equal(loaded.t_events[0], result.t_events[0])
+    assert len(result.t_events[0]) > 0
+    for name in ("nfev", "wall_time", "status", "message", "names", "method"):
+        assert getattr(loaded, name) == getattr(result, name), name
+    assert loaded.names == ("link1", "link2") and loaded.method == "DOP853"
+    assert loaded.sol is None and loaded.system is None
+
+
+def test_energies_along_the_path(reference):
+    """Kinetic ½ m ℓ² θ̇² and potential −m g ℓ cos θ at every output time (exact
+    formulas, round-off only), and their sum is conserved to the integration error
+    (rtol 1e-13 → 1e-12 of the energy scale)."""
+    theta, theta_dot = reference.q[:, 0], reference.s_dot[:, 0]
+    assert np.allclose(reference.kinetic, 0.5 * theta_dot**2, rtol=1e-13, atol=1e-13)
+    assert np.allclose(reference.potential, -9.81 * np.cos(theta), rtol=1e-13, atol=1e-13)
+    assert reference.energy_drift < 1e-12
+
+
+def test_a_torque_free_body_keeps_its_momenta_and_a_unit_quaternion():
+    """A free asymmetric body (principal moments 1, 2, 3 kg m², mass centre at its
+    origin) in zero gravity, spinning near its unstable middle axis while drifting: the
+    inertial angular momentum R I_c ω, the inertial momentum R m v and the kinetic energy
+    stay constant (Euler's equations), the mass centre moves uniformly, and the output
+    quaternion has unit norm (normalised output; 1e-15). DOP853 at rtol 1e-10 for 10 s:
+    measured 1e-11 relative for all; the bound 1e-9 is ten times rtol."""
+    body = pq.RigidBody(2.0, (0, 0, 0), np.diag([1.0, 2.0, 3.0]))
+    system = pq.System({"body": body}, {"body": pq.Free()})
+    s_dot0 = np.array([0.1, 0.0, 0.0, 0.01, 2.0, 0.01])
+    result = pq.simulate(system, 10.0, s_dot0=s_dot0, method="DOP853", rtol=1e-10, atol=1e-12, n_points=51)
+    quats = result.q[:, 3:]
+    assert np.abs(np.linalg.norm(quats, axis=1) - 1.0).max() < 1e-15
+    R = np.array([quaternion_matrix(quat) for quat in quats])
+    L = np.einsum("nij,nj->ni", R, result.s_dot[:, 3:] @ body.I_c.T)
+    p = np.einsum("nij,nj->ni", R, body.m * result.s_dot[:, :3])
+    assert np.abs(L - L[0]).max() < 1e-9 * np.linalg.norm(L[0])
+    assert np.abs(p - p[0]).max() < 1e-9 * np.linalg.norm(p[0])
+    assert np.abs(result.kinetic - result.kinetic[0]).max() < 1e-9 * result.kinetic[0]
+    distance = 10.0 * 0.1  # t_end |v|
+    assert np.abs(result.q[:, :3] - np.outer(result.t, p[0] / body.m)).max() < 1e-9 * distance
+    assert np.ptp(result.s_dot[:, 4]) > 3.0  # ω_y turns over: the body really tumbles
+
+
+def test_the_initial_quaternion_is_normalised():
+    """q0 with a quaternion of norm 2 starts from the same rotation, normalised."""
+    system = pq.System({"body": pq.RigidBody(1.0, I_c=np.eye(3))}, {"body": pq.Free()})
+    q0 = [0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0]
+    result = pq.simulate(system, 0.1, q0=q0, s_dot0=[0, 0, 0, 0, 0, 1.0], n_points=3)
+    assert np.array_equal(result.q[0], [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+
+
+def test_a_prescribed_joint_follows_its_motion():
+    """An arm turned about z by θ(t) = sin t carries a pendulum hinged at its tip: at
+    every output time the arm's pose is the rotation by sin t (exactly, round-off only)
+    and its kinetic energy ½ (m r² + I_z) θ̇² = cos² t; the pendulum swings freely."""
+    arm = pq.Prescribed(pq.Revolute(axis="z"), lambda t: (np.sin(t), np.cos(t), -np.sin(t)))
+    system = pq.System(
+        {"arm": pq.RigidBody(1.0, (1, 0, 0), np.eye(3)), "bob": pq.PointMass(1.0, (0.5, 0, 0))},
+        {"arm": arm, "bob": pq.Revolute(parent="arm", axis="z", r_pn=(2, 0, 0))},
+    )
+    assert (system.n_q, system.n_s) == (1, 1)  # only the pendulum
+    result = pq.simulate(system, 2.0, n_points=11)
+    for t, q, s_dot in zip(result.t, result.q, result.s_dot):
+        kin = forward(system, q, s_dot, t)
+        assert np.allclose(kin.R[0], rotation(np.array([0, 0, 1.0]), np.sin(t)), rtol=0, atol=1e-15)
+        assert np.allclose(kin.r[1], kin.R[0] @ [2.0, 0, 0], rtol=0, atol=1e-15)  # the tip carries the hinge
+        assert pq.RigidBody(1.0, (1, 0, 0), np.eye(3)).kinetic_energy(kin.y_dot[0]) == pytest.approx(
+            np.cos(t) ** 2
+        )
+    assert np.ptp(result.q[:, 0]) > 0.1  # the base motion drives the pendulum
+
+
+def test_a_system_with_only_prescribed_motion_has_nothing_to_integrate():
+    """n_s = 0: the run still reports the path's energies, ½ · 2 · cos² t."""
+    arm = pq.Prescribed(pq.Revolute(axis="z"), lambda t: (np.sin(t), np.cos(t), -np.sin(t)))
+    system = pq.System({"arm": pq.RigidBody(1.0, (1, 0, 0), np.eye(3))}, {"arm": arm})
+    result = pq.simulate(system, 1.0, n_points=5)
+    assert result.q.shape == (5, 0) and result.s_dot.shape == (5, 0)
+    assert np.allclose(result.kinetic, np.cos(result.t) ** 2, rtol=1e-14)
+
+
+def test_the_initial_state_defaults_to_the_systems():
+    """Omitted q0 and s_dot0 come from the system: scenes set their own (chain: first
+    joint at 0.5 rad, at rest); a system built with q0, s_dot0 starts there."""
+    chain = pq.scenes.chain(3)
+    result = pq.simulate(chain, 0.05, n_points=3)
+    assert np.array_equal(result.q[0], [0.5, 0.0, 0.0]) and np.array_equal(result.s_dot[0], np.zeros(3))
+    system = pq.System(
+        {"bob": pq.PointMass(1.0, (0, 0, -1.0))}, {"bob": pq.Revolute(axis="y")}, q0=[0.2], s_dot0=[-1.0]
+    )
+    result = pq.simulate(system, 0.05, n_points=3)
+    assert (result.q[0, 0], result.s_dot[0, 0]) == (0.2, -1.0)
+
+
+def test_progress_is_called_after_each_segment():
+    seen = []
+    result = pq.simulate(_pendulum(), 0.2, [THETA0], [0.0], n_segments=4, progress=seen.append)
+    assert np.allclose(seen, [0.05, 0.1, 0.15, 0.2]) and result.status == 0
+
+
+def _interrupt_from_progress(t):
+    if t > 0.09:
+        raise KeyboardInterrupt
+
+
+class _InterruptingTorque:
+    """A torque law that meets Ctrl-C during the third segment (t > 0.12)."""
+
+    def __call__(self, t, q, s_dot):
+        if t > 0.12:
+            raise KeyboardInterrupt
+        return np.zeros(3)
+
+
+@pytest.mark.parametrize("where", ["between-segments", "inside-a-segment"])
+def test_ctrl_c_keeps_what_was_computed(where):
+    """KeyboardInterrupt between segments (from the progress callback after the second
+    of four) or inside one (from a torque law in the third): status 2, the trajectory of
+    the finished segments kept, up to t = 0.1 s, no exception."""
+    forces = [pq.Torque("bob", _InterruptingTorque())] if where == "inside-a-segment" else []
+    progress = _interrupt_from_progress if where == "between-segments" else None
+    system = pq.System(
+        {"bob": pq.PointMass(1.0, (0, 0, -1.0))},
+        {"bob": pq.Revolute(axis="y")},
+        gravity=(0, 0, -9.81),
+        forces=forces,
+    )
+    result = pq.simulate(system, 0.2, [THETA0], [0.0], n_segments=4, n_points=21, progress=progress)
+    assert result.status == 2 and not result.success and "interrupted" in result.message
+    assert np.allclose(result.t, np.linspace(0.0, 0.1, 11))
+    assert np.all(np.isfinite(result.q)) and result.q[-1, 0] < THETA0  # it had started to fall

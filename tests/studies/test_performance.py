@@ -1,0 +1,50 @@
+"""No-regression check of the evaluators' cost (issue 7, item 5), by ratios measured in one
+run: absolute times depend on the machine and its load, ratios of interleaved minima much
+less (projeq.studies.bench.time_per_call alternates the evaluators and keeps each one's fastest
+call, so a burst of load slows every evaluator's worst calls, not its minimum).
+
+- at n = 100 the recursive and the fast evaluator are faster than the dense one (O(N) vs
+  O(N³)); measured on the shared 2-core machine (load 4.5): dense/recursive 1.7 to 13
+  (the dense time is bimodal, 15 or 200 ms, as its BLAS threads compete for the cores),
+  dense/fast 100 to 1300;
+- the cost growth exponent of the order-n evaluators over n = 25 … 200 is at most 1.2
+  (measured in CPU time: recursive 0.95, fast 0.8–0.95).
+"""
+
+import time
+
+import numpy as np
+import pytest
+
+from projeq.studies.bench import evaluators, time_per_call
+
+BUDGET = 0.4  # seconds of interleaved timing per size: enough rounds for stable minima
+SIZES = (25, 50, 100, 200)
+
+
+def _timings(calls: list, clock=time.process_time) -> dict:
+    """Interleaved minimum time of each (method, n) → s̈ call at a random state of chain(n)."""
+    funcs = {}
+    for method, n in calls:
+        f, rng = evaluators(n, peers=False)[method], np.random.default_rng(n)
+        q, s_dot = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
+        funcs[method, n] = lambda _q, _s, f=f, q=q, s_dot=s_dot: f(q, s_dot)
+    return time_per_call(funcs, None, None, BUDGET * len(SIZES), clock)
+
+
+def test_order_n_evaluators_beat_dense_at_100_bodies():
+    """Wall time: CPU time would count the spinning threads of the dense evaluator's BLAS."""
+    calls = [(m, 100) for m in ("recursive", "fast", "dense")]
+    seconds = {m: t for (m, _), t in _timings(calls, time.perf_counter).items()}
+    assert seconds["recursive"] < seconds["dense"], seconds
+    assert seconds["fast"] < seconds["dense"], seconds
+
+
+@pytest.mark.parametrize("method", ["recursive", "fast"])
+def test_cost_grows_at_most_like_n_to_1_2(method):
+    """Slope of log(time) against log(n), the order-n evaluator's cost against the chain
+    length, fitted by least squares over four sizes timed interleaved."""
+    timings = _timings([(method, n) for n in SIZES])
+    seconds = [timings[method, n] for n in SIZES]
+    slope = np.polyfit(np.log(SIZES), np.log(seconds), 1)[0]
+    assert slope <= 1.2, dict(zip(SIZES, seconds))
