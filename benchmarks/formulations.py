@@ -1,5 +1,7 @@
-"""Integration cost, energy drift and constraint drift of the formulations side by side, as Barhorst
-compares them (``seeds/000_…`` §3): the knife-edge disc of the lecture (``seeds/001_…`` slides 28–37).
+"""Integration cost, energy drift and constraint drift of the formulations side by side, as A. A. Barhorst
+compares them ("Generalized momenta in constrained non-holonomic systems — another perspective on the
+canonical equations of motion", §3): first the knife-edge disc of the lecture on non-holonomic systems and
+Lagrange multipliers (slides 28–37), then Barhorst's own three examples over his 10 s.
 
 Formulations, all from the same initial state (tilt ϕ = 0.2, θ̇ = −3, ψ̇ = 0.4, m = g = r = 1, μ = ¼, ν = ½):
 
@@ -14,11 +16,16 @@ integration wall time (s), right-hand-side evaluations, max |E − E₀| (energy
 forms zero by construction), max |z + r cos ϕ| (the integrable constraint, only position-level drift
 for the 6-coordinate forms). DOP853 at the given rtol, atol = rtol/100. Times are this machine's only.
 
-    python benchmarks/formulations.py            # t_end = 100, rtol 1e-6 and 1e-10
-    python benchmarks/formulations.py --quick    # t_end = 10, rtol 1e-8
+Barhorst's examples — the particle with a non-holonomic constraint, the rolling disk with an eccentric
+mass, the quick-return mechanism — run through ``projeq.compare`` (``projeq.studies.compare_barhorst``):
+Hamilton's canonical equations with multipliers integrated as an index-2 DAE, the projective (Kane) form
+with dependent speeds, his projective and Lagrangian canonical momentum forms (the disk also in his general
+speeds u = Y q̇ of eq. 93), all by the same Radau IIA code at rtol 1e-8; integration time normalised to his
+baseline row, energy and constraint drift, and his reported numbers beside.
 
-Not yet covered: Barhorst's rolling disk with eccentric mass (scene ``rolling_disk``), which needs its
-Lagrangian and constraint matrix written in the lecture's input form.
+    python benchmarks/formulations.py            # disc: t_end = 100, rtol 1e-6 and 1e-10; Barhorst: 10 s
+    python benchmarks/formulations.py --quick    # disc: t_end = 10, rtol 1e-8; Barhorst: 2 s
+    python benchmarks/formulations.py --barhorst # Barhorst's three examples only (10 s)
 """
 
 from __future__ import annotations
@@ -96,8 +103,9 @@ def _q_dot(canonical, sol):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--barhorst", action="store_true", help="only Barhorst's three examples")
     args = parser.parse_args()
-    cases = [(10.0, 1e-8)] if args.quick else [(100.0, 1e-6), (100.0, 1e-10)]
+    cases = [] if args.barhorst else [(10.0, 1e-8)] if args.quick else [(100.0, 1e-6), (100.0, 1e-10)]
     for t_end, rtol in cases:
         print(f"\nknife-edge disc, t_end = {t_end}, rtol = {rtol:g}, atol = {rtol / 100:g}")
         print(f"{'formulation':28s} {'setup s':>8s} {'run s':>7s} {'nfev':>6s} {'|ΔE|':>9s} {'|Aq̇|':>9s} "
@@ -106,6 +114,21 @@ def main():
         for name, setup, wall, nfev, dE, dA, dz in rows:
             print(f"{name:28s} {setup:8.2f} {wall:7.2f} {nfev:6d} {dE:9.2e} {dA:9.2e} {dz:9.2e} "
                   f"{wall / rows[0][2]:7.2f}")
+    barhorst(2.0 if args.quick else 10.0)
+
+
+def barhorst(t_end: float):
+    """Barhorst's three examples over ``t_end`` seconds (his runs: 10 s), each formulation's row with his
+    reported numbers beside."""
+    for name in ("barhorst_particle", "rolling_disk", "quick_return"):
+        table = pq.compare(name, t_end=t_end, repeats=1)
+        print()
+        print(table.format())
+        print(f"{'formulation':48s} {'time/base':>9s} {'nfev':>6s} {'E drift':>9s} {'c drift':>9s}")
+        for row in table.rows:
+            if "integration_s" in row:
+                print(f"{row['formulation']:48s} {row.get('time / baseline', float('nan')):9.3f} {row['nfev']:6d} "
+                      f"{row['energy_drift']:9.2e} {row['constraint_drift']:9.2e}")
 
 
 if __name__ == "__main__":

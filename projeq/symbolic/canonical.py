@@ -23,6 +23,7 @@ from typing import Mapping, Sequence
 import numpy as np
 import sympy as sp
 from scipy.integrate import solve_ivp
+from sympy.matrices.utilities import dotprodsimp
 
 from .lagrange import MultiplierSystem
 from .program import check_declared, choose_dependent, replace_derivatives
@@ -213,7 +214,8 @@ def energy_rate(form: CanonicalForm, E) -> sp.Expr:
     E = sp.sympify(E)
     q, u = sp.Matrix(form.q), sp.Matrix(form.u)
     D = form.p.jacobian(u)
-    D_inv = D.adjugate() / D.det() if D.rows > 1 else sp.Matrix([[1 / D[0, 0]]])
+    with dotprodsimp(False):  # sympy's intermediate simplification makes the 3 × 3 adjugate take minutes
+        D_inv = D.adjugate() / D.det() if D.rows > 1 else sp.Matrix([[1 / D[0, 0]]])
     dE_du = sp.Matrix([E]).jacobian(u)
     dE_dp = dE_du * D_inv
     dE_dq = sp.Matrix([E]).jacobian(q) - dE_dp * form.p.jacobian(q)
