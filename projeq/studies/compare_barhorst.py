@@ -219,11 +219,11 @@ def study_rows(study: str, formulations, example, wanted, simulate: bool, t_end:
 
 
 def _beside_paper(row: dict) -> str:
-    """Barhorst's reported time, energy and constraint numbers beside projeq's measured ones."""
+    """Barhorst's reported time, energy and constraint numbers, each followed by projeq's measured one."""
     def here(key, fmt):
-        return f" (here {format(row[key], fmt)})" if row.get(key) is not None else ""
+        return f", projeq {format(row[key], fmt)}" if row.get(key) is not None else ""
 
-    return (f"Barhorst (paper): time / baseline {row['Barhorst (paper) time']}{here('time / baseline', '.2g')}; "
+    return (f"time / baseline {row['Barhorst (paper) time']}{here('time / baseline', '.2g')}; "
             f"energy drift {row['Barhorst (paper) energy']}{here('energy_drift', '.1e')}; "
             f"constraint {row['Barhorst (paper) constraint']}{here('constraint_drift', '.1e')}")
 

@@ -52,7 +52,8 @@ class CanonicalForm:
         u = sp.Matrix(self.u)
         J = sp.zeros(len(self.q), 1) if self.J is None else self.J
         pieces = [self.p.jacobian(u), self.p.subs({ui: 0 for ui in u}), self.K, self.p_dot, J]
-        return sp.lambdify([self.t, self.q, self.u], [X.subs(self.parameters) for X in pieces],
+        numbers = {k: sp.sympify(v) for k, v in self.parameters.items()}  # xreplace: subs takes seconds here
+        return sp.lambdify([self.t, self.q, self.u], [X.xreplace(numbers) for X in pieces],
                            modules="numpy", cse=True)
 
     def _speeds(self, t, q, p):

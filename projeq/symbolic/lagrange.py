@@ -106,8 +106,8 @@ class MultiplierSystem:
         residual = A * sp.Matrix(u) - b
         gamma = residual.jacobian(q) * sp.Matrix(u) + residual.diff(t)
         pieces = [M, p_of_u.subs({v: 0 for v in u}), sp.Matrix([L]).jacobian(q).T + Q, w, A, b, gamma]
-        pieces = [X.subs(self.parameters) for X in pieces]
-        return sp.lambdify([t, q, u], pieces, modules="numpy", cse=True)
+        numbers = {k: sp.sympify(v) for k, v in self.parameters.items()}  # xreplace: subs takes seconds here
+        return sp.lambdify([t, q, u], [X.xreplace(numbers) for X in pieces], modules="numpy", cse=True)
 
     def _evaluate(self, t, q, u, alpha):
         """(M, ∂L/∂q̇|₀, ∂L/∂q + Q, Aᵀλ, q̈) with λ from A q̈ + Ȧq̇ − ḃ = −α (A q̇ − b)."""
@@ -169,7 +169,7 @@ class MultiplierSystem:
         duality) are evaluated numerically, so H is never inverted symbolically.
 
         Returns (f, mass, index): f(t, y) for M y′ = f, the diagonal of M, each component's index,
-        for :func:`projeq.integrators.radau_dae`.
+        for :func:`projeq.simulation.integrators.radau_dae`.
         """
         n, c = len(self.q), len(self.lam)
         position = None
@@ -195,11 +195,11 @@ class MultiplierSystem:
         return f, mass, index
 
     def simulate_dae(self, q0, q_dot0, t_span, phi=None, t_eval=None, rtol: float = 1e-8, atol: float = 1e-10):
-        """Integrate :meth:`hamilton_dae` by Radau IIA (:func:`projeq.integrators.radau_dae`) from a
+        """Integrate :meth:`hamilton_dae` by Radau IIA (:func:`projeq.simulation.integrators.radau_dae`) from a
         consistent state: p₀ = ∂L/∂q̇ at (q0, q̇0), λ₀ from the constraint differentiated once (only
         the start value: the integration keeps the DAE as it stands). Returns the
-        :class:`~projeq.integrators.DAEResult` with ``q``, ``p``, ``lam`` and ``q_dot`` added."""
-        from projeq.integrators import radau_dae
+        :class:`~projeq.simulation.integrators.DAEResult` with ``q``, ``p``, ``lam`` and ``q_dot`` added."""
+        from projeq.simulation.integrators import radau_dae
 
         n = len(self.q)
         q0, q_dot0 = (np.asarray(v, dtype=float).ravel() for v in (q0, q_dot0))
