@@ -223,7 +223,8 @@ def _beside_paper(row: dict) -> str:
     def here(key, fmt):
         return f", projeq {format(row[key], fmt)}" if row.get(key) is not None else ""
 
-    return (f"time / baseline {row['Barhorst (paper) time']}{here('time / baseline', '.2g')}; "
+    seconds = f" ({row['integration_s']:.3g} s)" if row.get("integration_s") is not None else ""
+    return (f"time / baseline {row['Barhorst (paper) time']}{here('time / baseline', '.2g')}{seconds}; "
             f"energy drift {row['Barhorst (paper) energy']}{here('energy_drift', '.1e')}; "
             f"constraint {row['Barhorst (paper) constraint']}{here('constraint_drift', '.1e')}")
 
