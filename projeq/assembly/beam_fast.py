@@ -28,19 +28,20 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.joints import Fixed, Prescribed
 from projeq.subsystems.beam.beam import RitzBeam
 
 
 def hub_beam_unsupported(system) -> str | None:
-    """Why ``system`` is not one RitzBeam on a prescribed or fixed root joint (None if it is)."""
+    """Why ``system`` is not one RitzBeam on a root joint without coordinates, whose motion
+    is a given function of time (Prescribed, Fixed) (None if it is)."""
     if len(system.subsystems) != 1:
         return f"the system has {len(system.subsystems)} subsystems (the beam path takes one RitzBeam)"
     name, beam, joint = system.names[0], system.subsystems[0], system.joints[0]
     if not isinstance(beam, RitzBeam):
         return f"subsystem {name!r} is a {type(beam).__name__}, not a RitzBeam"
-    if not isinstance(joint, (Prescribed, Fixed)):
-        return f"joint {name!r} is a {type(joint).__name__} (the beam path takes Prescribed or Fixed hubs)"
+    if joint.n_q or joint.n_s or joint.coupling:
+        return (f"joint {name!r} is a {type(joint).__name__} with coordinates (the beam path takes hubs "
+                "whose motion is given: Prescribed or Fixed)")
     if system.forces:
         return "the system has force laws (the beam path knows gravity only)"
     return None

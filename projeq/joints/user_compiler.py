@@ -19,11 +19,6 @@ _SINGULAR_CONDITION = 1e10  # condition number of K(q0) treated as singular
 _POSE_TOLERANCE = 1e-5  # central differences of step 1e-7 in pose_twist_mismatch: error ~1e-9
 
 
-def skew(a) -> sp.Matrix:
-    """Spin matrix ã of a 3-vector of sympy expressions (ã b = a × b)."""
-    return sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-
-
 def _matrix(name: str, value, shape: tuple) -> sp.Matrix:
     M = sp.Matrix(value)
     if shape[1] == 1 and M.shape == (1, shape[0]):
@@ -97,8 +92,8 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
         lambda q_n, time: np.asarray(K_fun(q_n, time), dtype=float),
         lambda q_n, s_dot_n, time: np.asarray(q_dot_fun(q_n, s_dot_n, time), dtype=float).ravel(),
         q0=q0, r_pn=r_pn, orientation=orientation, constraints=residual, n_c=n_c,
+        symbols={"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k},
     )
-    joint.symbols = {"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k}
     _check_pose(joint)
     return joint
 

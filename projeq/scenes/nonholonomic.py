@@ -27,7 +27,7 @@ import sympy as sp
 from projeq.constraints.nonholonomic import check_configuration, initial_speeds
 from projeq.forces import Force, Torque
 from projeq.joints import Fixed, UserJoint
-from projeq.joints.user_compiler import skew
+from projeq.joints.algebra import skew
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
 from projeq.system import System
 
