@@ -25,7 +25,7 @@ import sympy as sp
 from numpy.typing import NDArray
 
 from projeq.checks import finite_array, non_negative
-from projeq.joints import algebra
+from projeq.symbolic import algebra
 from projeq.spatial import cross
 
 

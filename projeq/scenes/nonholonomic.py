@@ -27,22 +27,12 @@ import sympy as sp
 from projeq.constraints.nonholonomic import check_configuration, initial_speeds
 from projeq.forces import Force, Torque
 from projeq.joints import Fixed, UserJoint
-from projeq.joints.algebra import skew
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
+from projeq.symbolic.algebra import rotation_x, rotation_y, rotation_z, skew
 from projeq.system import System
 
 
 # -- small sympy helpers ---------------------------------------------------------------
-def _rot(axis: int, angle) -> sp.Matrix:
-    """Active rotation about coordinate axis 0, 1 or 2 (x, y, z)."""
-    c, s = sp.cos(angle), sp.sin(angle)
-    if axis == 0:
-        return sp.Matrix([[1, 0, 0], [0, c, -s], [0, s, c]])
-    if axis == 1:
-        return sp.Matrix([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-    return sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
 def _twist_F(A: sp.Matrix, r: sp.Matrix, q, K: sp.Matrix, s) -> sp.Matrix:
     """F = ∂(v, ω)/∂ṡ in child coordinates from the pose (A, r) and q̇ = K ṡ:
     v = Aᵀ ṙ, ω̃ = Aᵀ Ȧ (exact symbolic differentiation, then trigsimp)."""
@@ -76,7 +66,7 @@ def car(m: float = 1200.0, C0: float = 3228.0, c: float = 1.2, f_x=0.0, M_z=0.0,
     x, y, g = sp.symbols("x y gamma")
     vx, wz = sp.symbols("v_x omega_z")
     xd, yd, gd = sp.symbols("xd yd gd")
-    A = _rot(2, g)
+    A = rotation_z(g)
     F = sp.Matrix([[1, 0], [0, 0], [0, 0], [0, 0], [0, 0], [0, 1]])
     K = sp.Matrix([[sp.cos(g), 0], [sp.sin(g), 0], [0, 1]])
     joint = UserJoint.from_sympy(
@@ -124,7 +114,7 @@ def _disc_joint_lecture():
         [-r * sps * sph, r * cps * cph, -r * sps],
         [1, 0, 0], [0, 1, 0], [0, 0, 1],
     ])
-    A = _rot(2, psi) * _rot(0, phi) * _rot(1, th)
+    A = rotation_z(psi) * rotation_x(phi) * rotation_y(th)
     pos = sp.Matrix([x, y, -r * cph])
     F = _twist_F(A, pos, q, K, s)
     constraints = [
@@ -211,10 +201,10 @@ def _rolling_disk_joint():
         [s3 * t2, 1, -c3 * t2],
     ])
     K = sp.Matrix.vstack(K_ang, R * sp.cos(q1) * K_ang[2, :], R * sp.sin(q1) * K_ang[2, :])  # eq. (97)
-    A_B = _rot(2, q1) * _rot(0, q2)
-    A = A_B * _rot(1, q3)
+    A_B = rotation_z(q1) * rotation_x(q2)
+    A = A_B * rotation_y(q3)
     pos = sp.Matrix([q[3], q[4], 0]) + R * A_B[:, 2]
-    b3_C = _rot(1, q3).T * sp.Matrix([0, 0, 1])
+    b3_C = rotation_y(q3).T * sp.Matrix([0, 0, 1])
     F = sp.Matrix.vstack(-R * skew(b3_C), sp.eye(3))  # v = ω × R b̂3, ω = u
     constraints = [qd[3] - R * sp.cos(q1) * qd[2], qd[4] - R * sp.sin(q1) * qd[2]]  # eq. (97)
     return q, s, A, pos, F, K, constraints, qd, R

@@ -11,7 +11,6 @@ rows share one integrator and one energy function.
 
 from __future__ import annotations
 
-import argparse
 import csv
 import time
 from dataclasses import dataclass, field, replace
@@ -345,23 +344,3 @@ def compare(name: str, formulations=None, simulate: bool = True, t_end: float | 
     if formulations is not None:
         formulations = [formulations] if isinstance(formulations, str) else list(formulations)
     return ComparisonTable(name, COMPARISONS[name](formulations, simulate, float(t_end)))
-
-
-def main(argv=None) -> int:
-    """``projeq compare NAME [--csv PATH] [--no-simulate] [--t-end T]``: print the table."""
-    parser = argparse.ArgumentParser(prog="projeq compare", description=compare.__doc__.splitlines()[0])
-    parser.add_argument("name", choices=sorted(COMPARISONS))
-    parser.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
-    parser.add_argument("--no-simulate", action="store_true", help="derive and check only")
-    parser.add_argument("--t-end", type=float, default=None, help="simulated time (s)")
-    parser.add_argument("--formulation", action="append", help="restrict to these rows (repeatable)")
-    args = parser.parse_args(argv)
-    try:
-        table = compare(args.name, args.formulation, simulate=not args.no_simulate, t_end=args.t_end)
-    except ValueError as error:
-        print(f"error: {error}")
-        return 2
-    print(table.format())
-    if args.csv:
-        table.to_csv(args.csv)
-    return 0

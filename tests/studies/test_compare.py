@@ -8,7 +8,8 @@ import csv
 
 import pytest
 
-from projeq.studies.compare import COMPARISONS, ComparisonTable, compare, main
+from projeq.cli import main as projeq
+from projeq.studies.compare import COMPARISONS, ComparisonTable, compare
 
 
 def _row(table, name):
@@ -109,14 +110,14 @@ def test_format_and_csv(car_table, tmp_path):
 
 def test_main_writes_csv(tmp_path, capsys):
     path = tmp_path / "out.csv"
-    assert main(["car", "--no-simulate", "--csv", str(path), "--formulation", "projection (symbolic)",
-                 "--formulation", "hamel"]) == 0
+    assert projeq(["compare", "car", "--no-simulate", "--csv", str(path), "--formulation", "projection (symbolic)",
+                   "--formulation", "hamel"]) == 0
     assert "hamel" in capsys.readouterr().out and path.exists()
 
 
 def test_main_bad_formulation(capsys):
-    assert main(["car", "--no-simulate", "--formulation", "bogus"]) == 2
-    assert "formulations" in capsys.readouterr().out
+    assert projeq(["compare", "car", "--no-simulate", "--formulation", "bogus"]) == 2
+    assert "projeq compare: formulations" in capsys.readouterr().err
 
 
 def test_bad_name():
