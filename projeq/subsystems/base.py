@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 REQUIRED = ("n_y", "gauss_terms", "kinetic_energy", "potential_energy")  # no default
 DEFAULTS = ("S", "n_e", "rigid_inertia")  # data members with a default
 _ABSENT = object()
+DERIVED = ("rigid_inertia", "elastic_terms")  # derived from gauss_terms: reset where it is restated
 CAPABILITIES = {"has_ports": ("port",), "deforms": ("centre_line", "deflection")}  # flag: its methods
 
 
@@ -41,17 +42,22 @@ class Subsystem:
         owned by the subsystem, with minimal velocities ṡ_e = q̇_e: the last n_e entries
         of ẏ_n. They follow the joint's coordinates in q and ṡ.
     rigid_inertia : (m, r_c, I_c) or None (default)
-        Set when :meth:`gauss_terms` are the rigid-body terms of THEORY §3 of this mass,
-        mass centre and inertia tensor (selected by ``S``): then the evaluators may compute
-        them in batches, compiled or in sympy from these three. A subclass that restates
-        ``gauss_terms`` loses the rigid_inertia it inherits unless it restates it too, so
-        no evaluator ever bypasses an override.
+        Set when :meth:`gauss_terms` are the rigid-body terms of B(13) (the formula table of
+        docs/theory.md) of this mass, mass centre and inertia tensor, selected by ``S``: then
+        the evaluators may compute them in batches, compiled or in sympy from these three.
     has_ports : bool
         The class implements :meth:`port`: joints of children sit at stations of this
         deforming subsystem (set when the class is defined).
     deforms : bool
         The class implements :meth:`centre_line` and :meth:`deflection` of a deforming
         centre line of length ``length`` (export, command line; set when the class is defined).
+    length : float
+        (``deforms``) Length of the centre line, in m.
+
+    Overrides are never bypassed: the members derived from :meth:`gauss_terms`
+    (``rigid_inertia``, :meth:`elastic_terms`) are stated for the class that defines them;
+    a subclass that restates ``gauss_terms`` gets the defaults back (no rigid_inertia,
+    elastic_terms as rows of its gauss_terms) unless it restates them too.
     """
 
     n_y: int
@@ -60,11 +66,14 @@ class Subsystem:
     rigid_inertia: tuple | None = None
     has_ports: bool = False
     deforms: bool = False
+    length: float
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        if "gauss_terms" in vars(cls) and "rigid_inertia" not in vars(cls):
-            cls.rigid_inertia = None  # the class states its own terms: they are no longer the rigid ones
+        if "gauss_terms" in vars(cls):  # the class states its own terms: what derived from the inherited ones goes
+            for derived in DERIVED:
+                if derived not in vars(cls):
+                    setattr(cls, derived, vars(Subsystem)[derived])
         for flag, methods in CAPABILITIES.items():
             setattr(cls, flag, all(getattr(cls, m) is not getattr(Subsystem, m) for m in methods))
 
