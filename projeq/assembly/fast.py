@@ -40,8 +40,6 @@ from projeq.assembly.beam_fast import HubBeamEvaluator, hub_beam_unsupported
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.subsystems.rigid import rigid_mass_matrix
 
-_KINDS = {"fixed": kernels.FIXED, "revolute": kernels.REVOLUTE, "prismatic": kernels.PRISMATIC}  # Joint.compiled_kind
-
 
 class FastEvaluator:
     """s̈ of one System by the compiled order-n kernel, or by the general path.
@@ -79,7 +77,7 @@ class FastEvaluator:
         """Flat arrays of the tree (built once) and the workspace."""
         N = len(system.joints)
         joints, bodies = system.joints, system.subsystems
-        self._kind = np.array([_KINDS[j.compiled_kind] for j in joints], dtype=np.int64)
+        self._kind = np.array([kernels.KINDS[j.compiled_kind] for j in joints], dtype=np.int64)
         self._parent = np.array(system.parent, dtype=np.int64)
         self._axis = np.array([np.zeros(3) if k == kernels.FIXED else j.axis for k, j in zip(self._kind, joints)])
         self._orientation = np.array([j.orientation for j in joints])
@@ -120,9 +118,9 @@ class FastEvaluator:
 def unsupported(system) -> str | None:
     """Why the fast kernel cannot evaluate ``system`` (None if it can)."""
     for name, joint, body in zip(system.names, system.joints, system.subsystems):
-        if joint.compiled_kind not in _KINDS:
+        if joint.compiled_kind not in kernels.KINDS:
             return (f"joint {name!r} is a {type(joint).__name__}, which has no compiled kind "
-                    f"(the kernel knows {', '.join(_KINDS)})")
+                    f"(the kernel knows {', '.join(kernels.KINDS)})")
         if joint.coupling:
             return f"joint {name!r} is coupled (shared minimal velocities)"
         if body.rigid_inertia is None or body.S is not None:
