@@ -82,7 +82,9 @@ class Joint:
     n_q = 0
     n_s = 0
     n_c = 0  # number of velocity constraints whose residual the joint reports
-    compiled_kind: str | None = None  # the compiled kernel's kind computing ``relative`` (None: none)
+    # the kind of the compiled kernel (projeq.assembly.kernels.KINDS) computing the same ``relative``:
+    # "fixed", or "revolute" / "prismatic" about / along the joint's unit ``axis``; None: none
+    compiled_kind: str | None = None
     symbolic_parameters: dict = {}  # {field: what it is} that symbolic_relative takes from gauss_form's parameters
 
     def __init__(self, parent=None, r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):

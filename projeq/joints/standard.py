@@ -43,12 +43,12 @@ class Revolute(_OneAxis):
     θ is positive by the right-hand rule about e; q = ṡ-integral = (θ,).
     """
 
+    compiled_kind = "revolute"
+
     def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
         super().__init__(parent, axis, r_pn, orientation, coupling)
         self._spin = axis_spin(self.axis)
         self._F = np.concatenate((np.zeros(3), self.axis))[:, None]
-
-    compiled_kind = "revolute"
 
     def relative(self, q_n, s_dot_n, t):
         A = rodrigues(self._spin, q_n[0])
@@ -62,11 +62,11 @@ class Revolute(_OneAxis):
 class Prismatic(_OneAxis):
     """Translation x along the unit axis e: F⁶ = [e; 0], r = e x (THEORY §4)."""
 
+    compiled_kind = "prismatic"
+
     def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
         super().__init__(parent, axis, r_pn, orientation, coupling)
         self._F = np.concatenate((self.axis, np.zeros(3)))[:, None]
-
-    compiled_kind = "prismatic"
 
     def relative(self, q_n, s_dot_n, t):
         return Relative(np.eye(3), self.axis * q_n[0], self._F, self._F[:, 0] * s_dot_n[0], _ZERO6)
