@@ -14,10 +14,12 @@ h_n = Q_n − G_n ẏ_n.
 
 from __future__ import annotations
 
+from types import MethodType
+
 from numpy.typing import NDArray
 
 REQUIRED = ("n_y", "gauss_terms", "kinetic_energy", "potential_energy")  # no default
-DEFAULTS = ("S", "n_e", "rigid_inertia")  # data members with a default
+DEFAULTS = ("S", "n_e", "rigid_inertia", "elastic_terms")  # optional members with a default
 _ABSENT = object()
 DERIVED = ("rigid_inertia", "elastic_terms")  # derived from gauss_terms: reset where it is restated
 CAPABILITIES = {"has_ports": ("port",), "deforms": ("centre_line", "deflection")}  # flag: its methods
@@ -121,10 +123,10 @@ def conform(name: str, sub) -> None:
     """Check that ``sub`` (added under ``name``) is a subsystem; called where a System is built.
 
     A missing required member (or a required method left to the base class) is a ValueError
-    naming it. An object that does not subclass
-    :class:`Subsystem` (duck-typed) is given the defaults of the data members it lacks
-    (``S``, ``n_e``, ``rigid_inertia``) and its capabilities (``has_ports`` if it has
-    ``port``, ...), so that the evaluators read declared members only.
+    naming it. An object that does not subclass :class:`Subsystem` (duck-typed) is given the
+    defaults of the members it lacks (``S``, ``n_e``, ``rigid_inertia``, :meth:`elastic_terms`
+    from its own ``gauss_terms``) and its capabilities (``has_ports`` if it has ``port``, ...),
+    so that the evaluators read declared members only.
     """
     missing = [m for m in REQUIRED if not hasattr(sub, m) or getattr(type(sub), m, None) is getattr(Subsystem, m, _ABSENT)]
     if missing:
@@ -136,7 +138,8 @@ def conform(name: str, sub) -> None:
         return
     for member in DEFAULTS:
         if not hasattr(sub, member):
-            _give(name, sub, member, getattr(Subsystem, member))
+            default = getattr(Subsystem, member)
+            _give(name, sub, member, MethodType(default, sub) if callable(default) else default)
     for flag, methods in CAPABILITIES.items():
         _give(name, sub, flag, all(hasattr(sub, m) for m in methods))
 
