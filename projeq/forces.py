@@ -85,6 +85,8 @@ class ForceLaw:
                     setattr(cls, twin, getattr(ForceLaw, twin))
 
     def bind(self, system) -> "ForceLaw":
+        """Resolve the names the law was given in ``system`` (indices, selections) and return
+        the law; the System binds a copy when it is built."""
         raise NotImplementedError
 
     def add_to(self, h, kin, t, q, s_dot) -> None:
@@ -92,6 +94,7 @@ class ForceLaw:
         raise NotImplementedError
 
     def potential(self, kin, q) -> float:
+        """Potential energy of the law at the kinematic state ``kin`` (0 for a law without one)."""
         return 0.0
 
     def symbolic_unsupported(self) -> str | None:
