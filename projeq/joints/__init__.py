@@ -2,8 +2,8 @@
 
 - :mod:`.base`: the joint contract (:class:`Joint`, :class:`Relative`, :class:`SymbolicRelative`)
   and the pose/twist check;
-- :mod:`.algebra`: the sympy algebra of the joints' (and force laws') symbolic statements;
-- :mod:`.standard`: Revolute, Prismatic, Fixed, Planar, Free, Prescribed;
+- :mod:`.standard`: Revolute, Prismatic, Fixed, Planar, Free, Prescribed, each with its sympy
+  form (written with :mod:`projeq.symbolic.algebra`) and compiled kind next to ``relative``;
 - :mod:`.user`: :class:`UserJoint` from sympy or callables, compiled by :mod:`.user_compiler`.
 """
 
