@@ -44,3 +44,21 @@ def test_bar_sliding_down_a_wall_leaves_it_at_cos_theta_2_3():
     assert abs(np.cos(q[2]) - 2 / 3 * np.cos(theta0)) < 1e-8
     floor = reactions(system, r)[:, 1]
     assert np.all(floor > 0)  # the floor keeps pushing up
+
+
+def test_the_result_ends_where_the_sphere_leaves():
+    """A terminal event's exact state is the Result's last row (issue 18, item 5): the
+    sphere's last row is where the normal force λ vanishes, cos θ = (10/17) cos θ0 (the
+    closed form of the test above: Problem 19 of the problem seminars on Lagrange's
+    equations, started at rest at θ0 instead of the top), read from ``result.q[-1]`` with no
+    dense output; the same state is in ``t_events``/``q_events``/``s_dot_events``, and λ
+    vanishes there. Root on the integrated trajectory: 10 rtol (achieved 4.7e-10 in θ)."""
+    theta0 = 0.1
+    system = sphere_on_sphere(a=0.1, b=1.0, theta0=theta0)
+    r = pq.simulate(system, 5.0, rtol=RTOL, atol=ATOL, n_points=41, events=contact_event(system, 0))
+    assert r.status == 1 and r.t[-1] == r.t_events[0][0] < 5.0
+    assert np.array_equal(r.q[-1], r.q_events[0][0]) and np.array_equal(r.s_dot[-1], r.s_dot_events[0][0])
+    theta = np.arccos(r.q[-1, 1] / np.hypot(r.q[-1, 0], r.q[-1, 1]))
+    assert abs(theta - np.arccos(10 / 17 * np.cos(theta0))) < 1e-8
+    lam = reactions(system, r)[:, 0]
+    assert abs(lam[-1]) < 1e-8 and np.all(lam[:-1] > 0)  # N, with m g = 9.81 N (measured 1.5e-9)
