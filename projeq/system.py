@@ -133,9 +133,10 @@ class Model(ABC):
 
     def accelerations(self, q, s_dot, t: float = 0.0, method: str | None = None) -> NDArray:
         """Minimal accelerations s̈ from the Projection Equation at (q, ṡ, t) by the
-        evaluator ``method``: ``"recursive"`` (order n, THEORY §6), ``"dense"`` (Gauss
-        form, §5) or ``"fast"`` (§6 compiled, :mod:`projeq.assembly.fast`); for a
-        ConstrainedSystem the evaluator of its tree (see its :meth:`evaluator`)."""
+        evaluator ``method``: ``"recursive"`` (order n, docs/theory.md "The recursive pass
+        in augmented form"), ``"dense"`` (the Gauss form M s̈ + b = 0 of Bremer's B(14)) or
+        ``"fast"`` (the recursive pass compiled, :mod:`projeq.assembly.fast`); for a
+        ConstrainedSystem the evaluator of its tree, projected (see its :meth:`evaluator`)."""
         q, s_dot = self.check_state(q, s_dot, t)
         return self.evaluator(method).accelerations(q, s_dot, float(t))
 

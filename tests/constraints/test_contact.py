@@ -18,7 +18,7 @@ def _lift_off(system, row, t_end):
 
 
 def test_sphere_rolling_off_a_sphere_leaves_at_cos_theta_10_17():
-    """Seed 003, Seminar 5, Problem 19: a solid sphere rolling without slipping off a fixed
+    """Problem seminars on Lagrange's equations, Seminar 5, Problem 19: a solid sphere rolling without slipping off a fixed
     sphere leaves it where the normal force vanishes, cos θ = 10/17 when started at rest at
     the top. Started at rest at θ0, energy gives (a + b) θ̇² = (10/7) g (cos θ0 − cos θ), so
     the same derivation gives cos θ = (10/17) cos θ0 (θ0 = 0.1 shortens the run)."""
@@ -33,7 +33,7 @@ def test_sphere_rolling_off_a_sphere_leaves_at_cos_theta_10_17():
 
 
 def test_bar_sliding_down_a_wall_leaves_it_at_cos_theta_2_3():
-    """Seed 003, Seminar 5, Problem 20: a uniform bar sliding down a frictionless wall and
+    """Problem seminars on Lagrange's equations, Seminar 5, Problem 20: a uniform bar sliding down a frictionless wall and
     floor loses the wall where the wall's normal force vanishes, cos θ = 2/3 from rest near
     the upright position; from rest at tilt θ0 the same energy argument gives
     cos θ = (2/3) cos θ0."""
