@@ -29,7 +29,7 @@ from projeq.subsystems.rigid import RigidGroup
 
 
 class Plan:
-    """Per-System preparation of the forward pass (built once, cached on the System).
+    """Per-System preparation of the forward pass (built once, by the System's constructor).
 
     - ``groups``: subsystems whose terms are the rigid-body terms of THEORY §3
       (``rigid_inertia``), one :class:`RigidGroup` per selection S, as (indices, group);
@@ -77,11 +77,8 @@ def _augmented_selection(S: NDArray | None) -> NDArray:
 
 
 def plan(system) -> Plan:
-    """The System's :class:`Plan`, built on first use (kept in the System's evaluator cache)."""
-    cache = system._evaluators
-    if "_plan" not in cache:
-        cache["_plan"] = Plan(system)
-    return cache["_plan"]
+    """The System's :class:`Plan` (built by its constructor)."""
+    return system.plan
 
 
 @dataclass
