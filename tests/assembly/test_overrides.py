@@ -59,7 +59,7 @@ def test_the_override_counts_beside_batched_rigid_bodies(method):
     """A cart (m_1) sliding along x carries the thruster (m_2) on a second slider along x,
     next to two plain bodies that are batched: Newton for the cart and for the thruster,
     (m_1 + m_2) s̈_1 + m_2 s̈_2 = T and m_2 (s̈_1 + s̈_2) = T, give s̈_1 = 0, s̈_2 = T / m_2.
-    The two plain pendulums hang from the ground (s̈ = −g/l sin θ / (1 + I/(m l²)) at rest: 0)."""
+    The two plain pendulums hang at rest from the ground (θ̈ = −(g/l) sin θ = 0 at θ = 0)."""
     m1, m2 = 3.0, 2.0
     system = pq.System(
         {"cart": pq.RigidBody(m1, I_c=np.eye(3)), "rocket": Thruster(m2, I_c=np.eye(3)),
