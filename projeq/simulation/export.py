@@ -1,7 +1,7 @@
 """Results for other tools: a VTU time series for ParaView (via meshio).
 
 Each output time becomes one ``.vtu`` file with the system drawn in inertial coordinates:
-beam centre lines as polylines (subsystems with a ``centre_line`` method) and every other
+beam centre lines as polylines (subsystems that ``deform``, ``centre_line``) and every other
 subsystem as a small frame glyph (three line segments along its axes). Point data:
 ``displacement`` (from the first time) and ``velocity`` (exact, from the kinematics);
 a ``.pvd`` collection file ties the steps together with their times.
@@ -20,16 +20,13 @@ from projeq.spatial import cross
 
 
 def _draw(system, q, s_dot, t, stations: int, frame_size: float):
-    """Points, velocities (inertial) and line cells of the system at one state.
-
-    A constrained system (one with a ``tree``) is drawn as its tree moving with the tree
-    velocities F ṡ."""
-    if hasattr(system, "tree"):
-        system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
+    """Points, velocities (inertial) and line cells of the model at one state: its tree
+    moving with the tree velocities (a ConstrainedSystem's F ṡ + f, a System's ṡ)."""
+    system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
     kin = forward(system, q, s_dot, t, chain_terms=False)
     points, velocities, lines = [], [], []
     for n, sub in enumerate(system.subsystems):
-        if hasattr(sub, "centre_line"):
+        if sub.deforms:
             local, local_velocity = sub.centre_line(q[system.e_q_slice[n]], kin.y_dot[n], stations)
             chain = [(i, i + 1) for i in range(len(local) - 1)]
         else:
@@ -50,14 +47,14 @@ def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21
     Needs ``result.system`` (a Result returned by :func:`projeq.simulate`). Returns the
     path of the ``.pvd`` file, which ParaView opens as a time series.
     """
-    system = getattr(result, "system", None)
+    system = result.system
     if system is None:
         raise ValueError("result: has no system (loaded from a file?); export a Result from simulate()")
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     entries, reference = [], None
-    for k, (t, q, s_dot) in enumerate(zip(result.t, result.q, result.s_dot)):
-        points, velocity, lines = _draw(system, q, s_dot, t, stations, frame_size)
+    for k, (model, t, q, s_dot) in enumerate(zip(system.row_models(result), result.t, result.q, result.s_dot)):
+        points, velocity, lines = _draw(model, q, s_dot, t, stations, frame_size)
         reference = points if reference is None else reference
         path = directory / f"{name}_{k:04d}.vtu"
         mesh = meshio.Mesh(points, [("line", lines)], point_data={"displacement": points - reference, "velocity": velocity})
