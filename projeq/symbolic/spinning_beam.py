@@ -233,16 +233,57 @@ def _matrices(E: sp.Matrix, q, q_dot, q_ddot) -> RitzModel:
     )
 
 
-@lru_cache(maxsize=None)
-def _hamilton_ritz(n: int) -> RitzModel:
-    """Lagrange's equations d/dt ∂L/∂ȧ − ∂L/∂a = 0 of the discretised Lagrangian ∫(T − V)dx
-    (Hamilton's principle, B(16)); α̇ is prescribed, so d/dt also acts through α̈."""
-    a, phi, fields = _ritz_coordinates(n)
-    (q, q_dot, q_ddot), rates = _state_symbols(a)
-    Lagrangian = sp.integrate(sp.expand(_quadratic_density().subs(fields).doit().subs(rates)), (x, 0, L))
+def _lagrange_ritz(Lagrangian, q, q_dot, q_ddot) -> RitzModel:
+    """Lagrange's equations d/dt ∂L/∂ȧ − ∂L/∂a = 0 of a discretised Lagrangian in the plain
+    symbols of :func:`_state_symbols`; α̇ is prescribed, so d/dt also acts through α̈."""
     p = sp.Matrix([Lagrangian]).jacobian(q_dot).T
     p_dot = p.jacobian(q) * sp.Matrix(q_dot) + p.jacobian(q_dot) * sp.Matrix(q_ddot) + p.diff(_Om) * _Om_dot
     return _matrices(p_dot - sp.Matrix([Lagrangian]).jacobian(q).T, q, q_dot, q_ddot)
+
+
+@lru_cache(maxsize=None)
+def _hamilton_ritz(n: int) -> RitzModel:
+    """Hamilton's principle, B(16), with the Cardan rates of B(17), discretised."""
+    a, phi, fields = _ritz_coordinates(n)
+    (q, q_dot, q_ddot), rates = _state_symbols(a)
+    Lagrangian = sp.integrate(sp.expand(_quadratic_density().subs(fields).doit().subs(rates)), (x, 0, L))
+    return _lagrange_ritz(Lagrangian, q, q_dot, q_ddot)
+
+
+def geometric_twist(v_field, w_field) -> sp.Expr:
+    """τ(x) = ½ ∫₀ˣ (v′w″ − w′v″) dξ: the turn about x (rotation-vector component) of the
+    slices of a beam without torsional strain, relative to the frame R spinning with the
+    clamped root. κ_x = τ′ − ½(θ × θ′)_x = 0 for θ = (τ, −w′, v′) (the body curvature of
+    exp(θ̃) to second order)."""
+    xi = sp.Symbol("xi")
+    rate = (_d(v_field, x) * _d(w_field, x, 2) - _d(w_field, x) * _d(v_field, x, 2)) / 2
+    return sp.integrate(sp.expand(rate.subs(x, xi)), (xi, 0, x))
+
+
+def torsion_free_angular_velocity(v_field, w_field) -> sp.Matrix:
+    """ω_c of a slice of a beam without torsional strain, in its own frame, to second order:
+    ω_c = (E − θ̃ + ½θ̃²)(α̇, 0, 0) + (E − ½θ̃) θ̇ with the rotation vector
+    θ = (τ, −w′, v′) of the slice relative to R (:func:`geometric_twist`)."""
+    theta = sp.Matrix([geometric_twist(v_field, w_field), -_d(w_field, x), _d(v_field, x)])
+    theta_skew = skew(theta)
+    E = sp.eye(3)
+    return (E - theta_skew + theta_skew**2 / 2) * sp.Matrix([_d(alpha, t), 0, 0]) + (E - theta_skew / 2) * _d(theta, t)
+
+
+@lru_cache(maxsize=None)
+def _torsion_free_ritz(n: int) -> RitzModel:
+    """Lagrange's equations of the beam whose slices have no torsional strain (κ_x = 0):
+    the kinematics a finely segmented chain of rigid slices joined by bending joints tends
+    to (:mod:`projeq.subsystems.beam.slice_chain`); only the slices' rotation differs from
+    :func:`_hamilton_ritz` (B(17)'s Cardan slices are twisted by −½v′w′ instead of τ)."""
+    a, phi, fields = _ritz_coordinates(n)
+    (q, q_dot, q_ddot), rates = _state_symbols(a)
+    v_c, omega_c = slice_velocity().subs(fields).doit(), torsion_free_angular_velocity(fields[v], fields[w])
+    T = rho_A * v_c.dot(v_c) / 2 + (omega_c.T * rho_I * sp.diag(2, 1, 1) * omega_c)[0] / 2
+    density = (T - EI * (_d(fields[v], x, 2) ** 2 + _d(fields[w], x, 2) ** 2) / 2).subs(rates)
+    quadratic = _order(density, 2, fields=tuple(q) + tuple(q_dot))
+    Lagrangian = sp.integrate(quadratic, (x, 0, L))
+    return _lagrange_ritz(Lagrangian, q, q_dot, q_ddot)
 
 
 @lru_cache(maxsize=None)
@@ -273,7 +314,10 @@ def ritz_models(n: int = 2, length: float = 1.0, rho_A_value: float = 1.0, rho_I
     for symbol, value in values.items():
         if not value > 0:
             raise ValueError(f"{symbol}: must be positive, got {value!r}")
-    models = {"hamilton": _hamilton_ritz(int(n)), "projection": _projection_ritz(int(n))}
+    models = {
+        "hamilton": _hamilton_ritz(int(n)), "projection": _projection_ritz(int(n)),
+        "torsion_free": _torsion_free_ritz(int(n)),
+    }
     return {
         name: RitzModel(*(np.array(m.subs(values), dtype=float) for m in model))
         for name, model in models.items()
