@@ -302,7 +302,7 @@ def _spinning_beam(formulations, simulate, t_end):
             row.update(identical="no" if (d_v, d_w) != (0, 0) else "yes", check="symbolic",
                        note=f"{row['note']}; v equation − B(23)'s = {d_v}, w equations equal: {d_w == 0}")
         if simulate:
-            model = sb.ritz_models(2, rho_I_value=0.05)[kind]
+            model = sb.ritz_models(2, rho_I_value=0.05, kinds=(kind,))[kind]
             a0 = np.array([0.01, 0.0, 0.0, 0.0])
             (times, a, _, E, W), row["integration_s"] = _timed(
                 lambda: sb.simulate_ritz(model, spin_up_motion(3.0, 2.0), a0, np.zeros(4), t_end))

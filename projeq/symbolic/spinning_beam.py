@@ -1,31 +1,45 @@
 """The spinning beam of B(16)–(23): Hamilton's principle versus the Projection Equation.
 
-A beam along x spins with the prescribed angle α(t) about its own axis; v(x, t), w(x, t)
-are its bending deflections in the co-rotating frame R (ω_IR = (α̇, 0, 0)); the section is
-circular (polar ρI_x = 2ρI). Both sets of field equations are derived here with sympy and
+H. Bremer, "Problems in fast moving non-holonomic elastic systems", B(16)–(23). A beam
+along x spins with the prescribed angle α(t) about its own axis; v(x, t), w(x, t) are its
+bending deflections in the co-rotating frame R (ω_IR = (α̇, 0, 0)); the section is
+circular (polar ρI_x = 2ρI). The field equations are derived here with sympy and
 linearised in (v, w):
 
 * :func:`hamilton_field_equations` — Hamilton's principle with the Cardan rates
-  (α̇, −ẇ′, v̇′) of B(17); reproduces B(18) (THEORY §9).
+  (α̇, −ẇ′, v̇′) of B(17); reproduces B(18).
 * :func:`projection_field_equations` — Newton–Euler residuals of a slice in R projected
-  with the operator D̄ of B(22) and its adjoint D (B(21)); reproduces B(23) as corrected in
-  THEORY §9.
+  with the operator D̄ of B(22) and its adjoint D (B(21)); reproduces B(23) (with the
+  signs of docs/theory.md, "The spinning beam's rotary inertia").
 
 They differ only in the ρI α̈ coupling of the v equation (:func:`field_difference`): the
 Cardan axes (x, y′, z″) are not orthogonal, so Hamilton's v equation is the directional
 derivative along the Cardan v′ axis, which picks up the torsional balance ρI_x α̈ times w′
 (the x component of that axis). :func:`ritz_models` discretises both with the clamped
-polynomial functions (x/L)^(k+1) of ``RitzBeam(family="polynomial")``.
+polynomial functions (x/L)^(k+1) of ``RitzBeam(family="polynomial")``, and a third model,
+:func:`_torsion_free_ritz`: the beam without torsional strain (κ_x = 0), which a finely
+segmented chain of rigid slices joined by bending joints tends to
+(:mod:`projeq.subsystems.beam.slice_chain`, the independent check).
 
-Interpretation. B(23) is the slice's Newton–Euler balance in the co-rotating frame R,
-projected on R's y and z directions: its ρI α̈ coupling is skew (circulatory, like the ρA
-part). B(18) is the same balance projected on the Cardan axes; its v equation contains
-the torsional balance ρI_x α̈ weighted by w′, so the ρI α̈ coupling is symmetric (the
-derivative of a time-dependent potential −½α̈ aᵀC_sym a at the Ritz level). At constant
-spin both coincide (and conserve the energy relative to R, the Jacobi integral); under
-spin-up each obeys its own work balance and the motions differ at first order in ρI.
-projeq's numeric ``RitzBeam`` projects the slice's Euler equations in the slice frame: its
-v rows coincide with Hamilton's, its coupling is skew (tests/symbolic/test_spinning_beam.py).
+Interpretation. Under spin-up the slices carry the spin-up torque ρI_x α̈ about x; what
+it does on a variation of (v, w) depends on how the slices turn about x when the beam
+bends — a second-order effect in (v, w) that the two documents' equations treat
+differently, and neither as the beam without torsional strain:
+
+* B(17)'s Cardan slices are turned by −½v′w′ about x (rotation-vector component of
+  R_y(−w′) R_z(v′)): B(18) is exact for that constraint, its coupling symmetric
+  (−ρI α̈ ∂²(∫v′w′ dx)/∂a²);
+* B(23) projects the balance on D̄'s rows (−ẇ′, v̇′) only — the x component of the slices'
+  virtual rotation, −½(θ × δθ)_x, is left out, which leaves the extra coupling
+  ρI α̈ (w′δv′ − v′δw′) in its equations (skew, circulatory); projecting the same balance in the
+  slice frame instead (projeq's RitzBeam before issue 18) gives its negative;
+* without torsional strain the slices turn by τ(x) = ½∫₀ˣ(v′w″ − w′v″)dξ
+  (:func:`geometric_twist`), and the coupling is ρI_x α̈ ∂²(∫τ dx)/∂a²: the transmitted
+  spin-up torque ρI_x α̈ (L − x) working on the twist rate ½(v′w″ − w′v″).
+
+At constant spin all coincide (and conserve the energy relative to R, the Jacobi
+integral); under spin-up the motions differ at first order in ρI. projeq's numeric
+``RitzBeam`` is the beam without torsional strain (tests/symbolic/test_spinning_beam.py).
 """
 
 from __future__ import annotations
@@ -148,7 +162,7 @@ def projection_field_equations() -> tuple[sp.Expr, sp.Expr]:
 
 
 def _field_expected(rho_I_coupling: tuple[int, int]):
-    """The two field equations of THEORY §9 with signs (s_v, s_w) of the ρI α̈ terms."""
+    """The two linear field equations with signs (s_v, s_w) of the ρI α̈ terms."""
     ad, add = _d(alpha, t), _d(alpha, t, 2)
     sv, sw = rho_I_coupling
     eq_v = (rho_A * (_d(v, t, 2) - 2 * ad * _d(w, t) - add * w - ad**2 * v)
@@ -159,13 +173,13 @@ def _field_expected(rho_I_coupling: tuple[int, int]):
 
 
 def expected_B18():
-    """B(18) as printed (circular section, EI constant), with ρA α̈ v (not α̈ v/2, a typo of
-    the seed's transcription): ρI α̈ coupling −ρI(… − α̈w″), −ρI(… − α̈v″), symmetric."""
+    """B(18) as printed (circular section, EI constant), with ρA α̈ v (not α̈ v/2, a slip of
+    the text's transcription): ρI α̈ coupling −ρI(… − α̈w″), −ρI(… − α̈v″), symmetric."""
     return _field_expected((-1, -1))
 
 
 def expected_B23():
-    """B(23) as corrected in THEORY §9: −ρI(… + α̈w″), −ρI(… − α̈v″), skew-symmetric."""
+    """B(23) with the signs of docs/theory.md: −ρI(… + α̈w″), −ρI(… − α̈v″), skew-symmetric."""
     return _field_expected((1, -1))
 
 
@@ -300,27 +314,31 @@ def _projection_ritz(n: int) -> RitzModel:
     return _matrices(sp.Matrix(equations), q, q_dot, q_ddot)
 
 
+_RITZ = {"hamilton": _hamilton_ritz, "projection": _projection_ritz, "torsion_free": _torsion_free_ritz}
+
+
 def ritz_models(n: int = 2, length: float = 1.0, rho_A_value: float = 1.0, rho_I_value: float = 0.01,
-                EI_value: float = 1.0) -> dict[str, RitzModel]:
-    """Numeric Ritz models ``{"hamilton": …, "projection": …}`` with n functions per plane.
+                EI_value: float = 1.0, kinds=tuple(_RITZ)) -> dict[str, RitzModel]:
+    """Numeric Ritz models ``{"hamilton": …, "projection": …, "torsion_free": …}`` (or the
+    ``kinds`` asked for) with n functions per plane.
 
     Coordinates a = (a_v1 … a_vn, a_w1 … a_wn), shapes (x/L)^(k+1) as in
     ``RitzBeam(family="polynomial")``. They differ only in C (the ρI α̈ coupling):
-    symmetric for Hamilton, skew-symmetric for the Projection Equation.
+    symmetric for Hamilton's B(18), skew-symmetric for the Projection Equation's B(23),
+    ρI_x ∂²(∫τ dx)/∂a² for the beam without torsional strain (:func:`_torsion_free_ritz`).
     """
     if int(n) != n or n < 1:
         raise ValueError(f"n: number of Ritz functions per plane must be a positive integer, got {n!r}")
+    unknown = [kind for kind in kinds if kind not in _RITZ]
+    if unknown:
+        raise ValueError(f"kinds: unknown {unknown}; available: {list(_RITZ)}")
     values = {L: length, rho_A: rho_A_value, rho_I: rho_I_value, EI: EI_value}
     for symbol, value in values.items():
         if not value > 0:
             raise ValueError(f"{symbol}: must be positive, got {value!r}")
-    models = {
-        "hamilton": _hamilton_ritz(int(n)), "projection": _projection_ritz(int(n)),
-        "torsion_free": _torsion_free_ritz(int(n)),
-    }
     return {
-        name: RitzModel(*(np.array(m.subs(values), dtype=float) for m in model))
-        for name, model in models.items()
+        kind: RitzModel(*(np.array(m.subs(values), dtype=float) for m in _RITZ[kind](int(n))))
+        for kind in kinds
     }
 
 

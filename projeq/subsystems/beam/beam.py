@@ -10,8 +10,10 @@ the Projection Equation B(19)–(25) for the slices gives
     M_n = ∫ Jᵀ J dm,   h_n = −∫ Jᵀ (ω̃ ṙ + ω̃ v_c − (q̇_vᵀH_v q̇_v + q̇_wᵀH_w q̇_w) e_x − g_R) dm − K_e q_e
 
 (the bracket is J̇ ẏ + ω̃ v_c − g, the acceleration not proportional to ÿ), plus the rotary
-inertia of the slices (Rayleigh) with ω_c = (E − θ̃) ω + Φ_θᵀ q̇_e in the slice's frame,
-small rotation θ = Φ_θᵀ q_e, Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (torsion β, THEORY §10). Because
+inertia of the slices (Rayleigh) with ω_c = (E − θ̃) ω + (E − ½θ̃) θ̇ in the slice's frame,
+rotation vector θ = Φ_θᵀ q_e + τ e_x, Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (torsion β, THEORY §10) and
+the geometric twist τ = q_vᵀ T(x) q_w of a beam without torsional strain (second order; it
+carries the spin-up torque's coupling, docs/theory.md). Because
 u₂ is part of the kinematics, the projection of the slices' axial inertia loads on
 ∂u₂/∂q gives the geometric stiffness ∫ N(x) Φ′Φ′ᵀ dx with N(x) = ∫ₓᴸ f_x: dynamic
 stiffening from spin, angular and frame acceleration and gravity alike, and the model
