@@ -89,11 +89,16 @@ def _progress_bar(t_start: float, t_end: float, quiet: bool):
 
 
 def _write(result, out: Path, name: str) -> list[Path]:
+    """``name.npz`` (the Result) and ``name.csv`` (:class:`~projeq.studies.table.Table`: t, q,
+    ṡ, kinetic and potential energy per output time)."""
+    from projeq.studies.table import Table
+
     npz, csv = out / f"{name}.npz", out / f"{name}.csv"
     result.save(npz)
-    columns = ["t"] + [f"q{i}" for i in range(result.q.shape[1])] + [f"s_dot{i}" for i in range(result.s_dot.shape[1])]
-    table = np.column_stack((result.t, result.q, result.s_dot, result.kinetic, result.potential))
-    np.savetxt(csv, table, delimiter=",", header=",".join(columns + ["kinetic", "potential"]), comments="")
+    columns = (["t"] + [f"q{i}" for i in range(result.q.shape[1])] + [f"s_dot{i}" for i in range(result.s_dot.shape[1])]
+               + ["kinetic", "potential"])
+    rows = np.column_stack((result.t, result.q, result.s_dot, result.kinetic, result.potential))
+    Table(columns, rows.tolist(), units={"t": "s", "kinetic": "J", "potential": "J"}).to_csv(csv)
     return [npz, csv]
 
 

@@ -15,6 +15,7 @@ import numpy as np
 
 from projeq.cli.options import number, output_directory, scene_settings_option
 from projeq.studies.compare import COMPARISONS, compare
+from projeq.studies.effort import DERIVATION_REPEATS
 from projeq.studies.tradeoff import METHODS, QUICK_TOLERANCES, format_table, get_study, plot, save_csv, tradeoff
 from projeq.studies.tradeoff_studies import STUDIES
 
@@ -25,11 +26,14 @@ def compare_arguments(parser) -> None:
     parser.add_argument("--no-simulate", action="store_true", help="derive and check only")
     parser.add_argument("--t-end", type=float, default=None, help="simulated time (s)")
     parser.add_argument("--formulation", action="append", help="restrict to these rows (repeatable)")
+    parser.add_argument("--repeats", type=int, default=DERIVATION_REPEATS,
+                        help=f"derivations per row, median reported (default {DERIVATION_REPEATS})")
     parser.set_defaults(execute=compare_formulations)
 
 
 def compare_formulations(args) -> int:
-    table = compare(args.name, args.formulation, simulate=not args.no_simulate, t_end=args.t_end)
+    table = compare(args.name, args.formulation, simulate=not args.no_simulate, t_end=args.t_end,
+                    repeats=args.repeats)
     print(table.format())
     if args.csv:
         table.to_csv(args.csv)

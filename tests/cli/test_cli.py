@@ -200,8 +200,8 @@ def test_compare_hands_its_options_to_the_library(monkeypatch, capsys):
         return pq.ComparisonTable("car")
 
     monkeypatch.setattr(projeq.cli.studies, "compare", compare)
-    assert main(["compare", "car", "--no-simulate", "--t-end", "1.5", "--formulation", "hamel"]) == 0
-    assert seen == [(("car", ["hamel"]), {"simulate": False, "t_end": 1.5})]
+    assert main(["compare", "car", "--no-simulate", "--t-end", "1.5", "--formulation", "hamel", "--repeats", "3"]) == 0
+    assert seen == [(("car", ["hamel"]), {"simulate": False, "t_end": 1.5, "repeats": 3})]
     assert capsys.readouterr().out.startswith("compare car")
 
 
@@ -270,3 +270,9 @@ def test_progress_bar_on_a_terminal_unless_quiet(quiet, tmp_path, monkeypatch):
     argv = ["run", "atwood", "--t-end", "0.2", "--out", str(tmp_path)] + (["--quiet"] if quiet else [])
     assert main(argv) == 0
     assert ("100%|" in terminal.getvalue() and "t = 0.2/0.2 s" in terminal.getvalue()) is not quiet
+
+
+def test_version(capsys):
+    """``projeq --version`` prints the one version source, ``projeq.__version__``, and exits 0."""
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"projeq {pq.__version__}"
