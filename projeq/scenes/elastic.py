@@ -6,7 +6,9 @@ import numpy as np
 
 from projeq.subsystems import inertia
 from projeq.checks import count, finite_array, positive
+from projeq.forces import JointSpring
 from projeq.joints import Fixed, Prescribed, Revolute
+from projeq.spatial import rotation_y, rotation_z
 from projeq.subsystems.beam.beam import RitzBeam
 from projeq.subsystems.rigid import PointMass, RigidBody
 from projeq.system import System
@@ -170,8 +172,6 @@ def rigid_slice_chain(n_slices: int, motion, length: float = 1.0, rho_A: float =
     subsystems = {"hub": RigidBody(1.0, (0.0, 0.0, 0.0), np.eye(3))}  # prescribed: its inertia does not enter
     joints = {"hub": Prescribed(Revolute(axis="x"), motion)}
     springs, parent = [], "hub"
-    from projeq.forces import JointSpring
-
     for i in range(n_slices):
         name = f"slice{i}"
         subsystems[name] = slice_body
@@ -193,7 +193,6 @@ def rigid_slice_chain_tip(q: np.ndarray, length: float = 1.0) -> np.ndarray:
     dx = length / n_slices
     A, tip = np.eye(3), np.zeros(3)
     for beta, gamma in q.reshape(n_slices, 2):
-        cb, sb, cg, sg = np.cos(beta), np.sin(beta), np.cos(gamma), np.sin(gamma)
-        A = A @ np.array([[cb, 0.0, sb], [0.0, 1.0, 0.0], [-sb, 0.0, cb]]) @ np.array([[cg, -sg, 0.0], [sg, cg, 0.0], [0.0, 0.0, 1.0]])
+        A = A @ rotation_y(beta) @ rotation_z(gamma)
         tip += A[:, 0] * dx
     return tip

@@ -32,14 +32,14 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from projeq.analysis.differentiation import complex_step, jacobian
 from projeq.checks import count, positive
-from projeq.spatial import skew, vee
+from projeq.spatial import rotation_y, rotation_z, skew, vee
 from projeq.subsystems.beam import shapes
 
 JOINTS = ("shortest", "yz", "zy")
 _E_X = np.array([1.0, 0.0, 0.0])
-_STEP = 1e-30  # complex step
-_FD_STEP = 1e-4  # central differences in a (𝕄 is a polynomial of low order in a: error ~1e-8)
+_FD_STEP = 1e-4  # second differences of 𝕄_αα in a (smooth, of low order: error ~1e-8)
 
 
 def _shortest_rotation(u: NDArray, v: NDArray) -> NDArray:
@@ -51,18 +51,9 @@ def _shortest_rotation(u: NDArray, v: NDArray) -> NDArray:
 def _revolute_pair(d: NDArray, joint: str) -> NDArray:
     """Two revolute joints turning e_x into the unit vector d: about y then z (``"yz"``),
     or about z then y (``"zy"``); complex-safe."""
-
-    def about_y(angle):
-        c, s = np.cos(angle), np.sin(angle)
-        return np.array([[c, 0 * c, s], [0 * c, 1 + 0 * c, 0 * c], [-s, 0 * c, c]])
-
-    def about_z(angle):
-        c, s = np.cos(angle), np.sin(angle)
-        return np.array([[c, -s, 0 * c], [s, c, 0 * c], [0 * c, 0 * c, 1 + 0 * c]])
-
     if joint == "yz":
-        return about_y(np.arctan(-d[2] / d[0])) @ about_z(np.arcsin(d[1]))
-    return about_z(np.arctan(d[1] / d[0])) @ about_y(np.arcsin(-d[2]))
+        return rotation_y(np.arctan(-d[2] / d[0])) @ rotation_z(np.arcsin(d[1]))
+    return rotation_z(np.arctan(d[1] / d[0])) @ rotation_y(np.arcsin(-d[2]))
 
 
 class SliceChain:
@@ -89,8 +80,8 @@ class SliceChain:
         K_plane = (rotation_jumps * (EI / spans)) @ rotation_jumps.T
         self.K = np.kron(np.eye(2), K_plane)
 
-    def _frames(self, a: NDArray) -> list[NDArray]:
-        """Slice frames B_i (slice → R coordinates) for the field a (real or complex)."""
+    def _frames(self, a: NDArray) -> NDArray:
+        """Slice frames B_i (slice → R coordinates) for the field a (real or complex), (N, 3, 3)."""
         tangents = np.stack([np.ones(self.n_slices, dtype=a.dtype), a[: self.n] @ self.Phi_x, a[self.n:] @ self.Phi_x], 1)
         tangents = tangents / np.sqrt((tangents**2).sum(axis=1))[:, None]
         B, previous, frames = np.eye(3, dtype=a.dtype), _E_X.astype(a.dtype), []
@@ -101,7 +92,7 @@ class SliceChain:
                 B = B @ _revolute_pair(B.T @ t, self.joint)
             frames.append(B)
             previous = t
-        return frames
+        return np.array(frames)
 
     def inertia_matrix(self, a: NDArray) -> NDArray:
         """𝕄(a) of T = ½ uᵀ 𝕄 u with u = (ȧ, α̇): translation of the slice centres in the
@@ -110,12 +101,12 @@ class SliceChain:
         m = 2 * self.n
         frames = self._frames(a)
         # ∂ω_i/∂ȧ_k = vee(B_iᵀ ∂B_i/∂a_k) by complex step, ∂ω_i/∂α̇ = B_iᵀ e_x
-        turned = [self._frames(a + 1j * _STEP * e) for e in np.eye(m)]
+        turned = [complex_step(lambda eps: self._frames(a + eps * e)) for e in np.eye(m)]
         M = np.zeros((m + 1, m + 1))
         v = a[: self.n] @ self.Phi
         w = a[self.n:] @ self.Phi
         for i, B in enumerate(frames):
-            J_omega = np.column_stack([vee(B.T @ (turned[k][i].imag / _STEP)) for k in range(m)] + [B.T @ _E_X])
+            J_omega = np.column_stack([vee(B.T @ turned[k][i]) for k in range(m)] + [B.T @ _E_X])
             J_r = np.zeros((3, m + 1))
             J_r[1, : self.n], J_r[2, self.n: m] = self.Phi[:, i], self.Phi[:, i]
             J_r[:, m] = np.cross(_E_X, [self.x[i], v[i], w[i]])
@@ -137,7 +128,7 @@ class SliceChain:
         m, h = 2 * self.n, _FD_STEP
         E = np.eye(m)
         M0 = self.inertia_matrix(np.zeros(m))
-        C = np.column_stack([(self.inertia_matrix(h * e)[:m, m] - self.inertia_matrix(-h * e)[:m, m]) / (2 * h) for e in E])
+        C = jacobian(lambda a: self.inertia_matrix(a)[:m, m], np.zeros(m))
         spin = self.spin_inertia
         hessian = np.array([
             [(spin(h * (ei + ej)) - spin(h * (ei - ej)) - spin(h * (ej - ei)) + spin(-h * (ei + ej))) / (4 * h * h) for ej in E]
