@@ -29,10 +29,11 @@ differently, and neither as the beam without torsional strain:
 * B(17)'s Cardan slices are turned by −½v′w′ about x (rotation-vector component of
   R_y(−w′) R_z(v′)): B(18) is exact for that constraint, its coupling symmetric
   (−ρI α̈ ∂²(∫v′w′ dx)/∂a²);
-* B(23) projects the balance on D̄'s rows (−ẇ′, v̇′) only — the x component of the slices'
-  virtual rotation, −½(θ × δθ)_x, is left out, which leaves the extra coupling
-  ρI α̈ (w′δv′ − v′δw′) in its equations (skew, circulatory); projecting the same balance in the
-  slice frame instead (projeq's RitzBeam before issue 18) gives its negative;
+* B(23) projects the balance on D̄'s rows (−ẇ′, v̇′) only: the slice's virtual turn about x
+  (first order on the bent beam) has no row, and what reaches the equations is the part of
+  the torque that the R components of the y, z balances carry (ρI α̈ θ × e_x): the extra
+  coupling ρI α̈ (w′δv′ − v′δw′) (skew, circulatory); projecting in the slice frame instead
+  (projeq's RitzBeam before issue 18) gives its negative;
 * without torsional strain the slices turn by τ(x) = ½∫₀ˣ(v′w″ − w′v″)dξ
   (:func:`geometric_twist`), and the coupling is ρI_x α̈ ∂²(∫τ dx)/∂a²: the transmitted
   spin-up torque ρI_x α̈ (L − x) working on the twist rate ½(v′w″ − w′v″).
