@@ -248,9 +248,10 @@ class System:
 
     # -- evaluation -----------------------------------------------------------------------
     def evaluator(self, method: str | None = None):
-        """The cached evaluator ``"recursive"``, ``"dense"`` or ``"fast"`` (compiled order n,
-        :mod:`projeq.assembly.fast`) (``None``: recursive, or
-        dense when minimal velocities are shared by coupled joints)."""
+        """The cached evaluator ``"recursive"``, ``"dense"``, ``"fast"`` (compiled order n,
+        :mod:`projeq.assembly.fast`), ``"hub_beam"`` or ``"auto"`` (the best of them available,
+        :mod:`projeq.assembly.auto`) (``None``: recursive, or dense when minimal velocities
+        are shared by coupled joints). One that cannot evaluate this system raises why."""
         from projeq.assembly import EVALUATORS
 
         if method is None:
@@ -264,8 +265,8 @@ class System:
     def accelerations(self, q, s_dot, t: float = 0.0, method: str | None = None) -> NDArray:
         """Minimal accelerations s̈ from the Projection Equation at (q, ṡ, t).
 
-        ``method="recursive"`` (order n, THEORY §6), ``"dense"`` (Gauss form, §5) or
-        ``"fast"`` (§6 compiled, :mod:`projeq.assembly.fast`).
+        ``method="recursive"`` (order n, THEORY §6), ``"dense"`` (Gauss form, §5),
+        ``"fast"`` (§6 compiled, :mod:`projeq.assembly.fast`), ``"hub_beam"`` or ``"auto"``.
         """
         q, s_dot = self.check_state(q, s_dot, t)
         return self.evaluator(method).accelerations(q, s_dot, float(t))
@@ -281,10 +282,10 @@ class System:
 
     def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:
         """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and gravity plus springs."""
-        from projeq.assembly.kinematics import forward
+        from projeq.assembly.kinematics import poses
 
         q, s_dot = self.check_state(q, s_dot, t)
-        kin = forward(self, q, s_dot, float(t), chain_terms=False)
+        kin = poses(self, q, s_dot, float(t))
         q_e = [q[sl] for sl in self.e_q_slice]
         kinetic = sum(sub.kinetic_energy(kin.y_dot[n], q_e[n]) for n, sub in enumerate(self.subsystems))
         potential = sum(

@@ -15,7 +15,7 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
-from projeq.assembly.kinematics import forward
+from projeq.assembly.kinematics import poses
 from projeq.spatial import cross
 
 
@@ -26,7 +26,7 @@ def _draw(system, q, s_dot, t, stations: int, frame_size: float):
     velocities F ṡ."""
     if hasattr(system, "tree"):
         system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
-    kin = forward(system, q, s_dot, t, chain_terms=False)
+    kin = poses(system, q, s_dot, t)
     points, velocities, lines = [], [], []
     for n, sub in enumerate(system.subsystems):
         if hasattr(sub, "centre_line"):

@@ -88,8 +88,16 @@ class RitzBeam(BeamProbes):
     precomputed_integrals : bool
         Shorthand for ``integration=PrecomputedIntegrals``; default False.
 
-    Attributes: ``integrals`` (the integration strategy built for this beam), ``K_e``,
-    ``first_frequency`` (lowest bending frequency at rest, rad/s), the stations ``x``.
+    Attributes
+    ----------
+    integrals : Quadrature or PrecomputedIntegrals
+        The integration strategy built for this beam.
+    K_e : ndarray
+        Stiffness matrix of the elastic coordinates.
+    first_frequency : float
+        Lowest bending frequency at rest (rad/s).
+    x : ndarray
+        The quadrature stations (m).
     """
 
     def __init__(
