@@ -23,7 +23,8 @@ from __future__ import annotations
 
 import argparse
 
-from projeq.studies.bench import QUICK_SIZES, add_exact_option, chain_scaling
+from projeq.cli.bench import exact_option
+from projeq.studies.bench import QUICK_SIZES, chain_scaling
 
 SIZES = (10, 30, 100, 200, 300, 1000)
 
@@ -34,7 +35,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--budget", type=float, default=1.0, help="seconds of timing per size (default 1)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
-    add_exact_option(parser)
+    exact_option(parser)
     args = parser.parse_args(argv)
     return chain_scaling(QUICK_SIZES if args.quick else SIZES, args.budget, args.json, not args.no_peers, args.exact_up_to)
 

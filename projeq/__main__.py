@@ -1,5 +1,5 @@
-"""``python -m projeq`` runs the command line (:mod:`projeq.cli.commands`)."""
+"""``python -m projeq`` runs the command line (:func:`projeq.cli.main`)."""
 
-from projeq.cli.commands import main
+from projeq.cli import main
 
 raise SystemExit(main())

@@ -8,6 +8,13 @@ Pure functions on numpy arrays, in Bremer's notation (THEORY §1, §4):
 - a *twist* is the 6-vector (v_O, ω) of a frame's origin velocity and angular velocity,
   both in that frame's own coordinates; ``T_np`` maps the twist of p to the part of the
   twist of n that p's motion causes (B(15), THEORY §4).
+
+This is the one numeric home of these formulas. Every function is complex-safe: complex
+input gives the complex result of the same formula (no float-only buffers), so complex-step
+differentiation, Im f(x + iε ẋ)/ε = ḟ to round-off, works through them (a beam port's Ḟ,
+the Ḟ of user joints from callables). The compiled order-n kernel keeps scalar twins of
+the rotation, the chain matrix and the rigid-body h (:mod:`projeq.assembly.kernels`),
+tested equal to these.
 """
 
 from __future__ import annotations
@@ -31,7 +38,7 @@ def cross(a, b) -> NDArray:
     """
     if a.ndim == 1 and b.ndim == 1:
         return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=np.result_type(a, b, float))
     out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
     out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
     out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
@@ -59,11 +66,41 @@ def unit_axis(axis, name: str = "axis") -> NDArray:
     return e / norm
 
 
-def rotation(e: NDArray, angle: float) -> NDArray:
-    """Rotation by ``angle`` about the unit axis ``e`` (Rodrigues): maps rotated-frame
-    coordinates into the original frame, R = E + sin φ ẽ + (1 − cos φ) ẽ²."""
+def axis_spin(e) -> tuple[NDArray, NDArray]:
+    """(ẽ, ẽ²) of a fixed unit axis e, formed once for :func:`rodrigues`."""
     E = skew(e)
-    return np.eye(3) + np.sin(angle) * E + (1.0 - np.cos(angle)) * (E @ E)
+    return E, E @ E
+
+
+def rodrigues(spin: tuple[NDArray, NDArray], angle) -> NDArray:
+    """Rodrigues' rotation R = E + sin φ ẽ + (1 − cos φ) ẽ² by the angle φ about the unit
+    axis e whose ``spin = (ẽ, ẽ²)`` (:func:`axis_spin`): maps rotated-frame coordinates
+    into the original frame (right-hand rule about e)."""
+    E, E2 = spin
+    return np.eye(3) + np.sin(angle) * E + (1.0 - np.cos(angle)) * E2
+
+
+def rotation(e: NDArray, angle) -> NDArray:
+    """Rotation by ``angle`` about the unit axis ``e``: :func:`rodrigues` with (ẽ, ẽ²) of e."""
+    return rodrigues(axis_spin(e), angle)
+
+
+def rotation_x(angle) -> NDArray:
+    """Rotation by ``angle`` about the x-axis, R_x(φ) = rotation(e_x, φ)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def rotation_y(angle) -> NDArray:
+    """Rotation by ``angle`` about the y-axis, R_y(φ) = rotation(e_y, φ)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def rotation_z(angle) -> NDArray:
+    """Rotation by ``angle`` about the z-axis, R_z(φ) = rotation(e_z, φ)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def quaternion_matrix(quat: NDArray) -> NDArray:
@@ -91,7 +128,7 @@ def chain_matrix(A_np: NDArray, r_pn: NDArray) -> NDArray:
     ``r_pn`` is O_p → O_n in p-coordinates; ẏ_n = T_np ẏ_p is the twist of a frame n
     rigidly attached to p.
     """
-    T = np.zeros(A_np.shape[:-2] + (6, 6))
+    T = np.zeros(A_np.shape[:-2] + (6, 6), dtype=np.result_type(A_np, r_pn, float))
     T[..., :3, :3] = A_np
     T[..., 3:, 3:] = A_np
     T[..., :3, 3:] = -A_np @ skew_stack(r_pn)
@@ -100,7 +137,7 @@ def chain_matrix(A_np: NDArray, r_pn: NDArray) -> NDArray:
 
 def skew_stack(a: NDArray) -> NDArray:
     """Spin matrices of a stack of 3-vectors (..., 3) → (..., 3, 3)."""
-    S = np.zeros(a.shape[:-1] + (3, 3))
+    S = np.zeros(a.shape[:-1] + (3, 3), dtype=np.result_type(a, float))
     S[..., 0, 1], S[..., 0, 2], S[..., 1, 2] = -a[..., 2], a[..., 1], -a[..., 0]
     S[..., 1, 0], S[..., 2, 0], S[..., 2, 1] = a[..., 2], -a[..., 1], a[..., 0]
     return S

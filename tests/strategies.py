@@ -36,7 +36,7 @@ import sympy as sp
 from hypothesis import strategies as st
 
 import projeq as pq
-from projeq.spatial import rotation, skew
+from projeq.spatial import rotation, rotation_x, rotation_y, rotation_z
 
 SPATIAL_KINDS = (
     "revolute",
@@ -81,26 +81,13 @@ def random_inertia(rng, m: float, R=None) -> np.ndarray:
     return R @ np.diag([J[1] + J[2], J[0] + J[2], J[0] + J[1]]) @ R.T
 
 
-def _rz(angle) -> np.ndarray:
-    """Rotation about z; numpy ufuncs only, so it accepts complex angles (complex step)."""
-    c, s = np.cos(angle), np.sin(angle)
-    z = 0 * c
-    return np.array([[c, -s, z], [s, c, z], [z, z, 1 + z]])
-
-
 # -- user joints from callables ------------------------------------------------------------
 def spherical_joint(parent=None, r_pn=(0.0, 0.0, 0.0)) -> pq.UserJoint:
     """A ball joint: Cardan angles q = (a, b, c), A = R_z(a) R_y(b) R_x(c), ṡ = q̇ and
     ω = ȧ R_xᵀR_yᵀ e_z + ḃ R_xᵀ e_y + ċ e_x in child coordinates (regular for |b| < π/2)."""
 
     def pose(q, t):
-        a, b, c = q
-        ca, sa, cb, sb, cc, sc = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(c), np.sin(c)
-        z = 0 * a
-        Rz = np.array([[ca, -sa, z], [sa, ca, z], [z, z, 1 + z]])
-        Ry = np.array([[cb, z, sb], [z, 1 + z, z], [-sb, z, cb]])
-        Rx = np.array([[1 + z, z, z], [z, cc, -sc], [z, sc, cc]])
-        return Rz @ Ry @ Rx, np.zeros(3)
+        return rotation_z(q[0]) @ rotation_y(q[1]) @ rotation_x(q[2]), np.zeros(3)
 
     def F(q, t):
         _, b, c = q
@@ -118,10 +105,9 @@ def screw_joint(axis, pitch: float, parent=None, r_pn=(0.0, 0.0, 0.0), orientati
     """A screw: rotation θ about the unit axis e and translation pitch·θ along it;
     F⁶ = [pitch e; e] (e is the same in joint and child coordinates), q̇ = ṡ."""
     e = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
-    E = skew(e)
 
     def pose(q, t):
-        return np.eye(3) + np.sin(q[0]) * E + (1 - np.cos(q[0])) * (E @ E), pitch * q[0] * e
+        return rotation(e, q[0]), pitch * q[0] * e
 
     F6 = np.concatenate((pitch * e, e))[:, None]
     return pq.UserJoint.from_functions(
@@ -137,7 +123,7 @@ def car_joint(parent=None, r_pn=(0.0, 0.0, 0.0), orientation=None) -> pq.UserJoi
     F6[0, 0] = F6[5, 1] = 1.0
 
     def pose(q, t):
-        return _rz(q[2]), np.array([q[0], q[1], 0 * q[0]])
+        return rotation_z(q[2]), np.array([q[0], q[1], 0 * q[0]])
 
     def K(q, t):
         c, s = np.cos(q[2]), np.sin(q[2])
@@ -176,7 +162,7 @@ def turntable_joint(spin: float, parent=None, r_pn=(0.0, 0.0, 0.0), orientation=
     F6[0, 0] = 1.0
 
     def pose(q, t):
-        A = _rz(spin * t)
+        A = rotation_z(spin * t)
         return A, A @ np.array([q[0], 0 * q[0], 0 * q[0]])
 
     def f(q, t):
@@ -239,7 +225,7 @@ def spatial_joint(kind: str, parent, rng) -> pq.Joint:
 def planar_joint(kind: str, parent, rng) -> pq.Joint:
     """A random joint of ``kind`` that keeps an x–y planar body in its plane."""
     r_pn = np.append(rng.uniform(-1, 1, 2), rng.uniform(-0.2, 0.2))  # an offset along z is harmless
-    orientation = _rz(rng.uniform(-np.pi, np.pi)) if rng.random() < 0.5 else None
+    orientation = rotation_z(rng.uniform(-np.pi, np.pi)) if rng.random() < 0.5 else None
     angle = rng.uniform(-np.pi, np.pi)
     in_plane = np.array([np.cos(angle), np.sin(angle), 0.0])
     if kind == "revolute":
@@ -249,7 +235,7 @@ def planar_joint(kind: str, parent, rng) -> pq.Joint:
     if kind == "planar":
         return pq.Planar(parent, "xy", r_pn, orientation)
     if kind == "fixed":
-        return pq.Fixed(parent, r_pn, _rz(angle))
+        return pq.Fixed(parent, r_pn, rotation_z(angle))
     if kind == "prescribed":
         inner = (
             pq.Revolute(parent, "z", r_pn, orientation)
@@ -397,7 +383,7 @@ def trees(
         r_c = rng.uniform(-0.5, 0.5, 3)
         if planar:
             subsystems[name] = pq.PlanarBody(
-                m, r_c, random_inertia(rng, m, _rz(rng.uniform(-np.pi, np.pi))), "xy"
+                m, r_c, random_inertia(rng, m, rotation_z(rng.uniform(-np.pi, np.pi))), "xy"
             )
             joints[name] = planar_joint(joint_kinds[i], parent, rng)
         else:

@@ -1,5 +1,6 @@
 """The documentation builds (``mkdocs build --strict``: no broken link, nav entry or API
-reference) and every tutorial is backed by a script in examples/ that test_examples.py runs."""
+reference), every tutorial is backed by a script in examples/ that test_examples.py runs, and
+the examples of docs/architecture.md run."""
 
 import re
 import subprocess
@@ -33,3 +34,13 @@ def test_every_example_belongs_to_a_tutorial():
     named = {m for p in TUTORIALS for m in re.findall(r"Script: `examples/(\w+\.py)`", p.read_text())}
     examples = {p.name for p in (ROOT / "examples").glob("*.py")}
     assert named == examples
+
+
+def test_the_architecture_examples_run():
+    """The python blocks of docs/architecture.md (a joint, a subsystem, a force law, each
+    checked there against a closed form) run in order in one namespace."""
+    blocks = re.findall(r"^```python\n(.*?)^```", (ROOT / "docs" / "architecture.md").read_text(), re.S | re.M)
+    assert len(blocks) == 3
+    namespace = {}
+    for block in blocks:
+        exec(compile(block, "docs/architecture.md", "exec"), namespace)

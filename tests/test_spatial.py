@@ -17,12 +17,17 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from projeq.spatial import (
+    axis_spin,
     chain_matrix,
     cross,
     cross_motion,
     quaternion_matrix,
     quaternion_rate_matrix,
+    rodrigues,
     rotation,
+    rotation_x,
+    rotation_y,
+    rotation_z,
     skew,
     skew_stack,
     unit_axis,
@@ -103,6 +108,16 @@ def test_rotation_is_proper_orthonormal_and_fixes_its_axis(seed):
     assert abs(np.linalg.det(R) - 1.0) <= RTOL
     assert _close(R @ e, e)
     assert _close(R @ rotation(e, b), rotation(e, a + b))
+
+
+@pytest.mark.parametrize("axis, R", [(0, rotation_x), (1, rotation_y), (2, rotation_z)], ids=["x", "y", "z"])
+def test_rotations_about_the_coordinate_axes_are_rodrigues(axis, R):
+    """R_x, R_y, R_z (written out) equal Rodrigues' R(e, φ) about e_x, e_y, e_z, and
+    ``rodrigues`` with a precomputed (ẽ, ẽ²) equals ``rotation``."""
+    e = np.eye(3)[axis]
+    for phi in np.linspace(-3.0, 3.0, 7):
+        assert _close(R(phi), rotation(e, phi))
+        assert np.array_equal(rodrigues(axis_spin(e), phi), rotation(e, phi))
 
 
 def test_rotation_about_z_by_a_quarter_turn():
@@ -221,3 +236,61 @@ def test_cross_motion_on_stacks_equals_one_by_one():
     got = cross_motion(u, w)
     for k in range(4):
         assert np.array_equal(got[k], cross_motion(u[k], w[k]))
+
+
+# -- complex safety: complex-step derivatives through the module ---------------------------
+# Im f(x + iε ẋ)/ε with ε = 1e-30 is the exact directional derivative to round-off (no
+# subtraction): measured ≤ 6e-16 relative over 300 seeds (rotation, chain matrix, cross
+# products), so COMPLEX_RTOL = 1e-14 still catches a float-only buffer (whose imaginary
+# part is lost: an error of O(1)) or a wrong derivative.
+STEP = 1e-30
+COMPLEX_RTOL = 1e-14
+
+
+@given(seeds)
+def test_complex_step_of_rodrigues_is_the_analytic_derivative(seed):
+    """R(e, φ) = exp(φ ẽ), so dR/dφ = ẽ R: the complex step through ``rotation``,
+    ``rodrigues`` and ``rotation_x/y/z`` gives it."""
+    rng = np.random.default_rng(seed)
+    e, phi = _unit(rng), rng.uniform(-np.pi, np.pi)
+    R_dot = np.imag(rotation(e, phi + 1j * STEP)) / STEP
+    assert _close(R_dot, skew(e) @ rotation(e, phi), rtol=COMPLEX_RTOL)
+    assert _close(np.imag(rodrigues(axis_spin(e), phi + 1j * STEP)) / STEP, R_dot, rtol=COMPLEX_RTOL)
+    for axis, R in enumerate((rotation_x, rotation_y, rotation_z)):
+        E = skew(np.eye(3)[axis])
+        assert _close(np.imag(R(phi + 1j * STEP)) / STEP, E @ R(phi), rtol=COMPLEX_RTOL)
+
+
+@given(seeds)
+def test_complex_step_of_the_chain_matrix_is_its_analytic_derivative(seed):
+    """T(φ) = chain_matrix(A(φ), r(φ)) with A = R(e, φ)ᵀ, r = r₀ + φ v: the complex step
+    gives Ṫ = [[Ȧ, −Ȧ r̃ − A ṽ], [0, Ȧ]] with Ȧ = −Aẽ (dRᵀ/dφ = (ẽ R)ᵀ = −Rᵀ ẽ); on stacks too."""
+    rng = np.random.default_rng(seed)
+    e, phi = _unit(rng), rng.uniform(-np.pi, np.pi)
+    r0, v = rng.uniform(-2, 2, (2, 3))
+    A, A_dot = rotation(e, phi).T, -rotation(e, phi).T @ skew(e)
+    expected = np.zeros((6, 6))
+    expected[:3, :3] = expected[3:, 3:] = A_dot
+    expected[:3, 3:] = -A_dot @ skew(r0 + phi * v) - A @ skew(v)
+    z = phi + 1j * STEP
+    T_dot = np.imag(chain_matrix(rotation(e, z).T, r0 + z * v)) / STEP
+    assert _close(T_dot, expected, 4.0, rtol=COMPLEX_RTOL)
+    stack = np.imag(chain_matrix(np.array([rotation(e, z).T] * 2), np.array([r0 + z * v] * 2))) / STEP
+    assert np.array_equal(stack, np.array([T_dot, T_dot]))
+
+
+@given(seeds)
+def test_complex_step_through_cross_products(seed):
+    """d/dε of a(ε) × b(ε) = ȧ × b + a × ḃ, through ``cross`` (vectors and stacks),
+    ``skew_stack`` and ``cross_motion`` (bilinear: the complex step is exact)."""
+    rng = np.random.default_rng(seed)
+    a, a_dot, b, b_dot = rng.uniform(-3, 3, (4, 4, 6))
+    expected = cross_motion(a_dot, b) + cross_motion(a, b_dot)
+    got = np.imag(cross_motion(a + 1j * STEP * a_dot, b + 1j * STEP * b_dot)) / STEP
+    assert _close(got, expected, 10.0, rtol=COMPLEX_RTOL)
+    u, u_dot, w, w_dot = (x[..., :3] for x in (a, a_dot, b, b_dot))
+    got = np.imag(cross(u + 1j * STEP * u_dot, w + 1j * STEP * w_dot)) / STEP
+    assert _close(got, cross(u_dot, w) + cross(u, w_dot), 10.0, rtol=COMPLEX_RTOL)
+    got = np.imag(cross(u[0] + 1j * STEP * u_dot[0], w[0])) / STEP
+    assert _close(got, cross(u_dot[0], w[0]), 10.0, rtol=COMPLEX_RTOL)
+    assert _close(np.imag(skew_stack(u + 1j * STEP * u_dot)) / STEP, skew_stack(u_dot), rtol=COMPLEX_RTOL)

@@ -16,8 +16,9 @@ happens with body-fixed quasi-velocities that rotate with a kept angle (Barhorst
 u1, u3 of the rolling disk with its roll angle q3): use speeds in which the motion is
 steady (the knife-edge disc's Euler rates).
 
-Accuracy. The Jacobians are Richardson-extrapolated central differences,
-D = (4 D(h/2) − D(h))/3 with h = 1e-4 max(1, |z|): truncation O(h⁴) ≈ 1e-16 and
+Accuracy. The Jacobians are Richardson-extrapolated central differences
+(:func:`projeq.analysis.differentiation.jacobian`), D = (4 D(h/2) − D(h))/3 with
+h = 1e-4 max(1, |z|): truncation O(h⁴) ≈ 1e-16 and
 round-off ≈ 3ε/h ≈ 1e-11 relative (h is not larger because the states' own scale may be
 small: a Ritz beam's stiff high modes are nonlinear already at 1e-3). The errors against
 closed forms are measured in ``tests/analysis/test_linearize.py``.
@@ -28,9 +29,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from projeq.analysis.differentiation import jacobian
 from projeq.checks import finite_array, state_vector
 
-_STEP = 1e-4  # relative step of the coarser of the two central differences
 _TOL = 1e-8  # relative threshold: zero columns of A, and the steady-motion residual
 
 
@@ -107,29 +108,6 @@ def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, i
             Q[system.s_slice[system.index(name)]] += tau_n
         s_ddot = np.linalg.solve(M, Q - b)
     return np.concatenate((system.q_dot(q, s_dot, t), s_ddot))
-
-
-def jacobian(f, z0: NDArray, step: float = _STEP) -> NDArray:
-    """∂f/∂z at z0 by Richardson-extrapolated central differences (error O(h⁴)).
-
-    >>> J = jacobian(lambda z: np.array([np.sin(z[0]) * z[1]]), np.array([0.5, 2.0]))
-    >>> bool(np.allclose(J, [[2 * np.cos(0.5), np.sin(0.5)]], rtol=1e-11, atol=0))
-    True
-    """
-    z0 = np.asarray(z0, dtype=float)
-    n_f = len(f(z0))
-    columns = []
-    for i in range(len(z0)):
-        e = np.zeros_like(z0)
-        e[i] = 1.0
-        columns.append(derivative(lambda eps, e=e: f(z0 + eps * e), step * max(1.0, abs(z0[i])) / 2))
-    return np.array(columns).T.reshape(n_f, len(z0))
-
-
-def derivative(f, h: float):
-    """df/dε at ε = 0 by the five-point stencil (−f(2h) + 8f(h) − 8f(−h) + f(−2h))/(12h):
-    Richardson's extrapolation (4 D(h) − D(2h))/3 of two central differences, error O(h⁴)."""
-    return (-f(2 * h) + 8 * f(h) - 8 * f(-h) + f(-2 * h)) / (12 * h)
 
 
 def ignorable_coordinates(A: NDArray, n_q: int, tol: float = _TOL) -> list[int]:

@@ -7,6 +7,13 @@ runs interpreted with ``compiled=False``, so both are the same algorithm.
 Joint kinds: ``FIXED`` (no dof), ``REVOLUTE`` (F⁶ = [0; e]), ``PRISMATIC`` (F⁶ = [e; 0]),
 about a unit axis e in joint-frame coordinates; subsystems: rigid bodies (M_n = M6,
 h_n of THEORY §3). Twists are (v_O, ω) in body coordinates; index −1 is the ground.
+
+Compiled twins. numba compiles scalar loops, not the array functions of
+:mod:`projeq.spatial`, so four formulas have a second, scalar form here and only here:
+:func:`_relative_rotation` (Rodrigues, :func:`projeq.spatial.rodrigues`), :func:`_chain_matrix`
+(:func:`projeq.spatial.chain_matrix`), :func:`_cross3` (:func:`projeq.spatial.cross`) and
+:func:`_rigid_h` (:func:`projeq.subsystems.rigid.rigid_h`); tests/assembly/test_fast.py
+checks each against its twin.
 """
 
 from __future__ import annotations
@@ -76,7 +83,8 @@ def chain_terms(kind, parent, axis, orientation, offset, q_index, m, r_c, I_c, g
 
 
 def _relative_rotation(kind, e, x, A):
-    """A_Jn: cos θ E + sin θ ẽ + (1 − cos θ) e eᵀ for a revolute joint, else E."""
+    """A_Jn: cos θ E + sin θ ẽ + (1 − cos θ) e eᵀ for a revolute joint, else E (Rodrigues'
+    E + sin θ ẽ + (1 − cos θ) ẽ² with ẽ² = e eᵀ − E; compiled twin of :func:`projeq.spatial.rodrigues`)."""
     c, s = (np.cos(x), np.sin(x)) if kind == REVOLUTE else (1.0, 0.0)
     for a in range(3):
         for b in range(3):
@@ -90,7 +98,8 @@ def _relative_rotation(kind, e, x, A):
 
 
 def _chain_matrix(A_np, r, T):
-    """T = [[A_np, −A_np r̃], [0, A_np]] written into T (the columns of −A_np r̃ are A_np (e_j × r))."""
+    """T = [[A_np, −A_np r̃], [0, A_np]] written into T (the columns of −A_np r̃ are A_np (e_j × r));
+    compiled twin of :func:`projeq.spatial.chain_matrix`."""
     T[:, :] = 0.0
     for a in range(3):
         for b in range(3):
@@ -101,12 +110,13 @@ def _chain_matrix(A_np, r, T):
 
 
 def _cross3(a, b):
-    """a × b of two 3-vectors."""
+    """a × b of two 3-vectors (compiled twin of :func:`projeq.spatial.cross`)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 def _rigid_h(m, r_c, I_c, twist, g_body, out):
-    """h = [m g − ω̃ p ; r̃_c (m g − ω̃ p) − ω̃ I_c ω], p = m (v + ω × r_c) (THEORY §3)."""
+    """h = [m g − ω̃ p ; r̃_c (m g − ω̃ p) − ω̃ I_c ω], p = m (v + ω × r_c) (THEORY §3), written
+    into ``out``; compiled twin of :func:`projeq.subsystems.rigid.rigid_h`."""
     omega = twist[3:]
     p_c = m * (twist[:3] + _cross3(omega, r_c))
     force = m * g_body - _cross3(omega, p_c)
@@ -204,15 +214,15 @@ def _compiled():
     """chain_terms and passes compiled by numba, once per process (and cached on disk).
 
     Compiled code resolves the functions it calls in its globals, so the kernels are
-    compiled as twins whose globals are a copy of this module's namespace holding numba's
-    versions of their callees; this module's functions stay plain Python."""
+    compiled as copies whose globals are a copy of this module's namespace holding numba's
+    versions of their callees; this module's functions stay plain Python (nothing rebound)."""
     numba = _numba()
     namespace = dict(globals())
 
-    def twin(f):
+    def rebound(f):
         return types.FunctionType(f.__code__, namespace, f.__name__, f.__defaults__, f.__closure__)
 
     for f in _CALLEES:
-        namespace[f.__name__] = numba.extending.register_jitable(twin(f))
+        namespace[f.__name__] = numba.extending.register_jitable(rebound(f))
     jit = numba.njit(cache=True)
-    return jit(twin(chain_terms)), jit(twin(passes))
+    return jit(rebound(chain_terms)), jit(rebound(passes))

@@ -49,7 +49,7 @@ from numpy.typing import NDArray
 
 from projeq.assembly.linalg import solve_spd
 from projeq.checks import positive, state_vector
-from projeq.analysis.linearize import derivative
+from projeq.analysis.differentiation import richardson, second
 
 CORRECTIONS = ("projection", "baumgarte", "none")
 # condition number κ = ‖A_s‖ ‖A_dep⁻¹‖ above which the partition is degenerate
@@ -61,11 +61,6 @@ REPIVOT_CONDITION = 1e2
 # |Φ| (relative to the largest coordinate, at least 1) accepted as on the manifold: 1e4 × round-off
 POSITION_TOLERANCE = 1e-12
 _H1, _H2 = 1e-3, 3e-3  # steps of the 1st/2nd differences: truncation ~h⁴, round-off ~1e-16/h, 1e-16/h²
-
-
-def _d2(f, h=_H2):
-    """d²f/dε² at 0 by the five-point stencil (error O(h⁴))."""
-    return (-f(2 * h) + 16 * f(h) - 30 * f(0.0) + 16 * f(-h) - f(-2 * h)) / (12 * h * h)
 
 
 class ConstrainedSystem:
@@ -175,13 +170,13 @@ class ConstrainedSystem:
     def phi_q(self, q: NDArray, t: float = 0.0) -> NDArray:
         """∂Φ/∂q (m_h × n_q) by central differences."""
         unit = np.eye(self.n_q)
-        columns = [derivative(lambda e, i=i: self.phi(q + e * unit[i], t), _H1) for i in range(self.n_q)]
+        columns = [richardson(lambda e, i=i: self.phi(q + e * unit[i], t), _H1) for i in range(self.n_q)]
         return np.array(columns).T.reshape(self.m_h, self.n_q)
 
     def velocity_constraints(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """(C, c) of C q̇ = c: C = [∂Φ/∂q; A], c = [−∂Φ/∂t; b]."""
         A, b = self._pfaffian(q, t)
-        phi_t = derivative(lambda e: self.phi(q, t + e), _H1) if self.m_h else np.zeros(0)
+        phi_t = richardson(lambda e: self.phi(q, t + e), _H1) if self.m_h else np.zeros(0)
         return np.vstack((self.phi_q(q, t), A)), np.concatenate((-phi_t, b))
 
     def constraint_residual(self, q: NDArray, q_dot: NDArray, t: float = 0.0) -> NDArray:
@@ -386,13 +381,13 @@ class ConstrainedSystem:
         def at(e):
             return q + e * step * q_dot, t + e * step
 
-        q_ddot = derivative(lambda e: tree.q_dot(at(e)[0], s_dot_tree, at(e)[1]), _H1) / step  # K̇ ṡ + k̇
+        q_ddot = richardson(lambda e: tree.q_dot(at(e)[0], s_dot_tree, at(e)[1]), _H1) / step  # K̇ ṡ + k̇
         C = self.velocity_constraints(q, t)[0] if C is None else C
         parts = []
         if self.m_h:
-            parts.append(_d2(lambda e: self.phi(*at(e))) / step**2)
+            parts.append(second(lambda e: self.phi(*at(e)), _H2) / step**2)
         if self.m_p:
-            parts.append(derivative(lambda e: _pfaffian_residual(self, at(e), q_dot), _H1) / step)
+            parts.append(richardson(lambda e: _pfaffian_residual(self, at(e), q_dot), _H1) / step)
         return np.concatenate(parts) + C @ q_ddot
 
     def accelerations_tree(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:

@@ -22,6 +22,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from projeq.analysis.differentiation import central
 from projeq.checks import finite_array
 from projeq.spatial import vee
 
@@ -119,10 +120,13 @@ def pose_twist_mismatch(joint: Joint, q_n: NDArray, s_dot_n: NDArray, t: float, 
     Used to validate user joints; for the built-in joints it is a test of their K.
     """
     q_dot = joint.q_dot(q_n, s_dot_n, t)
-    ahead = joint.relative(joint.normalized(q_n + h * q_dot), s_dot_n, t + h)
-    behind = joint.relative(joint.normalized(q_n - h * q_dot), s_dot_n, t - h)
+
+    def pose(eps):  # (A, r) at (q + ε q̇, t + ε), flattened
+        rel = joint.relative(joint.normalized(q_n + eps * q_dot), s_dot_n, t + eps)
+        return np.concatenate((rel.A.ravel(), rel.r))
+
+    rates = central(pose, h)
+    A_dot, r_dot = rates[:9].reshape(3, 3), rates[9:]
     now = joint.relative(q_n, s_dot_n, t)
-    A_dot = (ahead.A - behind.A) / (2 * h)
-    r_dot = (ahead.r - behind.r) / (2 * h)
     twist = np.concatenate((now.A.T @ r_dot, vee(now.A.T @ A_dot)))
     return float(np.abs(twist - now.w).max())

@@ -12,7 +12,7 @@ import numpy as np
 import sympy as sp
 
 from projeq.joints.base import Joint, Relative
-from projeq.spatial import quaternion_matrix, quaternion_rate_matrix, skew, unit_axis
+from projeq.spatial import axis_spin, quaternion_matrix, quaternion_rate_matrix, rodrigues, unit_axis
 
 _ZERO6 = np.zeros(6)
 _ZERO6.flags.writeable = False
@@ -36,12 +36,11 @@ class Revolute(_OneAxis):
 
     def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
         super().__init__(parent, axis, r_pn, orientation, coupling)
-        self._E = skew(self.axis)
-        self._E2 = self._E @ self._E
+        self._spin = axis_spin(self.axis)
         self._F = np.concatenate((np.zeros(3), self.axis))[:, None]
 
     def relative(self, q_n, s_dot_n, t):
-        A = np.eye(3) + np.sin(q_n[0]) * self._E + (1.0 - np.cos(q_n[0])) * self._E2
+        A = rodrigues(self._spin, q_n[0])
         return Relative(A, _ZERO6[:3], self._F, self._F[:, 0] * s_dot_n[0], _ZERO6)
 
 
@@ -86,13 +85,12 @@ class Planar(Joint):
         a, b, n = (np.eye(3)[i] for i in self._AXES[plane])
         self._P = np.array([a, b])
         self.normal = n
-        self._E = skew(n)
-        self._E2 = self._E @ self._E
+        self._spin = axis_spin(n)
         self._F = np.zeros((6, 3))
         self._F[:3, 0], self._F[:3, 1], self._F[3:, 2] = a, b, n
 
     def _A(self, theta):
-        return np.eye(3) + np.sin(theta) * self._E + (1.0 - np.cos(theta)) * self._E2
+        return rodrigues(self._spin, theta)
 
     def relative(self, q_n, s_dot_n, t):
         r = self._P.T @ q_n[:2]

@@ -11,17 +11,12 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from projeq.analysis.differentiation import complex_step
 from projeq.checks import finite_array
 from projeq.joints import Relative, pose_twist_mismatch
 
-_COMPLEX_STEP = 1e-30
 _SINGULAR_CONDITION = 1e10  # condition number of K(q0) treated as singular
 _POSE_TOLERANCE = 1e-5  # central differences of step 1e-7 in pose_twist_mismatch: error ~1e-9
-
-
-def skew(a) -> sp.Matrix:
-    """Spin matrix ã of a 3-vector of sympy expressions (ã b = a × b)."""
-    return sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
 
 
 def _matrix(name: str, value, shape: tuple) -> sp.Matrix:
@@ -129,10 +124,9 @@ def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, or
         A, r = pose(q_n, time)
         F_n = np.asarray(F(q_n, time), dtype=float)
         # complex step along (q̇, 1): Im F(q + iε q̇, t + iε)/ε = Ḟ exactly to round-off
-        q_c = q_n + 1j * _COMPLEX_STEP * q_dot(q_n, s_dot_n, time)
-        t_c = time + 1j * _COMPLEX_STEP
-        F_dot = np.imag(F(q_c, t_c)) / _COMPLEX_STEP
-        f_dot = np.imag(f(q_c, t_c)) / _COMPLEX_STEP
+        rate = q_dot(q_n, s_dot_n, time)
+        F_dot = complex_step(lambda eps: F(q_n + eps * rate, time + eps))
+        f_dot = complex_step(lambda eps: f(q_n + eps * rate, time + eps))
         w = F_n @ s_dot_n + np.real(f(q_n, time))
         return Relative(np.asarray(A, dtype=float), np.asarray(r, dtype=float), F_n, w, F_dot @ s_dot_n + f_dot)
 

@@ -20,7 +20,7 @@ from projeq.scenes.mechanisms import bar_on_wall, four_bar, quick_return, slider
 from projeq.scenes.parameters import Parameter, check_names, closest, parse_settings, scene_parameters
 from projeq.scenes.nonholonomic import (
     barhorst_particle, car, knife_edge_circle, knife_edge_disc, nonholonomic_particle, rolling_disk,
-    rolling_disk_critical_speed,
+    rolling_disk_critical_speed, rolling_disk_inertia,
 )
 from projeq.system import System
 
@@ -112,7 +112,8 @@ SCENES = {
     "atwood": Scene(atwood, "two masses on a rope over a pulley with inertia (coupled joints)", 2.0),
     "car": Scene(car, "Bremer's car: a planar body whose rear axle cannot slide (B(5)-(12))", 10.0, plane=(0, 1)),
     "knife_edge_disc": Scene(knife_edge_disc, "a knife-edge disc rolling without slip (lecture 001, slides 28-37)", 20.0, plane=(0, 1)),
-    "rolling_disk": Scene(rolling_disk, "Barhorst's rolling disk with an eccentric mass (seed 000, 3.2)", 10.0, plane=(3, 4)),
+    "rolling_disk": Scene(rolling_disk, "Barhorst's rolling disk with an eccentric mass (seed 000, 3.2)", 10.0,
+                          units={"inertia": "(or 'hoop', or (I, J) in kg m²)"}, plane=(3, 4)),
     "barhorst_particle": Scene(barhorst_particle, "a particle with the constraint y' - y^2 x' = 0 (seed 000, 3.1)", 10.0),
     "nonholonomic_particle": Scene(nonholonomic_particle, "a particle in space with y' + z x' = 0 (seed 000, 3.1)", 2.0),
     "whipple_bicycle": Scene(whipple_bicycle, "the Whipple bicycle of Meijaard et al. (2007), constraint equations", 5.0,
@@ -142,7 +143,7 @@ def build_scene(name: str, **overrides) -> System:
 
 __all__ = [
     "chain", "double_pendulum", "atwood", "spin_up_beam", "spinning_beam", "elastic_arm",
-    "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed",
+    "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed", "rolling_disk_inertia",
     "barhorst_particle", "nonholonomic_particle", "whipple_bicycle", "whipple_eigenvalues",
     "quick_return", "four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",
     "Scene", "SCENES", "DEFAULT_SCENE", "get_scene", "build_scene", "scene_parameters", "parse_settings", "Parameter",

@@ -52,9 +52,9 @@ from projeq.checks import finite_array
 from projeq.constraints.partitioned import ConstrainedSystem
 from projeq.joints import Revolute, UserJoint
 from projeq.analysis.linearize import linearize, sorted_eigenvalues
-from projeq.scenes.nonholonomic import _rot
-from projeq.spatial import skew
+from projeq.spatial import axis_spin, cross, rodrigues, rotation_x, rotation_y, rotation_z, skew
 from projeq.subsystems import RigidBody
+from projeq.symbolic import algebra
 from projeq.system import System
 
 BENCHMARK = {  # MJPR Table 1 (SI units; x forward, z down, from the rear contact)
@@ -127,12 +127,12 @@ def _rear_frame_symbols():
     r_R = sp.Symbol("r_R", positive=True)
     q = list(sp.symbols("x y psi phi theta"))
     s = list(sp.symbols("xd yd psid phid thetad"))
-    lean = _rot(2, q[2]) * _rot(0, q[3])
-    A = lean * _rot(1, q[4])
+    lean = algebra.rotation_z(q[2]) * algebra.rotation_x(q[3])
+    A = lean * algebra.rotation_y(q[4])
     r = sp.Matrix([q[0], q[1], 0]) + lean * sp.Matrix([0, 0, -r_R])
     u = sp.Matrix([s[3], sp.sin(q[3]) * s[2], sp.cos(q[3]) * s[2]])
     v_lean = lean.T * sp.Matrix([s[0], s[1], 0]) - r_R * u.cross(sp.Matrix([0, 0, 1]))
-    pitch = _rot(1, q[4]).T
+    pitch = algebra.rotation_y(q[4]).T
     twist = sp.Matrix.vstack(pitch * v_lean, pitch * u + sp.Matrix([0, s[4], 0]))
     return q, s, A, r, twist.jacobian(sp.Matrix(s)), r_R
 
@@ -157,15 +157,14 @@ class Contacts:
     def __init__(self, p: dict):
         self.r_R, self.r_F = p["r_R"], p["r_F"]
         self.e_s = _steer_axis(p)
-        self.E_s = skew(self.e_s)
-        self.E_s2 = self.E_s @ self.E_s
+        self.spin_s = axis_spin(self.e_s)
         self.d_fork = np.array([p["w"] + p["c"], 0.0, p["r_R"]])  # rear centre → fork origin, frame axes
         self.d_front = np.array([-p["c"], 0.0, -p["r_F"]])  # fork origin → front centre, fork axes
 
     def _poses(self, q):
-        lean = _rotation_z(q[2]) @ _rotation_x(q[3])
-        frame = lean @ _rotation_y(q[4])
-        fork = frame @ (_E + np.sin(q[6]) * self.E_s + (1.0 - np.cos(q[6])) * self.E_s2)  # Rodrigues
+        lean = rotation_z(q[2]) @ rotation_x(q[3])
+        frame = lean @ rotation_y(q[4])
+        fork = frame @ rodrigues(self.spin_s, q[6])
         rear_centre = np.array([q[0], q[1], 0.0]) - self.r_R * lean[:, 2]
         front_centre = rear_centre + frame @ self.d_fork + fork @ self.d_front
         a = fork[:, 1]
@@ -178,7 +177,7 @@ class Contacts:
         entry, and n_z = √(1 − a_z²)."""
         c_roll, s_roll = np.cos(q[3]), np.sin(q[3])
         frame_z = np.array([-c_roll * np.sin(q[4]), s_roll, c_roll * np.cos(q[4])])
-        fork_z = frame_z + np.sin(q[6]) * frame_z @ self.E_s + (1.0 - np.cos(q[6])) * frame_z @ self.E_s2
+        fork_z = frame_z @ rodrigues(self.spin_s, q[6])
         height = -self.r_R * c_roll + frame_z @ self.d_fork + fork_z @ self.d_front
         return np.array([height + self.r_F * np.sqrt(1.0 - fork_z[1] ** 2)])
 
@@ -190,8 +189,8 @@ class Contacts:
         J_frame[:, 2], J_frame[:, 3], J_frame[:, 4] = _E[2], lean[:, 0], lean[:, 1]
         J_v = np.zeros((3, 8))  # rear centre: (ẋ, ẏ, 0) − r_R ω_L × L e_z
         J_v[:2, :2] = np.eye(2)
-        J_v[:, 2] = -self.r_R * np.cross(_E[2], lean[:, 2])
-        J_v[:, 3] = -self.r_R * np.cross(lean[:, 0], lean[:, 2])
+        J_v[:, 2] = -self.r_R * cross(_E[2], lean[:, 2])
+        J_v[:, 3] = -self.r_R * cross(lean[:, 0], lean[:, 2])
         J_rear = J_frame.copy()
         J_rear[:, 5] = lean[:, 1]
         J_fork = J_frame.copy()
@@ -205,21 +204,6 @@ class Contacts:
 
 
 _E = np.eye(3)
-
-
-def _rotation_x(angle: float) -> NDArray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def _rotation_y(angle: float) -> NDArray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def _rotation_z(angle: float) -> NDArray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def upright_pitch(roll: float, steer: float, params: dict | None = None) -> float:

@@ -27,22 +27,12 @@ import sympy as sp
 from projeq.constraints.nonholonomic import check_configuration, initial_speeds
 from projeq.forces import Force, Torque
 from projeq.joints import Fixed, UserJoint
-from projeq.joints.user_compiler import skew
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
+from projeq.symbolic.algebra import rotation_x, rotation_y, rotation_z, skew
 from projeq.system import System
 
 
 # -- small sympy helpers ---------------------------------------------------------------
-def _rot(axis: int, angle) -> sp.Matrix:
-    """Active rotation about coordinate axis 0, 1 or 2 (x, y, z)."""
-    c, s = sp.cos(angle), sp.sin(angle)
-    if axis == 0:
-        return sp.Matrix([[1, 0, 0], [0, c, -s], [0, s, c]])
-    if axis == 1:
-        return sp.Matrix([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-    return sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
 def _twist_F(A: sp.Matrix, r: sp.Matrix, q, K: sp.Matrix, s) -> sp.Matrix:
     """F = ∂(v, ω)/∂ṡ in child coordinates from the pose (A, r) and q̇ = K ṡ:
     v = Aᵀ ṙ, ω̃ = Aᵀ Ȧ (exact symbolic differentiation, then trigsimp)."""
@@ -76,7 +66,7 @@ def car(m: float = 1200.0, C0: float = 3228.0, c: float = 1.2, f_x=0.0, M_z=0.0,
     x, y, g = sp.symbols("x y gamma")
     vx, wz = sp.symbols("v_x omega_z")
     xd, yd, gd = sp.symbols("xd yd gd")
-    A = _rot(2, g)
+    A = rotation_z(g)
     F = sp.Matrix([[1, 0], [0, 0], [0, 0], [0, 0], [0, 0], [0, 1]])
     K = sp.Matrix([[sp.cos(g), 0], [sp.sin(g), 0], [0, 1]])
     joint = UserJoint.from_sympy(
@@ -124,7 +114,7 @@ def _disc_joint_lecture():
         [-r * sps * sph, r * cps * cph, -r * sps],
         [1, 0, 0], [0, 1, 0], [0, 0, 1],
     ])
-    A = _rot(2, psi) * _rot(0, phi) * _rot(1, th)
+    A = rotation_z(psi) * rotation_x(phi) * rotation_y(th)
     pos = sp.Matrix([x, y, -r * cph])
     F = _twist_F(A, pos, q, K, s)
     constraints = [
@@ -211,17 +201,44 @@ def _rolling_disk_joint():
         [s3 * t2, 1, -c3 * t2],
     ])
     K = sp.Matrix.vstack(K_ang, R * sp.cos(q1) * K_ang[2, :], R * sp.sin(q1) * K_ang[2, :])  # eq. (97)
-    A_B = _rot(2, q1) * _rot(0, q2)
-    A = A_B * _rot(1, q3)
+    A_B = rotation_z(q1) * rotation_x(q2)
+    A = A_B * rotation_y(q3)
     pos = sp.Matrix([q[3], q[4], 0]) + R * A_B[:, 2]
-    b3_C = _rot(1, q3).T * sp.Matrix([0, 0, 1])
+    b3_C = rotation_y(q3).T * sp.Matrix([0, 0, 1])
     F = sp.Matrix.vstack(-R * skew(b3_C), sp.eye(3))  # v = ω × R b̂3, ω = u
     constraints = [qd[3] - R * sp.cos(q1) * qd[2], qd[4] - R * sp.sin(q1) * qd[2]]  # eq. (97)
     return q, s, A, pos, F, K, constraints, qd, R
 
 
+#: (I, J) / (m R²) of the named shapes: the uniform thin disk and the thin ring (hoop)
+DISK_SHAPES = {"disk": (0.25, 0.5), "hoop": (0.5, 1.0)}
+
+
+def rolling_disk_inertia(inertia, m: float, R: float) -> tuple[float, float]:
+    """(I, J): the moments of inertia of the rolling disk about a diameter and about its axis.
+
+    ``inertia``: ``"disk"`` (uniform thin disk, I = m R²/4, J = m R²/2), ``"hoop"`` (thin ring,
+    I = m R²/2, J = m R²) or a pair (I, J) in kg m², with 0 < J ≤ 2 I (the triangle inequality of
+    a body symmetric about its axis; a flat body has J = 2 I).
+    """
+    if isinstance(inertia, str):
+        if inertia not in DISK_SHAPES:
+            raise ValueError(f"inertia: expected 'disk', 'hoop' or a pair (I, J) in kg m², got {inertia!r}")
+        return tuple(factor * m * R * R for factor in DISK_SHAPES[inertia])
+    try:
+        I, J = (float(x) for x in inertia)
+    except (TypeError, ValueError):
+        raise ValueError(f"inertia: expected 'disk', 'hoop' or a pair (I, J) in kg m², got {inertia!r}") from None
+    if not (I > 0 and J > 0):
+        raise ValueError(f"inertia: I and J must be positive, got I = {I}, J = {J}")
+    if J > 2 * I:
+        raise ValueError(f"inertia: J = {J} exceeds 2 I = {2 * I}; no body symmetric about its axis has these "
+                         "moments (triangle inequality)")
+    return I, J
+
+
 def rolling_disk(m_disk: float = 0.030, R: float = 0.015, m_ecc: float = 0.001, ecc=None,
-                 g: float = 9.81, drag: float = 0.0,
+                 g: float = 9.81, drag: float = 0.0, inertia="disk",
                  q0=(0.0, 0.15, 0.0, 0.0, 0.0), s_dot0=(0.0, 20.0, 0.0), q_dot0=None) -> System:
     """Barhorst's thin disk rolling without slip, with an optional eccentric point mass
     (``seeds/000_…`` §3.2; his parameters converted to SI are the defaults: m_r = 30 g,
@@ -234,9 +251,26 @@ def rolling_disk(m_disk: float = 0.030, R: float = 0.015, m_ecc: float = 0.001, 
     constraints q̇4 = R cos q1 q̇3, q̇5 = R sin q1 q̇3 (eq. 97) as its last rows.
 
     ``ecc`` = (h, e, r) the eccentric mass's position from the centre in C (default
-    (0, 0, 0.95 R)); ``m_ecc = 0`` gives the symmetric disk. The disk is a uniform thin
-    disk (I = m R²/4 about a diameter, m R²/2 about its axis). ``drag`` ≥ 0 adds
-    Barhorst's air-drag torque −drag · u_i |u_i| about each body axis (eq. 104).
+    (0, 0, 0.95 R)); ``m_ecc = 0`` gives the symmetric disk. ``inertia``: the disk's moments
+    about a diameter and its axis (:func:`rolling_disk_inertia`): ``"disk"`` (uniform thin
+    disk, the default), ``"hoop"`` or a pair (I, J) in kg m². ``drag`` ≥ 0 adds Barhorst's
+    air-drag torque −drag · u_i |u_i| about each body axis (eq. 104).
+
+    Which inertia did Barhorst use? He writes of "the disk" and its central inertia; his
+    figures do not say. At the start (q3 = q̇1 = q̇2 = 0, q̇3 = Ω) the energy is, with the
+    eccentric mass at r on ĉ3,
+
+        E0 = ½ m_r (ΩR)² + ½ J Ω² + ½ m_s Ω² (R + r)² + g cos q2 (m_r R + m_s (R + r)),
+
+    68447.6 g cm²/s² for the uniform disk (J = m_r R²/2) and 75197.6 for the hoop (J = m_r R²).
+    His Fig. 8 (the run that conserves energy) shows E ≈ 75197, and his p₂ axes (Figs. 6, 8,
+    from about 2850 g cm²/s) fit p₂(0) = (J + m_r R² + m_s (R + r)²) Ω = 2871 of the hoop, not
+    2196 of the disk: both point to J = m_r R². His trajectories fit the uniform disk better:
+    over his 10 s the heading q1 reaches −56.5 rad, the roll q3 239 rad, q4 stays within ±7 cm
+    and q5 reaches −13.1 cm for the disk (his axes: about −60 rad, 250 rad, ±6 cm, −12 cm), but
+    −36.5 rad, 220 rad, ±9 cm and −18 cm for the hoop (``benchmarks/rolling_disk_inertia.py``).
+    No single body reproduces both his energy level and his trajectories; the uniform disk
+    stays the default.
 
     K(q) contains sec q2: at the tilt q2 = ±π/2 (disk flat) these Euler angles
     degenerate (Barhorst notes the singularity near q2 = π/2); a construction there
@@ -245,7 +279,8 @@ def rolling_disk(m_disk: float = 0.030, R: float = 0.015, m_ecc: float = 0.001, 
     q, s, A, pos, F, K, constraints, qd, R_sym = _rolling_disk_joint()
     joint = UserJoint.from_sympy(q, s, A, pos, F, K, constraints=constraints, q_dot=qd,
                                  parameters={R_sym: R}, q0=np.asarray(q0, dtype=float))
-    I_d = m_disk * R * R * np.diag([0.25, 0.5, 0.25])
+    I, J = rolling_disk_inertia(inertia, m_disk, R)
+    I_d = np.diag([I, J, I])
     subsystems = {"disk": RigidBody(m_disk, (0.0, 0.0, 0.0), I_d)}
     joints = {"disk": joint}
     if m_ecc > 0:
@@ -342,4 +377,5 @@ __all__ = [
     "nonholonomic_particle",
     "rolling_disk",
     "rolling_disk_critical_speed",
+    "rolling_disk_inertia",
 ]

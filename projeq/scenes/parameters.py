@@ -85,8 +85,10 @@ def _as_bool(name: str, text: str) -> bool:
 def parse_value(scene, name: str, text: str):
     """The value of ``name=text`` for ``scene``, of the type of the parameter's default.
 
-    bool: true/false/yes/no/1/0; int and float: a number; str: the text; a tuple or None
-    default: a Python literal (``0.1,0.2`` or ``(0.1, 0.2)`` or ``None``).
+    bool: true/false/yes/no/1/0; int and float: a number; str: the text, or a tuple when the
+    text is a tuple literal (for parameters that take a name or numbers, such as the rolling
+    disk's ``inertia=hoop`` or ``inertia=(2e-6,4e-6)``); a tuple or None default: a Python
+    literal (``0.1,0.2`` or ``(0.1, 0.2)`` or ``None``).
     """
     check_names(scene, {name: text})
     default = {p.name: p.default for p in scene_parameters(scene)}[name]
@@ -98,7 +100,11 @@ def parse_value(scene, name: str, text: str):
         except ValueError:
             raise ValueError(f"{name}: expected {expected}, got {text!r}") from None
     if isinstance(default, str):
-        return text
+        try:
+            value = ast.literal_eval(text)
+        except (ValueError, SyntaxError):
+            return text
+        return tuple(value) if isinstance(value, (list, tuple)) else text
     try:
         value = ast.literal_eval(text)
     except (ValueError, SyntaxError):

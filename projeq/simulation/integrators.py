@@ -29,6 +29,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import DOP853, RK45, DenseOutput, OdeSolver
 
+from projeq.analysis.differentiation import central, forward, gradient
+
 PROJECTED = {"RK45-projected": RK45, "DOP853-projected": DOP853}
 EXPLICIT = ("RK45", "RK23", "DOP853", *PROJECTED)
 
@@ -69,34 +71,20 @@ def energy_manifold(system, q0, s_dot0, t0: float = 0.0):
     def project(t: float, x) -> NDArray:
         x = np.array(x, dtype=float)
         E, scale = energy(x, t)
-        gradient = None
+        grad = None
         for _ in range(4):
             if abs(E - E0) <= 4 * np.finfo(float).eps * max(scale, abs(E0)):
                 break
-            if gradient is None:  # simplified Newton: ∇E at the first iterate serves all
-                gradient = _gradient(energy, x, t, E)
-            x -= (E - E0) * gradient / (gradient @ gradient)
+            if grad is None:  # simplified Newton: ∇E at the first iterate serves all
+                # forward differences (given E): O(h) error, ample for Newton steps, whose
+                # error shrinks by that factor per step
+                grad = gradient(lambda x_: energy(x_, t)[0], x, E)
+            x -= (E - E0) * grad / (grad @ grad)
             E, scale = energy(x, t)
         x[:n_q] = system.normalized(x[:n_q])
         return x
 
     return project
-
-
-def _gradient(energy, x: NDArray, t: float, E: float | None = None) -> NDArray:
-    """∇E(x) by differences with step h = 1e-6 (1 + |xᵢ|): central (O(h²) error), or,
-    given E = E(x), forward (O(h), half the evaluations; ample for the projection's
-    Newton steps, whose error shrinks by that factor per step)."""
-    gradient = np.empty_like(x)
-    for i in range(len(x)):
-        h = 1e-6 * (1.0 + abs(x[i]))
-        e = np.zeros_like(x)
-        e[i] = h
-        if E is None:
-            gradient[i] = (energy(x + e, t)[0] - energy(x - e, t)[0]) / (2 * h)
-        else:
-            gradient[i] = (energy(x + e, t)[0] - E) / h
-    return gradient
 
 
 def _check_conservative(system, x0: NDArray, t0: float, energy) -> None:
@@ -124,11 +112,10 @@ def _energy_rate(system, x: NDArray, t: float, energy) -> float | None:
     n_q = system.n_q
     q, s_dot = system.normalized(x[:n_q]), x[n_q:]
     x_dot = np.concatenate((system.q_dot(q, s_dot, t), system.accelerations(q, s_dot, t)))
-    h = 1e-6 * (1.0 + abs(t))
-    E_t = (energy(x, t + h)[0] - energy(x, t - h)[0]) / (2 * h)
-    gradient = _gradient(energy, x, t)
-    E_dot = gradient @ x_dot + E_t
-    return E_dot if abs(E_dot) > 1e-6 * (np.linalg.norm(gradient) * np.linalg.norm(x_dot) + abs(E_t)) else None
+    E_t = central(lambda eps: energy(x, t + eps)[0], 1e-6 * (1.0 + abs(t)))
+    grad = gradient(lambda x_: energy(x_, t)[0], x)
+    E_dot = grad @ x_dot + E_t
+    return E_dot if abs(E_dot) > 1e-6 * (np.linalg.norm(grad) * np.linalg.norm(x_dot) + abs(E_t)) else None
 
 
 def projected_solver(name: str, system, q0, s_dot0, t0: float = 0.0) -> type[OdeSolver]:
@@ -196,7 +183,7 @@ def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32) -> float:
     logs = []
     for _ in range(iterations):
         eps = np.sqrt(np.finfo(float).eps) * (1.0 + np.linalg.norm(x))
-        w = (fun(t, x + eps * v) - f0) / eps
+        w = forward(lambda e: fun(t, x + e * v), eps, f0)
         norm = np.linalg.norm(w)
         if not norm > 0:
             return 0.0

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from projeq.scenes import Scene, check_names, get_scene
+from projeq.studies.table import Table
 
 #: Outputs every sweep can ask for by name: a function of the Result.
 BUILTIN_OUTPUTS = {
@@ -92,15 +93,11 @@ class SweepTable(dict):
     ``error`` (the message of a failed point, else ""), one row per point in input order."""
 
     def save(self, path) -> list[Path]:
-        """Write ``path.csv`` and ``path.npz`` (path without suffix); returns both paths."""
+        """Write ``path.csv`` (:class:`~projeq.studies.table.Table`, the error message last) and
+        ``path.npz`` (path without suffix); returns both paths."""
         path = Path(path)
-        columns = [k for k in self if k != "error"]
         csv, npz = path.with_suffix(".csv"), path.with_suffix(".npz")
-        lines = [",".join(columns + ["error"])]
-        for i in range(len(self["status"])):
-            cells = [repr(self[k][i]) if isinstance(self[k][i], tuple) else str(self[k][i]) for k in columns]
-            lines.append(",".join(f'"{c}"' if "," in c else c for c in cells) + "," + self["error"][i].replace(",", ";"))
-        csv.write_text("\n".join(lines) + "\n")
+        Table.from_columns({k: self[k] for k in self if k != "error"} | {"error": self["error"]}).to_csv(csv)
         np.savez(npz, **{k: np.asarray(v, dtype=object if k in ("error",) else None) for k, v in self.items()})
         return [csv, npz]
 

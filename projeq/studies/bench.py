@@ -1,5 +1,7 @@
 """Quick benchmarks (``projeq bench``): cost of s̈ for ``scenes.chain(n)`` against peers,
-and the quick versions of the scripts in ``benchmarks/`` when they are present.
+then the quick modes of the derivation-effort and beam-convergence studies
+(:mod:`projeq.studies.bench_derivation`, :mod:`projeq.studies.bench_beam`; their full
+runs are ``benchmarks/derivation.py`` and ``benchmarks/beam_convergence.py``).
 
 Every evaluator is timed alternately with the others in one run and each entry is the
 minimum CPU time over repetitions, so ratios are robust on a noisy machine; absolute times hold for
@@ -14,25 +16,25 @@ the deviation from the dense s̈ includes the dense evaluator's own error, up to
 (κ(M) ≈ 1.3e8 at n = 100 at the benchmark's state), the deviation from the exact s̈ is each
 evaluator's own.
 
-    projeq bench                 # chain n = 10, 30, 100, then the scripts' quick modes
+    projeq bench                 # chain n = 10, 30, 100, then the quick studies
     projeq bench --json          # one JSON document with every report
     projeq bench --chain-only --no-peers --sizes 10,30
 """
 
 from __future__ import annotations
 
-import argparse
 import json
-import subprocess
-import sys
+import math
 import time
-from pathlib import Path
+import traceback
 
 import numpy as np
 
 from projeq import scenes
 from projeq.assembly.kernels import has_numba
 from projeq.subsystems import inertia
+from projeq.studies.bench_beam import convergence
+from projeq.studies.bench_derivation import derivation_effort
 from projeq.studies.bench_exact import chain_s_ddot
 
 QUICK_SIZES = (10, 30, 100)
@@ -182,23 +184,23 @@ def slopes(rows) -> dict:
     return {k: float(np.polyfit(n, np.log([r["seconds"][k] for r in rows]), 1)[0]) for k in sorted(names)}
 
 
-def print_table(rows, slope: dict) -> None:
+def format_table(rows, slope: dict) -> str:
     """µs per call, fast/peer time ratios, the fast evaluator's and the largest deviation
     from the reference s̈, the fast and the dense evaluator's deviation from the exact s̈
-    ("-" where not computed; see :func:`measure`)."""
+    ("-" where not computed; see :func:`measure`), and the log-log slopes."""
     names = list(rows[-1]["seconds"]) + [k for k in rows[0]["seconds"] if k not in rows[-1]["seconds"]]
-    print(f"{'n':>6} " + " ".join(f"{k + ' µs':>14}" for k in names) + f" {'fast/pin':>9} {'fast/mujoco':>12} "
-          f"{'fast dev':>9} {'max dev':>9} {'fast vs exact':>14} {'dense vs exact':>15}")
+    lines = [f"{'n':>6} " + " ".join(f"{k + ' µs':>14}" for k in names) + f" {'fast/pin':>9} {'fast/mujoco':>12} "
+             f"{'fast dev':>9} {'max dev':>9} {'fast vs exact':>14} {'dense vs exact':>15}"]
     for r in rows:
         s = r["seconds"]
         cells = " ".join(f"{s[k] * 1e6:>14.1f}" if k in s else f"{'-':>14}" for k in names)
         ratio = {p: f"{s['fast'] / s[p]:.2f}" if p in s and "fast" in s else "-" for p in ("pinocchio", "mujoco")}
         exact = {k: f"{r['exact_deviation'][k]:.1e}" if k in r.get("exact_deviation", {}) else "-" for k in ("fast", "dense")}
-        print(f"{r['n']:>6} {cells} {ratio['pinocchio']:>9} {ratio['mujoco']:>12} "
-              f"{r['deviation'].get('fast', np.nan):>9.1e} {max(r['deviation'].values()):>9.1e} {exact['fast']:>14} "
-              f"{exact['dense']:>15}")
+        lines.append(f"{r['n']:>6} {cells} {ratio['pinocchio']:>9} {ratio['mujoco']:>12} "
+                     f"{r['deviation'].get('fast', np.nan):>9.1e} {max(r['deviation'].values()):>9.1e} {exact['fast']:>14} {exact['dense']:>15}")
     if slope:
-        print("log-log slope: " + ", ".join(f"{k} {v:.3f}" for k, v in slope.items()))
+        lines.append("log-log slope: " + ", ".join(f"{k} {v:.3f}" for k, v in slope.items()))
+    return "\n".join(lines)
 
 
 def chain_report(sizes, budget: float, peers: bool = True, exact_up_to: int = EXACT_UP_TO) -> dict:
@@ -213,110 +215,67 @@ def chain_scaling(sizes, budget: float, as_json: bool, peers: bool = True, exact
     if as_json:
         print(json.dumps(report, indent=2))
     else:
-        print_table(report["rows"], report["slopes"])
+        print(format_table(report["rows"], report["slopes"]))
     return report
 
 
-QUICK_SCRIPTS = {"derivation.py": ["2", "4"], "beam_convergence.py": ["--quick"]}  # quick arguments, cheapest first
 TOTAL_BUDGET = 120.0  # s of wall time for all of projeq bench (issue 7, item 2: "under two minutes")
 
 
-def run_script(name: str, as_json: bool, timeout: float) -> dict:
-    """Run ``benchmarks/<name>`` of a source checkout with its quick arguments.
+def quick_derivation(deadline: float = math.inf, show=None) -> tuple[list, bool]:
+    """The derivation effort at N = 2 and 4 (:func:`projeq.studies.bench_derivation.derivation_effort`):
+    (rows, complete)."""
+    rows = derivation_effort((2, 4), deadline=deadline, show=show)
+    return rows, len(rows) == 2
 
-    Its output goes to this process's stdout, or with ``as_json`` is parsed as its JSON
-    report. Returns ``{"benchmark", "status", "seconds"}`` (+ ``"report"`` with
-    ``as_json``); status is "ok", "failed (exit code k)", "stopped after T s" or
-    "not available" (an installed package has no ``benchmarks/``).
+
+def quick_beam_convergence(deadline: float = math.inf, show=None) -> tuple[dict, bool]:
+    """The quick beam study (:func:`projeq.studies.bench_beam.convergence`): (report, complete)."""
+    report = convergence(quick=True, deadline=deadline, show=show)
+    return report, report["complete"]
+
+
+#: the quick studies after the chain part, cheapest first: name → function (deadline, show) ↦ (report, complete)
+QUICK_STUDIES = {"derivation": quick_derivation, "beam_convergence": quick_beam_convergence}
+
+
+def quick_suite(sizes=QUICK_SIZES, budget: float = 0.5, total: float = TOTAL_BUDGET, peers: bool = True,
+                exact_up_to: int = EXACT_UP_TO, chain_only: bool = False, show=None) -> dict:
+    """``projeq bench``: the chain part (:func:`chain_report`), then each of
+    :data:`QUICK_STUDIES` with an equal share of what is left of ``total`` seconds of wall
+    time (a study stops before its next row once its share is spent); a summary of the wall
+    times. ``show``, e.g. ``print``, receives the tables as they are computed.
+
+    Returns one document: the chain report, each study's report, ``"parts"`` (benchmark,
+    status — "ok", "stopped after T s" or "failed: ..." —, seconds), ``"total_seconds"`` and
+    ``"budget_seconds"``.
     """
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / name
-    entry = {"benchmark": name.removesuffix(".py"), "status": "not available", "seconds": 0.0}
-    if not script.exists():
-        return entry
-    args = QUICK_SCRIPTS[name] + ["--json"] * as_json
-    if not as_json:
-        print(f"\n$ python benchmarks/{name} {' '.join(args)}", flush=True)
+    show = show or (lambda text: None)
     started = time.perf_counter()
-    try:
-        done = subprocess.run([sys.executable, str(script), *args], check=False, timeout=timeout, text=True,
-                              stdout=subprocess.PIPE if as_json else None)
-        entry["status"] = "ok" if done.returncode == 0 else f"failed (exit code {done.returncode})"
-    except subprocess.TimeoutExpired:
-        done, entry["status"] = None, f"stopped after {timeout:.0f} s"
-    entry["seconds"] = time.perf_counter() - started
-    if as_json:
-        entry["report"] = _parse_json(done.stdout if done is not None else "")
-    return entry
-
-
-def _parse_json(text: str):
-    """A script's JSON report, or its raw output when that is not JSON."""
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError:
-        return {"output": text}
-
-
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="projeq bench", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
-    parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per chain length (default 0.5)")
-    parser.add_argument("--sizes", type=_sizes, default=QUICK_SIZES, metavar="N,N,...",
-                        help=f"chain lengths (default {','.join(map(str, QUICK_SIZES))})")
-    parser.add_argument("--total", type=float, default=TOTAL_BUDGET,
-                        help=f"wall-time budget in s for everything; the scripts share what the chain part "
-                             f"leaves and are stopped when it is spent (default {TOTAL_BUDGET:g})")
-    parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
-    add_exact_option(parser)
-    parser.add_argument("--chain-only", action="store_true", help="skip the scripts in benchmarks/")
-    return parser
-
-
-def add_exact_option(parser: argparse.ArgumentParser) -> None:
-    """``--exact-up-to N`` (for ``projeq bench`` and ``benchmarks/chain_scaling.py``)."""
-    parser.add_argument("--exact-up-to", type=int, default=EXACT_UP_TO, metavar="N",
-                        help=f"compare with the exact s̈ (projeq.studies.bench_exact) for n <= N (default {EXACT_UP_TO}; "
-                             f"it costs about 0.5 s at n = 100, 4 s at n = 300)")
-
-
-def _sizes(text: str) -> tuple:
-    """``"10,30"`` -> (10, 30); argparse prints the error as a bad --sizes (exit code 2)."""
-    try:
-        sizes = tuple(int(n) for n in text.split(","))
-        if min(sizes) < 1:
-            raise ValueError
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected chain lengths >= 1 separated by commas, got {text!r}") from None
-    return sizes
-
-
-def main(argv=None) -> int:
-    """``projeq bench``: quick chain scaling, then the quick beam and derivation scripts
-    within the total budget; a summary of the wall times. Exit code 1 when a script failed
-    or was stopped."""
-    args = _parser().parse_args(argv)
-    started = time.perf_counter()
-    chain = chain_report(args.sizes, args.budget, not args.no_peers, args.exact_up_to)
-    if not args.json:
-        print_table(chain["rows"], chain["slopes"])
+    chain = chain_report(sizes, budget, peers, exact_up_to)
+    show(format_table(chain["rows"], chain["slopes"]))
     parts = [{"benchmark": "chain_scaling", "status": "ok", "seconds": time.perf_counter() - started}]
-    scripts = [] if args.chain_only else list(QUICK_SCRIPTS)
-    for i, name in enumerate(scripts):
-        share = (args.total - (time.perf_counter() - started)) / (len(scripts) - i)
-        parts.append(run_script(name, args.json, max(share, 1.0)))
-    total = time.perf_counter() - started
-    if args.json:
-        reports = {p["benchmark"]: p.pop("report") for p in parts[1:]}
-        print(json.dumps({"chain_scaling": chain, **reports, "parts": parts, "total_seconds": total,
-                          "budget_seconds": args.total}, indent=2))
-    else:
-        print(f"\n{'benchmark':>18} {'wall s':>8}  status")
-        for p in parts:
-            print(f"{p['benchmark']:>18} {p['seconds']:>8.1f}  {p['status']}")
-        print(f"{'total':>18} {total:>8.1f}  = {total / args.total:.2f} of the {args.total:g} s budget")
-    return int(any(p["status"] not in ("ok", "not available") for p in parts))
+    reports = {}
+    studies = {} if chain_only else QUICK_STUDIES
+    for i, (name, study) in enumerate(studies.items()):
+        share = (total - (time.perf_counter() - started)) / (len(studies) - i)
+        show(f"\n{name} (quick):")
+        reports[name], part = _timed_part(name, study, max(share, 1.0), show)
+        parts.append(part)
+    seconds = time.perf_counter() - started
+    show(f"\n{'benchmark':>18} {'wall s':>8}  status")
+    for p in parts:
+        show(f"{p['benchmark']:>18} {p['seconds']:>8.1f}  {p['status']}")
+    show(f"{'total':>18} {seconds:>8.1f}  = {seconds / total:.2f} of the {total:g} s budget")
+    return {"chain_scaling": chain, **reports, "parts": parts, "total_seconds": seconds, "budget_seconds": total}
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+def _timed_part(name: str, study, share: float, show) -> tuple:
+    """(report, part) of one quick study given ``share`` seconds of wall time."""
+    started = time.perf_counter()
+    try:
+        report, complete = study(started + share, show)
+        status = "ok" if complete else f"stopped after {time.perf_counter() - started:.0f} s"
+    except Exception as exc:  # noqa: BLE001 -- one broken study is reported with its traceback; the others run
+        report, status = {"traceback": traceback.format_exc()}, f"failed: {type(exc).__name__}: {exc}"
+    return report, {"benchmark": name, "status": status, "seconds": time.perf_counter() - started}

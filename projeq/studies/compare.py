@@ -1,4 +1,4 @@
-"""Compare formulations of the equations of motion of one system (issue 5, THEORY §8, §9, §11).
+"""Compare formulations of the equations of motion of one system.
 
 ``compare(name)`` derives the equations of the named system with each available
 formulation, times the derivation, counts operations after common-subexpression
@@ -7,52 +7,105 @@ formulation, and optionally simulates each, reporting integration time, energy d
 constraint drift. Every formulation that yields a Gauss form M s̈ = rhs in the same
 coordinates is simulated through :func:`projeq.simulate` with a compiled evaluator, so all
 rows share one integrator and one energy function.
+
+Where a formulation's equations differ from the reference, ``difference`` holds the terms
+(reference minus that formulation, one sympy expression per equation) and ``why`` the
+reason; ``derivation`` says how each formulation follows from Bremer's Central Equation
+B(2) (docs/theory.md). Effort is measured the same way for every row (``EFFORT``), and the
+table states H. Bremer's effort claims ("Problems in Fast Moving Non-Holonomic Elastic
+Systems") beside the measured numbers, agreeing or not.
 """
 
 from __future__ import annotations
 
-import argparse
-import csv
-import time
+import textwrap
 from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
 import sympy as sp
 
-COLUMNS = ("formulation", "derivation_s", "n_ops", "identical", "check", "integration_s", "energy_drift",
-           "constraint_drift", "note")
+from projeq.studies.effort import (DERIVATION_REPEATS, EFFORT, as_symbols, cse_ops, derivation_repeats,
+                                   derivation_timed, timed)
+from projeq.studies.table import Table
+
+COLUMNS = ("formulation", "derivation_s", "n_ops", "identical", "check", "difference", "why", "integration_s",
+           "energy_drift", "constraint_drift", "derivation", "note")
+#: the columns of the text table (header shown); the others are printed below it, wrapped
+TEXT_COLUMNS = {"formulation": "formulation", "derivation_s": "deriv_s", "n_ops": "n_ops", "identical": "identical",
+                "integration_s": "integ_s", "energy_drift": "E_drift", "constraint_drift": "c_drift"}
+TEXT_WIDTH = 100
 
 
 @dataclass
 class ComparisonTable:
-    """Rows of a comparison, one dict per formulation with the keys of ``COLUMNS``."""
+    """Rows of a comparison, one dict per formulation with the keys of ``COLUMNS``; ``effort``
+    says how derivation_s and n_ops were measured, ``claims`` the documents' effort claims
+    beside the measured numbers."""
 
     name: str
     rows: list = field(default_factory=list)
+    effort: str = ""
+    claims: list = field(default_factory=list)
 
     def format(self) -> str:
-        """Plain-text table (numbers to 3 significant digits)."""
-        cells = [list(COLUMNS)] + [[_cell(row.get(c)) for c in COLUMNS] for row in self.rows]
-        widths = [max(len(r[i]) for r in cells) for i in range(len(COLUMNS))]
-        lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in cells]
-        lines.insert(1, "  ".join("-" * w for w in widths))
+        """Plain text at most ``TEXT_WIDTH`` columns wide: the table of numbers (3 significant
+        digits), then per row its check, difference (abbreviated), why and note, the derivations
+        from B(2), the effort procedure and the claims."""
+        grid = Table(tuple(TEXT_COLUMNS.values()), [[row.get(c) for c in TEXT_COLUMNS] for row in self.rows])
+        width = max(len(line) for line in grid.to_text().splitlines())
+        if width > TEXT_WIDTH:  # shorten the formulation names, the one column of free text
+            fitted = max(len("formulation"), max(len(row["formulation"]) for row in self.rows) - (width - TEXT_WIDTH))
+            grid = replace(grid, rows=[(_fit(row[0], fitted), *row[1:]) for row in grid.rows])
+        lines = grid.to_text().splitlines()
+        for row in self.rows:
+            details = _details(row)
+            if details:
+                lines += [_fit(row["formulation"], TEXT_WIDTH), *details]
+        derivations = list(dict.fromkeys(row["derivation"] for row in self.rows if row.get("derivation")))
+        if derivations:
+            lines.append("derivations from the Central Equation B(2), d/dt[(∂T/∂ṡ) δs] − δT − δW = 0 "
+                         "(docs/theory.md):")
+            lines += [line for text in derivations for line in _wrap(text, "- ", "  ")]
+        if self.effort:
+            lines += _wrap(self.effort, "effort: ", "  ")
+        lines += [line for claim in self.claims for line in _wrap(claim, "- ", "  ")]
         return f"compare {self.name}\n" + "\n".join(lines)
 
     def to_csv(self, path) -> None:
-        """Write the rows to ``path`` as CSV with a header line."""
-        with open(path, "w", newline="") as handle:
-            writer = csv.DictWriter(handle, fieldnames=COLUMNS)
-            writer.writeheader()
-            writer.writerows({c: row.get(c, "") for c in COLUMNS} for row in self.rows)
+        """Write the rows to ``path`` as CSV with a header line (``difference`` in full)."""
+        Table(COLUMNS, [[_csv_cell(row.get(c)) for c in COLUMNS] for row in self.rows]).to_csv(path)
 
 
-def _cell(value) -> str:
-    if value is None:
-        return "—"
-    if isinstance(value, float):
-        return f"{value:.3g}"
-    return str(value)
+def _csv_cell(value):
+    return _difference_text(value) if isinstance(value, tuple) else value
+
+
+def _fit(text: str, width: int) -> str:
+    """``text`` cut to ``width`` characters, with … where it was cut."""
+    return text if len(text) <= width else text[: width - 1] + "…"
+
+
+def _wrap(text: str, first: str, rest: str) -> list[str]:
+    return textwrap.wrap(text, TEXT_WIDTH, initial_indent=first, subsequent_indent=rest, break_on_hyphens=False)
+
+
+def _difference_text(difference) -> str:
+    """One string per equation, functions of time and space as plain symbols (α̈ → alpha_tt)."""
+    return "[" + ", ".join(sp.sstr(as_symbols(d)) for d in difference) + "]"
+
+
+def _details(row) -> list[str]:
+    """The row's check, nonzero difference (one line, abbreviated), why and note, indented."""
+    lines = []
+    if row.get("check"):
+        lines += _wrap(row["check"], "  check: ", "    ")
+    if row.get("difference") and any(d != 0 for d in row["difference"]):
+        lines.append(_fit("  difference (reference − this): " + _difference_text(row["difference"]), TEXT_WIDTH))
+    for key in ("why", "note"):
+        if row.get(key):
+            lines += _wrap(row[key], f"  {key}: ", "    ")
+    return lines
 
 
 @dataclass
@@ -64,27 +117,23 @@ class Formulation:
     derive: Callable | None = None
     evaluator: str | None = None
     note: str = ""
+    why: str = ""  # the reason, if its equations differ from the reference
 
 
-def _cse_ops(expressions) -> int:
-    """sympy.count_ops over the output of sympy.cse (replacements and reduced expressions)."""
-    from projeq.symbolic.projection import operation_count
-
-    return operation_count(*sp.cse(list(expressions)))
+def _residuals(gauss) -> sp.Matrix:
+    """M s̈ − rhs of a Gauss form, s̈ as the symbols ``<s>_dot``."""
+    return gauss.M * sp.Matrix([sp.Symbol(f"{x}_dot") for x in gauss.s]) - gauss.rhs
 
 
-def _timed(fn):
-    start = time.perf_counter()
-    out = fn()
-    return out, time.perf_counter() - start
+def _compare_equations(reference, other, evaluators, system) -> dict:
+    """identical ("yes"/"no"), check (how) and difference (reference − other per equation, or None).
 
-
-def _equal(reference, other, evaluators, system) -> tuple[str, str]:
-    """("yes"/"no", how): symbolic difference when both are small, else random states."""
-    if reference is not None and other is not None and sp.count_ops(other.rhs) < 400:
-        differences = [*(reference.M - other.M), *(reference.rhs - other.rhs)]
-        same = all(_vanishes(d, reference.q) for d in differences)
-        return ("yes" if same else "no"), "symbolic"
+    Symbolic when both are Gauss forms in the same symbols: the residuals' difference in the
+    normal form of :func:`_trig_normal` (zero there is a proof). Otherwise at random states."""
+    if reference is not None and other is not None and (reference.q, reference.s) == (other.q, other.s):
+        difference = tuple(_trig_normal(d, reference.q) for d in _residuals(reference) - _residuals(other))
+        return {"identical": "yes" if all(d == 0 for d in difference) else "no", "difference": difference,
+                "check": "symbolic: residuals subtracted, sin² + cos² = 1 normal form"}
     rng = np.random.default_rng(0)
     errors = []
     for _ in range(5):
@@ -92,52 +141,83 @@ def _equal(reference, other, evaluators, system) -> tuple[str, str]:
         a_ref, a = (e.accelerations(q, s_dot, 0.0) for e in evaluators)
         errors.append(np.max(np.abs(a - a_ref)) / max(1.0, np.max(np.abs(a_ref))))
     # 1e-9: round-off of two independently compiled evaluators, far below any modelling difference
-    return ("yes" if max(errors) < 1e-9 else "no"), f"numeric, 5 random states, max rel err {max(errors):.1e}"
+    return {"identical": "yes" if max(errors) < 1e-9 else "no", "difference": None,
+            "check": f"numeric, 5 random states, max rel err {max(errors):.1e}"}
 
 
-def _vanishes(expression, q) -> bool:
-    """expression ≡ 0: by a cheap exact normal form (trigonometric sums expanded, sin² q =
-    1 − cos² q, expanded) — zero there is a proof —, else by ``sympy.simplify``."""
-    normal = sp.expand(sp.expand(sp.expand_trig(expression)).subs({sp.sin(x) ** 2: 1 - sp.cos(x) ** 2 for x in q}))
-    return normal == 0 or sp.simplify(expression) == 0
+def _trig_normal(expression, q) -> sp.Expr:
+    """A normal form of ``expression`` that is 0 exactly when it vanishes identically in q:
+    trigonometric sums expanded, the numerator written as a polynomial in sᵢ = sin qᵢ,
+    cᵢ = cos qᵢ and reduced modulo sᵢ² + cᵢ² − 1 (these form a Gröbner basis — their leading
+    terms sᵢ² are coprime —, so the remainder is unique), then factored."""
+    sines = {x: sp.Dummy(f"sin_{x}") for x in q}
+    cosines = {x: sp.Dummy(f"cos_{x}") for x in q}
+    polynomial = sp.expand_trig(sp.sympify(expression)).xreplace({sp.sin(x): sines[x] for x in q})
+    numerator, denominator = sp.fraction(sp.together(polynomial.xreplace({sp.cos(x): cosines[x] for x in q})))
+    generators = [g for x in q for g in (sines[x], cosines[x])]
+    _, remainder = sp.reduced(sp.expand(numerator), [sines[x] ** 2 + cosines[x] ** 2 - 1 for x in q], *generators)
+    back = {sines[x]: sp.sin(x) for x in q} | {cosines[x]: sp.cos(x) for x in q}
+    return sp.factor(remainder.xreplace(back)) / denominator.xreplace(back)
 
 
-def _simulate_row(system, evaluator, t_end: float) -> dict:
+def _simulate_row(system, evaluator, t_end: float) -> tuple[dict, np.ndarray]:
+    """(integration time, energy and constraint drift of a run; the run's q at its output times)."""
     from projeq.simulation.driver import simulate
 
     result = simulate(system, t_end, evaluator=evaluator, rtol=1e-9, atol=1e-12)
     drift = float(np.abs(result.constraint_residual).max()) if result.constraint_residual.size else None
-    return {"integration_s": result.wall_time, "energy_drift": result.energy_drift, "constraint_drift": drift}
+    return {"integration_s": result.wall_time, "energy_drift": result.energy_drift, "constraint_drift": drift}, result.q
 
 
 def _gauss_form_rows(system, formulations, values, simulate: bool, t_end: float) -> list[dict]:
-    """Rows for formulations sharing the coordinates of ``system`` (first one = reference)."""
-    rows, reference, reference_evaluator = [], None, None
+    """Rows for formulations sharing the coordinates of ``system`` (first one = reference);
+    ``values``: numbers for the parameters of the symbolic forms."""
+    rows, reference, reference_evaluator, reference_q = [], None, None, None
     for f in formulations:
         row = {"formulation": f.name, "note": f.note}
         if f.derive is None and f.evaluator is None:
             row["identical"] = "not available"
             rows.append(row)
             continue
+        gauss = None
         if f.derive is not None:
-            gauss, row["derivation_s"] = _timed(f.derive)
-            evaluator = gauss.evaluator(values)
-            row["n_ops"] = evaluator.n_ops
+            gauss, row["derivation_s"] = derivation_timed(f.derive)
+            row["n_ops"] = cse_ops([*gauss.M, *gauss.rhs], values)
+            evaluator = gauss.evaluator({k: v for k, v in values.items() if k in gauss.parameters})
         else:
-            gauss, row["derivation_s"] = _timed(lambda: system.evaluator(f.evaluator))
             evaluator = f.evaluator
             row["note"] = row["note"] or "numeric evaluator: no symbolic expressions"
         numeric = system.evaluator(evaluator) if isinstance(evaluator, str) else evaluator
         if reference_evaluator is None:
-            reference, reference_evaluator = (gauss if f.derive else None), numeric
+            reference, reference_evaluator = gauss, numeric
             row["identical"], row["check"] = "reference", ""
         else:
-            row["identical"], row["check"] = _equal(reference, gauss if f.derive else None,
-                                                    (reference_evaluator, numeric), system)
+            row.update(_compare_equations(reference, gauss, (reference_evaluator, numeric), system))
+            if row["identical"] == "no":
+                row["why"] = f.why
         if simulate:
-            row.update(_simulate_row(system, evaluator, t_end))
+            metrics, q = _simulate_row(system, evaluator, t_end)
+            row.update(metrics)
+            reference_q = q if reference_q is None else reference_q
+            if row["identical"] == "no" and q.shape == reference_q.shape:
+                row["note"] += f"; its motion leaves the reference's by max |Δq| = {np.abs(q - reference_q).max():.2g}"
         rows.append(row)
     return rows
+
+
+# -- why formulations differ ----------------------------------------------------------------
+TOO_EARLY = "hamel (constraint inserted too early)"
+CAR_TOO_EARLY = ("constraint inserted before the derivation: with v_y = 0 in T, ∂T/∂v_y = m (v_y + c ω_z) is 0 "
+                 "instead of m c ω_z, so Hamel's terms β₂^{3,1} ω_z ∂T/∂v_y and β₂^{1,3} v_x ∂T/∂v_y of B(8) are "
+                 "lost (Bremer §2.1: \"not allowed to set v_y = 0 in advance\"). The lost terms do no work "
+                 "(v_x Δ₁ + ω_z Δ₂ = 0): the energy is conserved, the motion is wrong.")
+DISC_TOO_EARLY = ("constraint inserted before the derivation: with c₁ = c₂ = 0 in T, ∂T/∂c_ν (the horizontal "
+                  "momentum m v_G) is 0, so Hamel's terms (∂T/∂c_ν) ṡ_μ β_ν^{μ,n} of B(3) are lost. They do no "
+                  "work (β_ν^{μ,n} = −β_ν^{n,μ}, B(4)): the energy is conserved, the motion is wrong.")
+BEAM_NON_ORTHOGONAL = ("non-orthogonal axes: Hamilton's principle differentiates T along the Cardan rates "
+                       "(α̇, −ẇ′, v̇′), whose axes (x, y′, z″) are not orthogonal; its v equation picks up the "
+                       "torsional balance ρI_x α̈ = 2ρI α̈ weighted by w′ (Bremer §4.1), so B(18)'s ρI α̈ coupling is "
+                       "symmetric where B(23)'s, in the co-rotating frame, is skew.")
 
 
 # -- the systems ---------------------------------------------------------------------------
@@ -191,13 +271,6 @@ def _plain(q_t, u_t, M, forcing, q, s, parameters):
                      parameters=parameters)
 
 
-def _numbers(gauss, values: dict):
-    """``gauss`` with its parameters replaced by the numbers ``values`` (parameters left: none)."""
-    values = {k: sp.Float(v) for k, v in values.items()}
-    return replace(gauss, M=gauss.M.xreplace(values), rhs=gauss.rhs.xreplace(values), K=gauss.K.xreplace(values),
-                   parameters=())
-
-
 def _select(available, wanted):
     if wanted is None:
         return available
@@ -223,9 +296,11 @@ def _car(formulations, simulate, t_end):
         body = Body(v_c=(vx, c * wz, 0), omega=(0, 0, wz), m=m, I_c=sp.diag(0, 0, C0 - m * c**2), omega_IR=(0, 0, wz))
         return projection_equation({"car": body}, q, (vx, wz), K, parameters)
 
-    def hamel():  # B(3)–(8) with v_y, then v_y = 0 inserted after the derivation (THEORY §8)
+    def hamel(constraint_first=False):  # B(3)–(8) with v_y, then v_y = 0 inserted after the derivation
         H = sp.Matrix([[sp.cos(g), sp.sin(g), 0], [-sp.sin(g), sp.cos(g), 0], [0, 0, 1]])
         T = m * (vx**2 + (vy + c * wz) ** 2) / 2 + (C0 - m * c**2) * wz**2 / 2
+        if constraint_first:  # the mistake of Bremer §2.1: v_y = 0 put into T before the derivation
+            T = T.subs(vy, 0)
         s_ddot = sp.symbols("vx_dot vy_dot wz_dot")
         residual = hamel_equations(T, q, (vx, vy, wz), H, sp.zeros(3, 1), s_ddot, parameters=parameters)
         residual = residual.subs({vy: 0, s_ddot[1]: 0})
@@ -234,8 +309,10 @@ def _car(formulations, simulate, t_end):
 
     values = {m: 1200.0, c: 1.2, C0: 3228.0}  # scenes.car defaults
     available = [
-        Formulation("projection (symbolic)", projection, note="B(9)"),
+        Formulation("projection (symbolic)", projection, note="B(9) from B(11)–(12), v_y = 0 inserted up front"),
         Formulation("hamel", hamel, note="β of B(7); v_y = 0 after the derivation"),
+        Formulation(TOO_EARLY, lambda: hamel(constraint_first=True), note="β of B(7); v_y = 0 put into T first",
+                    why=CAR_TOO_EARLY),
         Formulation("projection (numeric, dense)", evaluator="dense"),
         Formulation("projection (numeric, recursive)", evaluator="recursive"),
     ]
@@ -247,24 +324,31 @@ def _car(formulations, simulate, t_end):
 
 
 def _knife_edge_disc(formulations, simulate, t_end):
-    """The knife-edge disc of the lecture (seed 001, slides 28–37): the scene's Projection
-    Equation numerically and symbolically (``gauss_form``), and the lecture's multiplier
-    and canonical forms in (x, y, z, ψ, ϕ, θ)."""
+    """The knife-edge disc of the lecture on non-holonomic systems (slides 28–37): the Projection
+    Equation with the lecture's frame E (reference) and from the scene, numerically, Hamel's
+    equations with the constraints inserted after and before the derivation, and the lecture's
+    multiplier and canonical forms in (x, y, z, ψ, ϕ, θ)."""
     from projeq.studies.compare_multipliers import FullCoordinates, multiplier_rows, without_multiplier_rows
     from projeq.scenes import knife_edge_disc
     from projeq.symbolic import gauss_form
-    from projeq.symbolic.formulation_examples import DISC_UNITS, hamel_disc, lecture_disc, lecture_disc_state
+    from projeq.symbolic.formulation_examples import (
+        DISC_UNITS, hamel_disc, lecture_disc, lecture_disc_state, projection_disc,
+    )
 
     system = knife_edge_disc()
     available = [
+        Formulation("projection (symbolic)", projection_disc,
+                    note="B(10) with R = E (turns with heading and tilt, not with the spin), rolling in the velocities"),
         Formulation("projection (numeric, dense)", evaluator="dense"),
         Formulation("projection (numeric, recursive)", evaluator="recursive"),
-        Formulation("projection (symbolic)", lambda: gauss_form(system), note="gauss_form(scenes.knife_edge_disc())"),
-        Formulation("hamel", lambda: _numbers(hamel_disc(), DISC_UNITS),
-                    note="β of ṡ = (ψ̇, ϕ̇, θ̇, c₁, c₂); c = 0 after the derivation"),
+        Formulation("projection (symbolic, from the scene)", lambda: gauss_form(knife_edge_disc()),
+                    note="gauss_form(scenes.knife_edge_disc()): R = the body frame, building the scene included"),
+        Formulation("hamel", hamel_disc, note="β of ṡ = (ψ̇, ϕ̇, θ̇, c₁, c₂); c = 0 after the derivation"),
+        Formulation(TOO_EARLY, lambda: hamel_disc(constraints_first=True),
+                    note="β of ṡ = (ψ̇, ϕ̇, θ̇, c₁, c₂); c = 0 put into T first", why=DISC_TOO_EARLY),
     ]
-    rows = _gauss_form_rows(system, _select(available, without_multiplier_rows(formulations, available)), {},
-                            simulate, t_end)
+    rows = _gauss_form_rows(system, _select(available, without_multiplier_rows(formulations, available)),
+                            DISC_UNITS, simulate, t_end)
     disc_coordinates = FullCoordinates(
         initial=lecture_disc_state,
         to_scene=lambda q, q_dot: (q[[0, 1, 3, 4, 5]].T, q_dot[3:].T),  # drop z = −r cos ϕ; ṡ = (ψ̇, ϕ̇, θ̇)
@@ -274,7 +358,7 @@ def _knife_edge_disc(formulations, simulate, t_end):
 
 
 def _spinning_beam(formulations, simulate, t_end):
-    """Field equations B(18) vs B(23) and their Ritz models under spin-up (THEORY §9)."""
+    """Field equations B(18) vs B(23) and their Ritz models under spin-up."""
     from projeq.scenes.elastic import spin_up_motion
     from projeq.symbolic import spinning_beam as sb
 
@@ -293,19 +377,19 @@ def _spinning_beam(formulations, simulate, t_end):
     rows, motions = [], {}
     for name in wanted:
         fields, ritz = derivations[name]
-        (equations, _), seconds = _timed(lambda: (fields(), ritz(2)))
+        (equations, _), seconds = derivation_timed(lambda: (fields(), ritz(2)))
         kind = name.split()[0]
-        row = {"formulation": name, "derivation_s": seconds, "n_ops": _cse_ops(equations), "note": notes[kind]}
+        row = {"formulation": name, "derivation_s": seconds, "n_ops": cse_ops(equations), "note": notes[kind]}
         if kind == "projection":
             row.update(identical="reference", check="")
         else:
-            d_v, d_w = sb.field_difference()  # after the timing: it reuses both derivations
-            row.update(identical="no" if (d_v, d_w) != (0, 0) else "yes", check="symbolic",
-                       note=f"{row['note']}; v equation − B(23)'s = {d_v}, w equations equal: {d_w == 0}")
+            difference = tuple(-d for d in sb.field_difference())  # B(23) − B(18), per equation (v, w)
+            row.update(identical="no" if any(d != 0 for d in difference) else "yes", difference=difference,
+                       check="symbolic: the field equations subtracted", why=BEAM_NON_ORTHOGONAL)
         if simulate:
             model = sb.ritz_models(2, rho_I_value=0.05)[kind]
             a0 = np.array([0.01, 0.0, 0.0, 0.0])
-            (times, a, _, E, W), row["integration_s"] = _timed(
+            (times, a, _, E, W), row["integration_s"] = timed(
                 lambda: sb.simulate_ritz(model, spin_up_motion(3.0, 2.0), a0, np.zeros(4), t_end))
             motions[kind] = a
             row["energy_drift"] = float(np.max(np.abs(E - E[0] - W)) / E[0])
@@ -326,42 +410,110 @@ COMPARISONS = {
 DEFAULT_T_END = {"car": 2.0, "knife_edge_disc": 2.0, "spinning_beam": 3.0, "n_link_pendulum": 2.0}
 
 
-def compare(name: str, formulations=None, simulate: bool = True, t_end: float | None = None) -> ComparisonTable:
+#: How each formulation follows from the Central Equation B(2) (docs/theory.md), by the first
+#: prefix of the formulation's name that matches.
+DERIVATIONS = (
+    ("projection (numeric", "Projection Equation, numeric: B(10) evaluated at each state, by the dense Gauss form "
+                            "B(14) or the order-n elimination of B(15); nothing is derived symbolically."),
+    ("projection (field", "Projection Equation for beam slices: B(2) as the virtual work B(20) with δy = D̄∘δs "
+                          "(B(22)), integrated by parts with the adjoint operator D (B(21)) into B(23)."),
+    ("projection", "Projection Equation: B(2) with the Cartesian positions of the mass elements, where "
+                   "d/dt δr = δṙ, is B(1); δr = (∂ṙ/∂ṡ) δs with velocities that already satisfy the constraints "
+                   "gives B(10) — no derivative of T, so the constraints may go in first."),
+    ("hamel", "Hamel: B(2) with ṡ = H(q) q̇; d δs − δ ds = Σ β ṡ δs (B(4)) gives B(3). The β terms carry "
+              "∂T/∂ṡ_ν of every speed, so T must keep the constrained speeds until the end."),
+    ("lagrange +", "Lagrange with multipliers: B(2) in redundant q, δq restricted by A δq = 0 and adjoined with "
+                   "λ: d/dt ∂L/∂q̇ − ∂L/∂q − Q = Aᵀλ with A q̇ = b."),
+    ("lagrange", "Lagrange (2nd kind): B(2) with ṡ = q̇ (H = E): d δq = δ dq, so d/dt ∂T/∂q̇ − ∂T/∂q = Q."),
+    ("hamilton canonical", "Hamilton's canonical equations with multipliers: the multiplier form with p = ∂L/∂q̇ "
+                           "and H = pᵀq̇ − L: q̇ = ∂H/∂p, ṗ = −∂H/∂q + Q + Aᵀλ."),
+    ("hamilton", "Hamilton's principle: B(2) integrated over [t₀, t₁] with δq(t₀) = δq(t₁) = 0, "
+                 "∫(δT − δV + δW) dt = 0 (B(16)), with the Cardan rates (α̇, −ẇ′, v̇′) of B(17) as velocities."),
+    ("barhorst lagrangian", "Barhorst's Lagrangian canonical form: the multiplier form with δq = K δu (Kᵀ Aᵀ = 0 "
+                            "removes λ): p = Kᵀ ∂L/∂q̇, ṗ = Kᵀ(∂L/∂q + Q) + K̇ᵀ ∂L/∂q̇."),
+    ("barhorst projective", "Barhorst's projective canonical form: B(10) projected with the partial velocities "
+                            "V = ∂v/∂u, W = ∂ω/∂u, momenta p = Σ (Vᵀ m v + Wᵀ I ω) and ṗ = Q + P."),
+    ("kane", "Kane: B(2) in Jourdain's form (δq = 0, δṡ free), Σ (∂v/∂u)ᵀ(m v̇ − f) + (∂ω/∂u)ᵀ(L̇ − M) = 0: "
+             "B(10) with the inertial frame as R."),
+)
+
+
+def derivation_of(name: str) -> str:
+    """How the formulation ``name`` follows from B(2) (``DERIVATIONS``; empty if none matches)."""
+    return next((text for prefix, text in DERIVATIONS if name.startswith(prefix)), "")
+
+
+_ANALYTICAL = ("hamel", "lagrange + multipliers", "hamilton canonical + multipliers", "barhorst lagrangian canonical")
+#: H. Bremer's effort claims, "Problems in Fast Moving Non-Holonomic Elastic Systems":
+#: (where and what, the Projection Equation's row, the rows it is claimed to beat)
+EFFORT_CLAIMS = {
+    "car": ("§2.2, the car: the Projection Equation is \"preferable to the use of any of the analytical methods\"; "
+            "\"The required effort is minimal.\"", "projection (symbolic)", _ANALYTICAL),
+    "knife_edge_disc": ("§6: with the Projection Equation the non-holonomic constraints may be inserted in advance; "
+                        "\"This goes along with a considerable reduction of calculation effort.\"",
+                        "projection (symbolic)", _ANALYTICAL),
+    "spinning_beam": ("§4.2: the Projection Equation gives B(23) \"along with much less effort in calculation\" "
+                      "than Hamilton's principle gives B(18).", "projection (field equations, Ritz)",
+                      ("hamilton (field equations, Ritz)",)),
+    "n_link_pendulum": ("§3, rigid multibody systems: \"the use of the Projection Equation once more leads to minimum "
+                        "effort when compared to the analytical procedures\".", "projection (symbolic)",
+                        ("lagrange (2nd kind)",)),
+}
+
+
+def _effort_claims(name: str, rows: list) -> list[str]:
+    """Bremer's claim for ``name`` with the measured ratios Projection Equation / other formulation
+    (derivation time, n_ops) and whether they agree with it."""
+    if name not in EFFORT_CLAIMS:
+        return []
+    claim, reference, others = EFFORT_CLAIMS[name]
+    by_name = {row["formulation"]: row for row in rows}
+    ref = by_name.get(reference, {})
+    if ref.get("derivation_s") is None:
+        return []
+    measured = []
+    for other in (by_name[o] for o in others if o in by_name and by_name[o].get("derivation_s") is not None):
+        time_ratio = ref["derivation_s"] / other["derivation_s"]
+        ops_ratio = ref["n_ops"] / other["n_ops"]
+        verdict = {(True, True): "agrees", (True, False): "agrees in time, not in n_ops",
+                   (False, True): "agrees in n_ops, not in time", (False, False): "disagrees"}[
+            (time_ratio < 1, ops_ratio <= 1)]
+        measured.append(f"vs {other['formulation']}: time ×{time_ratio:.2g}, n_ops ×{ops_ratio:.2g} → {verdict}")
+    if not measured:
+        return []
+    return [f"H. Bremer {claim} Measured, {reference} ({ref['derivation_s']:.3g} s, {ref['n_ops']} ops) "
+            + "; ".join(measured) + "."]
+
+
+def compare(name: str, formulations=None, simulate: bool = True, t_end: float | None = None,
+            repeats: int = DERIVATION_REPEATS) -> ComparisonTable:
     """Compare the formulations of the system ``name`` (a key of ``COMPARISONS``).
 
     formulations : names of the rows to compute (default all); the first is the reference
     simulate : also integrate each formulation's equations (rtol 1e-9, atol 1e-12)
     t_end : simulated time in s (default ``DEFAULT_T_END[name]``)
+    repeats : derivations per row; derivation_s is their median (``EFFORT``)
 
     Each row: derivation time (s), operation count after CSE (``sympy.count_ops``),
     whether the equations equal the reference (``check`` says how: symbolic difference or
-    random states), integration time (s), relative energy drift, max constraint residual.
+    random states), the ``difference`` (reference − this, per equation) and ``why`` where they
+    do not, integration time (s), relative energy drift, max constraint residual, and how the
+    formulation follows from the Central Equation B(2) (``derivation``).
     """
     if name not in COMPARISONS:
         raise ValueError(f"name: unknown comparison {name!r}; choose one of {sorted(COMPARISONS)}")
     t_end = DEFAULT_T_END[name] if t_end is None else t_end
     if not (isinstance(t_end, (int, float)) and t_end > 0):
         raise ValueError(f"t_end: must be a positive number of seconds, got {t_end!r}")
+    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
+        raise ValueError(f"repeats: must be a positive integer (derivations per row), got {repeats!r}")
     if formulations is not None:
         formulations = [formulations] if isinstance(formulations, str) else list(formulations)
-    return ComparisonTable(name, COMPARISONS[name](formulations, simulate, float(t_end)))
-
-
-def main(argv=None) -> int:
-    """``projeq compare NAME [--csv PATH] [--no-simulate] [--t-end T]``: print the table."""
-    parser = argparse.ArgumentParser(prog="projeq compare", description=compare.__doc__.splitlines()[0])
-    parser.add_argument("name", choices=sorted(COMPARISONS))
-    parser.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
-    parser.add_argument("--no-simulate", action="store_true", help="derive and check only")
-    parser.add_argument("--t-end", type=float, default=None, help="simulated time (s)")
-    parser.add_argument("--formulation", action="append", help="restrict to these rows (repeatable)")
-    args = parser.parse_args(argv)
+    token = derivation_repeats.set(repeats)
     try:
-        table = compare(args.name, args.formulation, simulate=not args.no_simulate, t_end=args.t_end)
-    except ValueError as error:
-        print(f"error: {error}")
-        return 2
-    print(table.format())
-    if args.csv:
-        table.to_csv(args.csv)
-    return 0
+        rows = COMPARISONS[name](formulations, simulate, float(t_end))
+    finally:
+        derivation_repeats.reset(token)
+    for row in rows:
+        row.setdefault("derivation", derivation_of(row["formulation"]))
+    return ComparisonTable(name, rows, EFFORT.format(repeats=repeats), _effort_claims(name, rows))

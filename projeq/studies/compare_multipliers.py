@@ -1,7 +1,8 @@
-"""The multiplier and canonical forms in a comparison table (:mod:`projeq.studies.compare`, issue 5).
+"""The multiplier and canonical forms in a comparison table (:mod:`projeq.studies.compare`).
 
-Lagrange's and Hamilton's equations with multipliers (seed 001, K(7), K(23)–(26)) and
-Barhorst's Lagrangian canonical form (seed 000, eqs. 45–52) live in the full coordinates of
+Lagrange's and Hamilton's equations with multipliers (the lecture on non-holonomic systems,
+K(7), K(23)–(26)) and Barhorst's Lagrangian canonical form (A. A. Barhorst, "Generalized
+momenta in constrained non-holonomic systems", eqs. 45–52) live in the full coordinates of
 a Pfaffian model, not in the scene's minimal velocities; each row is derived, counted, and
 compared with the scene's Projection Equation by the motion both produce from the same
 initial state (:class:`FullCoordinates` maps one onto the other).
@@ -15,7 +16,7 @@ from typing import Callable
 import numpy as np
 import sympy as sp
 
-from projeq.studies.compare import _cse_ops, _timed
+from projeq.studies.effort import cse_ops, derivation_timed, timed
 
 __all__ = ["MULTIPLIER_FORMS", "FullCoordinates", "CAR_COORDINATES", "car_multiplier_system", "multiplier_rows",
            "without_multiplier_rows"]
@@ -87,11 +88,11 @@ def multiplier_row(form: str, name: str, build, system, coordinates: FullCoordin
         if form == "barhorst":  # an ODE in (q, p) with q̇ = K u, no multiplier
             independent = [qi for qi in ms.q if qi.func.__name__ in coordinates.independent]
             canonical = lagrangian_canonical(ms, independent=independent)
-            return (ms, canonical), canonical.p_dot
+            return (ms, canonical), [*canonical.p, *canonical.p_dot]
         return (ms, None), (ms.lagrange_equations() if form == "lagrange" else sp.Matrix([*ms.canonical_equations()]))
 
-    ((ms, canonical), equations), seconds = _timed(derive)
-    row = {"formulation": name, "derivation_s": seconds, "n_ops": _cse_ops(equations),
+    ((ms, canonical), equations), seconds = derivation_timed(derive)
+    row = {"formulation": name, "derivation_s": seconds, "n_ops": cse_ops(equations, ms.parameters),
            "note": "q̇ = K u, ṗ = Kᵀ(∂L/∂q + Q) + K̇ᵀ∂L/∂q̇: no multiplier" if canonical else
            "index-1 by differentiating the constraint once (λ solved), no Baumgarte"}
     if reference is None:
@@ -100,11 +101,11 @@ def multiplier_row(form: str, name: str, build, system, coordinates: FullCoordin
     t_end = reference.t[-1]
     q0, q_dot0 = coordinates.initial(system)
     if canonical is None:
-        sol, row["integration_s"] = _timed(lambda: ms.simulate(
+        sol, row["integration_s"] = timed(lambda: ms.simulate(
             q0, q_dot0, (0.0, t_end), form=form, t_eval=reference.t, rtol=1e-9, atol=1e-12))
     else:
         independent = [ms.q_symbols.index(sp.Symbol(str(u)[: -len("_dot")])) for u in canonical.u]
-        sol, row["integration_s"] = _timed(lambda: canonical.simulate(
+        sol, row["integration_s"] = timed(lambda: canonical.simulate(
             q0, q_dot0[independent], (0.0, t_end), t_eval=reference.t, rtol=1e-9, atol=1e-12))
         K = sp.lambdify([canonical.q], canonical.K.subs(canonical.parameters), modules="numpy")
         sol.q_dot = np.column_stack([np.asarray(K(qi), float) @ ui for qi, ui in zip(sol.q.T, sol.u.T)])

@@ -25,10 +25,8 @@ stiffness warning of an explicit method) go to the ``warning`` column.
 
 from __future__ import annotations
 
-import argparse
 import hashlib
 import json
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -60,7 +58,7 @@ __all__ = [
     "build",
     "cheapest",
     "format_table",
-    "main",
+    "get_study",
     "plot",
     "read_csv",
     "reference",
@@ -174,7 +172,9 @@ def reference(study: Study, t_end: float, overrides: dict, out=None) -> np.ndarr
     return run["measured"]
 
 
-def _study(scene) -> Study:
+def get_study(scene) -> Study:
+    """The work-precision study of ``scene`` (a key of :data:`STUDIES` or a :class:`Study`);
+    ValueError naming the closest study."""
     if isinstance(scene, Study):
         return scene
     if scene not in STUDIES:
@@ -238,7 +238,7 @@ def tradeoff(scene, methods=METHODS, tolerances=None, knobs=None, *, quick: bool
         Columns :data:`COLUMNS` as numpy arrays, plus ``"measure"`` (the error's definition) and
         ``"complete"`` (False when Ctrl-C stopped the study).
     """
-    study = _study(scene)
+    study = get_study(scene)
     positive("timeout", timeout)
     methods, tolerances, knobs, t_end = _check_settings(
         study, methods, (QUICK_TOLERANCES if quick else TOLERANCES) if tolerances is None else tolerances,
@@ -312,85 +312,3 @@ def _knob_rows(study, knob, overrides, ref, methods, tolerances, t_end, timeout,
             record(row)
             if row["failure"] == "interrupted":
                 raise KeyboardInterrupt
-
-
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="projeq tradeoff", description="Work-precision study of a scene: error against a converged reference "
-        "versus CPU time for each integrator, tolerance and model knob; writes CSV and a PNG plot.")
-    parser.add_argument("scene", help=f"one of: {', '.join(STUDIES)}")
-    parser.add_argument("--quick", action="store_true", help=f"rtol {', '.join(f'{r:g}' for r in QUICK_TOLERANCES)}, "
-                        "fewer knobs, a shorter end time")
-    parser.add_argument("--methods", nargs="+", metavar="M", help=f"integrators (default all: {' '.join(METHODS)})")
-    parser.add_argument("--tolerances", nargs="+", metavar="RTOL", help="relative tolerances (default 1e-3 ... 1e-12)")
-    parser.add_argument("--knobs", nargs="+", metavar="KNOB", help="model knobs by label (default: all of the study)")
-    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                        help="override a scene parameter (see projeq list SCENE); repeatable")
-    parser.add_argument("--t-end", help="simulated time in s (default: the study's)")
-    parser.add_argument("--timeout", default="120", help="CPU seconds allowed per run (default 120)")
-    parser.add_argument("--out", default="projeq-tradeoff", help="output directory (default ./projeq-tradeoff)")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar and no table")
-    return parser
-
-
-def _number(option: str, text: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        raise ValueError(f"{option}: expected a number, got {text!r}") from None
-
-
-def _arguments(args) -> dict:
-    """Keyword arguments of :func:`tradeoff` from the parsed command line (ValueError naming the option)."""
-    from projeq.cli.commands import _output_directory
-    from projeq.scenes import get_scene, parse_settings
-
-    study = _study(args.scene)
-    timeout = _number("--timeout", args.timeout)
-    if not timeout > 0:
-        raise ValueError(f"--timeout: expected a positive number of seconds, got {args.timeout!r}")
-    return {
-        "scene": study, "quick": args.quick, "methods": args.methods or METHODS,
-        "tolerances": None if args.tolerances is None else [_number("--tolerances", r) for r in args.tolerances],
-        "knobs": args.knobs, "t_end": None if args.t_end is None else _number("--t-end", args.t_end),
-        "overrides": parse_settings(get_scene(study.scene), args.set), "timeout": timeout,
-        "out": _output_directory(args.out), "progress": not args.quiet,
-    }
-
-
-def main(argv=None) -> int:
-    """``projeq tradeoff SCENE [--quick] [--methods ...] [--tolerances ...] [--out DIR] [--t-end T]``.
-
-    Exit codes: 0 the study ran, 2 bad arguments (named), 1 the study failed (its reference
-    run failed, or Ctrl-C: the rows finished so far are written).
-    """
-    try:
-        args = _parser().parse_args(sys.argv[1:] if argv is None else list(argv))
-    except SystemExit as exit_:  # --help (0) or an argparse usage error (2), already printed
-        return int(exit_.code or 0)
-    try:
-        options = _arguments(args)
-        out = options["out"]
-        table = tradeoff(**options)
-    except ValueError as exc:
-        print(f"projeq tradeoff: {exc}", file=sys.stderr)
-        return 2
-    except RuntimeError as exc:
-        print(f"projeq tradeoff: {exc}", file=sys.stderr)
-        return 1
-    csv_path = save_csv(table, out / f"tradeoff_{args.scene}.csv")
-    files = [csv_path]
-    if np.any(table["failure"] == ""):
-        files.append(out / f"tradeoff_{args.scene}.png")
-        plot(table).savefig(files[-1], dpi=110)
-    if not args.quiet:
-        print(format_table(table))
-    print(f"wrote {', '.join(str(f) for f in files)}")
-    if not table["complete"]:
-        print(f"projeq tradeoff: interrupted after {len(table['method'])} settings; those are written", file=sys.stderr)
-        return 1
-    return 0
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

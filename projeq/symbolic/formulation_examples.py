@@ -18,7 +18,8 @@ from .canonical import CanonicalForm, projective_canonical
 from .lagrange import MultiplierSystem, multiplier_system
 from .projection import Body, t
 
-__all__ = ["DISC_UNITS", "lecture_disc", "lecture_disc_state", "projective_disc", "particle"]
+__all__ = ["DISC_UNITS", "hamel_disc", "lecture_disc", "lecture_disc_state", "particle", "projection_disc",
+           "projective_disc"]
 
 m, g, r, I, J = sp.symbols("m g r I J", positive=True)
 DISC_UNITS = {m: 1.0, g: 1.0, r: 1.0, I: 0.25, J: 0.5}  # the scene's defaults: μ = 1/4, ν = 1/2
@@ -53,19 +54,36 @@ def lecture_disc_state(system) -> tuple[np.ndarray, np.ndarray]:
             np.array([q_dot[0], q_dot[1], np.sin(q[3]) * q_dot[3], q_dot[2], q_dot[3], q_dot[4]]))
 
 
-@cache
-def projective_disc() -> CanonicalForm:
-    """The disc as one body in E = R_z(ψ) R_x(ϕ) (slide 29): v_G and gravity turned into E, ω and the
-    inertia diag(I, J, I) in E, E turning with ω_E = ω − θ̇ ê2."""
-    q = sp.symbols("x y z psi phi theta")
-    u = sp.symbols("u1:4")
+def _disc_in_E(q, u) -> Body:
+    """The disc as one body of B(10) in E = R_z(ψ) R_x(ϕ) (slide 29), for q = (x, y, z, ψ, ϕ, θ) and
+    u = (ψ̇, ϕ̇, θ̇): v_G and gravity turned into E, ω and the inertia diag(I, J, I) in E, E turning
+    with ω_E = ω − θ̇ ê2 (so I_c is constant in E although the disc spins)."""
     s, c, psi, phi = sp.sin, sp.cos, q[3], q[4]
-    K = _disc_K(q)
     R_E = sp.rot_axis3(-psi) * sp.rot_axis1(-phi)  # E's axes in N (sympy's rot_axis turns frames, hence −)
-    body = Body(v_c=R_E.T * (K * sp.Matrix(u))[:3, :], omega=[u[1], u[2] + s(phi) * u[0], c(phi) * u[0]],
+    return Body(v_c=R_E.T * (_disc_K(q) * sp.Matrix(u))[:3, :], omega=[u[1], u[2] + s(phi) * u[0], c(phi) * u[0]],
                 m=m, I_c=sp.diag(I, J, I), f=R_E.T * sp.Matrix([0, 0, m * g]),
                 omega_IR=[u[1], s(phi) * u[0], c(phi) * u[0]])
-    return projective_canonical([body], q, u, K, t, DISC_UNITS)
+
+
+@cache
+def projective_disc() -> CanonicalForm:
+    """Barhorst's projective canonical form of the disc in E (:func:`_disc_in_E`)."""
+    q = sp.symbols("x y z psi phi theta")
+    u = sp.symbols("u1:4")
+    return projective_canonical([_disc_in_E(q, u)], q, u, _disc_K(q), t, DISC_UNITS)
+
+
+def projection_disc():
+    """The disc by the Projection Equation B(10) with Bremer's free choice of the reference frame:
+    R = E (:func:`_disc_in_E`), the rolling constraints already in the velocities (slide 30). Same
+    coordinates and speeds as :func:`hamel_disc` and the scene ``knife_edge_disc``: q = (x, y, ψ, ϕ, θ)
+    (z = −r cos ϕ eliminated), ṡ = (ψ̇, ϕ̇, θ̇). Returns the Gauss form with parameters m, g, r, I, J."""
+    from .projection import projection_equation
+
+    x, y, z, psi, phi, theta = q6 = sp.symbols("x y z psi phi theta")
+    s = sp.symbols("psi_d phi_d theta_d")
+    K = _disc_K(q6).extract([0, 1, 3, 4, 5], [0, 1, 2])  # without the ż row
+    return projection_equation({"disc": _disc_in_E(q6, s)}, (x, y, psi, phi, theta), s, K, (I, J, g, m, r))
 
 
 @cache
@@ -75,11 +93,15 @@ def particle() -> MultiplierSystem:
     return multiplier_system((x.diff(t) ** 2 + y.diff(t) ** 2) / 2 - 10 * y, q, t, A=[[-y**2, 1]])
 
 
-def hamel_disc():
-    """The disc by Hamel's equations B(3) (THEORY §8) in the scene's q = (x, y, ψ, ϕ, θ): speeds
+def hamel_disc(constraints_first: bool = False):
+    """The disc by Hamel's equations B(3) in the scene's q = (x, y, ψ, ϕ, θ): speeds
     ṡ = H q̇ = (ψ̇, ϕ̇, θ̇, c₁, c₂) with c₁, c₂ the rolling constraints of slide 30 (z = −r cos ϕ
     eliminated), T and the weight's generalised forces Q = Kᵀ ∂(m g z)/∂q in these speeds; c₁ = c₂ = 0
-    inserted *after* the derivation. Returns the Gauss form in (ψ̇, ϕ̇, θ̇) with parameters m, g, r, I, J."""
+    inserted *after* the derivation. Returns the Gauss form in (ψ̇, ϕ̇, θ̇) with parameters m, g, r, I, J.
+
+    ``constraints_first=True`` inserts c₁ = c₂ = 0 into T *before* the derivation — the mistake
+    Bremer warns against for the car (B(8) text): ∂T/∂c_ν vanish, and with them the terms
+    (∂T/∂c_ν) ṡ_μ β_ν^{μ,n} of B(3)."""
     from .hamel import hamel_equations
     from .projection import GaussForm
 
@@ -94,6 +116,8 @@ def hamel_disc():
     z_dot = r * sp.sin(phi) * q_dot[3]
     T = (m * (q_dot[0] ** 2 + q_dot[1] ** 2 + z_dot**2) + I * q_dot[2] ** 2 * sp.cos(phi) ** 2 + I * q_dot[3] ** 2
          + J * (q_dot[4] + q_dot[2] * sp.sin(phi)) ** 2) / 2
+    if constraints_first:
+        T = T.subs({s[3]: 0, s[4]: 0})
     Q = K.T * sp.Matrix([0, 0, 0, m * g * r * sp.sin(phi), 0])  # −∂V/∂q, V = −m g z = m g r cos ϕ
     residual = hamel_equations(T, q, s, H, Q, s_ddot, parameters=(m, g, r, I, J))
     residual = residual[:3, :].subs({s[3]: 0, s[4]: 0, s_ddot[3]: 0, s_ddot[4]: 0})

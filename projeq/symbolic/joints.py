@@ -14,13 +14,12 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-import numpy as np
 import sympy as sp
 
 from ..joints import Fixed, Free, Planar, Prescribed, Prismatic, Revolute, UserJoint
-from projeq.joints.user_compiler import skew
+from .algebra import exact, mul, quaternion_matrix, quaternion_rate_matrix, rotation
 
-__all__ = ["SymbolicRelative", "relative", "exact", "skew", "cross", "mul"]
+__all__ = ["SymbolicRelative", "relative"]
 
 
 class SymbolicRelative(NamedTuple):
@@ -34,61 +33,12 @@ class SymbolicRelative(NamedTuple):
     k: sp.Matrix
 
 
-def exact(value) -> sp.Matrix | sp.Expr:
-    """A number or array as sympy: integral floats become integers (0, ±1 stay exact)."""
-    if isinstance(value, sp.Basic):
-        return value
-    array = np.asarray(value, dtype=float)
-    convert = np.vectorize(lambda x: sp.Integer(int(x)) if float(x).is_integer() else sp.Float(x),
-                           otypes=[object])
-    return convert(array).item() if array.ndim == 0 else sp.Matrix(convert(array))
-
-
-def _times(x, y):
-    """x y, or 0 without asking sympy: ``0 * x`` makes sympy query whether x is finite,
-    which dominated the derivation time of long chains (and sympy's EXRAW matrix product
-    multiplies zeros on purpose)."""
-    return 0 if x == 0 or y == 0 else x * y
-
-
-def mul(*matrices) -> sp.Matrix:
-    """The product of sympy matrices, skipping the exact zeros (see :func:`_times`)."""
-    out = matrices[0]
-    for B in matrices[1:]:
-        out = sp.Matrix(out.rows, B.cols,
-                        lambda i, j: sp.Add(*(_times(out[i, k], B[k, j]) for k in range(B.rows))))
-    return out
-
-
-def cross(a, b) -> sp.Matrix:
-    """a × b of 3-vectors, skipping the exact zeros (see :func:`_times`)."""
-    times = _times
-    return sp.Matrix([times(a[1], b[2]) - times(a[2], b[1]), times(a[2], b[0]) - times(a[0], b[2]),
-                      times(a[0], b[1]) - times(a[1], b[0])])
-
-
-def _about(e: sp.Matrix, angle) -> sp.Matrix:
-    """Rotation by ``angle`` about the unit axis e (Rodrigues, as the numeric joints)."""
-    E = skew(e)
-    return sp.eye(3) + sp.sin(angle) * E + (1 - sp.cos(angle)) * mul(E, E)
-
-
 def _one_axis(joint, q_n) -> tuple:
     """(A, r, F) of a Revolute or Prismatic joint at the coordinate q_n[0]."""
     e = exact(joint.axis)
     if isinstance(joint, Revolute):
-        return _about(e, q_n[0]), sp.zeros(3, 1), sp.Matrix.vstack(sp.zeros(3, 1), e)
+        return rotation(e, q_n[0]), sp.zeros(3, 1), sp.Matrix.vstack(sp.zeros(3, 1), e)
     return sp.eye(3), e * q_n[0], sp.Matrix.vstack(e, sp.zeros(3, 1))
-
-
-def _quaternion(quat) -> tuple[sp.Matrix, sp.Matrix]:
-    """Rotation and rate matrix Γ (q̇ = Γ ω) of a quaternion (w, x, y, z), assumed unit."""
-    w, x, y, z = quat
-    A = sp.Matrix([[1 - 2 * (y**2 + z**2), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                   [2 * (x * y + w * z), 1 - 2 * (x**2 + z**2), 2 * (y * z - w * x)],
-                   [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x**2 + y**2)]])
-    Gamma = sp.Matrix([[-x, -y, -z], [w, -z, y], [z, w, -x], [-y, x, w]]) / 2
-    return A, Gamma
 
 
 def _user(joint, name, q_n, s_n, t) -> SymbolicRelative:
@@ -113,11 +63,11 @@ def relative(joint, name: str, q_n, s_n, t, motion=None) -> SymbolicRelative:
         return SymbolicRelative(sp.eye(3), sp.zeros(3, 1), sp.zeros(6, 0), no_f, sp.zeros(0, 0), no_k)
     if isinstance(joint, Planar):
         P, n = exact(joint._P), exact(joint.normal)
-        A = _about(n, q_n[2])
+        A = rotation(n, q_n[2])
         K = sp.diag(mul(P, A, P.T), 1)
         return SymbolicRelative(A, mul(P.T, sp.Matrix(q_n[:2])), exact(joint._F), no_f, K, no_k)
     if isinstance(joint, Free):
-        A, Gamma = _quaternion(q_n[3:])
+        A, Gamma = quaternion_matrix(q_n[3:]), quaternion_rate_matrix(q_n[3:])
         return SymbolicRelative(A, sp.Matrix(q_n[:3]), sp.eye(6), no_f, sp.diag(A, Gamma), no_k)
     if isinstance(joint, Prescribed):
         if motion is None:

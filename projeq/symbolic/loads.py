@@ -11,7 +11,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..forces import Force, JointForce, JointSpring, SpringDamper, Torque
-from .joints import cross, exact, mul
+from .algebra import cross, exact, mul
 
 __all__ = ["check_loads", "body_wrenches", "joint_forces"]
 

@@ -36,7 +36,7 @@ from typing import NamedTuple
 import numpy as np
 import sympy as sp
 
-from projeq.joints.user_compiler import skew
+from projeq.symbolic.algebra import skew
 
 x, t, L = sp.symbols("x t L", positive=True)
 rho_A, rho_I, EI = sp.symbols("rho_A rho_I EI", positive=True)

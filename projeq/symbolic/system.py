@@ -35,7 +35,8 @@ import sympy as sp
 
 from ..joints import Prescribed
 from ..subsystems.rigid import Frame, RigidBody
-from .joints import cross, exact, mul, relative, skew
+from .algebra import cross, cross_motion, exact, mul, skew
+from .joints import relative
 from .loads import body_wrenches, check_loads, joint_forces
 from .projection import GaussForm, t
 
@@ -141,11 +142,6 @@ def _carry_back(link: _Link, wrench: sp.Matrix) -> sp.Matrix:
     return sp.Matrix.vstack(f, cross(link.r_pn, f) + moment)
 
 
-def _cross_motion(u: sp.Matrix, w: sp.Matrix) -> sp.Matrix:
-    """u × w = (u_ω × w_v + u_v × w_ω, u_ω × w_ω): Ṫ_np ẏ_p for u = T_np ẏ_p (THEORY §4)."""
-    return sp.Matrix.vstack(cross(u[3:, :], w[:3, :]) + cross(u[:3, :], w[3:, :]), cross(u[3:, :], w[3:, :]))
-
-
 def _forward(system, parameters, rels, s_joint, q_dot) -> list[_Link]:
     """Root → leaves: T_np, ẏ_n, ζ_n, the pose and gravity of every subsystem."""
     gravity = parameters.get("gravity", exact(system.gravity))
@@ -163,7 +159,7 @@ def _forward(system, parameters, rels, s_joint, q_dot) -> list[_Link]:
         w = mul(rel.F, s_n) + rel.f
         link.twist = u + w
         F_dot_s, f_dot = mul(_d_dt(rel.F, q_dot), s_n), _d_dt(rel.f, q_dot)
-        link.zeta = _carry(link, p.zeta) + _cross_motion(u, w) + F_dot_s + f_dot
+        link.zeta = _carry(link, p.zeta) + cross_motion(u, w) + F_dot_s + f_dot  # Ṫ_np ẏ_p = u × w
         links.append(link)
     return links
 
@@ -185,7 +181,8 @@ def _inertia(rigid) -> _Inertia | None:
 
 
 def _h(rigid, link: _Link) -> sp.Matrix:
-    """h = Q − G ẏ = (m g − ω × p ; r_c × (m g − ω × p) − ω × I_c ω), p = m (v + ω × r_c) (THEORY §3)."""
+    """h = Q − G ẏ = (m g − ω × p ; r_c × (m g − ω × p) − ω × I_c ω), p = m (v + ω × r_c) (THEORY §3):
+    the symbolic twin of :func:`projeq.subsystems.rigid.rigid_h`."""
     m, r_c, I_c = rigid
     v, omega = link.twist[:3, :], link.twist[3:, :]
     force = m * link.g - cross(omega, m * (v + cross(omega, r_c)))

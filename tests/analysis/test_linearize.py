@@ -14,7 +14,7 @@ import pytest
 from scipy.optimize import brentq
 
 import projeq as pq
-from projeq.analysis.linearize import NotSteadyError, eigenvalue_sweep, jacobian, linearize, state_derivative
+from projeq.analysis.linearize import NotSteadyError, eigenvalue_sweep, linearize, state_derivative
 from projeq.scenes import car, knife_edge_disc, rolling_disk, rolling_disk_critical_speed
 
 G = 9.81
@@ -112,14 +112,6 @@ def test_rolling_disk_critical_speed_by_root_finding():
         assert np.sum(row**2).real / 2 == pytest.approx(lam2, rel=1e-9, abs=1e-9 * abs(m * G * R / I))
     v_c = brentq(lambda v: np.sum(eigenvalue_sweep(build, [v])[0] ** 2).real, 0.1, 0.4, xtol=1e-14)
     assert v_c == pytest.approx(rolling_disk_critical_speed(m, R, I, J, G), rel=1e-9)
-
-
-def test_jacobian_is_fourth_order():
-    """Richardson extrapolation of central differences: the error falls by ≈ 2⁴ = 16 when the
-    step halves (d/dz of exp at 1, steps large enough that round-off is negligible)."""
-    f = lambda z: np.exp(z)
-    errors = [abs(jacobian(f, np.array([1.0]), step)[0, 0] - np.e) for step in (0.2, 0.1)]
-    assert 12 < errors[0] / errors[1] < 20
 
 
 def test_bad_inputs():

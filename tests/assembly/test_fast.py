@@ -22,7 +22,8 @@ from projeq.assembly import AutoEvaluator, kernels
 from projeq.assembly.beam_fast import HubBeamEvaluator
 from projeq.assembly.fast import FastEvaluator
 from projeq.assembly.linalg import SingularMassError
-from projeq.spatial import rotation
+from projeq.spatial import chain_matrix, cross, rotation
+from projeq.subsystems.rigid import rigid_h
 
 KERNEL_KINDS = ("revolute", "prismatic", "fixed")
 HAS_NUMBA = kernels.has_numba()
@@ -81,6 +82,40 @@ def test_compiled_without_numba_is_refused(monkeypatch):
     monkeypatch.setattr(kernels, "_numba", lambda: None)
     with pytest.raises(ValueError, match="compiled: numba is not installed"):
         FastEvaluator(pq.scenes.chain(2), compiled=True)
+
+
+# measured over 500 seeds: ≤ 1.3e-15 relative (rigid h), ≤ 8e-16 (rotation); the kernel
+# writes the same formulas as scalar sums in another order, so only round-off differs
+TWIN_RTOL = 5e-15
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_the_kernel_twins_equal_their_array_forms(seed):
+    """The kernel's scalar twins (projeq/assembly/kernels.py, "Compiled twins") equal the
+    one numeric home of each formula: Rodrigues' rotation (projeq.spatial.rotation; E for
+    prismatic and fixed joints), T_np (spatial.chain_matrix), a × b (spatial.cross) and the
+    rigid-body h of THEORY §3 (projeq.subsystems.rigid.rigid_h)."""
+    rng = np.random.default_rng(seed)
+    e = rng.standard_normal(3)
+    e /= np.linalg.norm(e)
+    x, r = rng.uniform(-np.pi, np.pi), rng.uniform(-2, 2, 3)
+    A = np.empty((3, 3))
+    for kind in (kernels.PRISMATIC, kernels.FIXED):
+        kernels._relative_rotation(kind, e, x, A)
+        assert np.array_equal(A, np.eye(3))
+    kernels._relative_rotation(kernels.REVOLUTE, e, x, A)
+    assert np.abs(A - rotation(e, x)).max() <= TWIN_RTOL
+    T = np.empty((6, 6))
+    kernels._chain_matrix(A, r, T)
+    assert np.abs(T - chain_matrix(A, r)).max() <= TWIN_RTOL * np.abs(T).max()
+    a, b = rng.uniform(-3, 3, (2, 3))
+    assert np.array_equal(kernels._cross3(a, b), cross(a, b))
+    m, r_c, L = 10 ** rng.uniform(-2, 2), rng.uniform(-1, 1, 3), rng.standard_normal((3, 3))
+    I_c, twist, g = m * L @ L.T, rng.uniform(-3, 3, 6), rng.uniform(-10, 10, 3)
+    h = np.empty(6)
+    kernels._rigid_h(m, r_c, I_c, twist, g, h)
+    expected = rigid_h(m, r_c, I_c, twist, g)
+    assert np.abs(h - expected).max() <= TWIN_RTOL * np.abs(expected).max()
 
 
 def _spring_chain():

@@ -161,7 +161,7 @@ def accelerations(model: KaneBicycle, q: np.ndarray, u_ind: np.ndarray) -> np.nd
 
 def lateral_state_matrix(model: KaneBicycle, speed: float, r_R: float) -> np.ndarray:
     """Jacobian of (q̇2, q̇5, u̇2, u̇5) by x = (q2, q5, u2, u5) at x = 0, u4 = −v/r_R."""
-    from projeq.analysis.linearize import jacobian
+    from projeq.analysis.differentiation import jacobian
 
     def x_dot(x):
         roll, steer, roll_rate, steer_rate = x

@@ -1,4 +1,4 @@
-"""The projeq command: list, run, sweep, delegated subcommands, exit codes, bad input."""
+"""The projeq command: list, run, sweep, compare, one exit-code convention, bad input."""
 
 import io
 import os
@@ -6,12 +6,12 @@ import runpy
 import signal
 import subprocess
 import sys
-import types
 
 import numpy as np
 import pytest
 
 import projeq as pq
+import projeq.cli.studies
 import projeq.simulation.driver
 from projeq.cli.commands import main
 
@@ -176,13 +176,11 @@ def test_a_real_ctrl_c_during_sweep_keeps_finished_and_partial_points(tmp_path):
         (["sweep", "chain", "--grid", "n=1:3"], "--grid: expected NAME=A:B:N"),
         (["sweep", "chain", "--grid", "links=1:3:3"], "links: unknown parameter"),
         (["sweep", "chain", "--grid", "n=1:2:2", "--workers", "0"], "--workers: expected a positive count"),
-        (["tradeoff", "chain"], "not available in this version"),
     ],
     ids=["scene", "parameter", "int", "setting", "float", "bool", "scene-check", "list", "grid", "grid-name",
-         "workers", "tradeoff"],
+         "workers"],
 )
-def test_bad_arguments_exit_2_with_the_reason(argv, message, capsys, monkeypatch, tmp_path):
-    monkeypatch.setitem(sys.modules, "projeq.studies.tradeoff", None)  # the module is absent in this version
+def test_bad_arguments_exit_2_with_the_reason(argv, message, capsys, tmp_path):
     assert main(argv + (["--out", str(tmp_path)] if argv[0] in ("run", "sweep") else [])) == 2
     assert message in capsys.readouterr().err
 
@@ -194,17 +192,43 @@ def test_an_output_directory_that_cannot_be_written(command, tmp_path, capsys):
     assert "--out: cannot write to directory" in capsys.readouterr().err
 
 
-def test_delegated_subcommands_get_their_arguments(monkeypatch):
+def test_compare_hands_its_options_to_the_library(monkeypatch, capsys):
     seen = []
-    monkeypatch.setitem(sys.modules, "projeq.studies.compare", types.SimpleNamespace(main=lambda argv: seen.append(argv) or 0))
-    assert main(["compare", "atwood", "--help"]) == 0 and seen == [["atwood", "--help"]]
+
+    def compare(*args, **options):
+        seen.append((args, options))
+        return pq.ComparisonTable("car")
+
+    monkeypatch.setattr(projeq.cli.studies, "compare", compare)
+    assert main(["compare", "car", "--no-simulate", "--t-end", "1.5", "--formulation", "hamel", "--repeats", "3"]) == 0
+    assert seen == [(("car", ["hamel"]), {"simulate": False, "t_end": 1.5, "repeats": 3})]
+    assert capsys.readouterr().out.startswith("compare car")
 
 
-@pytest.mark.parametrize("command", [[], ["list"], ["run"], ["sweep"]])
+@pytest.mark.parametrize("error, code", [(ValueError("t_end: must be positive"), 2),
+                                         (RuntimeError("reference: the run failed"), 1),
+                                         (KeyboardInterrupt(), 1)])
+def test_one_exit_code_convention_for_every_subcommand(error, code, monkeypatch, capsys):
+    """A ValueError (a refused input) is exit code 2, a RuntimeError (a failed run) or Ctrl-C
+    exit code 1, each with a one-line message naming the subcommand and no traceback."""
+    def failing(*args, **options):
+        raise error
+
+    monkeypatch.setattr(projeq.cli.studies, "compare", failing)
+    assert main(["compare", "car"]) == code
+    err = capsys.readouterr().err
+    assert err.startswith("projeq compare: ") and (str(error) or "interrupted") in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("command", [[], ["list"], ["run"], ["sweep"], ["compare"], ["bench"], ["tradeoff"]])
 def test_help_everywhere(command, capsys):
-    with pytest.raises(SystemExit) as exit_:
-        main(command + ["--help"])
-    assert exit_.value.code == 0 and "usage: projeq" in capsys.readouterr().out
+    assert main(command + ["--help"]) == 0
+    assert "usage: projeq" in capsys.readouterr().out
+
+
+def test_usage_errors_exit_2_without_raising(capsys):
+    assert main(["no-such-command"]) == 2 and main(["run", "--rtol", "tight"]) == 2
+    assert "invalid choice: 'no-such-command'" in capsys.readouterr().err
 
 
 def test_sweep_writes_one_table(tmp_path, capsys):
@@ -246,3 +270,9 @@ def test_progress_bar_on_a_terminal_unless_quiet(quiet, tmp_path, monkeypatch):
     argv = ["run", "atwood", "--t-end", "0.2", "--out", str(tmp_path)] + (["--quiet"] if quiet else [])
     assert main(argv) == 0
     assert ("100%|" in terminal.getvalue() and "t = 0.2/0.2 s" in terminal.getvalue()) is not quiet
+
+
+def test_version(capsys):
+    """``projeq --version`` prints the one version source, ``projeq.__version__``, and exits 0."""
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"projeq {pq.__version__}"

@@ -60,6 +60,18 @@ def test_singular_K_of_barhorsts_euler_angles():
     check_configuration(system, [0.0, 1.5, 0.0, 0.0, 0.0])  # 86°: regular
 
 
+@pytest.mark.parametrize("inertia, match", [
+    ("ring", r"^inertia: expected 'disk', 'hoop' or a pair \(I, J\)"),
+    ((1e-6,), r"^inertia: expected 'disk', 'hoop' or a pair \(I, J\)"),
+    ((0.0, 1e-6), r"^inertia: I and J must be positive"),
+    ((1e-6, 3e-6), r"^inertia: J = 3e-06 exceeds 2 I = 2e-06"),
+])
+def test_rolling_disk_inertia_is_checked(inertia, match):
+    """The disk's moments: a known shape name or (I, J) with 0 < J ≤ 2 I (triangle inequality)."""
+    with pytest.raises(ValueError, match=match):
+        pq.scenes.rolling_disk(inertia=inertia)
+
+
 def test_singular_F_of_the_knife_edge_disc_at_flat_tilt():
     """Slides 29–31: at ϕ = ±π/2 the ψ̇- and θ̇-directions of ω coincide (n̂z = ê2), F loses
     rank and the mass matrix is singular; the scene refuses to start there."""

@@ -6,6 +6,8 @@ scene's defaults, in SI units).
   states, with Barhorst's coordinates and body-fixed speeds (eqs. 89–93);
 - energy conservation without drag (his figures 5–8 show 3–13 % energy deviations of
   Mathematica's default integrator; projeq's run is checked at tight tolerance);
+- the disk's inertia as a parameter: the hoop's gives his energy level E ≈ 75197 g cm²/s²
+  (Fig. 8) exactly, the uniform disk's 68447.6 (closed form of the starting energy);
 - stability of upright straight rolling of the symmetric disk above the critical speed
   v_c = √(m g R³ I / (J (J + m R²))) (= √(g R / 3) for a uniform thin disk), derived in
   ``scenes.rolling_disk_critical_speed`` from the linearised slide-37 equations of the
@@ -32,10 +34,11 @@ def kane_model():
     """Kane's equations of Barhorst's disk with sympy.physics.mechanics: frames A (yaw q1 about
     n̂3), B (tilt q2 about â1), C (roll q3 about b̂2) (eqs. 89–91); u = body-fixed ω in C
     (eq. 92); centre at R b̂3 above the contact point, which is at rest (no slip);
-    eccentric point mass at (h, e, r) in C (§3.2). Returns u̇(q1..q3, u1..u3, params)."""
+    eccentric point mass at (h, e, r) in C (§3.2); the disk's moments I (diameter), J (axis).
+    Returns u̇(q1..q3, u1..u3, params)."""
     q1, q2, q3 = me.dynamicsymbols("q1:4")
     u1, u2, u3 = me.dynamicsymbols("u1:4")
-    m, ms, Rs, g, h, e, rr = sp.symbols("m m_s R g h e r")
+    m, ms, Rs, g, h, e, rr, I, J = sp.symbols("m m_s R g h e r I J")
     N = me.ReferenceFrame("N")
     A = N.orientnew("A", "Axis", [q1, N.z])
     B = A.orientnew("B", "Axis", [q2, A.x])
@@ -50,7 +53,7 @@ def kane_model():
     centre.v2pt_theory(contact, N, C)
     ecc = centre.locatenew("S", h * C.x + e * C.y + rr * C.z)
     ecc.v2pt_theory(centre, N, C)
-    I_d = me.inertia(C, m * Rs**2 / 4, m * Rs**2 / 2, m * Rs**2 / 4)
+    I_d = me.inertia(C, I, J, I)
     disk = me.RigidBody("disk", centre, C, m, (I_d, centre))
     mass = me.Particle("mass", ecc, ms)
     loads = [(centre, -m * g * N.z), (ecc, -ms * g * N.z)]
@@ -59,7 +62,7 @@ def kane_model():
     MM, f = kane.mass_matrix, kane.forcing
     sym_q, sym_u = sp.symbols("q1:4"), sp.symbols("u1:4")
     subs = dict(zip([q1, q2, q3, u1, u2, u3], [*sym_q, *sym_u]))
-    args = [sym_q, sym_u, (m, ms, Rs, g, h, e, rr)]
+    args = [sym_q, sym_u, (m, ms, Rs, g, h, e, rr, I, J)]
     return sp.lambdify(args, [me.msubs(MM, subs), me.msubs(f, subs)], modules="numpy", cse=True)
 
 
@@ -77,11 +80,52 @@ def test_accelerations_equal_kanes_method(method):
             q = np.array([*rng.uniform(-np.pi, np.pi, 1), rng.uniform(-1.2, 1.2), *rng.uniform(-np.pi, np.pi, 1),
                           *rng.uniform(-1, 1, 2)])
             u = rng.uniform(-30, 30, 3)
-            MM, rhs = f(q[:3], u, (M_R, ms, R, G, *ecc))
+            MM, rhs = f(q[:3], u, (M_R, ms, R, G, *ecc, M_R * R * R / 4, M_R * R * R / 2))
             expected = np.linalg.solve(np.asarray(MM, float), np.asarray(rhs, float).ravel())
             got = system.accelerations(q, u, method=method)
             # u̇ of order 10⁴ rad/s² (u² ≈ 10³ with sec q2 ≤ 3): round-off ~1e-12 relative
             assert np.allclose(got, expected, rtol=0, atol=1e-10 * (1 + np.abs(expected).max()))
+
+
+@pytest.mark.parametrize("inertia", ["hoop", (2e-6, 3e-6)])
+def test_other_inertias_equal_kanes_method(inertia):
+    """The ``inertia`` parameter reaches the dynamics: the hoop (I = m R²/2, J = m R²) and a
+    pair (I, J) give KanesMethod's u̇ with the same moments, at random states."""
+    f = kane_model()
+    I, J = (M_R * R * R / 2, M_R * R * R) if inertia == "hoop" else inertia
+    system = rolling_disk(inertia=inertia)
+    rng = np.random.default_rng(RNG_SEED)
+    for _ in range(5):
+        q = np.array([*rng.uniform(-np.pi, np.pi, 1), rng.uniform(-1.2, 1.2), *rng.uniform(-np.pi, np.pi, 1),
+                      *rng.uniform(-1, 1, 2)])
+        u = rng.uniform(-30, 30, 3)
+        MM, rhs = f(q[:3], u, (M_R, M_S, R, G, 0.0, 0.0, 0.95 * R, I, J))
+        expected = np.linalg.solve(np.asarray(MM, float), np.asarray(rhs, float).ravel())
+        # as above: round-off ~1e-12 relative to u̇ of order 10⁴ rad/s²
+        assert np.allclose(system.accelerations(q, u), expected, rtol=0, atol=1e-10 * (1 + np.abs(expected).max()))
+
+
+def starting_energy(J, q2=0.15, Omega=20.0, m_r=M_R, m_s=M_S, R=R, r=0.95 * R, g=G):
+    """E0 of Barhorst's start (q3 = q̇1 = q̇2 = 0, q̇3 = Ω, eccentric mass at r on ĉ3 = b̂3):
+    the centre moves with Ω R and the mass with Ω (R + r) along b̂1 (rolling about the contact
+    point), the disk spins with Ω about its axis, and both are at heights (R, R + r) cos q2."""
+    kinetic = 0.5 * m_r * (Omega * R) ** 2 + 0.5 * J * Omega**2 + 0.5 * m_s * (Omega * (R + r)) ** 2
+    return kinetic + g * np.cos(q2) * (m_r * R + m_s * (R + r))
+
+
+def test_hoop_inertia_gives_barhorsts_energy_level():
+    """Barhorst's Fig. 8 (the Lagrangian canonical run, which conserves energy) shows
+    E ≈ 75197 g cm²/s² (its axis spans 75196.5–75198.5). The closed form of the starting energy
+    gives exactly that for the hoop's axial moment J = m R² (75197.6) and 68447.6 for the uniform
+    disk's J = m R²/2; the scene's energy equals the closed form for each inertia."""
+    g_cm2_s2 = 1e7  # 1 kg m²/s²
+    for inertia, J in (("disk", M_R * R * R / 2), ("hoop", M_R * R * R), ((2e-6, 3e-6), 3e-6)):
+        system = rolling_disk(inertia=inertia)
+        # sums of a few terms of order 1e-3 J: round-off ~1e-18 J
+        assert sum(system.energy(system.q0, system.s_dot0)) == pytest.approx(starting_energy(J), rel=1e-12)
+    fig_8 = (75196.5, 75198.5)
+    assert fig_8[0] < starting_energy(M_R * R * R) * g_cm2_s2 < fig_8[1]  # the hoop: 75197.6
+    assert starting_energy(M_R * R * R / 2) * g_cm2_s2 < fig_8[0] - 6000  # the disk: 68447.6
 
 
 def test_barhorst_run_conserves_energy_and_rolls():

@@ -73,6 +73,10 @@ def test_settings_parse_to_the_type_of_the_default():
     parsed = pq.scenes.parse_settings(scene, ["m=900", "q0=1, 2, 0.5", "s_dot0=(5.0, 0.0)"])
     assert parsed == {"m": 900.0, "q0": (1, 2, 0.5), "s_dot0": (5.0, 0.0)} and type(parsed["m"]) is float
     assert pq.scenes.parse_settings(pq.scenes.SCENES["chain"], ["planar=yes", "n=3"]) == {"planar": True, "n": 3}
+    # a str parameter that also takes numbers: a name stays text, a tuple literal becomes the tuple
+    disk = pq.scenes.SCENES["rolling_disk"]
+    assert pq.scenes.parse_settings(disk, ["inertia=hoop"]) == {"inertia": "hoop"}
+    assert pq.scenes.parse_settings(disk, ["inertia=(2e-6, 3e-6)"]) == {"inertia": (2e-6, 3e-6)}
 
 
 @pytest.mark.parametrize(

@@ -128,8 +128,8 @@ def test_ctrl_c_keeps_the_finished_rows(tmp_path, monkeypatch):
         return real(*args)
 
     monkeypatch.setattr(tr, "run_setting", interrupted_on_second)
-    code = tr.main(["chain", "--set", "n=1", "--methods", "RK45", "--tolerances", "1e-3", "1e-4",
-                    "--knobs", "recursive", "--t-end", "0.5", "--out", str(tmp_path), "--quiet"])
+    code = projeq_main(["tradeoff", "chain", "--set", "n=1", "--methods", "RK45", "--tolerances", "1e-3", "1e-4",
+                        "--knobs", "recursive", "--t-end", "0.5", "--out", str(tmp_path), "--quiet"])
     assert code == 1
     table = tr.read_csv(tmp_path / "tradeoff_chain.csv")
     assert list(table["rtol"]) == [1e-3]
@@ -160,14 +160,14 @@ def test_cli_runs_a_study_and_writes_csv_and_plot(tmp_path, capsys):
 ])
 def test_cli_bad_arguments_exit_2_naming_the_argument(argv, name, capsys, tmp_path):
     out = [] if "--out" in argv else ["--out", str(tmp_path)]  # nothing written into the working directory
-    assert tr.main(argv + out) == 2
+    assert projeq_main(["tradeoff", *argv, *out]) == 2
     assert f"projeq tradeoff: {name}" in capsys.readouterr().err
 
 
 def test_cli_help_and_missing_scene(capsys):
-    assert tr.main(["--help"]) == 0
+    assert projeq_main(["tradeoff", "--help"]) == 0
     assert "--tolerances" in capsys.readouterr().out
-    assert tr.main([]) == 2  # argparse names the missing SCENE
+    assert projeq_main(["tradeoff"]) == 2  # argparse names the missing SCENE
     assert "scene" in capsys.readouterr().err
 
 

@@ -30,9 +30,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from projeq.analysis.differentiation import complex_step
 from projeq.checks import count, finite_array, non_negative, positive
 from projeq.joints import Relative
-from projeq.spatial import cross, skew_stack
+from projeq.spatial import cross, rotation_x, rotation_y, rotation_z, skew, skew_stack
 from projeq.subsystems.beam import shapes
 from projeq.subsystems.beam.checks import family_shapes, per_length
 from projeq.subsystems.beam.integrals import PrecomputedIntegrals, Quadrature
@@ -399,21 +400,16 @@ class RitzBeam(BeamProbes):
         e = self._local
         a = Phi["v"][1][:, 0] @ q_e[e(self.v_cols)]  # v′
         b = -(Phi["w"][1][:, 0] @ q_e[e(self.w_cols)])  # −w′
-        ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
-        R_z = np.array([[ca, -sa, 0 * ca], [sa, ca, 0 * ca], [0 * ca, 0 * ca, 1 + 0 * ca]])
-        R_y = np.array([[cb, 0 * cb, sb], [0 * cb, 1 + 0 * cb, 0 * cb], [-sb, 0 * cb, cb]])
         beta = Phi["beta"][0][:, 0] @ q_e[e(self.beta_cols)]
-        cg, sg = np.cos(beta), np.sin(beta)
-        R_x = np.array([[1 + 0 * cg, 0 * cg, 0 * cg], [0 * cg, cg, -sg], [0 * cg, sg, cg]])
-        A = R_z @ R_y @ R_x
+        R_x = rotation_x(beta)
+        A = rotation_z(a) @ rotation_y(b) @ R_x
         Phi_omega = np.zeros((3, self.n_e), dtype=A.dtype)
-        Phi_omega[0, e(self.v_cols)] = -sb * Phi["v"][1][:, 0]
-        Phi_omega[2, e(self.v_cols)] = cb * Phi["v"][1][:, 0]
+        Phi_omega[0, e(self.v_cols)] = -np.sin(b) * Phi["v"][1][:, 0]
+        Phi_omega[2, e(self.v_cols)] = np.cos(b) * Phi["v"][1][:, 0]
         Phi_omega[1, e(self.w_cols)] = -Phi["w"][1][:, 0]
         Phi_omega = R_x.T @ Phi_omega
         Phi_omega[0, e(self.beta_cols)] += Phi["beta"][0][:, 0]
-        C = np.array([[0, -offset[2], offset[1]], [offset[2], 0, -offset[0]], [-offset[1], offset[0], 0]])
-        F = np.vstack((A.T @ Phi_r[0] - C @ Phi_omega, Phi_omega))
+        F = np.vstack((A.T @ Phi_r[0] - skew(offset) @ Phi_omega, Phi_omega))
         return A, r_x[0] + A @ offset, F
 
     def __repr__(self) -> str:
@@ -434,8 +430,7 @@ class BeamPort:
         """Pose, F q̇_e and Ḟ q̇_e relative to the beam's frame (:meth:`RitzBeam.port`);
         Ḟ q̇_e by complex step."""
         A, r, F = self.beam._port_terms(q_e, self.data, self.offset)
-        step = 1e-30
-        F_dot = np.imag(self.beam._port_terms(q_e + 1j * step * q_e_dot, self.data, self.offset)[2]) / step
+        F_dot = complex_step(lambda eps: self.beam._port_terms(q_e + eps * q_e_dot, self.data, self.offset)[2])
         return Relative(A, r, F, F @ q_e_dot, F_dot @ q_e_dot)
 
 

@@ -1,0 +1,57 @@
+"""``projeq bench``: quick chain scaling, then the quick derivation and beam studies within a
+total wall-time budget (:func:`projeq.studies.bench.quick_suite`); tables or one JSON
+document. Exit code 1 when a study failed or was stopped by the budget."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from projeq.studies import bench
+from projeq.studies.bench import EXACT_UP_TO, QUICK_SIZES, TOTAL_BUDGET
+
+
+def bench_arguments(parser) -> None:
+    parser.description = bench.__doc__
+    parser.formatter_class = argparse.RawDescriptionHelpFormatter
+    parser.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
+    parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per chain length (default 0.5)")
+    parser.add_argument("--sizes", type=_sizes, default=QUICK_SIZES, metavar="N,N,...",
+                        help=f"chain lengths (default {','.join(map(str, QUICK_SIZES))})")
+    parser.add_argument("--total", type=float, default=TOTAL_BUDGET,
+                        help=f"wall-time budget in s for everything; the quick studies share what the chain part "
+                             f"leaves and stop when it is spent (default {TOTAL_BUDGET:g})")
+    parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
+    exact_option(parser)
+    parser.add_argument("--chain-only", action="store_true", help="skip the quick derivation and beam studies")
+    parser.set_defaults(execute=run_benchmarks)
+
+
+def exact_option(parser: argparse.ArgumentParser) -> None:
+    """``--exact-up-to N`` (for ``projeq bench`` and ``benchmarks/chain_scaling.py``)."""
+    parser.add_argument("--exact-up-to", type=int, default=EXACT_UP_TO, metavar="N",
+                        help=f"compare with the exact s̈ (projeq.studies.bench_exact) for n <= N (default {EXACT_UP_TO}; "
+                             f"it costs about 0.5 s at n = 100, 4 s at n = 300)")
+
+
+def run_benchmarks(args) -> int:
+    document = bench.quick_suite(args.sizes, args.budget, args.total, not args.no_peers, args.exact_up_to,
+                                 args.chain_only, show=None if args.json else _show)
+    if args.json:
+        print(json.dumps(document, indent=2))
+    return int(any(p["status"] != "ok" for p in document["parts"]))
+
+
+def _show(text: str) -> None:
+    print(text, flush=True)
+
+
+def _sizes(text: str) -> tuple:
+    """``"10,30"`` -> (10, 30); argparse prints the error as a bad --sizes (exit code 2)."""
+    try:
+        sizes = tuple(int(n) for n in text.split(","))
+        if min(sizes) < 1:
+            raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected chain lengths >= 1 separated by commas, got {text!r}") from None
+    return sizes
