@@ -5,7 +5,10 @@ numba is installed and the kernel knows every joint and subsystem; ``"hub_beam"`
 (:mod:`projeq.assembly.beam_fast`) for one RitzBeam on a prescribed or fixed hub; else the
 general evaluators, ``"dense"`` when joints share minimal velocities (coupled) and
 ``"recursive"`` otherwise. Each of them evaluates its systems or refuses them with the
-reason; "auto" is the only place that chooses, and it says what it chose.
+reason; "auto" is the only place that chooses, and it says what it chose. The choice is
+by cost per call: the compiled kernel is compiled on its first use in a fresh environment
+(seconds; cached on disk afterwards), which the default evaluator (``method=None``:
+recursive, or dense when coupled) never pays.
 
 >>> import projeq as pq
 >>> ev = AutoEvaluator(pq.scenes.atwood())
