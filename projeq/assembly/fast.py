@@ -11,7 +11,8 @@ source interpreted (for testing: correct, but slower than the recursive evaluato
 ``method="auto"`` (:mod:`projeq.assembly.auto`) picks this evaluator where it can, and
 another one where it cannot.
 
-Supported: trees of :class:`~projeq.RigidBody` / :class:`~projeq.PointMass` on
+Supported: trees of :class:`~projeq.RigidBody` / :class:`~projeq.PointMass` /
+:class:`~projeq.Frame` (massless) on
 :class:`~projeq.Revolute`, :class:`~projeq.Prismatic` and :class:`~projeq.Fixed` joints
 (no coupling), under gravity, without force laws. One :class:`~projeq.RitzBeam` on a
 prescribed or fixed hub has its own fast evaluator, ``method="hub_beam"``
@@ -38,9 +39,11 @@ from projeq.assembly import kernels
 from projeq.assembly.beam_fast import hub_beam_unsupported
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.joints import Fixed, Prismatic, Revolute
-from projeq.subsystems import PointMass, RigidBody
+from projeq.subsystems import Frame, PointMass, RigidBody
+from projeq.subsystems.rigid import rigid_mass_matrix
 
 _KINDS = {Fixed: kernels.FIXED, Revolute: kernels.REVOLUTE, Prismatic: kernels.PRISMATIC}
+_MASSLESS = (0.0, np.zeros(3), np.zeros((3, 3)))  # a Frame: M_n = 0, h_n = 0
 
 
 class FastEvaluator:
@@ -85,10 +88,9 @@ class FastEvaluator:
         self._orientation = np.array([j.orientation for j in joints])
         self._offset = np.array([j.r_pn for j in joints])
         self._q_index = np.array([system.q_slice[n].start for n in range(N)], dtype=np.int64)
-        self._m = np.array([b.m for b in bodies])
-        self._r_c = np.array([b.r_c for b in bodies])
-        self._I_c = np.array([b.I_c for b in bodies])
-        self._M6 = np.array([b.M6 for b in bodies])
+        inertia = [_MASSLESS if type(b) is Frame else (b.m, b.r_c, b.I_c) for b in bodies]
+        self._m, self._r_c, self._I_c = (np.array(part, dtype=float) for part in zip(*inertia))
+        self._M6 = np.array([rigid_mass_matrix(*mass) for mass in inertia])
         self._gravity = np.asarray(system.gravity, dtype=float)
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
         self._T, self._zeta = np.zeros((N, 6, 6)), np.zeros((N, 6))
@@ -124,8 +126,9 @@ def unsupported(system) -> str | None:
             return f"joint {name!r} is a {type(joint).__name__} (the kernel knows Revolute, Prismatic, Fixed)"
         if joint.coupling:
             return f"joint {name!r} is coupled (shared minimal velocities)"
-        if type(body) not in (RigidBody, PointMass) or body.S is not None:
-            return f"subsystem {name!r} is a {type(body).__name__} (the kernel knows spatial rigid bodies)"
+        if type(body) not in (RigidBody, PointMass, Frame) or body.S is not None:
+            return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows spatial rigid bodies, "
+                    "point masses and massless frames)")
     if system.forces:
         return "the system has force laws (the kernel knows gravity only)"
     return None
