@@ -37,10 +37,11 @@ from projeq.spatial import cross, rotation_x, rotation_y, rotation_z, skew, skew
 from projeq.subsystems.beam import shapes
 from projeq.subsystems.beam.checks import family_shapes, per_length
 from projeq.subsystems.beam.integrals import PrecomputedIntegrals, Quadrature
+from projeq.subsystems.base import Subsystem
 from projeq.subsystems.beam.probes import BeamProbes
 
 
-class RitzBeam(BeamProbes):
+class RitzBeam(BeamProbes, Subsystem):
     """A beam subsystem: Euler–Bernoulli bending in two planes, optional axial and torsional
     deformation and rotary inertia, dynamic stiffening, stiffness-proportional damping.
 
