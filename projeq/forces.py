@@ -21,12 +21,14 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
-import sympy as sp
 from numpy.typing import NDArray
 
 from projeq.checks import finite_array, non_negative
-from projeq.symbolic import algebra
+from projeq.symbolic import lazy_import
 from projeq.spatial import cross
+
+sp = lazy_import("sympy")
+algebra = lazy_import("projeq.symbolic.algebra")
 
 
 def _load(name: str, value, shape: tuple) -> Callable:
