@@ -13,6 +13,7 @@ import json
 import time as _time
 from collections import deque
 from dataclasses import dataclass, field, fields
+from types import SimpleNamespace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -243,6 +244,8 @@ def simulate(
             )
             nfev += sol.nfev
             sol.system = system  # the partition of a ConstrainedSystem its s_dot rows are in
+            if pieces and not dense_output:  # the previous segment's interpolants are no longer needed
+                pieces[-1].sol = SimpleNamespace(ts=pieces[-1].sol.ts[[0, -1]])
             pieces.append(sol)
             for collected, te in zip(t_events, sol.t_events or []):
                 collected.extend(te)

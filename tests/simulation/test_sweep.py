@@ -80,14 +80,13 @@ def test_ctrl_c_keeps_the_running_point_and_cancels_the_others(monkeypatch):
     """A KeyboardInterrupt while the first of three points runs on a one-thread pool: the
     running point is waited for and kept, the two not started are marked interrupted."""
 
-    def interrupted(futures):
+    def interrupted(futures):  # sweep's wait for the next finished point
         first = next(iter(futures))
         while not (first.running() or first.done()):
             time.sleep(1e-3)
         raise KeyboardInterrupt
-        yield  # a generator, like cf.as_completed
 
-    monkeypatch.setattr(sweep_module.cf, "as_completed", interrupted)
+    monkeypatch.setattr(sweep_module, "_finished", interrupted)
     with cf.ThreadPoolExecutor(1) as pool:
         table = sweep("chain", grid={"n": [1, 2, 3]}, outputs=["q0"], executor=pool, t_end=0.05, progress=False)
     assert table["status"].tolist() == [0, -1, -1] and table["error"] == ["", "interrupted", "interrupted"]
