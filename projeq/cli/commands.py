@@ -9,8 +9,8 @@ subcommand alike:
 - 2: bad arguments — refused by argparse, or a ValueError (the library's way of refusing an
   input, naming it: a scene, a parameter, a value, ``--out``) — nothing is run;
 - 1: a failed or interrupted run (a RuntimeError such as a failed simulation, Ctrl-C or
-  SIGTERM, or a command's own report of failed points, settings or benchmarks); what was
-  computed is written.
+  SIGTERM, a file that cannot be written, or a command's own report of failed points,
+  settings or benchmarks); what was computed is written, each file complete or not at all.
 
 SIGTERM (``kill``, a batch scheduler's time limit) is handled as Ctrl-C: a KeyboardInterrupt
 that each command turns into partial results.
@@ -64,6 +64,9 @@ def main(argv=None) -> int:
         return BAD_ARGUMENTS
     except RuntimeError as exc:
         print(f"projeq {args.command}: {exc}", file=sys.stderr)
+        return FAILED
+    except OSError as exc:  # a file that cannot be written (a full disk): nothing left half-written
+        print(f"projeq {args.command}: cannot write {exc.filename or 'a file'}: {exc.strerror or exc}", file=sys.stderr)
         return FAILED
     except KeyboardInterrupt:
         print(f"projeq {args.command}: interrupted", file=sys.stderr)

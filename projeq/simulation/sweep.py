@@ -33,6 +33,8 @@ import itertools
 import os
 import pickle
 import signal
+import threading
+import time
 import warnings
 from collections import deque
 from pathlib import Path
@@ -75,6 +77,7 @@ def output_value(result, name: str) -> float:
 
 
 INTERRUPT_GRACE = 10.0  # s to wait, after Ctrl-C, for the running points to return their partial results
+PARENT_POLL = 0.5  # s between a worker's checks that the main process is alive
 _simulating = False  # in a pool worker: True while run_point simulates
 
 
@@ -89,9 +92,18 @@ def interruptible_worker() -> None:
     """Initializer of a process-pool worker: SIGINT (Ctrl-C) stops the point it simulates
     (which :func:`projeq.simulate` turns into a partial result, status 2) and is ignored
     while the worker waits for work, so no worker dies with a traceback; SIGTERM ends the
-    worker (whatever handler it inherited from the main process)."""
+    worker (whatever handler it inherited from the main process), and so does the death of
+    the main process (a worker waiting for work would otherwise wait for ever)."""
     signal.signal(signal.SIGINT, _interrupt_a_running_point)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    threading.Thread(target=_exit_with_parent, args=(os.getppid(),), daemon=True).start()
+
+
+def _exit_with_parent(parent: int) -> None:
+    """Exit this process once its parent has gone (it is re-parented: ``getppid`` changes)."""
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL)
+    os._exit(1)
 
 
 def run_point(scene: Scene, parameters: dict, outputs, t_end: float, options: dict):
@@ -104,7 +116,7 @@ def run_point(scene: Scene, parameters: dict, outputs, t_end: float, options: di
         result = simulate(scene.build(**parameters), t_end, **options)
         return result.status, [output_value(result, o) for o in outputs], ""
     except Exception as exc:  # noqa: BLE001 - a failed point is reported in the table, never dropped
-        return -1, [np.nan] * len(outputs), f"{type(exc).__name__}: {exc}"
+        return -1, [np.nan] * len(outputs), " ".join(f"{type(exc).__name__}: {exc}".splitlines())  # one line
     finally:
         _simulating = False
 
@@ -372,45 +384,64 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
 
 class _Run:
     """The points of one sweep on an executor: at most one point per worker in flight on an
-    owned pool (so a dead worker costs only its points), every point at once on another
-    executor; a broken owned pool is replaced, an interrupt gathers the running points."""
+    owned pool, every point at once on another executor. A worker's death breaks an owned
+    pool: it is replaced, and the points that were in flight run again one at a time, so the
+    point that kills its worker again is found and failed, and the others are computed.
+    An interrupt gathers the running points."""
 
     def __init__(self, pool, owned: bool, workers, task, n_outputs: int):
         self.pool, self.owned, self.task, self.n_outputs = pool, owned, task, n_outputs
         self.window = (workers or os.cpu_count() or 1) if owned else None
         self.running = {}  # future -> point index
         self.processes = {}  # pid -> worker process of the owned pool, for the reason of a death
+        self.suspects = deque()  # points in flight when a worker died, to run again alone
+        self.retried = set()
         self.interrupted = False
 
     def all(self, todo: list, points: list, record) -> None:
         waiting = deque(todo)
         try:
-            while waiting or self.running:
-                while waiting and (self.window is None or len(self.running) < self.window):
-                    i = waiting.popleft()
+            while waiting or self.suspects or self.running:
+                while (self.suspects or waiting) and not self._full():
+                    i = (self.suspects or waiting).popleft()
                     try:
                         self.running[self.pool.submit(*self.task(points[i]))] = i
                     except cf.BrokenExecutor as exc:  # an executor not ours, broken: nothing more runs
                         record(i, self._failure(f"not run: the executor is broken ({exc})"))
                 self.processes.update(getattr(self.pool, "_processes", None) or {})
                 for future in _finished(self.running):
-                    record(self.running.pop(future), self._outcome(future))
+                    self._done(future, record)
                 if self.owned and getattr(self.pool, "_broken", False):  # a worker died: a new pool
-                    self.pool.shutdown(wait=True)  # ... once every point of the old one is marked failed
+                    self.pool.shutdown(wait=True)  # ... once every point of the old one is marked
                     for future in [f for f in self.running if f.done()]:
-                        record(self.running.pop(future), self._outcome(future))
+                        self._done(future, record)
                     self.pool, self.processes = process_pool(self.window), {}
         except KeyboardInterrupt:
             self.interrupted = True
             self._gather(record)
 
-    def _outcome(self, future):
+    def _full(self) -> bool:
+        """No room for another point: one per worker, and a point run again runs alone."""
+        alone = self.suspects or any(i in self.retried for i in self.running.values())
+        limit = 1 if alone else self.window
+        return limit is not None and len(self.running) >= limit
+
+    def _done(self, future, record) -> None:
+        i = self.running.pop(future)
+        if self.owned and isinstance(future.exception(), cf.BrokenExecutor) and i not in self.retried:
+            self.retried.add(i)
+            self.suspects.append(i)
+        else:
+            record(i, self._outcome(future, i in self.retried))
+
+    def _outcome(self, future, alone: bool):
         exc = future.exception()
         if exc is None:
             return future.result()
         if isinstance(exc, cf.BrokenExecutor):
-            return self._failure(f"worker process died{_cause_of_death(self.processes.values())} while this "
-                                 "point was running (with resume=True / --resume it runs again)")
+            when = " twice while running this point, the second time alone" if alone else " while this point was running"
+            return self._failure(f"worker process died{_cause_of_death(list(self.processes.values()))}{when} "
+                                 "(with resume=True / --resume it runs again)")
         return self._failure(f"{type(exc).__name__}: {exc}")
 
     def _failure(self, message: str) -> tuple:
@@ -459,16 +490,21 @@ def _signal(process, signum) -> None:
         pass
 
 
-def _cause_of_death(processes) -> str:
-    """" (killed by SIGKILL ...)" from the exit codes of a broken pool's workers, else ""."""
-    for process in processes:
-        code = process.exitcode
-        if code is not None and code < 0 and -code != signal.SIGTERM:  # the others are terminated by the pool
-            name = signal.Signals(-code).name
-            return f" (killed by {name}{', as the out-of-memory killer does' if name == 'SIGKILL' else ''})"
-        if code is not None and code > 0:
-            return f" (exit code {code})"
-    return ""
+def _cause_of_death(processes, wait: float = 2.0) -> str:
+    """" (killed by SIGKILL ...)" from the exit codes of a broken pool's workers, else "".
+    Waits up to ``wait`` s for them: the pool's own thread may be reaping them just now."""
+    deadline = time.monotonic() + wait
+    while True:
+        codes = [process.exitcode for process in processes]
+        for code in codes:
+            if code is not None and code < 0 and -code != signal.SIGTERM:  # the others are terminated by the pool
+                name = signal.Signals(-code).name
+                return f" (killed by {name}{', as the out-of-memory killer does' if name == 'SIGKILL' else ''})"
+            if code is not None and code > 0:
+                return f" (exit code {code})"
+        if time.monotonic() > deadline:
+            return ""
+        time.sleep(0.05)
 
 
 def _check_picklable(scene, options) -> None:
