@@ -26,6 +26,7 @@ Nothing is lost under faults:
 
 from __future__ import annotations
 
+import ast
 import concurrent.futures as cf
 import csv
 import io
@@ -127,8 +128,10 @@ class SweepTable(dict):
 
     def save(self, path) -> list[Path]:
         """Write ``path.csv`` and ``path.npz`` (path without suffix), each under a temporary
-        name renamed when complete; returns both paths."""
+        name renamed when complete (the directory is created if it is missing, e.g. deleted
+        during the sweep); returns both paths."""
         path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
         csv_path, npz = path.with_suffix(".csv"), path.with_suffix(".npz")
         with written_atomically(csv_path) as temporary:
             temporary.write_text(_csv_line(self) + "".join(_csv_line(row) for row in self.rows()))
@@ -157,6 +160,7 @@ class SweepTable(dict):
             else:
                 values = [_value(c) for c in cells]
                 scalar = all(not isinstance(v, (tuple, str)) for v in values)
+                # tuples stay objects: the None keeps numpy from making them a 2-d array
                 table[name] = np.array(values) if scalar else np.array(values + [None], dtype=object)[:-1]
         return table
 
@@ -188,8 +192,6 @@ def _value(text: str):
             return parse(text)
         except ValueError:
             pass
-    import ast
-
     try:
         return ast.literal_eval(text)
     except (ValueError, SyntaxError):
@@ -331,8 +333,9 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     SweepTable
         A dict of columns. On Ctrl-C the points finished so far are returned, the points that
         were running with their partial results (status 2), the others marked status −1,
-        error "interrupted". Points lost with a dead worker have status −1 and an error
-        saying so.
+        error "interrupted". A point whose worker process died has status −1 and an error
+        saying so (on the default pool: only a point that killed its worker twice, the second
+        time running alone).
 
     >>> table = sweep("chain", grid={"n": [1, 2]}, outputs=["q0"], executor=cf.ThreadPoolExecutor(2),
     ...               t_end=0.1, progress=False)
@@ -353,14 +356,16 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     rows = [None] * len(points)  # (status, outputs, error) of each point, None until it is done
     if resume:
         _resumed(Path(path).with_suffix(".csv"), header, points, rows)
-    pool, owned = _executor(executor, workers)
-    if owned or isinstance(pool, cf.ProcessPoolExecutor):
+    if executor is None or isinstance(executor, cf.ProcessPoolExecutor):
         _check_picklable(scene, options)
+    pool, owned = _executor(executor, workers)
     log = None if path is None else _Log(Path(path).with_suffix(".csv"), header,
                                          [_row(points[i], r) for i, r in enumerate(rows) if r is not None])
     from tqdm import tqdm
 
     def record(i, row):
+        if rows[i] is not None:  # recorded already (an interrupt between recording and forgetting it)
+            return
         rows[i] = row
         if log is not None:
             log.append(_row(points[i], row))
@@ -427,12 +432,15 @@ class _Run:
         return limit is not None and len(self.running) >= limit
 
     def _done(self, future, record) -> None:
-        i = self.running.pop(future)
+        """Record a finished point (or queue it to run again alone), then forget its future:
+        in this order, so that an interrupt in between cannot lose it."""
+        i = self.running[future]
         if self.owned and isinstance(future.exception(), cf.BrokenExecutor) and i not in self.retried:
             self.retried.add(i)
             self.suspects.append(i)
         else:
             record(i, self._outcome(future, i in self.retried))
+        del self.running[future]
 
     def _outcome(self, future, alone: bool):
         exc = future.exception()

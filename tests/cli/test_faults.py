@@ -46,7 +46,7 @@ from projeq.cli.commands import main
 from projeq.scenes import SCENES
 from tests.cli.test_faults import FAULTY
 SCENES["faulty"] = FAULTY
-simulate, finished = projeq.simulation.driver.simulate, projeq.simulation.sweep._finished
+simulate, append = projeq.simulation.driver.simulate, projeq.simulation.sweep._Log.append
 
 def reporting_simulate(system, t_end, progress=None, **options):  # projeq run passes a progress bar
     def report(t):
@@ -54,12 +54,11 @@ def reporting_simulate(system, t_end, progress=None, **options):  # projeq run p
         print("segment done", flush=True)
     return simulate(system, t_end, progress=progress and report, **options)
 
-def reporting_finished(running):  # sweep's wait for the next finished points
-    done = finished(running)
+def reporting_append(log, row):  # a finished point appended to sweep_SCENE.csv
+    append(log, row)
     print("point done", flush=True)
-    return done
 
-projeq.simulation.driver.simulate, projeq.simulation.sweep._finished = reporting_simulate, reporting_finished
+projeq.simulation.driver.simulate, projeq.simulation.sweep._Log.append = reporting_simulate, reporting_append
 sys.exit(main(sys.argv[1:]))
 """
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -109,8 +108,8 @@ def loaded(tmp_path) -> tuple[SweepTable, dict]:
 
 def test_sigterm_to_a_sweep_keeps_the_finished_points_and_stops_the_workers(tmp_path):
     """SIGTERM to the main process only, once point 0 has finished while the slow point 1
-    runs: the running point is told (SIGINT) and returns its partial result (status 2), the
-    points not started are marked interrupted, the table is written complete (CSV and NPZ
+    runs: the running points are told (SIGINT) and return their partial results (status 2),
+    the points not started are marked interrupted, the table is written complete (CSV and NPZ
     agree), exit 1 without a traceback, and no worker process is left."""
     child = start(sweep_argv(tmp_path, "k=0:5:6", "--set", "slow=1"))
     assert child.stdout.readline() == "point done\n"
@@ -122,8 +121,8 @@ def test_sigterm_to_a_sweep_keeps_the_finished_points_and_stops_the_workers(tmp_
     assert table["k"].tolist() == [0, 1, 2, 3, 4, 5]
     assert table["status"][0] == 0 and np.isfinite(table["q0"][0])
     assert table["status"][1] == 2 and table["error"][1] == ""  # stopped, with its partial result (maybe no step)
-    for status, error in zip(table["status"][2:], table["error"][2:]):
-        assert (status, error) in ((0, ""), (-1, "interrupted"))
+    for status, error in zip(table["status"][2:], table["error"][2:]):  # finished, running, or not started
+        assert (status, error) in ((0, ""), (2, ""), (-1, "interrupted"))
 
 
 def test_a_killed_sweep_keeps_its_finished_points_and_resume_runs_the_rest(tmp_path, monkeypatch, capsys):
