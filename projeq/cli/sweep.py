@@ -54,7 +54,7 @@ def sweep_scene(args) -> int:
         raise ValueError(f"--workers: expected a positive count, got {args.workers}")
     client = _dask_client(args.scheduler, args.scheduler_timeout) if args.scheduler else None
     options = {"method": args.method, "rtol": args.rtol}
-    with client or contextlib.nullcontext():  # a Dask client is closed also when --out is refused
+    with client if client is not None else contextlib.nullcontext():  # a Dask client is closed also when --out is refused
         out = output_directory(args.out)
         if not args.quiet:
             where = f"the Dask scheduler at {args.scheduler}" if client else f"{args.workers or os.cpu_count()} local processes"
