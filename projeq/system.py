@@ -1,4 +1,5 @@
-"""The System: a validated, immutable tree of subsystems, joints and forces.
+"""The System: a validated, immutable tree of subsystems, joints and forces; and the Model
+protocol that it shares with :class:`~projeq.constraints.partitioned.ConstrainedSystem`.
 
 Subsystems are numbered in topological order (``parent[n] < n``; ``GROUND = -1``). Each
 joint owns a slice of the coordinates q and of the minimal velocities ṡ (``q_slice[n]``,
@@ -12,10 +13,12 @@ All validation happens here, where input enters; the kernels trust what they get
 from __future__ import annotations
 
 import copy
+from abc import ABC, abstractmethod
 
 import numpy as np
 from numpy.typing import NDArray
 
+from projeq.assembly.kinematics import Plan
 from projeq.checks import finite_array, state_vector
 from projeq.constraints.nonholonomic import check_configuration
 from projeq.joints import Joint
@@ -24,8 +27,166 @@ GROUND = -1
 _GROUND_S = np.zeros((0, 6))
 
 
-class System:
+class Model(ABC):
+    """What :func:`projeq.simulate`, :func:`projeq.linearize`, the reactions
+    (:mod:`projeq.constraints.reactions`) and the ParaView export ask of a model, and all
+    they ask: a :class:`System` (a tree whose joints hold every constraint) and a
+    :class:`~projeq.constraints.partitioned.ConstrainedSystem` (a tree with constraint
+    equations, in partitioned minimal velocities) are Models.
+
+    The state is x = (q, ṡ): the tree's coordinates q (``n_q``) and the minimal
+    velocities ṡ (``n_s``), with q̇ = K(q) ṡ + k(q, t) and the Gauss form
+    M(q) s̈ + b(q, ṡ, t) = Q (docs/theory.md §4, §5, §7).
+
+    Attributes
+    ----------
+    names : tuple of str
+        The tree's subsystem names in topological order.
+    n_q, n_s : int
+        Lengths of q and ṡ.
+    n_c : int
+        Rows of :meth:`constraint_residual`.
+    n_lambda : int
+        Constraint equations with multipliers λ (:meth:`accelerations_tree`); 0 for a
+        System, whose constraints are built into its joints' K and F.
+    q0, s_dot0 : ndarray
+        The default initial state.
+    tree : System
+        The tree whose kinematics place the bodies (a System is its own tree).
+
+    Events. A model may stop a run by its own terminal :meth:`events` and say how the run
+    goes on (:meth:`after_event`): a ConstrainedSystem re-partitions there when its
+    partition degenerates; a System has none.
+    """
+
+    names: tuple
+    n_q: int
+    n_s: int
+    n_c: int
+    n_lambda: int = 0
+    q0: NDArray
+    s_dot0: NDArray
+    tree: "System"
+
+    # -- states ---------------------------------------------------------------------------
+    @abstractmethod
+    def check_q(self, name: str, q) -> NDArray:
+        """q as a float array of length n_q with finite entries; ValueError naming ``name``."""
+
+    def check_state(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
+        """q and ṡ as float arrays of the right lengths with finite entries (q checked by
+        :meth:`check_q`), and a finite time t."""
+        finite_array("t", t, ())
+        return self.check_q("q", q), state_vector("s_dot", s_dot, self.n_s)
+
+    @abstractmethod
+    def normalized(self, q: NDArray) -> NDArray:
+        """q moved onto its manifold (unit quaternions; a ConstrainedSystem's loop closures)."""
+
+    @abstractmethod
+    def check_configuration(self, q: NDArray, t: float = 0.0) -> None:
+        """ValueError naming what makes (q, t) singular (a joint's K or F, a partition)."""
+
+    # -- names ----------------------------------------------------------------------------
+    @abstractmethod
+    def joint(self, name: str) -> Joint:
+        """The tree joint that attaches subsystem ``name``."""
+
+    @property
+    def partition(self) -> tuple | None:
+        """The tree velocities that are the minimal velocities ṡ, when ṡ is a choice among
+        them (a ConstrainedSystem's independent velocities); None for a System."""
+        return None
+
+    def state_names(self) -> list[str]:
+        """Names of x = (q, ṡ): ``"<subsystem>.q[i]"``, then ``"<subsystem>.s_dot[i]"`` (i
+        within the subsystem's joint and internal coordinates; ṡ: the :attr:`partition`'s
+        tree velocities when there is one)."""
+        tree = self.tree
+        names = {}
+        for kind, slices in (("q", tree.q_slice), ("s_dot", tree.s_slice)):
+            names[kind] = [f"{name}.{kind}[{i}]" for name, sl in zip(tree.names, slices)
+                           for i in range(sl.stop - sl.start)]
+        if self.partition is not None:
+            names["s_dot"] = [names["s_dot"][i] for i in self.partition]
+        return names["q"] + names["s_dot"]
+
+    # -- kinematics -----------------------------------------------------------------------
+    @abstractmethod
+    def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
+        """q̇ = K(q) ṡ + k(q, t)."""
+
+    @abstractmethod
+    def tree_velocities(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
+        """The tree's minimal velocities ṡ_tree at the state (ṡ itself for a System)."""
+
+    @abstractmethod
+    def constraint_residual(self, q: NDArray, q_dot: NDArray, t: float = 0.0) -> NDArray:
+        """The n_c residuals of the constraints at (q, q̇, t) (zero on the motion)."""
+
+    # -- dynamics -------------------------------------------------------------------------
+    @abstractmethod
+    def evaluator(self, method: str | None = None):
+        """An object whose ``accelerations(q, s_dot, t)`` gives s̈ by ``method``
+        (``"recursive"``, ``"dense"`` or ``"fast"``; None: the model's default), without
+        checking the state: the right-hand side that :func:`projeq.simulate` calls."""
+
+    def accelerations(self, q, s_dot, t: float = 0.0, method: str | None = None) -> NDArray:
+        """Minimal accelerations s̈ from the Projection Equation at (q, ṡ, t) by the
+        evaluator ``method``: ``"recursive"`` (order n, docs/theory.md "The recursive pass
+        in augmented form"), ``"dense"`` (the Gauss form M s̈ + b = 0 of Bremer's B(14)) or
+        ``"fast"`` (the recursive pass compiled, :mod:`projeq.assembly.fast`); for a
+        ConstrainedSystem the evaluator of its tree, projected (see its :meth:`evaluator`)."""
+        q, s_dot = self.check_state(q, s_dot, t)
+        return self.evaluator(method).accelerations(q, s_dot, float(t))
+
+    @abstractmethod
+    def accelerations_tree(self, q: NDArray, s_dot: NDArray, t: float = 0.0,
+                           method: str | None = None) -> tuple[NDArray, NDArray]:
+        """(s̈_tree, λ): the tree's accelerations and the n_lambda multipliers."""
+
+    @abstractmethod
+    def gauss_form(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
+        """M and b of the Gauss form M s̈ + b = Q in the minimal velocities ṡ."""
+
+    @abstractmethod
+    def generalized_force(self, q: NDArray, t: float, joint_forces: dict) -> NDArray:
+        """Q (n_s) of generalized forces τ_j {joint name: τ_j} along each joint's own
+        velocities ṡ_j (the virtual power Σ τ_jᵀ ṡ_j = Qᵀ ṡ)."""
+
+    @abstractmethod
+    def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:
+        """(kinetic, potential) energy at (q, ṡ, t)."""
+
+    # -- events ---------------------------------------------------------------------------
+    def events(self) -> tuple:
+        """The model's own terminal events ``event(t, q, s_dot)`` (none by default); where
+        one fires :func:`projeq.simulate` goes on with :meth:`after_event`."""
+        return ()
+
+    def after_event(self, q: NDArray, s_dot: NDArray, t: float) -> tuple["Model", NDArray]:
+        """(model, ṡ) to go on with after one of :meth:`events` fired at (q, ṡ, t)
+        (unchanged by default)."""
+        return self, s_dot
+
+    def row_models(self, result) -> list:
+        """The model each row of ``result`` is in (this one, unless :meth:`after_event`
+        changed it during the run: ``Result.partitions``)."""
+        return [self] * len(result.t)
+
+
+def check_model(model) -> None:
+    """ValueError unless ``model`` is a :class:`Model` (a System or a ConstrainedSystem)."""
+    if not isinstance(model, Model):
+        raise ValueError(f"system: expected a System or a ConstrainedSystem (a projeq.system.Model), got {model!r}")
+
+
+class System(Model):
     """A multibody system for the Projection Equation Σ J_nᵀ (M_n ÿ_n + G_n ẏ_n − Q_n) = 0.
+
+    Immutable: every attribute is set by the constructor (the kinematic plan of the forward
+    pass included, :class:`projeq.assembly.kinematics.Plan`); assigning one raises
+    AttributeError. Only the evaluators are made on first use (:meth:`evaluator`).
 
     Parameters
     ----------
@@ -72,8 +233,26 @@ class System:
         for a in (self.gravity, self.q0, self.s_dot0):
             a.flags.writeable = False
         self._evaluators: dict = {}  # the one cache: an evaluator per method (not thread-safe)
+        self.plan = Plan(self)  # what the forward pass needs, once (projeq.assembly.kinematics)
+        self._frozen = True
         self._check_planar()
         self.check_configuration(self.q0)  # K(q0), F(q0) regular: no coordinate singularity at the start
+
+    def __setattr__(self, name: str, value) -> None:
+        if self.__dict__.get("_frozen"):
+            raise AttributeError(
+                f"System is immutable: cannot set {name!r} after construction; build a new System "
+                "(or use SystemBuilder) with what should change"
+            )
+        super().__setattr__(name, value)
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"System is immutable: cannot delete {name!r}")
+
+    @property
+    def tree(self) -> "System":
+        """A System is its own tree."""
+        return self
 
     # -- names and indexing -------------------------------------------------------------
     def index(self, name: str) -> int:
@@ -186,12 +365,6 @@ class System:
                 )
         return q
 
-    def check_state(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
-        """q and ṡ as float arrays of the right lengths with finite entries (q normalisable),
-        and a finite time t."""
-        finite_array("t", t, ())
-        return self.check_q("q", q), state_vector("s_dot", s_dot, self.n_s)
-
     def check_configuration(self, q: NDArray, t: float = 0.0) -> None:
         """ValueError naming the joint whose K(q) or F(q) is singular or not finite at q
         (:func:`projeq.constraints.nonholonomic.check_configuration`)."""
@@ -261,14 +434,23 @@ class System:
             self._evaluators[method] = EVALUATORS[method](self)
         return self._evaluators[method]
 
-    def accelerations(self, q, s_dot, t: float = 0.0, method: str | None = None) -> NDArray:
-        """Minimal accelerations s̈ from the Projection Equation at (q, ṡ, t).
+    def accelerations_tree(self, q, s_dot, t: float = 0.0, method: str | None = None) -> tuple[NDArray, NDArray]:
+        """(s̈, λ) with no multipliers λ: a System is its own tree."""
+        return self.accelerations(q, s_dot, t, method), np.zeros(0)
 
-        ``method="recursive"`` (order n, THEORY §6), ``"dense"`` (Gauss form, §5) or
-        ``"fast"`` (§6 compiled, :mod:`projeq.assembly.fast`).
-        """
-        q, s_dot = self.check_state(q, s_dot, t)
-        return self.evaluator(method).accelerations(q, s_dot, float(t))
+    def tree_velocities(self, q, s_dot, t: float = 0.0) -> NDArray:
+        """ṡ: a System is its own tree."""
+        return np.asarray(s_dot, dtype=float)
+
+    def generalized_force(self, q, t: float, joint_forces: dict) -> NDArray:
+        """Q with Q[columns] = Σ_j P_jᵀ τ_j, ṡ_j = P_j ṡ[columns] (:meth:`joint_s_columns`:
+        a coupled joint's τ acts on the velocities it follows)."""
+        Q = np.zeros(self.n_s)
+        for name, tau in joint_forces.items():
+            n = self.index(name)
+            cols, P = self.joint_s_columns(n)
+            Q[cols] += P[: self.joints[n].n_s].T @ state_vector(f"inputs[{name!r}]", tau, self.joints[n].n_s)
+        return Q
 
     def gauss_form(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """M(q) and b(q, ṡ, t) of the Gauss form M s̈ + b = 0 (THEORY §5)."""

@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import jacobian
-from projeq.checks import finite_array, state_vector
+from projeq.system import check_model
 
 _TOL = 1e-8  # relative threshold: zero columns of A, and the steady-motion residual
 
@@ -73,40 +73,17 @@ class Linearization(tuple):
         return sorted_eigenvalues(self[0])
 
 
-def state_names(system) -> list[str]:
-    """Names of x = (q, ṡ): ``"<subsystem>.q[i]"``, then ``"<subsystem>.s_dot[i]"``
-    (for a :class:`~projeq.constraints.partitioned.ConstrainedSystem`: its tree's names, ṡ = the
-    independent tree velocities)."""
-    tree = getattr(system, "tree", system)
-    names = {}
-    for kind, slices in (("q", tree.q_slice), ("s_dot", tree.s_slice)):
-        names[kind] = [f"{name}.{kind}[{i}]" for name, sl in zip(tree.names, slices)
-                       for i in range(sl.stop - sl.start)]
-    if tree is not system:
-        names["s_dot"] = [names["s_dot"][i] for i in system.independent]
-    return names["q"] + names["s_dot"]
-
-
-def _check_state(system, q, s_dot, t) -> tuple[NDArray, NDArray]:
-    """q, ṡ and t checked by the system (a ConstrainedSystem: q by its tree)."""
-    if hasattr(system, "check_state"):
-        return system.check_state(q, s_dot, t)
-    finite_array("t", t, ())
-    return system.check_q("q", q), state_vector("s_dot", s_dot, system.n_s)
-
-
 def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, inputs=()) -> NDArray:
     """ẋ = (q̇, s̈) at x = (q, ṡ); ``tau`` are generalized forces on the joints ``inputs``
-    (added to Q of the Gauss form M s̈ + b = Q, THEORY §5)."""
+    (added to Q of the Gauss form M s̈ + b = Q, THEORY §5; for a ConstrainedSystem projected
+    with its F, Fᵀ Q_tree, §7)."""
     q, s_dot = x[: system.n_q], x[system.n_q :]
     if tau is None or not len(inputs):
         s_ddot = system.evaluator().accelerations(q, s_dot, t)
     else:
         M, b = system.gauss_form(q, s_dot, t)
-        Q = np.zeros(system.n_s)
-        for name, tau_n in zip(inputs, np.split(tau, np.cumsum([system.joint(j).n_s for j in inputs])[:-1])):
-            Q[system.s_slice[system.index(name)]] += tau_n
-        s_ddot = np.linalg.solve(M, Q - b)
+        split = np.split(tau, np.cumsum([system.joint(j).n_s for j in inputs])[:-1])
+        s_ddot = np.linalg.solve(M, system.generalized_force(q, t, dict(zip(inputs, split))) - b)
     return np.concatenate((system.q_dot(q, s_dot, t), s_ddot))
 
 
@@ -144,7 +121,7 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
         Joints whose generalized forces τ are the inputs (B's columns).
     ignore : "auto", None or sequence of str/int
         Coordinates to drop: ``"auto"`` those detected by :func:`ignorable_coordinates`,
-        ``None`` none, or names (``"car.q[0]"``, see :func:`state_names`) / indices into q.
+        ``None`` none, or names (``"car.q[0]"``, see :meth:`projeq.system.Model.state_names`) / indices into q.
     tol : float
         Relative threshold for a vanishing column of A and for the steady-motion residual.
     require_steady : bool
@@ -161,13 +138,14 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
         If the kept states' derivative at (q, ṡ) exceeds ``tol`` (relative to the largest
         entry of ẋ and 1): neither an equilibrium nor a steady motion.
     """
+    check_model(system)
     q = system.q0 if q is None else q
     s_dot = system.s_dot0 if s_dot is None else s_dot
-    q, s_dot = _check_state(system, q, s_dot, t)
+    q, s_dot = system.check_state(q, s_dot, t)
     inputs = _check_inputs(system, inputs)
     x0 = np.concatenate((q, s_dot))
     A = jacobian(lambda x: state_derivative(system, x, t), x0)
-    names = state_names(system)
+    names = system.state_names()
     dropped = _dropped(system, names, A, ignore, tol)
     kept = [i for i in range(len(x0)) if i not in dropped]
     if require_steady:
@@ -182,6 +160,8 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
 
 def _check_inputs(system, inputs) -> tuple:
     inputs = tuple(inputs or ())
+    if len(set(inputs)) != len(inputs):
+        raise ValueError(f"inputs: each joint at most once, got {list(inputs)}")
     for name in inputs:
         if name not in system.names:
             raise ValueError(f"inputs: unknown joint {name!r}; the system has {list(system.names)}")

@@ -28,7 +28,7 @@ from projeq.spatial import chain_matrix, cross, cross_motion
 
 
 class Plan:
-    """Per-System preparation of the forward pass (built once, cached on the System).
+    """Per-System preparation of the forward pass (built once, by the System's constructor).
 
     - ``groups``: subsystems that share a batch implementation (``type(sub).group``), as
       (indices, group object); ``singles``: the others, evaluated one by one;
@@ -75,11 +75,8 @@ def _augmented_selection(S: NDArray | None) -> NDArray:
 
 
 def plan(system) -> Plan:
-    """The System's :class:`Plan`, built on first use (kept in the System's evaluator cache)."""
-    cache = system._evaluators
-    if "_plan" not in cache:
-        cache["_plan"] = Plan(system)
-    return cache["_plan"]
+    """The System's :class:`Plan` (built by its constructor)."""
+    return system.plan
 
 
 @dataclass

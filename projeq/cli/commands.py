@@ -41,7 +41,10 @@ COMMANDS = {
 
 def parser() -> argparse.ArgumentParser:
     """The parser of ``projeq`` with every subcommand."""
+    from projeq import __version__
+
     top = argparse.ArgumentParser(prog="projeq", description="Multibody dynamics by Bremer's Projection Equation.")
+    top.add_argument("--version", action="version", version=f"projeq {__version__}")
     sub = top.add_subparsers(dest="command", required=True)
     for name, (arguments, text) in COMMANDS.items():
         arguments(sub.add_parser(name, help=text, description=text))

@@ -91,16 +91,20 @@ def _progress_bar(t_start: float, t_end: float, quiet: bool):
 
 
 def _write(result, out: Path, name: str) -> list[Path]:
+    """``name.npz`` (the Result) and ``name.csv`` (:class:`~projeq.studies.table.Table`: t, q,
+    ṡ, kinetic and potential energy per output time), each under a temporary name renamed
+    when complete; ``out`` is created again if it was deleted during the run."""
     from projeq.simulation.export import written_atomically
+    from projeq.studies.table import Table
 
-    out.mkdir(parents=True, exist_ok=True)  # again: it may have been deleted during the run
+    out.mkdir(parents=True, exist_ok=True)
     npz, csv = out / f"{name}.npz", out / f"{name}.csv"
-    with written_atomically(npz) as temporary:
-        result.save(temporary)
-    columns = ["t"] + [f"q{i}" for i in range(result.q.shape[1])] + [f"s_dot{i}" for i in range(result.s_dot.shape[1])]
-    table = np.column_stack((result.t, result.q, result.s_dot, result.kinetic, result.potential))
+    result.save(npz)  # under a temporary name too
+    columns = (["t"] + [f"q{i}" for i in range(result.q.shape[1])] + [f"s_dot{i}" for i in range(result.s_dot.shape[1])]
+               + ["kinetic", "potential"])
+    rows = np.column_stack((result.t, result.q, result.s_dot, result.kinetic, result.potential))
     with written_atomically(csv) as temporary:
-        np.savetxt(temporary, table, delimiter=",", header=",".join(columns + ["kinetic", "potential"]), comments="")
+        Table(columns, rows.tolist(), units={"t": "s", "kinetic": "J", "potential": "J"}).to_csv(temporary)
     return [npz, csv]
 
 

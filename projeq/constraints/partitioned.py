@@ -29,14 +29,22 @@ With ``repivot`` (the default when the partition is chosen automatically) the pa
 carries a limit on its condition number κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ (≥ cond(A_dep); unlike
 cond(A_dep) it also sees a 1 × 1 block shrink to zero), max(REPIVOT_CONDITION, 10 κ at its
 start), and :func:`projeq.simulate` stops the integration by a terminal event where κ rises
-through it, re-partitions by pivoted QR at the current q (:meth:`~ConstrainedSystem.repartitioned`,
-ṡ_new = (F_old ṡ_old + f_old)[independent_new], the same tree velocities) and continues.
+through it (:meth:`~ConstrainedSystem.events`), re-partitions by pivoted QR at the current q
+(:meth:`~ConstrainedSystem.after_event`, ṡ_new = (F_old ṡ_old + f_old)[independent_new], the
+same tree velocities) and continues.
 ``Result.partitions`` lists (t_k, independent_k): the ``s_dot`` rows at times t with
 t_k < t ≤ t_k+1 are the tree velocities independent_k (the first partition also holds at
 t_start); energies and constraint residuals are computed in each row's own partition.
 A user-fixed partition (``repivot=False``) stops the run at the same event with a
 ValueError naming (q, t): integrated on, the solver could step across the degeneracy
 (where ṡ_tree = F ṡ is ∞ · 0) and lose accuracy silently.
+
+Evaluators. The projection Fᵀ M F needs the tree's mass matrix M, which the dense Gauss form
+of the tree gives together with b (the default, ``method="dense"``). With
+``method="recursive"`` or ``"fast"`` b comes from that evaluator's free accelerations of the
+tree, M s̈_free + b = 0, so that M s̈_tree + b = M (s̈_tree − s̈_free): the three agree to
+round-off (a cross-check of the tree's evaluators in the constrained motion), and dense is
+the cheapest.
 """
 
 from __future__ import annotations
@@ -50,6 +58,8 @@ from numpy.typing import NDArray
 from projeq.assembly.linalg import solve_spd
 from projeq.checks import positive, state_vector
 from projeq.analysis.differentiation import richardson, second
+from projeq.joints import Joint
+from projeq.system import Model
 
 CORRECTIONS = ("projection", "baumgarte", "none")
 # condition number κ = ‖A_s‖ ‖A_dep⁻¹‖ above which the partition is degenerate
@@ -63,8 +73,11 @@ POSITION_TOLERANCE = 1e-12
 _H1, _H2 = 1e-3, 3e-3  # steps of the 1st/2nd differences: truncation ~h⁴, round-off ~1e-16/h, 1e-16/h²
 
 
-class ConstrainedSystem:
+class ConstrainedSystem(Model):
     """A tree System with constraint equations, in minimal velocities by coordinate partitioning.
+
+    A :class:`~projeq.system.Model` like a System: ``accelerations(q, s_dot, t, method=...)``,
+    ``gauss_form``, ``energy``, ``q_dot`` and the rest take and give the minimal velocities ṡ.
 
     Parameters
     ----------
@@ -129,7 +142,7 @@ class ConstrainedSystem:
         self.m_p = self._constraint_rows("A", A, (q0, 0.0), 2)
         if b is not None:
             self._constraint_rows("b", b, (q0, 0.0), 1, self.m_p)
-        self.n_c = self.m_h + self.m_p
+        self.n_c = self.n_lambda = self.m_h + self.m_p
         if correction == "projection" and self.m_h and any(  # simulate normalises q without the time
                 not np.allclose(self.phi(q0, t), self.phi(q0, 0.0), rtol=0, atol=1e-14) for t in (0.37, 1.9)):
             raise ValueError("correction: 'projection' needs Φ independent of t (q is normalised without the "
@@ -234,22 +247,28 @@ class ConstrainedSystem:
         constraints, ∞ for a singular A_dep): ‖F‖ ≤ κ bounds the gain from ṡ to ṡ_tree."""
         return _partition_condition(self.constraint_matrix(q, t)[0], self.dependent)
 
-    def partition_event(self):
+    @property
+    def partition(self) -> tuple:
+        """The independent tree velocities: ṡ = ṡ_tree[partition]."""
+        return tuple(self.independent.tolist())
+
+    def events(self) -> tuple:
         """The terminal event ``event(t, q, s_dot) = κ − limit`` (rising) at which
-        :func:`projeq.simulate` calls :meth:`repartitioned` (None without constraints)."""
+        :func:`projeq.simulate` calls :meth:`after_event` (none without constraints)."""
         if not self.n_c:
-            return None
+            return ()
 
         def degenerates(t, q, s_dot):
             return self.condition(q, t) - self.limit
 
         degenerates.terminal, degenerates.direction = True, 1
-        return degenerates
+        return (degenerates,)
 
-    def repartitioned(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple["ConstrainedSystem", NDArray]:
-        """(system, s_dot) in the partition pivoted QR picks at (q, t): the same tree, the
-        same tree velocities ṡ_tree = F_old ṡ_old + f_old, ṡ_new = ṡ_tree[independent_new];
-        the new system starts at (q, ṡ_new). Without ``repivot``: ValueError naming (q, t)."""
+    def after_event(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple["ConstrainedSystem", NDArray]:
+        """Re-partitioned where the partition degenerates: (system, s_dot) in the partition
+        pivoted QR picks at (q, t), the same tree, the same tree velocities
+        ṡ_tree = F_old ṡ_old + f_old, ṡ_new = ṡ_tree[independent_new]; the new system
+        starts at (q, ṡ_new). Without ``repivot``: ValueError naming (q, t)."""
         if not self.repivot:
             raise self._degenerate(q, t, self.condition(q, t), self.limit)
         dependent = _pivoted_dependent(self.constraint_matrix(q, t)[0], self.n_c)
@@ -267,7 +286,7 @@ class ConstrainedSystem:
         new.repivot = self.repivot if repivot is None else _check_repivot(repivot)
         return new
 
-    def row_systems(self, result) -> list:
+    def row_models(self, result) -> list:
         """This system in the partition of each row of ``result`` (``Result.partitions``:
         (t_k, independent_k) holds for t_k < t ≤ t_k+1, the first one from the start)."""
         if not result.partitions:
@@ -315,10 +334,14 @@ class ConstrainedSystem:
         F, f = self.F(q, t)
         return F @ s_dot + f
 
-    # -- the System interface used by projeq.simulate --------------------------------------------
+    # -- the Model protocol (projeq.system.Model) --------------------------------------------
     def check_q(self, name: str, q) -> NDArray:
         """q as the tree checks it."""
         return self.tree.check_q(name, q)
+
+    def joint(self, name: str) -> Joint:
+        """The tree joint that attaches subsystem ``name``."""
+        return self.tree.joint(name)
 
     def K(self, q: NDArray, t: float = 0.0) -> NDArray:
         """K of q̇ = K ṡ + k in the minimal velocities: K_tree F."""
@@ -361,10 +384,6 @@ class ConstrainedSystem:
                 )
         return self.project(q0) if self.m_h else q0
 
-    def evaluator(self, method=None):
-        """This system itself: its accelerations use the tree's dense Gauss form."""
-        return self
-
     def energy(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple[float, float]:
         """(kinetic, potential) of the tree at ṡ_tree = F ṡ + f."""
         return self.tree.energy(q, self.tree_velocities(q, s_dot, t), t)
@@ -390,31 +409,69 @@ class ConstrainedSystem:
             parts.append(richardson(lambda e: _pfaffian_residual(self, at(e), q_dot), _H1) / step)
         return np.concatenate(parts) + C @ q_ddot
 
-    def accelerations_tree(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
-        """(s̈_tree, λ): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0, and the
-        multipliers λ of M s̈_tree + b = A_sᵀ λ (the constraint forces)."""
+    def _projected(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
+        """(A_s, F, f̄, M, b) at (q, ṡ, t): ṡ_tree = F ṡ + f, s̈_tree = F s̈ + f̄, and the tree's
+        Gauss form M s̈_tree + b at ṡ_tree (b by the tree evaluator ``method``, module docstring)."""
         C, c = self.velocity_constraints(q, t)
         K, k = self.tree.K(q, t), self.tree.q_dot(q, np.zeros(self.tree.n_s), t)
         A_s = C @ K
         F, f = self.F(q, t, (A_s, c - C @ k))
         s_dot_tree = F @ s_dot + f
         M, b = self.tree.evaluator("dense").gauss_form(q, s_dot_tree, t)
+        if method not in (None, "dense"):  # M s̈_free + b = 0
+            b = -M @ self.tree.evaluator(method).accelerations(q, s_dot_tree, t)
         f_bar = np.zeros(self.tree.n_s)
         if self.n_c:
             f_bar[self.dependent] = -np.linalg.solve(A_s[:, self.dependent], self.gamma(q, s_dot_tree, t, C))
-        M_min = F.T @ M @ F
-        s_ddot = -solve_spd(M_min, (F.T @ (M @ f_bar + b))[:, None], "constrained mass matrix FᵀMF",
+        return A_s, F, f_bar, M, b
+
+    def gauss_form(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
+        """M_min = FᵀMF and b_min = Fᵀ(M f̄ + b) of M_min s̈ + b_min = 0, the tree's Gauss form
+        with the constraint inserted before the projection (module docstring)."""
+        q, s_dot = self.check_state(q, s_dot, t)
+        return _minimal(*self._projected(q, s_dot, float(t), None)[1:])
+
+    def accelerations_tree(self, q: NDArray, s_dot: NDArray, t: float = 0.0,
+                           method: str | None = None) -> tuple[NDArray, NDArray]:
+        """(s̈_tree, λ): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0, and the
+        multipliers λ of M s̈_tree + b = A_sᵀ λ (the constraint forces); ``method`` picks
+        the tree's evaluator (module docstring; None: dense)."""
+        A_s, F, f_bar, M, b = self._projected(q, s_dot, t, method)
+        M_min, b_min = _minimal(F, f_bar, M, b)
+        s_ddot = -solve_spd(M_min, b_min[:, None], "constrained mass matrix FᵀMF",
                             max(np.abs(np.diag(M_min)).max(initial=0.0), 1e-300))[:, 0]
         s_ddot_tree = F @ s_ddot + f_bar
         lam = np.linalg.lstsq(A_s.T, M @ s_ddot_tree + b, rcond=None)[0] if self.n_c else np.zeros(0)
         return s_ddot_tree, lam
 
-    def accelerations(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
-        """Minimal accelerations s̈ (the independent entries of s̈_tree)."""
-        return self.accelerations_tree(q, s_dot, t)[0][self.independent]
+    def evaluator(self, method: str | None = None) -> "PartitionedEvaluator":
+        """s̈ with the tree evaluator ``method`` (None: dense), unchecked: for :func:`projeq.simulate`."""
+        return PartitionedEvaluator(self, method)
+
+    def generalized_force(self, q: NDArray, t: float, joint_forces: dict) -> NDArray:
+        """Fᵀ Q_tree: the tree's generalized forces projected like its Gauss form."""
+        return self.F(q, t)[0].T @ self.tree.generalized_force(q, t, joint_forces)
 
     def __repr__(self) -> str:
         return f"ConstrainedSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian)"
+
+
+class PartitionedEvaluator:
+    """s̈ = s̈_tree[independent] of a ConstrainedSystem by the tree evaluator ``method``
+    (checked here: an unknown name raises ValueError); the state is not checked."""
+
+    def __init__(self, system: ConstrainedSystem, method: str | None):
+        if method is not None:
+            system.tree.evaluator(method)
+        self.system, self.method = system, method
+
+    def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
+        return self.system.accelerations_tree(q, s_dot, t, self.method)[0][self.system.independent]
+
+
+def _minimal(F: NDArray, f_bar: NDArray, M: NDArray, b: NDArray) -> tuple[NDArray, NDArray]:
+    """FᵀMF and Fᵀ(M f̄ + b): the Gauss form in the minimal velocities."""
+    return F.T @ M @ F, F.T @ (M @ f_bar + b)
 
 
 def _check_repivot(repivot) -> bool:

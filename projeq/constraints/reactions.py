@@ -20,24 +20,33 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.checks import state_vector
 from projeq.assembly.kinematics import forward, gauss_terms
+from projeq.system import check_model
 
 
 def reactions(system, result) -> NDArray:
-    """λ (n_t × n_c) along a trajectory of a :class:`~projeq.constraints.partitioned.ConstrainedSystem`
+    """λ (n_t × n_lambda) along a trajectory of a :class:`~projeq.constraints.partitioned.ConstrainedSystem`
     (rows: Φ first, then the Pfaffian rows), from ``M s̈_tree + b = A_sᵀ λ``; each row in
     its own partition if the run re-pivoted (``result.partitions``)."""
-    if not hasattr(system, "accelerations_tree"):
-        raise ValueError(f"system: reactions need a ConstrainedSystem, got {system!r}")
+    _check_multipliers(system, "reactions")
     if result.q.shape[1:] != (system.n_q,) or result.s_dot.shape[1:] != (system.n_s,):
         raise ValueError(
             f"result: its states (q {result.q.shape[1:]}, s_dot {result.s_dot.shape[1:]}) are not "
             f"those of the system (n_q = {system.n_q}, n_s = {system.n_s})"
         )
-    rows = [row_system.accelerations_tree(q, s, t)[1]
-            for row_system, t, q, s in zip(system.row_systems(result), result.t, result.q, result.s_dot)]
-    return np.array(rows).reshape(len(result.t), system.n_c)
+    rows = [model.accelerations_tree(q, s, t)[1]
+            for model, t, q, s in zip(system.row_models(result), result.t, result.q, result.s_dot)]
+    return np.array(rows).reshape(len(result.t), system.n_lambda)
+
+
+def _check_multipliers(system, what: str) -> None:
+    """ValueError unless ``system`` is a model with constraint equations (multipliers λ)."""
+    check_model(system)
+    if not system.n_lambda:
+        raise ValueError(
+            f"system: {what} need a ConstrainedSystem (constraint equations with multipliers λ), got {system!r}, "
+            "whose constraints are in its joints (their reactions: joint_reactions)"
+        )
 
 
 
@@ -45,8 +54,9 @@ def contact_event(system, row: int, terminal: bool = True):
     """An event ``event(t, q, s_dot) = λ_row`` for :func:`projeq.simulate` that fires when the
     unilateral contact force of constraint ``row`` falls through zero (the body lifts off);
     terminal by default, so the run stops there."""
-    if not isinstance(row, (int, np.integer)) or not 0 <= row < system.n_c:
-        raise ValueError(f"row: expected a constraint row in 0..{system.n_c - 1}, got {row!r}")
+    _check_multipliers(system, "contact events")
+    if not isinstance(row, (int, np.integer)) or not 0 <= row < system.n_lambda:
+        raise ValueError(f"row: expected a constraint row in 0..{system.n_lambda - 1}, got {row!r}")
 
     def event(t, q, s_dot):
         return system.accelerations_tree(q, s_dot, t)[1][row]
@@ -65,13 +75,11 @@ def joint_reactions(system, q, s_dot, t: float = 0.0, cuts=None) -> dict:
     {name: :class:`~projeq.constraints.cut_joints.PinClosure`} of the cut joints whose closures make up
     its Φ, in the order of Φ's rows; their multipliers λ are the cut joints' forces, applied
     as the wrenches w_n, and the result also holds, under each cut's name, the wrench of the
-    cut joint on its subsystem a. For a tree System ``cuts`` is not used (w_n = 0).
+    cut joint on its subsystem a. For a tree System (no multipliers) ``cuts`` is not used (w_n = 0).
     """
-    if not hasattr(system, "accelerations_tree"):
-        q, s_dot = system.check_state(q, s_dot, t)
-        return _transmitted(system, q, s_dot, system.accelerations(q, s_dot, t), t, {})
-    tree, cuts = system.tree, _check_cuts(system, cuts)
-    q, s_dot = tree.check_q("q", q), state_vector("s_dot", s_dot, system.n_s)
+    check_model(system)
+    tree, cuts = system.tree, (_check_cuts(system, cuts) if system.n_lambda else {})
+    q, s_dot = system.check_state(q, s_dot, t)
     s_ddot_tree, lam = system.accelerations_tree(q, s_dot, t)
     s_dot_tree = system.tree_velocities(q, s_dot, t)
     kin = forward(tree, q, s_dot_tree, float(t))

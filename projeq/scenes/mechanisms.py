@@ -102,7 +102,7 @@ def _sliders(body) -> tuple[dict, dict]:
 def sphere_on_sphere(a: float = 0.1, b: float = 1.0, m: float = 1.0, g: float = 9.81,
                      theta0: float = 0.1) -> ConstrainedSystem:
     """A solid sphere (radius a, mass m) rolling without slipping on a fixed sphere of radius
-    b > a (seed 003, Problem 19), in the x–z plane with gravity −z: q = (x, z, ψ) of its
+    b > a (Lagrange seminars, Problem 19), in the x–z plane with gravity −z: q = (x, z, ψ) of its
     centre and its turn about y. Constraints: Φ = √(x² + z²) − (a + b) = 0 (contact; its
     multiplier is the normal force) and the rolling condition n_z ẋ − n_x ż − a ψ̇ = 0
     (contact point at rest, n = (x, z)/|(x, z)|). Starts at rest at angle ``theta0`` from the top.
@@ -126,7 +126,7 @@ def sphere_on_sphere(a: float = 0.1, b: float = 1.0, m: float = 1.0, g: float = 
 
 def bar_on_wall(l: float = 0.5, m: float = 1.0, g: float = 9.81, theta0: float = 0.2) -> ConstrainedSystem:
     """A uniform bar of length 2l and mass m with its upper end on a frictionless wall x = 0
-    and its lower end on a frictionless floor z = 0 (seed 003, Problem 20), in the x–z plane
+    and its lower end on a frictionless floor z = 0 (Lagrange seminars, Problem 20), in the x–z plane
     with gravity −z: q = (x, z, ψ) of its centre and its turn about y, the bar along the
     body z-axis, ψ = −θ with θ its tilt from the vertical. Constraints: Φ_wall = x + l sin ψ
     (multiplier: the wall's push along +x) and Φ_floor = z − l cos ψ. Starts at rest at tilt θ0.

@@ -1,18 +1,25 @@
 """Simulation: integrate q̇ = K(q) ṡ + k, s̈ from the Projection Equation, with solve_ivp.
 
-The state is x = (q, ṡ). The run is split into segments (``n_segments``) so that a
-failure, a non-finite state or Ctrl-C keeps everything computed up to the last finished
-segment; each segment is one ``scipy.integrate.solve_ivp`` call with the user's method,
-tolerances and events. Quaternions are normalised where the pose is evaluated and in the
-output.
+The state is x = (q, ṡ) of a model (:class:`projeq.system.Model`: a System or a
+ConstrainedSystem). The run is split into segments (``n_segments``) so that a failure, a
+non-finite state or Ctrl-C keeps everything computed up to the last finished segment;
+each segment is one ``scipy.integrate.solve_ivp`` call with the user's method, tolerances
+and events, plus the model's own events (a ConstrainedSystem's degenerating partition),
+after which the run goes on with the model's :meth:`~projeq.system.Model.after_event`.
+Quaternions are normalised where the pose is evaluated and in the output.
+
+The steps: :class:`_Run` checks the arguments and holds the run's state, ``_Run.solve``
+integrates one segment, ``_Run.after_model_event`` re-partitions, ``_Run.stopping``
+turns Ctrl-C and failures into a status, :func:`_assemble` builds the :class:`Result`
+and :func:`_failure` the :class:`SimulationError`.
 """
 
 from __future__ import annotations
 
-import json
 import time as _time
 from collections import deque
-from dataclasses import dataclass, field, fields
+from contextlib import contextmanager
+from dataclasses import dataclass, replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -22,6 +29,10 @@ from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 from projeq.assembly import EVALUATORS
 from projeq.checks import count, finite_array, positive, state_vector
 from projeq.simulation.integrators import EXPLICIT, PROJECTED, projected_solver, warn_if_stiff
+from projeq.simulation.result import Result, SimulationError
+from projeq.system import Model, check_model
+
+__all__ = ["INTEGRATORS", "Result", "SimulationError", "simulate"]
 
 
 INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # the methods of solve_ivp
@@ -37,92 +48,6 @@ def _check_method(method) -> None:
     )
 
 
-class SimulationError(RuntimeError):
-    """The integration failed; ``.result`` holds the trajectory up to ``.result.t[-1]``."""
-
-    def __init__(self, message: str, result: "Result"):
-        super().__init__(message)
-        self.result = result
-
-
-@dataclass(frozen=True)
-class Result:
-    """A simulated trajectory: one row per output time.
-
-    Attributes
-    ----------
-    t : (n,) times; q : (n, n_q) coordinates; s_dot : (n, n_s) minimal velocities
-    kinetic, potential : (n,) energies (``energy`` is their sum)
-    constraint_residual : (n, m) residuals of velocity constraints (m = 0 without any)
-    nfev : right-hand-side evaluations; wall_time : seconds
-    status : 0 finished, 1 stopped by a terminal event, -1 failed, 2 interrupted
-    message : the integrator's message; t_events : times of each event
-    names : subsystem names; sol : dense output ``sol(t) -> (q, s_dot)`` or None
-    partitions : ((t_k, independent_k), ...) of a ConstrainedSystem, one per partition used
-    (more than one if it re-pivoted): rows (and ``sol(t)``) with t_k < t ≤ t_k+1 hold the
-    tree velocities independent_k in ``s_dot`` (:mod:`projeq.constraints.partitioned`); empty for other systems
-    """
-
-    t: NDArray
-    q: NDArray
-    s_dot: NDArray
-    kinetic: NDArray
-    potential: NDArray
-    constraint_residual: NDArray
-    nfev: int = 0
-    wall_time: float = 0.0
-    status: int = 0
-    message: str = ""
-    t_events: tuple = ()
-    names: tuple = ()
-    method: str = ""
-    partitions: tuple = ()
-    sol: object = field(default=None, repr=False, compare=False)
-    system: object = field(default=None, repr=False, compare=False)  # in memory only, not saved
-
-    @property
-    def energy(self) -> NDArray:
-        """Total mechanical energy kinetic + potential along the trajectory."""
-        return self.kinetic + self.potential
-
-    @property
-    def energy_drift(self) -> float:
-        """max |E(t) − E(t₀)| relative to the largest kinetic or potential energy of the run
-        (a scale that stays meaningful when E(t₀) = 0)."""
-        if len(self.t) == 0:
-            return 0.0
-        scale = max(np.abs(self.kinetic).max(), np.abs(self.potential).max(), 1e-300)
-        return float(np.abs(self.energy - self.energy[0]).max() / scale)
-
-    @property
-    def success(self) -> bool:
-        """True when the run reached its end or a terminal event."""
-        return self.status in (0, 1)
-
-    def save(self, path) -> None:
-        """Write the arrays and metadata to an ``.npz`` file (readable by numpy alone)."""
-        arrays = {f.name: getattr(self, f.name) for f in fields(self) if isinstance(getattr(self, f.name), np.ndarray)}
-        meta = {
-            "nfev": self.nfev, "wall_time": self.wall_time, "status": self.status,
-            "message": self.message, "names": list(self.names), "method": self.method,
-            "partitions": [[t, list(independent)] for t, independent in self.partitions],
-        }
-        events = {f"t_events_{i}": np.asarray(e) for i, e in enumerate(self.t_events)}
-        np.savez(path, **arrays, **events, meta=json.dumps(meta))
-
-    @classmethod
-    def load(cls, path) -> "Result":
-        """Read a Result written by :meth:`save` (without dense output)."""
-        with np.load(path) as data:
-            meta = json.loads(str(data["meta"]))
-            n_events = sum(1 for k in data.files if k.startswith("t_events_"))
-            arrays = {k: data[k] for k in data.files if k != "meta" and not k.startswith("t_events_")}
-            t_events = tuple(data[f"t_events_{i}"] for i in range(n_events))
-        meta["names"] = tuple(meta["names"])
-        meta["partitions"] = tuple((t, tuple(independent)) for t, independent in meta.get("partitions", ()))
-        return cls(**arrays, **meta, t_events=t_events)
-
-
 def _event_wrapper(event, n_q):
     def wrapped(t, x):
         return event(t, x[:n_q], x[n_q:])
@@ -133,8 +58,10 @@ def _event_wrapper(event, n_q):
     return wrapped
 
 
+
+
 def simulate(
-    system,
+    system: Model,
     t_end: float,
     q0=None,
     s_dot0=None,
@@ -156,7 +83,8 @@ def simulate(
 
     Parameters
     ----------
-    system : System
+    system : System or ConstrainedSystem
+        The model (:class:`projeq.system.Model`).
     t_end : float
         End time (s), > t_start.
     q0, s_dot0 : arrays, optional
@@ -172,13 +100,15 @@ def simulate(
     rtol, atol : float
         Tolerances passed to the integrator.
     events : callable or list of callables ``event(t, q, s_dot)``
-        Zero crossings; ``terminal`` and ``direction`` attributes as in solve_ivp.
+        Zero crossings; ``terminal`` and ``direction`` attributes as in solve_ivp. Where
+        each fired is in ``Result.t_events`` (times), ``q_events`` and ``s_dot_events``
+        (states); a terminal event's exact state is also the Result's last row.
     t_eval : array, optional
         Output times (default ``n_points`` equally spaced).
     dense_output : bool
         Keep a continuous solution ``result.sol(t) -> (q, s_dot)``.
-    evaluator : "recursive", "dense" or an object with ``accelerations(q, s_dot, t)``
-        Right-hand side (default: recursive for trees, dense for coupled joints).
+    evaluator : "recursive", "dense", "fast" or an object with ``accelerations(q, s_dot, t)``
+        Right-hand side (default: the model's, :meth:`projeq.system.Model.evaluator`).
     progress : callable ``progress(t)``, optional
         Called after each segment with the time reached.
     **options
@@ -194,112 +124,160 @@ def simulate(
         model that cannot be evaluated at the initial state raises its own error there
         (:class:`projeq.SingularMassError`, a force law's ``ValueError``).
     """
-    q0 = system.normalized(system.check_q("q0", system.q0 if q0 is None else q0))
-    s_dot0 = state_vector("s_dot0", system.s_dot0 if s_dot0 is None else s_dot0, system.n_s)
-    t_start = float(finite_array("t_start", t_start, ()))
-    if not float(finite_array("t_end", t_end, ())) > t_start:
-        raise ValueError(f"t_end: must be after t_start = {t_start}, got {t_end}")
-    positive("rtol", rtol)
-    positive("atol", atol)
-    _check_method(method)
-    t_eval = _output_times(t_start, float(t_end), t_eval, count("n_points", n_points, 2))
-    n_segments = count("n_segments", n_segments)
-    if progress is not None and not callable(progress):
-        raise ValueError(f"progress: expected a callable progress(t), got {progress!r}")
-    events = [] if events is None else (list(events) if isinstance(events, (list, tuple)) else [events])
-    for i, e in enumerate(events):
-        if not callable(e):
-            raise ValueError(f"events[{i}]: expected a callable event(t, q, s_dot), got {e!r}")
-    ev = _evaluator(system, evaluator)
-    system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
-    ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
-    solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
-    n_q = system.n_q
-    reached = [t_start]  # time of the latest right-hand side evaluation, for error messages
+    run = _Run(system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
+               evaluator, n_segments, progress, options)
+    started, stiff_warned = _time.perf_counter(), False  # one StiffnessWarning per run at most
+    with run.stopping():
+        segments = deque(zip(run.bounds[:-1], run.bounds[1:]))  # a model event splits one
+        while segments:
+            if run.pieces and not dense_output:  # the last segment's interpolants are no longer needed
+                run.pieces[-1] = replace(run.pieces[-1], sol=SimpleNamespace(ts=run.pieces[-1].sol.ts[[0, -1]]))
+            a, b = segments.popleft()
+            segment = run.solve(a, b)
+            if run.model_event_fired(segment):  # a ConstrainedSystem's partition degenerates
+                a = run.after_model_event(segment)
+                if a < b:
+                    segments.appendleft((a, b))
+            elif segment.status != 0:
+                run.status, run.message = segment.status, segment.message
+                break
+            else:
+                stiff_warned = stiff_warned or warn_if_stiff(run.rhs, segment, method, rtol)
+                run.end_segment(segment, b)
+    result = _assemble(run, _time.perf_counter() - started, dense_output)
+    if run.status == -1:
+        raise _failure(run, result) from run.cause
+    return result
 
-    def rhs(t, x):
-        reached[0] = t
+
+@dataclass(frozen=True)
+class _Piece:
+    """What one segment gave: the model its ṡ rows are in, the output times t and states x
+    (one row (q, ṡ) per time), and its dense solution."""
+
+    model: Model
+    t: NDArray
+    x: NDArray
+    sol: OdeSolution
+
+
+class _Run:
+    """One call of :func:`simulate`: the checked arguments, the model (a ConstrainedSystem
+    changes its partition during a run), the state x = (q, ṡ) where the next segment starts,
+    and what the finished segments gave (pieces, the user's events, nfev, status)."""
+
+    def __init__(self, system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
+                 evaluator, n_segments, progress, options):
+        check_model(system)
+        q0 = system.normalized(system.check_q("q0", system.q0 if q0 is None else q0))
+        s_dot0 = state_vector("s_dot0", system.s_dot0 if s_dot0 is None else s_dot0, system.n_s)
+        self.t_start = t_start = float(finite_array("t_start", t_start, ()))
+        self.t_end = t_end = float(finite_array("t_end", t_end, ()))
+        if not t_end > t_start:
+            raise ValueError(f"t_end: must be after t_start = {t_start}, got {t_end}")
+        self.rtol, self.atol = positive("rtol", rtol), positive("atol", atol)
+        _check_method(method)
+        self.t_eval = _output_times(t_start, t_end, t_eval, count("n_points", n_points, 2))
+        self.bounds = np.linspace(t_start, t_end, count("n_segments", n_segments) + 1)
+        if progress is not None and not callable(progress):
+            raise ValueError(f"progress: expected a callable progress(t), got {progress!r}")
+        self.events = _checked_events(events)
+        self.model = self.user_model = system
+        self.choice, self.ev = evaluator, _evaluator(system, evaluator)
+        system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
+        self.ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
+        self.method, self.progress, self.options = method, progress, options
+        self.solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
+        self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
+        self.pieces, self.nfev, self.cause = [], 0, None
+        self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
+        self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
+
+    def rhs(self, t: float, x: NDArray) -> NDArray:
+        """ẋ = (q̇, s̈) of the current model."""
+        self.reached = t
+        n_q = self.model.n_q
         q, s_dot = x[:n_q], x[n_q:]
-        x_dot = np.concatenate((system.q_dot(q, s_dot, t), ev.accelerations(q, s_dot, t)))
+        x_dot = np.concatenate((self.model.q_dot(q, s_dot, t), self.ev.accelerations(q, s_dot, t)))
         if not np.all(np.isfinite(x_dot)):
             raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
         return x_dot
 
-    wrapped_events = [_event_wrapper(e, n_q) for e in events] or None
-    bounds = np.linspace(t_start, float(t_end), n_segments + 1)
-    pieces, nfev, status, message = [], 0, 0, "The solver successfully reached the end of the integration interval."
-    t_events = [[] for _ in events]
-    cause = None  # the exception that stopped the run, if any
-    stiff_warned = False  # one StiffnessWarning per run at most
-    x = np.concatenate((q0, s_dot0))
-    started = _time.perf_counter()
-    try:
-        segments = deque(zip(bounds[:-1], bounds[1:]))  # a re-partition splits one (below)
-        while segments:
-            a, b = segments.popleft()
-            inside = t_eval[(t_eval > a) & (t_eval <= b)] if pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
-            sol = solve_ivp(
-                rhs, (a, b), x, method=solver, t_eval=inside, rtol=rtol, atol=atol,
-                events=_with_partition_event(wrapped_events, system, n_q), dense_output=True, **options,
-            )
-            nfev += sol.nfev
-            sol.system = system  # the partition of a ConstrainedSystem its s_dot rows are in
-            if pieces and not dense_output:  # the previous segment's interpolants are no longer needed
-                pieces[-1].sol = SimpleNamespace(ts=pieces[-1].sol.ts[[0, -1]])
-            pieces.append(sol)
-            for collected, te in zip(t_events, sol.t_events or []):
-                collected.extend(te)
-            if sol.status == 1 and len(sol.t_events) > len(events) and len(sol.t_events[-1]):
-                # a ConstrainedSystem's partition degenerates: go on in a new one (or its ValueError)
-                x, a = sol.y_events[-1][0], sol.t_events[-1][0]
-                system, s_dot = system.repartitioned(x[:n_q], x[n_q:], a)
-                x, ev = np.concatenate((x[:n_q], s_dot)), _evaluator(system, evaluator)
-                if method in PROJECTED:  # the same energy, now in the new partition's s_dot
-                    solver = projected_solver(method, system, x[:n_q], s_dot, a)
-                if a < b:
-                    segments.appendleft((a, b))
-                continue
-            if sol.status != 0:
-                status, message = sol.status, sol.message
-                break
-            x = sol.sol(b).copy()  # the state at the segment's end, not at its last output time
-            stiff_warned = stiff_warned or warn_if_stiff(rhs, sol, method, rtol)
-            x[:n_q] = system.normalized(x[:n_q])
-            if progress is not None:
-                progress(b)
-    except KeyboardInterrupt:
-        status, message = 2, "interrupted (Ctrl-C): the trajectory up to the last finished segment is kept"
-    except (FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
-        status, message, cause = -1, str(exc), exc
-    except Exception as exc:  # noqa: BLE001 - a user's force law or event failed: keep the trajectory
-        status, message, cause = -1, f"{type(exc).__name__}: {exc}", exc
-    result = _assemble(system, pieces, nfev, status, message, t_events, _time.perf_counter() - started, method, dense_output)
-    if status == -1:
-        kept = result.t[-1] if len(result.t) else t_start
-        hint = ""
-        if method in EXPLICIT and "step size" in message:
-            hint = (
-                "; the solution may blow up here, or the system is stiff for an explicit method "
-                "(a very stiff beam): then try method='Radau' or 'BDF'"
-            )
-        raise SimulationError(
-            f"integration failed at t = {reached[0]:.6g} s (t_end = {t_end}): {message}{hint}; "
-            f"the trajectory up to t = {kept:.6g} s is in .result",
-            result,
-        ) from cause
-    return result
+    def solve(self, a: float, b: float):
+        """One segment from the current state at a to b (solve_ivp's result), with the user's
+        events and, last, the model's own; its output rows are kept as a :class:`_Piece`."""
+        t_eval = self.t_eval
+        inside = t_eval[(t_eval > a) & (t_eval <= b)] if self.pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
+        n_q = self.model.n_q
+        events = [_event_wrapper(e, n_q) for e in self.events + list(self.model.events())]
+        segment = solve_ivp(self.rhs, (a, b), self.x, method=self.solver, t_eval=inside, rtol=self.rtol,
+                            atol=self.atol, events=events or None, dense_output=True, **self.options)
+        self.nfev += segment.nfev
+        self._keep(segment)
+        return segment
+
+    def _keep(self, segment) -> None:
+        """The segment's rows, ended by the state where a terminal event of the user's
+        stopped it, and where the user's events fired."""
+        n_q, n_x = self.model.n_q, self.model.n_q + self.model.n_s
+        t, x = segment.t, np.reshape(segment.y, (n_x, len(segment.t))).T  # no output times: y = []
+        for (times, q, s_dot), te, ye in zip(self.fired, segment.t_events or [], segment.y_events or []):
+            times.extend(te)
+            q.extend(self.model.normalized(y[:n_q]) for y in ye)
+            s_dot.extend(y[n_q:] for y in ye)
+        if segment.status == 1 and not self.model_event_fired(segment):
+            t_stop = segment.sol.ts[-1]  # the terminal event, where the dense solution ends
+            if not len(t) or t_stop > t[-1]:
+                t, x = np.append(t, t_stop), np.vstack((x, segment.sol(t_stop)))
+        self.pieces.append(_Piece(self.model, t, x, segment.sol))
+
+    def model_event_fired(self, segment) -> bool:
+        """Whether one of the model's own (terminal) events stopped the segment."""
+        return segment.status == 1 and any(len(te) for te in segment.t_events[len(self.events):])
+
+    def after_model_event(self, segment) -> float:
+        """Go on from the model's event with :meth:`Model.after_event` (a ConstrainedSystem's
+        new partition, or its ValueError); the time to go on from."""
+        k = next(i for i, te in enumerate(segment.t_events) if i >= len(self.events) and len(te))
+        t, x = segment.t_events[k][0], segment.y_events[k][0]
+        n_q = self.model.n_q
+        self.model, s_dot = self.model.after_event(x[:n_q], x[n_q:], t)
+        self.x, self.ev = np.concatenate((x[:n_q], s_dot)), _evaluator(self.model, self.choice)
+        if self.method in PROJECTED:  # the same energy, now in the new partition's s_dot
+            self.solver = projected_solver(self.method, self.model, x[:n_q], s_dot, t)
+        return t
+
+    def end_segment(self, segment, b: float) -> None:
+        """The next segment starts at b, from the state there (not at the last output time)."""
+        self.x = segment.sol(b).copy()
+        n_q = self.model.n_q
+        self.x[:n_q] = self.model.normalized(self.x[:n_q])
+        if self.progress is not None:
+            self.progress(b)
+
+    @contextmanager
+    def stopping(self):
+        """Ctrl-C or a failure ends the run with a status; the finished segments are kept."""
+        try:
+            yield
+        except KeyboardInterrupt:
+            self.status, self.message = 2, "interrupted (Ctrl-C): the trajectory up to the last finished segment is kept"
+        except (FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
+            self.status, self.message, self.cause = -1, str(exc), exc
+        except Exception as exc:  # noqa: BLE001 - a user's force law or event failed: keep the trajectory
+            self.status, self.message, self.cause = -1, f"{type(exc).__name__}: {exc}", exc
 
 
-def _with_partition_event(wrapped_events, system, n_q):
-    """The user's events plus, last, a ConstrainedSystem's partition event (κ reaches its limit)."""
-    partition_event = getattr(system, "partition_event", lambda: None)()
-    if partition_event is None:
-        return wrapped_events
-    return (wrapped_events or []) + [_event_wrapper(partition_event, n_q)]
+def _checked_events(events) -> list:
+    events = [] if events is None else (list(events) if isinstance(events, (list, tuple)) else [events])
+    for i, e in enumerate(events):
+        if not callable(e):
+            raise ValueError(f"events[{i}]: expected a callable event(t, q, s_dot), got {e!r}")
+    return events
 
 
 def _evaluator(system, evaluator):
-    """The right-hand side's evaluator: a user object, or the system's cached one by name."""
+    """The right-hand side's evaluator: a user object, or the system's by name."""
     if hasattr(evaluator, "accelerations"):
         return evaluator
     if evaluator is None or (isinstance(evaluator, str) and evaluator in EVALUATORS):
@@ -319,34 +297,50 @@ def _output_times(t_start, t_end, t_eval, n_points) -> NDArray:
     return t_eval
 
 
-def _assemble(system, pieces, nfev, status, message, t_events, wall_time, method, dense_output) -> Result:
-    """One Result from the segments' solutions: normalised q, energies along the path."""
-    n_q = system.n_q
-    if pieces:
-        t = np.concatenate([p.t for p in pieces])
-        n_x = n_q + system.n_s  # a segment without output times has y = []
-        x = np.concatenate([np.reshape(p.y, (n_x, len(p.t))) for p in pieces], axis=1).T
-    else:
-        t, x = np.zeros(0), np.zeros((0, n_q + system.n_s))
-    q = np.array([system.normalized(row) for row in x[:, :n_q]]).reshape(len(t), n_q)
+def _assemble(run: _Run, wall_time: float, dense_output: bool) -> Result:
+    """One Result from the pieces: normalised q, and the energies and constraint residuals
+    of each row in its own piece's model (its partition)."""
+    system, pieces = run.user_model, run.pieces
+    n_q, n_s = system.n_q, system.n_s
+    rows = [(p.model, ti) for p in pieces for ti in p.t]
+    t = np.array([ti for _, ti in rows])
+    x = np.vstack([p.x for p in pieces] + [np.zeros((0, n_q + n_s))])
+    q = np.array([s.normalized(xi[:n_q]) for (s, _), xi in zip(rows, x)]).reshape(len(t), n_q)
     s_dot = x[:, n_q:]
-    rows = [(p.system, ti) for p in pieces for ti in p.t]  # each row in its piece's partition
     energies = np.array([s.energy(qi, si, ti) for (s, ti), qi, si in zip(rows, q, s_dot)]).reshape(len(t), 2)
     residual = np.array(
         [s.constraint_residual(qi, s.q_dot(qi, si, ti), ti) for (s, ti), qi, si in zip(rows, q, s_dot)]
     ).reshape(len(t), system.n_c)
     partitions = tuple(
-        (float(p.sol.ts[0]), tuple(p.system.independent.tolist())) for i, p in enumerate(pieces)
-        if hasattr(p.system, "independent") and (i == 0 or p.system is not pieces[i - 1].system)
+        (float(p.sol.ts[0]), p.model.partition) for i, p in enumerate(pieces)
+        if p.model.partition is not None and (i == 0 or p.model is not pieces[i - 1].model)
     )
-    system = pieces[0].system if pieces else system  # the user's, before any re-partition
-    sol = _dense_solution(pieces, n_q) if dense_output and pieces else None
+    t_events, q_events, s_dot_events = (
+        tuple(np.array(fired[k]).reshape((len(fired[k]),) + shape) for fired in run.fired)
+        for k, shape in enumerate(((), (n_q,), (n_s,)))
+    )
     return Result(
         t=t, q=q, s_dot=s_dot, kinetic=energies[:, 0], potential=energies[:, 1],
-        constraint_residual=residual, nfev=int(nfev), wall_time=wall_time,
-        status=int(status), message=str(message), t_events=tuple(np.array(e) for e in t_events),
-        names=system.names, method=getattr(method, "__name__", str(method)), partitions=partitions,
-        sol=sol, system=system,
+        constraint_residual=residual, nfev=int(run.nfev), wall_time=wall_time,
+        status=int(run.status), message=str(run.message), t_events=t_events, q_events=q_events,
+        s_dot_events=s_dot_events, names=system.names, method=getattr(run.method, "__name__", str(run.method)),
+        partitions=partitions, sol=_dense_solution(pieces, n_q) if dense_output and pieces else None, system=system,
+    )
+
+
+def _failure(run: _Run, result: Result) -> SimulationError:
+    """The error of a failed run, with the time reached and a hint for explicit methods."""
+    kept = result.t[-1] if len(result.t) else run.t_start
+    hint = ""
+    if run.method in EXPLICIT and "step size" in run.message:
+        hint = (
+            "; the solution may blow up here, or the system is stiff for an explicit method "
+            "(a very stiff beam): then try method='Radau' or 'BDF'"
+        )
+    return SimulationError(
+        f"integration failed at t = {run.reached:.6g} s (t_end = {run.t_end}): {run.message}{hint}; "
+        f"the trajectory up to t = {kept:.6g} s is in .result",
+        result,
     )
 
 

@@ -43,12 +43,9 @@ def written_atomically(path):
 
 
 def _draw(system, q, s_dot, t, stations: int, frame_size: float):
-    """Points, velocities (inertial) and line cells of the system at one state.
-
-    A constrained system (one with a ``tree``) is drawn as its tree moving with the tree
-    velocities F ṡ."""
-    if hasattr(system, "tree"):
-        system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
+    """Points, velocities (inertial) and line cells of the model at one state: its tree
+    moving with the tree velocities (a ConstrainedSystem's F ṡ + f, a System's ṡ)."""
+    system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
     kin = forward(system, q, s_dot, t, chain_terms=False)
     points, velocities, lines = [], [], []
     for n, sub in enumerate(system.subsystems):
@@ -73,14 +70,14 @@ def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21
     Needs ``result.system`` (a Result returned by :func:`projeq.simulate`). Returns the
     path of the ``.pvd`` file, which ParaView opens as a time series.
     """
-    system = getattr(result, "system", None)
+    system = result.system
     if system is None:
         raise ValueError("result: has no system (loaded from a file?); export a Result from simulate()")
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     entries, reference = [], None
-    for k, (t, q, s_dot) in enumerate(zip(result.t, result.q, result.s_dot)):
-        points, velocity, lines = _draw(system, q, s_dot, t, stations, frame_size)
+    for k, (model, t, q, s_dot) in enumerate(zip(system.row_models(result), result.t, result.q, result.s_dot)):
+        points, velocity, lines = _draw(model, q, s_dot, t, stations, frame_size)
         reference = points if reference is None else reference
         path = directory / f"{name}_{k:04d}.vtu"
         mesh = meshio.Mesh(points, [("line", lines)], point_data={"displacement": points - reference, "velocity": velocity})

@@ -44,6 +44,7 @@ import numpy as np
 
 from projeq.scenes import Scene, check_names, get_scene
 from projeq.simulation.export import written_atomically
+from projeq.studies.table import Table, csv_cells, csv_line
 
 #: Outputs every sweep can ask for by name: a function of the Result.
 BUILTIN_OUTPUTS = {
@@ -127,21 +128,18 @@ class SweepTable(dict):
     ``error`` (the message of a failed point, else ""), one row per point in input order."""
 
     def save(self, path) -> list[Path]:
-        """Write ``path.csv`` and ``path.npz`` (path without suffix), each under a temporary
-        name renamed when complete (the directory is created if it is missing, e.g. deleted
-        during the sweep); returns both paths."""
+        """Write ``path.csv`` (:class:`~projeq.studies.table.Table`, the error message last) and
+        ``path.npz`` (path without suffix), each under a temporary name renamed when complete
+        (the directory is created if it is missing, e.g. deleted during the sweep); returns
+        both paths."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         csv_path, npz = path.with_suffix(".csv"), path.with_suffix(".npz")
         with written_atomically(csv_path) as temporary:
-            temporary.write_text(_csv_line(self) + "".join(_csv_line(row) for row in self.rows()))
+            Table.from_columns({k: self[k] for k in self if k != "error"} | {"error": self["error"]}).to_csv(temporary)
         with written_atomically(npz) as temporary:
             np.savez(temporary, **{k: np.asarray(v, dtype=object if k in ("error",) else None) for k, v in self.items()})
         return [csv_path, npz]
-
-    def rows(self) -> list[list]:
-        """The table as rows of cells in column order."""
-        return [list(row) for row in zip(*self.values())]
 
     @classmethod
     def load(cls, path) -> "SweepTable":
@@ -163,26 +161,6 @@ class SweepTable(dict):
                 # tuples stay objects: the None keeps numpy from making them a 2-d array
                 table[name] = np.array(values) if scalar else np.array(values + [None], dtype=object)[:-1]
         return table
-
-
-def _cell(value) -> str:
-    """A CSV cell: floats as their round-trip repr, integers and tuples exactly, text on one line."""
-    if isinstance(value, (bool, np.bool_)):
-        return str(bool(value))
-    if isinstance(value, (float, np.floating)):
-        return repr(float(value))
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    if isinstance(value, tuple):
-        return repr(tuple(v.item() if isinstance(v, np.generic) else v for v in value))
-    return " ".join(str(value).splitlines())
-
-
-def _csv_line(cells) -> str:
-    """One CSV line (``\\n``-terminated) of cells; text with a comma or a quote is quoted."""
-    stream = io.StringIO()
-    csv.writer(stream, lineterminator="\n").writerow([_cell(c) for c in cells])
-    return stream.getvalue()
 
 
 def _value(text: str):
@@ -225,13 +203,13 @@ class _Log:
     def __init__(self, path: Path, header: list, kept_rows: list):
         path.parent.mkdir(parents=True, exist_ok=True)
         with written_atomically(path) as temporary:
-            temporary.write_text(_csv_line(header) + "".join(_csv_line(row) for row in kept_rows))
+            temporary.write_text(csv_line(header) + "".join(csv_line(row) for row in kept_rows))
         self.path, self.fd = path, os.open(path, os.O_WRONLY | os.O_APPEND)
 
     def append(self, row) -> None:
         if self.fd is None:
             return
-        line, size = _csv_line(row).encode(), os.fstat(self.fd).st_size
+        line, size = csv_line(row).encode(), os.fstat(self.fd).st_size
         try:
             while line:
                 line = line[os.write(self.fd, line):]
@@ -547,7 +525,7 @@ def _resumed(path: Path, header: list, points: list, rows: list) -> None:
             finished[key] = []
         if line[-2] in ("0", "1"):
             finished[key].append((int(line[-2]), [float(c) for c in line[n_parameters:n_parameters + n_outputs]], ""))
-    keys = [tuple(_cell(v) for v in p.values()) for p in points]
+    keys = [tuple(csv_cells(p.values())) for p in points]
     foreign = set(finished) - set(keys)
     if foreign:
         raise ValueError(f"resume: {str(path)!r} holds points not in this sweep (e.g. "

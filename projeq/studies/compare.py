@@ -18,9 +18,8 @@ Systems") beside the measured numbers, agreeing or not.
 
 from __future__ import annotations
 
-import csv
 import textwrap
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
@@ -28,6 +27,7 @@ import sympy as sp
 
 from projeq.studies.effort import (DERIVATION_REPEATS, EFFORT, as_symbols, cse_ops, derivation_repeats,
                                    derivation_timed, timed)
+from projeq.studies.table import Table
 
 COLUMNS = ("formulation", "derivation_s", "n_ops", "identical", "check", "difference", "why", "integration_s",
            "energy_drift", "constraint_drift", "derivation", "note")
@@ -52,12 +52,12 @@ class ComparisonTable:
         """Plain text at most ``TEXT_WIDTH`` columns wide: the table of numbers (3 significant
         digits), then per row its check, difference (abbreviated), why and note, the derivations
         from B(2), the effort procedure and the claims."""
-        columns = list(TEXT_COLUMNS)
-        cells = [list(TEXT_COLUMNS.values())] + [[_cell(row.get(c)) for c in columns] for row in self.rows]
-        widths = [max(len(r[i]) for r in cells) for i in range(len(columns))]
-        widths[0] = min(widths[0], TEXT_WIDTH - sum(widths[1:]) - 2 * (len(columns) - 1))
-        lines = ["  ".join(_fit(c, w).ljust(w) for c, w in zip(r, widths)).rstrip() for r in cells]
-        lines.insert(1, "  ".join("-" * w for w in widths))
+        grid = Table(tuple(TEXT_COLUMNS.values()), [[row.get(c) for c in TEXT_COLUMNS] for row in self.rows])
+        width = max(len(line) for line in grid.to_text().splitlines())
+        if width > TEXT_WIDTH:  # shorten the formulation names, the one column of free text
+            fitted = max(len("formulation"), max(len(row["formulation"]) for row in self.rows) - (width - TEXT_WIDTH))
+            grid = replace(grid, rows=[(_fit(row[0], fitted), *row[1:]) for row in grid.rows])
+        lines = grid.to_text().splitlines()
         for row in self.rows:
             details = _details(row)
             if details:
@@ -74,23 +74,10 @@ class ComparisonTable:
 
     def to_csv(self, path) -> None:
         """Write the rows to ``path`` as CSV with a header line (``difference`` in full)."""
-        with open(path, "w", newline="") as handle:
-            writer = csv.DictWriter(handle, fieldnames=COLUMNS)
-            writer.writeheader()
-            writer.writerows({c: _csv_cell(row.get(c)) for c in COLUMNS} for row in self.rows)
+        Table(COLUMNS, [[_csv_cell(row.get(c)) for c in COLUMNS] for row in self.rows]).to_csv(path)
 
 
-def _cell(value) -> str:
-    if value is None:
-        return "—"
-    if isinstance(value, float):
-        return f"{value:.3g}"
-    return str(value)
-
-
-def _csv_cell(value) -> str:
-    if value is None:
-        return ""
+def _csv_cell(value):
     return _difference_text(value) if isinstance(value, tuple) else value
 
 

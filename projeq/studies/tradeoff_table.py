@@ -7,10 +7,11 @@ setting), as returned by :func:`projeq.studies.tradeoff.tradeoff`.
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
+
+from projeq.studies.table import Table
 
 ERROR_LEVELS = (1e-2, 1e-4, 1e-6, 1e-8)
 COLUMNS = ("scene", "method", "rtol", "atol", "knob", "error", "cpu", "setup_cpu", "n_evaluations",
@@ -35,18 +36,12 @@ def columns(rows) -> dict:
 
 def save_csv(table: dict, path) -> Path:
     """Write the columns :data:`COLUMNS` of ``table`` as CSV (a header row, then one row per setting)."""
-    path = Path(path)
-    with path.open("w", newline="") as stream:
-        writer = csv.writer(stream)
-        writer.writerow(COLUMNS)
-        writer.writerows(zip(*(table[name].tolist() for name in COLUMNS)))
-    return path
+    return Table.from_columns({name: table[name].tolist() for name in COLUMNS}).to_csv(path)
 
 
 def read_csv(path) -> dict:
     """The table written by :func:`save_csv` (columns of :data:`COLUMNS`)."""
-    with Path(path).open(newline="") as stream:
-        rows = list(csv.DictReader(stream))
+    rows = Table.read_csv(path)
     return columns([{name: _kind(name)(row[name]) for name in COLUMNS} for row in rows])
 
 
@@ -81,11 +76,13 @@ def _setting(table: dict, i: int) -> str:
 
 def format_table(table: dict, levels=ERROR_LEVELS) -> str:
     """The table as text, followed by the cheapest setting for each error level."""
-    lines = [f"{'knob':26s} {'method':16s} {'rtol':>7s} {'error':>9s} {'cpu (s)':>9s} {'evals':>8s}  failure / warning"]
-    for i in range(len(table["method"])):
-        note = table["failure"][i] or table["warning"][i]
-        lines.append(f"{table['knob'][i]:26s} {table['method'][i]:16s} {table['rtol'][i]:7.0e} {table['error'][i]:9.2e} "
-                     f"{table['cpu'][i]:9.3g} {table['n_evaluations'][i]:8d}  {note}")
+    notes = [failure or warning for failure, warning in zip(table["failure"], table["warning"])]
+    text = Table.from_columns(
+        {"knob": table["knob"], "method": table["method"], "rtol": table["rtol"], "error": table["error"],
+         "cpu": table["cpu"], "evals": table["n_evaluations"], "failure / warning": notes},
+        units={"cpu": "s"}, formats={"rtol": ".0e", "error": ".2e"},
+    )
+    lines = [text.to_text()]
     if "measure" in table:
         lines.append(f"error = {table['measure']}")
     for level, i in cheapest(table, levels).items():

@@ -270,3 +270,9 @@ def test_progress_bar_on_a_terminal_unless_quiet(quiet, tmp_path, monkeypatch):
     argv = ["run", "atwood", "--t-end", "0.2", "--out", str(tmp_path)] + (["--quiet"] if quiet else [])
     assert main(argv) == 0
     assert ("100%|" in terminal.getvalue() and "t = 0.2/0.2 s" in terminal.getvalue()) is not quiet
+
+
+def test_version(capsys):
+    """``projeq --version`` prints the one version source, ``projeq.__version__``, and exits 0."""
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"projeq {pq.__version__}"

@@ -181,20 +181,20 @@ def _full_disk(*args, **kwargs):
 def test_a_run_whose_files_cannot_be_completed_leaves_none_under_a_final_name(tmp_path, monkeypatch, capsys):
     """The disk fills while chain.npz is written (half a file, then ENOSPC), or the final
     rename fails: exit 1 with the reason, no file under its final name, no temporary left."""
-    real_save = pq.Result.save
+    real_savez = np.savez
 
-    def half_then_full(result, path):
-        real_save(result, path)
+    def half_then_full(path, *args, **kwargs):
+        real_savez(path, *args, **kwargs)
         with open(path, "r+b") as stream:
             stream.truncate(os.path.getsize(path) // 2)
         _full_disk()
 
-    monkeypatch.setattr(pq.Result, "save", half_then_full)
+    monkeypatch.setattr(np, "savez", half_then_full)
     assert main(["run", "chain", "--set", "n=1", "--t-end", "0.1", "--out", str(tmp_path), "--quiet"]) == 1
     assert "No space left on device" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
 
-    monkeypatch.setattr(pq.Result, "save", real_save)
+    monkeypatch.setattr(np, "savez", real_savez)
     monkeypatch.setattr(os, "replace", _full_disk)
     assert main(["run", "chain", "--set", "n=1", "--t-end", "0.1", "--out", str(tmp_path), "--quiet"]) == 1
     assert list(tmp_path.iterdir()) == []

@@ -133,15 +133,18 @@ def test_a_closed_dask_client_is_refused_before_any_work():
 
 
 def test_points_are_appended_as_they_finish_and_resume_runs_only_the_rest(tmp_path, monkeypatch):
-    """With path, each finished point is in path.csv before the sweep returns (checked as the
-    third point starts); the final CSV (input order) and NPZ agree. resume=True on a table
+    """With path, each finished point is in path.csv before the sweep returns (checked while
+    the third point runs); the final CSV (input order) and NPZ agree. resume=True on a table
     missing one point and holding a failed one runs exactly those two and keeps the others
     bit for bit."""
     seen = []
     real_run_point = sweep_module.run_point
 
     def watching(scene, parameters, *args):
-        if parameters["n"] == 3:  # the two before it have finished (one thread)
+        if parameters["n"] == 3:  # the two before it have finished (one thread): the main thread appends them
+            deadline = time.monotonic() + 5.0
+            while len(sweep_module.SweepTable.load(tmp_path / "chains")["n"]) < 2 and time.monotonic() < deadline:
+                time.sleep(0.01)
             seen.append(sweep_module.SweepTable.load(tmp_path / "chains")["n"].tolist())
         return real_run_point(scene, parameters, *args)
 

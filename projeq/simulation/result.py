@@ -1,0 +1,121 @@
+"""The outcome of :func:`projeq.simulate`: a :class:`Result` (one row per output time), or a
+:class:`SimulationError` that carries the Result computed up to the failure."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+_EVENT_ARRAYS = ("t_events", "q_events", "s_dot_events")  # tuples of arrays, one per event
+
+
+class SimulationError(RuntimeError):
+    """The integration failed; ``.result`` holds the trajectory up to ``.result.t[-1]``."""
+
+    def __init__(self, message: str, result: "Result"):
+        super().__init__(message)
+        self.result = result
+
+
+@dataclass(frozen=True)
+class Result:
+    """A simulated trajectory: one row per output time.
+
+    Attributes
+    ----------
+    t : (n,) times; q : (n, n_q) coordinates; s_dot : (n, n_s) minimal velocities
+    kinetic, potential : (n,) energies (``energy`` is their sum)
+    constraint_residual : (n, m) residuals of velocity constraints (m = 0 without any)
+    nfev : right-hand-side evaluations; wall_time : seconds
+    status : 0 finished, 1 stopped by a terminal event, -1 failed, 2 interrupted
+    message : the integrator's message
+    t_events, q_events, s_dot_events : for each of the user's events, the times where it
+    fired and the states (k, n_q) and (k, n_s) there. A terminal event's state is also the
+    last row: the output ends at the event, not at the last output time before it.
+    names : subsystem names; sol : dense output ``sol(t) -> (q, s_dot)`` or None
+    partitions : ((t_k, independent_k), ...) of a ConstrainedSystem, one per partition used
+    (more than one if it re-pivoted): rows (and ``sol(t)``) with t_k < t ≤ t_k+1 hold the
+    tree velocities independent_k in ``s_dot`` (:mod:`projeq.constraints.partitioned`); empty for other systems
+    """
+
+    t: NDArray
+    q: NDArray
+    s_dot: NDArray
+    kinetic: NDArray
+    potential: NDArray
+    constraint_residual: NDArray
+    nfev: int = 0
+    wall_time: float = 0.0
+    status: int = 0
+    message: str = ""
+    t_events: tuple = ()
+    q_events: tuple = ()
+    s_dot_events: tuple = ()
+    names: tuple = ()
+    method: str = ""
+    partitions: tuple = ()
+    sol: object = field(default=None, repr=False, compare=False)
+    system: object = field(default=None, repr=False, compare=False)  # in memory only, not saved
+
+    @property
+    def energy(self) -> NDArray:
+        """Total mechanical energy kinetic + potential along the trajectory."""
+        return self.kinetic + self.potential
+
+    @property
+    def energy_drift(self) -> float:
+        """max |E(t) − E(t₀)| relative to the largest kinetic or potential energy of the run
+        (a scale that stays meaningful when E(t₀) = 0)."""
+        if len(self.t) == 0:
+            return 0.0
+        scale = max(np.abs(self.kinetic).max(), np.abs(self.potential).max(), 1e-300)
+        return float(np.abs(self.energy - self.energy[0]).max() / scale)
+
+    @property
+    def success(self) -> bool:
+        """True when the run reached its end or a terminal event."""
+        return self.status in (0, 1)
+
+    def save(self, path) -> None:
+        """Write the arrays and metadata to an ``.npz`` file (readable by numpy alone; ``.npz``
+        is appended to a name without it, as numpy does), under a temporary name renamed when
+        complete: a full disk or a killed process never leaves a truncated file."""
+        arrays = {f.name: getattr(self, f.name) for f in fields(self) if isinstance(getattr(self, f.name), np.ndarray)}
+        meta = {
+            "nfev": self.nfev, "wall_time": self.wall_time, "status": self.status,
+            "message": self.message, "names": list(self.names), "method": self.method,
+            "partitions": [[t, list(independent)] for t, independent in self.partitions],
+        }
+        events = {f"{name}_{i}": np.asarray(e) for name in _EVENT_ARRAYS for i, e in enumerate(getattr(self, name))}
+        if hasattr(path, "write"):  # an open file
+            np.savez(path, **arrays, **events, meta=json.dumps(meta))
+            return
+        from projeq.simulation.export import written_atomically
+
+        path = Path(path)
+        with written_atomically(path if path.suffix == ".npz" else path.with_name(path.name + ".npz")) as temporary:
+            np.savez(temporary, **arrays, **events, meta=json.dumps(meta))
+
+    @classmethod
+    def load(cls, path) -> "Result":
+        """Read a Result written by :meth:`save` (without dense output)."""
+        with np.load(path) as data:
+            meta = json.loads(str(data["meta"]))
+            events = {name: _numbered(data, name) for name in _EVENT_ARRAYS}
+            arrays = {k: data[k] for k in data.files if k != "meta" and not k.startswith(_EVENT_ARRAYS)}
+        meta["names"] = tuple(meta["names"])
+        meta["partitions"] = tuple((t, tuple(independent)) for t, independent in meta.get("partitions", ()))
+        return cls(**arrays, **meta, **events)
+
+
+def _numbered(data, name: str) -> tuple:
+    """(data[name_0], data[name_1], ...) as far as they exist in the file."""
+    arrays, i = [], 0
+    while f"{name}_{i}" in data.files:
+        arrays.append(data[f"{name}_{i}"])
+        i += 1
+    return tuple(arrays)
