@@ -12,9 +12,10 @@ Nothing is lost under faults:
   points in flight; at the end ``path.csv`` (in input order) and ``path.npz`` are written
   under temporary names and renamed (:func:`projeq.simulation.export.written_atomically`).
   ``resume=True`` keeps the finished points of an earlier ``path.csv`` and runs the rest;
-- a worker process that dies (killed, or by the out-of-memory killer) fails only the points
-  it was running, with the reason; the pool is replaced and the sweep goes on (the default
-  pool holds one point per worker, so a death costs at most that many points);
+- the default pool holds one point per worker. A worker process that dies (killed, or by
+  the out-of-memory killer) breaks it: a new pool runs the points that were in flight again,
+  one at a time, so only a point that kills its worker again is marked failed, with the
+  reason, and the sweep goes on;
 - Ctrl-C on a terminal reaches the whole process group: the pool's workers are started with
   :func:`interruptible_worker`, so a point being simulated stops and returns what it has
   (``status`` 2, outputs at the time reached, see :func:`projeq.simulate`) while idle workers
