@@ -6,7 +6,7 @@ recursively in order n. See docs/theory.md and docs/architecture.md.
 
 from projeq.subsystems import inertia
 from projeq.assembly import SingularMassError
-from projeq.forces import Force, JointForce, JointSpring, SpringDamper, Torque
+from projeq.forces import Force, ForceLaw, JointForce, JointSpring, SpringDamper, Torque
 from projeq.analysis.linearize import Linearization, NotSteadyError, eigenvalue_sweep, linearize
 from projeq.joints import Fixed, Free, Joint, Planar, Prescribed, Prismatic, Revolute, UserJoint
 from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, RitzBeam, Subsystem
@@ -17,7 +17,7 @@ __version__ = "0.1.0"
 __all__ = [
     "GROUND", "System", "SystemBuilder", "Subsystem", "RigidBody", "PlanarBody", "PointMass", "Frame", "RitzBeam",
     "Joint", "Revolute", "Prismatic", "Fixed", "Planar", "Free", "Prescribed", "UserJoint",
-    "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
+    "ForceLaw", "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
     "inertia", "simulate", "Result", "SimulationError", "scenes", "linearize", "Linearization", "NotSteadyError",
     "eigenvalue_sweep", "compare", "ComparisonTable", "ConstrainedSystem", "reactions", "joint_reactions", "PinClosure",
     "contact_event", "StiffnessWarning", "plots", "sweep", "SweepTable", "symbolic",

@@ -9,6 +9,11 @@ with F_nᵀ w = τ (w = F_n (F_nᵀF_n)⁻¹ τ), whose projection Σ J_nᵀ h_n
 (B(14)); so the assemblers never special-case joint forces.
 
 Callables receive ``(t, q, s_dot)`` and return the load.
+
+Each law states its symbolic form next to its numeric one (:class:`ForceLaw`):
+``symbolic_wrenches`` (body wrenches) or ``symbolic_joint_forces`` (τ on minimal
+velocities), which :func:`projeq.symbolic.gauss_form` adds; a law that has none says why
+in ``symbolic_unsupported`` (a load given as a callable has values, not expressions).
 """
 
 from __future__ import annotations
@@ -16,9 +21,11 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
+import sympy as sp
 from numpy.typing import NDArray
 
 from projeq.checks import finite_array, non_negative
+from projeq.symbolic import algebra
 from projeq.spatial import cross
 
 
@@ -27,14 +34,23 @@ def _load(name: str, value, shape: tuple) -> Callable:
     if callable(value):
         def load(t, q, s_dot):
             return finite_array(name, value(t, q, s_dot), shape)
+        load.constant = None
         return load
     constant = finite_array(name, value, shape)
 
     def load(t, q, s_dot):
         return constant
 
-    load.constant = constant  # what the symbolic side (projeq.symbolic.loads) reads
+    load.constant = constant  # the value, for the symbolic forms
     return load
+
+
+def _callable(parameter: str, load: Callable) -> str | None:
+    """Why a law with this load has no symbolic form (None for a constant load)."""
+    if load.constant is None:
+        return (f"has a callable {parameter}, which is not supported symbolically; give a constant or use "
+                "projection_equation")
+    return None
 
 
 def _index(system, name, parameter: str) -> int:
@@ -50,7 +66,53 @@ def _frame(frame: str) -> str:
     return frame
 
 
-class _BodyLoad:
+class ForceLaw:
+    """The force-law contract: bound to a System by names (:meth:`bind`, which returns the
+    law), it adds its loads to the subsystems' h_n at each evaluation (:meth:`add_to`) and
+    reports its potential energy (:meth:`potential`).
+
+    Its symbolic form: :meth:`symbolic_wrenches` and :meth:`symbolic_joint_forces`, and
+    :meth:`symbolic_unsupported` (None when it has one). A subclass that restates
+    ``add_to``, ``wrench`` or ``generalized_force`` loses the symbolic form it inherits
+    unless it restates it too, so an override is never bypassed.
+    """
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if any(member in vars(cls) for member in ("add_to", "wrench", "generalized_force")):
+            for twin in ("symbolic_unsupported", "symbolic_wrenches", "symbolic_joint_forces"):
+                if twin not in vars(cls):  # the inherited twin states another law
+                    setattr(cls, twin, getattr(ForceLaw, twin))
+
+    def bind(self, system) -> "ForceLaw":
+        """Resolve the names the law was given in ``system`` (indices, selections) and return
+        the law; the System binds a copy when it is built."""
+        raise NotImplementedError
+
+    def add_to(self, h, kin, t, q, s_dot) -> None:
+        """Add the law's wrenches to the list h of h_n at the kinematic state ``kin``."""
+        raise NotImplementedError
+
+    def potential(self, kin, q) -> float:
+        """Potential energy of the law at the kinematic state ``kin`` (0 for a law without one)."""
+        return 0.0
+
+    def symbolic_unsupported(self) -> str | None:
+        """Why the law has no symbolic form (completing "forces[i] (Law) ..."), else None."""
+        return "is not supported symbolically"
+
+    def symbolic_wrenches(self, links) -> dict:
+        """{n: wrench (f; M_O) in body n's coordinates, sympy} given the symbolic chain's
+        ``links`` (pose ``R``, ``r`` and ``twist`` of each subsystem)."""
+        return {}
+
+    def symbolic_joint_forces(self, q_joint, s_joint) -> dict:
+        """{n: τ on joint n's minimal velocities, sympy}; ``q_joint[n]``, ``s_joint[n]`` are
+        the joint's coordinates and velocities (symbols or the coupling's combinations)."""
+        return {}
+
+
+class _BodyLoad(ForceLaw):
     """A wrench on one body, given as a force at a point and/or a torque."""
 
     def __init__(self, body: str, frame: str):
@@ -66,9 +128,6 @@ class _BodyLoad:
         n = self.index
         wrench = self.wrench(kin.R[n], t, q, s_dot)
         h[n] += wrench if self.S is None else self.S @ wrench
-
-    def potential(self, kin, q) -> float:
-        return 0.0
 
 
 class Force(_BodyLoad):
@@ -88,6 +147,14 @@ class Force(_BodyLoad):
         f = R.T @ f if self.frame == "world" else f
         return np.concatenate((f, cross(self.point, f)))
 
+    def symbolic_unsupported(self) -> str | None:
+        return _callable("force", self.force)
+
+    def symbolic_wrenches(self, links) -> dict:
+        f = algebra.exact(self.force.constant)
+        f = algebra.mul(links[self.index].R.T, f) if self.frame == "world" else f
+        return {self.index: sp.Matrix.vstack(f, algebra.cross(algebra.exact(self.point), f))}
+
 
 class Torque(_BodyLoad):
     """A torque (N m) on ``body``: a 3-vector or callable, world or body coordinates."""
@@ -100,8 +167,16 @@ class Torque(_BodyLoad):
         tau = self.torque(t, q, s_dot)
         return np.concatenate((np.zeros(3), R.T @ tau if self.frame == "world" else tau))
 
+    def symbolic_unsupported(self) -> str | None:
+        return _callable("torque", self.torque)
 
-class JointForce:
+    def symbolic_wrenches(self, links) -> dict:
+        tau = algebra.exact(self.torque.constant)
+        tau = algebra.mul(links[self.index].R.T, tau) if self.frame == "world" else tau
+        return {self.index: sp.Matrix.vstack(sp.zeros(3, 1), tau)}
+
+
+class JointForce(ForceLaw):
     """A generalized force τ on the minimal velocities ṡ_n of ``joint`` (a motor torque,
     a drive force): a constant or a callable ``(t, q, s_dot) -> τ``."""
 
@@ -126,8 +201,11 @@ class JointForce:
         h[n] += w
         h[self.parent] -= kin.T_aug[n][:-1, :-1].T @ w  # reaction on p: −T_npᵀ w
 
-    def potential(self, kin, q) -> float:
-        return 0.0
+    def symbolic_unsupported(self) -> str | None:
+        return _callable("tau", self._tau)
+
+    def symbolic_joint_forces(self, q_joint, s_joint) -> dict:
+        return {self.index: sp.Matrix(algebra.exact(self._tau.constant))}
 
 
 class JointSpring(JointForce):
@@ -157,12 +235,19 @@ class JointSpring(JointForce):
     def generalized_force(self, t, q, s_dot) -> NDArray:
         return -self.stiffness * (self._q(q) - self._q_ref) - self.damping * self._s(s_dot)
 
+    def symbolic_unsupported(self) -> str | None:
+        return None
+
+    def symbolic_joint_forces(self, q_joint, s_joint) -> dict:
+        q_n, s_n = sp.Matrix(q_joint[self.index]), sp.Matrix(s_joint[self.index])
+        return {self.index: -self.stiffness * (q_n - algebra.exact(self._q_ref)) - self.damping * s_n}
+
     def potential(self, kin, q) -> float:
         dq = self._q(q) - self._q_ref
         return 0.5 * self.stiffness * float(dq @ dq)
 
 
-class SpringDamper:
+class SpringDamper(ForceLaw):
     """A linear spring-damper between two points: force k (ℓ − ℓ₀) + d ℓ̇ along the line.
 
     ``body_a`` / ``body_b`` are subsystem names or ``None`` for the ground; points are in
@@ -214,3 +299,29 @@ class SpringDamper:
     def potential(self, kin, q) -> float:
         (x_a, _), (x_b, _) = self._ends(kin)
         return 0.5 * self.stiffness * (np.linalg.norm(x_b - x_a) - self.length) ** 2
+
+    def symbolic_unsupported(self) -> str | None:
+        return None
+
+    def symbolic_wrenches(self, links) -> dict:
+        """The tension k (ℓ − ℓ₀) + d ℓ̇ along the line a → b, as in :meth:`add_to`."""
+        ends = []
+        for n, point in zip(self.index, self.points):
+            point = algebra.exact(point)
+            if n < 0:
+                ends.append((point, sp.zeros(3, 1)))
+                continue
+            link = links[n]
+            v_O, omega = link.twist[:3, :], link.twist[3:, :]
+            ends.append((link.r + algebra.mul(link.R, point), algebra.mul(link.R, v_O + algebra.cross(omega, point))))
+        (x_a, v_a), (x_b, v_b) = ends
+        d = x_b - x_a
+        length = sp.sqrt(d.dot(d))
+        e = d / length
+        tension = self.stiffness * (length - self.length) + self.damping * e.dot(v_b - v_a)
+        wrenches = {}
+        for n, point, sign in zip(self.index, self.points, (1, -1)):
+            if n >= 0:
+                f = algebra.mul(links[n].R.T, sign * tension * e)  # pulls a towards b and b towards a
+                wrenches[n] = sp.Matrix.vstack(f, algebra.cross(algebra.exact(point), f))
+        return wrenches

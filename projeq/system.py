@@ -22,6 +22,7 @@ from projeq.assembly.kinematics import Plan
 from projeq.checks import finite_array, state_vector
 from projeq.constraints.nonholonomic import check_configuration
 from projeq.joints import Joint
+from projeq.subsystems.base import conform
 
 GROUND = -1
 _GROUND_S = np.zeros((0, 6))
@@ -191,7 +192,8 @@ class System(Model):
     Parameters
     ----------
     subsystems : dict[str, Subsystem]
-        The bodies by name (any object with ``n_y``, ``S`` and ``gauss_terms``).
+        The bodies by name (:class:`projeq.Subsystem` s, or objects with its required
+        members, :func:`projeq.subsystems.base.conform`).
     joints : dict[str, Joint]
         For each subsystem name the joint that attaches it to its ``parent``.
     gravity : 3-vector
@@ -275,7 +277,7 @@ class System(Model):
         q_slice, s_slice, e_q, e_s, n_q, n_s = [], [], [], [], 0, 0
         for joint, sub in zip(self.joints, self.subsystems):
             own_q, own_s = (0, 0) if joint.coupling else (joint.n_q, joint.n_s)
-            n_e = getattr(sub, "n_e", 0)
+            n_e = sub.n_e
             q_slice.append(slice(n_q, n_q + own_q + n_e))
             s_slice.append(slice(n_s, n_s + own_s + n_e))
             e_q.append(slice(n_q + own_q, n_q + own_q + n_e))
@@ -336,7 +338,7 @@ class System(Model):
     # -- states ---------------------------------------------------------------------------
     def _default_q(self) -> NDArray:
         parts = [
-            np.concatenate(([] if j.coupling else j.default_q(), np.zeros(getattr(sub, "n_e", 0))))
+            np.concatenate(([] if j.coupling else j.default_q(), np.zeros(sub.n_e)))
             for j, sub in zip(self.joints, self.subsystems)
         ]
         return np.concatenate(parts) if parts else np.zeros(0)
@@ -510,8 +512,7 @@ def _check_names(subsystems, joints) -> None:
     if extra:
         raise ValueError(f"joints: joint(s) for unknown subsystem(s) {sorted(extra)}")
     for name, sub in subsystems.items():
-        if not all(hasattr(sub, a) for a in ("n_y", "S", "gauss_terms", "kinetic_energy", "potential_energy")):
-            raise ValueError(f"subsystems[{name!r}]: {sub!r} is not a subsystem (needs n_y, S, gauss_terms, ...)")
+        conform(name, sub)
     for name, joint in joints.items():
         if not isinstance(joint, Joint):
             raise ValueError(f"joints[{name!r}]: {joint!r} is not a Joint")

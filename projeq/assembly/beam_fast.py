@@ -13,7 +13,9 @@ and no rotary inertia only the elastic rows (M_ee, M_eR, h_e) are formed
 (:meth:`~projeq.subsystems.beam.beam.RitzBeam.elastic_terms`). M_ee = ∫ Φ_rᵀ Φ_r dm is
 positive definite for the independent Ritz functions a RitzBeam accepts, so a plain LU
 solve suffices. Equal to the general evaluators to round-off
-(tests/assembly/test_fast.py).
+(tests/assembly/test_fast.py). Any other subsystem with internal coordinates and the beam's
+layout ẏ = (twist, q̇_e) takes the same path through its ``elastic_terms``
+(:class:`projeq.Subsystem`: by default the last n_e rows of its own ``gauss_terms``).
 
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.spin_up_beam(omega_s=4.0, n_shapes=2, family="clamped_free")
@@ -28,19 +30,20 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.joints import Fixed, Prescribed
-from projeq.subsystems.beam.beam import RitzBeam
-
 
 def hub_beam_unsupported(system) -> str | None:
-    """Why ``system`` is not one RitzBeam on a prescribed or fixed root joint (None if it is)."""
+    """Why ``system`` is not one subsystem with internal coordinates laid out as a beam's,
+    ẏ = (twist, q̇_e) (``S`` = [E; 0], a RitzBeam), on a root joint without coordinates,
+    whose motion is a given function of time (Prescribed, Fixed) (None if it is)."""
     if len(system.subsystems) != 1:
         return f"the system has {len(system.subsystems)} subsystems (the beam path takes one RitzBeam)"
     name, beam, joint = system.names[0], system.subsystems[0], system.joints[0]
-    if not isinstance(beam, RitzBeam):
-        return f"subsystem {name!r} is a {type(beam).__name__}, not a RitzBeam"
-    if not isinstance(joint, (Prescribed, Fixed)):
-        return f"joint {name!r} is a {type(joint).__name__} (the beam path takes Prescribed or Fixed hubs)"
+    if not beam.n_e or beam.S is None or not np.array_equal(beam.S, np.eye(6 + beam.n_e, 6)):
+        return (f"subsystem {name!r} is a {type(beam).__name__}, not one with internal coordinates and "
+                "ẏ = (twist, q̇_e) (a RitzBeam)")
+    if joint.n_q or joint.n_s or joint.coupling:
+        return (f"joint {name!r} is a {type(joint).__name__} with coordinates (the beam path takes hubs "
+                "whose motion is given: Prescribed or Fixed)")
     if system.forces:
         return "the system has force laws (the beam path knows gravity only)"
     return None
@@ -52,8 +55,10 @@ class HubBeamEvaluator:
     Parameters
     ----------
     system : System
-        One RitzBeam on a :class:`~projeq.Prescribed` or :class:`~projeq.Fixed` joint to
-        the ground, without force laws; otherwise ValueError naming the reason.
+        One RitzBeam (or another subsystem with internal coordinates and ẏ = (twist, q̇_e),
+        through its ``elastic_terms``) on a :class:`~projeq.Prescribed` or
+        :class:`~projeq.Fixed` joint to the ground, without force laws; otherwise
+        ValueError naming the reason.
     """
 
     def __init__(self, system):

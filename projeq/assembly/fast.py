@@ -9,9 +9,11 @@ With numba installed (``pip install 'projeq[fast]'``) both are compiled on first
 says so): the same kernel source runs interpreted only on request (``compiled=False`` or
 ``PROJEQ_FAST_KERNEL=python``, for testing) — correct, but slower than the recursive one.
 
-Supported: trees of :class:`~projeq.RigidBody` / :class:`~projeq.PointMass` on
-:class:`~projeq.Revolute`, :class:`~projeq.Prismatic` and :class:`~projeq.Fixed` joints
-(no coupling), under gravity, without force laws; and one :class:`~projeq.RitzBeam` on a
+Supported: trees of subsystems with rigid-body terms and no selection (``rigid_inertia``
+and ``S = None``: :class:`~projeq.RigidBody`, :class:`~projeq.PointMass`, :class:`~projeq.Frame`)
+on joints whose ``compiled_kind`` the kernel has (:class:`~projeq.Revolute`,
+:class:`~projeq.Prismatic`, :class:`~projeq.Fixed`; no coupling), under gravity, without
+force laws; and one :class:`~projeq.RitzBeam` on a
 prescribed or fixed hub (the spin-up beam), by :mod:`projeq.assembly.beam_fast` (pure
 numpy; with ``precomputed_integrals`` its cost per call does not grow with the number of
 quadrature stations). Any other system (beams in chains, planar bodies, free or user —
@@ -36,10 +38,7 @@ from numpy.typing import NDArray
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import HubBeamEvaluator, hub_beam_unsupported
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
-from projeq.joints import Fixed, Prismatic, Revolute
-from projeq.subsystems import PointMass, RigidBody
-
-_KINDS = {Fixed: kernels.FIXED, Revolute: kernels.REVOLUTE, Prismatic: kernels.PRISMATIC}
+from projeq.subsystems.rigid import rigid_mass_matrix
 
 
 class FastEvaluator:
@@ -78,16 +77,14 @@ class FastEvaluator:
         """Flat arrays of the tree (built once) and the workspace."""
         N = len(system.joints)
         joints, bodies = system.joints, system.subsystems
-        self._kind = np.array([_KINDS[type(j)] for j in joints], dtype=np.int64)
+        self._kind = np.array([kernels.KINDS[j.compiled_kind] for j in joints], dtype=np.int64)
         self._parent = np.array(system.parent, dtype=np.int64)
-        self._axis = np.array([getattr(j, "axis", np.zeros(3)) for j in joints])
+        self._axis = np.array([np.zeros(3) if k == kernels.FIXED else j.axis for k, j in zip(self._kind, joints)])
         self._orientation = np.array([j.orientation for j in joints])
         self._offset = np.array([j.r_pn for j in joints])
         self._q_index = np.array([system.q_slice[n].start for n in range(N)], dtype=np.int64)
-        self._m = np.array([b.m for b in bodies])
-        self._r_c = np.array([b.r_c for b in bodies])
-        self._I_c = np.array([b.I_c for b in bodies])
-        self._M6 = np.array([b.M6 for b in bodies])
+        self._m, self._r_c, self._I_c = (np.array(part) for part in zip(*(b.rigid_inertia for b in bodies)))
+        self._M6 = np.array([rigid_mass_matrix(*b.rigid_inertia) for b in bodies])
         self._gravity = np.asarray(system.gravity, dtype=float)
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
         self._T, self._zeta = np.zeros((N, 6, 6)), np.zeros((N, 6))
@@ -121,12 +118,14 @@ class FastEvaluator:
 def unsupported(system) -> str | None:
     """Why the fast kernel cannot evaluate ``system`` (None if it can)."""
     for name, joint, body in zip(system.names, system.joints, system.subsystems):
-        if type(joint) not in _KINDS:
-            return f"joint {name!r} is a {type(joint).__name__} (the kernel knows Revolute, Prismatic, Fixed)"
+        if joint.compiled_kind not in kernels.KINDS:
+            return (f"joint {name!r} is a {type(joint).__name__}, which has no compiled kind "
+                    f"(the kernel knows {', '.join(kernels.KINDS)})")
         if joint.coupling:
             return f"joint {name!r} is coupled (shared minimal velocities)"
-        if type(body) not in (RigidBody, PointMass) or body.S is not None:
-            return f"subsystem {name!r} is a {type(body).__name__} (the kernel knows spatial rigid bodies)"
+        if body.rigid_inertia is None or body.S is not None:
+            return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of spatial "
+                    "rigid bodies, rigid_inertia with S = None)")
     if system.forces:
         return "the system has force laws (the kernel knows gravity only)"
     return None

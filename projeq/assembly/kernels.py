@@ -23,6 +23,7 @@ import os
 import numpy as np
 
 FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
+KINDS = {"fixed": FIXED, "revolute": REVOLUTE, "prismatic": PRISMATIC}  # a joint's compiled_kind -> its code here
 
 
 def _numba():

@@ -25,33 +25,35 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.spatial import chain_matrix, cross, cross_motion
+from projeq.subsystems.rigid import RigidGroup
 
 
 class Plan:
     """Per-System preparation of the forward pass (built once, by the System's constructor).
 
-    - ``groups``: subsystems that share a batch implementation (``type(sub).group``), as
-      (indices, group object); ``singles``: the others, evaluated one by one;
+    - ``groups``: subsystems whose terms are the rigid-body terms of THEORY §3
+      (``rigid_inertia``), one :class:`RigidGroup` per selection S, as (indices, group);
+      ``singles``: the others, whose own ``gauss_terms`` are called one by one;
     - ``S_aug[n]`` = blockdiag(S_n, 1), and [0 … 0 1] for the ground, so that
       T̃_np = S̃_n T̃⁶_np S̃_pᵀ; ``plain[n]`` marks the common case S̃ = E on both sides;
     - ``internal``: subsystems with internal coordinates q_e (ṡ_e = q̇_e), whose last n_e
       rows of ẏ_n are ṡ_e (S_n has zero rows there);
-    - ``port[n]``: joint n sits on a deforming parent (one with a ``port`` method, a beam),
-      at the station its ``r_pn`` names.
+    - ``port[n]``: joint n sits on a deforming parent (``has_ports``, a beam), at the
+      station its ``r_pn`` names.
     """
 
     def __init__(self, system):
         N = len(system.joints)
-        by_key: dict = {}
+        by_selection: dict = {}
         self.singles = []
         for n, sub in enumerate(system.subsystems):
-            key = getattr(sub, "group_key", None)
-            if key is None:
+            if sub.rigid_inertia is None:
                 self.singles.append(n)
             else:
-                by_key.setdefault((type(sub).group, key), []).append(n)
+                selection = None if sub.S is None else (sub.S.shape, sub.S.tobytes())
+                by_selection.setdefault(selection, []).append(n)
         self.groups = [
-            (np.array(idx), group([system.subsystems[n] for n in idx])) for (group, _), idx in by_key.items()
+            (np.array(idx), RigidGroup([system.subsystems[n] for n in idx])) for idx in by_selection.values()
         ]
         ground = np.zeros((1, 7))
         ground[0, 6] = 1.0
@@ -59,8 +61,8 @@ class Plan:
         self.plain = [
             system.S[n] is None and system.parent[n] >= 0 and system.S[system.parent[n]] is None for n in range(N)
         ]
-        self.internal = [n for n in range(N) if getattr(system.subsystems[n], "n_e", 0)]
-        self.port = [system.parent[n] >= 0 and hasattr(system.subsystems[system.parent[n]], "port") for n in range(N)]
+        self.internal = [n for n in range(N) if system.subsystems[n].n_e]
+        self.port = [system.parent[n] >= 0 and system.subsystems[system.parent[n]].has_ports for n in range(N)]
         self.plain = [plain and not port for plain, port in zip(self.plain, self.port)]
 
 

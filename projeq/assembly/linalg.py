@@ -16,7 +16,7 @@ def mass_scale(system) -> float:
     """The largest diagonal entry of the subsystems' M_n at rest in q0: the yardstick for
     calling a pivot zero."""
     diagonals = [
-        np.abs(np.diagonal(sub.gauss_terms(np.zeros(sub.n_y), np.eye(3), system.gravity, np.zeros(getattr(sub, "n_e", 0)))[0])).max()
+        np.abs(np.diagonal(sub.gauss_terms(np.zeros(sub.n_y), np.eye(3), system.gravity, np.zeros(sub.n_e))[0])).max()
         for sub in system.subsystems
     ]
     return max(diagonals + [1e-300])

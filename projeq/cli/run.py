@@ -116,7 +116,7 @@ def _plots(result, system, scene, out: Path, name: str) -> list[Path]:
     if scene.plane:
         figures["path"] = plots.planar_trajectory(result, *scene.plane)
     for sub_name, sub in zip(system.names, system.subsystems):
-        if hasattr(sub, "deflection"):
+        if sub.deforms:
             figures[f"tip_{sub_name}"] = plots.tip_deflection(result, sub)
     from projeq.simulation.export import written_atomically
 
@@ -140,7 +140,7 @@ def _summary(name, system, result, files, cpu: float) -> None:
     print(f"energy {result.energy[0]:.10g} J -> {result.energy[-1]:.10g} J (change {change:.3g} J, "
           f"{result.energy_drift:.2e} of the energy scale; not conserved where a motion is prescribed)")
     for sub_name, sub in zip(system.names, system.subsystems):
-        if hasattr(sub, "deflection"):
+        if sub.deforms:
             tip = sub.deflection(result, sub.length)[-1]
             print(f"{sub_name}: tip displacement (u, v, w) = {np.array2string(tip, precision=5)} m at t = {result.t[-1]:.6g} s")
     if system.n_c:

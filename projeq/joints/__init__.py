@@ -1,13 +1,15 @@
 """How subsystems connect: the kinematic chain ẏ_n = T_np ẏ_p + F_n ṡ_n (THEORY §4).
 
-- :mod:`.base`: the joint contract (:class:`Joint`, :class:`Relative`) and the pose/twist check;
-- :mod:`.standard`: Revolute, Prismatic, Fixed, Planar, Free, Prescribed;
+- :mod:`.base`: the joint contract (:class:`Joint`, :class:`Relative`, :class:`SymbolicRelative`)
+  and the pose/twist check;
+- :mod:`.standard`: Revolute, Prismatic, Fixed, Planar, Free, Prescribed, each with its sympy
+  form (written with :mod:`projeq.symbolic.algebra`) and compiled kind next to ``relative``;
 - :mod:`.user`: :class:`UserJoint` from sympy or callables, compiled by :mod:`.user_compiler`.
 """
 
-from projeq.joints.base import Joint, Relative, pose_twist_mismatch
+from projeq.joints.base import Joint, Relative, SymbolicRelative, pose_twist_mismatch
 from projeq.joints.standard import Fixed, Free, Planar, Prescribed, Prismatic, Revolute
 from projeq.joints.user import UserJoint
 
-__all__ = ["Joint", "Relative", "pose_twist_mismatch", "Revolute", "Prismatic", "Fixed", "Planar", "Free",
-           "Prescribed", "UserJoint"]
+__all__ = ["Joint", "Relative", "SymbolicRelative", "pose_twist_mismatch", "Revolute", "Prismatic", "Fixed",
+           "Planar", "Free", "Prescribed", "UserJoint"]

@@ -12,12 +12,20 @@ the parent p (placed at ``r_pn`` with ``orientation`` J → p). Every joint retu
 The chain matrix T_np follows from (A, r) once, in :mod:`projeq.assembly.kinematics`, for every
 joint alike; positions follow q̇_n = K_n(q) ṡ_n + k_n(q, t).
 
+A joint class states its terms in one place: next to ``relative`` (and ``K``) its sympy
+form ``symbolic_relative`` (a :class:`SymbolicRelative`, used by
+:func:`projeq.symbolic.gauss_form`) and ``compiled_kind``, the kind of the compiled
+kernel that computes the same (:mod:`projeq.assembly.kernels`). No evaluator keeps a
+list of joint types. A subclass that restates ``relative``, ``K`` or ``q_dot`` loses the
+symbolic and compiled forms it inherits unless it restates them as well, so an override
+is never bypassed.
+
 Letters: ``K`` is q̇ = K ṡ (never a stiffness); ``A`` a rotation; ``t`` time.
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,6 +33,9 @@ from numpy.typing import NDArray
 from projeq.analysis.differentiation import central
 from projeq.checks import finite_array
 from projeq.spatial import vee
+
+if TYPE_CHECKING:
+    import sympy as sp
 
 
 class Relative(NamedTuple):
@@ -35,6 +46,19 @@ class Relative(NamedTuple):
     F: NDArray
     w: NDArray
     zeta: NDArray
+
+
+class SymbolicRelative(NamedTuple):
+    """Relative kinematics of a joint in sympy, at symbols (q_n, ṡ_n, t): ``A``, ``r``,
+    ``F`` as in :class:`Relative`, the rheonomic twist ``f`` (f⁶: w = F ṡ + f) and the
+    kinematics q̇_n = ``K`` ṡ_n + ``k``. Ḟ ṡ + ḟ follows by differentiation."""
+
+    A: Any  # sp.Matrix (3, 3)
+    r: Any  # sp.Matrix (3, 1)
+    F: Any  # sp.Matrix (6, n_s)
+    f: Any  # sp.Matrix (6, 1)
+    K: Any  # sp.Matrix (n_q, n_s)
+    k: Any  # sp.Matrix (n_q, 1)
 
 
 class Joint:
@@ -58,6 +82,10 @@ class Joint:
     n_q = 0
     n_s = 0
     n_c = 0  # number of velocity constraints whose residual the joint reports
+    # the kind of the compiled kernel (projeq.assembly.kernels.KINDS) computing the same ``relative``:
+    # "fixed", or "revolute" / "prismatic" about / along the joint's unit ``axis``; None: none
+    compiled_kind: str | None = None
+    symbolic_parameters: dict = {}  # {field: what it is} that symbolic_relative takes from gauss_form's parameters
 
     def __init__(self, parent=None, r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
         if parent is not None and not isinstance(parent, str):
@@ -67,9 +95,26 @@ class Joint:
         self.orientation = _rotation_matrix("orientation", orientation)
         self.coupling = _coupling(coupling, self)
 
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if any(member in vars(cls) for member in ("relative", "K", "q_dot")):
+            for twin in ("symbolic_relative", "symbolic_parameters", "compiled_kind"):
+                if twin not in vars(cls):  # the inherited twin states other kinematics
+                    setattr(cls, twin, getattr(Joint, twin))
+
     def relative(self, q_n: NDArray, s_dot_n: NDArray, t: float) -> Relative:
         """Relative kinematics (A, r, F⁶, w, ζ) at (q_n, ṡ_n, t)."""
         raise NotImplementedError
+
+    def symbolic_relative(self, q_n, s_n, t: sp.Symbol, **parameters) -> SymbolicRelative:
+        """The same kinematics as :meth:`relative` and :meth:`K` in sympy, at the symbols or
+        expressions q_n, ṡ_n (``s_n``) and t; ``parameters`` are the fields named in
+        ``symbolic_parameters``. Raises NotImplementedError with the reason (completing
+        "joint 'name' ...") when the joint has no symbolic form."""
+        raise NotImplementedError(
+            f"({type(self).__name__}) is not supported symbolically; state its symbolic_relative, "
+            "or use projection_equation with its velocity expressions"
+        )
 
     def K(self, q_n: NDArray, t: float) -> NDArray:
         """K_n(q) of q̇_n = K_n ṡ_n + k_n (identity for q̇ = ṡ)."""

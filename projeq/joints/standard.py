@@ -1,7 +1,8 @@
 """The standard joints: Revolute, Prismatic, Fixed, Planar, Free and Prescribed (THEORY §4).
 
-Each states its relative kinematics (A, r, F⁶, w, ζ) once in ``relative``; see
-:mod:`projeq.joints.base` for the contract.
+Each states its relative kinematics (A, r, F⁶, w, ζ) in ``relative``, next to it their
+sympy form in ``symbolic_relative`` and, where the compiled kernel has the same
+kinematics, its ``compiled_kind``; see :mod:`projeq.joints.base` for the contract.
 """
 
 from __future__ import annotations
@@ -11,11 +12,19 @@ from typing import Callable
 import numpy as np
 import sympy as sp
 
-from projeq.joints.base import Joint, Relative
+from projeq.joints.base import Joint, Relative, SymbolicRelative
 from projeq.spatial import axis_spin, quaternion_matrix, quaternion_rate_matrix, rodrigues, unit_axis
+from projeq.symbolic import algebra
+from projeq.symbolic.algebra import exact, mul
 
 _ZERO6 = np.zeros(6)
 _ZERO6.flags.writeable = False
+
+
+def _scleronomic(A, r, F, K) -> SymbolicRelative:
+    """A SymbolicRelative without rheonomic terms (f = 0, k = 0)."""
+    return SymbolicRelative(A, r, F, sp.zeros(6, 1), K, sp.zeros(K.rows, 1))
+
 
 class _OneAxis(Joint):
     """Shared part of the one-dof joints along or about a unit axis e (joint-frame coordinates)."""
@@ -34,6 +43,8 @@ class Revolute(_OneAxis):
     θ is positive by the right-hand rule about e; q = ṡ-integral = (θ,).
     """
 
+    compiled_kind = "revolute"
+
     def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
         super().__init__(parent, axis, r_pn, orientation, coupling)
         self._spin = axis_spin(self.axis)
@@ -43,9 +54,15 @@ class Revolute(_OneAxis):
         A = rodrigues(self._spin, q_n[0])
         return Relative(A, _ZERO6[:3], self._F, self._F[:, 0] * s_dot_n[0], _ZERO6)
 
+    def symbolic_relative(self, q_n, s_n, t):
+        e = exact(self.axis)
+        return _scleronomic(algebra.rotation(e, q_n[0]), sp.zeros(3, 1), sp.Matrix.vstack(sp.zeros(3, 1), e), sp.eye(1))
+
 
 class Prismatic(_OneAxis):
     """Translation x along the unit axis e: F⁶ = [e; 0], r = e x (THEORY §4)."""
+
+    compiled_kind = "prismatic"
 
     def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
         super().__init__(parent, axis, r_pn, orientation, coupling)
@@ -54,14 +71,22 @@ class Prismatic(_OneAxis):
     def relative(self, q_n, s_dot_n, t):
         return Relative(np.eye(3), self.axis * q_n[0], self._F, self._F[:, 0] * s_dot_n[0], _ZERO6)
 
+    def symbolic_relative(self, q_n, s_n, t):
+        e = exact(self.axis)
+        return _scleronomic(sp.eye(3), e * q_n[0], sp.Matrix.vstack(e, sp.zeros(3, 1)), sp.eye(1))
+
 
 class Fixed(Joint):
     """A rigid connection: no coordinates; the child is the joint frame."""
 
     _F = np.zeros((6, 0))
+    compiled_kind = "fixed"
 
     def relative(self, q_n, s_dot_n, t):
         return Relative(np.eye(3), _ZERO6[:3], self._F, _ZERO6, _ZERO6)
+
+    def symbolic_relative(self, q_n, s_n, t):
+        return _scleronomic(sp.eye(3), sp.zeros(3, 1), sp.zeros(6, 0), sp.zeros(0, 0))
 
 
 class Planar(Joint):
@@ -102,6 +127,11 @@ class Planar(Joint):
         K[2, 2] = 1.0
         return K
 
+    def symbolic_relative(self, q_n, s_n, t):
+        P = exact(self._P)
+        A = algebra.rotation(exact(self.normal), q_n[2])
+        return _scleronomic(A, mul(P.T, sp.Matrix(q_n[:2])), exact(self._F), sp.diag(mul(P, A, P.T), 1))
+
 
 class Free(Joint):
     """Six dof: q = (r, quaternion (w, x, y, z)), ṡ = (v, ω) of the child in child coordinates.
@@ -124,6 +154,11 @@ class Free(Joint):
         K[:3, :3] = quaternion_matrix(quat)
         K[3:, 3:] = quaternion_rate_matrix(quat)
         return K
+
+    def symbolic_relative(self, q_n, s_n, t):
+        """With the quaternion taken as unit (the numeric joint normalises it)."""
+        A = algebra.quaternion_matrix(q_n[3:])
+        return _scleronomic(A, sp.Matrix(q_n[:3]), sp.eye(6), sp.diag(A, algebra.quaternion_rate_matrix(q_n[3:])))
 
     def default_q(self):
         return np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
@@ -149,6 +184,8 @@ class Prescribed(Joint):
         ``t -> (θ, θ̇, θ̈)``.
     """
 
+    symbolic_parameters = {"motion": "its motion θ(t) as a sympy expression"}
+
     def __init__(self, joint: Joint, motion):
         if not isinstance(joint, _OneAxis) or joint.coupling:
             raise ValueError("joint: Prescribed needs an uncoupled Revolute or Prismatic joint")
@@ -161,6 +198,12 @@ class Prescribed(Joint):
         inner = self.joint.relative(np.array([theta]), np.array([theta_dot]), t)
         zeta = inner.zeta + inner.F[:, 0] * theta_ddot
         return Relative(inner.A, inner.r, Fixed._F, inner.w, zeta)
+
+    def symbolic_relative(self, q_n, s_n, t, motion):
+        """The inner joint's kinematics at θ = ``motion`` (an expression in t): f = F θ̇."""
+        inner = self.joint.symbolic_relative([motion], [], t)
+        return SymbolicRelative(inner.A, inner.r, sp.zeros(6, 0), inner.F * motion.diff(t), sp.zeros(0, 0),
+                                sp.zeros(0, 1))
 
 
 def _time_function(expr) -> Callable:

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Callable, Sequence
 import numpy as np
 
 from projeq.checks import finite_array
-from projeq.joints.base import Joint
+from projeq.joints.base import Joint, SymbolicRelative
 
 if TYPE_CHECKING:
     import sympy as sp
@@ -28,22 +28,34 @@ class UserJoint(Joint):
     q̇ (symbolically, or by complex-step for callables), and the pose is checked against
     F and K at construction.
 
-    Build with :meth:`from_sympy` or :meth:`from_functions`.
+    Build with :meth:`from_sympy` or :meth:`from_functions`. ``symbols`` holds the
+    expressions of a joint from sympy ({"q", "s", "t", "A", "r", "F", "K", "f", "k"}),
+    None for one from callables.
     """
 
     def __init__(self, parent, n_q, n_s, relative, K, q_dot, q0=None, r_pn=(0, 0, 0), orientation=None,
-                 constraints=None, n_c=0):
+                 constraints=None, n_c=0, symbols: dict | None = None):
         super().__init__(parent, r_pn, orientation)
         self.n_q, self.n_s, self.n_c = n_q, n_s, n_c
         self._relative, self._K, self._q_dot = relative, K, q_dot
         self._constraints = constraints
         self._q0 = np.zeros(n_q) if q0 is None else finite_array("q0", q0, (n_q,))
+        self.symbols = symbols
 
     def relative(self, q_n, s_dot_n, t):
         return self._relative(q_n, s_dot_n, t)
 
     def K(self, q_n, t):
         return self._K(q_n, t)
+
+    def symbolic_relative(self, q_n, s_n, t):
+        """The expressions of :meth:`from_sympy` with the given symbols put in."""
+        if self.symbols is None:
+            raise NotImplementedError("(UserJoint from callables) has no expressions; build it with "
+                                      "UserJoint.from_sympy to derive it symbolically")
+        symbols = self.symbols
+        rename = dict(zip(symbols["q"], q_n)) | dict(zip(symbols["s"], s_n)) | {symbols["t"]: t}
+        return SymbolicRelative(*(symbols[key].xreplace(rename) for key in ("A", "r", "F", "f", "K", "k")))
 
     def q_dot(self, q_n, s_dot_n, t):
         return self._q_dot(q_n, s_dot_n, t)

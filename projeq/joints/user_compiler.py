@@ -92,8 +92,8 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
         lambda q_n, time: np.asarray(K_fun(q_n, time), dtype=float),
         lambda q_n, s_dot_n, time: np.asarray(q_dot_fun(q_n, s_dot_n, time), dtype=float).ravel(),
         q0=q0, r_pn=r_pn, orientation=orientation, constraints=residual, n_c=n_c,
+        symbols={"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k},
     )
-    joint.symbols = {"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k}
     _check_pose(joint)
     return joint
 

@@ -6,7 +6,9 @@ import numpy as np
 
 from projeq.subsystems import inertia
 from projeq.checks import count, finite_array, positive
+from projeq.forces import JointSpring
 from projeq.joints import Fixed, Prescribed, Revolute
+from projeq.spatial import rotation_y, rotation_z
 from projeq.subsystems.beam.beam import RitzBeam
 from projeq.subsystems.rigid import PointMass, RigidBody
 from projeq.system import System
@@ -131,3 +133,66 @@ def spinning_beam(
     )
     spin = Prescribed(Revolute(axis="x"), lambda t: (omega * t, omega, 0.0))
     return System({"beam": beam}, {"beam": spin})
+
+
+def _cardan_joint(parent: str, r_pn) -> "UserJoint":
+    """Two revolute joints in one: about y by β, then about z by γ (q = ṡ-integrable,
+    q̇ = ṡ), the relative angular velocity R_zᵀ e_y β̇ + e_z γ̇ in child coordinates."""
+    import sympy as sp
+
+    from projeq.joints.user import UserJoint
+
+    b, g, b_dot, g_dot = sp.symbols("beta gamma beta_dot gamma_dot")
+    R_y = sp.Matrix([[sp.cos(b), 0, sp.sin(b)], [0, 1, 0], [-sp.sin(b), 0, sp.cos(b)]])
+    R_z = sp.Matrix([[sp.cos(g), -sp.sin(g), 0], [sp.sin(g), sp.cos(g), 0], [0, 0, 1]])
+    F = sp.zeros(6, 2)
+    F[3:, 0] = R_z.T * sp.Matrix([0, 1, 0])
+    F[5, 1] = 1
+    return UserJoint.from_sympy([b, g], [b_dot, g_dot], R_y * R_z, sp.zeros(3, 1), F, sp.eye(2), parent=parent, r_pn=r_pn)
+
+
+def rigid_slice_chain(n_slices: int, motion, length: float = 1.0, rho_A: float = 1.0, EI: float = 1.0,
+                      rho_I: float = 0.01, initial_deflection=None) -> tuple[System, np.ndarray]:
+    """The beam of B(16)–(23) as ``n_slices`` rigid slices (an independent model of
+    ``spinning_beam``): a hub turned about x by ``motion(t) -> (α, α̇, α̈)``, then slices of
+    length Δx, mass ρA Δx, inertia about their centres diag(2ρI, ρI, ρI) Δx + ρA Δx³/12 on
+    y, z, joined at their ends by Cardan joints (about y, then z) with JointSprings EI/Δx
+    (2EI/Δx at the root, which stands for the half cell [0, Δx/2]). Without torsional
+    strain as Δx → 0 (docs/theory.md, "The spinning beam's rotary inertia").
+
+    Returns ``(system, q0)``: q0 bends the chain in the x–y plane along
+    ``initial_deflection(x) -> v`` (slice slopes = chord slopes), or straight.
+    """
+    n_slices = count("n_slices", n_slices)
+    length, rho_A, EI, rho_I = (positive(name, value) for name, value in
+                                (("length", length), ("rho_A", rho_A), ("EI", EI), ("rho_I", rho_I)))
+    dx = length / n_slices
+    transverse = rho_I * dx + rho_A * dx**3 / 12
+    slice_body = RigidBody(rho_A * dx, (dx / 2, 0.0, 0.0), np.diag([2 * rho_I * dx, transverse, transverse]))
+    subsystems = {"hub": RigidBody(1.0, (0.0, 0.0, 0.0), np.eye(3))}  # prescribed: its inertia does not enter
+    joints = {"hub": Prescribed(Revolute(axis="x"), motion)}
+    springs, parent = [], "hub"
+    for i in range(n_slices):
+        name = f"slice{i}"
+        subsystems[name] = slice_body
+        joints[name] = _cardan_joint(parent, (0.0 if i == 0 else dx, 0.0, 0.0))
+        springs.append(JointSpring(name, (2.0 if i == 0 else 1.0) * EI / dx))
+        parent = name
+    q0 = np.zeros(2 * n_slices)
+    if initial_deflection is not None:
+        edges = np.linspace(0.0, length, n_slices + 1)
+        slopes = np.arctan(np.diff(initial_deflection(edges)) / dx)
+        q0[1::2] = np.diff(np.r_[0.0, slopes])  # γ: relative turns about z
+    return System(subsystems, joints, forces=springs), q0
+
+
+def rigid_slice_chain_tip(q: np.ndarray, length: float = 1.0) -> np.ndarray:
+    """The tip of :func:`rigid_slice_chain` in the hub frame R, (x, v, w)(L), from the joint
+    angles q = (β₀, γ₀, β₁, γ₁, …)."""
+    n_slices = len(q) // 2
+    dx = length / n_slices
+    A, tip = np.eye(3), np.zeros(3)
+    for beta, gamma in q.reshape(n_slices, 2):
+        A = A @ rotation_y(beta) @ rotation_z(gamma)
+        tip += A[:, 0] * dx
+    return tip

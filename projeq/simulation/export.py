@@ -1,7 +1,7 @@
 """Results for other tools: a VTU time series for ParaView (via meshio).
 
 Each output time becomes one ``.vtu`` file with the system drawn in inertial coordinates:
-beam centre lines as polylines (subsystems with a ``centre_line`` method) and every other
+beam centre lines as polylines (subsystems that ``deform``, ``centre_line``) and every other
 subsystem as a small frame glyph (three line segments along its axes). Point data:
 ``displacement`` (from the first time) and ``velocity`` (exact, from the kinematics);
 a ``.pvd`` collection file ties the steps together with their times.
@@ -49,7 +49,7 @@ def _draw(system, q, s_dot, t, stations: int, frame_size: float):
     kin = forward(system, q, s_dot, t, chain_terms=False)
     points, velocities, lines = [], [], []
     for n, sub in enumerate(system.subsystems):
-        if hasattr(sub, "centre_line"):
+        if sub.deforms:
             local, local_velocity = sub.centre_line(q[system.e_q_slice[n]], kin.y_dot[n], stations)
             chain = [(i, i + 1) for i in range(len(local) - 1)]
         else:

@@ -1,8 +1,12 @@
-"""The subsystem interface: one term of the sum in B(14).
+"""The subsystem contract: one term of the sum in B(14).
 
 A subsystem n has describing velocities ẏ_n and contributes M_n ÿ_n + G_n ẏ_n − Q_n to
-the Projection Equation. The assemblers only ever call the members below, so a new kind
-of subsystem (an elastic beam, a user-defined one) plugs in without changing them.
+the Projection Equation. :class:`Subsystem` lists every member that an evaluator, the
+command line or the exporter uses; the optional ones have defaults there, and what a
+subsystem can do (carry joints at stations, deform) is an attribute set once, when its
+class is defined, never probed during evaluation. So a new kind of subsystem (an elastic
+beam, a user-defined one) plugs in by subclassing :class:`Subsystem` without changing the
+evaluators.
 
 Letters in this module: ``M`` is the subsystem mass matrix (never a torque), ``h`` is
 h_n = Q_n − G_n ẏ_n.
@@ -10,31 +14,70 @@ h_n = Q_n − G_n ẏ_n.
 
 from __future__ import annotations
 
-from typing import Protocol
+from types import MethodType
 
 from numpy.typing import NDArray
 
+REQUIRED = ("n_y", "gauss_terms", "kinetic_energy", "potential_energy")  # no default
+DEFAULTS = ("S", "n_e", "rigid_inertia", "elastic_terms")  # optional members with a default
+_ABSENT = object()
+DERIVED = ("rigid_inertia", "elastic_terms")  # derived from gauss_terms: reset where it is restated
+CAPABILITIES = {"has_ports": ("port",), "deforms": ("centre_line", "deflection")}  # flag: its methods
 
-class Subsystem(Protocol):
+
+class Subsystem:
     """Something that moves: the Gauss-form terms of one subsystem (B(13)–(14)).
+
+    Required: ``n_y``, :meth:`gauss_terms`, :meth:`kinetic_energy`, :meth:`potential_energy`.
 
     Attributes
     ----------
     n_y : int
         Number of describing velocities ẏ_n.
-    S : ndarray of shape (n_y, 6), or None
+    S : ndarray of shape (n_y, 6), or None (default)
         Selection of ẏ_n from the twist (v_O, ω) of the subsystem's reference frame R_n,
         ẏ_n = S · twist + [0; ṡ_e] (``None`` means ẏ_n *is* the twist). Joints act through
         it: F_n = [S F⁶, [0; E]], T_np = S T⁶_np Sₚᵀ (THEORY §4). Planar bodies select
         three rows; a subsystem with internal coordinates has zero rows for them.
-    n_e : int, optional (default 0)
+    n_e : int (default 0)
         Internal coordinates q_e (elastic coordinates of a beam, an absorber's travel),
         owned by the subsystem, with minimal velocities ṡ_e = q̇_e: the last n_e entries
         of ẏ_n. They follow the joint's coordinates in q and ṡ.
+    rigid_inertia : (m, r_c, I_c) or None (default)
+        Set when :meth:`gauss_terms` are the rigid-body terms of B(13) (the formula table of
+        docs/theory.md) of this mass, mass centre and inertia tensor, selected by ``S``: then
+        the evaluators may compute them in batches, compiled or in sympy from these three.
+    has_ports : bool
+        The class implements :meth:`port`: joints of children sit at stations of this
+        deforming subsystem (set when the class is defined).
+    deforms : bool
+        The class implements :meth:`centre_line` and :meth:`deflection` of a deforming
+        centre line of length ``length`` (export, command line; set when the class is defined).
+    length : float
+        (``deforms``) Length of the centre line, in m.
+
+    Overrides are never bypassed: the members derived from :meth:`gauss_terms`
+    (``rigid_inertia``, :meth:`elastic_terms`) are stated for the class that defines them;
+    a subclass that restates ``gauss_terms`` gets the defaults back (no rigid_inertia,
+    elastic_terms as rows of its gauss_terms) unless it restates them too.
     """
 
     n_y: int
-    S: NDArray | None
+    S: NDArray | None = None
+    n_e: int = 0
+    rigid_inertia: tuple | None = None
+    has_ports: bool = False
+    deforms: bool = False
+    length: float
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "gauss_terms" in vars(cls):  # the class states its own terms: what derived from the inherited ones goes
+            for derived in DERIVED:
+                if derived not in vars(cls):
+                    setattr(cls, derived, vars(Subsystem)[derived])
+        for flag, methods in CAPABILITIES.items():
+            setattr(cls, flag, all(getattr(cls, m) is not getattr(Subsystem, m) for m in methods))
 
     def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray) -> tuple[NDArray, NDArray]:
         """Return (M_n, h_n), h_n = Q_n − G_n ẏ_n with gravity included in Q_n.
@@ -43,12 +86,68 @@ class Subsystem(Protocol):
         the gravitational acceleration in inertial coordinates; ``q_e`` the internal
         coordinates (empty for rigid bodies).
         """
-        ...
+        raise NotImplementedError
 
     def kinetic_energy(self, y_dot: NDArray, q_e: NDArray) -> float:
         """½ ẏ_nᵀ M_n ẏ_n."""
-        ...
+        raise NotImplementedError
 
     def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray, q_e: NDArray) -> float:
         """Potential of the subsystem (gravity, internal springs) with frame pose (R, r)."""
-        ...
+        raise NotImplementedError
+
+    def elastic_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray) -> tuple[NDArray, NDArray]:
+        """The last n_e rows (M_e, h_e) of :meth:`gauss_terms`: what the internal
+        coordinates of a subsystem on a hub of given motion need (M_ee q̈_e = h_e − M_eR ζ)."""
+        M, h = self.gauss_terms(y_dot, R, gravity, q_e)
+        return M[-self.n_e :], h[-self.n_e :]
+
+    def port(self, point: NDArray, q_e: NDArray, q_e_dot: NDArray):
+        """(``has_ports``) The frame at the station ``point`` (reference-frame coordinates of
+        the undeformed subsystem) as a :class:`projeq.joints.Relative` of the reference
+        frame: its pose, twist F q̇_e and ζ = Ḟ q̇_e (THEORY §10)."""
+        raise NotImplementedError(f"{type(self).__name__} has no ports (has_ports is False)")
+
+    def centre_line(self, q_e: NDArray, y_dot: NDArray, stations: int = 21) -> tuple[NDArray, NDArray]:
+        """(``deforms``) Positions and velocities of ``stations`` points of the centre line
+        in the reference frame (for drawing and export)."""
+        raise NotImplementedError(f"{type(self).__name__} does not deform (deforms is False)")
+
+    def deflection(self, result, x: float) -> NDArray:
+        """(``deforms``) Displacement (u, v, w) of the centre line at station x, one row per
+        time point of a simulated ``result``."""
+        raise NotImplementedError(f"{type(self).__name__} does not deform (deforms is False)")
+
+
+def conform(name: str, sub) -> None:
+    """Check that ``sub`` (added under ``name``) is a subsystem; called where a System is built.
+
+    A missing required member (or a required method left to the base class) is a ValueError
+    naming it. An object that does not subclass :class:`Subsystem` (duck-typed) is given the
+    defaults of the members it lacks (``S``, ``n_e``, ``rigid_inertia``, :meth:`elastic_terms`
+    from its own ``gauss_terms``) and its capabilities (``has_ports`` if it has ``port``, ...),
+    so that the evaluators read declared members only.
+    """
+    missing = [m for m in REQUIRED if not hasattr(sub, m) or getattr(type(sub), m, None) is getattr(Subsystem, m, _ABSENT)]
+    if missing:
+        raise ValueError(
+            f"subsystems[{name!r}]: {sub!r} is not a subsystem (it lacks {', '.join(missing)}; "
+            "subclass projeq.Subsystem, which lists the members)"
+        )
+    if isinstance(sub, Subsystem):
+        return
+    for member in DEFAULTS:
+        if not hasattr(sub, member):
+            default = getattr(Subsystem, member)
+            _give(name, sub, member, MethodType(default, sub) if callable(default) else default)
+    for flag, methods in CAPABILITIES.items():
+        _give(name, sub, flag, all(hasattr(sub, m) for m in methods))
+
+
+def _give(name: str, sub, member: str, value) -> None:
+    try:
+        setattr(sub, member, value)
+    except AttributeError:
+        raise ValueError(
+            f"subsystems[{name!r}]: {sub!r} does not take the member {member}; subclass projeq.Subsystem"
+        ) from None

@@ -18,8 +18,11 @@ from numpy.typing import NDArray
 
 from projeq.checks import finite_array, inertia_tensor, positive
 from projeq.spatial import cross, skew
+from projeq.subsystems.base import Subsystem
 
 _PLANES = {"xy": (0, 1, 5), "yz": (1, 2, 3), "zx": (2, 0, 4), "xz": (0, 2, 4)}
+_ZERO3, _ZERO3x3 = np.zeros(3), np.zeros((3, 3))
+_ZERO3.flags.writeable = _ZERO3x3.flags.writeable = False
 
 
 def rigid_mass_matrix(m: float, r_c: NDArray, I_c: NDArray) -> NDArray:
@@ -49,16 +52,15 @@ def rigid_h(m, r_c: NDArray, I_c: NDArray, twist: NDArray, g_body: NDArray) -> N
 
 
 class RigidGroup:
-    """Rigid bodies of one kind (same S) evaluated together: :func:`rigid_h` on stacks.
+    """Subsystems with rigid-body terms (``rigid_inertia``) and the same S evaluated
+    together: :func:`rigid_h` on stacks.
 
     ``M[k]`` and the rows of ``h(...)`` belong to ``bodies[k]``; equal to calling each
     body's ``gauss_terms`` (tests/subsystems/test_rigid.py), several times faster.
     """
 
     def __init__(self, bodies):
-        self.m = np.array([b.m for b in bodies])
-        self.r_c = np.array([b.r_c for b in bodies])
-        self.I_c = np.array([b.I_c for b in bodies])
+        self.m, self.r_c, self.I_c = (np.array(part) for part in zip(*(b.rigid_inertia for b in bodies)))
         self.M = [b.gauss_terms(np.zeros(b.n_y), np.eye(3), np.zeros(3))[0] for b in bodies]
         self.S = bodies[0].S
 
@@ -70,7 +72,7 @@ class RigidGroup:
         return h6 if self.S is None else h6 @ self.S.T
 
 
-class RigidBody:
+class RigidBody(Subsystem):
     """A spatial rigid body: the subsystem of THEORY §3 with ẏ = (v_O, ω).
 
     Parameters
@@ -93,13 +95,6 @@ class RigidBody:
     """
 
     n_y = 6
-    S: NDArray | None = None
-    group = RigidGroup  # how several bodies of this kind are evaluated at once
-
-    @property
-    def group_key(self) -> tuple:
-        """Bodies with equal keys can share one :class:`RigidGroup`."""
-        return ("rigid",) if self.S is None else ("rigid", tuple(np.flatnonzero(self.S)))
 
     def __init__(self, m: float, r_c=(0.0, 0.0, 0.0), I_c=None):
         self.m = positive("m (mass)", m)
@@ -111,6 +106,12 @@ class RigidBody:
     @staticmethod
     def _check_inertia(I_c) -> NDArray:
         return inertia_tensor("I_c", I_c)
+
+    @property
+    def rigid_inertia(self) -> tuple:
+        """(m, r_c, I_c): :meth:`gauss_terms` are THEORY §3's of these (a subclass that
+        overrides ``gauss_terms`` has ``rigid_inertia = None``, :class:`Subsystem`)."""
+        return self.m, self.r_c, self.I_c
 
     def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e=None):
         """(M_n, h_n) of THEORY §3; ``R`` body → inertial, ``gravity`` inertial (a rigid
@@ -160,6 +161,7 @@ class PlanarBody(RigidBody):
     """
 
     n_y = 3
+    rigid_inertia = RigidBody.rigid_inertia  # its terms are the rigid ones, selected by S
 
     def __init__(self, m: float, r_c=(0.0, 0.0, 0.0), I_c=0.0, plane: str = "xy"):
         if plane not in _PLANES:
@@ -181,15 +183,16 @@ class PlanarBody(RigidBody):
         return 0.5 * float(y_dot @ self.M @ y_dot)
 
 
-class Frame:
+class Frame(Subsystem):
     """A massless frame: a place to chain joints (a universal joint as two revolutes).
 
-    M_n = 0 and h_n = 0; the system stays regular as long as every joint moves some mass
-    further out (else the evaluators raise :class:`projeq.SingularMassError`).
+    M_n = 0 and h_n = 0 (the rigid-body terms of zero mass and inertia); the system stays
+    regular as long as every joint moves some mass further out (else the evaluators raise
+    :class:`projeq.SingularMassError`).
     """
 
     n_y = 6
-    S = None
+    rigid_inertia = (0.0, _ZERO3, _ZERO3x3)
 
     def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e=None):
         """(0, 0): no mass, no load."""

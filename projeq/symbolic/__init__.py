@@ -10,7 +10,8 @@
 - :mod:`.program`: high-order program constraints (the generalized program motion
   equations of "On derivation of motion equations for systems with non-holonomic
   high-order program constraints", eqs. 6.30–6.33);
-- :mod:`.spinning_beam`: Hamilton vs Projection Equation for the spinning beam (B(16)–(23)).
+- :mod:`.spinning_beam`: Hamilton vs Projection Equation for the spinning beam (B(16)–(23)), and
+  the beam without torsional strain that both miss under spin-up.
 
 The names below load their module on first use, so that importing one module of this
 package (e.g. :mod:`.algebra` from the numeric scenes) does not import the others.

@@ -1,31 +1,46 @@
 """The spinning beam of B(16)–(23): Hamilton's principle versus the Projection Equation.
 
-A beam along x spins with the prescribed angle α(t) about its own axis; v(x, t), w(x, t)
-are its bending deflections in the co-rotating frame R (ω_IR = (α̇, 0, 0)); the section is
-circular (polar ρI_x = 2ρI). Both sets of field equations are derived here with sympy and
+H. Bremer, "Problems in fast moving non-holonomic elastic systems", B(16)–(23). A beam
+along x spins with the prescribed angle α(t) about its own axis; v(x, t), w(x, t) are its
+bending deflections in the co-rotating frame R (ω_IR = (α̇, 0, 0)); the section is
+circular (polar ρI_x = 2ρI). The field equations are derived here with sympy and
 linearised in (v, w):
 
 * :func:`hamilton_field_equations` — Hamilton's principle with the Cardan rates
-  (α̇, −ẇ′, v̇′) of B(17); reproduces B(18) (THEORY §9).
+  (α̇, −ẇ′, v̇′) of B(17); reproduces B(18).
 * :func:`projection_field_equations` — Newton–Euler residuals of a slice in R projected
-  with the operator D̄ of B(22) and its adjoint D (B(21)); reproduces B(23) as corrected in
-  THEORY §9.
+  with the operator D̄ of B(22) and its adjoint D (B(21)); reproduces B(23) (with the
+  signs of docs/theory.md, "The spinning beam's rotary inertia").
 
 They differ only in the ρI α̈ coupling of the v equation (:func:`field_difference`): the
 Cardan axes (x, y′, z″) are not orthogonal, so Hamilton's v equation is the directional
 derivative along the Cardan v′ axis, which picks up the torsional balance ρI_x α̈ times w′
 (the x component of that axis). :func:`ritz_models` discretises both with the clamped
-polynomial functions (x/L)^(k+1) of ``RitzBeam(family="polynomial")``.
+polynomial functions (x/L)^(k+1) of ``RitzBeam(family="polynomial")``, and a third model,
+:func:`_torsion_free_ritz`: the beam without torsional strain (κ_x = 0), which a finely
+segmented chain of rigid slices joined by bending joints tends to
+(:mod:`projeq.subsystems.beam.slice_chain`, the independent check).
 
-Interpretation. B(23) is the slice's Newton–Euler balance in the co-rotating frame R,
-projected on R's y and z directions: its ρI α̈ coupling is skew (circulatory, like the ρA
-part). B(18) is the same balance projected on the Cardan axes; its v equation contains
-the torsional balance ρI_x α̈ weighted by w′, so the ρI α̈ coupling is symmetric (the
-derivative of a time-dependent potential −½α̈ aᵀC_sym a at the Ritz level). At constant
-spin both coincide (and conserve the energy relative to R, the Jacobi integral); under
-spin-up each obeys its own work balance and the motions differ at first order in ρI.
-projeq's numeric ``RitzBeam`` projects the slice's Euler equations in the slice frame: its
-v rows coincide with Hamilton's, its coupling is skew (tests/symbolic/test_spinning_beam.py).
+Interpretation. Under spin-up the slices carry the spin-up torque ρI_x α̈ about x; what
+it does on a variation of (v, w) depends on how the slices turn about x when the beam
+bends — a second-order effect in (v, w) that the two documents' equations treat
+differently, and neither as the beam without torsional strain:
+
+* B(17)'s Cardan slices are turned by −½v′w′ about x (rotation-vector component of
+  R_y(−w′) R_z(v′)): B(18) is exact for that constraint, its coupling symmetric
+  (−ρI α̈ ∂²(∫v′w′ dx)/∂a²);
+* B(23) projects the balance on D̄'s rows (−ẇ′, v̇′) only: the slice's virtual turn about x
+  (first order on the bent beam) has no row, and what reaches the equations is the part of
+  the torque that the R components of the y, z balances carry (ρI α̈ θ × e_x): the extra
+  coupling ρI α̈ (w′δv′ − v′δw′) (skew, circulatory); projecting in the slice frame instead
+  (projeq's RitzBeam before issue 18) gives its negative;
+* without torsional strain the slices turn by τ(x) = ½∫₀ˣ(v′w″ − w′v″)dξ
+  (:func:`geometric_twist`), and the coupling is ρI_x α̈ ∂²(∫τ dx)/∂a²: the transmitted
+  spin-up torque ρI_x α̈ (L − x) working on the twist rate ½(v′w″ − w′v″).
+
+At constant spin all coincide (and conserve the energy relative to R, the Jacobi
+integral); under spin-up the motions differ at first order in ρI. projeq's numeric
+``RitzBeam`` is the beam without torsional strain (tests/symbolic/test_spinning_beam.py).
 """
 
 from __future__ import annotations
@@ -148,7 +163,7 @@ def projection_field_equations() -> tuple[sp.Expr, sp.Expr]:
 
 
 def _field_expected(rho_I_coupling: tuple[int, int]):
-    """The two field equations of THEORY §9 with signs (s_v, s_w) of the ρI α̈ terms."""
+    """The two linear field equations with signs (s_v, s_w) of the ρI α̈ terms."""
     ad, add = _d(alpha, t), _d(alpha, t, 2)
     sv, sw = rho_I_coupling
     eq_v = (rho_A * (_d(v, t, 2) - 2 * ad * _d(w, t) - add * w - ad**2 * v)
@@ -159,13 +174,13 @@ def _field_expected(rho_I_coupling: tuple[int, int]):
 
 
 def expected_B18():
-    """B(18) as printed (circular section, EI constant), with ρA α̈ v (not α̈ v/2, a typo of
-    the seed's transcription): ρI α̈ coupling −ρI(… − α̈w″), −ρI(… − α̈v″), symmetric."""
+    """B(18) as printed (circular section, EI constant), with ρA α̈ v (not α̈ v/2, a slip of
+    the text's transcription): ρI α̈ coupling −ρI(… − α̈w″), −ρI(… − α̈v″), symmetric."""
     return _field_expected((-1, -1))
 
 
 def expected_B23():
-    """B(23) as corrected in THEORY §9: −ρI(… + α̈w″), −ρI(… − α̈v″), skew-symmetric."""
+    """B(23) with the signs of docs/theory.md: −ρI(… + α̈w″), −ρI(… − α̈v″), skew-symmetric."""
     return _field_expected((1, -1))
 
 
@@ -233,16 +248,57 @@ def _matrices(E: sp.Matrix, q, q_dot, q_ddot) -> RitzModel:
     )
 
 
-@lru_cache(maxsize=None)
-def _hamilton_ritz(n: int) -> RitzModel:
-    """Lagrange's equations d/dt ∂L/∂ȧ − ∂L/∂a = 0 of the discretised Lagrangian ∫(T − V)dx
-    (Hamilton's principle, B(16)); α̇ is prescribed, so d/dt also acts through α̈."""
-    a, phi, fields = _ritz_coordinates(n)
-    (q, q_dot, q_ddot), rates = _state_symbols(a)
-    Lagrangian = sp.integrate(sp.expand(_quadratic_density().subs(fields).doit().subs(rates)), (x, 0, L))
+def _lagrange_ritz(Lagrangian, q, q_dot, q_ddot) -> RitzModel:
+    """Lagrange's equations d/dt ∂L/∂ȧ − ∂L/∂a = 0 of a discretised Lagrangian in the plain
+    symbols of :func:`_state_symbols`; α̇ is prescribed, so d/dt also acts through α̈."""
     p = sp.Matrix([Lagrangian]).jacobian(q_dot).T
     p_dot = p.jacobian(q) * sp.Matrix(q_dot) + p.jacobian(q_dot) * sp.Matrix(q_ddot) + p.diff(_Om) * _Om_dot
     return _matrices(p_dot - sp.Matrix([Lagrangian]).jacobian(q).T, q, q_dot, q_ddot)
+
+
+@lru_cache(maxsize=None)
+def _hamilton_ritz(n: int) -> RitzModel:
+    """Hamilton's principle, B(16), with the Cardan rates of B(17), discretised."""
+    a, phi, fields = _ritz_coordinates(n)
+    (q, q_dot, q_ddot), rates = _state_symbols(a)
+    Lagrangian = sp.integrate(sp.expand(_quadratic_density().subs(fields).doit().subs(rates)), (x, 0, L))
+    return _lagrange_ritz(Lagrangian, q, q_dot, q_ddot)
+
+
+def geometric_twist(v_field, w_field) -> sp.Expr:
+    """τ(x) = ½ ∫₀ˣ (v′w″ − w′v″) dξ: the turn about x (rotation-vector component) of the
+    slices of a beam without torsional strain, relative to the frame R spinning with the
+    clamped root. κ_x = τ′ − ½(θ × θ′)_x = 0 for θ = (τ, −w′, v′) (the body curvature of
+    exp(θ̃) to second order)."""
+    xi = sp.Symbol("xi")
+    rate = (_d(v_field, x) * _d(w_field, x, 2) - _d(w_field, x) * _d(v_field, x, 2)) / 2
+    return sp.integrate(sp.expand(rate.subs(x, xi)), (xi, 0, x))
+
+
+def torsion_free_angular_velocity(v_field, w_field) -> sp.Matrix:
+    """ω_c of a slice of a beam without torsional strain, in its own frame, to second order:
+    ω_c = (E − θ̃ + ½θ̃²)(α̇, 0, 0) + (E − ½θ̃) θ̇ with the rotation vector
+    θ = (τ, −w′, v′) of the slice relative to R (:func:`geometric_twist`)."""
+    theta = sp.Matrix([geometric_twist(v_field, w_field), -_d(w_field, x), _d(v_field, x)])
+    theta_skew = skew(theta)
+    E = sp.eye(3)
+    return (E - theta_skew + theta_skew**2 / 2) * sp.Matrix([_d(alpha, t), 0, 0]) + (E - theta_skew / 2) * _d(theta, t)
+
+
+@lru_cache(maxsize=None)
+def _torsion_free_ritz(n: int) -> RitzModel:
+    """Lagrange's equations of the beam whose slices have no torsional strain (κ_x = 0):
+    the kinematics a finely segmented chain of rigid slices joined by bending joints tends
+    to (:mod:`projeq.subsystems.beam.slice_chain`); only the slices' rotation differs from
+    :func:`_hamilton_ritz` (B(17)'s Cardan slices are twisted by −½v′w′ instead of τ)."""
+    a, phi, fields = _ritz_coordinates(n)
+    (q, q_dot, q_ddot), rates = _state_symbols(a)
+    v_c, omega_c = slice_velocity().subs(fields).doit(), torsion_free_angular_velocity(fields[v], fields[w])
+    T = rho_A * v_c.dot(v_c) / 2 + (omega_c.T * rho_I * sp.diag(2, 1, 1) * omega_c)[0] / 2
+    density = (T - EI * (_d(fields[v], x, 2) ** 2 + _d(fields[w], x, 2) ** 2) / 2).subs(rates)
+    quadratic = _order(density, 2, fields=tuple(q) + tuple(q_dot))
+    Lagrangian = sp.integrate(quadratic, (x, 0, L))
+    return _lagrange_ritz(Lagrangian, q, q_dot, q_ddot)
 
 
 @lru_cache(maxsize=None)
@@ -259,24 +315,31 @@ def _projection_ritz(n: int) -> RitzModel:
     return _matrices(sp.Matrix(equations), q, q_dot, q_ddot)
 
 
+_RITZ = {"hamilton": _hamilton_ritz, "projection": _projection_ritz, "torsion_free": _torsion_free_ritz}
+
+
 def ritz_models(n: int = 2, length: float = 1.0, rho_A_value: float = 1.0, rho_I_value: float = 0.01,
-                EI_value: float = 1.0) -> dict[str, RitzModel]:
-    """Numeric Ritz models ``{"hamilton": …, "projection": …}`` with n functions per plane.
+                EI_value: float = 1.0, kinds=tuple(_RITZ)) -> dict[str, RitzModel]:
+    """Numeric Ritz models ``{"hamilton": …, "projection": …, "torsion_free": …}`` (or the
+    ``kinds`` asked for) with n functions per plane.
 
     Coordinates a = (a_v1 … a_vn, a_w1 … a_wn), shapes (x/L)^(k+1) as in
     ``RitzBeam(family="polynomial")``. They differ only in C (the ρI α̈ coupling):
-    symmetric for Hamilton, skew-symmetric for the Projection Equation.
+    symmetric for Hamilton's B(18), skew-symmetric for the Projection Equation's B(23),
+    ρI_x ∂²(∫τ dx)/∂a² for the beam without torsional strain (:func:`_torsion_free_ritz`).
     """
     if int(n) != n or n < 1:
         raise ValueError(f"n: number of Ritz functions per plane must be a positive integer, got {n!r}")
+    unknown = [kind for kind in kinds if kind not in _RITZ]
+    if unknown:
+        raise ValueError(f"kinds: unknown {unknown}; available: {list(_RITZ)}")
     values = {L: length, rho_A: rho_A_value, rho_I: rho_I_value, EI: EI_value}
     for symbol, value in values.items():
         if not value > 0:
             raise ValueError(f"{symbol}: must be positive, got {value!r}")
-    models = {"hamilton": _hamilton_ritz(int(n)), "projection": _projection_ritz(int(n))}
     return {
-        name: RitzModel(*(np.array(m.subs(values), dtype=float) for m in model))
-        for name, model in models.items()
+        kind: RitzModel(*(np.array(m.subs(values), dtype=float) for m in _RITZ[kind](int(n))))
+        for kind in kinds
     }
 
 

@@ -13,12 +13,14 @@ M̄_p = M_p + Σ T_npᵀ M̄_n T_np give M(q) column block by column block, and 
 then acts on a vector or on a composite inertia (m, first moment, I_O) by the
 parallel-axis formulas, so no R Rᵀ products need trigonometric simplification.
 
-Supported: every joint of :mod:`projeq.joints` (Revolute, Prismatic, Fixed, Planar,
-Free with a unit quaternion, Prescribed with its motion given as a parameter, coupled
-joints, ``UserJoint.from_sympy``), rigid bodies (RigidBody, PointMass, PlanarBody — the
-spatial terms, equal on planar motion) and massless ``Frame`` s, gravity and the force
-laws of :mod:`projeq.forces` with constant loads. Anything else raises ``ValueError``
-naming the joint, subsystem or force.
+Supported: every joint with a symbolic form (``Joint.symbolic_relative``: Revolute,
+Prismatic, Fixed, Planar, Free with a unit quaternion, Prescribed with its motion given as
+a parameter, ``UserJoint.from_sympy``; coupled joints too), the subsystems whose terms are
+rigid-body terms (``rigid_inertia``: RigidBody, PointMass, PlanarBody — the spatial terms,
+equal on planar motion — and massless ``Frame`` s; not a subclass that restates
+``gauss_terms``), gravity and the force laws with a symbolic form (those of
+:mod:`projeq.forces` with constant loads). Anything else raises ``ValueError`` naming the
+joint, subsystem or force.
 
 Parameters are made symbolic with ``parameters={"link1.m": m1, "link1.r_c": ..., "link1.I_c":
 ..., "link2.r_pn": ..., "gravity": ..., "arm.motion": θ(t)}``: the sympy value replaces
@@ -33,8 +35,6 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-from ..joints import Prescribed
-from ..subsystems.rigid import Frame, RigidBody
 from .algebra import cross, cross_motion, exact, mul, skew
 from .joints import relative
 from .loads import body_wrenches, check_loads, joint_forces
@@ -101,7 +101,7 @@ def gauss_form(system, parameters=None) -> GaussForm:
     q_all, s_all = np.array(q, dtype=object), np.array(s, dtype=object)
     q_joint = [list(system.joint_q_getter(n)(q_all)) for n in range(len(system.names))]
     s_joint = [list(system.joint_s_dot_getter(n)(s_all)) for n in range(len(system.names))]
-    rels = [relative(joint, name, q_joint[n], s_joint[n], t, parameters.get(f"{name}.motion"))
+    rels = [relative(joint, name, q_joint[n], s_joint[n], t, parameters)
             for n, (name, joint) in enumerate(zip(system.names, system.joints))]
     K, k = _kinematics(system, rels)
     q_dot = dict(zip(q, mul(K, sp.Matrix(s)) + k))
@@ -164,18 +164,15 @@ def _forward(system, parameters, rels, s_joint, q_dot) -> list[_Link]:
     return links
 
 
-def _rigid(body, name: str, parameters) -> tuple | None:
-    """(m, r_c, I_c) of a rigid body, parameters put in; ``None`` for a massless Frame."""
-    if isinstance(body, Frame):
-        return None
-    return (parameters.get(f"{name}.m", exact(body.m)), parameters.get(f"{name}.r_c", exact(body.r_c)),
-            parameters.get(f"{name}.I_c", exact(body.I_c)))
+def _rigid(body, name: str, parameters) -> tuple:
+    """(m, r_c, I_c) of a subsystem with rigid-body terms (``rigid_inertia``), parameters put in."""
+    m, r_c, I_c = body.rigid_inertia
+    return (parameters.get(f"{name}.m", exact(m)), parameters.get(f"{name}.r_c", exact(r_c)),
+            parameters.get(f"{name}.I_c", exact(I_c)))
 
 
-def _inertia(rigid) -> _Inertia | None:
+def _inertia(rigid) -> _Inertia:
     """M_n as (m, c = m r_c, I_O = I_c − m r̃_c r̃_c) (THEORY §3)."""
-    if rigid is None:
-        return None
     m, r_c, I_c = rigid
     return _Inertia(m, m * r_c, I_c - m * mul(skew(r_c), skew(r_c)))
 
@@ -194,8 +191,7 @@ def _bias(system, links, rigids, inertias) -> list:
     wrenches = body_wrenches(system, links)
     beta = []
     for n, (link, rigid, inertia) in enumerate(zip(links, rigids, inertias)):
-        b = -wrenches.get(n, sp.zeros(6, 1))
-        beta.append(b if rigid is None else b + inertia * link.zeta - _h(rigid, link))
+        beta.append(inertia * link.zeta - _h(rigid, link) - wrenches.get(n, sp.zeros(6, 1)))
     return beta
 
 
@@ -207,7 +203,7 @@ def _backward(system, links, inertias, beta, tau) -> tuple[dict, dict]:
     for n in reversed(range(N)):
         link, p = links[n], system.parent[n]
         rhs[n] = -mul(link.F.T, beta[n]) + tau.get(n, sp.zeros(link.F.shape[1], 1))
-        if composite[n] is not None and link.F.shape[1]:
+        if link.F.shape[1]:
             X = sp.Matrix.hstack(*(composite[n] * link.F[:, k] for k in range(link.F.shape[1])))
             j = n
             while j >= 0:
@@ -216,9 +212,7 @@ def _backward(system, links, inertias, beta, tau) -> tuple[dict, dict]:
                 j = system.parent[j]
         if p >= 0:
             beta[p] = beta[p] + _carry_back(link, beta[n])
-            if composite[n] is not None:
-                moved = composite[n].to_parent(link)
-                composite[p] = moved if composite[p] is None else composite[p] + moved
+            composite[p] = composite[p] + composite[n].to_parent(link)
     return M, rhs
 
 
@@ -244,9 +238,10 @@ def _to_minimal(system, M_joint: dict, rhs_joint: dict) -> tuple[sp.Matrix, sp.M
 def _check_parameters(system, parameters) -> dict:
     """Refuse the subsystems the symbolic chain does not cover, by name; parameters as sympy values."""
     for name, body in zip(system.names, system.subsystems):
-        if not isinstance(body, (RigidBody, Frame)):
+        if body.rigid_inertia is None:
             raise ValueError(f"system: subsystem {name!r} ({type(body).__name__}) is not supported "
-                             "symbolically")
+                             "symbolically: its gauss_terms are numeric, not the rigid-body terms of a mass, "
+                             "mass centre and inertia (its rigid_inertia is None)")
     check_loads(system)
     shapes = {"m": (), "r_c": (3, 1), "I_c": (3, 3), "r_pn": (3, 1), "motion": ()}
     out = {}
@@ -256,7 +251,7 @@ def _check_parameters(system, parameters) -> dict:
         if key != "gravity" and (name not in system.names or shape is None):
             raise ValueError(f"parameters: unknown key {key!r}; use 'gravity' or '<name>.m', '.r_c', '.I_c', "
                              "'.r_pn', '.motion'")
-        if field == "motion" and not isinstance(system.joint(name), Prescribed):
+        if field == "motion" and field not in system.joint(name).symbolic_parameters:
             raise ValueError(f"parameters: {key!r} is for Prescribed joints; joint {name!r} is a "
                              f"{type(system.joint(name)).__name__}")
         value = sp.sympify(value) if shape == () else sp.Matrix(value)

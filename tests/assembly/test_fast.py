@@ -114,6 +114,20 @@ def _spring_chain():
     )
 
 
+def test_the_kernel_takes_massless_frames():
+    """A Frame states rigid-body terms of zero mass (``rigid_inertia``), so a universal joint
+    (two revolutes through a Frame) is compiled and equals the recursive evaluator."""
+    system = pq.System(
+        {"cross": pq.Frame(), "bob": pq.RigidBody(2.0, (0, 0, -1), np.diag([0.1, 0.2, 0.3]))},
+        {"cross": pq.Revolute(axis="x"), "bob": pq.Revolute(parent="cross", axis="y")},
+        gravity=(0, 0, -9.81), q0=[0.3, 0.5], s_dot0=[1.0, -2.0],
+    )
+    ev = FastEvaluator(system, compiled=False)  # the kernel's source, with or without numba
+    assert ev.fast and ev.reason is None
+    np.testing.assert_allclose(ev.accelerations(system.q0, system.s_dot0, 0.0),
+                               system.accelerations(system.q0, system.s_dot0, method="recursive"), rtol=1e-13, atol=1e-14)
+
+
 @pytest.mark.parametrize(
     ("build", "reason"),
     [

@@ -10,8 +10,10 @@ the Projection Equation B(19)–(25) for the slices gives
     M_n = ∫ Jᵀ J dm,   h_n = −∫ Jᵀ (ω̃ ṙ + ω̃ v_c − (q̇_vᵀH_v q̇_v + q̇_wᵀH_w q̇_w) e_x − g_R) dm − K_e q_e
 
 (the bracket is J̇ ẏ + ω̃ v_c − g, the acceleration not proportional to ÿ), plus the rotary
-inertia of the slices (Rayleigh) with ω_c = (E − θ̃) ω + Φ_θᵀ q̇_e in the slice's frame,
-small rotation θ = Φ_θᵀ q_e, Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (torsion β, THEORY §10). Because
+inertia of the slices (Rayleigh) with ω_c = (E − θ̃) ω + (E − ½θ̃) θ̇ in the slice's frame,
+rotation vector θ = Φ_θᵀ q_e + τ e_x, Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (torsion β, THEORY §10) and
+the geometric twist τ = q_vᵀ T(x) q_w of a beam without torsional strain (second order; it
+carries the spin-up torque's coupling, docs/theory.md). Because
 u₂ is part of the kinematics, the projection of the slices' axial inertia loads on
 ∂u₂/∂q gives the geometric stiffness ∫ N(x) Φ′Φ′ᵀ dx with N(x) = ∫ₓᴸ f_x: dynamic
 stiffening from spin, angular and frame acceleration and gravity alike, and the model
@@ -33,10 +35,11 @@ from projeq.spatial import cross, rotation_x, rotation_y, rotation_z, skew, skew
 from projeq.subsystems.beam import shapes
 from projeq.subsystems.beam.checks import family_shapes, per_length
 from projeq.subsystems.beam.integrals import ShapeIntegrals
+from projeq.subsystems.base import Subsystem
 from projeq.subsystems.beam.probes import BeamProbes
 
 
-class RitzBeam(BeamProbes):
+class RitzBeam(BeamProbes, Subsystem):
     """A beam subsystem: Euler–Bernoulli bending in two planes, optional axial and torsional
     deformation and rotary inertia, dynamic stiffening, stiffness-proportional damping.
 
@@ -226,6 +229,22 @@ class RitzBeam(BeamProbes):
         J[:, 1, self.w_cols] = -self.Phi["w"][1].T  # rotation about y: −w′
         J[:, 2, self.v_cols] = self.Phi["v"][1].T  # rotation about z: +v′
         self.J_omega = J
+        self.twist_matrix = self._geometric_twist(self.x)
+
+    def _geometric_twist(self, x: NDArray) -> NDArray:
+        """T(x) = ½ ∫₀ˣ (Φ_v′Φ_w″ᵀ − Φ_v″Φ_w′ᵀ) dξ at stations x: the slices of a beam without
+        torsional strain (κ_x = 0) turn about x by τ(x) = q_vᵀ T(x) q_w relative to R, the
+        rotation vector's x component that κ_x = τ′ − ½(θ × θ′)_x = 0 asks for, θ = (τ, −w′, v′)
+        (docs/theory.md, "The spinning beam's rotary inertia")."""
+        n_v, n_w = self.n_v, self.n_w
+        if not (n_v and n_w):
+            return np.zeros((len(x), n_v, n_w))
+        t, w = np.polynomial.legendre.leggauss(self.order)
+        xi = (0.5 * x[:, None] * (t[None, :] + 1.0)).ravel()  # quadrature points in [0, x]
+        dv = [np.asarray(d).reshape(n_v, len(x), len(t)) for d in self.families["v"](xi)[1:3]]
+        dw = [np.asarray(d).reshape(n_w, len(x), len(t)) for d in self.families["w"](xi)[1:3]]
+        weights = 0.25 * x[:, None] * w[None, :]  # ½ of the quadrature weights on [0, x]
+        return np.einsum("igk,jgk,gk->gij", dv[0], dw[1], weights) - np.einsum("igk,jgk,gk->gij", dv[1], dw[0], weights)
 
     def _check_independent(self) -> None:
         gram = np.zeros((self.n_e, self.n_e))
@@ -362,14 +381,33 @@ class RitzBeam(BeamProbes):
         return M, h
 
     def _slice_rotation(self, omega, q_e, q_e_dot, y_dot):
-        """Angular velocity of the slices in their own (slightly turned) frames,
-        ω_c = (E − θ̃) ω + Φ_θᵀ q̇_e with the small rotation θ(x) = Φ_θᵀ q_e = (β, −w′, v′):
-        its Jacobian J_ω(x, q_e), ω_c, and J̇_ω ẏ = ω̃ θ̇ (the rotary-inertia terms of the
-        Rayleigh beam; with Euler's ω̃_c I ω_c the power is exactly d/dt ½ ω_cᵀ I ω_c)."""
+        """Angular velocity of the slices in their own (slightly turned) frames to second
+        order, ω_c = (E − θ̃) ω + (E − ½θ̃) θ̇ with the rotation vector θ = (β + τ, −w′, v′) of
+        the slice relative to R, τ = q_vᵀ T q_w the geometric twist of a beam without
+        torsional strain (:meth:`_geometric_twist`): its Jacobian J_ω(x, q_e) (q̇_e columns
+        (E − ½θ̃) ∂θ/∂q_e), ω_c, and J̇_ω ẏ = ω̃ θ̇ + (E − ½θ̃) e_x 2 q̇_vᵀT q̇_w (the rotary
+        terms of the Rayleigh beam; with Euler's ω̃_c I ω_c the power is exactly
+        d/dt ½ ω_cᵀ I ω_c). The second-order parts carry the ρI_p α̈ coupling of a beam spun
+        about its axis (docs/theory.md, "The spinning beam's rotary inertia")."""
         J = self.J_omega.copy()
-        theta = J[:, :, 6:] @ q_e
-        J[:, :, 3:6] -= skew_stack(theta)
-        return J, J @ y_dot, cross(omega, J[:, :, 6:] @ q_e_dot)
+        e = self._local
+        q_v, q_w = q_e[e(self.v_cols)], q_e[e(self.w_cols)]
+        qd_v, qd_w = q_e_dot[e(self.v_cols)], q_e_dot[e(self.w_cols)]
+        T_q_w = self.twist_matrix @ q_w
+        J[:, 0, self.v_cols] += T_q_w  # ∂τ/∂q_v
+        J[:, 0, self.w_cols] += q_v @ self.twist_matrix  # ∂τ/∂q_w
+        theta = self.J_omega[:, :, 6:] @ q_e
+        theta[:, 0] += T_q_w @ q_v  # τ
+        Phi_theta = J[:, :, 6:]  # ∂θ/∂q_e
+        theta_skew = skew_stack(theta)
+        theta_dot = Phi_theta @ q_e_dot
+        twist_acceleration = 2.0 * ((self.twist_matrix @ qd_w) @ qd_v)
+        J[:, :, 6:] = Phi_theta - 0.5 * theta_skew @ Phi_theta
+        J[:, :, 3:6] -= theta_skew
+        c_w = cross(omega, theta_dot)
+        c_w[:, 0] += twist_acceleration
+        c_w -= 0.5 * np.cross(theta, twist_acceleration[:, None] * np.array([1.0, 0.0, 0.0]))
+        return J, J @ y_dot, c_w
 
     def kinetic_energy(self, y_dot: NDArray, q_e: NDArray) -> float:
         """½ ẏᵀ M ẏ (exact for the slice kinematics)."""

@@ -44,7 +44,7 @@ class BeamProbes:
         array of q_e rows is taken as is."""
         if isinstance(result, np.ndarray):
             return np.atleast_2d(result)
-        system = getattr(result, "system", None)
+        system = result.system
         if system is None:
             raise ValueError("result: has no system (loaded from a file?); probe a Result from simulate()")
         places = [n for n, sub in enumerate(system.subsystems) if sub is self]
