@@ -166,8 +166,8 @@ def long_runs(periods: float, revolutions: float, methods=LONG_RUN_METHODS, syst
            "round-off of E at the final state (energy_round_off); rolling constraints ≤ 10 ε R u2 for every "
            "method; RK45/DOP853's energy error is reported (start = first 10 % of the run, end = last 10 %)")
     disk = pq.scenes.rolling_disk()
-    cases = {  # the pendulum is a tree: it takes the fast evaluator (the recursive one without numba)
-        "pendulum": (pendulum(), dict(q0=[1.0], s_dot0=[0.0], evaluator="fast"),
+    cases = {  # the pendulum is a tree: "auto" picks the fast evaluator (the recursive one without numba)
+        "pendulum": (pendulum(), dict(q0=[1.0], s_dot0=[0.0], evaluator="auto"),
                      periods * 2 * np.pi * np.sqrt(1 / 9.81) * 1.07, 9.81),
         "rolling disk": (disk, {}, revolutions * 2 * np.pi / disk.s_dot0[1], None),
     }
@@ -223,7 +223,7 @@ def near_singular() -> list[dict]:
             system = pq.scenes.chain(n, q0=np.r_[first, np.zeros(n - 1)])
             q, s_dot = system.q0, np.linspace(-1.0, 1.0, n)
             kappa = np.linalg.cond(system.mass_matrix(q))
-            results = [system.accelerations(q, s_dot, method=m) for m in ("dense", "recursive", "fast")]
+            results = [system.accelerations(q, s_dot, method=m) for m in ("dense", "recursive", "auto")]
             reference = results[0] if first else np.zeros(n)  # hanging: s̈ = 0 (collinear)
             scale = np.abs(results[0]).max() if first else n * n  # hanging: velocity terms ~ n² |ṡ|²
             diff = max(np.abs(r - reference).max() for r in results) / scale
@@ -253,7 +253,7 @@ def mass_ratios() -> list[dict]:
             kappas.append(np.linalg.cond(system.mass_matrix(q)))
             dense = system.accelerations(q, s_dot, method="dense")
             diffs.append(max(np.abs(system.accelerations(q, s_dot, method=m) - dense).max()
-                             for m in ("recursive", "fast")) / np.abs(dense).max())
+                             for m in ("recursive", "auto")) / np.abs(dense).max())
         x0 = np.concatenate((system.q0, system.s_dot0))
         rho = spectral_radius(lambda t, x: np.concatenate((x[3:], system.accelerations(x[:3], x[3:], t))), 0.0, x0)
         rtol = 1e-9
@@ -272,19 +272,19 @@ def big_chain(t_end: float, n: int = 1000) -> list[dict]:
     passes(f"chain({n}) runs {t_end} s with the fast evaluator (RK45, rtol 1e-6) without failure; energy "
            "drift below n_steps · rtol; fast = recursive at the start to 1e-9")
     system = pq.scenes.chain(n)
-    fast = system.accelerations(system.q0, system.s_dot0, method="fast")
+    fast = system.accelerations(system.q0, system.s_dot0, method="auto")
     recursive = system.accelerations(system.q0, system.s_dot0, method="recursive")
     diff = float(np.abs(fast - recursive).max() / np.abs(recursive).max())
     rtol = 1e-6
     r, error, cpu, warned = timed_simulate(system, t_end, method="RK45", rtol=rtol, atol=1e-9,
-                                           evaluator="fast", n_points=11, n_segments=10)
+                                           evaluator="auto", n_points=11, n_segments=10)
     started = time.process_time()
     for _ in range(20):
         system.q_dot(system.q0, system.s_dot0)
     q_dot_cost = (time.process_time() - started) / 20
     started = time.process_time()
     for _ in range(20):
-        system.accelerations(system.q0, system.s_dot0, method="fast")
+        system.accelerations(system.q0, system.s_dot0, method="auto")
     fast_cost = (time.process_time() - started) / 20
     ok = bool(not error and r.energy_drift < r.nfev / 6 * rtol and diff < 1e-9)
     print(f"{'n':>5}{'t_end':>7}{'nfev':>8}{'CPU s':>8}{'energy':>10}{'|fast−rec|':>12}{'warned':>8}"

@@ -24,7 +24,7 @@ dense = system.accelerations(q, s_dot, method="dense")
 difference = np.abs(recursive - dense).max() / np.abs(dense).max()
 print(f"accelerations at a random state: relative difference {difference:.1e}")
 assert difference < 1e-12  # a 4x4 solve: round-off is ~1e-15; 1e-12 leaves a factor 1000
-fast = system.accelerations(q, s_dot, method="fast")  # numba-compiled when installed, else numpy
+fast = system.accelerations(q, s_dot, method="auto")  # the compiled kernel with numba, else the recursive evaluator
 symbolic = gauss_form(system).evaluator().accelerations(q, s_dot)
 for name, value in (("fast", fast), ("symbolic", symbolic)):
     print(f"{name}: relative difference to dense {np.abs(value - dense).max() / np.abs(dense).max():.1e}")

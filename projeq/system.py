@@ -129,15 +129,18 @@ class Model(ABC):
     @abstractmethod
     def evaluator(self, method: str | None = None):
         """An object whose ``accelerations(q, s_dot, t)`` gives s̈ by ``method``
-        (``"recursive"``, ``"dense"`` or ``"fast"``; None: the model's default), without
-        checking the state: the right-hand side that :func:`projeq.simulate` calls."""
+        (``"recursive"``, ``"dense"``, ``"fast"``, ``"hub_beam"`` or ``"auto"``; None: the
+        model's default), without checking the state: the right-hand side that
+        :func:`projeq.simulate` calls. One that cannot evaluate the model raises why."""
 
     def accelerations(self, q, s_dot, t: float = 0.0, method: str | None = None) -> NDArray:
         """Minimal accelerations s̈ from the Projection Equation at (q, ṡ, t) by the
         evaluator ``method``: ``"recursive"`` (order n, docs/theory.md "The recursive pass
         in augmented form"), ``"dense"`` (the Gauss form M s̈ + b = 0 of Bremer's B(14)) or
-        ``"fast"`` (the recursive pass compiled, :mod:`projeq.assembly.fast`); for a
-        ConstrainedSystem the evaluator of its tree, projected (see its :meth:`evaluator`)."""
+        ``"fast"`` (the recursive pass compiled, :mod:`projeq.assembly.fast`), ``"hub_beam"``
+        (a beam on a prescribed hub, :mod:`projeq.assembly.beam_fast`) or ``"auto"`` (the
+        fastest of them that can, :mod:`projeq.assembly.auto`); for a ConstrainedSystem the
+        evaluator of its tree, projected (see its :meth:`evaluator`)."""
         q, s_dot = self.check_state(q, s_dot, t)
         return self.evaluator(method).accelerations(q, s_dot, float(t))
 
@@ -423,9 +426,10 @@ class System(Model):
 
     # -- evaluation -----------------------------------------------------------------------
     def evaluator(self, method: str | None = None):
-        """The cached evaluator ``"recursive"``, ``"dense"`` or ``"fast"`` (compiled order n,
-        :mod:`projeq.assembly.fast`) (``None``: recursive, or
-        dense when minimal velocities are shared by coupled joints)."""
+        """The cached evaluator ``"recursive"``, ``"dense"``, ``"fast"`` (compiled order n,
+        :mod:`projeq.assembly.fast`), ``"hub_beam"`` or ``"auto"`` (the best of them available,
+        :mod:`projeq.assembly.auto`) (``None``: recursive, or dense when minimal velocities
+        are shared by coupled joints). One that cannot evaluate this system raises why."""
         from projeq.assembly import EVALUATORS
 
         if method is None:
@@ -465,10 +469,10 @@ class System(Model):
 
     def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:
         """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and gravity plus springs."""
-        from projeq.assembly.kinematics import forward
+        from projeq.assembly.kinematics import poses
 
         q, s_dot = self.check_state(q, s_dot, t)
-        kin = forward(self, q, s_dot, float(t), chain_terms=False)
+        kin = poses(self, q, s_dot, float(t))
         q_e = [q[sl] for sl in self.e_q_slice]
         kinetic = sum(sub.kinetic_energy(kin.y_dot[n], q_e[n]) for n, sub in enumerate(self.subsystems))
         potential = sum(

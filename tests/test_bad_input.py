@@ -393,7 +393,7 @@ def test_an_integrator_that_fails_reports_its_message_and_keeps_the_trajectory()
         ({"t_start": np.inf}, r"^t_start: non-finite entries"),
         ({"method": "Euler42"}, r"^method: unknown integrator 'Euler42'; use one of \['RK45', "),
         ({"method": len}, "^method: unknown integrator"),
-        ({"evaluator": "newton"}, r"^evaluator: unknown evaluator 'newton'; use one of \['dense', 'fast', 'recursive'\]"),
+        ({"evaluator": "newton"}, r"^evaluator: unknown evaluator 'newton'; use one of \['auto', 'dense', 'fast', 'hub_beam', 'recursive'\]"),
         ({"rtol": 0.0}, "^rtol: must be positive, got 0.0"),
         ({"atol": -1e-9}, "^atol: must be positive"),
         ({"t_eval": [0.0, 2.0]}, r"^t_eval: must increase strictly within \[0.0, 1.0\]"),
@@ -436,6 +436,6 @@ def test_simulate_arguments(kwargs, message):
 @pytest.mark.parametrize("method", ["newton", 3])
 def test_unknown_evaluator(method):
     with pytest.raises(
-        ValueError, match=r"^method: unknown evaluator .*; use one of \['dense', 'fast', 'recursive'\]"
+        ValueError, match=r"^method: unknown evaluator .*; use one of \['auto', 'dense', 'fast', 'hub_beam', 'recursive'\]"
     ):
         _pendulum().accelerations([0.0], [0.0], method=method)

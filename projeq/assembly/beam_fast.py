@@ -1,5 +1,6 @@
-"""The fast path of a beam on a moving hub: one RitzBeam whose root follows a prescribed
-motion (a rheonomic hub, THEORY §4) or is fixed to the ground — the spin-up beam.
+"""The evaluator of a beam on a moving hub, ``method="hub_beam"``: one RitzBeam whose root
+follows a prescribed motion (a rheonomic hub, THEORY §4) or is fixed to the ground — the
+spin-up beam.
 
 Then the beam's reference frame moves as given, ẏ = (w(t), q̇_e) with the hub's twist w
 and ÿ = (ζ(t), q̈_e) with ζ = Ḟ⁶ θ̇ + F⁶ θ̈ (the parent is the ground at rest), and the
@@ -59,7 +60,11 @@ class HubBeamEvaluator:
         through its ``elastic_terms``) on a :class:`~projeq.Prescribed` or
         :class:`~projeq.Fixed` joint to the ground, without force laws; otherwise
         ValueError naming the reason.
+
+    Attributes: ``name`` ("hub_beam"), ``n_calls``.
     """
+
+    name = "hub_beam"
 
     def __init__(self, system):
         reason = hub_beam_unsupported(system)

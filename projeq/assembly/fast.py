@@ -4,27 +4,28 @@ The System stays frozen; :class:`FastEvaluator` packs its tree once into arrays 
 joint kinds, axes, joint frames, masses, r_c, I_c, M_n) and each call runs
 :func:`projeq.assembly.kernels.chain_terms` (T_np, ζ_n, F_n, h_n; THEORY §3–4) and
 :func:`projeq.assembly.kernels.passes` (Bremer's backward and forward passes, §6).
-With numba installed (``pip install 'projeq[fast]'``) both are compiled on first use
-(cached on disk). Without it ``method="fast"`` is the recursive evaluator (``reason``
-says so): the same kernel source runs interpreted only on request (``compiled=False`` or
-``PROJEQ_FAST_KERNEL=python``, for testing) — correct, but slower than the recursive one.
+Both are compiled by numba (``pip install 'projeq[fast]'``) on first use (cached on
+disk); ``method="fast"`` is this kernel or a ValueError saying why not (numba missing, or
+a piece of the system the kernel does not know). ``compiled=False`` runs the same kernel
+source interpreted (for testing: correct, but slower than the recursive evaluator).
+``method="auto"`` (:mod:`projeq.assembly.auto`) picks this evaluator where it can, and
+another one where it cannot.
 
 Supported: trees of subsystems with rigid-body terms and no selection (``rigid_inertia``
 and ``S = None``: :class:`~projeq.RigidBody`, :class:`~projeq.PointMass`, :class:`~projeq.Frame`)
 on joints whose ``compiled_kind`` the kernel has (:class:`~projeq.Revolute`,
 :class:`~projeq.Prismatic`, :class:`~projeq.Fixed`; no coupling), under gravity, without
-force laws; and one :class:`~projeq.RitzBeam` on a
-prescribed or fixed hub (the spin-up beam), by :mod:`projeq.assembly.beam_fast` (pure
-numpy; with ``precomputed_integrals`` its cost per call does not grow with the number of
-quadrature stations). Any other system (beams in chains, planar bodies, free or user —
-e.g. non-holonomic — joints, couplings, forces) is evaluated by the general path
-(recursive, or dense for coupled joints); then ``fast`` is False and ``reason`` says why.
+force laws. One :class:`~projeq.RitzBeam` on a prescribed or fixed hub has its own fast
+evaluator, ``method="hub_beam"`` (:mod:`projeq.assembly.beam_fast`); any other system
+(beams in chains, planar bodies, free or user — e.g. non-holonomic — joints, couplings,
+forces) is refused with the piece named: it is evaluated by the general ones (recursive,
+or dense for coupled joints).
 
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.chain(3)
 >>> ev = FastEvaluator(system, compiled=False)
->>> ev.fast, ev.compiled
-(True, False)
+>>> ev.name, ev.compiled
+('fast', False)
 >>> q, s_dot = np.array([0.5, -0.2, 0.1]), np.array([0.3, 0.0, -1.0])
 >>> bool(np.allclose(ev.accelerations(q, s_dot, 0.0), system.accelerations(q, s_dot, method="dense"), atol=1e-12))
 True
@@ -36,42 +37,42 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.assembly import kernels
-from projeq.assembly.beam_fast import HubBeamEvaluator, hub_beam_unsupported
+from projeq.assembly.beam_fast import hub_beam_unsupported
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.subsystems.rigid import rigid_mass_matrix
 
 
 class FastEvaluator:
-    """s̈ of one System by the compiled order-n kernel, or by the general path.
+    """s̈ of one System by the order-n kernel.
 
     Parameters
     ----------
     system : System
-    compiled : bool or None
-        True: numba (ValueError if it is missing); False: the interpreted kernel (the
-        pure-numpy fallback); None: numba when installed, the interpreted kernel if the
-        environment variable ``PROJEQ_FAST_KERNEL=python``, else the general path.
+        A tree the kernel knows (module docstring); otherwise ValueError naming the piece
+        it does not know.
+    compiled : bool
+        True (default): compiled by numba (ValueError if it is not installed); False: the
+        same kernel interpreted.
 
-    Attributes: ``fast`` (a fast path is used), ``reason`` (why not, else None),
-    ``compiled`` (numba), ``n_calls``. The workspace (T_np, ζ_n, f_n, M̂_n, ĥ_n) is
-    allocated once and overwritten by every call.
+    Attributes: ``name`` ("fast"), ``compiled``, ``n_calls``. The workspace (T_np, ζ_n,
+    f_n, M̂_n, ĥ_n) is allocated once and overwritten by every call.
     """
 
-    def __init__(self, system, compiled: bool | None = None):
+    name = "fast"
+
+    def __init__(self, system, compiled: bool = True):
+        reason = unsupported(system)
+        if reason is not None:
+            hub_beam = " (method='hub_beam' is the fast one for it)" if hub_beam_unsupported(system) is None else ""
+            raise ValueError(
+                f"system: the fast kernel cannot evaluate it: {reason}; method='auto' picks the best "
+                f"evaluator available{hub_beam}"
+            )
         self.system = system
         self.n_calls = 0
-        self.compiled = False
-        self._delegate = None  # another evaluator that answers instead of the kernel
-        if hub_beam_unsupported(system) is None:
-            self.reason, self._delegate = None, HubBeamEvaluator(system)  # the beam's own fast path
-        else:
-            self.reason = unsupported(system) or kernels.missing_compiler(compiled)
-            if self.reason is not None:
-                self._delegate = system.evaluator("dense" if system.coupled else "recursive")
-        self.fast = self.reason is None
-        if self._delegate is None:
-            self._chain_terms, self._passes, self.compiled = kernels.kernel(compiled)
-            self._pack(system)
+        self.compiled = bool(compiled)
+        self._chain_terms, self._passes = kernels.kernel(self.compiled)
+        self._pack(system)
 
     def _pack(self, system) -> None:
         """Flat arrays of the tree (built once) and the workspace."""
@@ -93,8 +94,6 @@ class FastEvaluator:
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """s̈ at (q, ṡ, t) (THEORY §6); raises SingularMassError for a zero pivot D_n."""
         self.n_calls += 1
-        if self._delegate is not None:
-            return self._delegate.accelerations(q, s_dot, t)
         q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
         self._chain_terms(
             self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index,

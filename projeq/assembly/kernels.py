@@ -1,8 +1,8 @@
 """The loops of the fast evaluator on flat arrays: THEORY §4 (kinematics) and §6 (passes).
 
 Plain Python on scalars and small arrays, written so that numba can compile it
-(:func:`kernel` applies ``numba.njit(cache=True)`` when numba is installed); the same
-source runs interpreted as the fallback, so both are the same algorithm.
+(:func:`kernel` with ``compiled=True`` applies ``numba.njit(cache=True)``); the same source
+runs interpreted with ``compiled=False``, so both are the same algorithm.
 
 Joint kinds: ``FIXED`` (no dof), ``REVOLUTE`` (F⁶ = [0; e]), ``PRISMATIC`` (F⁶ = [e; 0]),
 about a unit axis e in joint-frame coordinates; subsystems: rigid bodies (M_n = M6,
@@ -18,7 +18,8 @@ checks each against its twin.
 
 from __future__ import annotations
 
-import os
+import functools
+import types
 
 import numpy as np
 
@@ -32,6 +33,11 @@ def _numba():
     except ImportError:
         return None
     return numba
+
+
+def has_numba() -> bool:
+    """Whether numba is installed (``pip install 'projeq[fast]'``)."""
+    return _numba() is not None
 
 
 def chain_terms(kind, parent, axis, orientation, offset, q_index, m, r_c, I_c, gravity, q, s_dot,
@@ -188,35 +194,36 @@ def _add_congruence(T, M, c, MT, M_p, h_p):
         h_p[a] += total
 
 
-def missing_compiler(compiled: bool | None) -> str | None:
-    """Why the default kernel choice (``compiled=None``) falls back to the general path:
-    numba is missing and the interpreted kernel was not asked for; else None."""
-    if compiled is None and _numba() is None and os.environ.get("PROJEQ_FAST_KERNEL", "") != "python":
-        return "numba is not installed (pip install 'projeq[fast]'): the recursive evaluator is used"
-    return None
-
-
-def kernel(compiled: bool | None = None):
-    """(chain_terms, passes), compiled by numba when ``compiled`` is true, or when it is
-    None, numba is installed and the environment variable ``PROJEQ_FAST_KERNEL`` is not
-    ``"python"``. Returns the functions and whether they are compiled."""
-    if compiled is None:
-        compiled = os.environ.get("PROJEQ_FAST_KERNEL", "") != "python" and _numba() is not None
+def kernel(compiled: bool = True):
+    """(chain_terms, passes): compiled by numba (ValueError if it is not installed), or with
+    ``compiled=False`` the interpreted functions of this module."""
     if not compiled:
-        return chain_terms, passes, False
-    numba = _numba()
-    if numba is None:
-        raise ValueError("compiled: numba is not installed (pip install 'projeq[fast]')")
-    if "compiled" not in _CACHE:
-        global _relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _add_congruence
-        # callees of compiled code (still plain Python when called from Python)
-        _relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _add_congruence = (
-            numba.extending.register_jitable(g)
-            for g in (_relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _add_congruence)
+        return chain_terms, passes
+    if not has_numba():
+        raise ValueError(
+            "compiled: numba is not installed (pip install 'projeq[fast]'); compiled=False runs the same "
+            "kernel interpreted, method='auto' picks the best evaluator available"
         )
-        jit = numba.njit(cache=True)
-        _CACHE["compiled"] = (jit(chain_terms), jit(passes))
-    return (*_CACHE["compiled"], True)
+    return _compiled()
 
 
-_CACHE: dict = {}
+_CALLEES = (_relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _add_congruence)
+
+
+@functools.cache
+def _compiled():
+    """chain_terms and passes compiled by numba, once per process (and cached on disk).
+
+    Compiled code resolves the functions it calls in its globals, so the kernels are
+    compiled as copies whose globals are a copy of this module's namespace holding numba's
+    versions of their callees; this module's functions stay plain Python (nothing rebound)."""
+    numba = _numba()
+    namespace = dict(globals())
+
+    def rebound(f):
+        return types.FunctionType(f.__code__, namespace, f.__name__, f.__defaults__, f.__closure__)
+
+    for f in _CALLEES:
+        namespace[f.__name__] = numba.extending.register_jitable(rebound(f))
+    jit = numba.njit(cache=True)
+    return jit(rebound(chain_terms)), jit(rebound(passes))

@@ -1,5 +1,9 @@
 """One forward pass over the tree: poses, describing velocities and chain terms (THEORY §4).
 
+:func:`forward` gives all of them (:class:`Kinematics`, what the evaluators need);
+:func:`poses` only the poses, twists and ẏ_n (:class:`Poses`, what energies, exports and
+constraint positions need, at about half the cost).
+
 For each subsystem n with predecessor p and joint frame J (fixed in p):
 
     A_pn = A_pJ A_Jn,  r_pn = r_pJ + A_pJ r_Jn,  T⁶_np = [[A_np, −A_np r̃_pn], [0, A_np]]
@@ -39,7 +43,8 @@ class Plan:
     - ``internal``: subsystems with internal coordinates q_e (ṡ_e = q̇_e), whose last n_e
       rows of ẏ_n are ṡ_e (S_n has zero rows there);
     - ``port[n]``: joint n sits on a deforming parent (``has_ports``, a beam), at the
-      station its ``r_pn`` names.
+      station its ``r_pn`` names; ``stations[n]``: that frame of the parent, built here
+      once (``parent.port_at(r_pn)``).
     """
 
     def __init__(self, system):
@@ -64,6 +69,9 @@ class Plan:
         self.internal = [n for n in range(N) if system.subsystems[n].n_e]
         self.port = [system.parent[n] >= 0 and system.subsystems[system.parent[n]].has_ports for n in range(N)]
         self.plain = [plain and not port for plain, port in zip(self.plain, self.port)]
+        self.stations = {
+            n: system.subsystems[system.parent[n]].port_at(system.joints[n].r_pn) for n in range(N) if self.port[n]
+        }
 
 
 def _augmented_selection(S: NDArray | None) -> NDArray:
@@ -82,17 +90,23 @@ def plan(system) -> Plan:
 
 
 @dataclass
-class Kinematics:
-    """Per-subsystem kinematic state; index −1 is the ground.
-
-    ``T_aug[n]`` is T̃_np = [[T_np, ζ_n], [0, 1]], the affine map (ÿ_p; 1) ↦ (ÿ_n − F_n s̈_n; 1)
-    that both evaluators use; ``T[n]`` and ``zeta[n]`` are views into it.
-    """
+class Poses:
+    """Poses and velocities of every subsystem; index −1 is the ground."""
 
     R: list  # body → inertial rotation of frame n
     r: list  # origin of frame n, inertial coordinates
     twist: list  # (v_O, ω) of frame n in its own coordinates
     y_dot: list  # ẏ_n = S_n twist
+
+
+@dataclass
+class Kinematics(Poses):
+    """Poses, velocities and chain terms of every subsystem; index −1 is the ground.
+
+    ``T_aug[n]`` is T̃_np = [[T_np, ζ_n], [0, 1]], the affine map (ÿ_p; 1) ↦ (ÿ_n − F_n s̈_n; 1)
+    that both evaluators use; ``T[n]`` and ``zeta[n]`` are views into it.
+    """
+
     T_aug: list  # T̃_np
     F: list  # F_n (n_y × n_s_n)
 
@@ -107,17 +121,18 @@ class Kinematics:
         return [T[:-1, -1] for T in self.T_aug[:-1]]
 
 
-def forward(system, q: NDArray, s_dot: NDArray, t: float, chain_terms: bool = True) -> Kinematics:
-    """Poses, ẏ_n, T̃_np (T_np and ζ_n) and F_n of every subsystem at (q, ṡ, t).
+def poses(system, q: NDArray, s_dot: NDArray, t: float) -> Poses:
+    """Poses, twists and ẏ_n of every subsystem at (q, ṡ, t), without the chain terms."""
+    prep = plan(system)
+    R, r, twist = _poses_and_twists(system, prep, q, s_dot, t)[:3]
+    return Poses(R, r, twist, _describing_velocities(system, prep, twist, s_dot))
 
-    With ``chain_terms=False`` only poses, twists and ẏ_n are computed (``T_aug`` and ``F``
-    are None): what energies, exports and constraint positions need, at about half the cost.
-    """
+
+def forward(system, q: NDArray, s_dot: NDArray, t: float) -> Kinematics:
+    """Poses, ẏ_n, T̃_np (T_np and ζ_n) and F_n of every subsystem at (q, ṡ, t)."""
     prep = plan(system)
     R, r, twist, rels, A_np, r_pn, u, P_aug = _poses_and_twists(system, prep, q, s_dot, t)
     y_dot = _describing_velocities(system, prep, twist, s_dot)
-    if not chain_terms:
-        return Kinematics(R, r, twist, y_dot, None, None)
     w = np.array([rel.w for rel in rels])
     zeta6 = cross_motion(np.array(u), w) + np.array([rel.zeta for rel in rels])  # Ṫ ẏ_p + Ḟ ṡ + ḟ
     T_aug6 = np.zeros((len(rels), 7, 7))
@@ -139,7 +154,7 @@ def _poses_and_twists(system, prep: Plan, q: NDArray, s_dot: NDArray, t: float) 
         p = parent[n]
         rels[n] = rel = joint.relative(system._q_get[n](q), system._s_get[n](s_dot), t)
         if prep.port[n]:  # the joint sits at a station of a deforming parent
-            base_R, base_r, base_twist, offset, P_aug[n] = _port(system, n, p, q, s_dot, R, r, twist)
+            base_R, base_r, base_twist, offset, P_aug[n] = _port(system, prep.stations[n], p, q, s_dot, R, r, twist)
         else:
             base_R, base_r, base_twist, offset = R[p], r[p], twist[p], joint.r_pn
         A_pn = joint.orientation @ rel.A
@@ -152,11 +167,11 @@ def _poses_and_twists(system, prep: Plan, q: NDArray, s_dot: NDArray, t: float) 
     return R, r, twist, rels, A_np, r_pn, u, P_aug
 
 
-def _port(system, n, p, q, s_dot, R, r, twist):
-    """The frame at joint n's station on its deforming parent p (``parent.port``): its
+def _port(system, station, p, q, s_dot, R, r, twist):
+    """The frame ``station`` (``Plan.stations``) of a joint on its deforming parent p: its
     pose, its twist, and P̃ = [[T⁶_port Sₚᵀ + F_port Eₑᵀ, ζ_port], [0, 1]], the map
     (ÿ_p; 1) ↦ (port acceleration; 1) that T̃_np composes with (THEORY §10, last line)."""
-    port = system.subsystems[p].port(system.joints[n].r_pn, q[system.e_q_slice[p]], s_dot[system.e_s_slice[p]])
+    port = station.relative(q[system.e_q_slice[p]], s_dot[system.e_s_slice[p]])
     T6 = chain_matrix(port.A.T, port.r)
     u = T6 @ twist[p]
     n_y = system.subsystems[p].n_y

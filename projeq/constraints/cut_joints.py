@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.checks import finite_array
-from projeq.assembly.kinematics import forward
+from projeq.assembly.kinematics import poses
 from projeq.spatial import cross
 
 _AXES = "xyz"
@@ -66,7 +66,7 @@ class PinClosure:
 
     def __call__(self, q, t: float = 0.0) -> NDArray:
         """Φ = (P_a − P_b)[axes] in inertial coordinates."""
-        kin = forward(self.tree, np.asarray(q, dtype=float), np.zeros(self.tree.n_s), float(t), chain_terms=False)
+        kin = poses(self.tree, np.asarray(q, dtype=float), np.zeros(self.tree.n_s), float(t))
         return (self._point(kin, self.a, self.rho_a) - self._point(kin, self.b, self.rho_b))[self.rows]
 
     def wrenches(self, kin, lam: NDArray) -> dict:

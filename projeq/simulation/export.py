@@ -22,7 +22,7 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
-from projeq.assembly.kinematics import forward
+from projeq.assembly.kinematics import poses
 from projeq.spatial import cross
 
 
@@ -46,7 +46,7 @@ def _draw(system, q, s_dot, t, stations: int, frame_size: float):
     """Points, velocities (inertial) and line cells of the model at one state: its tree
     moving with the tree velocities (a ConstrainedSystem's F ṡ + f, a System's ṡ)."""
     system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
-    kin = forward(system, q, s_dot, t, chain_terms=False)
+    kin = poses(system, q, s_dot, t)
     points, velocities, lines = [], [], []
     for n, sub in enumerate(system.subsystems):
         if sub.deforms:

@@ -31,6 +31,7 @@ import traceback
 import numpy as np
 
 from projeq import scenes
+from projeq.assembly.kernels import has_numba
 from projeq.subsystems import inertia
 from projeq.studies.bench_beam import convergence
 from projeq.studies.bench_derivation import derivation_effort
@@ -89,9 +90,10 @@ def mujoco_chain(n: int):
 
 
 def evaluators(n: int, peers: bool = True) -> dict:
-    """Name → function (q, ṡ) ↦ s̈ for projeq's evaluators and the installed peers."""
+    """Name → function (q, ṡ) ↦ s̈ for projeq's evaluators and the installed peers ("fast",
+    the compiled kernel, needs numba as the peers need their packages)."""
     system = scenes.chain(n)
-    names = [m for m in OURS if m != "dense" or n <= DENSE_UP_TO]
+    names = [m for m in OURS if (m != "dense" or n <= DENSE_UP_TO) and (m != "fast" or has_numba())]
     funcs = {m: _s_ddot(system.evaluator(m)) for m in names}
     if peers:
         builders = [("pinocchio", pinocchio_chain)] * (n <= PINOCCHIO_UP_TO) + [("mujoco", mujoco_chain)]
@@ -192,10 +194,10 @@ def format_table(rows, slope: dict) -> str:
     for r in rows:
         s = r["seconds"]
         cells = " ".join(f"{s[k] * 1e6:>14.1f}" if k in s else f"{'-':>14}" for k in names)
-        ratio = {p: f"{s['fast'] / s[p]:.2f}" if p in s else "-" for p in ("pinocchio", "mujoco")}
+        ratio = {p: f"{s['fast'] / s[p]:.2f}" if p in s and "fast" in s else "-" for p in ("pinocchio", "mujoco")}
         exact = {k: f"{r['exact_deviation'][k]:.1e}" if k in r.get("exact_deviation", {}) else "-" for k in ("fast", "dense")}
         lines.append(f"{r['n']:>6} {cells} {ratio['pinocchio']:>9} {ratio['mujoco']:>12} "
-                     f"{r['deviation']['fast']:>9.1e} {max(r['deviation'].values()):>9.1e} {exact['fast']:>14} {exact['dense']:>15}")
+                     f"{r['deviation'].get('fast', np.nan):>9.1e} {max(r['deviation'].values()):>9.1e} {exact['fast']:>14} {exact['dense']:>15}")
     if slope:
         lines.append("log-log slope: " + ", ".join(f"{k} {v:.3f}" for k, v in slope.items()))
     return "\n".join(lines)

@@ -19,7 +19,7 @@ from types import MethodType
 from numpy.typing import NDArray
 
 REQUIRED = ("n_y", "gauss_terms", "kinetic_energy", "potential_energy")  # no default
-DEFAULTS = ("S", "n_e", "rigid_inertia", "elastic_terms")  # optional members with a default
+DEFAULTS = ("S", "n_e", "rigid_inertia", "elastic_terms", "port_at")  # optional members with a default
 _ABSENT = object()
 DERIVED = ("rigid_inertia", "elastic_terms")  # derived from gauss_terms: reset where it is restated
 CAPABILITIES = {"has_ports": ("port",), "deforms": ("centre_line", "deflection")}  # flag: its methods
@@ -108,6 +108,13 @@ class Subsystem:
         frame: its pose, twist F q̇_e and ζ = Ḟ q̇_e (THEORY §10)."""
         raise NotImplementedError(f"{type(self).__name__} has no ports (has_ports is False)")
 
+    def port_at(self, point: NDArray) -> "Port":
+        """(``has_ports``) The frame at ``point``, built once per joint by the kinematic plan:
+        an object whose ``relative(q_e, q_e_dot)`` is :meth:`port` there. The default calls
+        :meth:`port`; a subsystem overrides it to prepare what the station needs once (a
+        beam: its shape functions there)."""
+        return Port(self, point)
+
     def centre_line(self, q_e: NDArray, y_dot: NDArray, stations: int = 21) -> tuple[NDArray, NDArray]:
         """(``deforms``) Positions and velocities of ``stations`` points of the centre line
         in the reference frame (for drawing and export)."""
@@ -119,13 +126,24 @@ class Subsystem:
         raise NotImplementedError(f"{type(self).__name__} does not deform (deforms is False)")
 
 
+class Port:
+    """The frame at ``point`` of ``subsystem`` (the default of :meth:`Subsystem.port_at`)."""
+
+    def __init__(self, subsystem, point: NDArray):
+        self.subsystem, self.point = subsystem, point
+
+    def relative(self, q_e: NDArray, q_e_dot: NDArray):
+        """:meth:`Subsystem.port` at this point."""
+        return self.subsystem.port(self.point, q_e, q_e_dot)
+
+
 def conform(name: str, sub) -> None:
     """Check that ``sub`` (added under ``name``) is a subsystem; called where a System is built.
 
     A missing required member (or a required method left to the base class) is a ValueError
     naming it. An object that does not subclass :class:`Subsystem` (duck-typed) is given the
     defaults of the members it lacks (``S``, ``n_e``, ``rigid_inertia``, :meth:`elastic_terms`
-    from its own ``gauss_terms``) and its capabilities (``has_ports`` if it has ``port``, ...),
+    from its own ``gauss_terms``, :meth:`port_at` from its own ``port``) and its capabilities (``has_ports`` if it has ``port``, ...),
     so that the evaluators read declared members only.
     """
     missing = [m for m in REQUIRED if not hasattr(sub, m) or getattr(type(sub), m, None) is getattr(Subsystem, m, _ABSENT)]

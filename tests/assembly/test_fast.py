@@ -3,10 +3,12 @@ dense Gauss form (THEORY §5, an independent O(N³) formulation) on random trees
 tolerance of tests/assembly/test_recursive_vs_dense.py (1e-10 relative to max(1, |s̈|∞)
 while κ∞(M) ≤ 1e4, the forward-error bound 1e-14 κ∞(M) max(1, |s̈|∞) beyond; both are
 backward stable, see that module's docstring). Both the numba-compiled kernel and the
-interpreted one (the fallback without numba) are checked; systems the kernel does not
-know must report it and give the general path's result.
+interpreted one are checked; method="fast" is the compiled kernel or a ValueError saying
+why (numba missing, a piece the kernel does not know), and method="auto" picks the best
+evaluator available and says which.
 """
 
+import types
 import warnings
 
 import numpy as np
@@ -16,7 +18,7 @@ from strategies import trees
 from test_recursive_vs_dense import _agree
 
 import projeq as pq
-from projeq.assembly import kernels
+from projeq.assembly import AutoEvaluator, kernels
 from projeq.assembly.beam_fast import HubBeamEvaluator
 from projeq.assembly.fast import FastEvaluator
 from projeq.assembly.linalg import SingularMassError
@@ -24,16 +26,17 @@ from projeq.spatial import chain_matrix, cross, rotation
 from projeq.subsystems.rigid import rigid_h
 
 KERNEL_KINDS = ("revolute", "prismatic", "fixed")
-HAS_NUMBA = kernels._numba() is not None
+HAS_NUMBA = kernels.has_numba()
 
 
 @given(trees(max_n=30, kinds=KERNEL_KINDS, forces=False))
 def test_fast_equals_dense_on_random_trees(tree):
     """Trees of 1–30 rigid bodies on revolute, prismatic and fixed joints about random axes,
-    random joint frames, masses over four decades: fast s̈ = dense s̈ (without numba
-    method="fast" is the recursive evaluator; the interpreted kernel is tested below)."""
-    assert tree.system.evaluator("fast").fast is HAS_NUMBA
-    _agree(tree, "fast", "dense")
+    random joint frames, masses over four decades: fast s̈ = dense s̈ (method="auto" is the
+    compiled kernel with numba, the recursive evaluator without; the interpreted kernel is
+    tested below)."""
+    assert tree.system.evaluator("auto").name == ("fast" if HAS_NUMBA else "recursive")
+    _agree(tree, "auto", "dense")
 
 
 @settings(max_examples=max(5, settings().max_examples // 5))
@@ -46,23 +49,33 @@ def test_interpreted_kernel_equals_dense(tree):
     _agree(tree, "fast", "dense")
 
 
-def test_environment_switch_selects_the_interpreted_kernel(monkeypatch):
-    """PROJEQ_FAST_KERNEL=python turns the compiled kernel off; the default follows numba."""
+@pytest.mark.skipif(not HAS_NUMBA, reason="numba is not installed")
+def test_the_kernel_is_compiled_unless_asked_otherwise(monkeypatch):
+    """The interpreted kernel only on request (compiled=False); no environment variable
+    switches it (the former PROJEQ_FAST_KERNEL=python is ignored), and compiling rebinds
+    nothing in projeq.assembly.kernels (its functions stay plain Python)."""
+    monkeypatch.setenv("PROJEQ_FAST_KERNEL", "python")
+    plain = {name: getattr(kernels, name) for name in dir(kernels) if callable(getattr(kernels, name))}
     system = pq.scenes.chain(2)
-    assert FastEvaluator(system).compiled is HAS_NUMBA
-    monkeypatch.setenv("PROJEQ_FAST_KERNEL", "python")
-    assert FastEvaluator(system).compiled is False
+    assert system.evaluator("fast").compiled is True and FastEvaluator(system).compiled is True
+    assert FastEvaluator(system, compiled=False).compiled is False
+    assert {name: getattr(kernels, name) for name in plain} == plain
+    assert all(type(f) is types.FunctionType for f in (kernels.chain_terms, kernels.passes, kernels._rigid_h))
 
 
-def test_without_numba_the_default_is_the_recursive_evaluator(monkeypatch):
+def test_without_numba_fast_is_refused_and_auto_picks_the_recursive_evaluator(monkeypatch):
     """The interpreted kernel is slower than the recursive evaluator, so without numba
-    method="fast" does not use it unless asked (PROJEQ_FAST_KERNEL=python)."""
+    method="fast" raises saying so, and method="auto" picks the recursive evaluator and
+    says why; the interpreted kernel still runs on request (compiled=False)."""
     monkeypatch.setattr(kernels, "_numba", lambda: None)
-    monkeypatch.delenv("PROJEQ_FAST_KERNEL", raising=False)
-    ev = FastEvaluator(pq.scenes.chain(2))
-    assert ev.fast is False and "numba is not installed" in ev.reason
-    monkeypatch.setenv("PROJEQ_FAST_KERNEL", "python")
-    assert FastEvaluator(pq.scenes.chain(2)).fast is True
+    system = pq.scenes.chain(2)
+    with pytest.raises(ValueError, match="numba is not installed"):
+        system.evaluator("fast")
+    auto = AutoEvaluator(system)
+    assert auto.name == "recursive" and "numba is not installed" in auto.reason
+    q, s_dot = np.array([0.3, -0.2]), np.array([0.1, 0.5])
+    np.testing.assert_array_equal(auto.accelerations(q, s_dot, 0.0), system.accelerations(q, s_dot, method="recursive"))
+    assert FastEvaluator(system, compiled=False).compiled is False
 
 
 def test_compiled_without_numba_is_refused(monkeypatch):
@@ -122,8 +135,7 @@ def test_the_kernel_takes_massless_frames():
         {"cross": pq.Revolute(axis="x"), "bob": pq.Revolute(parent="cross", axis="y")},
         gravity=(0, 0, -9.81), q0=[0.3, 0.5], s_dot0=[1.0, -2.0],
     )
-    ev = FastEvaluator(system, compiled=False)  # the kernel's source, with or without numba
-    assert ev.fast and ev.reason is None
+    ev = FastEvaluator(system, compiled=False)  # the kernel's source, with or without numba: not refused
     np.testing.assert_allclose(ev.accelerations(system.q0, system.s_dot0, 0.0),
                                system.accelerations(system.q0, system.s_dot0, method="recursive"), rtol=1e-13, atol=1e-14)
 
@@ -141,27 +153,31 @@ def test_the_kernel_takes_massless_frames():
     ],
     ids=["planar body", "coupled joints", "non-holonomic joint", "beam", "prescribed joint", "force law"],
 )
-def test_unsupported_systems_report_the_general_path(build, reason):
-    """Unknown pieces: ``fast`` is False, ``reason`` names the piece, and s̈ is exactly the
-    general evaluator's (it is the same call)."""
+def test_unsupported_systems_are_refused_and_auto_picks_the_general_path(build, reason):
+    """Unknown pieces: method="fast" raises naming the piece; method="auto" picks the
+    general evaluator, says why, and its s̈ is exactly the general evaluator's (it is the
+    same call)."""
     system = build()
-    ev = system.evaluator("fast")
-    assert ev.fast is False and reason in ev.reason
+    with pytest.raises(ValueError, match=f"^system: the fast kernel cannot evaluate it: .*{reason}"):
+        system.evaluator("fast")
     general = "dense" if system.coupled else "recursive"
+    ev = system.evaluator("auto")
+    assert ev.name == general and reason in ev.reason
     rng = np.random.default_rng(3)
     q, s_dot = system.normalized(system.q0 + 0.1 * rng.standard_normal(system.n_q)), rng.standard_normal(system.n_s)
-    np.testing.assert_array_equal(system.accelerations(q, s_dot, 0.2, method="fast"),
+    np.testing.assert_array_equal(system.accelerations(q, s_dot, 0.2, method="auto"),
                                   system.accelerations(q, s_dot, 0.2, method=general))
 
 
 def test_workspace_reuse_gives_identical_results():
-    """One evaluator called at many states returns bit for bit what a new one returns."""
+    """One evaluator called at many states returns bit for bit what a new one returns (the
+    compiled kernel, or without numba the interpreted one)."""
     system = pq.scenes.chain(12)
-    ev, rng = FastEvaluator(system), np.random.default_rng(5)
+    ev, rng = FastEvaluator(system, compiled=HAS_NUMBA), np.random.default_rng(5)
     states = [(rng.uniform(-2, 2, 12), rng.uniform(-2, 2, 12)) for _ in range(4)]
     reused = [ev.accelerations(q, s_dot, 0.0) for q, s_dot in states]
     for (q, s_dot), a in zip(states, reused):
-        np.testing.assert_array_equal(a, FastEvaluator(system).accelerations(q, s_dot, 0.0))
+        np.testing.assert_array_equal(a, FastEvaluator(system, compiled=HAS_NUMBA).accelerations(q, s_dot, 0.0))
 
 
 @pytest.mark.parametrize("compiled", [False, True] if HAS_NUMBA else [False])
@@ -173,10 +189,11 @@ def test_zero_pivot_raises_singular_mass_error(compiled):
 
 
 def test_simulate_with_the_fast_evaluator():
-    """simulate(..., evaluator="fast") follows the recursive run (same integrator steps up
-    to round-off: the trajectories agree far below rtol = 1e-8)."""
+    """simulate(..., evaluator="auto") (the compiled kernel with numba) follows the
+    recursive run (same integrator steps up to round-off: the trajectories agree far below
+    rtol = 1e-8)."""
     system = pq.scenes.chain(4)
-    a = pq.simulate(system, 1.0, evaluator="fast", rtol=1e-8, atol=1e-10, n_points=11)
+    a = pq.simulate(system, 1.0, evaluator="auto", rtol=1e-8, atol=1e-10, n_points=11)
     b = pq.simulate(system, 1.0, evaluator="recursive", rtol=1e-8, atol=1e-10, n_points=11)
     np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-9)  # 10 atol: step choices may differ by round-off
 
@@ -215,19 +232,21 @@ def _clamped_beam():
     ids=["spin-up", "spin-up precomputed", "tilted hub", "tilted hub precomputed", "unstiffened", "fixed root"],
 )
 def test_hub_beam_path_equals_recursive(build):
-    """One RitzBeam on a prescribed or fixed hub goes through the beam path
-    (projeq/assembly/beam_fast.py: M_ee q̈ = h_e − M_eR ζ, no chain, no passes) and
-    equals the recursive evaluator (THEORY §6) to round-off (1e-10 of max(1, |s̈|∞)) at
-    deformed, moving states and several times."""
+    """One RitzBeam on a prescribed or fixed hub goes through its own evaluator
+    (method="hub_beam", projeq/assembly/beam_fast.py: M_ee q̈ = h_e − M_eR ζ, no chain, no
+    passes), which "auto" picks and "fast" (the rigid-body kernel) refuses, and equals the
+    recursive evaluator (THEORY §6) to round-off (1e-10 of max(1, |s̈|∞)) at deformed,
+    moving states and several times."""
     system = build()
-    ev = system.evaluator("fast")
-    assert ev.fast and ev.reason is None
+    assert system.evaluator("auto").name == "hub_beam"
+    with pytest.raises(ValueError, match="the fast kernel cannot evaluate it: .*method='hub_beam' is the fast one"):
+        system.evaluator("fast")
     rng = np.random.default_rng(4)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # the unstiffened beam may spin too fast: said once
         for t in (0.3, 2.0, 7.5):
             q, s_dot = 0.05 * rng.standard_normal(system.n_q), rng.standard_normal(system.n_s)
-            fast = system.accelerations(q, s_dot, t, method="fast")
+            fast = system.accelerations(q, s_dot, t, method="hub_beam")
             recursive = system.accelerations(q, s_dot, t, method="recursive")
             assert np.abs(fast - recursive).max() <= 1e-10 * max(1.0, np.abs(recursive).max())
 

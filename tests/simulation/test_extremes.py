@@ -3,6 +3,8 @@
 Each test's docstring states what "passes" means and the independent reference it is
 checked against. The long runs (1e5 pendulum periods, 1e4 disk revolutions, the
 1000-body chain for 1 s, the spin-up at four speeds) are in benchmarks/extremes.py.
+"The fast evaluator" below is method="auto": the compiled kernel when numba is installed,
+else the recursive evaluator.
 """
 
 import warnings
@@ -131,7 +133,7 @@ def test_projected_method_keeps_the_pendulum_energy_at_round_off():
         warnings.simplefilter("error", StiffnessWarning)  # a non-stiff system: no warning
         for method in ("RK45", "RK45-projected"):
             result = pq.simulate(pendulum(), 10 * period, q0=[1.0], s_dot0=[0.0], method=method,
-                                 rtol=rtol, atol=atol, n_points=201, evaluator="fast")
+                                 rtol=rtol, atol=atol, n_points=201, evaluator="auto")
             errors[method] = np.abs(result.energy - result.energy[0]) / (9.81 * 1.0)  # / (m g l)
     quarter = 50
     assert errors["RK45"][-quarter:].max() > 2 * errors["RK45"][:quarter].max()
@@ -213,7 +215,7 @@ def test_chain_stretched_straight_is_not_singular():
         system = pq.scenes.chain(n, q0=np.r_[first, np.zeros(n - 1)])
         kappa = np.linalg.cond(system.mass_matrix(system.q0))
         assert kappa * EPS < 1e-6
-        results = [system.accelerations(system.q0, s_dot, method=m) for m in ("dense", "recursive", "fast")]
+        results = [system.accelerations(system.q0, s_dot, method=m) for m in ("dense", "recursive", "auto")]
         # hanging: s̈ = 0 up to round-off of the centripetal terms, n² |ṡ|² ~ 400 m/s²
         scale = np.abs(results[0]).max() if first else 400.0
         for other in results[1:]:
@@ -246,7 +248,7 @@ def test_mass_ratios_evaluators_agree(masses):
         q, s_dot = rng.uniform(-1.5, 1.5, 3), rng.uniform(-2.0, 2.0, 3)
         kappa = np.linalg.cond(system.mass_matrix(q))
         dense = system.accelerations(q, s_dot, method="dense")
-        for method in ("recursive", "fast"):
+        for method in ("recursive", "auto"):
             other = system.accelerations(q, s_dot, method=method)
             assert np.abs(other - dense).max() <= 10 * kappa * EPS * np.abs(dense).max(), method
 
@@ -270,10 +272,10 @@ def test_thousand_body_chain_short_run():
     with its energy conserved to n_steps · rtol (as above) and the fast evaluator equal to
     the recursive one at the initial state to 10 κ(M) ε (perturbation bound)."""
     system = pq.scenes.chain(1000)
-    fast = system.accelerations(system.q0, system.s_dot0, method="fast")
+    fast = system.accelerations(system.q0, system.s_dot0, method="auto")
     recursive = system.accelerations(system.q0, system.s_dot0, method="recursive")
     assert np.abs(fast - recursive).max() <= 1e-9 * np.abs(recursive).max()
     rtol = 1e-8
-    result = pq.simulate(system, 5e-3, method="RK45", rtol=rtol, atol=1e-10, evaluator="fast", n_points=3,
+    result = pq.simulate(system, 5e-3, method="RK45", rtol=rtol, atol=1e-10, evaluator="auto", n_points=3,
                          n_segments=1)
     assert result.energy_drift < result.nfev / 6 * rtol

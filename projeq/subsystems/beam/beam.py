@@ -17,13 +17,17 @@ carries the spin-up torque's coupling, docs/theory.md). Because
 u₂ is part of the kinematics, the projection of the slices' axial inertia loads on
 ∂u₂/∂q gives the geometric stiffness ∫ N(x) Φ′Φ′ᵀ dx with N(x) = ∫ₓᴸ f_x: dynamic
 stiffening from spin, angular and frame acceleration and gravity alike, and the model
-stays conservative (tests/subsystems/test_beam.py checks energy). Integrals by
-Gauss–Legendre quadrature at stations fixed at construction.
+stays conservative (tests/subsystems/test_beam.py checks energy). Integrals at
+Gauss–Legendre stations fixed at construction, summed per call or from moments computed
+once (the ``integration`` strategy, :mod:`projeq.subsystems.beam.integrals`).
 
 Letters: ``K_e`` is the stiffness matrix (``K`` is kept for q̇ = K ṡ).
 """
 
 from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,7 +38,7 @@ from projeq.joints import Relative
 from projeq.spatial import cross, rotation_x, rotation_y, rotation_z, skew, skew_stack
 from projeq.subsystems.beam import shapes
 from projeq.subsystems.beam.checks import family_shapes, per_length
-from projeq.subsystems.beam.integrals import ShapeIntegrals
+from projeq.subsystems.beam.integrals import PrecomputedIntegrals, Quadrature
 from projeq.subsystems.base import Subsystem
 from projeq.subsystems.beam.probes import BeamProbes
 
@@ -77,10 +81,27 @@ class RitzBeam(BeamProbes, Subsystem):
         Include u₂ (dynamic stiffening); default True.
     damping : float
         β of the stiffness-proportional damping force −β K_e q̇_e (s).
+    integration : Quadrature or PrecomputedIntegrals, optional
+        How the slices' translation terms of B(25) are integrated, chosen here once
+        (:mod:`projeq.subsystems.beam.integrals`): by quadrature at every call
+        (:class:`~projeq.subsystems.beam.integrals.Quadrature`, the default) or from moments
+        of the shape functions computed once
+        (:class:`~projeq.subsystems.beam.integrals.PrecomputedIntegrals`: exact for this
+        model at any deformation). Any class ``integration(beam)`` answering ``terms`` and
+        ``elastic_rows`` as these do.
     precomputed_integrals : bool
-        Assemble M_n, h_n from moments of the shape functions computed once (exact for
-        this model at any deformation, see :mod:`projeq.subsystems.beam.integrals`) instead of
-        quadrature per call; default False.
+        Shorthand for ``integration=PrecomputedIntegrals``; default False.
+
+    Attributes
+    ----------
+    integrals : Quadrature or PrecomputedIntegrals
+        The integration strategy built for this beam.
+    K_e : ndarray
+        Stiffness matrix of the elastic coordinates.
+    first_frequency : float
+        Lowest bending frequency at rest (rad/s).
+    x : ndarray
+        The quadrature stations (m).
     """
 
     def __init__(
@@ -103,6 +124,7 @@ class RitzBeam(BeamProbes, Subsystem):
         stiffening: bool = True,
         damping: float = 0.0,
         precomputed_integrals: bool = False,
+        integration=None,
     ):
         self.length = L = positive("length", length)
         for name, n in (("n_v", n_v), ("n_w", n_w), ("n_u", n_u), ("n_beta", n_beta)):
@@ -137,10 +159,10 @@ class RitzBeam(BeamProbes, Subsystem):
         self._stiffness(EI_z, self._EI["y"], EA, GI_t)
         self._rotary(rho_I, rho_I_p)
         self._check_independent()
-        self.integrals = ShapeIntegrals(self) if precomputed_integrals else None
-        self._ports: dict = {}  # station data of joints attached to the beam, by station
-        self._warned = False  # the unstiffened-spin warning is given once per beam
-        self.first_frequency = self._first_frequency()
+        self.integrals = _integration(integration, precomputed_integrals)(self)
+        bending = np.r_[self.v_cols, self.w_cols] - 6
+        M_b = self._mass_at_rest()[np.ix_(bending, bending)]
+        self.first_frequency = first_bending_frequency(self.K_e[np.ix_(bending, bending)], M_b)
 
     # -- precomputation ------------------------------------------------------------------
     def _shapes(self, family, L) -> None:
@@ -266,37 +288,18 @@ class RitzBeam(BeamProbes, Subsystem):
                 return f"{key}[{k - cols.start + 6}]"
         raise IndexError(k)
 
-    def _first_frequency(self) -> float:
-        """Lowest bending frequency of the beam at rest on its support (rad/s), from the
-        bending blocks of M_ee and K_e."""
-        from scipy.linalg import eigh
-
-        M, _ = self.gauss_terms(np.zeros(self.n_y), np.eye(3), np.zeros(3), np.zeros(self.n_e))
-        bending = np.r_[self.v_cols, self.w_cols] - 6
-        if bending.size == 0:
-            return np.inf
-        M_b, K_b = M[6:, 6:][np.ix_(bending, bending)], self.K_e[np.ix_(bending, bending)]
-        return float(np.sqrt(max(eigh(K_b, M_b, eigvals_only=True)[0], 0.0)))
-
-    def _warn_unstiffened_spin(self, omega: NDArray) -> None:
-        """Without stiffening a spin about an axis across the beam faster than its first
-        bending frequency makes the model unstable (ω_lag² = ω₁² − Ω² < 0): allowed, but
-        said once."""
-        spin = float(np.hypot(omega[1], omega[2]))
-        if spin > self.first_frequency:
-            import warnings
-
-            self._warned = True
-            warnings.warn(
-                f"RitzBeam without stiffening spins at {spin:.3g} rad/s, above its first bending "
-                f"frequency {self.first_frequency:.3g} rad/s: the unstiffened model is unstable there "
-                "(use stiffening=True)",
-                RuntimeWarning,
-                stacklevel=2,
-            )
+    def _mass_at_rest(self) -> NDArray:
+        """M_ee of the undeformed beam: Σ_k m_k Ψ_kᵀ Ψ_k + Σ_k Φ_θ,kᵀ I_k Φ_θ,k over the stations
+        (translation with Ψ = Φ_r(x, 0), and the slices' rotary inertia)."""
+        Psi = self.slices(np.zeros(self.n_e))[1]
+        M = np.einsum("k,kai,kaj->ij", self.mass_weights, Psi, Psi)
+        if self.rotary is not None:
+            Phi_theta = self.J_omega[:, :, 6:]
+            M += np.einsum("ka,kai,kaj->ij", self.rotary, Phi_theta, Phi_theta)
+        return M
 
     # -- slice kinematics ------------------------------------------------------------------
-    def _slices(self, q_e: NDArray, x: NDArray | None = None, data=None):
+    def slices(self, q_e: NDArray, x: NDArray | None = None, data=None):
         """r(x) and Φ_r(x, q_e) at the quadrature stations (or at ``x`` with its
         ``station_data``)."""
         x, (Phi, H) = (self.x, (self.Phi, self.H)) if x is None else (x, data)
@@ -318,7 +321,7 @@ class RitzBeam(BeamProbes, Subsystem):
             Phi_r[:, 0, e(self.w_cols)] = -Hq_w
         return r, Phi_r
 
-    def _jacobian(self, r: NDArray, Phi_r: NDArray) -> NDArray:
+    def jacobian(self, r: NDArray, Phi_r: NDArray) -> NDArray:
         """J(x) = [E, −r̃(x), Φ_r(x)], stacked over the stations."""
         J = np.empty((len(r), 3, self.n_y))
         J[:, :, :3] = np.eye(3)
@@ -328,14 +331,11 @@ class RitzBeam(BeamProbes, Subsystem):
 
     # -- the subsystem interface -------------------------------------------------------------
     def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray):
-        """(M_n, h_n) of B(25) by quadrature (see the module docstring) or, with
-        ``precomputed_integrals``, from the shape integrals."""
+        """(M_n, h_n) of B(25): the translation by the beam's integration strategy, the
+        rotary inertia of the slices and the restoring forces (module docstring)."""
         omega, q_e_dot = y_dot[3:6], y_dot[6:]
         self._check_spin(omega)
-        if getattr(self, "integrals", None) is None:
-            M, h = self._translation_terms(y_dot, R, gravity, q_e)
-        else:
-            M, h = self.integrals.terms(y_dot, R, gravity, q_e)
+        M, h = self.integrals.terms(y_dot, R, gravity, q_e)
         if self.rotary is not None:
             Jw, omega_c, c_w = self._slice_rotation(omega, q_e, q_e_dot, y_dot)
             Jw_flat = (Jw * np.sqrt(self.rotary)[:, :, None]).reshape(-1, self.n_y)
@@ -346,9 +346,9 @@ class RitzBeam(BeamProbes, Subsystem):
 
     def elastic_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray):
         """The last n_e rows (M_e, h_e) of :meth:`gauss_terms`: all a beam on a prescribed
-        hub needs (:mod:`projeq.assembly.beam_fast`); with precomputed integrals and no
-        rotary inertia only these rows are formed."""
-        if getattr(self, "integrals", None) is None or self.rotary is not None:
+        hub needs (:mod:`projeq.assembly.beam_fast`); without rotary inertia only these rows
+        are asked of the integration strategy (precomputed integrals form only them)."""
+        if self.rotary is not None:
             M, h = self.gauss_terms(y_dot, R, gravity, q_e)
             return M[6:], h[6:]
         self._check_spin(y_dot[3:6])
@@ -356,29 +356,21 @@ class RitzBeam(BeamProbes, Subsystem):
         return M_e, h_e - self._restoring_force(q_e, y_dot[6:])
 
     def _check_spin(self, omega: NDArray) -> None:
-        """Warn once if the unstiffened model spins above its first bending frequency."""
-        if not (self.stiffening or self._warned) and hasattr(self, "first_frequency"):
-            self._warn_unstiffened_spin(omega)
+        """Without stiffening a spin about an axis across the beam faster than its first
+        bending frequency makes the model unstable (ω_lag² = ω₁² − Ω² < 0): allowed, but
+        said by a RuntimeWarning whose text is fixed per beam, so that Python's warning
+        filters show it once (the default action: once per text and place)."""
+        if not self.stiffening and np.hypot(omega[1], omega[2]) > self.first_frequency:
+            warnings.warn(
+                f"RitzBeam without stiffening spins about an axis across the beam faster than its first "
+                f"bending frequency {self.first_frequency:.3g} rad/s: the unstiffened model is unstable "
+                "there (use stiffening=True)",
+                RuntimeWarning,
+            )
 
     def _restoring_force(self, q_e: NDArray, q_e_dot: NDArray) -> NDArray:
         """K_e (q_e + d q̇_e): elastic and stiffness-proportional damping forces."""
         return self.K_e @ (q_e + self.damping * q_e_dot)
-
-    def _translation_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray):
-        """∫Jᵀ J dm and −∫Jᵀ c dm of the slices' translation by quadrature."""
-        r, Phi_r = self._slices(q_e)
-        J = self._jacobian(r, Phi_r)
-        v_R, omega, q_e_dot = y_dot[:3], y_dot[3:6], y_dot[6:]
-        r_dot = Phi_r @ q_e_dot
-        v_c = v_R + cross(omega, r) + r_dot
-        c = cross(omega, r_dot) + cross(omega, v_c) - R.T @ gravity  # J̇ẏ + ω̃ v_c − g
-        if self.stiffening:
-            qd_v, qd_w = q_e_dot[self._local(self.v_cols)], q_e_dot[self._local(self.w_cols)]
-            c[:, 0] -= (self.H["v"] @ qd_v) @ qd_v + (self.H["w"] @ qd_w) @ qd_w  # d/dt(∂u₂/∂q) q̇
-        J_flat = (J * np.sqrt(self.mass_weights)[:, None, None]).reshape(-1, self.n_y)
-        M = J_flat.T @ J_flat
-        h = -J.reshape(-1, self.n_y).T @ (c * self.mass_weights[:, None]).ravel()
-        return M, h
 
     def _slice_rotation(self, omega, q_e, q_e_dot, y_dot):
         """Angular velocity of the slices in their own (slightly turned) frames to second
@@ -416,7 +408,7 @@ class RitzBeam(BeamProbes, Subsystem):
 
     def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray, q_e: NDArray) -> float:
         """Gravity −∫ g·r_slice dm plus the strain energy ½ q_eᵀ K_e q_e."""
-        r_x, _ = self._slices(q_e)
+        r_x, _ = self.slices(q_e)
         return float(-self.mass_weights @ (r_x @ R.T + r) @ gravity + 0.5 * q_e @ self.K_e @ q_e)
 
     def port(self, point: NDArray, q_e: NDArray, q_e_dot: NDArray) -> Relative:
@@ -428,25 +420,21 @@ class RitzBeam(BeamProbes, Subsystem):
         relative twist F q̇_e in port coordinates with F = [[Aᵀ Φ_r − c̃ Φ_ω], [Φ_ω]],
         Φ_ω q̇_e = R_xᵀ(v̇′ (−sin(−w′), 0, cos(−w′)) − ẇ′ e_y) + β̇ e_x; Ḟ q̇_e by complex step.
         """
+        return self.port_at(point).relative(q_e, q_e_dot)
+
+    def port_at(self, point: NDArray) -> BeamPort:
+        """The frame attached at ``point`` with its station data computed once: its
+        ``relative(q_e, q_e_dot)`` is :meth:`port` (for evaluators that keep it)."""
         x = float(point[0])
         if not 0.0 <= x <= self.length:
             raise ValueError(f"r_pn: a joint on a beam must sit at a station 0 ≤ x ≤ {self.length}, got x = {x}")
-        offset = np.array([0.0, point[1], point[2]])
-        data = self._port_data(x)
-        A, r, F = self._port_terms(q_e, data, offset)
-        F_dot = complex_step(lambda eps: self._port_terms(q_e + eps * q_e_dot, data, offset)[2])
-        return Relative(A, r, F, F @ q_e_dot, F_dot @ q_e_dot)
-
-    def _port_data(self, x: float):
-        """Station data at x, kept per station (ports sit at fixed stations)."""
-        if x not in self._ports:
-            self._ports[x] = (np.array([x]), self.station_data(np.array([x])))
-        return self._ports[x]
+        station = np.array([x])
+        return BeamPort(self, (station, self.station_data(station)), np.array([0.0, point[1], point[2]]))
 
     def _port_terms(self, q_e, data, offset):
         """(A, r, F) of a port; complex-safe, for the complex-step Ḟ."""
         x, (Phi, H) = data
-        r_x, Phi_r = self._slices(q_e, x, (Phi, H))
+        r_x, Phi_r = self.slices(q_e, x, (Phi, H))
         e = self._local
         a = Phi["v"][1][:, 0] @ q_e[e(self.v_cols)]  # v′
         b = -(Phi["w"][1][:, 0] @ q_e[e(self.w_cols)])  # −w′
@@ -465,3 +453,51 @@ class RitzBeam(BeamProbes, Subsystem):
     def __repr__(self) -> str:
         counts = f"n_u={self.n_u}, n_v={self.n_v}, n_w={self.n_w}, n_beta={self.n_beta}"
         return f"RitzBeam(L={self.length}, {counts}, support={self.support!r}, stiffening={self.stiffening})"
+
+
+@dataclass(frozen=True)
+class BeamPort:
+    """A frame attached to a RitzBeam at a station x with cross-section offset c, and the
+    beam's station data there (built once by :meth:`RitzBeam.port_at`)."""
+
+    beam: RitzBeam
+    data: tuple  # (x as a 1-array, station_data(x))
+    offset: NDArray  # c = (0, y, z)
+
+    def relative(self, q_e: NDArray, q_e_dot: NDArray) -> Relative:
+        """Pose, F q̇_e and Ḟ q̇_e relative to the beam's frame (:meth:`RitzBeam.port`);
+        Ḟ q̇_e by complex step."""
+        A, r, F = self.beam._port_terms(q_e, self.data, self.offset)
+        F_dot = complex_step(lambda eps: self.beam._port_terms(q_e + eps * q_e_dot, self.data, self.offset)[2])
+        return Relative(A, r, F, F @ q_e_dot, F_dot @ q_e_dot)
+
+
+def first_bending_frequency(K_b: NDArray, M_b: NDArray) -> float:
+    """Lowest bending frequency (rad/s) of a beam at rest on its support: ω₁ = √λ₁ with λ₁
+    the smallest eigenvalue of K_b φ = λ M_b φ, the bending blocks of the stiffness and mass
+    matrices; ∞ without bending functions.
+
+    >>> round(first_bending_frequency(np.diag([4.0, 9.0]), np.eye(2)), 12)
+    2.0
+    """
+    if K_b.size == 0:
+        return np.inf
+    from scipy.linalg import eigh
+
+    return float(np.sqrt(max(eigh(K_b, M_b, eigvals_only=True)[0], 0.0)))
+
+
+def _integration(integration, precomputed_integrals: bool):
+    """The integration strategy from ``integration`` or its shorthand ``precomputed_integrals``."""
+    if integration is None:
+        return PrecomputedIntegrals if precomputed_integrals else Quadrature
+    if not callable(integration):
+        raise ValueError(
+            f"integration: expected Quadrature, PrecomputedIntegrals or a class integration(beam), got {integration!r}"
+        )
+    if precomputed_integrals and integration is not PrecomputedIntegrals:
+        raise ValueError(
+            f"precomputed_integrals, integration: precomputed_integrals=True is integration=PrecomputedIntegrals, "
+            f"but integration={integration!r} was given"
+        )
+    return integration

@@ -1,7 +1,20 @@
-"""Precomputed shape integrals of a RitzBeam: M_n and h_n of B(25) without quadrature per
-call, exact for the beam's model (THEORY §10, "a speed/accuracy knob").
+"""How a RitzBeam integrates the slices' translation terms of B(25), chosen once in its
+constructor (``integration=``): :class:`Quadrature` sums them at the Gauss stations at every
+call; :class:`PrecomputedIntegrals` assembles them from moments of the shape functions
+computed once, exact for the beam's model (THEORY §10, "a speed/accuracy knob").
 
-The slice position is a polynomial of degree two in the elastic coordinates,
+Both are built with the beam, ``integration(beam)``, and answer ``terms(y_dot, R,
+gravity, q_e)`` (M_n, h_n of the translation) and ``elastic_rows(...)`` (their last n_e
+rows). Rotary inertia and the stiffness stay with the beam (shared by both).
+
+**Quadrature.** With J(x) = [E, −r̃(x), Φ_r(x)] and the acceleration not proportional to ÿ,
+c(x) = J̇ ẏ + ω̃ v_c − g_R = ω̃ ṙ + ω̃ v_c − (q̇_vᵀH_v q̇_v + q̇_wᵀH_w q̇_w) e_x − g_R,
+
+    M_n = Σ_k m_k J(x_k)ᵀ J(x_k),   h_n = −Σ_k m_k J(x_k)ᵀ c(x_k)
+
+over the stations x_k with masses m_k = w_k ρA(x_k).
+
+**Precomputed integrals.** The slice position is a polynomial of degree two in the elastic coordinates,
 
     r(x, q) = R(x) z(q),   z = (1, q, q_v ⊗ q_v, q_w ⊗ q_w),
 
@@ -22,8 +35,7 @@ c = a + ω̃ω̃ r + 2 ω̃ ṙ + R Ż q̇ (a = ω̃ v_R − g_R) give
 and M_n = ∫ Jᵀ J dm, h_n = −∫ Jᵀ c dm follow from them without approximation: equal to
 the quadrature mode to round-off, for any deformation (tests/subsystems/test_beam_integrals.py).
 The cost per call is O(n_z²) with n_z = 1 + n_e + n_v² + n_w², independent of the number
-of stations. Rotary inertia and the stiffness stay with the beam (shared with the
-quadrature mode).
+of stations.
 """
 
 from __future__ import annotations
@@ -34,8 +46,40 @@ from numpy.typing import NDArray
 from projeq.spatial import cross, skew, vee
 
 
-class ShapeIntegrals:
-    """The moments G_ab, R̄, m of ``beam`` (a RitzBeam), by its quadrature, once."""
+class Quadrature:
+    """The translation terms of ``beam`` (a RitzBeam) by its Gauss quadrature at every call
+    (module docstring); the default."""
+
+    def __init__(self, beam):
+        self.beam = beam
+        self._v, self._w = (slice(cols.start - 6, cols.stop - 6) for cols in (beam.v_cols, beam.w_cols))
+
+    def terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray) -> tuple[NDArray, NDArray]:
+        """(M_n, h_n) of the slices' translation, B(25): Σ m_k Jᵀ J and −Σ m_k Jᵀ c."""
+        beam = self.beam
+        r, Phi_r = beam.slices(q_e)
+        J = beam.jacobian(r, Phi_r)
+        v_R, omega, q_e_dot = y_dot[:3], y_dot[3:6], y_dot[6:]
+        r_dot = Phi_r @ q_e_dot
+        v_c = v_R + cross(omega, r) + r_dot
+        c = cross(omega, r_dot) + cross(omega, v_c) - R.T @ gravity  # J̇ẏ + ω̃ v_c − g
+        if beam.stiffening:
+            qd_v, qd_w = q_e_dot[self._v], q_e_dot[self._w]
+            c[:, 0] -= (beam.H["v"] @ qd_v) @ qd_v + (beam.H["w"] @ qd_w) @ qd_w  # d/dt(∂u₂/∂q) q̇
+        J_flat = (J * np.sqrt(beam.mass_weights)[:, None, None]).reshape(-1, beam.n_y)
+        M = J_flat.T @ J_flat
+        h = -J.reshape(-1, beam.n_y).T @ (c * beam.mass_weights[:, None]).ravel()
+        return M, h
+
+    def elastic_rows(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e: NDArray) -> tuple[NDArray, NDArray]:
+        """The last n_e rows of :meth:`terms` (by quadrature they cost as much as all rows)."""
+        M, h = self.terms(y_dot, R, gravity, q_e)
+        return M[6:], h[6:]
+
+
+class PrecomputedIntegrals:
+    """The translation terms of ``beam`` (a RitzBeam) from its moments G_ab, R̄, m, computed
+    once by its quadrature (module docstring)."""
 
     def __init__(self, beam):
         self.beam = beam
@@ -50,7 +94,7 @@ class ShapeIntegrals:
         self.n_z = 1 + n_e + sum(block.shape[1] for block in quadratic)
         R = np.zeros((len(beam.x), 3, self.n_z))
         R[:, 0, 0] = beam.x
-        R[:, :, 1 : 1 + n_e] = beam._slices(np.zeros(n_e))[1]  # Ψ(x) = Φ_r(x, 0)
+        R[:, :, 1 : 1 + n_e] = beam.slices(np.zeros(n_e))[1]  # Ψ(x) = Φ_r(x, 0)
         if quadratic:
             R[:, 0, 1 + n_e :] = np.hstack(quadratic)
         m = beam.mass_weights

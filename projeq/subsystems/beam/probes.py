@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 
 class BeamProbes:
-    """Mixin of RitzBeam: probes at stations (needs ``station_data``, ``_slices`` and the
+    """Mixin of RitzBeam: probes at stations (needs ``station_data``, ``slices`` and the
     column slices of the beam)."""
 
     def displacement(self, q_e, x) -> NDArray:
@@ -23,7 +23,7 @@ class BeamProbes:
         x = self._stations(x)
         data = self.station_data(x)
         q_e = np.asarray(q_e, dtype=float)
-        rows = [self._slices(q, x, data)[0] - np.outer(x, (1.0, 0.0, 0.0)) for q in np.atleast_2d(q_e)]
+        rows = [self.slices(q, x, data)[0] - np.outer(x, (1.0, 0.0, 0.0)) for q in np.atleast_2d(q_e)]
         return np.array(rows) if q_e.ndim == 2 else rows[0]
 
     def _stations(self, x) -> NDArray:
@@ -36,8 +36,8 @@ class BeamProbes:
         """Positions r(x) and velocities J(x) ẏ of ``stations`` equally spaced points of the
         centre line, in the beam's reference frame (for drawing and export)."""
         x = np.linspace(0.0, self.length, int(stations))
-        r, Phi_r = self._slices(q_e, x, self.station_data(x))
-        return r, self._jacobian(r, Phi_r) @ y_dot
+        r, Phi_r = self.slices(q_e, x, self.station_data(x))
+        return r, self.jacobian(r, Phi_r) @ y_dot
 
     def _coordinates(self, result) -> NDArray:
         """This beam's q_e along a trajectory (rows), found in ``result.system``; a plain
