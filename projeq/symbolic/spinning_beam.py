@@ -162,28 +162,6 @@ def projection_field_equations() -> tuple[sp.Expr, sp.Expr]:
     return tuple(equations)
 
 
-def _field_expected(rho_I_coupling: tuple[int, int]):
-    """The two linear field equations with signs (s_v, s_w) of the ρI α̈ terms."""
-    ad, add = _d(alpha, t), _d(alpha, t, 2)
-    sv, sw = rho_I_coupling
-    eq_v = (rho_A * (_d(v, t, 2) - 2 * ad * _d(w, t) - add * w - ad**2 * v)
-            - rho_I * (_d(v, x, 2, t, 2) + ad**2 * _d(v, x, 2) + sv * add * _d(w, x, 2)) + EI * _d(v, x, 4))
-    eq_w = (rho_A * (_d(w, t, 2) + 2 * ad * _d(v, t) + add * v - ad**2 * w)
-            - rho_I * (_d(w, x, 2, t, 2) + ad**2 * _d(w, x, 2) + sw * add * _d(v, x, 2)) + EI * _d(w, x, 4))
-    return sp.expand(eq_v), sp.expand(eq_w)
-
-
-def expected_B18():
-    """B(18) as printed (circular section, EI constant), with ρA α̈ v (not α̈ v/2, a slip of
-    the text's transcription): ρI α̈ coupling −ρI(… − α̈w″), −ρI(… − α̈v″), symmetric."""
-    return _field_expected((-1, -1))
-
-
-def expected_B23():
-    """B(23) with the signs of docs/theory.md: −ρI(… + α̈w″), −ρI(… − α̈v″), skew-symmetric."""
-    return _field_expected((1, -1))
-
-
 def field_difference() -> tuple[sp.Expr, sp.Expr]:
     """Hamilton minus Projection Equation, per equation: (2ρI α̈ w″, 0).
 
