@@ -76,3 +76,15 @@ def inertia_tensor(name: str, I_c, allow_zero: bool = False) -> NDArray:
             "A + B >= C (no mass distribution has them)"
         )
     return I_c
+
+
+def drop_inherited_twins(cls, base, numeric: tuple, twins: tuple) -> None:
+    """The plug-in contracts' override rule, for ``__init_subclass__``: a subclass ``cls`` that
+    restates one of the ``numeric`` members loses the ``twins`` it inherits (symbolic, compiled
+    or batched forms of the inherited numbers) unless it restates them too; they fall back to
+    ``base``'s defaults, so an evaluator never bypasses an override."""
+    if any(member in vars(cls) for member in numeric):
+        for twin in twins:
+            if twin not in vars(cls):  # the inherited twin states another plug-in's terms
+                setattr(cls, twin, vars(base)[twin])
+

@@ -21,12 +21,14 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
-import sympy as sp
 from numpy.typing import NDArray
 
-from projeq.checks import finite_array, non_negative
-from projeq.symbolic import algebra
+from projeq.checks import drop_inherited_twins, finite_array, non_negative
+from projeq.symbolic import lazy_import
 from projeq.spatial import cross
+
+sp = lazy_import("sympy")
+algebra = lazy_import("projeq.symbolic.algebra")
 
 
 def _load(name: str, value, shape: tuple) -> Callable:
@@ -79,10 +81,8 @@ class ForceLaw:
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        if any(member in vars(cls) for member in ("add_to", "wrench", "generalized_force")):
-            for twin in ("symbolic_unsupported", "symbolic_wrenches", "symbolic_joint_forces"):
-                if twin not in vars(cls):  # the inherited twin states another law
-                    setattr(cls, twin, getattr(ForceLaw, twin))
+        drop_inherited_twins(cls, ForceLaw, ("add_to", "wrench", "generalized_force"),
+                             ("symbolic_unsupported", "symbolic_wrenches", "symbolic_joint_forces"))
 
     def bind(self, system) -> "ForceLaw":
         """Resolve the names the law was given in ``system`` (indices, selections) and return

@@ -8,14 +8,21 @@ subcommand alike:
 - 0: success;
 - 2: bad arguments — refused by argparse, or a ValueError (the library's way of refusing an
   input, naming it: a scene, a parameter, a value, ``--out``) — nothing is run;
-- 1: a failed or interrupted run (a RuntimeError such as a failed simulation, Ctrl-C, or a
-  command's own report of failed points, settings or benchmarks); what was computed is written.
+- 1: a failed or interrupted run (a RuntimeError such as a failed simulation, Ctrl-C or
+  SIGTERM, a file that cannot be written, or a command's own report of failed points,
+  settings or benchmarks); what was computed is written, each file complete or not at all.
+
+SIGTERM (``kill``, a batch scheduler's time limit) is handled as Ctrl-C: a KeyboardInterrupt
+that each command turns into partial results.
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
+from contextlib import contextmanager
 
 from projeq.cli import bench, run, studies, sweep
 
@@ -53,13 +60,35 @@ def main(argv=None) -> int:
     except SystemExit as exit_:  # --help (0) or a usage error (2), printed by argparse
         return OK if exit_.code is None else int(exit_.code)
     try:
-        return int(args.execute(args) or OK)
+        with sigterm_as_ctrl_c():
+            return int(args.execute(args) or OK)
     except ValueError as exc:
         print(f"projeq {args.command}: {exc}", file=sys.stderr)
         return BAD_ARGUMENTS
     except RuntimeError as exc:
         print(f"projeq {args.command}: {exc}", file=sys.stderr)
         return FAILED
+    except OSError as exc:  # a file that cannot be written (a full disk): nothing left half-written
+        print(f"projeq {args.command}: cannot write {exc.filename or 'a file'}: {exc.strerror or exc}", file=sys.stderr)
+        return FAILED
     except KeyboardInterrupt:
         print(f"projeq {args.command}: interrupted", file=sys.stderr)
         return FAILED
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+@contextmanager
+def sigterm_as_ctrl_c():
+    """Within the block SIGTERM raises KeyboardInterrupt, as Ctrl-C does (on the main thread
+    only, where Python delivers signals); the previous handler is restored afterwards."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

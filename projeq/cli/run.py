@@ -2,7 +2,9 @@
 
 ``projeq run`` simulates a scene (default: the spin-up beam), prints a summary and writes
 NPZ, CSV, PNG plots and a ParaView VTU series to ``--out``; a failed or interrupted run
-writes its results up to where it stopped and exits 1.
+(Ctrl-C or SIGTERM) writes its results up to where it stopped and exits 1. Each file is
+written under a temporary name and renamed when complete, and ``--out`` is created again
+if it was deleted during the run.
 """
 
 from __future__ import annotations
@@ -90,15 +92,19 @@ def _progress_bar(t_start: float, t_end: float, quiet: bool):
 
 def _write(result, out: Path, name: str) -> list[Path]:
     """``name.npz`` (the Result) and ``name.csv`` (:class:`~projeq.studies.table.Table`: t, q,
-    ṡ, kinetic and potential energy per output time)."""
+    ṡ, kinetic and potential energy per output time), each under a temporary name renamed
+    when complete; ``out`` is created again if it was deleted during the run."""
+    from projeq.simulation.export import written_atomically
     from projeq.studies.table import Table
 
+    out.mkdir(parents=True, exist_ok=True)
     npz, csv = out / f"{name}.npz", out / f"{name}.csv"
-    result.save(npz)
+    result.save(npz)  # under a temporary name too
     columns = (["t"] + [f"q{i}" for i in range(result.q.shape[1])] + [f"s_dot{i}" for i in range(result.s_dot.shape[1])]
                + ["kinetic", "potential"])
     rows = np.column_stack((result.t, result.q, result.s_dot, result.kinetic, result.potential))
-    Table(columns, rows.tolist(), units={"t": "s", "kinetic": "J", "potential": "J"}).to_csv(csv)
+    with written_atomically(csv) as temporary:
+        Table(columns, rows.tolist(), units={"t": "s", "kinetic": "J", "potential": "J"}).to_csv(temporary)
     return [npz, csv]
 
 
@@ -112,10 +118,13 @@ def _plots(result, system, scene, out: Path, name: str) -> list[Path]:
     for sub_name, sub in zip(system.names, system.subsystems):
         if sub.deforms:
             figures[f"tip_{sub_name}"] = plots.tip_deflection(result, sub)
+    from projeq.simulation.export import written_atomically
+
     paths = []
     for suffix, fig in figures.items():
         paths.append(out / f"{name}_{suffix}.png")
-        fig.savefig(paths[-1], dpi=100)
+        with written_atomically(paths[-1]) as temporary:
+            fig.savefig(temporary, dpi=100)
     return paths
 
 

@@ -1,16 +1,28 @@
 """``projeq sweep SCENE --grid NAME=A:B:N ...``: a scene on a parameter grid, in parallel
 local processes or on a Dask cluster; writes ``sweep_SCENE.csv`` and ``.npz``.
 
-A point that failed or was interrupted makes the exit code 1 (the table is written).
+Each finished point is appended to ``sweep_SCENE.csv`` at once, so a crash loses only the
+points in flight, and ``--resume`` runs only the points not finished there. Ctrl-C or
+SIGTERM stops the workers and writes the table with the points finished (and the running
+ones' partial results). A point that failed or was interrupted makes the exit code 1 (the
+table is written). The grid is checked first: no parameter twice (in ``--grid`` or in both
+``--grid`` and ``--set``), no repeated values, and at most :data:`MAX_POINTS` points
+unless ``--allow-large``.
 """
 
 from __future__ import annotations
 
+import contextlib
+import math
+import os
 import sys
 
 import numpy as np
 
 from projeq.cli.options import output_directory, simulation_options
+
+
+MAX_POINTS = 100_000  # a larger grid needs --allow-large
 
 
 def sweep_arguments(parser) -> None:
@@ -22,32 +34,36 @@ def sweep_arguments(parser) -> None:
     parser.add_argument("--scheduler", help="address of a Dask scheduler, e.g. tcp://host:8786 (default: local processes)")
     parser.add_argument("--scheduler-timeout", type=float, default=10.0, help="seconds to wait for the scheduler (default 10)")
     parser.add_argument("--workers", type=int, default=None, help="local worker processes (default: one per CPU)")
+    parser.add_argument("--resume", action="store_true",
+                        help="keep the finished points of an earlier sweep_SCENE.csv in --out and run only the others")
+    parser.add_argument("--allow-large", action="store_true", help=f"run a grid of more than {MAX_POINTS:,} points")
     simulation_options(parser)
     parser.set_defaults(execute=sweep_scene)
 
 
 def sweep_scene(args) -> int:
-    from projeq.scenes import check_names, get_scene, parse_settings, scene_parameters
-    from projeq.simulation.sweep import process_pool, sweep
+    from projeq.scenes import get_scene, parse_settings
+    from projeq.simulation.sweep import sweep
 
     scene = get_scene(args.scene)
     fixed = parse_settings(scene, args.set)
-    defaults = {p.name: p.default for p in scene_parameters(scene)}
-    grid = dict(_grid_axis(text) for text in args.grid)
-    check_names(scene, grid)
-    grid = {k: v.round().astype(int) if type(defaults[k]) is int else v for k, v in grid.items()}
-    if fixed:
-        grid.update({name: [value] for name, value in fixed.items()})
+    grid = _grid(scene, args.grid, fixed, args.allow_large)
+    n_points = math.prod(len(values) for values in grid.values())
+    grid.update({name: [value] for name, value in fixed.items()})
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers: expected a positive count, got {args.workers}")
-    executor = (_dask_client(args.scheduler, args.scheduler_timeout) if args.scheduler
-                else process_pool(args.workers))
+    client = _dask_client(args.scheduler, args.scheduler_timeout) if args.scheduler else None
     options = {"method": args.method, "rtol": args.rtol}
-    with executor:  # closed (a Dask client disconnected) also when --out is refused
+    with client if client is not None else contextlib.nullcontext():  # a Dask client is closed also when --out is refused
         out = output_directory(args.out)
-        table = sweep(scene, grid=grid, outputs=args.outputs.split(","), executor=executor, t_end=args.t_end,
-                      progress=not args.quiet, **options)
-    files = table.save(out / f"sweep_{args.scene}")
+        if not args.quiet:
+            where = f"the Dask scheduler at {args.scheduler}" if client else f"{args.workers or os.cpu_count()} local processes"
+            print(f"sweep {args.scene}: {n_points} points on {where}; each is appended to "
+                  f"{out / f'sweep_{args.scene}.csv'} as it finishes", flush=True)
+        table = sweep(scene, grid=grid, outputs=args.outputs.split(","), executor=client, t_end=args.t_end,
+                      progress=not args.quiet, path=out / f"sweep_{args.scene}", resume=args.resume,
+                      workers=None if client else args.workers, **options)
+    files = [out / f"sweep_{args.scene}.csv", out / f"sweep_{args.scene}.npz"]
     failed, partial = int((table["status"] == -1).sum()), int((table["status"] == 2).sum())
     if not args.quiet:
         print(f"{len(table['status'])} points, {failed} failed or not run, {partial} interrupted with partial results; "
@@ -58,17 +74,48 @@ def sweep_scene(args) -> int:
     return 1 if failed or partial else 0
 
 
-def _grid_axis(text: str) -> tuple[str, np.ndarray]:
-    """``name=a:b:n`` -> (name, linspace(a, b, n)); ValueError naming the bad part."""
+def _grid(scene, texts: list[str], fixed: dict, allow_large: bool) -> dict:
+    """The swept axes of ``--grid`` (integer parameters rounded); ValueError for a parameter
+    given twice or in both ``--grid`` and ``--set``, repeated values, or more than
+    :data:`MAX_POINTS` points without ``allow_large`` (refused before any array is made)."""
+    from projeq.scenes import check_names, scene_parameters
+
+    axes = [_grid_axis(text) for text in texts]
+    sizes = [n for _, _, _, n in axes]
+    if math.prod(sizes) > MAX_POINTS and not allow_large:
+        raise ValueError(f"--grid: {math.prod(sizes):,} points ({' x '.join(map(str, sizes))}) is more than "
+                         f"{MAX_POINTS:,}; give --allow-large to run them")
+    defaults = {p.name: p.default for p in scene_parameters(scene)}
+    grid = {}
+    for text, (name, a, b, n) in zip(texts, axes):
+        if name in grid:
+            raise ValueError(f"--grid: {name} is given twice; give each parameter once")
+        if name in fixed:
+            raise ValueError(f"--grid: {name} is also given in --set; give it in one of them")
+        check_names(scene, {name: None})
+        values = np.linspace(a, b, n)
+        if type(defaults[name]) is int:
+            values = values.round().astype(int)
+        unique, counts = np.unique(values, return_counts=True)
+        if (counts > 1).any():
+            kind = f" after rounding to integers ({name} is an integer)" if values.dtype.kind == "i" else ""
+            raise ValueError(f"--grid: {text!r} repeats the values {unique[counts > 1][:5].tolist()}{kind}; "
+                             "each point would run more than once")
+        grid[name] = values
+    return grid
+
+
+def _grid_axis(text: str) -> tuple[str, float, float, int]:
+    """``name=a:b:n`` -> (name, a, b, n), the axis linspace(a, b, n); ValueError naming the bad part."""
     name, _, spec = text.partition("=")
     parts = spec.split(":")
     try:
         a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
-        if len(parts) != 3 or n < 1:
+        if len(parts) != 3 or n < 1 or not (np.isfinite(a) and np.isfinite(b)):
             raise ValueError
     except (ValueError, IndexError):
         raise ValueError(f"--grid: expected NAME=A:B:N (numbers A, B, a count N >= 1), got {text!r}") from None
-    return name.strip(), np.linspace(a, b, n)
+    return name.strip(), a, b, n
 
 
 def _dask_client(address: str, timeout: float):

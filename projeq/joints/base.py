@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import central
-from projeq.checks import finite_array
+from projeq.checks import drop_inherited_twins, finite_array
 from projeq.spatial import vee
 
 if TYPE_CHECKING:
@@ -97,10 +97,8 @@ class Joint:
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        if any(member in vars(cls) for member in ("relative", "K", "q_dot")):
-            for twin in ("symbolic_relative", "symbolic_parameters", "compiled_kind"):
-                if twin not in vars(cls):  # the inherited twin states other kinematics
-                    setattr(cls, twin, getattr(Joint, twin))
+        drop_inherited_twins(cls, Joint, ("relative", "K", "q_dot"),
+                             ("symbolic_relative", "symbolic_parameters", "compiled_kind"))
 
     def relative(self, q_n: NDArray, s_dot_n: NDArray, t: float) -> Relative:
         """Relative kinematics (A, r, F⁶, w, ζ) at (q_n, ṡ_n, t)."""

@@ -10,12 +10,13 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
-import sympy as sp
 
 from projeq.joints.base import Joint, Relative, SymbolicRelative
 from projeq.spatial import axis_spin, quaternion_matrix, quaternion_rate_matrix, rodrigues, unit_axis
-from projeq.symbolic import algebra
-from projeq.symbolic.algebra import exact, mul
+from projeq.symbolic import lazy_import
+
+sp = lazy_import("sympy")
+algebra = lazy_import("projeq.symbolic.algebra")
 
 _ZERO6 = np.zeros(6)
 _ZERO6.flags.writeable = False
@@ -55,7 +56,7 @@ class Revolute(_OneAxis):
         return Relative(A, _ZERO6[:3], self._F, self._F[:, 0] * s_dot_n[0], _ZERO6)
 
     def symbolic_relative(self, q_n, s_n, t):
-        e = exact(self.axis)
+        e = algebra.exact(self.axis)
         return _scleronomic(algebra.rotation(e, q_n[0]), sp.zeros(3, 1), sp.Matrix.vstack(sp.zeros(3, 1), e), sp.eye(1))
 
 
@@ -72,7 +73,7 @@ class Prismatic(_OneAxis):
         return Relative(np.eye(3), self.axis * q_n[0], self._F, self._F[:, 0] * s_dot_n[0], _ZERO6)
 
     def symbolic_relative(self, q_n, s_n, t):
-        e = exact(self.axis)
+        e = algebra.exact(self.axis)
         return _scleronomic(sp.eye(3), e * q_n[0], sp.Matrix.vstack(e, sp.zeros(3, 1)), sp.eye(1))
 
 
@@ -128,9 +129,9 @@ class Planar(Joint):
         return K
 
     def symbolic_relative(self, q_n, s_n, t):
-        P = exact(self._P)
-        A = algebra.rotation(exact(self.normal), q_n[2])
-        return _scleronomic(A, mul(P.T, sp.Matrix(q_n[:2])), exact(self._F), sp.diag(mul(P, A, P.T), 1))
+        P = algebra.exact(self._P)
+        A = algebra.rotation(algebra.exact(self.normal), q_n[2])
+        return _scleronomic(A, algebra.mul(P.T, sp.Matrix(q_n[:2])), algebra.exact(self._F), sp.diag(algebra.mul(P, A, P.T), 1))
 
 
 class Free(Joint):

@@ -19,7 +19,8 @@ from __future__ import annotations
 import time as _time
 from collections import deque
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from types import SimpleNamespace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -129,6 +130,8 @@ def simulate(
     with run.stopping():
         segments = deque(zip(run.bounds[:-1], run.bounds[1:]))  # a model event splits one
         while segments:
+            if run.pieces and not dense_output:  # the last segment's interpolants are no longer needed
+                run.pieces[-1] = replace(run.pieces[-1], sol=SimpleNamespace(ts=run.pieces[-1].sol.ts[[0, -1]]))
             a, b = segments.popleft()
             segment = run.solve(a, b)
             if run.model_event_fired(segment):  # a ConstrainedSystem's partition degenerates

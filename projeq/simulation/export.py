@@ -5,10 +5,17 @@ beam centre lines as polylines (subsystems that ``deform``, ``centre_line``) and
 subsystem as a small frame glyph (three line segments along its axes). Point data:
 ``displacement`` (from the first time) and ``velocity`` (exact, from the kinematics);
 a ``.pvd`` collection file ties the steps together with their times.
+
+Every file is written through :func:`written_atomically`: under a temporary name in its
+directory, renamed when complete, so a full disk or a killed process never leaves a
+truncated file under its final name.
 """
 
 from __future__ import annotations
 
+import os
+import secrets
+from contextlib import contextmanager
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -17,6 +24,22 @@ import numpy as np
 
 from projeq.assembly.kinematics import poses
 from projeq.spatial import cross
+
+
+@contextmanager
+def written_atomically(path):
+    """Yield a temporary path beside ``path`` (same directory and suffix, so writers that go
+    by the suffix still work) for the caller to write; when the block ends without an error
+    the file is renamed to ``path`` (``os.replace``, atomic on POSIX), else it is deleted.
+    Readers thus see the old file or the complete new one, never a truncated one."""
+    path = Path(path)
+    temporary = path.with_name(f".{path.name}.{os.getpid()}-{secrets.token_hex(3)}.tmp{path.suffix}")
+    try:
+        yield temporary
+        os.replace(temporary, path)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
 
 
 def _draw(system, q, s_dot, t, stations: int, frame_size: float):
@@ -58,12 +81,14 @@ def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21
         reference = points if reference is None else reference
         path = directory / f"{name}_{k:04d}.vtu"
         mesh = meshio.Mesh(points, [("line", lines)], point_data={"displacement": points - reference, "velocity": velocity})
-        mesh.write(path)
+        with written_atomically(path) as temporary:
+            mesh.write(temporary)
         entries.append(f'    <DataSet timestep="{t:.12g}" part="0" file={quoteattr(path.name)}/>')
     pvd = directory / f"{name}.pvd"
-    pvd.write_text(
-        '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
-        + "\n".join(entries)
-        + "\n  </Collection>\n</VTKFile>\n"
-    )
+    with written_atomically(pvd) as temporary:  # last: it names only files already complete
+        temporary.write_text(
+            '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+            + "\n".join(entries)
+            + "\n  </Collection>\n</VTKFile>\n"
+        )
     return pvd

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field, fields
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
@@ -80,7 +81,9 @@ class Result:
         return self.status in (0, 1)
 
     def save(self, path) -> None:
-        """Write the arrays and metadata to an ``.npz`` file (readable by numpy alone)."""
+        """Write the arrays and metadata to an ``.npz`` file (readable by numpy alone; ``.npz``
+        is appended to a name without it, as numpy does), under a temporary name renamed when
+        complete: a full disk or a killed process never leaves a truncated file."""
         arrays = {f.name: getattr(self, f.name) for f in fields(self) if isinstance(getattr(self, f.name), np.ndarray)}
         meta = {
             "nfev": self.nfev, "wall_time": self.wall_time, "status": self.status,
@@ -88,7 +91,14 @@ class Result:
             "partitions": [[t, list(independent)] for t, independent in self.partitions],
         }
         events = {f"{name}_{i}": np.asarray(e) for name in _EVENT_ARRAYS for i, e in enumerate(getattr(self, name))}
-        np.savez(path, **arrays, **events, meta=json.dumps(meta))
+        if hasattr(path, "write"):  # an open file
+            np.savez(path, **arrays, **events, meta=json.dumps(meta))
+            return
+        from projeq.simulation.export import written_atomically
+
+        path = Path(path)
+        with written_atomically(path if path.suffix == ".npz" else path.with_name(path.name + ".npz")) as temporary:
+            np.savez(temporary, **arrays, **events, meta=json.dumps(meta))
 
     @classmethod
     def load(cls, path) -> "Result":

@@ -4,26 +4,48 @@
 :class:`concurrent.futures.Executor`, or on a Dask cluster given a
 ``dask.distributed.Client`` (``pip install "projeq[dask]"``). A point whose build or run
 fails is kept in the table with ``status = -1`` and its error message, never dropped.
-Nothing is written to disk here; :meth:`SweepTable.save` writes CSV + NPZ once the table
-is complete, so an unreachable scheduler or Ctrl-C leaves no half-written files.
 
-Ctrl-C on a terminal reaches the whole process group: the pool's workers are started with
-:func:`interruptible_worker`, so a point being simulated stops and returns what it has
-(``status`` 2, outputs at the time reached, see :func:`projeq.simulate`) while idle workers
-stay quiet, and :func:`sweep` gathers those partial points before it returns.
+Nothing is lost under faults:
+
+- with ``path``, each finished point is appended to ``path.csv`` as it completes (one
+  complete line per point, an append that fails is undone), so a crash loses only the
+  points in flight; at the end ``path.csv`` (in input order) and ``path.npz`` are written
+  under temporary names and renamed (:func:`projeq.simulation.export.written_atomically`).
+  ``resume=True`` keeps the finished points of an earlier ``path.csv`` and runs the rest;
+- the default pool holds one point per worker. A worker process that dies (killed, or by
+  the out-of-memory killer) breaks it: a new pool runs the points that were in flight again,
+  one at a time, so only a point that kills its worker again is marked failed, with the
+  reason, and the sweep goes on;
+- Ctrl-C on a terminal reaches the whole process group: the pool's workers are started with
+  :func:`interruptible_worker`, so a point being simulated stops and returns what it has
+  (``status`` 2, outputs at the time reached, see :func:`projeq.simulate`) while idle workers
+  stay quiet, and :func:`sweep` gathers those partial points before it returns. A
+  KeyboardInterrupt that reaches only the main process (``projeq sweep`` turns SIGTERM into
+  one) is passed on to the workers of the default pool, which are stopped before
+  :func:`sweep` returns.
 """
 
 from __future__ import annotations
 
+import ast
 import concurrent.futures as cf
+import csv
+import io
 import itertools
+import os
+import pickle
 import signal
+import threading
+import time
+import warnings
+from collections import deque
 from pathlib import Path
 
 import numpy as np
 
 from projeq.scenes import Scene, check_names, get_scene
-from projeq.studies.table import Table
+from projeq.simulation.export import written_atomically
+from projeq.studies.table import Table, csv_cells, csv_line
 
 #: Outputs every sweep can ask for by name: a function of the Result.
 BUILTIN_OUTPUTS = {
@@ -58,19 +80,33 @@ def output_value(result, name: str) -> float:
 
 
 INTERRUPT_GRACE = 10.0  # s to wait, after Ctrl-C, for the running points to return their partial results
+PARENT_POLL = 0.5  # s between a worker's checks that the main process is alive
 _simulating = False  # in a pool worker: True while run_point simulates
 
 
 def _interrupt_a_running_point(signum, frame):
-    if _simulating:
+    global _simulating
+    if _simulating:  # once: a second SIGINT must not break the partial result being assembled
+        _simulating = False
         raise KeyboardInterrupt
 
 
 def interruptible_worker() -> None:
     """Initializer of a process-pool worker: SIGINT (Ctrl-C) stops the point it simulates
     (which :func:`projeq.simulate` turns into a partial result, status 2) and is ignored
-    while the worker waits for work, so no worker dies with a traceback."""
+    while the worker waits for work, so no worker dies with a traceback; SIGTERM ends the
+    worker (whatever handler it inherited from the main process), and so does the death of
+    the main process (a worker waiting for work would otherwise wait for ever)."""
     signal.signal(signal.SIGINT, _interrupt_a_running_point)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    threading.Thread(target=_exit_with_parent, args=(os.getppid(),), daemon=True).start()
+
+
+def _exit_with_parent(parent: int) -> None:
+    """Exit this process once its parent has gone (it is re-parented: ``getppid`` changes)."""
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL)
+    os._exit(1)
 
 
 def run_point(scene: Scene, parameters: dict, outputs, t_end: float, options: dict):
@@ -83,7 +119,7 @@ def run_point(scene: Scene, parameters: dict, outputs, t_end: float, options: di
         result = simulate(scene.build(**parameters), t_end, **options)
         return result.status, [output_value(result, o) for o in outputs], ""
     except Exception as exc:  # noqa: BLE001 - a failed point is reported in the table, never dropped
-        return -1, [np.nan] * len(outputs), f"{type(exc).__name__}: {exc}"
+        return -1, [np.nan] * len(outputs), " ".join(f"{type(exc).__name__}: {exc}".splitlines())  # one line
     finally:
         _simulating = False
 
@@ -94,12 +130,100 @@ class SweepTable(dict):
 
     def save(self, path) -> list[Path]:
         """Write ``path.csv`` (:class:`~projeq.studies.table.Table`, the error message last) and
-        ``path.npz`` (path without suffix); returns both paths."""
+        ``path.npz`` (path without suffix), each under a temporary name renamed when complete
+        (the directory is created if it is missing, e.g. deleted during the sweep); returns
+        both paths."""
         path = Path(path)
-        csv, npz = path.with_suffix(".csv"), path.with_suffix(".npz")
-        Table.from_columns({k: self[k] for k in self if k != "error"} | {"error": self["error"]}).to_csv(csv)
-        np.savez(npz, **{k: np.asarray(v, dtype=object if k in ("error",) else None) for k, v in self.items()})
-        return [csv, npz]
+        path.parent.mkdir(parents=True, exist_ok=True)
+        csv_path, npz = path.with_suffix(".csv"), path.with_suffix(".npz")
+        with written_atomically(csv_path) as temporary:
+            Table.from_columns({k: self[k] for k in self if k != "error"} | {"error": self["error"]}).to_csv(temporary)
+        with written_atomically(npz) as temporary:
+            np.savez(temporary, **{k: np.asarray(v, dtype=object if k in ("error",) else None) for k, v in self.items()})
+        return [csv_path, npz]
+
+    @classmethod
+    def load(cls, path) -> "SweepTable":
+        """Read ``path.csv`` (path with or without the suffix): a table written by
+        :meth:`save`, or the points of a sweep still running or killed, in the order they
+        finished. Numbers come back exactly (floats are written as their round-trip repr)."""
+        path = Path(path).with_suffix(".csv")
+        header, rows = _read_csv(path)
+        table = cls()
+        for j, name in enumerate(header):
+            cells = [row[j] for row in rows]
+            if name == "error":
+                table[name] = cells
+            elif name == "status":
+                table[name] = np.array([int(c) for c in cells], dtype=int)
+            else:
+                values = [_value(c) for c in cells]
+                scalar = all(not isinstance(v, (tuple, str)) for v in values)
+                # tuples stay objects: the None keeps numpy from making them a 2-d array
+                table[name] = np.array(values) if scalar else np.array(values + [None], dtype=object)[:-1]
+        return table
+
+
+def _value(text: str):
+    """A CSV cell back to its value: int, float, a tuple, a bool, else the text."""
+    for parse in (int, float):
+        try:
+            return parse(text)
+        except ValueError:
+            pass
+    try:
+        return ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return text
+
+
+def _read_csv(path: Path) -> tuple[list[str], list[list[str]]]:
+    """Header and rows of a sweep CSV; a last line cut off without its newline (a process
+    killed while appending) is left out; ValueError naming the file if it is not a sweep table."""
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ValueError(f"path: cannot read the sweep table {str(path)!r}: {exc.strerror or exc}") from None
+    if not text.endswith("\n"):
+        text = text[: text.rfind("\n") + 1]
+    lines = list(csv.reader(io.StringIO(text)))
+    if not lines or lines[0][-2:] != ["status", "error"]:
+        raise ValueError(f"path: {str(path)!r} is not a sweep table (its header must end with status,error)")
+    bad = [i + 2 for i, row in enumerate(lines[1:]) if len(row) != len(lines[0])]
+    if bad:
+        raise ValueError(f"path: {str(path)!r} line {bad[0]} has a different number of cells than its header")
+    return lines[0], lines[1:]
+
+
+class _Log:
+    """``path.csv`` while a sweep runs: the header and the points kept from an earlier run,
+    then one line appended per finished point. Each line is one ``os.write`` to a file opened
+    for appending, and an append that fails (a full disk) is cut off again, so the file holds
+    whole rows only; after a failure the points are kept in memory only (a warning says so)."""
+
+    def __init__(self, path: Path, header: list, kept_rows: list):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with written_atomically(path) as temporary:
+            temporary.write_text(csv_line(header) + "".join(csv_line(row) for row in kept_rows))
+        self.path, self.fd = path, os.open(path, os.O_WRONLY | os.O_APPEND)
+
+    def append(self, row) -> None:
+        if self.fd is None:
+            return
+        line, size = csv_line(row).encode(), os.fstat(self.fd).st_size
+        try:
+            while line:
+                line = line[os.write(self.fd, line):]
+        except OSError as exc:
+            os.ftruncate(self.fd, size)
+            self.close()
+            warnings.warn(f"path: cannot append to {str(self.path)!r} ({exc.strerror or exc}); the sweep goes on "
+                          "with its points in memory only", RuntimeWarning, stacklevel=2)
+
+    def close(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
 
 
 def _points(grid, samples) -> list[dict]:
@@ -108,13 +232,20 @@ def _points(grid, samples) -> list[dict]:
     if grid is not None:
         if not isinstance(grid, dict) or not grid:
             raise ValueError(f"grid: expected a non-empty dict name -> values, got {grid!r}")
+        empty = [name for name, values in grid.items() if not len(values)]
+        if empty:
+            raise ValueError(f"grid: {empty[0]} has no values; give it at least one")
         return [dict(zip(grid, values)) for values in itertools.product(*grid.values())]
     if isinstance(samples, dict):
         lengths = {len(v) for v in samples.values()}
         if len(lengths) != 1:
             raise ValueError(f"samples: all columns must have the same length, got {sorted(lengths)}")
-        return [dict(zip(samples, values)) for values in zip(*samples.values())]
-    return [dict(p) for p in samples]
+        points = [dict(zip(samples, values)) for values in zip(*samples.values())]
+    else:
+        points = [dict(p) for p in samples]
+    if not points or not points[0]:
+        raise ValueError(f"samples: expected at least one point with at least one parameter, got {samples!r}")
+    return points
 
 
 def process_pool(workers: int | None = None) -> cf.ProcessPoolExecutor:
@@ -123,10 +254,16 @@ def process_pool(workers: int | None = None) -> cf.ProcessPoolExecutor:
     return cf.ProcessPoolExecutor(workers, initializer=interruptible_worker)
 
 
-def _executor(executor):
-    """(executor, owned): a Dask Client becomes its concurrent.futures view."""
+def _executor(executor, workers):
+    """(executor, owned): a Dask Client becomes its concurrent.futures view; None, a pool of
+    ``workers`` local processes that :func:`sweep` owns (replaces when broken, stops on an
+    interrupt)."""
+    if workers is not None and (not isinstance(workers, (int, np.integer)) or isinstance(workers, bool) or workers < 1):
+        raise ValueError(f"workers: expected a positive number of processes, got {workers!r}")
     if executor is None:
-        return process_pool(), True
+        return process_pool(workers), True
+    if workers is not None:
+        raise ValueError("workers: only for the default process pool; the executor given sets its own workers")
     if hasattr(executor, "get_executor"):  # dask.distributed.Client
         if getattr(executor, "status", "running") != "running":
             raise ValueError(f"executor: the Dask client is not connected (status {executor.status!r})")
@@ -137,7 +274,8 @@ def _executor(executor):
 
 
 def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"), executor=None, *,
-          t_end=None, progress: bool = True, **options) -> SweepTable:
+          t_end=None, progress: bool = True, path=None, resume: bool = False, workers: int | None = None,
+          **options) -> SweepTable:
     """Simulate ``scene`` at every parameter point and gather the outputs in one table.
 
     Parameters
@@ -152,11 +290,20 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     outputs : sequence of str
         Names understood by :func:`output_value` (final ``q<i>``, ``s_dot<i>``, ``energy_drift`` ...).
     executor : concurrent.futures.Executor or dask.distributed.Client, optional
-        Default: a local process pool.
+        Default: a local process pool of ``workers`` processes.
     t_end : float, optional
         End time (s), default the scene's.
     progress : bool
         A progress bar (tqdm) on a terminal.
+    path : str or Path, optional
+        Write the table to ``path.csv`` and ``path.npz`` (path without suffix): each point is
+        appended to ``path.csv`` as it finishes, and both files are complete, in input order,
+        when the sweep returns (also after an interrupt).
+    resume : bool
+        Keep the finished points (status 0 or 1) of an earlier ``path.csv`` of the same sweep
+        and run only the others (failed, interrupted or not run).
+    workers : int, optional
+        Processes of the default pool (default one per core).
     **options
         Passed to :func:`projeq.simulate` (method, rtol, atol, n_points ...).
 
@@ -165,7 +312,9 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     SweepTable
         A dict of columns. On Ctrl-C the points finished so far are returned, the points that
         were running with their partial results (status 2), the others marked status −1,
-        error "interrupted".
+        error "interrupted". A point whose worker process died has status −1 and an error
+        saying so (on the default pool: only a point that killed its worker twice, the second
+        time running alone).
 
     >>> table = sweep("chain", grid={"n": [1, 2]}, outputs=["q0"], executor=cf.ThreadPoolExecutor(2),
     ...               t_end=0.1, progress=False)
@@ -180,34 +329,211 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     for name in outputs:
         _column(name)
     t_end = scene.t_end if t_end is None else float(t_end)
-    pool, owned = _executor(executor)
-    rows = [(-1, [np.nan] * len(outputs), "interrupted")] * len(points)
+    if resume and path is None:
+        raise ValueError("resume: needs path, the table of the sweep to resume")
+    header = list(points[0]) + outputs + ["status", "error"]
+    rows = [None] * len(points)  # (status, outputs, error) of each point, None until it is done
+    if resume:
+        _resumed(Path(path).with_suffix(".csv"), header, points, rows)
+    if executor is None or isinstance(executor, cf.ProcessPoolExecutor):
+        _check_picklable(scene, options)
+    pool, owned = _executor(executor, workers)
+    log = None if path is None else _Log(Path(path).with_suffix(".csv"), header,
+                                         [_row(points[i], r) for i, r in enumerate(rows) if r is not None])
     from tqdm import tqdm
 
-    futures = {}
+    def record(i, row):
+        if rows[i] is not None:  # recorded already (an interrupt between recording and forgetting it)
+            return
+        rows[i] = row
+        if log is not None:
+            log.append(_row(points[i], row))
+        bar.update()
+
+    run = _Run(pool, owned, workers, lambda p: (run_point, scene, p, outputs, t_end, options), len(outputs))
     try:
-        futures = {pool.submit(run_point, scene, p, outputs, t_end, options): i for i, p in enumerate(points)}
-        with tqdm(total=len(points), unit="run", disable=None if progress else True) as bar:
-            for future in cf.as_completed(futures):
-                rows[futures[future]] = future.result()
-                bar.update()
-    except KeyboardInterrupt:
-        _gather_interrupted(futures, rows)
+        with tqdm(total=len(points), initial=sum(r is not None for r in rows), unit="run",
+                  disable=None if progress else True) as bar:
+            run.all([i for i, r in enumerate(rows) if r is None], points, record)
     finally:
-        if owned:
-            pool.shutdown(wait=False, cancel_futures=True)
-    return _table(points, outputs, rows)
+        run.close()
+        if log is not None:
+            log.close()
+    rows = [(-1, [np.nan] * len(outputs), "interrupted") if r is None else r for r in rows]
+    table = _table(points, outputs, rows)
+    if path is not None:
+        table.save(path)
+    return table
 
 
-def _gather_interrupted(futures: dict, rows: list) -> None:
-    """After Ctrl-C: cancel the points not started, and keep the running points' partial
-    results (status 2) when they return within :data:`INTERRUPT_GRACE` seconds."""
-    for future in futures:
-        future.cancel()
-    done, _ = cf.wait(futures, timeout=INTERRUPT_GRACE)
-    for future in done:
-        if not future.cancelled() and future.exception() is None:
-            rows[futures[future]] = future.result()
+class _Run:
+    """The points of one sweep on an executor: at most one point per worker in flight on an
+    owned pool, every point at once on another executor. A worker's death breaks an owned
+    pool: it is replaced, and the points that were in flight run again one at a time, so the
+    point that kills its worker again is found and failed, and the others are computed.
+    An interrupt gathers the running points."""
+
+    def __init__(self, pool, owned: bool, workers, task, n_outputs: int):
+        self.pool, self.owned, self.task, self.n_outputs = pool, owned, task, n_outputs
+        self.window = (workers or os.cpu_count() or 1) if owned else None
+        self.running = {}  # future -> point index
+        self.processes = {}  # pid -> worker process of the owned pool, for the reason of a death
+        self.suspects = deque()  # points in flight when a worker died, to run again alone
+        self.retried = set()
+        self.interrupted = False
+
+    def all(self, todo: list, points: list, record) -> None:
+        waiting = deque(todo)
+        try:
+            while waiting or self.suspects or self.running:
+                while (self.suspects or waiting) and not self._full():
+                    i = (self.suspects or waiting).popleft()
+                    try:
+                        self.running[self.pool.submit(*self.task(points[i]))] = i
+                    except cf.BrokenExecutor as exc:  # an executor not ours, broken: nothing more runs
+                        record(i, self._failure(f"not run: the executor is broken ({exc})"))
+                self.processes.update(getattr(self.pool, "_processes", None) or {})
+                for future in _finished(self.running):
+                    self._done(future, record)
+                if self.owned and getattr(self.pool, "_broken", False):  # a worker died: a new pool
+                    self.pool.shutdown(wait=True)  # ... once every point of the old one is marked
+                    for future in [f for f in self.running if f.done()]:
+                        self._done(future, record)
+                    self.pool, self.processes = process_pool(self.window), {}
+        except KeyboardInterrupt:
+            self.interrupted = True
+            self._gather(record)
+
+    def _full(self) -> bool:
+        """No room for another point: one per worker, and a point run again runs alone."""
+        alone = self.suspects or any(i in self.retried for i in self.running.values())
+        limit = 1 if alone else self.window
+        return limit is not None and len(self.running) >= limit
+
+    def _done(self, future, record) -> None:
+        """Record a finished point (or queue it to run again alone), then forget its future:
+        in this order, so that an interrupt in between cannot lose it."""
+        i = self.running[future]
+        if self.owned and isinstance(future.exception(), cf.BrokenExecutor) and i not in self.retried:
+            self.retried.add(i)
+            self.suspects.append(i)
+        else:
+            record(i, self._outcome(future, i in self.retried))
+        del self.running[future]
+
+    def _outcome(self, future, alone: bool):
+        exc = future.exception()
+        if exc is None:
+            return future.result()
+        if isinstance(exc, cf.BrokenExecutor):
+            when = " twice while running this point, the second time alone" if alone else " while this point was running"
+            return self._failure(f"worker process died{_cause_of_death(list(self.processes.values()))}{when} "
+                                 "(with resume=True / --resume it runs again)")
+        return self._failure(f"{type(exc).__name__}: {exc}")
+
+    def _failure(self, message: str) -> tuple:
+        return -1, [np.nan] * self.n_outputs, message
+
+    def _gather(self, record) -> None:
+        """After an interrupt: cancel the points not started, tell the owned pool's workers
+        (a SIGINT, as Ctrl-C on a terminal would), and keep the running points' partial
+        results (status 2) when they return within :data:`INTERRUPT_GRACE` seconds."""
+        for future in self.running:
+            future.cancel()
+        if self.owned:
+            for process in _workers(self.pool):
+                _signal(process, signal.SIGINT)
+        done, _ = cf.wait(self.running, timeout=INTERRUPT_GRACE)
+        for future in done:
+            if not future.cancelled() and future.exception() is None:
+                record(self.running[future], future.result())
+
+    def close(self) -> None:
+        """Shut an owned pool down; after an interrupt, its workers still alive are terminated."""
+        if not self.owned:
+            return
+        processes = _workers(self.pool)
+        self.pool.shutdown(wait=not self.interrupted, cancel_futures=True)
+        for process in processes if self.interrupted else ():
+            process.join(1.0)
+            process.terminate()  # still busy after the grace: SIGTERM ends a worker (interruptible_worker)
+            process.join(1.0)
+
+
+def _finished(running: dict) -> set:
+    """The futures among ``running`` that are done, waiting for at least one."""
+    return cf.wait(running, return_when=cf.FIRST_COMPLETED)[0]
+
+
+def _workers(pool) -> list:
+    """The worker processes of a ProcessPoolExecutor (none for another executor)."""
+    return list((getattr(pool, "_processes", None) or {}).values())
+
+
+def _signal(process, signum) -> None:
+    try:
+        os.kill(process.pid, signum)
+    except (ProcessLookupError, TypeError):  # gone already, or never started
+        pass
+
+
+def _cause_of_death(processes, wait: float = 2.0) -> str:
+    """" (killed by SIGKILL ...)" from the exit codes of a broken pool's workers, else "".
+    Waits up to ``wait`` s for them: the pool's own thread may be reaping them just now."""
+    deadline = time.monotonic() + wait
+    while True:
+        codes = [process.exitcode for process in processes]
+        for code in codes:
+            if code is not None and code < 0 and -code != signal.SIGTERM:  # the others are terminated by the pool
+                name = signal.Signals(-code).name
+                return f" (killed by {name}{', as the out-of-memory killer does' if name == 'SIGKILL' else ''})"
+            if code is not None and code > 0:
+                return f" (exit code {code})"
+        if time.monotonic() > deadline:
+            return ""
+        time.sleep(0.05)
+
+
+def _check_picklable(scene, options) -> None:
+    """ValueError before any work if the scene or the options cannot reach worker processes."""
+    try:
+        pickle.dumps((scene, options))
+    except Exception as exc:  # noqa: BLE001 - pickling raises many types
+        raise ValueError(
+            f"scene: cannot be sent to worker processes ({type(exc).__name__}: {exc}); define its build "
+            "function at module level of an importable module, or pass executor=concurrent.futures.ThreadPoolExecutor()"
+        ) from None
+
+
+def _row(point: dict, row) -> list:
+    status, values, error = row
+    return list(point.values()) + list(values) + [status, error]
+
+
+def _resumed(path: Path, header: list, points: list, rows: list) -> None:
+    """Fill ``rows`` with the finished points (status 0 or 1) of an earlier ``path``."""
+    if not path.exists():
+        return
+    found, lines = _read_csv(path)
+    if found != header:
+        raise ValueError(f"resume: {str(path)!r} has the columns {found}, this sweep writes {header}; "
+                         "resume with the same grid (and --set) and outputs, or write elsewhere")
+    n_parameters, n_outputs = len(points[0]), len(header) - len(points[0]) - 2
+    finished = {}
+    for line in lines:
+        key = tuple(line[:n_parameters])
+        if key not in finished:
+            finished[key] = []
+        if line[-2] in ("0", "1"):
+            finished[key].append((int(line[-2]), [float(c) for c in line[n_parameters:n_parameters + n_outputs]], ""))
+    keys = [tuple(csv_cells(p.values())) for p in points]
+    foreign = set(finished) - set(keys)
+    if foreign:
+        raise ValueError(f"resume: {str(path)!r} holds points not in this sweep (e.g. "
+                         f"{dict(zip(header, sorted(foreign)[0]))}); resume with the same grid, or write elsewhere")
+    for i, key in enumerate(keys):
+        if finished.get(key):
+            rows[i] = finished[key].pop(0)
 
 
 def _table(points, outputs, rows) -> SweepTable:

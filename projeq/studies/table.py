@@ -20,6 +20,7 @@ all write through :class:`Table`, so their files follow one convention:
 from __future__ import annotations
 
 import csv
+import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -45,6 +46,19 @@ def _csv_cell(value) -> str:
     if _is_number(value):
         return str(int(value))
     return _one_line(value)
+
+
+def csv_cells(row) -> list[str]:
+    """The cells of one row as :meth:`Table.to_csv` writes them (before CSV quoting)."""
+    return [_csv_cell(value) for value in row]
+
+
+def csv_line(row) -> str:
+    """One row as the newline-terminated CSV line :meth:`Table.to_csv` writes, for a file
+    appended to row by row (:func:`projeq.simulation.sweep.sweep` with ``path``)."""
+    stream = io.StringIO()
+    csv.writer(stream, lineterminator="\n").writerow(csv_cells(row))
+    return stream.getvalue()
 
 
 @dataclass(frozen=True)

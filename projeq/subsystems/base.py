@@ -18,6 +18,8 @@ from types import MethodType
 
 from numpy.typing import NDArray
 
+from projeq.checks import drop_inherited_twins
+
 REQUIRED = ("n_y", "gauss_terms", "kinetic_energy", "potential_energy")  # no default
 DEFAULTS = ("S", "n_e", "rigid_inertia", "elastic_terms", "port_at")  # optional members with a default
 _ABSENT = object()
@@ -72,10 +74,7 @@ class Subsystem:
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        if "gauss_terms" in vars(cls):  # the class states its own terms: what derived from the inherited ones goes
-            for derived in DERIVED:
-                if derived not in vars(cls):
-                    setattr(cls, derived, vars(Subsystem)[derived])
+        drop_inherited_twins(cls, Subsystem, ("gauss_terms",), DERIVED)
         for flag, methods in CAPABILITIES.items():
             setattr(cls, flag, all(getattr(cls, m) is not getattr(Subsystem, m) for m in methods))
 

@@ -35,6 +35,23 @@ _LAZY = {
 __all__ = list(_LAZY)
 
 
+def lazy_import(name: str):
+    """The module ``name``, loaded at its first attribute access (the standard library's
+    ``importlib.util.LazyLoader`` recipe): the numeric joints and force laws keep their sympy
+    forms next to their numeric ones without ``import projeq`` paying for sympy."""
+    import importlib.util
+    import sys
+
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.find_spec(name)
+    spec.loader = importlib.util.LazyLoader(spec.loader)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
 def __getattr__(name):
     import importlib
 

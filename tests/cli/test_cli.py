@@ -112,7 +112,7 @@ import signal, sys
 signal.signal(signal.SIGINT, signal.default_int_handler)
 import projeq.simulation.driver, projeq.simulation.sweep
 from projeq.cli.commands import main
-simulate, as_completed = projeq.simulation.driver.simulate, projeq.simulation.sweep.cf.as_completed
+simulate, finished = projeq.simulation.driver.simulate, projeq.simulation.sweep._finished
 
 def reporting_simulate(system, t_end, progress=None, **options):  # projeq run passes a progress bar
     def report(t):
@@ -120,12 +120,12 @@ def reporting_simulate(system, t_end, progress=None, **options):  # projeq run p
         print("segment done", flush=True)
     return simulate(system, t_end, progress=progress and report, **options)
 
-def reporting_as_completed(futures):
-    for future in as_completed(futures):
-        yield future
-        print("point done", flush=True)
+def reporting_finished(running):  # sweep's wait for the next finished points
+    done = finished(running)
+    print("point done", flush=True)
+    return done
 
-projeq.simulation.driver.simulate, projeq.simulation.sweep.cf.as_completed = reporting_simulate, reporting_as_completed
+projeq.simulation.driver.simulate, projeq.simulation.sweep._finished = reporting_simulate, reporting_finished
 sys.exit(main(sys.argv[1:]))
 """
 

@@ -292,3 +292,29 @@ def test_ctrl_c_keeps_what_was_computed(where):
     assert result.status == 2 and not result.success and "interrupted" in result.message
     assert np.allclose(result.t, np.linspace(0.0, 0.1, 11))
     assert np.all(np.isfinite(result.q)) and result.q[-1, 0] < THETA0  # it had started to fall
+
+
+def test_interpolants_are_kept_only_when_asked_for(monkeypatch):
+    """dense_output=False: each finished segment's interpolants (~10 KB per step for
+    chain(100)) are released during the run, only the current segment's are alive;
+    dense_output=True keeps every one of them for ``result.sol``."""
+    import weakref
+
+    import projeq.simulation.driver as driver
+
+    solutions, real = [], driver.solve_ivp
+
+    def recording(*args, **kwargs):
+        segment = real(*args, **kwargs)
+        solutions.append(weakref.ref(segment.sol))
+        return segment
+
+    def count_alive(t):  # no reference cycles hold them: released at once, no gc.collect needed
+        alive.append(sum(ref() is not None for ref in solutions))
+
+    monkeypatch.setattr(driver, "solve_ivp", recording)
+    for dense, expected in ((False, [1] * 5), (True, [1, 2, 3, 4, 5])):
+        solutions.clear()
+        alive = []
+        pq.simulate(_pendulum(), 2.0, [THETA0], [0.0], n_segments=5, dense_output=dense, progress=count_alive)
+        assert alive == expected

@@ -1,6 +1,8 @@
 """Parameter sweeps (projeq.sweep, module projeq.simulation.sweep): same numbers on every executor, physics, failures, Ctrl-C."""
 
 import concurrent.futures as cf
+import errno
+import os
 import sys
 import time
 import types
@@ -80,14 +82,13 @@ def test_ctrl_c_keeps_the_running_point_and_cancels_the_others(monkeypatch):
     """A KeyboardInterrupt while the first of three points runs on a one-thread pool: the
     running point is waited for and kept, the two not started are marked interrupted."""
 
-    def interrupted(futures):
+    def interrupted(futures):  # sweep's wait for the next finished point
         first = next(iter(futures))
         while not (first.running() or first.done()):
             time.sleep(1e-3)
         raise KeyboardInterrupt
-        yield  # a generator, like cf.as_completed
 
-    monkeypatch.setattr(sweep_module.cf, "as_completed", interrupted)
+    monkeypatch.setattr(sweep_module, "_finished", interrupted)
     with cf.ThreadPoolExecutor(1) as pool:
         table = sweep("chain", grid={"n": [1, 2, 3]}, outputs=["q0"], executor=pool, t_end=0.05, progress=False)
     assert table["status"].tolist() == [0, -1, -1] and table["error"] == ["", "interrupted", "interrupted"]
@@ -129,3 +130,94 @@ def test_a_closed_dask_client_is_refused_before_any_work():
         client.close()
         with pytest.raises(ValueError, match="executor: the Dask client is not connected"):
             sweep("atwood", grid={"m1": [1.0]}, executor=client)
+
+
+def test_points_are_appended_as_they_finish_and_resume_runs_only_the_rest(tmp_path, monkeypatch):
+    """With path, each finished point is in path.csv before the sweep returns (checked while
+    the third point runs); the final CSV (input order) and NPZ agree. resume=True on a table
+    missing one point and holding a failed one runs exactly those two and keeps the others
+    bit for bit."""
+    seen = []
+    real_run_point = sweep_module.run_point
+
+    def watching(scene, parameters, *args):
+        if parameters["n"] == 3:  # the two before it have finished (one thread): the main thread appends them
+            deadline = time.monotonic() + 5.0
+            while len(sweep_module.SweepTable.load(tmp_path / "chains")["n"]) < 2 and time.monotonic() < deadline:
+                time.sleep(0.01)
+            seen.append(sweep_module.SweepTable.load(tmp_path / "chains")["n"].tolist())
+        return real_run_point(scene, parameters, *args)
+
+    monkeypatch.setattr(sweep_module, "run_point", watching)
+    grid = {"n": [1, 2, 3]}
+    with cf.ThreadPoolExecutor(1) as pool:
+        table = sweep("chain", grid=grid, outputs=["q0", "wall_time"], executor=pool, t_end=0.05, progress=False,
+                      path=tmp_path / "chains")
+    assert seen == [[1, 2]]
+    saved = np.load(tmp_path / "chains.npz", allow_pickle=True)
+    for name in ("n", "q0", "wall_time", "status"):
+        assert np.array_equal(sweep_module.SweepTable.load(tmp_path / "chains.csv")[name], saved[name])
+
+    lines = (tmp_path / "chains.csv").read_text().splitlines()
+    failed = lines[2].split(",")[:-2] + ["-1", "ValueError: on purpose"]
+    (tmp_path / "chains.csv").write_text("\n".join([lines[0], lines[1], ",".join(failed)]) + "\n")  # n = 3 lost
+    ran = []
+    monkeypatch.setattr(sweep_module, "run_point", lambda scene, p, *args: ran.append(p["n"]) or real_run_point(scene, p, *args))
+    with cf.ThreadPoolExecutor(1) as pool:
+        resumed = sweep("chain", grid=grid, outputs=["q0", "wall_time"], executor=pool, t_end=0.05, progress=False,
+                        path=tmp_path / "chains", resume=True)
+    assert sorted(ran) == [2, 3] and resumed["status"].tolist() == [0, 0, 0]
+    assert resumed["wall_time"][0] == table["wall_time"][0]  # kept, not run again
+    assert np.array_equal(resumed["q0"], table["q0"])  # the same deterministic runs
+
+
+def test_a_cut_off_last_line_is_left_out_and_a_foreign_file_is_named(tmp_path):
+    """A process killed while appending leaves a line without its newline: the loader reads
+    the whole lines; a file that is not a sweep table is refused by name."""
+    (tmp_path / "t.csv").write_text("m1,q0,status,error\n1.0,-2.5,0,\n2.0,-3")
+    assert sweep_module.SweepTable.load(tmp_path / "t")["m1"].tolist() == [1.0]
+    (tmp_path / "u.csv").write_text("t,q0\n0,1\n")
+    with pytest.raises(ValueError, match="u.csv' is not a sweep table"):
+        sweep_module.SweepTable.load(tmp_path / "u.csv")
+
+
+def test_an_append_that_fails_is_undone(tmp_path, monkeypatch):
+    """A full disk during an append: the partial line is cut off again (the file keeps whole
+    rows), a warning says the points stay in memory, later appends are skipped."""
+    log = sweep_module._Log(tmp_path / "t.csv", ["m1", "status", "error"], [[1.0, 0, ""]])
+    real_write = os.write
+
+    def half_then_full(fd, data):
+        real_write(fd, data[: len(data) // 2])
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(os, "write", half_then_full)
+    with pytest.warns(RuntimeWarning, match="cannot append to .*No space left on device"):
+        log.append([2.0, 0, ""])
+    log.append([3.0, 0, ""])
+    assert (tmp_path / "t.csv").read_text() == "m1,status,error\n1.0,0,\n"
+
+
+def test_a_scene_that_cannot_reach_the_workers_is_refused_before_any_work():
+    """A build function defined inside a function cannot be pickled for a worker process."""
+    from projeq.scenes import Scene, build_scene
+
+    local = Scene(lambda n=1: build_scene("chain", n=n), "a chain built by a lambda", 0.1)
+    with pytest.raises(ValueError, match="scene: cannot be sent to worker processes"):
+        sweep(local, grid={"n": [1]}, workers=1)
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"grid": {"m1": []}}, "grid: m1 has no values"),
+        ({"samples": []}, "samples: expected at least one point"),
+        ({"grid": {"m1": [1.0]}, "resume": True}, "resume: needs path"),
+        ({"grid": {"m1": [1.0]}, "workers": 0}, "workers: expected a positive number"),
+        ({"grid": {"m1": [1.0]}, "workers": 2, "executor": cf.ThreadPoolExecutor(1)}, "workers: only for the default"),
+    ],
+    ids=["empty-axis", "no-samples", "resume-without-path", "workers", "workers-and-executor"],
+)
+def test_more_bad_input(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        sweep("atwood", **kwargs)

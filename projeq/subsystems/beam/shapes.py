@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
 # roots of 1 + cos βL cosh βL = 0 (clamped–free), refined numerically below
 _CLAMPED_FREE_GUESS = (1.875, 4.694, 7.855, 10.996)
@@ -42,6 +41,8 @@ def axial_polynomial(n: int, L: float):
 
 def clamped_free_roots(n: int) -> NDArray:
     """β_k L of 1 + cos βL cosh βL = 0, k = 1 … n (1.8751041, 4.6940911, …)."""
+    from scipy.optimize import brentq  # here, not at the top: keeps `import projeq` light
+
     guesses = list(_CLAMPED_FREE_GUESS) + [(2 * k - 1) * np.pi / 2 for k in range(5, n + 1)]
     f = lambda b: 1.0 + np.cos(b) * np.cosh(b)  # noqa: E731
     return np.array([brentq(f, g - 0.3, g + 0.3) for g in guesses[:n]])
@@ -81,6 +82,8 @@ def axial_clamped_free(n: int, L: float):
 def pinned_free_roots(n: int) -> NDArray:
     """β_k L of tan βL = tanh βL, k = 1 … n (3.9266023, 7.0685835, 10.2101761, …; the
     root βL = 0, the rigid rotation about the pin, is left to the hub joint)."""
+    from scipy.optimize import brentq
+
     f = lambda b: np.sin(b) * np.cosh(b) - np.cos(b) * np.sinh(b)  # noqa: E731  (tan = tanh)
     guesses = (4 * np.arange(1, n + 1) + 1) * np.pi / 4
     return np.array([brentq(f, g - 0.3, g + 0.3) for g in guesses])
