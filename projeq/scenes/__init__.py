@@ -14,7 +14,7 @@ import numpy as np
 from projeq.subsystems import inertia
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
-from projeq.scenes.bicycle import whipple_bicycle, whipple_eigenvalues
+from projeq.scenes.bicycle import fallen_over, whipple_bicycle, whipple_eigenvalues
 from projeq.scenes.elastic import elastic_arm, spin_up_beam, spinning_beam
 from projeq.scenes.mechanisms import bar_on_wall, four_bar, quick_return, slider_pendulum, sphere_on_sphere
 from projeq.scenes.parameters import Parameter, check_names, closest, parse_settings, scene_parameters
@@ -92,8 +92,10 @@ class Scene(NamedTuple):
 
     ``units`` maps parameter names to SI units where they differ from or are missing in
     :data:`projeq.scenes.parameters.UNITS`; ``plane`` = the indices (i, j) of q that are a
-    position in the ground plane, for a trajectory plot. Registering a scene is one entry in
-    ``SCENES``.
+    position in the ground plane, for a trajectory plot; ``events`` = terminal events
+    ``event(t, q, s_dot)`` that end a run for a physical reason, each with a ``description``
+    (``projeq run`` passes them to ``simulate`` and says which one stopped the run).
+    Registering a scene is one entry in ``SCENES``.
     """
 
     build: Callable[..., System]
@@ -101,6 +103,7 @@ class Scene(NamedTuple):
     t_end: float
     units: dict | None = None
     plane: tuple | None = None
+    events: tuple = ()
 
 
 SCENES = {
@@ -117,7 +120,7 @@ SCENES = {
     "barhorst_particle": Scene(barhorst_particle, "a particle with the constraint y' - y^2 x' = 0 (seed 000, 3.1)", 10.0),
     "nonholonomic_particle": Scene(nonholonomic_particle, "a particle in space with y' + z x' = 0 (seed 000, 3.1)", 2.0),
     "whipple_bicycle": Scene(whipple_bicycle, "the Whipple bicycle of Meijaard et al. (2007), constraint equations", 5.0,
-                             plane=(0, 1)),
+                             plane=(0, 1), events=(fallen_over,)),
     "quick_return": Scene(quick_return, "Barhorst's quick-return mechanism, a closed loop (seed 000, 3.3)", 5.0),
     "four_bar": Scene(four_bar, "a four-bar linkage closed by a constraint equation", 5.0),
 }

@@ -206,6 +206,20 @@ class Contacts:
 _E = np.eye(3)
 
 
+FALLEN_ROLL = np.pi / 3  # rad: |roll| at which the bicycle counts as fallen over
+
+
+def fallen_over(t: float, q, s_dot) -> float:
+    """Terminal event of the bicycle falling over: zero where the roll φ = q[3] reaches
+    ±60° (:data:`FALLEN_ROLL`). Beyond it the model's knife-edge wheels approach lying flat on
+    the ground, where the rolling constraints cannot be solved for the dependent speeds."""
+    return FALLEN_ROLL - abs(q[3])
+
+
+fallen_over.terminal = True
+fallen_over.description = f"the bicycle fell over (|roll| reached {np.degrees(FALLEN_ROLL):.0f}°)"
+
+
 def upright_pitch(roll: float, steer: float, params: dict | None = None) -> float:
     """The pitch θ that puts the front wheel on the ground at the given roll and steer
     (Φ = 0 solved by Brent's method within ±0.5 rad; 0 for the upright, straight bicycle)."""
@@ -236,7 +250,10 @@ def whipple_bicycle(params: dict | None = None, speed: float = 4.0, roll: float 
     roll, steer, roll_rate, steer_rate : float
         Initial roll φ, steer δ (rad) and their rates (rad/s); the pitch is solved from Φ = 0.
     **options
-        Passed to :class:`~projeq.constraints.partitioned.ConstrainedSystem` (``correction``, ``beta``).
+        Passed to :class:`~projeq.constraints.partitioned.ConstrainedSystem` (``correction``,
+        ``beta``, ``repivot``). ``repivot`` defaults to True: the run starts with ṡ = (φ̇, θ̇_R, δ̇)
+        and re-partitions where those stop determining the others (a steep roll), so a falling
+        bicycle runs until it has fallen (:func:`fallen_over`).
 
     Returns
     -------
@@ -259,7 +276,7 @@ def whipple_bicycle(params: dict | None = None, speed: float = 4.0, roll: float 
     s_dot0 = np.array([roll_rate, -speed / p["r_R"], steer_rate])
     return ConstrainedSystem(
         _tree(p, q0), phi=contacts.phi, A=contacts.A,
-        independent=INDEPENDENT, q0=q0, s_dot0=s_dot0, **options,
+        independent=INDEPENDENT, q0=q0, s_dot0=s_dot0, **{"repivot": True, **options},
     )
 
 

@@ -276,3 +276,18 @@ def test_version(capsys):
     """``projeq --version`` prints the one version source, ``projeq.__version__``, and exits 0."""
     assert main(["--version"]) == 0
     assert capsys.readouterr().out.strip() == f"projeq {pq.__version__}"
+
+
+def test_the_cli_pages_bicycle_falls_over_with_a_physical_message(tmp_path, capsys):
+    """``projeq run whipple_bicycle --set speed=3 --set roll=0.05`` (docs/cli.md): below the weave
+    speed 4.29 m/s the benchmark bicycle is unstable (Meijaard, Papadopoulos, Ruina and Schwab,
+    Proc. R. Soc. A 463 (2007), Table 2), so it falls. The run re-partitions where (φ̇, θ̇_R, δ̇)
+    stop determining the other speeds, ends at the scene's fall event with exit 0, says so, and
+    writes its results; the last row is the event's state, |roll| = 60°."""
+    out = tmp_path / "bike"
+    assert main(["run", "whipple_bicycle", "--set", "speed=3", "--set", "roll=0.05", "--quiet",
+                 "--out", str(out)]) == 0
+    assert "fell over" in capsys.readouterr().out
+    result = pq.Result.load(next(out.rglob("whipple_bicycle.npz")))
+    assert abs(abs(result.q[-1, 3]) - np.pi / 3) < 1e-8
+    assert len(result.partitions) >= 2
