@@ -22,6 +22,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+def numeric(value) -> NDArray:
+    """``value`` as a float array, or a complex one if it is complex (a complex step passes)."""
+    array = np.asarray(value)
+    return array if np.iscomplexobj(array) else array.astype(float)
+
+
 _AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 
 

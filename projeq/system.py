@@ -392,7 +392,7 @@ class System(Model):
     def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
         """q̇ = K(q) ṡ + k(q, t): q̇ = ṡ in one step where K = E (revolute and prismatic
         joints, elastic coordinates), joint by joint elsewhere."""
-        q_dot = np.empty(self.n_q)
+        q_dot = np.empty(self.n_q, dtype=np.result_type(q, s_dot, float))  # complex for a complex step
         q_dot[self._identity_q] = np.asarray(s_dot)[self._identity_s]
         for n in self._general_kinematics:
             j = self.joints[n]
@@ -415,7 +415,7 @@ class System(Model):
 
     def K(self, q: NDArray, t: float = 0.0) -> NDArray:
         """K(q) of q̇ = K ṡ + k (block-diagonal over the joints)."""
-        K = np.zeros((self.n_q, self.n_s))
+        K = np.zeros((self.n_q, self.n_s), dtype=np.result_type(q, float))
         for n, j in enumerate(self.joints):
             if not j.coupling:
                 rows = slice(self.q_slice[n].start, self.e_q_slice[n].start)

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.analysis.differentiation import jacobian
+from projeq.analysis.jacobians import differentiate, state_derivative
 from projeq.system import check_model
 
 _TOL = 1e-8  # relative threshold: zero columns of A, and the steady-motion residual
@@ -73,20 +73,6 @@ class Linearization(tuple):
         return sorted_eigenvalues(self[0])
 
 
-def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, inputs=()) -> NDArray:
-    """ẋ = (q̇, s̈) at x = (q, ṡ); ``tau`` are generalized forces on the joints ``inputs``
-    (added to Q of the Gauss form M s̈ + b = Q, THEORY §5; for a ConstrainedSystem projected
-    with its F, Fᵀ Q_tree, §7)."""
-    q, s_dot = x[: system.n_q], x[system.n_q :]
-    if tau is None or not len(inputs):
-        s_ddot = system.evaluator().accelerations(q, s_dot, t)
-    else:
-        M, b = system.gauss_form(q, s_dot, t)
-        split = np.split(tau, np.cumsum([system.joint(j).n_s for j in inputs])[:-1])
-        s_ddot = np.linalg.solve(M, system.generalized_force(q, t, dict(zip(inputs, split))) - b)
-    return np.concatenate((system.q_dot(q, s_dot, t), s_ddot))
-
-
 def ignorable_coordinates(A: NDArray, n_q: int, tol: float = _TOL) -> list[int]:
     """Indices of the largest set D of coordinates q_i whose columns of A vanish in every
     row not in D (the derivatives of the remaining states do not depend on them).
@@ -105,7 +91,7 @@ def ignorable_coordinates(A: NDArray, n_q: int, tol: float = _TOL) -> list[int]:
 
 
 def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="auto",
-              tol: float = _TOL, require_steady: bool = True) -> Linearization:
+              tol: float = _TOL, require_steady: bool = True, derivatives: str = "exact") -> Linearization:
     """Linearisation δẋ = A δx + B δτ about the state (q, ṡ) at time t.
 
     Parameters
@@ -126,6 +112,10 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
         Relative threshold for a vanishing column of A and for the steady-motion residual.
     require_steady : bool
         If False, return the Jacobians at any state (no steady-motion checks).
+    derivatives : "exact" or "differences"
+        The complex step through the model's evaluation, exact to round-off (the default;
+        :mod:`projeq.analysis.jacobians`), or Richardson's central differences on request
+        (used anyway where a user callable cannot take complex arguments).
 
     Returns
     -------
@@ -144,16 +134,16 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
     q, s_dot = system.check_state(q, s_dot, t)
     inputs = _check_inputs(system, inputs)
     x0 = np.concatenate((q, s_dot))
-    A = jacobian(lambda x: state_derivative(system, x, t), x0)
+    A, derivatives = differentiate(lambda x: state_derivative(system, x, t), x0, derivatives)
     names = system.state_names()
     dropped = _dropped(system, names, A, ignore, tol)
     kept = [i for i in range(len(x0)) if i not in dropped]
     if require_steady:
         x_dot = state_derivative(system, x0, t)
         _check_steady(x_dot, kept, names, tol)
-        _check_invariant(system, x0, x_dot, t, A, dropped, kept, names)
+        _check_invariant(system, x0, x_dot, t, A, dropped, kept, names, derivatives)
     n_u = sum(system.joint(name).n_s for name in inputs)
-    B = jacobian(lambda u: state_derivative(system, x0, t, u, inputs), np.zeros(n_u))
+    B = differentiate(lambda u: state_derivative(system, x0, t, u, inputs), np.zeros(n_u), derivatives)[0]
     return Linearization(A[np.ix_(kept, kept)], B[kept], [names[i] for i in kept],
                          [names[i] for i in dropped], inputs)
 
@@ -201,7 +191,7 @@ def _check_steady(x_dot: NDArray, kept: list[int], names: list[str], tol: float)
         )
 
 
-def _check_invariant(system, x0, x_dot, t, A, dropped, kept, names) -> None:
+def _check_invariant(system, x0, x_dot, t, A, dropped, kept, names, derivatives) -> None:
     """Along a steady motion the dropped coordinates move at their rates ẋ_D; A must not
     change with them (ignorable in a neighbourhood of the motion, not only at x0). Checked
     at x0 + τ ẋ_D with τ such that the largest shift is 1; the bound 1e-6 max|A| is far
@@ -211,7 +201,7 @@ def _check_invariant(system, x0, x_dot, t, A, dropped, kept, names) -> None:
     if not np.any(rates):
         return  # an equilibrium: nothing moves
     shifted = x0 + rates / np.abs(rates).max()
-    A_shifted = jacobian(lambda x: state_derivative(system, x, t), shifted)[np.ix_(kept, kept)]
+    A_shifted = differentiate(lambda x: state_derivative(system, x, t), shifted, derivatives)[0][np.ix_(kept, kept)]
     change = np.abs(A_shifted - A[np.ix_(kept, kept)]).max()
     if change > 1e-6 * max(1.0, np.abs(A).max()):
         moving = [names[i] for i in dropped if x_dot[i]]

@@ -36,8 +36,9 @@ class DenseEvaluator:
         M_n, h_n = gauss_terms(system, kin, q, s_dot, t)
         J = [None] * len(system.joints) + [np.zeros((0, system.n_s))]
         zeta_bar = [None] * len(system.joints) + [np.zeros(0)]
-        M = np.zeros((system.n_s, system.n_s))
-        b = np.zeros(system.n_s)
+        dtype = np.result_type(kin.T_aug[0], *h_n[:-1])  # complex for a complex step
+        M = np.zeros((system.n_s, system.n_s), dtype=dtype)
+        b = np.zeros(system.n_s, dtype=dtype)
         for n in range(len(system.joints)):
             p = system.parent[n]
             cols, P = self.P[n]

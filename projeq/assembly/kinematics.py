@@ -135,8 +135,9 @@ def forward(system, q: NDArray, s_dot: NDArray, t: float) -> Kinematics:
     y_dot = _describing_velocities(system, prep, twist, s_dot)
     w = np.array([rel.w for rel in rels])
     zeta6 = cross_motion(np.array(u), w) + np.array([rel.zeta for rel in rels])  # Ṫ ẏ_p + Ḟ ṡ + ḟ
-    T_aug6 = np.zeros((len(rels), 7, 7))
-    T_aug6[:, :6, :6] = chain_matrix(np.array(A_np), np.array(r_pn))
+    chain = chain_matrix(np.array(A_np), np.array(r_pn))
+    T_aug6 = np.zeros((len(rels), 7, 7), dtype=np.result_type(chain, zeta6))
+    T_aug6[:, :6, :6] = chain
     T_aug6[:, :6, 6] = zeta6
     T_aug6[:, 6, 6] = 1.0
     T_aug, F = _chain_terms(system, prep, rels, T_aug6, P_aug)
@@ -176,7 +177,7 @@ def _port(system, station, p, q, s_dot, R, r, twist):
     u = T6 @ twist[p]
     n_y = system.subsystems[p].n_y
     n_e = port.F.shape[1]
-    P_aug = np.zeros((7, n_y + 1))
+    P_aug = np.zeros((7, n_y + 1), dtype=np.result_type(T6, port.F, port.zeta))
     P_aug[:6, :n_y] = T6 @ system.S[p].T
     P_aug[:6, n_y - n_e : n_y] += port.F
     P_aug[:6, -1] = cross_motion(u, port.w) + port.zeta
@@ -191,7 +192,7 @@ def _describing_velocities(system, prep: Plan, twist, s_dot: NDArray) -> list:
     y_dot = [twist[n] if system.S[n] is None else system.S[n] @ twist[n] for n in range(N)] + [np.zeros(0)]
     for n in prep.internal:
         n_e = system.e_s_slice[n].stop - system.e_s_slice[n].start
-        y_dot[n] = y_dot[n].copy()
+        y_dot[n] = y_dot[n].astype(np.result_type(y_dot[n], s_dot))
         y_dot[n][-n_e:] += s_dot[system.e_s_slice[n]]
     return y_dot
 

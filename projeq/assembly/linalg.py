@@ -30,6 +30,9 @@ def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
     ``what`` when a pivot is below ``1e-13 · scale``.
     """
     k = D.shape[0]
+    if np.iscomplexobj(D) or np.iscomplexobj(B):  # a complex step: Cholesky would conjugate
+        _check_pivots(np.real(D), what, scale)
+        return np.linalg.solve(D, B) if k else B
     if k == 1:
         if D[0, 0] > SINGULAR_PIVOT * scale:
             return B / D[0, 0]
@@ -43,6 +46,11 @@ def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
     if np.diagonal(L).min() ** 2 <= SINGULAR_PIVOT * scale:
         raise SingularMassError(f"{_name(what)} is singular (smallest pivot {np.diagonal(L).min() ** 2:.3g})")
     return np.linalg.solve(L.T, np.linalg.solve(L, B))
+
+
+def _check_pivots(D: NDArray, what: str, scale: float) -> None:
+    """The checks of :func:`solve_spd` on a real D."""
+    solve_spd(D, np.zeros((D.shape[0], 0)), what, scale)
 
 
 def _name(what: str) -> str:

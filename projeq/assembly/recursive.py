@@ -47,16 +47,20 @@ class RecursiveEvaluator:
             )
         self.system = system
         self.scale = mass_scale(system)
-        self._fill_groups, self._A_hat = _workspace(system)
+        self._workspaces = {np.dtype(float): _workspace(system, float)}  # and complex, for a complex step
         self.n_calls = 0
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """s̈ by the backward and forward passes of THEORY §6."""
         self.n_calls += 1
-        system, scale, A_hat = self.system, self.scale, self._A_hat
+        system, scale = self.system, self.scale
         kin = forward(system, q, s_dot, t)
         M, h = gauss_terms(system, kin, q, s_dot, t)
-        for idx, A in self._fill_groups:  # Ã_n = [[M_n, −h_n], [−h_nᵀ, 0]], a stack per n_y
+        dtype = np.result_type(kin.T_aug[0], *h[:-1])
+        if dtype not in self._workspaces:
+            self._workspaces[dtype] = _workspace(system, dtype)
+        fill_groups, A_hat = self._workspaces[dtype]
+        for idx, A in fill_groups:  # Ã_n = [[M_n, −h_n], [−h_nᵀ, 0]], a stack per n_y
             k = A.shape[1] - 1
             # not np.negative(..., out=view): numpy 2.4 mis-reads such strided views when the
             # stack has one member (tests/assembly/test_recursive_vs_dense.py covers both)
@@ -85,15 +89,15 @@ class RecursiveEvaluator:
         return -np.concatenate(minus_s_ddot)
 
 
-def _workspace(system) -> tuple[list, list]:
+def _workspace(system, dtype) -> tuple[list, list]:
     """The augmented matrices Ã_n, stacked by n_y so that one call fills each stack, and
     per-subsystem views into them (the ground's 1×1 Ã last)."""
     by_size: dict = {}
     for n, sub in enumerate(system.subsystems):
         by_size.setdefault(sub.n_y, []).append(n)
-    groups, A_hat = [], [None] * len(system.subsystems) + [np.zeros((1, 1))]
+    groups, A_hat = [], [None] * len(system.subsystems) + [np.zeros((1, 1), dtype=dtype)]
     for k, idx in by_size.items():
-        stack = np.zeros((len(idx), k + 1, k + 1))
+        stack = np.zeros((len(idx), k + 1, k + 1), dtype=dtype)
         groups.append((idx, stack))
         for j, n in enumerate(idx):
             A_hat[n] = stack[j]

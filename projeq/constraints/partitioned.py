@@ -57,8 +57,10 @@ from numpy.typing import NDArray
 
 from projeq.assembly.linalg import solve_spd
 from projeq.checks import positive, state_vector
-from projeq.analysis.differentiation import richardson, second
+from projeq.analysis.differentiation import (derivative_along, derivative_along_differences, is_complex_safe,
+                                             second_derivative_along, second_derivative_along_differences)
 from projeq.joints import Joint
+from projeq.spatial import numeric
 from projeq.system import Model
 
 CORRECTIONS = ("projection", "baumgarte", "none")
@@ -70,7 +72,6 @@ PARTITION_CONDITION = 1e8
 REPIVOT_CONDITION = 1e2
 # |Φ| (relative to the largest coordinate, at least 1) accepted as on the manifold: 1e4 × round-off
 POSITION_TOLERANCE = 1e-12
-_H1, _H2 = 1e-3, 3e-3  # steps of the 1st/2nd differences: truncation ~h⁴, round-off ~1e-16/h, 1e-16/h²
 
 
 class ConstrainedSystem(Model):
@@ -143,6 +144,7 @@ class ConstrainedSystem(Model):
         if b is not None:
             self._constraint_rows("b", b, (q0, 0.0), 1, self.m_p)
         self.n_c = self.n_lambda = self.m_h + self.m_p
+        self.exact = self._choose_derivatives(q0)
         if correction == "projection" and self.m_h and any(  # simulate normalises q without the time
                 not np.allclose(self.phi(q0, t), self.phi(q0, 0.0), rtol=0, atol=1e-14) for t in (0.37, 1.9)):
             raise ValueError("correction: 'projection' needs Φ independent of t (q is normalised without the "
@@ -170,26 +172,40 @@ class ConstrainedSystem(Model):
             raise ValueError(f"{name}: returns non-finite values {value.tolist()} at q0")
         return value.shape[0]
 
+    def _choose_derivatives(self, q0) -> bool:
+        """The derivatives of Φ, A and b: by the complex step (exact to round-off) if the
+        callables take complex arguments, else by Richardson's stencils (``exact`` False)."""
+        given = [f for f in (self._phi, self._A, self._b) if f is not None]
+        exact = all(is_complex_safe(lambda x, f=f: f(x[:-1], x[-1].real), np.append(q0, 0.0)) for f in given)
+        self._d1 = derivative_along if exact else derivative_along_differences
+        self._d2 = second_derivative_along if exact else second_derivative_along_differences
+        return exact
+
     def phi(self, q: NDArray, t: float = 0.0) -> NDArray:
         """Φ(q, t), the holonomic constraints (empty without any)."""
-        return np.asarray(self._phi(q, t), dtype=float) if self.m_h else np.zeros(0)
+        return numeric(self._phi(q, t)) if self.m_h else np.zeros(0)
 
     def _pfaffian(self, q, t) -> tuple[NDArray, NDArray]:
         if not self.m_p:
             return np.zeros((0, self.n_q)), np.zeros(0)
-        b = np.zeros(self.m_p) if self._b is None else np.asarray(self._b(q, t), dtype=float)
-        return np.asarray(self._A(q, t), dtype=float), b
+        b = np.zeros(self.m_p) if self._b is None else numeric(self._b(q, t))
+        return numeric(self._A(q, t)), b
+
+    def _phi_x(self, x: NDArray) -> NDArray:
+        """Φ at x = (q, t)."""
+        return self.phi(x[:-1], x[-1])
 
     def phi_q(self, q: NDArray, t: float = 0.0) -> NDArray:
-        """∂Φ/∂q (m_h × n_q) by central differences."""
-        unit = np.eye(self.n_q)
-        columns = [richardson(lambda e, i=i: self.phi(q + e * unit[i], t), _H1) for i in range(self.n_q)]
+        """∂Φ/∂q (m_h × n_q), column i = Φ′ along e_i (module docstring)."""
+        x, unit = np.append(q, t), np.eye(self.n_q + 1)
+        columns = [self._d1(self._phi_x, x, unit[i]) for i in range(self.n_q)]
         return np.array(columns).T.reshape(self.m_h, self.n_q)
 
     def velocity_constraints(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """(C, c) of C q̇ = c: C = [∂Φ/∂q; A], c = [−∂Φ/∂t; b]."""
         A, b = self._pfaffian(q, t)
-        phi_t = richardson(lambda e: self.phi(q, t + e), _H1) if self.m_h else np.zeros(0)
+        time = np.eye(self.n_q + 1)[-1]
+        phi_t = self._d1(self._phi_x, np.append(q, t), time) if self.m_h else np.zeros(0)
         return np.vstack((self.phi_q(q, t), A)), np.concatenate((-phi_t, b))
 
     def constraint_residual(self, q: NDArray, q_dot: NDArray, t: float = 0.0) -> NDArray:
@@ -320,9 +336,9 @@ class ConstrainedSystem(Model):
         """(F, f) of ṡ_tree = F ṡ + f: F = [E; −A_dep⁻¹ A_ind], f = [0; A_dep⁻¹ b_s]
         (``constraint_matrix``: (A_s, b_s) at (q, t) if known)."""
         A_s, b_s = self.constraint_matrix(q, t) if constraint_matrix is None else constraint_matrix
-        F = np.zeros((self.tree.n_s, self.n_s))
+        F = np.zeros((self.tree.n_s, self.n_s), dtype=np.result_type(A_s, b_s))
         F[self.independent] = np.eye(self.n_s)
-        f = np.zeros(self.tree.n_s)
+        f = np.zeros(self.tree.n_s, dtype=F.dtype)
         if self.n_c:
             self._check_dependent(A_s, q, t)  # the partition degenerates during a run
             solved = np.linalg.solve(A_s[:, self.dependent], np.column_stack((A_s[:, self.independent], b_s)))
@@ -391,22 +407,30 @@ class ConstrainedSystem(Model):
     # -- dynamics ---------------------------------------------------------------------------
     def gamma(self, q: NDArray, s_dot_tree: NDArray, t: float = 0.0, C=None) -> NDArray:
         """γ of A_s s̈_tree = −γ: d/dt (C q̇ − c) along the motion with s̈_tree = 0
-        (``C``: the velocity constraint matrix at (q, t) if known)."""
-        tree = self.tree
+        (``C``: the velocity constraint matrix at (q, t) if known), in x = (q, t) moving at
+        v = (q̇, 1):
+
+            γ = [Φ″(v, v); (A′ v) q̇ − b′ v] + C (K̇ ṡ_tree + k̇),
+
+        Φ″(v, v) = Φ″(v_q, v_q) + 2 Φ″(v_q, v_t) + Φ″(v_t, v_t) with v_q = (q̇, 0), v_t = (0, 1)
+        taken apart so that each part keeps its relative accuracy at any speed (the first is
+        ∝ |q̇|², the rheonomic ones are not); the first derivatives by the complex step, Φ″ by
+        the complex step inside Richardson's stencil (≈ 1e-14 relative, :data:`projeq.analysis.differentiation.MIXED_STEP`)."""
+        tree, n = self.tree, self.n_q
         q_dot = tree.q_dot(q, s_dot_tree, t)
-        moving = np.concatenate((q_dot, [1.0]))
-        step = 1.0 / np.linalg.norm(moving)  # differences along the unit direction (q̇, 1)
-
-        def at(e):
-            return q + e * step * q_dot, t + e * step
-
-        q_ddot = richardson(lambda e: tree.q_dot(at(e)[0], s_dot_tree, at(e)[1]), _H1) / step  # K̇ ṡ + k̇
+        x, v = np.append(q, t), np.append(q_dot, 1.0)
+        # frozen arguments ride along in the point with zero rate (they may carry an outer complex step)
+        q_ddot = derivative_along(lambda y: tree.q_dot(y[:n], y[n + 1:], y[n]), np.append(x, s_dot_tree),
+                                  np.append(v, np.zeros(tree.n_s)))  # K̇ ṡ + k̇
         C = self.velocity_constraints(q, t)[0] if C is None else C
         parts = []
         if self.m_h:
-            parts.append(second(lambda e: self.phi(*at(e)), _H2) / step**2)
+            v_q, v_t = np.append(q_dot, 0.0), np.eye(len(x))[-1]
+            parts.append(self._d2(self._phi_x, x, v_q, v_q) + 2 * self._d2(self._phi_x, x, v_q, v_t)
+                         + self._d2(self._phi_x, x, v_t, v_t))
         if self.m_p:
-            parts.append(richardson(lambda e: _pfaffian_residual(self, at(e), q_dot), _H1) / step)
+            parts.append(self._d1(lambda y: _pfaffian_residual(self, (y[:n], y[n]), y[n + 1:]), np.append(x, q_dot),
+                                  np.append(v, np.zeros(n))))
         return np.concatenate(parts) + C @ q_ddot
 
     def _projected(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
@@ -420,7 +444,7 @@ class ConstrainedSystem(Model):
         M, b = self.tree.evaluator("dense").gauss_form(q, s_dot_tree, t)
         if method not in (None, "dense"):  # M s̈_free + b = 0
             b = -M @ self.tree.evaluator(method).accelerations(q, s_dot_tree, t)
-        f_bar = np.zeros(self.tree.n_s)
+        f_bar = np.zeros(self.tree.n_s, dtype=np.result_type(A_s, M, b))
         if self.n_c:
             f_bar[self.dependent] = -np.linalg.solve(A_s[:, self.dependent], self.gamma(q, s_dot_tree, t, C))
         return A_s, F, f_bar, M, b

@@ -11,9 +11,10 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from projeq.analysis.differentiation import complex_step
+from projeq.analysis.differentiation import derivative_along
 from projeq.checks import finite_array
 from projeq.joints import Relative, pose_twist_mismatch
+from projeq.spatial import numeric
 
 _SINGULAR_CONDITION = 1e10  # condition number of K(q0) treated as singular
 _POSE_TOLERANCE = 1e-5  # central differences of step 1e-7 in pose_twist_mismatch: error ~1e-9
@@ -79,18 +80,18 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
     def relative(q_n, s_dot_n, time):
         A_, r_, F_, w_, z_ = rel(q_n, s_dot_n, time)
         return Relative(
-            np.asarray(A_, dtype=float),
-            np.asarray(r_, dtype=float).ravel(),
-            np.asarray(F_, dtype=float),
-            np.asarray(w_, dtype=float).ravel(),
-            np.asarray(z_, dtype=float).ravel(),
+            numeric(A_),
+            numeric(r_).ravel(),
+            numeric(F_),
+            numeric(w_).ravel(),
+            numeric(z_).ravel(),
         )
 
     residual, n_c = _compile_constraints(constraints, q, q_dot, t, values)
     joint = cls(
         parent, n_q, n_s, relative,
-        lambda q_n, time: np.asarray(K_fun(q_n, time), dtype=float),
-        lambda q_n, s_dot_n, time: np.asarray(q_dot_fun(q_n, s_dot_n, time), dtype=float).ravel(),
+        lambda q_n, time: numeric(K_fun(q_n, time)),
+        lambda q_n, s_dot_n, time: numeric(q_dot_fun(q_n, s_dot_n, time)).ravel(),
         q0=q0, r_pn=r_pn, orientation=orientation, constraints=residual, n_c=n_c,
         symbols={"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k},
     )
@@ -122,13 +123,13 @@ def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, or
 
     def relative(q_n, s_dot_n, time):
         A, r = pose(q_n, time)
-        F_n = np.asarray(F(q_n, time), dtype=float)
+        F_n = numeric(F(q_n, time))
         # complex step along (q̇, 1): Im F(q + iε q̇, t + iε)/ε = Ḟ exactly to round-off
-        rate = q_dot(q_n, s_dot_n, time)
-        F_dot = complex_step(lambda eps: F(q_n + eps * rate, time + eps))
-        f_dot = complex_step(lambda eps: f(q_n + eps * rate, time + eps))
-        w = F_n @ s_dot_n + np.real(f(q_n, time))
-        return Relative(np.asarray(A, dtype=float), np.asarray(r, dtype=float), F_n, w, F_dot @ s_dot_n + f_dot)
+        x, rate = np.append(q_n, time), np.append(q_dot(q_n, s_dot_n, time), 1.0)
+        F_dot = derivative_along(lambda x: F(x[:-1], x[-1]), x, rate)
+        f_dot = derivative_along(lambda x: f(x[:-1], x[-1]), x, rate)
+        w = F_n @ s_dot_n + numeric(f(q_n, time))
+        return Relative(numeric(A), numeric(r), F_n, w, F_dot @ s_dot_n + f_dot)
 
     joint = cls(parent, n_q, n_s, relative, K, q_dot, q0=q0, r_pn=r_pn, orientation=orientation,
                 constraints=constraints, n_c=n_c)

@@ -185,9 +185,9 @@ class Contacts:
         """Rows of A q̇ = 0: horizontal velocities of the rear and the front wheel's material
         contact points."""
         lean, frame, fork, rear_centre, front_centre, n = self._poses(q)
-        J_frame = np.zeros((3, 8))
+        J_frame = np.zeros((3, 8), dtype=lean.dtype)  # complex for a complex step
         J_frame[:, 2], J_frame[:, 3], J_frame[:, 4] = _E[2], lean[:, 0], lean[:, 1]
-        J_v = np.zeros((3, 8))  # rear centre: (ẋ, ẏ, 0) − r_R ω_L × L e_z
+        J_v = np.zeros((3, 8), dtype=lean.dtype)  # rear centre: (ẋ, ẏ, 0) − r_R ω_L × L e_z
         J_v[:2, :2] = np.eye(2)
         J_v[:, 2] = -self.r_R * cross(_E[2], lean[:, 2])
         J_v[:, 3] = -self.r_R * cross(lean[:, 0], lean[:, 2])

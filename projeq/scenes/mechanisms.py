@@ -114,10 +114,10 @@ def sphere_on_sphere(a: float = 0.1, b: float = 1.0, m: float = 1.0, g: float = 
     rho = a + b
 
     def contact(q, t):
-        return [np.hypot(q[0], q[1]) - rho]
+        return [np.sqrt(q[0] ** 2 + q[1] ** 2) - rho]
 
     def rolling(q, t):
-        n = q[:2] / np.hypot(q[0], q[1])
+        n = q[:2] / np.sqrt(q[0] ** 2 + q[1] ** 2)
         return [[n[1], -n[0], -a]]
 
     q0 = (rho * np.sin(theta0), rho * np.cos(theta0), 0.0)
@@ -147,5 +147,5 @@ def slider_pendulum(l: float = 1.0, m: float = 1.0, g: float = 9.81, theta0: flo
     Starts at rest at angle θ0 from the downward vertical; gravity −z."""
     tree = System({"x": Frame(), "bob": PointMass(m)},
                   {"x": Prismatic(axis="x"), "bob": Prismatic(parent="x", axis="z")}, gravity=(0.0, 0.0, -g))
-    return ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - l],
+    return ConstrainedSystem(tree, phi=lambda q, t: [np.sqrt(q[0] ** 2 + q[1] ** 2) - l],
                              q0=(l * np.sin(theta0), -l * np.cos(theta0)), independent=[0], **options)

@@ -1,0 +1,85 @@
+"""Jacobians of the equations of motion, exact to round-off: ∂s̈/∂q, ∂s̈/∂ṡ, ∂s̈/∂τ, ∂q̇/∂q, ∂q̇/∂ṡ.
+
+The state derivative ẋ = f(x, τ) = (q̇, s̈) at x = (q, ṡ) (docs/theory.md, "Kinematics" and
+"Gauss form") is evaluated by the model's own code in complex arithmetic and differentiated
+by the complex step, Im f(x + i h e_k) / h with h = 1e-30 (Squire & Trapp, "Using complex
+variables to estimate derivatives of real functions", SIAM Review 40, 1998; Martins, Sturdza
+& Alonso, ACM TOMS 29, 2003): no difference is taken, so the columns are exact to round-off
+for every model whose evaluation is complex-safe — the tree evaluators, user joints, elastic
+bodies and constraint equations are. Inner derivatives (a user joint's Ḟ, the constraints'
+Φ_q and γ) cannot take a second complex step; they return the first-order imaginary part
+by the complex step inside Richardson's stencil
+(:func:`projeq.analysis.differentiation.derivative_along`), ≈ 1e-14 relative (MIXED_STEP).
+
+Why the complex step (measured in ``tests/analysis/test_jacobians.py`` and the issue's note):
+it reuses the evaluation code unchanged (one source for s̈ and its derivatives), costs
+n + 1 complex evaluations (≈ 2–3 real ones each), and needs no symbolic derivation — sympy's
+derivation of the Whipple bicycle's Jacobian takes longer than the whole linearisation here.
+Central differences (``derivatives="differences"``) remain on request, e.g. for user
+callables that cannot take complex arguments (then they are used automatically).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.analysis.differentiation import exact_jacobian, jacobian
+
+DERIVATIVES = ("exact", "differences")
+
+
+class StateJacobians(NamedTuple):
+    """∂s̈/∂q, ∂s̈/∂ṡ, ∂s̈/∂τ, ∂q̇/∂q, ∂q̇/∂ṡ at one state, and how they were taken."""
+
+    s_ddot_q: NDArray
+    s_ddot_s_dot: NDArray
+    s_ddot_tau: NDArray
+    q_dot_q: NDArray
+    q_dot_s_dot: NDArray
+    derivatives: str
+
+
+def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, inputs=()) -> NDArray:
+    """ẋ = (q̇, s̈) at x = (q, ṡ); ``tau`` are generalized forces on the joints ``inputs``
+    (added to Q of the Gauss form M s̈ + b = Q, THEORY §5; for a ConstrainedSystem projected
+    with its F, Fᵀ Q_tree, §7). Complex-safe."""
+    q, s_dot = x[: system.n_q], x[system.n_q :]
+    if tau is None or not len(inputs):
+        s_ddot = system.evaluator().accelerations(q, s_dot, t)
+    else:
+        M, b = system.gauss_form(q, s_dot, t)
+        split = np.split(tau, np.cumsum([system.joint(j).n_s for j in inputs])[:-1])
+        s_ddot = np.linalg.solve(M, system.generalized_force(q, t, dict(zip(inputs, split))) - b)
+    return np.concatenate((system.q_dot(q, s_dot, t), s_ddot))
+
+
+def differentiate(f, z0: NDArray, derivatives: str = "exact") -> tuple[NDArray, str]:
+    """(∂f/∂z at z0, the method used): the complex step (:func:`exact_jacobian`) for
+    ``"exact"``, falling back to Richardson's differences
+    (:func:`projeq.analysis.differentiation.jacobian`) where f cannot take complex arguments;
+    the differences alone for ``"differences"``."""
+    if derivatives not in DERIVATIVES:
+        raise ValueError(f"derivatives: expected one of {list(DERIVATIVES)}, got {derivatives!r}")
+    if derivatives == "exact":
+        try:
+            return exact_jacobian(f, z0), "exact"
+        except (TypeError, np.exceptions.ComplexWarning):
+            pass  # a user callable that casts to float or calls a real-only function
+    return jacobian(f, z0), "differences"
+
+
+def state_jacobians(system, q: NDArray, s_dot: NDArray, t: float = 0.0, inputs=(),
+                    derivatives: str = "exact") -> StateJacobians:
+    """The Jacobians of q̇ and s̈ at (q, ṡ, t) (module docstring); ``inputs`` name the joints
+    whose generalized forces τ are differentiated for (∂s̈/∂τ, zero columns without)."""
+    q, s_dot = system.check_state(q, s_dot, t)
+    x0 = np.concatenate((q, s_dot))
+    J, used = differentiate(lambda x: state_derivative(system, x, t), x0, derivatives)
+    n_u = sum(system.joint(name).n_s for name in inputs)
+    B, used_B = differentiate(lambda u: state_derivative(system, x0, t, u, inputs), np.zeros(n_u), used)
+    n_q = system.n_q
+    return StateJacobians(J[n_q:, :n_q], J[n_q:, n_q:], B[n_q:], J[:n_q, :n_q], J[:n_q, n_q:],
+                          used if used == used_B else "differences")
