@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from projeq.checks import drop_inherited_twins, finite_array, non_negative
 from projeq.symbolic import lazy_import
-from projeq.spatial import cross
+from projeq.spatial import cross, norm, numeric
 
 sp = lazy_import("sympy")
 algebra = lazy_import("projeq.symbolic.algebra")
@@ -35,7 +35,9 @@ def _load(name: str, value, shape: tuple) -> Callable:
     """A constant or a callable ``(t, q, s_dot) -> array`` as a checked callable."""
     if callable(value):
         def load(t, q, s_dot):
-            return finite_array(name, value(t, q, s_dot), shape)
+            out = numeric(value(t, q, s_dot))  # complex in a complex step
+            finite_array(name, np.real(out), shape)
+            return out
         load.constant = None
         return load
     constant = finite_array(name, value, shape)
@@ -284,11 +286,11 @@ class SpringDamper(ForceLaw):
     def add_to(self, h, kin, t, q, s_dot) -> None:
         (x_a, v_a), (x_b, v_b) = self._ends(kin)
         d = x_b - x_a
-        length = np.linalg.norm(d)
-        if length < 1e-12:
+        length = norm(d)
+        if abs(length) < 1e-12:
             raise ValueError(f"SpringDamper between {self.bodies}: the two points coincide, no direction")
         e = d / length
-        tension = self.stiffness * (length - self.length) + self.damping * float(e @ (v_b - v_a))
+        tension = self.stiffness * (length - self.length) + self.damping * (e @ (v_b - v_a))
         for n, point, S, sign in zip(self.index, self.points, self.S, (1.0, -1.0)):
             if n < 0:
                 continue

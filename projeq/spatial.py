@@ -28,6 +28,13 @@ def numeric(value) -> NDArray:
     return array if np.iscomplexobj(array) else array.astype(float)
 
 
+def norm(v) -> NDArray:
+    """The Euclidean length √(v · v) of the last axis, analytic in complex arithmetic (a complex
+    step passes; ``np.linalg.norm`` takes moduli)."""
+    v = np.asarray(v)
+    return np.sqrt(np.sum(v * v, axis=-1))
+
+
 _AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 
 

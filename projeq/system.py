@@ -22,6 +22,7 @@ from projeq.assembly.kinematics import Plan
 from projeq.checks import finite_array, state_vector
 from projeq.constraints.nonholonomic import check_configuration
 from projeq.joints import Joint
+from projeq.spatial import numeric
 from projeq.subsystems.base import conform
 
 GROUND = -1
@@ -451,11 +452,12 @@ class System(Model):
     def generalized_force(self, q, t: float, joint_forces: dict) -> NDArray:
         """Q with Q[columns] = Σ_j P_jᵀ τ_j, ṡ_j = P_j ṡ[columns] (:meth:`joint_s_columns`:
         a coupled joint's τ acts on the velocities it follows)."""
-        Q = np.zeros(self.n_s)
+        Q = np.zeros(self.n_s, dtype=np.result_type(float, *joint_forces.values()))  # complex in a complex step
         for name, tau in joint_forces.items():
             n = self.index(name)
             cols, P = self.joint_s_columns(n)
-            Q[cols] += P[: self.joints[n].n_s].T @ state_vector(f"inputs[{name!r}]", tau, self.joints[n].n_s)
+            state_vector(f"inputs[{name!r}]", np.real(tau), self.joints[n].n_s)
+            Q[cols] += P[: self.joints[n].n_s].T @ numeric(tau)
         return Q
 
     def gauss_form(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:

@@ -12,7 +12,7 @@ from typing import Callable
 import numpy as np
 
 from projeq.joints.base import Joint, Relative, SymbolicRelative
-from projeq.spatial import axis_spin, quaternion_matrix, quaternion_rate_matrix, rodrigues, unit_axis
+from projeq.spatial import axis_spin, quaternion_matrix, norm, quaternion_rate_matrix, rodrigues, unit_axis
 from projeq.symbolic import lazy_import
 
 sp = lazy_import("sympy")
@@ -123,8 +123,9 @@ class Planar(Joint):
         return Relative(self._A(q_n[2]), r, self._F, self._F @ s_dot_n, _ZERO6)
 
     def K(self, q_n, t):
-        K = np.zeros((3, 3))
-        K[:2, :2] = self._P @ self._A(q_n[2]) @ self._P.T
+        A = self._A(q_n[2])
+        K = np.zeros((3, 3), dtype=A.dtype)
+        K[:2, :2] = self._P @ A @ self._P.T
         K[2, 2] = 1.0
         return K
 
@@ -146,12 +147,12 @@ class Free(Joint):
     _F = np.eye(6)
 
     def relative(self, q_n, s_dot_n, t):
-        A = quaternion_matrix(q_n[3:] / np.linalg.norm(q_n[3:]))
+        A = quaternion_matrix(q_n[3:] / norm(q_n[3:]))
         return Relative(A, q_n[:3], self._F, s_dot_n, _ZERO6)
 
     def K(self, q_n, t):
-        quat = q_n[3:] / np.linalg.norm(q_n[3:])
-        K = np.zeros((7, 6))
+        quat = q_n[3:] / norm(q_n[3:])
+        K = np.zeros((7, 6), dtype=quat.dtype)
         K[:3, :3] = quaternion_matrix(quat)
         K[3:, 3:] = quaternion_rate_matrix(quat)
         return K

