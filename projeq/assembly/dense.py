@@ -36,7 +36,7 @@ class DenseEvaluator:
         M_n, h_n = gauss_terms(system, kin, q, s_dot, t)
         J = [None] * len(system.joints) + [np.zeros((0, system.n_s))]
         zeta_bar = [None] * len(system.joints) + [np.zeros(0)]
-        dtype = np.result_type(kin.T_aug[0], *h_n[:-1])  # complex for a complex step
+        dtype = np.result_type(*kin.T_aug, *kin.F, *M_n, *h_n)  # complex for a complex step
         M = np.zeros((system.n_s, system.n_s), dtype=dtype)
         b = np.zeros(system.n_s, dtype=dtype)
         for n in range(len(system.joints)):

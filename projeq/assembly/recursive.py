@@ -56,7 +56,7 @@ class RecursiveEvaluator:
         system, scale = self.system, self.scale
         kin = forward(system, q, s_dot, t)
         M, h = gauss_terms(system, kin, q, s_dot, t)
-        dtype = np.result_type(kin.T_aug[0], *h[:-1])
+        dtype = np.result_type(*kin.T_aug, *kin.F, *M, *h)
         if dtype not in self._workspaces:
             self._workspaces[dtype] = _workspace(system, dtype)
         fill_groups, A_hat = self._workspaces[dtype]
@@ -82,7 +82,7 @@ class RecursiveEvaluator:
         minus_s_ddot = [None] * N
         y_aug = [None] * N + [np.ones(1)]  # (ÿ; 1), ground at rest
         for n in range(N):  # forward: root → leaves
-            a = T_aug[n] @ y_aug[parent[n]]  # (T_np ÿ_p + ζ_n; 1)
+            a = np.asarray(T_aug[n] @ y_aug[parent[n]], dtype=dtype)  # (T_np ÿ_p + ζ_n; 1)
             minus_s_ddot[n] = gain[n] @ a  # −s̈_n = −D_n⁻¹ F_nᵀ (ĥ_n − M̂_n a)
             a[:-1] -= F[n] @ minus_s_ddot[n]  # ÿ_n = a + F_n s̈_n
             y_aug[n] = a

@@ -26,6 +26,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
+from projeq.analysis.differentiation import exact_jacobian
+from projeq.analysis.jacobians import state_derivative
 from projeq.assembly import EVALUATORS
 from projeq.checks import count, finite_array, positive, state_vector
 from projeq.simulation.integrators import EXPLICIT, PROJECTED, projected_solver, warn_if_stiff
@@ -36,6 +38,7 @@ __all__ = ["INTEGRATORS", "Result", "SimulationError", "simulate"]
 
 
 INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # the methods of solve_ivp
+IMPLICIT = ("Radau", "BDF", "LSODA")  # they solve with ∂ẋ/∂x: given exactly (jac="exact") unless told otherwise
 
 
 def _check_method(method) -> None:
@@ -111,6 +114,10 @@ def simulate(
         Right-hand side (default: the model's, :meth:`projeq.system.Model.evaluator`).
     progress : callable ``progress(t)``, optional
         Called after each segment with the time reached.
+    jac : "exact", "differences", callable or matrix
+        For Radau, BDF and LSODA: ∂ẋ/∂x by the complex step through the model ("exact",
+        the default; exact to round-off, n complex evaluations per Jacobian, counted in
+        ``Result.njev``), by scipy's finite differences ("differences"), or the user's.
     **options
         Further options for the integrator (max_step, first_step, ...).
 
@@ -189,7 +196,8 @@ class _Run:
         self.method, self.progress, self.options = method, progress, options
         self.solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
-        self.pieces, self.nfev, self.cause = [], 0, None
+        self.jac = _jac_option(method, options.pop("jac", "exact"))
+        self.pieces, self.nfev, self.njev, self.cause = [], 0, 0, None
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
 
@@ -203,6 +211,12 @@ class _Run:
             raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
         return x_dot
 
+    def jacobian(self, t: float, x: NDArray) -> NDArray:
+        """∂ẋ/∂x of the current model by the complex step (:mod:`projeq.analysis.jacobians`;
+        the model's own evaluator, which takes complex arguments), for the implicit methods."""
+        self.njev += 1
+        return exact_jacobian(lambda y: state_derivative(self.model, y, t), x)
+
     def solve(self, a: float, b: float):
         """One segment from the current state at a to b (solve_ivp's result), with the user's
         events and, last, the model's own; its output rows are kept as a :class:`_Piece`."""
@@ -210,8 +224,9 @@ class _Run:
         inside = t_eval[(t_eval > a) & (t_eval <= b)] if self.pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
         n_q = self.model.n_q
         events = [_event_wrapper(e, n_q) for e in self.events + list(self.model.events())]
+        jac = {"jac": self.jacobian if self.jac == "exact" else self.jac} if self.method in IMPLICIT else {}
         segment = solve_ivp(self.rhs, (a, b), self.x, method=self.solver, t_eval=inside, rtol=self.rtol,
-                            atol=self.atol, events=events or None, dense_output=True, **self.options)
+                            atol=self.atol, events=events or None, dense_output=True, **jac, **self.options)
         self.nfev += segment.nfev
         self._keep(segment)
         return segment
@@ -268,6 +283,15 @@ class _Run:
             self.status, self.message, self.cause = -1, f"{type(exc).__name__}: {exc}", exc
 
 
+def _jac_option(method, jac):
+    """``jac`` of :func:`simulate`: "exact", "differences" (scipy's own, None) or the user's."""
+    if isinstance(jac, str) and jac not in ("exact", "differences"):
+        raise ValueError(f"jac: expected 'exact', 'differences', a callable jac(t, x) or a matrix, got {jac!r}")
+    if jac is not None and not isinstance(jac, str) and method not in IMPLICIT:
+        raise ValueError(f"jac: only the implicit methods {list(IMPLICIT)} use a Jacobian, not {method!r}")
+    return None if jac == "differences" else jac
+
+
 def _checked_events(events) -> list:
     events = [] if events is None else (list(events) if isinstance(events, (list, tuple)) else [events])
     for i, e in enumerate(events):
@@ -321,7 +345,7 @@ def _assemble(run: _Run, wall_time: float, dense_output: bool) -> Result:
     )
     return Result(
         t=t, q=q, s_dot=s_dot, kinetic=energies[:, 0], potential=energies[:, 1],
-        constraint_residual=residual, nfev=int(run.nfev), wall_time=wall_time,
+        constraint_residual=residual, nfev=int(run.nfev), njev=int(run.njev), wall_time=wall_time,
         status=int(run.status), message=str(run.message), t_events=t_events, q_events=q_events,
         s_dot_events=s_dot_events, names=system.names, method=getattr(run.method, "__name__", str(run.method)),
         partitions=partitions, sol=_dense_solution(pieces, n_q) if dense_output and pieces else None, system=system,

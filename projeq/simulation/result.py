@@ -31,6 +31,7 @@ class Result:
     kinetic, potential : (n,) energies (``energy`` is their sum)
     constraint_residual : (n, m) residuals of velocity constraints (m = 0 without any)
     nfev : right-hand-side evaluations; wall_time : seconds
+    njev : Jacobians by the complex step for an implicit method (each n_q + n_s complex evaluations)
     status : 0 finished, 1 stopped by a terminal event, -1 failed, 2 interrupted
     message : the integrator's message
     t_events, q_events, s_dot_events : for each of the user's events, the times where it
@@ -58,6 +59,7 @@ class Result:
     names: tuple = ()
     method: str = ""
     partitions: tuple = ()
+    njev: int = 0
     sol: object = field(default=None, repr=False, compare=False)
     system: object = field(default=None, repr=False, compare=False)  # in memory only, not saved
 
@@ -86,7 +88,7 @@ class Result:
         complete: a full disk or a killed process never leaves a truncated file."""
         arrays = {f.name: getattr(self, f.name) for f in fields(self) if isinstance(getattr(self, f.name), np.ndarray)}
         meta = {
-            "nfev": self.nfev, "wall_time": self.wall_time, "status": self.status,
+            "nfev": self.nfev, "njev": self.njev, "wall_time": self.wall_time, "status": self.status,
             "message": self.message, "names": list(self.names), "method": self.method,
             "partitions": [[t, list(independent)] for t, independent in self.partitions],
         }

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.analysis.differentiation import complex_step
+from projeq.analysis.differentiation import derivative_along
 from projeq.checks import count, finite_array, non_negative, positive
 from projeq.joints import Relative
 from projeq.spatial import cross, rotation_x, rotation_y, rotation_z, skew, skew_stack
@@ -323,7 +323,7 @@ class RitzBeam(BeamProbes, Subsystem):
 
     def jacobian(self, r: NDArray, Phi_r: NDArray) -> NDArray:
         """J(x) = [E, −r̃(x), Φ_r(x)], stacked over the stations."""
-        J = np.empty((len(r), 3, self.n_y))
+        J = np.empty((len(r), 3, self.n_y), dtype=np.result_type(r, Phi_r))
         J[:, :, :3] = np.eye(3)
         J[:, :, 3:6] = -skew_stack(r)
         J[:, :, 6:] = Phi_r
@@ -360,7 +360,7 @@ class RitzBeam(BeamProbes, Subsystem):
         bending frequency makes the model unstable (ω_lag² = ω₁² − Ω² < 0): allowed, but
         said by a RuntimeWarning whose text is fixed per beam, so that Python's warning
         filters show it once (the default action: once per text and place)."""
-        if not self.stiffening and np.hypot(omega[1], omega[2]) > self.first_frequency:
+        if not self.stiffening and np.hypot(*np.real(omega[1:])) > self.first_frequency:
             warnings.warn(
                 f"RitzBeam without stiffening spins about an axis across the beam faster than its first "
                 f"bending frequency {self.first_frequency:.3g} rad/s: the unstiffened model is unstable "
@@ -381,7 +381,7 @@ class RitzBeam(BeamProbes, Subsystem):
         terms of the Rayleigh beam; with Euler's ω̃_c I ω_c the power is exactly
         d/dt ½ ω_cᵀ I ω_c). The second-order parts carry the ρI_p α̈ coupling of a beam spun
         about its axis (docs/theory.md, "The spinning beam's rotary inertia")."""
-        J = self.J_omega.copy()
+        J = self.J_omega.astype(np.result_type(self.J_omega, q_e, q_e_dot))  # complex in a complex step
         e = self._local
         q_v, q_w = q_e[e(self.v_cols)], q_e[e(self.w_cols)]
         qd_v, qd_w = q_e_dot[e(self.v_cols)], q_e_dot[e(self.w_cols)]
@@ -468,7 +468,7 @@ class BeamPort:
         """Pose, F q̇_e and Ḟ q̇_e relative to the beam's frame (:meth:`RitzBeam.port`);
         Ḟ q̇_e by complex step."""
         A, r, F = self.beam._port_terms(q_e, self.data, self.offset)
-        F_dot = complex_step(lambda eps: self.beam._port_terms(q_e + eps * q_e_dot, self.data, self.offset)[2])
+        F_dot = derivative_along(lambda q: self.beam._port_terms(q, self.data, self.offset)[2], q_e, q_e_dot)
         return Relative(A, r, F, F @ q_e_dot, F_dot @ q_e_dot)
 
 
