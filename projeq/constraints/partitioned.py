@@ -16,8 +16,12 @@ and the Projection Equation with the constraint inserted before the projection i
 
     Fᵀ (M_tree (F s̈ + f̄) + b_tree) = 0.
 
-Derivatives of Φ, A and b are taken by fourth-order central differences (no user
-Jacobians needed). Position drift of the loop closures Φ = 0 is corrected either by a
+Derivatives of Φ, A and b (no user Jacobians needed) are taken by the complex step, exact to
+round-off, if the callables take complex arguments (numpy functions do; ``exact`` says which),
+else by a sixth-order central stencil. The second derivative in γ is the complex step inside a
+sixth-order stencil on normalised directions, ≈ 1e-14 relative whatever the speed
+(:meth:`~ConstrainedSystem.gamma`; issue 16: fixed-step differences lost the accuracy of slow
+motions, 6e-3 relative at 1/1000 of the four-bar's rates). Position drift of the loop closures Φ = 0 is corrected either by a
 Gauss–Newton projection of q onto Φ = 0 wherever :func:`projeq.simulate` normalises q
 (segment ends and outputs; ``correction="projection"``, the default) or by Baumgarte's
 first-order stabilisation q̇ += −β C_Φ⁺ Φ (``correction="baumgarte"``), or not at all
@@ -67,7 +71,7 @@ CORRECTIONS = ("projection", "baumgarte", "none")
 # condition number κ = ‖A_s‖ ‖A_dep⁻¹‖ above which the partition is degenerate
 PARTITION_CONDITION = 1e8
 # re-pivot when κ exceeds this (or 10 × its value where the partition was chosen): up to
-# there ‖F‖ ≤ κ amplifies the differences' ~1e-11 errors at most ~κ-fold, and the integrator
+# there ‖F‖ ≤ κ amplifies the constraint terms' round-off at most ~κ-fold, and the integrator
 # has not met the ∞ · 0 of ṡ_tree = F ṡ at the degeneracy
 REPIVOT_CONDITION = 1e2
 # |Φ| (relative to the largest coordinate, at least 1) accepted as on the manifold: 1e4 × round-off
