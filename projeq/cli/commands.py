@@ -57,6 +57,7 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
         args = parser().parse_args(argv)
+        args.argv = argv  # the command line, for run records
     except SystemExit as exit_:  # --help (0) or a usage error (2), printed by argparse
         return OK if exit_.code is None else int(exit_.code)
     try:
