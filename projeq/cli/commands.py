@@ -32,6 +32,7 @@ OK, FAILED, BAD_ARGUMENTS = 0, 1, 2
 COMMANDS = {
     "list": (run.list_arguments, "list the scenes, or one scene's parameters"),
     "run": (run.run_arguments, "simulate a scene and write the results"),
+    "export": (run.export_arguments, "write ParaView files of a saved run (its .npz)"),
     "sweep": (sweep.sweep_arguments, "simulate a scene on a parameter grid, in parallel"),
     "compare": (studies.compare_arguments, "compare derivations of one system (Projection Equation, Lagrange, Kane ...)"),
     "bench": (bench.bench_arguments, "run the performance benchmarks"),

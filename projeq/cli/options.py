@@ -16,6 +16,16 @@ def scene_settings_option(parser: argparse.ArgumentParser) -> None:
                         help="override a scene parameter (see projeq list SCENE); repeatable")
 
 
+def jsonable(value):
+    """``default`` of ``json.dumps``: numpy arrays and numbers as JSON values, anything else
+    (a tuple default, a sympy expression) as its text."""
+    import numpy as np
+
+    if isinstance(value, (np.ndarray, np.generic)):
+        return value.tolist()
+    return str(value)
+
+
 def json_option(parser: argparse.ArgumentParser) -> None:
     """``--json``: one JSON document on standard output instead of text."""
     parser.add_argument("--json", action="store_true", help="print one JSON document instead of text")
@@ -45,6 +55,11 @@ def simulation_options(parser: argparse.ArgumentParser, out: str = "projeq-out")
 def simulate_options(args) -> dict:
     """The keywords of :func:`projeq.simulate` given by :func:`simulation_options`."""
     return {"method": args.method, "rtol": args.rtol, "atol": args.atol, "evaluator": args.evaluator}
+
+
+def scene_label(scene: str) -> str:
+    """The name of the scene in file names: itself, or ``FILE-FUNCTION`` for ``FILE.py:FUNCTION``."""
+    return "".join(c if c.isalnum() or c in "_-" else "-" for c in Path(scene.replace(".py:", "-")).name)
 
 
 def output_directory(text: str) -> Path:

@@ -1,4 +1,5 @@
-"""``projeq list [SCENE]`` and ``projeq run [SCENE]``: the scenes, and one simulated.
+"""``projeq list [SCENE]``, ``projeq run [SCENE]`` and ``projeq export RESULT.npz``: the
+scenes, one simulated, and the ParaView files of a saved run.
 
 ``projeq run`` simulates a scene (default: the spin-up beam; a registered name or the
 user's ``FILE.py:FUNCTION``, :func:`projeq.scenes.resolve_scene`), prints a summary (or,
@@ -26,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from projeq.cli.options import json_option, output_directory, simulate_options, simulation_options
+from projeq.cli.options import json_option, jsonable, output_directory, scene_label, simulate_options, simulation_options
 
 STATUS = {0: "finished", 1: "stopped by an event", -1: "failed", 2: "interrupted"}
 WIDTH = 100  # columns of the text output
@@ -47,6 +48,29 @@ def run_arguments(parser) -> None:
     parser.set_defaults(execute=run_scene)
 
 
+def export_arguments(parser) -> None:
+    parser.add_argument("result", help="the .npz of a run (projeq run writes one into its folder)")
+    parser.add_argument("--out", default=None, help="output directory (default: paraview/ beside the .npz)")
+    parser.add_argument("--stations", type=int, default=21, help="points along each beam's centre line (default 21)")
+    parser.set_defaults(execute=export_result)
+
+
+def export_result(args) -> int:
+    """ParaView files of a saved run: its scene rebuilt from the run record in the .npz
+    (:func:`projeq.simulation.export.system_of`)."""
+    from projeq.simulation.export import write_vtu_series
+    from projeq.simulation.result import Result
+
+    path = Path(args.result)
+    if not path.is_file():
+        raise ValueError(f"result: no file {args.result!r}")
+    if args.stations < 2:
+        raise ValueError(f"--stations: expected at least 2 points, got {args.stations}")
+    out = output_directory(args.out or str(path.parent / "paraview"))
+    print(f"wrote {write_vtu_series(Result.load(path), out, name=path.stem, stations=args.stations)}")
+    return 0
+
+
 def list_scenes(args) -> int:
     from projeq.scenes import SCENES, resolve_scene, scene_parameters
 
@@ -61,7 +85,7 @@ def list_scenes(args) -> int:
     parameters = scene_parameters(scene)
     if args.json:
         print(json.dumps({"scene": args.scene, "description": scene.description, "t_end": scene.t_end,
-                          "parameters": [p._asdict() for p in parameters]}, indent=2, default=_jsonable))
+                          "parameters": [p._asdict() for p in parameters]}, indent=2, default=jsonable))
         return 0
     print(f"{args.scene}: {scene.description} (default t_end = {scene.t_end:g} s)")
     width = max((len(p.name) for p in parameters), default=0)
@@ -110,7 +134,7 @@ def run_scene(args) -> int:
             out.rmdir()
         raise
     if args.json:
-        print(json.dumps(record | {"folder": str(out)}, indent=2, default=_jsonable))
+        print(json.dumps(record | {"folder": str(out)}, indent=2, default=jsonable))
         return code
     for note in notes:  # also when quiet: why the run ended early
         print(f"projeq: {note}")
@@ -144,11 +168,6 @@ def run_record(args, scene, overrides: dict, t_end: float) -> dict:
         "command_line": ["projeq", *getattr(args, "argv", sys.argv[1:])],
         "started": datetime.now().astimezone().isoformat(timespec="seconds"),
     }
-
-
-def scene_label(scene: str) -> str:
-    """The name of the scene in file names: itself, or ``FILE-FUNCTION`` for ``FILE.py:FUNCTION``."""
-    return "".join(c if c.isalnum() or c in "_-" else "-" for c in Path(scene.replace(".py:", "-")).name)
 
 
 def run_directory(out: Path, label: str) -> Path:
@@ -188,21 +207,12 @@ def _conserves_energy(system) -> bool:
     return conserves_energy(system, system.q0, system.s_dot0)
 
 
-def _jsonable(value):
-    """numpy numbers and arrays, tuples and other objects as JSON values."""
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    return repr(value)
-
-
 def _write_json(path: Path, document: dict) -> Path:
     from projeq.simulation.export import written_atomically
 
     path.parent.mkdir(parents=True, exist_ok=True)
     with written_atomically(path) as temporary:
-        temporary.write_text(json.dumps(document, indent=2, default=_jsonable) + "\n")
+        temporary.write_text(json.dumps(document, indent=2, default=jsonable) + "\n")
     return path
 
 
@@ -216,7 +226,7 @@ def _progress_bar(t_start: float, t_end: float, quiet: bool):
 
 def _write(result, out: Path, name: str) -> list[Path]:
     """``name.npz`` (the Result with its record) and ``name.csv``
-    (:class:`~projeq.studies.table.Table`: t, q and ṡ by name with units, kinetic and
+    (:class:`~projeq.studies.table.Table`: t, q and ṡ by name, each header with its unit, kinetic and
     potential energy per output time), each under a temporary name renamed when complete;
     ``out`` is created again if it was deleted during the run."""
     from projeq.simulation.export import written_atomically
@@ -225,12 +235,10 @@ def _write(result, out: Path, name: str) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     npz, csv = out / f"{name}.npz", out / f"{name}.csv"
     result.save(npz)  # under a temporary name too
-    q_names, s_names = result.column_names()
-    units = dict(zip(q_names, (u for _, u in result.coordinates))) | dict(zip(s_names, (u for _, u in result.velocities)))
+    q_names, s_names = result.column_names(units=True)
     rows = np.column_stack((result.t, result.q, result.s_dot, result.kinetic, result.potential))
     with written_atomically(csv) as temporary:
-        Table(["t", *q_names, *s_names, "kinetic", "potential"], rows.tolist(),
-              units=units | {"t": "s", "kinetic": "J", "potential": "J"}).to_csv(temporary)
+        Table(["t (s)", *q_names, *s_names, "kinetic (J)", "potential (J)"], rows.tolist()).to_csv(temporary)
     return [npz, csv]
 
 
