@@ -1,20 +1,22 @@
 """Jacobians of the equations of motion, exact to round-off: ∂s̈/∂q, ∂s̈/∂ṡ, ∂s̈/∂τ, ∂q̇/∂q, ∂q̇/∂ṡ.
 
-The state derivative ẋ = f(x, τ) = (q̇, s̈) at x = (q, ṡ) (docs/theory.md, "Kinematics" and
-"Gauss form") is evaluated by the model's own code in complex arithmetic and differentiated
-by the complex step, Im f(x + i h e_k) / h with h = 1e-30 (Squire & Trapp, "Using complex
-variables to estimate derivatives of real functions", SIAM Review 40, 1998; Martins, Sturdza
-& Alonso, ACM TOMS 29, 2003): no difference is taken, so the columns are exact to round-off
+The state derivative ẋ = f(x, τ) = (q̇, s̈) at x = (q, ṡ) is evaluated by the model's own
+code in complex arithmetic and differentiated by the complex step, Im f(x + i h e_k) / h with
+h = 1e-30 (Squire & Trapp, "Using complex variables to estimate derivatives of real
+functions", SIAM Review 40, 1998; Martins, Sturdza & Alonso, ACM TOMS 29, 2003): no difference is taken, so the columns are exact to round-off
 for every model whose evaluation is complex-safe — the tree evaluators, user joints, elastic
 bodies and constraint equations are. Inner derivatives (a user joint's Ḟ, the constraints'
 Φ_q and γ) cannot take a second complex step; they return the first-order imaginary part
-by the complex step inside Richardson's stencil
-(:func:`projeq.analysis.differentiation.derivative_along`), ≈ 1e-14 relative (MIXED_STEP).
+by the complex step inside a sixth-order stencil
+(:func:`projeq.analysis.differentiation.derivative_along`), ≈ 1e-14 relative.
 
-Why the complex step (measured in ``tests/analysis/test_jacobians.py`` and the issue's note):
-it reuses the evaluation code unchanged (one source for s̈ and its derivatives), costs
-n + 1 complex evaluations (≈ 2–3 real ones each), and needs no symbolic derivation — sympy's
-derivation of the Whipple bicycle's Jacobian takes longer than the whole linearisation here.
+Why the complex step (docs/theory.md, "Exact derivatives", has the measured tables): it
+reuses the evaluation code unchanged (one source for s̈ and its derivatives) and costs n
+complex evaluations, measured at 2.5 (chain of 10), 2.6 (four-bar), 3.3 (Whipple bicycle,
+with its inner derivatives) and 1.1 (elastic arm) real ones each; a symbolic alternative
+costs more before the first number: sympy's KanesMethod derivation of the Whipple bicycle
+(tests/bicycle/kane_whipple.py) took 110 s, projeq's whole exact linearisation 3.4 s, in
+one run (``python benchmarks/jacobians.py`` measures the integrators).
 Central differences (``derivatives="differences"``) remain on request, e.g. for user
 callables that cannot take complex arguments (then they are used automatically).
 """
@@ -44,8 +46,8 @@ class StateJacobians(NamedTuple):
 
 def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, inputs=()) -> NDArray:
     """ẋ = (q̇, s̈) at x = (q, ṡ); ``tau`` are generalized forces on the joints ``inputs``
-    (added to Q of the Gauss form M s̈ + b = Q, THEORY §5; for a ConstrainedSystem projected
-    with its F, Fᵀ Q_tree, §7). Complex-safe."""
+    (added to Q of the Gauss form M s̈ + b = Q; for a ConstrainedSystem projected with its F,
+    Fᵀ Q_tree). Complex-safe."""
     q, s_dot = x[: system.n_q], x[system.n_q :]
     if tau is None or not len(inputs):
         s_ddot = system.evaluator().accelerations(q, s_dot, t)
