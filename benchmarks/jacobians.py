@@ -60,7 +60,8 @@ def main() -> None:
                 real, cplx, wall, result = run(system, method, jac, args.t_end, args.rtol)
                 ends.append(result.q[-1] if result.status == 0 else np.full(system.n_q, np.nan))
                 diff = np.abs(ends[-1] - ends[0]).max()
-                reached = "t_end" if result.status == 0 else f"failed at t = {result.t[-1]:.3g} s: {result.message[:50]}"
+                t_reached = result.t[-1] if len(result.t) else 0.0
+                reached = "t_end" if result.status == 0 else f"failed at t = {t_reached:.3g} s: {result.message[:40]}"
                 print(f"{name:24} {method:6} {jac:12} {real:8d} {cplx:8d} {wall:8.2f} {diff:9.1e}  {reached}")
 
 

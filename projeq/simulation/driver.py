@@ -26,8 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
-from projeq.analysis.differentiation import exact_jacobian
-from projeq.analysis.jacobians import state_derivative
+from projeq.analysis.jacobians import differentiate, state_derivative
 from projeq.assembly import EVALUATORS
 from projeq.checks import count, finite_array, positive, state_vector
 from projeq.simulation.integrators import EXPLICIT, PROJECTED, projected_solver, warn_if_stiff
@@ -80,6 +79,7 @@ def simulate(
     evaluator: str | object | None = None,
     n_segments: int = 20,
     progress=None,
+    jac="exact",
     **options,
 ) -> Result:
     """Integrate the equations of motion of ``system`` from ``t_start`` to ``t_end``.
@@ -132,7 +132,7 @@ def simulate(
         (:class:`projeq.SingularMassError`, a force law's ``ValueError``).
     """
     run = _Run(system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
-               evaluator, n_segments, progress, options)
+               evaluator, n_segments, progress, jac, options)
     started, stiff_warned = _time.perf_counter(), False  # one StiffnessWarning per run at most
     with run.stopping():
         segments = deque(zip(run.bounds[:-1], run.bounds[1:]))  # a model event splits one
@@ -174,7 +174,7 @@ class _Run:
     and what the finished segments gave (pieces, the user's events, nfev, status)."""
 
     def __init__(self, system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
-                 evaluator, n_segments, progress, options):
+                 evaluator, n_segments, progress, jac, options):
         check_model(system)
         q0 = system.normalized(system.check_q("q0", system.q0 if q0 is None else q0))
         s_dot0 = state_vector("s_dot0", system.s_dot0 if s_dot0 is None else s_dot0, system.n_s)
@@ -196,7 +196,7 @@ class _Run:
         self.method, self.progress, self.options = method, progress, options
         self.solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
-        self.jac = _jac_option(method, options.pop("jac", "exact"))
+        self.jac = _jac_option(method, jac)
         self.pieces, self.nfev, self.njev, self.cause = [], 0, 0, None
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
@@ -213,9 +213,10 @@ class _Run:
 
     def jacobian(self, t: float, x: NDArray) -> NDArray:
         """∂ẋ/∂x of the current model by the complex step (:mod:`projeq.analysis.jacobians`;
-        the model's own evaluator, which takes complex arguments), for the implicit methods."""
+        the model's own evaluator, which takes complex arguments; differences for user
+        callables that do not), for the implicit methods."""
         self.njev += 1
-        return exact_jacobian(lambda y: state_derivative(self.model, y, t), x)
+        return differentiate(lambda y: state_derivative(self.model, y, t), x)[0]
 
     def solve(self, a: float, b: float):
         """One segment from the current state at a to b (solve_ivp's result), with the user's

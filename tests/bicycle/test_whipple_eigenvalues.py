@@ -6,13 +6,10 @@ two-point formula for the kinematics, Kane's partial velocities for the dynamics
 nonholonomic generalized forces for the front no-slip constraint).
 
 Tolerance. The KanesMethod model is lambdified exactly; its Jacobian by extrapolated
-central differences is accurate to ~1e-10. projeq's accelerations carry the
-finite-difference error of the constraint derivatives in ``ConstrainedSystem``
-(~1e-11 relative, its second difference's round-off ε/h², h = 3e-3), which the
-Jacobian's step 1e-4 amplifies to ~1e-7 in A; the eigenvalues here are simple and well
-separated (speeds away from the coalescence of the two unstable real ones near 0.7 m/s,
-where they become the weave pair), so they inherit
-that: |Δλ| ≤ 1e-6 max(1, |λ|) leaves a margin of ten.
+central differences is accurate to ~1e-10. projeq's Jacobians are exact (complex step,
+issue 16; its eigenvalues match Meijaard et al.'s Table 2 to 3e-14 in
+``test_whipple_table2.py``); the bound |Δλ| ≤ 1e-6 max(1, |λ|) dates from projeq's
+finite-difference Jacobians (~1e-7) and is kept.
 """
 
 import numpy as np
