@@ -230,7 +230,7 @@ def eigenvalue_sweep(build, values, **options) -> NDArray:
     values : sequence of float
         The parameter values.
     **options
-        Passed to :func:`linearize` (``t``, ``ignore``, ``tol``).
+        Passed to :func:`linearize` (``t``, ``ignore``, ``tol``, ``derivatives``).
 
     Returns
     -------

@@ -69,3 +69,20 @@ def test_differences_on_request():
     assert J.derivatives == "differences"
     with pytest.raises(ValueError, match="derivatives"):
         state_jacobians(pq.scenes.chain(2), [0.3, -0.2], [0.1, 0.4], derivatives="symbolic")
+
+
+def test_callables_without_complex_support_fall_back_to_differences():
+    """np.hypot takes no complex arguments: the constraint derivatives and the Jacobians
+    fall back to differences and say so; the pendulum's s̈ still matches the closed form
+    θ̈ = −(g/l) sin θ of the bob on the circle (x = l sin θ, z = −l cos θ; ṡ = ẋ)."""
+    tree = pq.System({"x": pq.Frame(), "bob": pq.PointMass(1.0)},
+                     {"x": pq.Prismatic(axis="x"), "bob": pq.Prismatic(parent="x", axis="z")},
+                     gravity=(0, 0, -9.81))
+    theta = 0.6
+    pendulum = pq.ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0],
+                                    q0=[np.sin(theta), -np.cos(theta)], independent=[0])
+    assert not pendulum.exact
+    J = state_jacobians(pendulum, pendulum.q0, [0.0])
+    assert J.derivatives == "differences"
+    x_ddot = pendulum.accelerations(pendulum.q0, [0.0])[0]  # at rest: ẍ = l cos θ θ̈
+    assert x_ddot == pytest.approx(-9.81 * np.sin(theta) * np.cos(theta), rel=1e-10)
