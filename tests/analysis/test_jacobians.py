@@ -86,3 +86,14 @@ def test_callables_without_complex_support_fall_back_to_differences():
     assert J.derivatives == "differences"
     x_ddot = pendulum.accelerations(pendulum.q0, [0.0])[0]  # at rest: ẍ = l cos θ θ̈
     assert x_ddot == pytest.approx(-9.81 * np.sin(theta) * np.cos(theta), rel=1e-10)
+
+
+@pytest.mark.parametrize("precomputed", [False, True], ids=["quadrature", "precomputed"])
+def test_elastic_beam_on_a_hub(precomputed):
+    """A RitzBeam (bending both ways, axial, stiffening) on a revolute hub with gravity, by
+    both integration strategies: exact Jacobians against differences."""
+    beam = pq.RitzBeam(1.0, 1.0, 2.0, EA=50.0, n_v=2, n_w=2, n_u=1, precomputed_integrals=precomputed)
+    system = pq.System({"beam": beam}, {"beam": pq.Revolute(axis="y")}, gravity=(0.0, 0.0, -9.81))
+    rng = np.random.default_rng(3)
+    q = 0.01 * rng.uniform(-1, 1, system.n_q)
+    _check_against_differences(system, q, rng.uniform(-1, 1, system.n_s), 0.2)

@@ -128,7 +128,7 @@ class PrecomputedIntegrals:
         Gz = (self._G_rows @ z).reshape(3, 3, n_z)  # Gz[a, b] = ∫ R_aᵀ r_b dm
         Y = np.swapaxes(Gz @ Z, 0, 1)  # Y[a, b] = ∫ r_a Φ_r,b dm
         r_bar, Phi_bar = self.R_bar @ z, self.R_bar @ Z
-        M_e = np.empty((n_e, 6 + n_e))
+        M_e = np.empty((n_e, 6 + n_e), dtype=np.result_type(Z, Y))  # complex in a complex step
         M_e[:, :3] = Phi_bar.T
         M_e[:, 3:6] = -2.0 * vee(Y).T  # (∫ r̃ Φ_r dm)ᵀ: −2 vee(C) = Σ_bc ε_abc C_bc, C = ∫ r xᵀ dm
         M_e[:, 6:] = Z.T @ self.G_trace @ Z
@@ -155,7 +155,7 @@ class PrecomputedIntegrals:
         k = self._moments(q_e, q_e_dot, omega, a)
         W, WW, Gz, Y, r_bar, Phi_bar = k["W"], k["WW"], k["Gz"], k["Y"], k["r_bar"], k["Phi_bar"]
         S = Gz @ k["z"]  # ∫ r rᵀ dm
-        M = np.empty((6 + len(q_e), 6 + len(q_e)))
+        M = np.empty((6 + len(q_e), 6 + len(q_e)), dtype=np.result_type(S, Y, k["M_e"]))
         M[:3, :3] = self.mass * np.eye(3)
         M[:3, 3:6] = -skew(r_bar)
         M[3:6, :3] = skew(r_bar)
