@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+
 def numeric(value) -> NDArray:
     """``value`` as a float array, or a complex one if it is complex (a complex step passes)."""
     array = np.asarray(value)
