@@ -14,11 +14,13 @@ another one where it cannot.
 Supported: trees of subsystems with rigid-body terms and no selection (``rigid_inertia``
 and ``S = None``: :class:`~projeq.RigidBody`, :class:`~projeq.PointMass`, :class:`~projeq.Frame`)
 on joints whose ``compiled_kind`` the kernel has (:class:`~projeq.Revolute`,
-:class:`~projeq.Prismatic`, :class:`~projeq.Fixed`; no coupling), under gravity, without
-force laws. One :class:`~projeq.RitzBeam` on a prescribed or fixed hub has its own fast
+:class:`~projeq.Prismatic`, :class:`~projeq.Fixed`; no coupling), under gravity and any
+force laws: between the compiled kinematics and the compiled passes each law adds its loads
+by its own ``add_to`` (the one statement the reference evaluators call) to the kernel's
+h_n, reading poses, twists, F_n and T̃_np from the kernel's workspace. One :class:`~projeq.RitzBeam` on a prescribed or fixed hub has its own fast
 evaluator, ``method="hub_beam"`` (:mod:`projeq.assembly.beam_fast`); any other system
-(beams in chains, planar bodies, free or user — e.g. non-holonomic — joints, couplings,
-forces) is refused with the piece named: it is evaluated by the general ones (recursive,
+(beams in chains, planar bodies, free or user — e.g. non-holonomic — joints, couplings)
+is refused with the piece named: it is evaluated by the general ones (recursive,
 or dense for coupled joints).
 
 >>> import numpy as np, projeq as pq
@@ -38,6 +40,7 @@ from numpy.typing import NDArray
 
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import hub_beam_unsupported
+from projeq.assembly.kinematics import Kinematics
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.subsystems.rigid import rigid_mass_matrix
 
@@ -89,7 +92,19 @@ class FastEvaluator:
         self._gravity = np.asarray(system.gravity, dtype=float)
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
         self._T, self._zeta = np.zeros((N, 6, 6)), np.zeros((N, 6))
-        self._f, self._M_hat, self._h_hat = np.zeros((N, 6)), np.zeros((N, 6, 6)), np.zeros((N, 6))
+        self._f, self._M_hat, self._h_hat = np.zeros((N, 6)), np.zeros((N, 6, 6)), np.zeros((N + 1, 6))
+        self._R, self._r, self._twist = np.zeros((N + 1, 3, 3)), np.zeros((N + 1, 3)), np.zeros((N + 1, 6))
+        self._kin = _kinematics(self._kind, self._R, self._r, self._twist, self._f) if system.forces else None
+
+    def _add_forces(self, q: NDArray, s_dot: NDArray, t: float) -> None:
+        """The force laws' own ``add_to`` (the statement the reference evaluators call) on the
+        kernel's kinematics: T̃_np = [[T_np, ζ_n], [0, 1]] is filled from the workspace."""
+        kin = self._kin
+        kin.T_aug[:-1, :6, :6] = self._T
+        kin.T_aug[:-1, :6, 6] = self._zeta
+        self._h_hat[-1] = 0.0  # the ground's row: reactions land there, nothing reads them
+        for force in self.system.forces:
+            force.add_to(self._h_hat, kin, t, q, s_dot)
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """s̈ at (q, ṡ, t) (THEORY §6); raises SingularMassError for a zero pivot D_n."""
@@ -98,8 +113,10 @@ class FastEvaluator:
         self._chain_terms(
             self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index,
             self._m, self._r_c, self._I_c, self._gravity, q, s_dot,
-            self._T, self._zeta, self._f, self._h_hat,
+            self._T, self._zeta, self._f, self._h_hat[:-1], self._R, self._r, self._twist,
         )
+        if self._kin is not None:
+            self._add_forces(q, s_dot, t)
         self._M_hat[:] = self._M6
         s_ddot = np.empty(self.system.n_s)
         failed = self._passes(
@@ -125,6 +142,14 @@ def unsupported(system) -> str | None:
         if body.rigid_inertia is None or body.S is not None:
             return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of spatial "
                     "rigid bodies, rigid_inertia with S = None)")
-    if system.forces:
-        return "the system has force laws (the kernel knows gravity only)"
     return None
+
+
+def _kinematics(kind, R, r, twist, f) -> Kinematics:
+    """The :class:`~projeq.assembly.kinematics.Kinematics` the force laws read, as views of the
+    kernel's workspace (poses, twists = ẏ_n, F_n = f_n or no column for a fixed joint) and a
+    T̃_np stack that :meth:`FastEvaluator._add_forces` fills (the ground's row last)."""
+    T_aug = np.zeros((len(kind) + 1, 7, 7))
+    T_aug[:, 6, 6] = 1.0
+    F = [f[n, :, None] if k != kernels.FIXED else f[n, :, None][:, :0] for n, k in enumerate(kind)]
+    return Kinematics(R, r, twist, twist, T_aug, F)

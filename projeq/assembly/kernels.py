@@ -41,15 +41,21 @@ def has_numba() -> bool:
 
 
 def chain_terms(kind, parent, axis, orientation, offset, q_index, m, r_c, I_c, gravity, q, s_dot,
-                T, zeta, f, h):
-    """T_np, ζ_n, F_n (as a 6-vector f_n) and h_n = Q_n − G_n ẏ_n of every body (THEORY §3–4).
+                T, zeta, f, h, R, r_O, twist):
+    """T_np, ζ_n, F_n (as a 6-vector f_n) and h_n = Q_n − G_n ẏ_n of every body (THEORY §3–4),
+    and the poses R_n, r_n and twists ẏ_n (row N of R, r_O, twist: the ground, at rest).
 
     A_pn = A_pJ A_Jn, r_pn = r_pJ + A_pJ r_Jn, T_np = [[A_np, −A_np r̃_pn], [0, A_np]],
-    u = T_np ẏ_p, w = f_n ṡ_n, ẏ_n = u + w, ζ_n = u × w (motion cross product).
+    u = T_np ẏ_p, w = f_n ṡ_n, ẏ_n = u + w, ζ_n = u × w (motion cross product),
+    R_n = R_p A_pn, r_n = r_p + R_p r_pn.
     Scalar loops only (no temporaries per body), which is what numba compiles best.
     """
     N = kind.shape[0]
-    twist = np.zeros((N + 1, 6))  # row N: the ground, at rest
+    twist[N] = 0.0
+    R[N] = 0.0
+    r_O[N] = 0.0
+    for a in range(3):
+        R[N, a, a] = 1.0
     g_body = np.zeros((N + 1, 3))
     g_body[N] = gravity
     A_rel, A_np, r, u, w = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty(6), np.empty(6)
@@ -63,6 +69,10 @@ def chain_terms(kind, parent, axis, orientation, offset, q_index, m, r_c, I_c, g
                 A_np[b, a] = orientation[n, a, 0] * A_rel[0, b] + orientation[n, a, 1] * A_rel[1, b] + orientation[n, a, 2] * A_rel[2, b]
                 if k == PRISMATIC:
                     r[a] += orientation[n, a, b] * e[b] * x
+        for a in range(3):  # R_n = R_p A_pn, r_n = r_p + R_p r_pn
+            r_O[n, a] = r_O[p, a] + R[p, a, 0] * r[0] + R[p, a, 1] * r[1] + R[p, a, 2] * r[2]
+            for b in range(3):
+                R[n, a, b] = R[p, a, 0] * A_np[b, 0] + R[p, a, 1] * A_np[b, 1] + R[p, a, 2] * A_np[b, 2]
         v_p, w_p = twist[p, :3] + _cross3(twist[p, 3:], r), twist[p, 3:]
         for a in range(3):  # u = T_np ẏ_p, g_n = A_np g_p
             u[a] = A_np[a, 0] * v_p[0] + A_np[a, 1] * v_p[1] + A_np[a, 2] * v_p[2]
@@ -128,6 +138,7 @@ def _rigid_h(m, r_c, I_c, twist, g_body, out):
 
 def passes(kind, parent, q_index, T, zeta, f, M_hat, h_hat, pivot_min, s_ddot):
     """Backward and forward pass of THEORY §6 for one-dof and fixed joints; writes s̈.
+    ``h_hat`` has N rows (the bodies) or more (a ground row N that collects, never read).
 
     Backward: U = M̂_n f_n, D_n = f_nᵀ U, M̄_n = M̂_n − U Uᵀ / D_n,
     h̄_n = c − U (f_nᵀ c) / D_n with c = ĥ_n − M̂_n ζ_n; M̂_p += T_npᵀ M̄_n T_np, ĥ_p += T_npᵀ h̄_n.
