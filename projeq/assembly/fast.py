@@ -4,7 +4,7 @@ The System stays frozen; :class:`FastEvaluator` packs its tree once into arrays 
 joint kinds, axes, joint frames, masses, r_c, I_c, M_n) and each call runs
 :func:`projeq.assembly.kernels.chain_terms` (T_np, ζ_n, F_n, h_n; THEORY §3–4) and
 :func:`projeq.assembly.kernels.passes` (Bremer's backward and forward passes, §6).
-Both are compiled by numba (``pip install 'projeq[fast]'``) on first use (cached on
+Both are compiled by numba (a dependency) on first use (cached on
 disk); ``method="fast"`` is this kernel or a ValueError saying why not (numba missing, or
 a piece of the system the kernel does not know). ``compiled=False`` runs the same kernel
 source interpreted (for testing: correct, but slower than the recursive evaluator).
@@ -13,15 +13,18 @@ another one where it cannot.
 
 Supported: trees of subsystems with rigid-body terms and no selection (``rigid_inertia``
 and ``S = None``: :class:`~projeq.RigidBody`, :class:`~projeq.PointMass`, :class:`~projeq.Frame`)
-on joints whose ``compiled_kind`` the kernel has (:class:`~projeq.Revolute`,
-:class:`~projeq.Prismatic`, :class:`~projeq.Fixed`; no coupling), under gravity and any
-force laws: between the compiled kinematics and the compiled passes each law adds its loads
-by its own ``add_to`` (the one statement the reference evaluators call) to the kernel's
-h_n, reading poses, twists, F_n and T̃_np from the kernel's workspace. One :class:`~projeq.RitzBeam` on a prescribed or fixed hub has its own fast
-evaluator, ``method="hub_beam"`` (:mod:`projeq.assembly.beam_fast`); any other system
-(beams in chains, planar bodies, free or user — e.g. non-holonomic — joints, couplings)
-is refused with the piece named: it is evaluated by the general ones (recursive,
-or dense for coupled joints).
+on any uncoupled joint: the kernel computes the relative motion of the joints whose
+``compiled_kind`` it has (:class:`~projeq.Revolute`, :class:`~projeq.Prismatic`,
+:class:`~projeq.Fixed`); every other joint (Planar, Free, Spherical, Screw, Prescribed,
+UserJoint — non-holonomic ones too) states it by its own ``relative`` before each call, which
+the kernel reads (kind ``GIVEN``, 0–6 minimal velocities). Under gravity and any force laws:
+between the compiled kinematics and the compiled passes each law adds its loads by its own
+``add_to`` (the one statement the reference evaluators call) to the kernel's h_n, reading
+poses, twists, F_n and T̃_np from the kernel's workspace. One :class:`~projeq.RitzBeam` on a
+prescribed or fixed hub has its own fast evaluator, ``method="hub_beam"``
+(:mod:`projeq.assembly.beam_fast`); any other system (beams in chains, planar bodies,
+coupled joints) is refused with the piece named: it is evaluated by the reference ones
+(recursive, or dense for coupled joints).
 
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.chain(3)

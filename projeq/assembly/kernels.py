@@ -38,7 +38,7 @@ def _numba():
 
 
 def has_numba() -> bool:
-    """Whether numba is installed (``pip install 'projeq[fast]'``)."""
+    """Whether numba (a dependency of projeq) can be imported."""
     return _numba() is not None
 
 
@@ -277,7 +277,7 @@ def kernel(compiled: bool = True):
         return chain_terms, passes
     if not has_numba():
         raise ValueError(
-            "compiled: numba is not installed (pip install 'projeq[fast]'); compiled=False runs the same "
+            "compiled: numba is not installed (pip install numba); compiled=False runs the same "
             "kernel interpreted, method='auto' picks the best evaluator available"
         )
     return _compiled()
