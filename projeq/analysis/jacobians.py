@@ -50,12 +50,20 @@ def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, i
     Fᵀ Q_tree). Complex-safe."""
     q, s_dot = x[: system.n_q], x[system.n_q :]
     if tau is None or not len(inputs):
-        s_ddot = system.evaluator().accelerations(q, s_dot, t)
+        s_ddot = interpreted_evaluator(system).accelerations(q, s_dot, t)
     else:
         M, b = system.gauss_form(q, s_dot, t)
         split = np.split(tau, np.cumsum([system.joint(j).n_s for j in inputs])[:-1])
         s_ddot = np.linalg.solve(M, system.generalized_force(q, t, dict(zip(inputs, split))) - b)
     return np.concatenate((system.q_dot(q, s_dot, t), s_ddot))
+
+
+def interpreted_evaluator(system):
+    """The model's interpreted evaluator, which takes complex arguments (the compiled one does
+    not): recursive, or dense for coupled joints; a ConstrainedSystem's default."""
+    if system.tree is not system:
+        return system.evaluator(None)
+    return system.evaluator("dense" if system.coupled else "recursive")
 
 
 def differentiate(f, z0: NDArray, derivatives: str = "exact") -> tuple[NDArray, str]:
