@@ -1,5 +1,5 @@
 """Closed loops through singular positions and with redundant constraints: the augmented
-Lagrangian formulation (docs/theory.md, "Constraints").
+Lagrangian formulation (docs/theory.md, the table of formulations).
 
 Coordinate partitioning (:mod:`.partitioned`) needs a regular block A_dep of the constraint
 matrix A_s; it cannot exist where the constraints become dependent — a mechanism whose links
@@ -23,11 +23,17 @@ from the free motion z_free = −L⁻¹ b by Σ_i v_i f_i (u_iᵀ (r − A_s L�
 f_i = 1 − (1 + α σ_i²)^(−k) (α in units of 1/σ_max²): this closed form is what is evaluated. It is
 Gauss's principle of least constraint for every direction the constraints hold (α σ_i² ≫ 1:
 f_i = 1 to round-off) and lets go smoothly of the directions that vanish at a singular position
-(σ_i → 0, f_i → 0), where the partitioned form divides by zero. Redundant rows (σ_i = 0) do not
-act; their multipliers are the minimum-norm solution of A_sᵀ λ = M s̈ + b (the λ orthogonal to
+(σ_i → 0, f_i → 0), where the partitioned form divides by zero. Redundant rows (σ_i below
+RANK_TOLERANCE σ_max) do not act; their multipliers are the minimum-norm solution of A_sᵀ λ = M s̈ + b (the λ orthogonal to
 every combination of rows that cancels): λ = Σ_i u_i f_i (u_iᵀ r̃) / σ_i², r̃ = r − A_s L⁻ᵀ z_free.
 The rank of A_s and the mobility are computed at every evaluation (:meth:`AugmentedSystem.rank`,
 :meth:`AugmentedSystem.mobility`); nothing stops the run at a singular position.
+
+Measured against :class:`~projeq.constraints.tangent.TangentSystem` (``benchmarks/iftomm.py``): on
+the double four-bar both run through the singular positions, but here the released directions
+drift while they are released and the stabilisation pulls them back, so that point B0 is off the
+parallelogram motion by ~1e-3 after two singular positions at rtol 1e-9 (TangentSystem: ~1e-8),
+with twice the evaluations; TangentSystem is the one the IFToMM scenes use.
 
 Drift: q is projected onto Φ = 0 wherever :func:`projeq.simulate` normalises it (segment ends,
 outputs), as by the partitioned form; the velocities are held by the stabilisation.
@@ -39,7 +45,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.checks import positive
-from projeq.constraints.partitioned import ConstrainedSystem
+from projeq.constraints.partitioned import RANK_TOLERANCE, ConstrainedSystem
 
 PENALTY = 1e8  # α σ_max²: Bayo & Ledesma's 1e7–1e9 (times the mass scale) in mass-weighted units
 ITERATIONS = 3  # augmented Lagrangian iterations: a direction with α σ² = 1e4 holds to 1e-12
@@ -167,7 +173,7 @@ def _least_constraint(A_s, L, z_free, r, penalty, iterations) -> tuple[NDArray, 
     U, sigma, Vt = np.linalg.svd(np.linalg.solve(L, A_s.T).T, full_matrices=False)  # A_s L⁻ᵀ
     scaled = penalty * (sigma / sigma[0]) ** 2 if sigma[0] > 0 else np.zeros_like(sigma)
     f = -np.expm1(-iterations * np.log1p(scaled))  # 1 − (1 + α σ²)^(−k)
-    held = sigma > 0
+    held = sigma > RANK_TOLERANCE * sigma[0]  # a redundant row's direction (σ = 0 to round-off) does not act
     gain = np.where(held, f / np.where(held, sigma, 1.0), 0.0)
     residual = U.T @ r - sigma * (Vt @ z_free)  # r − A_s L⁻ᵀ z_free in the directions u_i
     lam = U @ (np.where(held, gain / np.where(held, sigma, 1.0), 0.0) * residual)

@@ -35,6 +35,10 @@ same tree velocities) and continues.
 ``Result.partitions`` lists (t_k, independent_k): the ``s_dot`` rows at times t with
 t_k < t ≤ t_k+1 are the tree velocities independent_k (the first partition also holds at
 t_start); energies and constraint residuals are computed in each row's own partition.
+Where the constraint rows themselves become nearly dependent at the event (cond(A_s) above a
+tenth of the limit: every partition is as bad, a singular position of the mechanism such as
+links coming into line) re-pivoting would carry on along another branch of the motion: the run
+stops there and says so (:class:`projeq.constraints.tangent.TangentSystem` runs through).
 A user-fixed partition (``repivot=False``) stops the run at the same event with a
 ValueError naming (q, t): integrated on, the solver could step across the degeneracy
 (where ṡ_tree = F ṡ is ∞ · 0) and lose accuracy silently.
@@ -221,8 +225,8 @@ class ConstrainedSystem(Model):
         if redundant:
             raise ValueError(
                 f"phi: the constraint rows are rank-deficient at q0 (rank {len(kept)} of {self.n_c}): rows "
-                f"{redundant} depend on rows {kept} (rows count Φ first, then A); remove the redundant ones, or use AugmentedSystem "
-                "(projeq.constraints.augmented), which takes redundant constraints as they are"
+                f"{redundant} depend on rows {kept} (rows count Φ first, then A); remove the redundant ones, or use TangentSystem "
+                "(projeq.constraints.tangent), which takes redundant constraints as they are"
             )
 
     def _partition(self, q0, independent) -> tuple[NDArray, NDArray]:
@@ -279,6 +283,8 @@ class ConstrainedSystem(Model):
         starts at (q, ṡ_new). Without ``repivot``: ValueError naming (q, t)."""
         if not self.repivot:
             raise self._degenerate(q, t, self.condition(q, t), self.limit)
+        if self._near_dependent(q, t):  # re-pivoting here would carry on along another branch, silently
+            raise self._singular_position(q, t)
         dependent = _pivoted_dependent(self.constraint_matrix(q, t)[0], self.n_c)
         new = self._in_partition(np.setdiff1d(np.arange(self.tree.n_s), dependent), q, t)
         new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
@@ -324,18 +330,26 @@ class ConstrainedSystem(Model):
                 f"(condition number of the partition {cond:.3g}, limit {limit:.3g}); choose other independent "
                 "velocities (default: pivoted QR picks them at q0), or pass repivot=True"
             )
-        rank, mobility = self.rank(q, t), self.mobility(q, t)
-        if rank < self.n_c:  # no partition exists: the mechanism is in a singular position
-            return ValueError(
-                f"phi: the mechanism reaches a singular position at {where}: its {self.n_c} constraints become "
-                f"dependent (rank {rank}, {mobility} degrees of freedom instead of {self.tree.n_s - self.n_c}: links in line, "
-                "where the motion may branch), and no choice of independent velocities can be solved for there; "
-                "AugmentedSystem (projeq.constraints.augmented) runs through such positions"
-            )
+        if self._near_dependent(q, t):
+            return self._singular_position(q, t)
         return ValueError(
             f"independent: the dependent velocities {self.dependent.tolist()} cannot be solved for at {where}, "
             "reached within one step before the partition could be re-chosen; pass a smaller max_step to "
-            "simulate, or use AugmentedSystem (projeq.constraints.augmented), which needs no partition"
+            "simulate, or use TangentSystem (projeq.constraints.tangent), which re-chooses at every step"
+        )
+
+    def _near_dependent(self, q, t) -> bool:
+        """Whether the constraint rows themselves are nearly dependent at (q, t): every partition's
+        κ ≥ cond(A_s), so none can be 10 times below the limit."""
+        sigma = np.linalg.svd(self.constraint_matrix(q, t)[0], compute_uv=False)
+        return not sigma[-1] * getattr(self, "limit", REPIVOT_CONDITION) > 10 * sigma[0]
+
+    def _singular_position(self, q, t) -> ValueError:
+        return ValueError(
+            f"phi: the mechanism reaches a singular position at q = {np.round(q, 6).tolist()}, t = {t:.6g}: its "
+            f"{self.n_c} constraint equations become dependent there (links coming into line, where the motion "
+            "can branch), so that no choice of independent velocities carries the motion through it; "
+            "TangentSystem (projeq.constraints.tangent) does"
         )
 
     def rank(self, q: NDArray, t: float = 0.0) -> int:

@@ -1,6 +1,6 @@
 """Closed loops through singular positions and with redundant constraints: minimal velocities
-in the tangent space of the constraints, by a rank-revealing factorisation (docs/theory.md,
-"Constraints").
+in the tangent space of the constraints, by a rank-revealing factorisation (docs/theory.md, the
+table of formulations).
 
 Coordinate partitioning (:mod:`.partitioned`) writes ṡ_tree = F ṡ + f with F = [E; −A_dep⁻¹ A_ind]:
 it needs the block A_dep of the constraint matrix A_s regular. That block cannot be regular where

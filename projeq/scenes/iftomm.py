@@ -78,10 +78,13 @@ def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, spee
 
 
 def point_b0(system, q, s_dot) -> np.ndarray:
-    """(x, y, ẋ, ẏ) of point B0, the tip of crank0 of :func:`n_four_bar`, for each row of q, ṡ."""
+    """(x, y, ẋ, ẏ) of point B0, the tip of crank0 of :func:`n_four_bar`, for each row of q and
+    of the model's velocities ṡ (any formulation of the same tree)."""
     i = system.tree.index("crank0")
     L = 2 * system.tree.subsystems[i].r_c[0]
-    theta, omega = np.asarray(q)[..., system.tree.q_slice[i].start], np.asarray(s_dot)[..., system.tree.s_slice[i].start]
+    q, s_dot = np.atleast_2d(q), np.atleast_2d(s_dot)
+    theta = q[:, system.tree.q_slice[i].start]
+    omega = np.array([system.tree_velocities(qi, si)[system.tree.s_slice[i].start] for qi, si in zip(q, s_dot)])
     return np.stack((L * np.cos(theta), L * np.sin(theta), -L * np.sin(theta) * omega, L * np.cos(theta) * omega), axis=-1)
 
 
