@@ -24,7 +24,8 @@ f_i = 1 − (1 + α σ_i²)^(−k) (α in units of 1/σ_max²): this closed form
 Gauss's principle of least constraint for every direction the constraints hold (α σ_i² ≫ 1:
 f_i = 1 to round-off) and lets go smoothly of the directions that vanish at a singular position
 (σ_i → 0, f_i → 0), where the partitioned form divides by zero. Redundant rows (σ_i below
-RANK_TOLERANCE σ_max) do not act; their multipliers are the minimum-norm solution of A_sᵀ λ = M s̈ + b (the λ orthogonal to
+RANK_TOLERANCE σ_max) do not act; their multipliers are the minimum-norm solution of
+A_sᵀ λ = M s̈ + b (the λ orthogonal to
 every combination of rows that cancels): λ = Σ_i u_i f_i (u_iᵀ r̃) / σ_i², r̃ = r − A_s L⁻ᵀ z_free.
 The rank of A_s and the mobility are computed at every evaluation (:meth:`AugmentedSystem.rank`,
 :meth:`AugmentedSystem.mobility`); nothing stops the run at a singular position.
@@ -127,8 +128,8 @@ class AugmentedSystem(ConstrainedSystem):
         return np.eye(self.n_s), np.zeros(self.n_s)
 
     def gauss_form(self, q, s_dot, t: float = 0.0):
-        raise ValueError("system: an AugmentedSystem has no Gauss form in minimal velocities (its velocities "
-                         "are constrained by multipliers); use a ConstrainedSystem away from singular positions")
+        raise ValueError("system: an AugmentedSystem has no Gauss form in minimal velocities (its "
+                         "velocities are constrained by multipliers); use a TangentSystem")
 
     def project_velocities(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
         """ṡ moved onto A_s ṡ = b_s mass-orthogonally: ṡ − M⁻¹ A_sᵀ (A_s M⁻¹ A_sᵀ)⁺ (A_s ṡ − b_s),

@@ -235,14 +235,8 @@ class ConstrainedSystem(Model):
         if independent is None:
             dependent = _pivoted_dependent(A_s, self.n_c)
         else:
-            chosen = np.asarray(independent)
-            integers = chosen.ndim == 1 and np.issubdtype(chosen.dtype, np.integer)
-            if not integers or len(chosen) != n_s - self.n_c or len(set(chosen.tolist())) != len(chosen) \
-                    or np.any((chosen < 0) | (chosen >= n_s)):
-                raise ValueError(
-                    f"independent: expected {n_s - self.n_c} distinct indices of ṡ_tree in 0..{n_s - 1} "
-                    f"(n_s = {n_s} minus {self.n_c} constraints), got {independent!r}"
-                )
+            why = f"n_s = {n_s} minus {self.n_c} constraints"
+            chosen = independent_indices(independent, n_s - self.n_c, n_s, why)
             dependent = np.setdiff1d(np.arange(n_s), chosen)
         free = np.setdiff1d(np.arange(n_s), dependent)
         self.independent, self.dependent = free, dependent
@@ -333,9 +327,9 @@ class ConstrainedSystem(Model):
         if self._near_dependent(q, t):
             return self._singular_position(q, t)
         return ValueError(
-            f"independent: the dependent velocities {self.dependent.tolist()} cannot be solved for at {where}, "
-            "reached within one step before the partition could be re-chosen; pass a smaller max_step to "
-            "simulate, or use TangentSystem (projeq.constraints.tangent), which re-chooses at every step"
+            f"independent: the dependent velocities {self.dependent.tolist()} cannot be solved for at "
+            f"{where}, reached within one step before the partition could be re-chosen; pass a smaller "
+            "max_step to simulate, or use TangentSystem (projeq.constraints.tangent), which needs no partition"
         )
 
     def _near_dependent(self, q, t) -> bool:
@@ -346,10 +340,10 @@ class ConstrainedSystem(Model):
 
     def _singular_position(self, q, t) -> ValueError:
         return ValueError(
-            f"phi: the mechanism reaches a singular position at q = {np.round(q, 6).tolist()}, t = {t:.6g}: its "
-            f"{self.n_c} constraint equations become dependent there (links coming into line, where the motion "
-            "can branch), so that no choice of independent velocities carries the motion through it; "
-            "TangentSystem (projeq.constraints.tangent) does"
+            f"phi: the mechanism reaches a singular position at q = {np.round(q, 6).tolist()}, "
+            f"t = {t:.6g}: its {self.n_c} constraint equations become dependent there (links coming into "
+            "line, where the motion can branch), so that no choice of independent velocities carries the "
+            "motion through it; TangentSystem (projeq.constraints.tangent) does"
         )
 
     def rank(self, q: NDArray, t: float = 0.0) -> int:
@@ -412,7 +406,8 @@ class ConstrainedSystem(Model):
         return self.project(q, t) if self.correction == "projection" else q
 
     def project(self, q: NDArray, t: float = 0.0, max_iter: int = 20) -> NDArray:
-        """q moved onto Φ(q, t) = 0 by minimum-norm Gauss–Newton steps (redundant rows: singular values of ∂Φ/∂q below RANK_TOLERANCE σ_max dropped); ValueError if it fails."""
+        """q moved onto Φ(q, t) = 0 by minimum-norm Gauss–Newton steps (redundant rows: singular
+        values of ∂Φ/∂q below RANK_TOLERANCE σ_max dropped); ValueError if it fails."""
         q = np.array(q, dtype=float)
         tol = POSITION_TOLERANCE * max(1.0, np.abs(q).max())
         for _ in range(max_iter):
@@ -492,7 +487,9 @@ class ConstrainedSystem(Model):
         s_ddot = -solve_spd(M_min, b_min[:, None], "constrained mass matrix FᵀMF",
                             max(np.abs(np.diag(M_min)).max(initial=0.0), 1e-300))[:, 0]
         s_ddot_tree = F @ s_ddot + f_bar
-        lam = np.linalg.lstsq(A_s.T, M @ s_ddot_tree + b, rcond=RANK_TOLERANCE)[0] if self.n_c else np.zeros(0)
+        lam = np.zeros(0)
+        if self.n_c:  # the minimum-norm λ where rows are redundant
+            lam = np.linalg.lstsq(A_s.T, M @ s_ddot_tree + b, rcond=RANK_TOLERANCE)[0]
         return s_ddot_tree, lam
 
     def evaluator(self, method: str | None = None) -> "PartitionedEvaluator":
@@ -537,6 +534,17 @@ def _partition_condition(A_s: NDArray, dependent: NDArray) -> float:
         return 1.0
     sigma = np.linalg.svd(A_s[:, dependent], compute_uv=False)
     return float(np.linalg.norm(A_s, 2) / sigma[-1]) if sigma[-1] > 0 else np.inf
+
+
+def independent_indices(independent, count: int, n_tree: int, why: str) -> NDArray:
+    """``independent`` as sorted indices of ṡ_tree: ``count`` distinct integers in 0..n_tree − 1
+    (ValueError naming the parameter and ``why`` that many otherwise)."""
+    chosen = np.asarray(independent)
+    if chosen.ndim != 1 or not np.issubdtype(chosen.dtype, np.integer) or len(chosen) != count \
+            or len(set(chosen.tolist())) != count or np.any((chosen < 0) | (chosen >= n_tree)):
+        raise ValueError(f"independent: expected {count} distinct indices of ṡ_tree in 0..{n_tree - 1} "
+                         f"({why}), got {independent!r}")
+    return np.sort(chosen)
 
 
 def numerical_rank(A: NDArray) -> int:

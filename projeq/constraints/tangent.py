@@ -38,7 +38,9 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
-from projeq.constraints.partitioned import RANK_TOLERANCE, REPIVOT_CONDITION, ConstrainedSystem, numerical_rank
+from projeq.constraints.partitioned import (
+    RANK_TOLERANCE, REPIVOT_CONDITION, ConstrainedSystem, independent_indices, numerical_rank,
+)
 
 
 class TangentSystem(ConstrainedSystem):
@@ -73,11 +75,7 @@ class TangentSystem(ConstrainedSystem):
         if independent is None:
             chosen = _pivoted_independent(self._null_space(A_s), self.n_s)
         else:
-            chosen = np.sort(np.asarray(independent))
-            if chosen.ndim != 1 or not np.issubdtype(chosen.dtype, np.integer) or len(chosen) != self.n_s \
-                    or len(set(chosen.tolist())) != self.n_s or np.any((chosen < 0) | (chosen >= self.tree.n_s)):
-                raise ValueError(f"independent: expected {self.n_s} distinct indices of ṡ_tree in 0..{self.tree.n_s - 1} "
-                                 f"(the mobility at q0), got {independent!r}")
+            chosen = independent_indices(independent, self.n_s, self.tree.n_s, "the mobility at q0")
         self.independent, self.dependent = chosen, np.setdiff1d(np.arange(self.tree.n_s), chosen)
         self.repivot = independent is None if repivot is None else bool(repivot)
         self.check_configuration(q0, 0.0)

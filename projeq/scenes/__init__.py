@@ -124,9 +124,12 @@ SCENES = {
                              plane=(0, 1), events=(fallen_over,)),
     "quick_return": Scene(quick_return, "Barhorst's quick-return mechanism, a closed loop (seed 000, 3.3)", 5.0),
     "four_bar": Scene(four_bar, "a four-bar linkage closed by a constraint equation", 5.0),
-    "simple_pendulum": Scene(simple_pendulum, "IFToMM benchmark A01: a pendulum in natural coordinates", 10.0),
-    "n_four_bar": Scene(n_four_bar, "IFToMM benchmark A02: n four-bars in a row, through singular positions", 20.0),
-    "bricard": Scene(bricard, "IFToMM benchmark A04: Bricard's overconstrained mechanism (a redundant row)", 10.0),
+    "simple_pendulum": Scene(simple_pendulum, "IFToMM benchmark A01: a pendulum in natural coordinates",
+                             10.0),
+    "n_four_bar": Scene(n_four_bar, "IFToMM benchmark A02: n four-bars in a row, through singular positions",
+                        20.0),
+    "bricard": Scene(bricard, "IFToMM benchmark A04: Bricard's overconstrained mechanism (a redundant row)",
+                     10.0),
 }
 DEFAULT_SCENE = "spin_up_beam"
 

@@ -59,14 +59,16 @@ def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, spee
     rod = slender_rod(positive("m", m), positive("L", L))
     cranks, couplers = [f"crank{i}" for i in range(n + 1)], [f"coupler{i}" for i in range(1, n + 1)]
     joints = {name: Revolute(axis="z", r_pn=(i * L, 0.0, 0.0)) for i, name in enumerate(cranks)}
-    joints |= {name: Revolute(parent=cranks[i], axis="z", r_pn=(L, 0.0, 0.0)) for i, name in enumerate(couplers)}
+    joints |= {name: Revolute(parent=cranks[i], axis="z", r_pn=(L, 0.0, 0.0))
+               for i, name in enumerate(couplers)}
     tree = System(dict.fromkeys(cranks + couplers, rod), joints, gravity=(0.0, -g, 0.0))
-    crank, coupler = (np.array([tree.q_slice[tree.index(name)].start for name in names]) for names in (cranks, couplers))
+    crank, coupler = (np.array([tree.q_slice[tree.index(name)].start for name in names])
+                      for names in (cranks, couplers))
 
     def closure(q, t):  # tip of coupler i − (tip of crank i), i = 1 … n: x rows, then y rows
         theta, phi = q[crank], q[coupler]
         absolute = theta[:-1] + phi
-        x = np.arange(n) * L + L * (np.cos(theta[:-1]) + np.cos(absolute)) - (np.arange(1, n + 1) * L + L * np.cos(theta[1:]))
+        x = L * (np.cos(theta[:-1]) + np.cos(absolute) - 1.0 - np.cos(theta[1:]))  # pivots 1 apart
         y = L * (np.sin(theta[:-1]) + np.sin(absolute) - np.sin(theta[1:]))
         return np.concatenate((x, y))
 
@@ -84,8 +86,15 @@ def point_b0(system, q, s_dot) -> np.ndarray:
     L = 2 * system.tree.subsystems[i].r_c[0]
     q, s_dot = np.atleast_2d(q), np.atleast_2d(s_dot)
     theta = q[:, system.tree.q_slice[i].start]
-    omega = np.array([system.tree_velocities(qi, si)[system.tree.s_slice[i].start] for qi, si in zip(q, s_dot)])
-    return np.stack((L * np.cos(theta), L * np.sin(theta), -L * np.sin(theta) * omega, L * np.cos(theta) * omega), axis=-1)
+    column = system.tree.s_slice[i].start
+    omega = np.array([system.tree_velocities(qi, si)[column] for qi, si in zip(q, s_dot)])
+    return _tip(L, theta, omega)
+
+
+def _tip(L: float, theta, omega) -> np.ndarray:
+    """(x, y, ẋ, ẏ) of a crank's tip at angle θ turning at θ̇ (rows)."""
+    return np.stack((L * np.cos(theta), L * np.sin(theta), -L * np.sin(theta) * omega, L * np.cos(theta) * omega),
+                    axis=-1)
 
 
 def parallelogram_motion(t, n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, speed: float = 1.0,
@@ -99,7 +108,7 @@ def parallelogram_motion(t, n: int = 2, m: float = 1.0, L: float = 1.0, g: float
     sol = solve_ivp(lambda _, x: [x[1], -weight * np.cos(x[0]) / inertia], (0.0, t.max()),
                     [np.pi / 2, -speed / L], t_eval=t, rtol=rtol, atol=rtol * 1e-2, method="DOP853")
     theta, omega = sol.y
-    return np.stack((L * np.cos(theta), L * np.sin(theta), -L * np.sin(theta) * omega, L * np.cos(theta) * omega), axis=-1)
+    return _tip(L, theta, omega)
 
 
 # Bricard's mechanism: the joints at the corners of the benchmark's figure, their axes, and the

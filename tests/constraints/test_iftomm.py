@@ -16,15 +16,18 @@ import pytest
 import projeq as pq
 from projeq.constraints.augmented import AugmentedSystem
 from projeq.constraints.partitioned import ConstrainedSystem
-from projeq.scenes.iftomm import bricard, n_four_bar, parallelogram_motion, pendulum_angle, point_b0, simple_pendulum
+from projeq.scenes.iftomm import (
+    bricard, n_four_bar, parallelogram_motion, pendulum_angle, point_b0, simple_pendulum,
+)
 
 
 @pytest.fixture(scope="module")
-def double_four_bar():
+def double_four_bar():  # ~25 s
     system = n_four_bar(2)
     return system, pq.simulate(system, 10.0, n_points=401, rtol=1e-9, atol=1e-11)
 
 
+@pytest.mark.slow
 def test_double_four_bar_runs_through_its_singular_positions(double_four_bar):
     """A02 with N = 2, all bars 1 m and 1 kg, B0 starting at 1 m/s: the cranks turn over and over,
     passing the horizontal (rank 2 of 4 rows, 3 degrees of freedom) 10 times in 10 s (θ0 from π/2 to
@@ -36,7 +39,8 @@ def test_double_four_bar_runs_through_its_singular_positions(double_four_bar):
     crossings = np.count_nonzero(np.diff(np.floor(r.q[:, 0] / np.pi)))
     assert crossings == 10
     horizontal = np.array([np.pi] * 3 + [-np.pi] * 2)  # cranks at π, couplers at 0 absolute: bars in line
-    assert system.rank(horizontal) == 2 and system.mobility(horizontal) == 3 and system.mobility(system.q0) == 1
+    assert system.rank(horizontal) == 2 and system.mobility(horizontal) == 3
+    assert system.mobility(system.q0) == 1
     error = np.abs(point_b0(system, r.q, r.s_dot) - parallelogram_motion(r.t, 2))
     assert error[-1].max() < 1e-4 and error.max() < 1e-4, error.max(axis=0)
     assert np.abs(r.constraint_residual).max() < 1e-10
@@ -54,11 +58,12 @@ def test_partitioned_formulation_stops_at_the_singular_position_saying_so(double
 
 
 @pytest.fixture(scope="module")
-def bricard_run():
+def bricard_run():  # ~60 s
     system = bricard()
     return system, pq.simulate(system, 10.0, n_points=101, rtol=1e-10, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_bricard_runs_without_removing_a_row(bricard_run):
     """A04: five closure rows of rank 4 (Grübler count 0, mobility 1) taken as they are; over
     10 s the loop stays closed to 1e-8 and the energy to 1e-8 J (the issue's bounds; achieved
@@ -95,6 +100,7 @@ def test_bricard_multipliers_are_the_minimum_norm_solution(bricard_run):
         assert abs(cancelling @ lam) < 1e-8 * np.linalg.norm(lam)
 
 
+@pytest.mark.slow
 def test_simple_pendulum_matches_the_elliptic_closed_form():
     """A01: released from the horizontal, the pendulum in natural coordinates (x, y) passes the
     positions where either coordinate's rate alone cannot describe it; its angle follows
@@ -110,8 +116,10 @@ def test_augmented_lagrangian_holds_a_redundant_pendulum():
     twice: the same motion as the closed form over 1 s, the multipliers minimum-norm (λ₂ = 2 λ₁
     for the rows Φ and 2Φ)."""
     tree = simple_pendulum().tree
-    twice = AugmentedSystem(tree, phi=lambda q, t: [q[0] ** 2 + q[1] ** 2 - 1.0, 2 * (q[0] ** 2 + q[1] ** 2 - 1.0)],
-                            q0=[1.0, 0.0])
+    def circle_twice(q, t):
+        return [q[0] ** 2 + q[1] ** 2 - 1.0, 2 * (q[0] ** 2 + q[1] ** 2 - 1.0)]
+
+    twice = AugmentedSystem(tree, phi=circle_twice, q0=[1.0, 0.0])
     r = pq.simulate(twice, 1.0, n_points=21, rtol=1e-10, atol=1e-12)
     assert np.abs(np.arctan2(r.q[:, 0], -r.q[:, 1]) - pendulum_angle(r.t)).max() < 1e-6
     lam = twice.accelerations_tree(r.q[10], r.s_dot[10])[1]
