@@ -9,12 +9,13 @@ far are written).
 
 from __future__ import annotations
 
+import json
 import sys
 
 import numpy as np
 
-from projeq.cli.options import number, output_directory, scene_settings_option
-from projeq.studies.compare import COMPARISONS, compare
+from projeq.cli.options import json_option, jsonable, number, output_directory, scene_settings_option
+from projeq.studies.compare import COMPARISONS, TEXT_WIDTH, compare
 from projeq.studies.effort import DERIVATION_REPEATS
 from projeq.studies.tradeoff import METHODS, QUICK_TOLERANCES, format_table, get_study, plot, save_csv, tradeoff
 from projeq.studies.tradeoff_studies import STUDIES
@@ -28,13 +29,18 @@ def compare_arguments(parser) -> None:
     parser.add_argument("--formulation", action="append", help="restrict to these rows (repeatable)")
     parser.add_argument("--repeats", type=int, default=DERIVATION_REPEATS,
                         help=f"derivations per row, median reported (default {DERIVATION_REPEATS})")
+    json_option(parser)
     parser.set_defaults(execute=compare_formulations)
 
 
 def compare_formulations(args) -> int:
     table = compare(args.name, args.formulation, simulate=not args.no_simulate, t_end=args.t_end,
                     repeats=args.repeats)
-    print(table.format())
+    if args.json:
+        print(json.dumps({"name": table.name, "rows": table.rows, "effort": table.effort, "claims": table.claims},
+                         indent=2, default=jsonable))
+    else:
+        print(table.format())
     if args.csv:
         table.to_csv(args.csv)
     return 0
@@ -52,6 +58,7 @@ def tradeoff_arguments(parser) -> None:
     parser.add_argument("--timeout", default="120", help="CPU seconds allowed per run (default 120)")
     parser.add_argument("--out", default="projeq-tradeoff", help="output directory (default ./projeq-tradeoff)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar and no table")
+    parser.add_argument("--wide", action="store_true", help=f"print the table uncut (default: {TEXT_WIDTH} columns)")
     parser.set_defaults(execute=tradeoff_study)
 
 
@@ -64,7 +71,7 @@ def tradeoff_study(args) -> int:
         files.append(out / f"tradeoff_{args.scene}.png")
         plot(table).savefig(files[-1], dpi=110)
     if not args.quiet:
-        print(format_table(table))
+        print(format_table(table, width=None if args.wide else TEXT_WIDTH))
     print(f"wrote {', '.join(str(f) for f in files)}")
     if not table["complete"]:
         print(f"projeq tradeoff: interrupted after {len(table['method'])} settings; those are written", file=sys.stderr)
