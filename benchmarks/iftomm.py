@@ -65,7 +65,11 @@ def problems(args) -> None:
              (f"A02 {args.n}-four-bar", n_four_bar(args.n), 10.0, b0_error(args.n)),
              ("A04 Bricard", bricard(), 10.0, lambda system, r: float("nan"))]
     for label, system, t_end, error in cases:
-        row = measure(system, t_end, args.rtol, error)
+        try:
+            row = measure(system, t_end, args.rtol, error)
+        except pq.SimulationError as failure:
+            print(f"{label:<24}stopped at t = {failure.result.t[-1]:.3f} s: {str(failure)[:80]}")
+            continue
         print(f"{label:<24}{row['t']:>6.1f}{row['cpu']:>8.1f}{row['nfev']:>7d}{row['phi']:>10.1e}"
               f"{row['velocity']:>11.1e}{row['energy']:>11.1e}{row['error']:>10.1e}")
 

@@ -26,7 +26,12 @@ Near a singular position the null space of A_s is separated from the vanishing s
 their size (∝ the distance from the singular position), so that F, and with it the motion's branch,
 stays continuous through it: the velocity never leaves the mechanism's one-dimensional tangent
 (the branch is kept by construction; an acceleration-level formulation has to hold it by its
-stabilisation). On the constraint manifold the rank of A_s can only drop below its value at a
+stabilisation). Known limitation: the explicit integrators evaluate stages off the manifold (by
+the step's curvature error, ~1e-4..1e-3 at rtol 1e-9); within that distance of a singular position
+the null vector is not separated from the directions that come free, and a stage can take the wrong
+one: the double four-bar of IFToMM A02 passes its first singular positions to 2e-7, but runs to
+10 s leave the parallelogram motion at a later crossing (a continuation of the branch from the
+previous step, or an index-3 formulation, is the remedy still to be built). On the constraint manifold the rank of A_s can only drop below its value at a
 regular q0 (at singular positions), never rise, so the n_s directions always exist (q0 must be a
 regular configuration: its rank fixes n_s). Where the independent velocities stop describing the
 motion (a crank at a dead centre, N_ind singular) the independent set is re-chosen as in :mod:`.partitioned`.
