@@ -1,6 +1,9 @@
 """Constraints (THEORY §7): closed loops and Pfaffian constraints given as equations on a tree.
 
 - :mod:`.partitioned`: :class:`ConstrainedSystem`, the partitioned model with minimal velocities;
+- :mod:`.tangent`: :class:`TangentSystem`, minimal velocities in the constraints' null space (through
+  singular positions, redundant constraints taken as they are);
+- :mod:`.augmented`: :class:`AugmentedSystem`, the augmented Lagrangian formulation (the alternative);
 - :mod:`.cut_joints`: cut joints of closed loops (:class:`PinClosure`);
 - :mod:`.reactions`: reaction forces and the contact event;
 - :mod:`.nonholonomic`: checks of non-holonomic quasi-velocities (singular K, constraint drift).

@@ -39,6 +39,10 @@ same tree velocities) and continues.
 ``Result.partitions`` lists (t_k, independent_k): the ``s_dot`` rows at times t with
 t_k < t ≤ t_k+1 are the tree velocities independent_k (the first partition also holds at
 t_start); energies and constraint residuals are computed in each row's own partition.
+Where the constraint rows themselves become nearly dependent at the event (cond(A_s) above a
+tenth of the limit: every partition is as bad, a singular position of the mechanism such as
+links coming into line) re-pivoting would carry on along another branch of the motion: the run
+stops there and says so (:class:`projeq.constraints.tangent.TangentSystem` runs through).
 A user-fixed partition (``repivot=False``) stops the run at the same event with a
 ValueError naming (q, t): integrated on, the solver could step across the degeneracy
 (where ṡ_tree = F ṡ is ∞ · 0) and lose accuracy silently.
@@ -76,6 +80,9 @@ PARTITION_CONDITION = 1e8
 REPIVOT_CONDITION = 1e2
 # |Φ| (relative to the largest coordinate, at least 1) accepted as on the manifold: 1e4 × round-off
 POSITION_TOLERANCE = 1e-12
+# singular values of A_s below this fraction of the largest count as zero (rank, mobility): the
+# differences' errors (~1e-10 relative) lie below, a constraint that still acts far above
+RANK_TOLERANCE = 1e-7
 
 
 class ConstrainedSystem(Model):
@@ -153,11 +160,7 @@ class ConstrainedSystem(Model):
                 not np.allclose(self.phi(q0, t), self.phi(q0, 0.0), rtol=0, atol=1e-14) for t in (0.37, 1.9)):
             raise ValueError("correction: 'projection' needs Φ independent of t (q is normalised without the "
                              "time); use correction='baumgarte' for rheonomic constraints")
-        self._check_rank(q0)
-        self.independent, self.dependent = self._partition(q0, independent)
-        self.n_s = len(self.independent)
-        self.repivot = independent is None if repivot is None else _check_repivot(repivot)
-        self.limit = max(REPIVOT_CONDITION, 10 * self.condition(q0))
+        self._choose_velocities(q0, independent, repivot)
         self.q0 = self._initial_q(q0, project_q0)
         self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
 
@@ -218,6 +221,14 @@ class ConstrainedSystem(Model):
         return np.concatenate((self.phi(q, t), A @ q_dot - b))
 
     # -- partition --------------------------------------------------------------------------
+    def _choose_velocities(self, q0, independent, repivot) -> None:
+        """The minimal velocities: the partition (checked at q0) and its re-pivoting limit."""
+        self._check_rank(q0)
+        self.repivot = independent is None if repivot is None else _check_repivot(repivot)
+        self.independent, self.dependent = self._partition(q0, independent)
+        self.n_s = len(self.independent)
+        self.limit = max(REPIVOT_CONDITION, 10 * self.condition(q0))
+
     def constraint_matrix(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """(A_s, b_s) of A_s ṡ_tree = b_s: A_s = C K, b_s = c − C k."""
         C, c = self.velocity_constraints(q, t)
@@ -234,7 +245,8 @@ class ConstrainedSystem(Model):
         if redundant:
             raise ValueError(
                 f"phi: the constraint rows are rank-deficient at q0 (rank {len(kept)} of {self.n_c}): rows "
-                f"{redundant} depend on rows {kept} (rows count Φ first, then A); remove the redundant ones"
+                f"{redundant} depend on rows {kept} (rows count Φ first, then A); remove the redundant ones, or use TangentSystem "
+                "(projeq.constraints.tangent), which takes redundant constraints as they are"
             )
 
     def _partition(self, q0, independent) -> tuple[NDArray, NDArray]:
@@ -243,14 +255,8 @@ class ConstrainedSystem(Model):
         if independent is None:
             dependent = _pivoted_dependent(A_s, self.n_c)
         else:
-            chosen = np.asarray(independent)
-            integers = chosen.ndim == 1 and np.issubdtype(chosen.dtype, np.integer)
-            if not integers or len(chosen) != n_s - self.n_c or len(set(chosen.tolist())) != len(chosen) \
-                    or np.any((chosen < 0) | (chosen >= n_s)):
-                raise ValueError(
-                    f"independent: expected {n_s - self.n_c} distinct indices of ṡ_tree in 0..{n_s - 1} "
-                    f"(n_s = {n_s} minus {self.n_c} constraints), got {independent!r}"
-                )
+            why = f"n_s = {n_s} minus {self.n_c} constraints"
+            chosen = independent_indices(independent, n_s - self.n_c, n_s, why)
             dependent = np.setdiff1d(np.arange(n_s), chosen)
         free = np.setdiff1d(np.arange(n_s), dependent)
         self.independent, self.dependent = free, dependent
@@ -291,6 +297,8 @@ class ConstrainedSystem(Model):
         starts at (q, ṡ_new). Without ``repivot``: ValueError naming (q, t)."""
         if not self.repivot:
             raise self._degenerate(q, t, self.condition(q, t), self.limit)
+        if self._near_dependent(q, t):  # re-pivoting here would carry on along another branch, silently
+            raise self._singular_position(q, t)
         dependent = _pivoted_dependent(self.constraint_matrix(q, t)[0], self.n_c)
         new = self._in_partition(np.setdiff1d(np.arange(self.tree.n_s), dependent), q, t)
         new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
@@ -329,12 +337,43 @@ class ConstrainedSystem(Model):
             raise self._degenerate(q, t, cond, PARTITION_CONDITION)
 
     def _degenerate(self, q, t, cond, limit) -> ValueError:
+        where = f"q = {np.round(q, 6).tolist()}, t = {t:.6g}"
+        if not self.repivot:
+            return ValueError(
+                f"independent: the dependent velocities {self.dependent.tolist()} cannot be solved for at {where} "
+                f"(condition number of the partition {cond:.3g}, limit {limit:.3g}); choose other independent "
+                "velocities (default: pivoted QR picks them at q0), or pass repivot=True"
+            )
+        if self._near_dependent(q, t):
+            return self._singular_position(q, t)
         return ValueError(
             f"independent: the dependent velocities {self.dependent.tolist()} cannot be solved for at "
-            f"q = {np.round(q, 6).tolist()}, t = {t:.6g} (condition number of the partition {cond:.3g}, limit "
-            f"{limit:.3g}); choose other independent velocities (default: pivoted QR picks them at q0), "
-            "or pass repivot=True"
+            f"{where}, reached within one step before the partition could be re-chosen; pass a smaller "
+            "max_step to simulate, or use TangentSystem (projeq.constraints.tangent), which needs no partition"
         )
+
+    def _near_dependent(self, q, t) -> bool:
+        """Whether the constraint rows themselves are nearly dependent at (q, t): every partition's
+        κ ≥ cond(A_s), so none can be 10 times below the limit."""
+        sigma = np.linalg.svd(self.constraint_matrix(q, t)[0], compute_uv=False)
+        return not sigma[-1] * getattr(self, "limit", REPIVOT_CONDITION) > 10 * sigma[0]
+
+    def _singular_position(self, q, t) -> ValueError:
+        return ValueError(
+            f"phi: the mechanism reaches a singular position at q = {np.round(q, 6).tolist()}, "
+            f"t = {t:.6g}: its {self.n_c} constraint equations become dependent there (links coming into "
+            "line, where the motion can branch), so that no choice of independent velocities carries the "
+            "motion through it; TangentSystem (projeq.constraints.tangent) does"
+        )
+
+    def rank(self, q: NDArray, t: float = 0.0) -> int:
+        """The numerical rank of A_s at (q, t): its singular values above RANK_TOLERANCE ‖A_s‖₂."""
+        return numerical_rank(self.constraint_matrix(q, t)[0])
+
+    def mobility(self, q: NDArray, t: float = 0.0) -> int:
+        """Degrees of freedom at (q, t): the tree's velocities minus :meth:`rank` (Grübler's count
+        n_s,tree − n_c when no constraint is redundant)."""
+        return self.tree.n_s - self.rank(q, t)
 
     def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:
         """(F, f) of ṡ_tree = F ṡ + f: F = [E; −A_dep⁻¹ A_ind], f = [0; A_dep⁻¹ b_s]
@@ -348,6 +387,12 @@ class ConstrainedSystem(Model):
             solved = np.linalg.solve(A_s[:, self.dependent], np.column_stack((A_s[:, self.independent], b_s)))
             F[self.dependent], f[self.dependent] = -solved[:, :-1], solved[:, -1]
         return F, f
+
+    def particular(self, A_s: NDArray, c: NDArray) -> NDArray:
+        """The solution x of A_s x = c with x[independent] = 0: [0; A_dep⁻¹ c]."""
+        x = np.zeros(self.tree.n_s, dtype=np.result_type(A_s, c))  # complex under the complex step
+        x[self.dependent] = np.linalg.solve(A_s[:, self.dependent], c)
+        return x
 
     def tree_velocities(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
         """ṡ_tree = F ṡ + f."""
@@ -371,7 +416,7 @@ class ConstrainedSystem(Model):
         """q̇ = K_tree (F ṡ + f) + k, minus β C_Φ⁺ Φ with Baumgarte's correction."""
         q_dot = self.tree.q_dot(q, self.tree_velocities(q, s_dot, t), t)
         if self.correction == "baumgarte" and self.m_h:
-            q_dot -= self.beta * np.linalg.lstsq(self.phi_q(q, t), self.phi(q, t), rcond=None)[0]
+            q_dot -= self.beta * np.linalg.lstsq(self.phi_q(q, t), self.phi(q, t), rcond=RANK_TOLERANCE)[0]
         return q_dot
 
     def normalized(self, q: NDArray, t: float = 0.0) -> NDArray:
@@ -381,14 +426,15 @@ class ConstrainedSystem(Model):
         return self.project(q, t) if self.correction == "projection" else q
 
     def project(self, q: NDArray, t: float = 0.0, max_iter: int = 20) -> NDArray:
-        """q moved onto Φ(q, t) = 0 by minimum-norm Gauss–Newton steps; ValueError if it fails."""
+        """q moved onto Φ(q, t) = 0 by minimum-norm Gauss–Newton steps (redundant rows: singular
+        values of ∂Φ/∂q below RANK_TOLERANCE σ_max dropped); ValueError if it fails."""
         q = np.array(q, dtype=float)
         tol = POSITION_TOLERANCE * max(1.0, np.abs(q).max())
         for _ in range(max_iter):
             residual = self.phi(q, t)
             if not residual.size or np.abs(residual).max() <= tol:
                 return q
-            q = self.tree.normalized(q - np.linalg.lstsq(self.phi_q(q, t), residual, rcond=None)[0])
+            q = self.tree.normalized(q - np.linalg.lstsq(self.phi_q(q, t), residual, rcond=RANK_TOLERANCE)[0])
         raise ValueError(
             f"q: cannot be projected onto the constraints Φ(q, t) = 0 (residual "
             f"{np.array2string(self.phi(q, t), precision=3)} after {max_iter} Gauss–Newton steps)"
@@ -450,7 +496,7 @@ class ConstrainedSystem(Model):
             b = -M @ self.tree.evaluator(method).accelerations(q, s_dot_tree, t)
         f_bar = np.zeros(self.tree.n_s, dtype=np.result_type(A_s, M, b))
         if self.n_c:
-            f_bar[self.dependent] = -np.linalg.solve(A_s[:, self.dependent], self.gamma(q, s_dot_tree, t, C))
+            f_bar = self.particular(A_s, -self.gamma(q, s_dot_tree, t, C))
         return A_s, F, f_bar, M, b
 
     def gauss_form(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
@@ -469,7 +515,9 @@ class ConstrainedSystem(Model):
         s_ddot = -solve_spd(M_min, b_min[:, None], "constrained mass matrix FᵀMF",
                             max(np.abs(np.diag(M_min)).max(initial=0.0), 1e-300))[:, 0]
         s_ddot_tree = F @ s_ddot + f_bar
-        lam = np.linalg.lstsq(A_s.T, M @ s_ddot_tree + b, rcond=None)[0] if self.n_c else np.zeros(0)
+        lam = np.zeros(0)
+        if self.n_c:  # the minimum-norm λ where rows are redundant
+            lam = np.linalg.lstsq(A_s.T, M @ s_ddot_tree + b, rcond=RANK_TOLERANCE)[0]
         return s_ddot_tree, lam
 
     def evaluator(self, method: str | None = None) -> "PartitionedEvaluator":
@@ -514,6 +562,25 @@ def _partition_condition(A_s: NDArray, dependent: NDArray) -> float:
         return 1.0
     sigma = np.linalg.svd(A_s[:, dependent], compute_uv=False)
     return float(np.linalg.norm(A_s, 2) / sigma[-1]) if sigma[-1] > 0 else np.inf
+
+
+def independent_indices(independent, count: int, n_tree: int, why: str) -> NDArray:
+    """``independent`` as sorted indices of ṡ_tree: ``count`` distinct integers in 0..n_tree − 1
+    (ValueError naming the parameter and ``why`` that many otherwise)."""
+    chosen = np.asarray(independent)
+    if chosen.ndim != 1 or not np.issubdtype(chosen.dtype, np.integer) or len(chosen) != count \
+            or len(set(chosen.tolist())) != count or np.any((chosen < 0) | (chosen >= n_tree)):
+        raise ValueError(f"independent: expected {count} distinct indices of ṡ_tree in 0..{n_tree - 1} "
+                         f"({why}), got {independent!r}")
+    return np.sort(chosen)
+
+
+def numerical_rank(A: NDArray) -> int:
+    """The number of singular values of A above RANK_TOLERANCE times the largest (0 for no rows)."""
+    if not A.size:
+        return 0
+    sigma = np.linalg.svd(A, compute_uv=False)
+    return int(np.count_nonzero(sigma > RANK_TOLERANCE * sigma[0]))
 
 
 def _pivoted_dependent(A_s: NDArray, n_c: int) -> NDArray:

@@ -19,6 +19,7 @@ from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
 from projeq.scenes.bicycle import fallen_over, whipple_bicycle, whipple_eigenvalues
 from projeq.scenes.elastic import elastic_arm, spin_up_beam, spinning_beam
+from projeq.scenes.iftomm import bricard, n_four_bar, simple_pendulum
 from projeq.scenes.mechanisms import bar_on_wall, four_bar, quick_return, slider_pendulum, sphere_on_sphere
 from projeq.scenes.parameters import Parameter, check_names, closest, parse_settings, scene_parameters
 from projeq.scenes.nonholonomic import (
@@ -126,6 +127,12 @@ SCENES = {
                              plane=(0, 1), events=(fallen_over,)),
     "quick_return": Scene(quick_return, "Barhorst's quick-return mechanism, a closed loop (seed 000, 3.3)", 5.0),
     "four_bar": Scene(four_bar, "a four-bar linkage closed by a constraint equation", 5.0),
+    "simple_pendulum": Scene(simple_pendulum, "IFToMM benchmark A01: a pendulum in natural coordinates",
+                             10.0),
+    "n_four_bar": Scene(n_four_bar, "IFToMM benchmark A02: n four-bars in a row, through singular positions",
+                        20.0),
+    "bricard": Scene(bricard, "IFToMM benchmark A04: Bricard's overconstrained mechanism (a redundant row)",
+                     10.0),
 }
 DEFAULT_SCENE = "spin_up_beam"
 
@@ -188,5 +195,6 @@ __all__ = [
     "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed", "rolling_disk_inertia",
     "barhorst_particle", "nonholonomic_particle", "whipple_bicycle", "whipple_eigenvalues",
     "quick_return", "four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",
+    "simple_pendulum", "n_four_bar", "bricard",
     "Scene", "SCENES", "DEFAULT_SCENE", "get_scene", "resolve_scene", "build_scene", "scene_parameters", "parse_settings", "Parameter",
 ]

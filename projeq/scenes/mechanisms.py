@@ -14,7 +14,7 @@ from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody
 from projeq.system import System
 
 
-def _rod(m: float, L: float) -> PlanarBody:
+def slender_rod(m: float, L: float) -> PlanarBody:
     """A uniform slender rod of mass m and length L along the body x-axis from its joint,
     moving in the x–y plane (centroidal moment m L²/12)."""
     return PlanarBody(m, (L / 2, 0.0, 0.0), m * L * L / 12, plane="xy")
@@ -36,7 +36,7 @@ def quick_return(A: float = 1.0, H: float = 1.0 / 3.0, m_a: float = 0.5, m_b: fl
     """
     B = A + 1.5 * H
     tree = System(
-        {"crank": _rod(m_a, H), "follower": _rod(m_b, B), "slider": Frame()},
+        {"crank": slender_rod(m_a, H), "follower": slender_rod(m_b, B), "slider": Frame()},
         {"crank": Revolute(axis="z"), "follower": Revolute(axis="z", r_pn=(A, 0.0, 0.0)),
          "slider": Prismatic(parent="follower", axis="x")},
         gravity=(0.0, -g, 0.0),
@@ -75,7 +75,7 @@ def four_bar(a: float = 0.3, b: float = 1.0, c: float = 0.8, d: float = 1.0, m=(
     rate q̇3, which degenerates at the rocker's extreme positions).
     """
     tree = System(
-        {"crank": _rod(m[0], a), "rocker": _rod(m[2], c), "coupler": _rod(m[1], b)},
+        {"crank": slender_rod(m[0], a), "rocker": slender_rod(m[2], c), "coupler": slender_rod(m[1], b)},
         {"crank": Revolute(axis="z"), "rocker": Revolute(axis="z", r_pn=(d, 0.0, 0.0)),
          "coupler": Revolute(parent="crank", axis="z", r_pn=(a, 0.0, 0.0))},
         gravity=(0.0, -g, 0.0),

@@ -1,0 +1,170 @@
+"""Closed loops through singular positions and with redundant constraints: minimal velocities
+in the tangent space of the constraints, by a rank-revealing factorisation (docs/theory.md, the
+table of formulations).
+
+Coordinate partitioning (:mod:`.partitioned`) writes ṡ_tree = F ṡ + f with F = [E; −A_dep⁻¹ A_ind]:
+it needs the block A_dep of the constraint matrix A_s regular. That block cannot be regular where
+the constraints become dependent — a mechanism whose links come into line (the N-four-bar of the
+IFToMM benchmark A02 with its bars horizontal, where its mobility jumps from 1 to N + 1) — nor
+anywhere for an overconstrained mechanism (Bricard's, Grübler count 0, mobility 1). Yet the
+motion's tangent is regular there: F is the null space of A_s scaled to the independent velocities.
+:class:`TangentSystem` takes it from the singular value decomposition A_s = U Σ Vᵀ at every
+evaluation:
+
+    N = the columns of V of the n_s smallest singular values,   F = N N_ind⁻¹,
+
+with n_s = n_s,tree − rank A_s at q0 (the mobility, redundant rows counted out) and the
+independent velocities those whose rows N_ind are best conditioned (column-pivoted QR of Nᵀ).
+Particular solutions come from the pseudo-inverse A_s⁺ (singular values below RANK_TOLERANCE σ_max
+dropped): f = f₀ − F f₀[independent] with f₀ = A_s⁺ b_s, and likewise f̄ from A_s s̈_tree = −γ, so
+that the Projection Equation Fᵀ (M (F s̈ + f̄) + b) = 0 is that of :mod:`.partitioned`, and the
+multipliers λ of M s̈_tree + b = A_sᵀ λ are the minimum-norm solution (least squares): a redundant
+row's share of a constraint force is not determined by rigid bodies, and the minimum-norm λ gives
+none of it to the combination of rows that cancels.
+
+Near a singular position the null space of A_s is separated from the vanishing singular values by
+their size (∝ the distance from the singular position), so that F, and with it the motion's branch,
+stays continuous through it: the velocity never leaves the mechanism's one-dimensional tangent
+(the branch is kept by construction; an acceleration-level formulation has to hold it by its
+stabilisation). Known limitation: the explicit integrators evaluate stages off the manifold (by
+the step's curvature error, ~1e-4..1e-3 at rtol 1e-9); within that distance of a singular position
+the null vector is not separated from the directions that come free, and a stage can take the wrong
+one: the double four-bar of IFToMM A02 passes its first singular positions to 2e-7, but runs to
+10 s leave the parallelogram motion at a later crossing (a continuation of the branch from the
+previous step, or an index-3 formulation, is the remedy still to be built). On the constraint manifold the rank of A_s can only drop below its value at a
+regular q0 (at singular positions), never rise, so the n_s directions always exist (q0 must be a
+regular configuration: its rank fixes n_s). Where the independent velocities stop describing the
+motion (a crank at a dead centre, N_ind singular) the independent set is re-chosen as in :mod:`.partitioned`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import NDArray
+
+from projeq.constraints.partitioned import (
+    RANK_TOLERANCE, REPIVOT_CONDITION, ConstrainedSystem, independent_indices, numerical_rank,
+)
+
+
+# singular values of A_s below this fraction of the largest do not act in the particular solutions:
+# the errors of the differences (~1e-11) divided by σ stay below ~1e-5 (m/s² per m/s²)
+ACTING = 1e-6
+
+
+class TangentSystem(ConstrainedSystem):
+    """A tree System with constraint equations in minimal velocities whose matrix F spans the
+    null space of the constraints (module docstring): runs through singular positions and takes
+    redundant constraints as they are.
+
+    The arguments are those of :class:`~projeq.constraints.partitioned.ConstrainedSystem`; its
+    n_s is the mobility at q0 (tree velocities minus the rank of the constraints there), and
+    ``independent`` (default: column-pivoted QR of the null space) names n_s tree velocities.
+
+    Examples
+    --------
+    A pendulum on x and z sliders, its constraint written twice (a redundant row):
+
+    >>> import numpy as np, projeq as pq
+    >>> tree = pq.System({"x": pq.Frame(), "bob": pq.PointMass(1.0)},
+    ...     {"x": pq.Prismatic(axis="x"), "bob": pq.Prismatic(parent="x", axis="z")},
+    ...     gravity=(0, 0, -9.81))
+    >>> circle = lambda q, t: [np.hypot(q[0], q[1]) - 1.0, 2 * (np.hypot(q[0], q[1]) - 1.0)]
+    >>> pendulum = TangentSystem(tree, phi=circle, q0=[0.6, -0.8])
+    >>> pendulum.n_c, pendulum.rank(pendulum.q0), pendulum.n_s
+    (2, 1, 1)
+    >>> r = pq.simulate(pendulum, 0.2, n_points=5, n_segments=2)
+    >>> bool(np.abs(r.constraint_residual).max() < 1e-10)
+    True
+    """
+
+    def _choose_velocities(self, q0, independent, repivot) -> None:
+        A_s = self.constraint_matrix(q0)[0]
+        self.n_s = self.tree.n_s - numerical_rank(A_s)
+        if independent is None:
+            chosen = _pivoted_independent(self._null_space(A_s), self.n_s)
+        else:
+            chosen = independent_indices(independent, self.n_s, self.tree.n_s, "the mobility at q0")
+        self.independent, self.dependent = chosen, np.setdiff1d(np.arange(self.tree.n_s), chosen)
+        self.repivot = independent is None if repivot is None else bool(repivot)
+        self.check_configuration(q0, 0.0)
+        self.limit = max(REPIVOT_CONDITION, 10 * self.condition(q0))
+
+    def velocity_constraints(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
+        """(C, c) of ConstrainedSystem, kept for the latest (q, t): the integrator asks for q̇ and
+        s̈ at the same state, and both need them."""
+        key = (np.asarray(q, dtype=float).tobytes(), float(t))
+        if getattr(self, "_latest", (None,))[0] != key:
+            self._latest = (key, super().velocity_constraints(q, t))
+        return self._latest[1]
+
+    def _null_space(self, A_s: NDArray) -> NDArray:
+        """N (n_s,tree × n_s): the right singular vectors of A_s of its n_s smallest singular values."""
+        if not A_s.size:
+            return np.eye(self.tree.n_s)
+        return np.linalg.svd(A_s)[2][self.tree.n_s - self.n_s:].conj().T  # Vᴴ's rows: conj, so complex-step safe
+
+    def _scaled(self, N: NDArray) -> NDArray:
+        """F = N N_ind⁻¹ (F[independent] = E)."""
+        F = np.linalg.solve(N[self.independent].T, N.T).T
+        F[self.independent] = np.eye(self.n_s)
+        return F
+
+    def condition(self, q: NDArray, t: float = 0.0) -> float:
+        """κ = 1/σ_min(N_ind) ≥ 1, ‖F‖₂ ≤ κ: how badly the independent velocities describe the motion."""
+        sigma = np.linalg.svd(self._null_space(self.constraint_matrix(q, t)[0])[self.independent],
+                              compute_uv=False)
+        return float(1.0 / sigma[-1]) if sigma[-1] > 0 else np.inf
+
+    def check_configuration(self, q: NDArray, t: float = 0.0) -> None:
+        """ValueError if the independent velocities cannot describe the motion at q (N_ind singular)."""
+        if not self.condition(q, t) < 1e8:
+            raise ValueError(
+                f"independent: the velocities {self.independent.tolist()} cannot describe the motion at "
+                f"q = {np.round(q, 6).tolist()}, t = {t:.6g} (they stand still while the mechanism moves); "
+                "choose others (default: pivoted QR picks them at q0)"
+            )
+
+    def after_event(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple:
+        """Re-chosen independent velocities where N_ind degenerates (pivoted QR of N at q)."""
+        if not self.repivot:
+            self.check_configuration(q, t)
+        chosen = _pivoted_independent(self._null_space(self.constraint_matrix(q, t)[0]), self.n_s)
+        new = self._in_partition(chosen, q, t)
+        new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
+        return new, new.s_dot0.copy()
+
+    def with_independent(self, independent, repivot: bool | None = None) -> "TangentSystem":
+        """This system with the tree velocities ``independent`` as its minimal velocities."""
+        new = self._in_partition(np.sort(np.asarray(independent)), self.q0)
+        new.check_configuration(self.q0)
+        new.s_dot0 = self.tree_velocities(self.q0, self.s_dot0)[new.independent]
+        new.repivot = self.repivot if repivot is None else bool(repivot)
+        return new
+
+    def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:
+        """(F, f) of ṡ_tree = F ṡ + f: F = N N_ind⁻¹, f the particular solution of A_s f = b_s
+        with f[independent] = 0 (module docstring)."""
+        A_s, b_s = self.constraint_matrix(q, t) if constraint_matrix is None else constraint_matrix
+        return self._scaled(self._null_space(A_s)), self.particular(A_s, b_s)
+
+    def particular(self, A_s: NDArray, c: NDArray) -> NDArray:
+        """x₀ − F x₀[independent] with x₀ = A_s⁺ c, the pseudo-inverse over the largest
+        n_s,tree − n_s singular values (the rank at q0) above ACTING σ_max, F from the same
+        decomposition: A_s x = c with x[independent] = 0, where A_s x = c can hold."""
+        if not A_s.size:
+            return np.zeros(self.tree.n_s)
+        U, sigma, Vt = np.linalg.svd(A_s)
+        rank = self.tree.n_s - self.n_s
+        acting = min(rank, np.count_nonzero(sigma > ACTING * sigma[0]))
+        x0 = Vt[:acting].conj().T @ ((U[:, :acting].conj().T @ c) / sigma[:acting])
+        return x0 - self._scaled(Vt[rank:].conj().T) @ x0[self.independent]
+
+    def __repr__(self) -> str:
+        return f"TangentSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian)"
+
+
+def _pivoted_independent(N: NDArray, n_s: int) -> NDArray:
+    """The n_s tree velocities whose rows of the null space N pivoted QR of Nᵀ takes first (sorted)."""
+    return np.sort(scipy.linalg.qr(N.T, pivoting=True)[2][:n_s])
