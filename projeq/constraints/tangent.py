@@ -103,7 +103,7 @@ class TangentSystem(ConstrainedSystem):
         """N (n_s,tree × n_s): the right singular vectors of A_s of its n_s smallest singular values."""
         if not A_s.size:
             return np.eye(self.tree.n_s)
-        return np.linalg.svd(A_s)[2][self.tree.n_s - self.n_s:].conj().T  # Vᴴ's rows: conj, so complex-step safe
+        return np.linalg.svd(_real(A_s))[2][self.tree.n_s - self.n_s:].T
 
     def _scaled(self, N: NDArray) -> NDArray:
         """F = N N_ind⁻¹ (F[independent] = E)."""
@@ -155,14 +155,23 @@ class TangentSystem(ConstrainedSystem):
         decomposition: A_s x = c with x[independent] = 0, where A_s x = c can hold."""
         if not A_s.size:
             return np.zeros(self.tree.n_s)
-        U, sigma, Vt = np.linalg.svd(A_s)
+        U, sigma, Vt = np.linalg.svd(_real(A_s))
         rank = self.tree.n_s - self.n_s
         acting = min(rank, np.count_nonzero(sigma > ACTING * sigma[0]))
-        x0 = Vt[:acting].conj().T @ ((U[:, :acting].conj().T @ c) / sigma[:acting])
-        return x0 - self._scaled(Vt[rank:].conj().T) @ x0[self.independent]
+        x0 = Vt[:acting].T @ ((U[:, :acting].T @ c) / sigma[:acting])
+        return x0 - self._scaled(Vt[rank:].T) @ x0[self.independent]
 
     def __repr__(self) -> str:
         return f"TangentSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian)"
+
+
+def _real(A_s: NDArray) -> NDArray:
+    """A_s itself; a TypeError for complex A_s: the SVD is not complex-analytic (its rotations
+    conjugate), so the complex step through it would be silently wrong and the Jacobians of
+    :mod:`projeq.analysis.jacobians` fall back to differences (reported as such)."""
+    if np.iscomplexobj(A_s):
+        raise TypeError("TangentSystem: the SVD of A_s cannot be differentiated by the complex step")
+    return A_s
 
 
 def _pivoted_independent(N: NDArray, n_s: int) -> NDArray:
