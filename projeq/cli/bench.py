@@ -15,10 +15,10 @@ def bench_arguments(parser) -> None:
     parser.description = bench.__doc__
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
-    parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per chain length (default 0.5)")
+    parser.add_argument("--budget", type=_seconds, default=0.5, help="seconds of timing per chain length (default 0.5)")
     parser.add_argument("--sizes", type=_sizes, default=QUICK_SIZES, metavar="N,N,...",
                         help=f"chain lengths (default {','.join(map(str, QUICK_SIZES))})")
-    parser.add_argument("--total", type=float, default=TOTAL_BUDGET,
+    parser.add_argument("--total", type=_seconds, default=TOTAL_BUDGET,
                         help=f"wall-time budget in s for everything; the quick studies share what the chain part "
                              f"leaves and stop when it is spent (default {TOTAL_BUDGET:g})")
     parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
@@ -44,6 +44,17 @@ def run_benchmarks(args) -> int:
 
 def _show(text: str) -> None:
     print(text, flush=True)
+
+
+def _seconds(text: str) -> float:
+    """A positive, finite number of seconds; argparse names the option in its error (exit code 2)."""
+    try:
+        seconds = float(text)
+        if not 0.0 < seconds < float("inf"):
+            raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}") from None
+    return seconds
 
 
 def _sizes(text: str) -> tuple:

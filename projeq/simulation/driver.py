@@ -16,7 +16,10 @@ and :func:`_failure` the :class:`SimulationError`.
 
 from __future__ import annotations
 
+import inspect
+import os
 import time as _time
+import traceback
 from collections import deque
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
@@ -27,7 +30,7 @@ from numpy.typing import NDArray
 from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
 from projeq.assembly import EVALUATORS
-from projeq.checks import count, finite_array, positive, state_vector
+from projeq.checks import closest, count, finite_array, positive, state_vector
 from projeq.simulation.integrators import EXPLICIT, PROJECTED, projected_solver, warn_if_stiff
 from projeq.simulation.result import Result, SimulationError
 from projeq.system import Model, check_model
@@ -48,9 +51,35 @@ def _check_method(method) -> None:
     )
 
 
-def _event_wrapper(event, n_q):
+# the keyword options of scipy's own solvers (solve_ivp passes them on; unknown ones only warn)
+SOLVER_OPTIONS = {
+    "RK45": ("first_step", "max_step"), "RK23": ("first_step", "max_step"), "DOP853": ("first_step", "max_step"),
+    "Radau": ("first_step", "max_step", "jac", "jac_sparsity"), "BDF": ("first_step", "max_step", "jac", "jac_sparsity"),
+    "LSODA": ("first_step", "max_step", "min_step", "jac", "lband", "uband"),
+}
+
+
+def _check_options(method, options: dict) -> None:
+    """ValueError naming an option the integrator does not know (solve_ivp would ignore it)."""
+    if isinstance(method, str):
+        known = SOLVER_OPTIONS[PROJECTED[method].__name__ if method in PROJECTED else method]
+    else:
+        known = tuple(p for p in inspect.signature(method).parameters if p not in ("fun", "t0", "y0", "t_bound",
+                                                                                     "rtol", "atol", "vectorized"))
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        hint = "".join(closest(name, known) for name in unknown[:1])
+        raise ValueError(f"options: unknown option{'s' * (len(unknown) > 1)} {unknown} for method {method!r}{hint}; "
+                         f"it takes {list(known)} (simulate's own: t_start, t_eval, n_points, dense_output, "
+                         "evaluator, n_segments, progress)")
+
+
+def _event_wrapper(event, n_q, label):
     def wrapped(t, x):
-        return event(t, x[:n_q], x[n_q:])
+        value = event(t, x[:n_q], x[n_q:])
+        if not np.isfinite(value):
+            raise FloatingPointError(f"{label}: returned {value} at t = {t:.6g}; an event function must be finite")
+        return value
 
     for attr in ("terminal", "direction"):
         if hasattr(event, attr):
@@ -176,12 +205,15 @@ class _Run:
         if not t_end > t_start:
             raise ValueError(f"t_end: must be after t_start = {t_start}, got {t_end}")
         self.rtol, self.atol = positive("rtol", rtol), positive("atol", atol)
+        if self.rtol >= 1.0:
+            raise ValueError(f"rtol: a relative tolerance must be below 1 (1 allows 100 % error), got {rtol}")
         _check_method(method)
+        _check_options(method, options)
         self.t_eval = _output_times(t_start, t_end, t_eval, count("n_points", n_points, 2))
         self.bounds = np.linspace(t_start, t_end, count("n_segments", n_segments) + 1)
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable progress(t), got {progress!r}")
-        self.events = _checked_events(events)
+        self.events = _checked_events(events, t_start, q0, s_dot0)
         self.model = self.user_model = system
         self.choice, self.ev = evaluator, _evaluator(system, evaluator)
         system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
@@ -198,6 +230,9 @@ class _Run:
         self.reached = t
         n_q = self.model.n_q
         q, s_dot = x[:n_q], x[n_q:]
+        if not np.all(np.isfinite(x)):
+            raise FloatingPointError(f"the state is not finite at t = {t:.6g} (q = {q}, s_dot = {s_dot}): the "
+                                     "solution blew up (or a tolerance too loose let it)")
         x_dot = np.concatenate((self.model.q_dot(q, s_dot, t), self.ev.accelerations(q, s_dot, t)))
         if not np.all(np.isfinite(x_dot)):
             raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
@@ -209,7 +244,9 @@ class _Run:
         t_eval = self.t_eval
         inside = t_eval[(t_eval > a) & (t_eval <= b)] if self.pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
         n_q = self.model.n_q
-        events = [_event_wrapper(e, n_q) for e in self.events + list(self.model.events())]
+        labels = [f"events[{i}] ({_name(e)})" for i, e in enumerate(self.events)]
+        labels += [f"the model's event {_name(e)}" for e in self.model.events()]
+        events = [_event_wrapper(e, n_q, label) for e, label in zip(self.events + list(self.model.events()), labels)]
         segment = solve_ivp(self.rhs, (a, b), self.x, method=self.solver, t_eval=inside, rtol=self.rtol,
                             atol=self.atol, events=events or None, dense_output=True, **self.options)
         self.nfev += segment.nfev
@@ -265,14 +302,41 @@ class _Run:
         except (FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
             self.status, self.message, self.cause = -1, str(exc), exc
         except Exception as exc:  # noqa: BLE001 - a user's force law or event failed: keep the trajectory
-            self.status, self.message, self.cause = -1, f"{type(exc).__name__}: {exc}", exc
+            self.status, self.message, self.cause = -1, f"{type(exc).__name__} in {_raised_in(exc)}: {exc}", exc
 
 
-def _checked_events(events) -> list:
+def _raised_in(exc: BaseException) -> str:
+    """Where ``exc`` was raised: the innermost frame outside projeq, numpy and scipy (the
+    user's function), as 'name (file:line)'."""
+    frames = [f for f, _ in traceback.walk_tb(exc.__traceback__)]
+    mine = [f for f in frames if not any(part in f.f_code.co_filename for part in _LIBRARIES)] or frames[-1:]
+    code = mine[-1].f_code
+    return f"{getattr(code, 'co_qualname', code.co_name)} ({code.co_filename}:{mine[-1].f_lineno})"
+
+
+_LIBRARIES = (f"{os.sep}projeq{os.sep}", f"{os.sep}numpy{os.sep}", f"{os.sep}scipy{os.sep}", f"{os.sep}sympy{os.sep}")
+
+
+def _name(function) -> str:
+    return getattr(function, "__qualname__", type(function).__name__)
+
+
+def _checked_events(events, t, q, s_dot) -> list:
+    """The user's events, each called once at the initial state: a callable event(t, q, s_dot)
+    returning one finite number."""
     events = [] if events is None else (list(events) if isinstance(events, (list, tuple)) else [events])
     for i, e in enumerate(events):
         if not callable(e):
             raise ValueError(f"events[{i}]: expected a callable event(t, q, s_dot), got {e!r}")
+        try:
+            value = e(t, q.copy(), s_dot.copy())
+        except TypeError as exc:
+            raise ValueError(f"events[{i}] ({_name(e)}): calling it as event(t, q, s_dot) at t = {t} failed: {exc}") from exc
+        if np.ndim(value) != 0 or not np.isrealobj(value):
+            raise ValueError(f"events[{i}] ({_name(e)}): must return one real number, returned {value!r}")
+        if not np.isfinite(value):
+            raise ValueError(f"events[{i}] ({_name(e)}): returned {value} at the initial state t = {t}; "
+                             "an event function must be finite")
     return events
 
 

@@ -128,7 +128,7 @@ class RitzBeam(BeamProbes, Subsystem):
     ):
         self.length = L = positive("length", length)
         for name, n in (("n_v", n_v), ("n_w", n_w), ("n_u", n_u), ("n_beta", n_beta)):
-            if int(n) != n or n < 0:
+            if isinstance(n, bool) or not isinstance(n, (int, np.integer, float)) or int(n) != n or n < 0:
                 raise ValueError(f"{name}: number of Ritz functions must be a non-negative integer, got {n!r}")
         self.n_u, self.n_v, self.n_w, self.n_beta = int(n_u), int(n_v), int(n_w), int(n_beta)
         self.n_e = self.n_u + self.n_v + self.n_w + self.n_beta
