@@ -30,6 +30,9 @@ def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
     ``what`` when a pivot is below ``1e-13 · scale``.
     """
     k = D.shape[0]
+    if not np.all(np.isfinite(D)):
+        raise FloatingPointError(f"{_name(what)} is not finite ({D.ravel()[:4]}...): the state or the model's data "
+                                 "is NaN or overflowed, which no mass matrix explains")
     if k == 1:
         if D[0, 0] > SINGULAR_PIVOT * scale:
             return B / D[0, 0]
@@ -39,10 +42,20 @@ def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
     try:
         L = np.linalg.cholesky(D)
     except np.linalg.LinAlgError as exc:
-        raise SingularMassError(f"{_name(what)} is not positive definite: {exc}") from exc
+        raise SingularMassError(_massless(D, what)) from exc
     if np.diagonal(L).min() ** 2 <= SINGULAR_PIVOT * scale:
-        raise SingularMassError(f"{_name(what)} is singular (smallest pivot {np.diagonal(L).min() ** 2:.3g})")
+        raise SingularMassError(_massless(D, what))
     return np.linalg.solve(L.T, np.linalg.solve(L, B))
+
+
+def _massless(D: NDArray, what: str) -> str:
+    """The message for a singular or indefinite D: its smallest eigenvalue and the direction
+    of the minimal velocities that moves (almost) no mass or inertia."""
+    eigenvalues, vectors = np.linalg.eigh(D)
+    return (f"{_name(what)} is singular or indefinite (smallest eigenvalue {eigenvalues[0]:.3g} of "
+            f"{eigenvalues[-1]:.3g}): the motion along its minimal velocities {np.round(vectors[:, 0], 3).tolist()} "
+            "moves no mass or inertia (a joint axis along which the body has none, such as a rotation "
+            "about a beam's own axis without rotary inertia rho_I)")
 
 
 def _name(what: str) -> str:
