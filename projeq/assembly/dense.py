@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.assembly.linalg import mass_scale, solve_spd
+from projeq.assembly.linalg import mass_scale, solve_spd, warn_if_ill_conditioned
 from projeq.assembly.kinematics import forward, gauss_terms
 
 
@@ -51,6 +51,9 @@ class DenseEvaluator:
         return M, b
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """s̈ = −M⁻¹ b."""
+        """s̈ = −M⁻¹ b; the first call warns when M is too ill-conditioned for it (see
+        :func:`projeq.assembly.linalg.warn_if_ill_conditioned`)."""
         M, b = self.gauss_form(q, s_dot, t)
+        if self.n_calls == 1:
+            warn_if_ill_conditioned(M, "the dense evaluator's mass matrix M(q)")
         return -solve_spd(M, b[:, None], "system mass matrix M(q)", self.scale)[:, 0]

@@ -20,6 +20,7 @@ import inspect
 import os
 import time as _time
 import traceback
+import warnings
 from collections import deque
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
@@ -33,12 +34,14 @@ from projeq.assembly import EVALUATORS
 from projeq.checks import closest, count, finite_array, positive, state_vector
 from projeq.simulation.integrators import EXPLICIT, PROJECTED, projected_solver, warn_if_stiff
 from projeq.simulation.result import Result, SimulationError
+from projeq.constraints.nonholonomic import near_singularity
 from projeq.system import Model, check_model
 
-__all__ = ["INTEGRATORS", "Result", "SimulationError", "simulate"]
+__all__ = ["INTEGRATORS", "Result", "SimulationError", "ValidityWarning", "simulate"]
 
 
 INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # the methods of solve_ivp
+MONITOR_EVERY = 200  # right-hand sides between checks of the state's distance to a coordinate singularity
 
 
 def _check_method(method) -> None:
@@ -155,7 +158,7 @@ def simulate(
     """
     run = _Run(system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
                evaluator, n_segments, progress, options)
-    started, stiff_warned = _time.perf_counter(), False  # one StiffnessWarning per run at most
+    started, stiff_warned, checked = _time.perf_counter(), False, 0  # one StiffnessWarning per run at most
     with run.stopping():
         segments = deque(zip(run.bounds[:-1], run.bounds[1:]))  # a model event splits one
         while segments:
@@ -171,9 +174,14 @@ def simulate(
                 run.status, run.message = segment.status, segment.message
                 break
             else:
-                stiff_warned = stiff_warned or warn_if_stiff(run.rhs, segment, method, rtol)
+                run.steps += len(segment.sol.ts) - 1
+                if not stiff_warned and run.steps >= 2 * checked:  # ρ at most log₂(steps) times per run
+                    checked = run.steps
+                    stiff_warned = warn_if_stiff(run.rhs, run.steps, run.t_start, b, segment.sol(b), method, rtol)
                 run.end_segment(segment, b)
     result = _assemble(run, _time.perf_counter() - started, dense_output)
+    if not run.out_of_range and len(result.t) and result.q.shape[1] == system.tree.n_q:
+        warn_out_of_range(system.tree, result.q, result.t[-1])
     if run.status == -1:
         raise _failure(run, result) from run.cause
     return result
@@ -221,7 +229,8 @@ class _Run:
         self.method, self.progress, self.options = method, progress, options
         self.solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
-        self.pieces, self.nfev, self.cause = [], 0, None
+        self.pieces, self.nfev, self.cause, self.steps, self.calls = [], 0, None, 0, 0
+        self.out_of_range = False  # warned that a subsystem left the range of its model
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
 
@@ -233,6 +242,9 @@ class _Run:
         if not np.all(np.isfinite(x)):
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (q = {q}, s_dot = {s_dot}): the "
                                      "solution blew up (or a tolerance too loose let it)")
+        self.calls += 1
+        if self.calls % MONITOR_EVERY == 0:
+            near_singularity(self.model.tree, q, t)
         x_dot = np.concatenate((self.model.q_dot(q, s_dot, t), self.ev.accelerations(q, s_dot, t)))
         if not np.all(np.isfinite(x_dot)):
             raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
@@ -289,6 +301,8 @@ class _Run:
         self.x = segment.sol(b).copy()
         n_q = self.model.n_q
         self.x[:n_q] = self.model.normalized(self.x[:n_q])
+        near_singularity(self.model.tree, self.x[:n_q], b)
+        self.out_of_range = self.out_of_range or warn_out_of_range(self.model.tree, self.x[None, :n_q], b)
         if self.progress is not None:
             self.progress(b)
 
@@ -303,6 +317,22 @@ class _Run:
             self.status, self.message, self.cause = -1, str(exc), exc
         except Exception as exc:  # noqa: BLE001 - a user's force law or event failed: keep the trajectory
             self.status, self.message, self.cause = -1, f"{type(exc).__name__} in {_raised_in(exc)}: {exc}", exc
+
+
+class ValidityWarning(UserWarning):
+    """A run left the range its model describes (a beam beyond moderate deflections)."""
+
+
+def warn_out_of_range(tree, q_rows: NDArray, t: float) -> bool:
+    """Warn (:class:`ValidityWarning`) for each subsystem of ``tree`` whose internal
+    coordinates in the rows ``q_rows`` (up to time t) leave its model's range; True if one did."""
+    warned = False
+    for n, sub in enumerate(tree.subsystems):
+        problem = sub.out_of_range(q_rows[:, tree.e_q_slice[n]]) if sub.n_e else None
+        if problem:
+            warnings.warn(f"{tree.names[n]!r} by t = {t:.6g} s: {problem}", ValidityWarning, stacklevel=3)
+            warned = True
+    return warned
 
 
 def _raised_in(exc: BaseException) -> str:
