@@ -26,7 +26,7 @@ class DenseEvaluator:
         self.system = system
         self.P = [system.joint_s_columns(n) for n in range(len(system.joints))]
         self.scale = mass_scale(system)
-        self.n_calls = 0
+        self.n_calls, self.conditioned = 0, False
 
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
         """M(q) and b(q, ṡ, t) with M s̈ + b = 0."""
@@ -54,6 +54,7 @@ class DenseEvaluator:
         """s̈ = −M⁻¹ b; the first call warns when M is too ill-conditioned for it (see
         :func:`projeq.assembly.linalg.warn_if_ill_conditioned`)."""
         M, b = self.gauss_form(q, s_dot, t)
-        if self.n_calls == 1:
+        if not self.conditioned:  # once per evaluator
+            self.conditioned = True
             warn_if_ill_conditioned(M, "the dense evaluator's mass matrix M(q)")
         return -solve_spd(M, b[:, None], "system mass matrix M(q)", self.scale)[:, 0]

@@ -231,6 +231,14 @@ def test_usage_errors_exit_2_without_raising(capsys):
     assert "invalid choice: 'no-such-command'" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("option, value", [("--total", "-5"), ("--total", "0"), ("--budget", "nan"), ("--budget", "-1")])
+def test_bench_budgets_must_be_positive_seconds(option, value, capsys):
+    """Passes if a negative, zero or NaN time budget of projeq bench is a usage error (exit 2)
+    naming the option and the value, before anything is timed (issue 20: --total -5 ran)."""
+    assert main(["bench", option, value, "--chain-only", "--sizes", "2"]) == 2
+    assert f"argument {option}: expected a positive number of seconds, got '{value}'" in capsys.readouterr().err
+
+
 def test_sweep_writes_one_table(tmp_path, capsys):
     """projeq sweep: a 3-point grid of the Atwood machine, final angles = closed form."""
     argv = ["sweep", "atwood", "--grid", "m1=1:3:3", "--t-end", "0.5", "--rtol", "1e-10", "--outputs", "q0",
