@@ -117,3 +117,11 @@ def test_energy_drift_is_the_largest_change_over_the_energy_scale():
     result = Result(t=np.arange(3.0), q=np.zeros((3, 1)), s_dot=np.zeros((3, 1)), kinetic=np.array([1.0, 2.0, 0.0]),
                     potential=np.array([0.0, 1.0, 0.0]), constraint_residual=np.zeros((3, 0)))
     assert result.energy_drift == 1.0
+
+
+def test_fast_spin_up_warns_beyond_moderate_deflection():
+    """Passes if the spin-up to 6 rad/s in t_s = 2 s (issue 20: `projeq run spin_up_beam --set t_s=2
+    --t-end 3` ended with a 42 m tip deflection on the 10 m beam, exit 0) warns once the tip
+    passes 0.1 L, before t = 0.7 s, and names the beam and what to do."""
+    with pytest.warns(ValidityWarning, match=r"^'beam' by t = 0\.[56]\d* s: lateral deflection 0\.1\d* L.*more Ritz functions"):
+        pq.simulate(pq.scenes.spin_up_beam(t_s=2.0), 0.7, method="DOP853", rtol=1e-9)
