@@ -62,13 +62,16 @@ SOLVER_OPTIONS = {
 }
 
 
+_SOLVE_IVP_OWN = ("fun", "t0", "y0", "t_bound", "rtol", "atol", "vectorized")  # set by solve_ivp itself
+
+
 def _check_options(method, options: dict) -> None:
     """ValueError naming an option the integrator does not know (solve_ivp would ignore it)."""
     if isinstance(method, str):
         known = SOLVER_OPTIONS[PROJECTED[method].__name__ if method in PROJECTED else method]
     else:
-        known = tuple(p for p in inspect.signature(method).parameters if p not in ("fun", "t0", "y0", "t_bound",
-                                                                                     "rtol", "atol", "vectorized"))
+        parameters = inspect.signature(method).parameters.values()
+        known = tuple(p.name for p in parameters if p.kind is not p.VAR_KEYWORD and p.name not in _SOLVE_IVP_OWN)
     unknown = sorted(set(options) - set(known))
     if unknown:
         hint = "".join(closest(name, known) for name in unknown[:1])
@@ -144,7 +147,9 @@ def simulate(
     progress : callable ``progress(t)``, optional
         Called after each segment with the time reached.
     **options
-        Further options for the integrator (max_step, first_step, ...).
+        Further options for the integrator (max_step, first_step; jac for Radau, BDF, LSODA;
+        see ``SOLVER_OPTIONS``): an option the method does not take is a ValueError naming the
+        valid ones (solve_ivp would ignore it).
 
     Returns
     -------
@@ -154,7 +159,12 @@ def simulate(
         the time reached; Ctrl-C returns the partial trajectory with ``status = 2``. Bad
         arguments raise ``ValueError`` naming the argument before the run starts, and a
         model that cannot be evaluated at the initial state raises its own error there
-        (:class:`projeq.SingularMassError`, a force law's ``ValueError``).
+        (:class:`projeq.SingularMassError`, a force law's ``ValueError``). During the run a
+        NaN from a user function, an exception in one (named with its file and line) or a
+        state approaching a coordinate singularity (K or F with condition number above 1e5,
+        checked every ``MONITOR_EVERY`` right-hand sides) is such a failure; a subsystem
+        leaving the range its model describes (a beam beyond moderate deflections) gets a
+        :class:`ValidityWarning`.
     """
     run = _Run(system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
                evaluator, n_segments, progress, options)
