@@ -558,3 +558,11 @@ def test_bad_input_is_refused_by_name(tmp_path, call, error, words):
     parameter, the value and what is expected (issue 20: 11 silently accepted, 34 unclear)."""
     with pytest.raises(error, match=words):
         call(tmp_path)
+
+
+def test_sweep_output_out_of_range_is_named_per_point():
+    """Passes if an output q<i> beyond a point's coordinates fails that point with a message
+    naming the output and the valid range (chain(n) has n coordinates: q2 exists for n = 3 only)."""
+    table = pq.sweep("chain", grid={"n": [2, 3]}, outputs=["q2"], t_end=0.01, progress=False, workers=1)
+    assert table["status"].tolist() == [-1, 0]
+    assert table["error"][0] == "ValueError: outputs: 'q2' asks for q[2], but this point's model has 2 (q0 … q1)"

@@ -76,7 +76,11 @@ def output_value(result, name: str) -> float:
     column = _column(name)
     if column is None:
         return float(BUILTIN_OUTPUTS[name](result))
-    return float(getattr(result, column[0])[-1, column[1]])
+    values = getattr(result, column[0])
+    if column[1] >= values.shape[1]:
+        raise ValueError(f"outputs: {name!r} asks for {column[0]}[{column[1]}], but this point's model has "
+                         f"{values.shape[1]} ({column[0]}0 … {column[0]}{values.shape[1] - 1})")
+    return float(values[-1, column[1]])
 
 
 INTERRUPT_GRACE = 10.0  # s to wait, after Ctrl-C, for the running points to return their partial results
