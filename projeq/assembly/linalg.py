@@ -60,6 +60,8 @@ def warn_if_ill_conditioned(M: NDArray, what: str) -> None:
     :data:`ACCURACY` relative accuracy: the bound ε κ(M) of a backward-stable solve (Golub &
     Van Loan, *Matrix Computations*, 4th ed., 2013, §3.5). The Gauss form of a long chain has
     κ(M) growing like n⁴ (chain(500): 2.4e11), the recursive pass factors 6×6 blocks only."""
+    if not M.size:  # no minimal velocities: nothing to solve
+        return
     bound = np.finfo(float).eps * np.linalg.cond(M)
     if bound > ACCURACY:
         warnings.warn(f"{what} ({M.shape[0]}×{M.shape[0]}) has condition number {bound / np.finfo(float).eps:.3g}: "
