@@ -6,8 +6,16 @@ what is wrong, so that bad input never reaches the numeric kernels.
 
 from __future__ import annotations
 
+import difflib
+
 import numpy as np
 from numpy.typing import NDArray
+
+
+def closest(name: str, known) -> str:
+    """`` (did you mean 'x'?)`` for the closest known name, or an empty string."""
+    match = difflib.get_close_matches(name, list(known), n=1)
+    return f" (did you mean {match[0]!r}?)" if match else ""
 
 
 def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
@@ -22,6 +30,16 @@ def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
         bad = np.flatnonzero(~np.isfinite(a.ravel()))
         raise ValueError(f"{name}: non-finite entries (NaN or inf) at flat index {bad.tolist()}")
     return a
+
+
+def check_rotation(name: str, A, where: str = "", tol: float = 1e-9) -> NDArray:
+    """A proper rotation matrix: AᵀA = I to ``tol`` and det A = +1."""
+    A = finite_array(name, A, (3, 3))
+    error = np.abs(A.T @ A - np.eye(3)).max()
+    if error > tol or np.linalg.det(A) < 0.0:
+        raise ValueError(f"{name}: is not a rotation matrix {where} (|AᵀA − I| = {error:.3g}, det A = "
+                         f"{np.linalg.det(A):.3g}); it must be orthonormal with det A = +1")
+    return A
 
 
 def positive(name: str, value) -> float:

@@ -229,7 +229,11 @@ class JointSpring(JointForce):
         if joint.n_q != joint.n_s or not np.allclose(joint.K(joint.default_q(), 0.0), np.eye(joint.n_q)):
             raise ValueError(f"joint: JointSpring needs q̇ = ṡ, which joint {self.joint!r} does not have")
         self.n_s = joint.n_s
-        self._q_ref = finite_array("q_ref", np.broadcast_to(self.q_ref, (self.n_s,)), (self.n_s,))
+        q_ref = finite_array("q_ref", self.q_ref)
+        if q_ref.ndim > 1 or q_ref.size not in (1, self.n_s):
+            raise ValueError(f"q_ref: joint {self.joint!r} has {self.n_s} coordinate(s); give one number or "
+                             f"{self.n_s}, got shape {q_ref.shape}")
+        self._q_ref = np.broadcast_to(q_ref.ravel(), (self.n_s,)).copy()
         self._q = system.joint_q_getter(n)
         self._s = system.joint_s_dot_getter(n)
         return self

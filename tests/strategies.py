@@ -251,8 +251,9 @@ def planar_joint(kind: str, parent, rng) -> pq.Joint:
 
 
 # -- forces --------------------------------------------------------------------------------
-def _force(kind, names, kinds, rng, planar: bool, damped: bool):
-    """A random force law of ``kind`` (None when the tree has no joint it can act on)."""
+def _force(kind, names, kinds, rng, planar: bool, damped: bool, constant: bool = False):
+    """A random force law of ``kind`` (None when the tree has no joint it can act on); loads
+    given as callables half of the time unless ``constant``."""
     body = names[rng.integers(len(names))]
     point = rng.uniform(-0.5, 0.5, 3)
     if planar:
@@ -261,7 +262,7 @@ def _force(kind, names, kinds, rng, planar: bool, damped: bool):
         f0 = rng.uniform(-5, 5, 3)
         if planar:
             f0[2] = 0.0
-        if rng.random() < 0.5:
+        if constant or rng.random() < 0.5:
             return pq.Force(body, f0, point, frame="world" if planar or rng.random() < 0.5 else "body")
         # a load that depends on time and state (s_dot in it makes it non-conservative)
         return pq.Force(
@@ -291,7 +292,7 @@ def _force(kind, names, kinds, rng, planar: bool, damped: bool):
             kinds[names.index(joint)], 1
         )
         tau = rng.uniform(-3, 3, n_s)
-        if rng.random() < 0.5:
+        if constant or rng.random() < 0.5:
             return pq.JointForce(joint, tau)
         return pq.JointForce(joint, lambda t, q, s_dot: tau * np.sin(2 * t))
     if kind == "spring_damper":
@@ -356,7 +357,8 @@ def trees(
     ``kinds``: the joint kinds to draw from (default: all of ``SPATIAL_KINDS`` or
     ``PLANAR_KINDS``); ``scleronomic=True`` leaves out the rheonomic ones.
     ``forces``: ``True`` (any force laws, damped or not), ``"conservative"`` (undamped
-    joint springs and spring-dampers only: T + V is conserved), or ``False`` (gravity only).
+    joint springs and spring-dampers only: T + V is conserved), ``"constant"`` (any, with
+    constant loads only: what the symbolic Gauss form takes), or ``False`` (gravity only).
     """
     pool = kinds or (PLANAR_KINDS if planar else SPATIAL_KINDS)
     if scleronomic:
@@ -389,7 +391,8 @@ def trees(
         else:
             subsystems[name] = pq.RigidBody(m, r_c, random_inertia(rng, m))
             joints[name] = spatial_joint(joint_kinds[i], parent, rng)
-    laws = [_force(k, names, joint_kinds, rng, planar, damped=forces is True) for k in force_kinds]
+    laws = [_force(k, names, joint_kinds, rng, planar, damped=forces in (True, "constant"),
+                   constant=forces == "constant") for k in force_kinds]
     gravity = rng.uniform(-10, 10, 3)
     if planar:
         gravity[2] = 0.0

@@ -439,3 +439,130 @@ def test_unknown_evaluator(method):
         ValueError, match=r"^method: unknown evaluator .*; use one of \['auto', 'dense', 'fast', 'hub_beam', 'recursive'\]"
     ):
         _pendulum().accelerations([0.0], [0.0], method=method)
+
+
+# -- issue 20: the silently accepted and the unclear, one table -------------------------------
+# Each row: (id, the call, the exception, the words its message must contain, in order).
+
+
+def _prescribed(motion):
+    """A hub turned by ``motion`` carrying a pendulum."""
+    hub = pq.Prescribed(pq.Revolute(axis="z"), motion)
+    return pq.System({"hub": pq.RigidBody(**ROD), "bob": pq.RigidBody(**ROD)},
+                     {"hub": hub, "bob": pq.Revolute("hub", "y")}, gravity=(0, 0, -9.81))
+
+
+def _run(system, **kwargs):
+    return pq.simulate(system, 1.0, n_points=11, **kwargs)
+
+
+def motor_torque(t, q, s_dot):
+    """A user force law that fails after 0.1 s."""
+    if t > 0.1:
+        raise RuntimeError("the motor model broke")
+    return np.zeros(1)
+
+
+def _shifted_derivative_family(n, L):
+    """Clamped polynomials whose Φ′ is 3 times too large: inconsistent with Φ."""
+    k = np.arange(2, n + 2)[:, None]
+
+    def shapes(x):
+        xi = np.asarray(x, dtype=float)[None, :] / L
+        return xi**k, 3 * k * xi ** (k - 1) / L, k * (k - 1) * xi ** (k - 2) / L**2
+
+    return shapes
+
+
+def _slider(**kwargs):
+    """A point mass on a slider along x, through a user joint from callables."""
+    return pq.UserJoint.from_functions(
+        1, 1, kwargs.pop("pose", lambda q, t: (np.eye(3), np.array([q[0], 0 * q[0], 0 * q[0]]))),
+        lambda q, t: np.array([[1.0], [0], [0], [0], [0], [0]]) + 0 * q[0], lambda q, t: np.eye(1), **kwargs)
+
+
+def _load(tmp_path, kind):
+    path = tmp_path / "run.npz"
+    if kind == "foreign":
+        np.savez(path, a=np.arange(3))
+    elif kind == "random":
+        path.write_bytes(np.random.default_rng(0).bytes(500))
+    else:
+        result = pq.simulate(_pendulum(), 0.1, n_points=5)
+        if kind == "inconsistent":
+            from dataclasses import replace
+
+            result = replace(result, q=result.q[:3])
+        result.save(path)
+        if kind == "truncated":
+            path.write_bytes(path.read_bytes()[:400])
+    return pq.Result.load(path)
+
+
+BAD_INPUT = [
+    ("simulate-misspelt-option", lambda tmp: _run(_pendulum(), max_stepp=0.1), ValueError,
+     r"options: unknown option \['max_stepp'\] .* \(did you mean 'max_step'\?\); it takes \['first_step', 'max_step'\]"),
+    ("simulate-rtol-above-1", lambda tmp: _run(_pendulum(), rtol=5.0), ValueError, r"^rtol: .* below 1"),
+    ("simulate-a-name", lambda tmp: pq.simulate("chain", 1.0), ValueError, r"^system: expected a System"),
+    ("prescribed-nan", lambda tmp: _run(_prescribed(lambda t: (np.nan, 0.0, 0.0))), ValueError,
+     r"^motion: the prescribed motion .*<lambda> returned .*nan.* at t = 0; they must be finite"),
+    ("prescribed-nan-later", lambda tmp: _run(_prescribed(lambda t: (t, 1.0, 0.0) if t < 0.5 else (np.nan, 1.0, 0.0))),
+     pq.SimulationError, r"failed at t = 0.5 s .*motion: the prescribed motion .* at t = 0.5"),
+    ("prescribed-scalar", lambda tmp: _prescribed(lambda t: 0.1 * t), ValueError,
+     r"^motion: .* must return three numbers \(θ, θ̇, θ̈\) at t = 0, got 0.0"),
+    ("prescribed-malformed-text", lambda tmp: _prescribed("sin(t"), ValueError, r"^motion: cannot read 'sin\(t'"),
+    ("event-signature", lambda tmp: _run(_pendulum(), events=lambda t, x: x[0]), ValueError,
+     r"^events\[0\] .*: calling it as event\(t, q, s_dot\) at t = 0.0 failed"),
+    ("event-nan", lambda tmp: _run(_pendulum(), events=lambda t, q, s_dot: np.nan), ValueError,
+     r"^events\[0\] .*: returned nan at the initial state"),
+    ("event-nan-later", lambda tmp: _run(_pendulum(), events=lambda t, q, s_dot: 1.0 if t < 0.5 else np.nan),
+     pq.SimulationError, r"events\[0\] .*: returned nan at t = 0.5"),
+    ("event-array", lambda tmp: _run(_pendulum(), events=lambda t, q, s_dot: q), ValueError,
+     r"^events\[0\] .*: must return one real number"),
+    ("force-law-raises", lambda tmp: _run(_pendulum(forces=[pq.JointForce("bob", motor_torque)])), pq.SimulationError,
+     r"failed at t = 0.1.* RuntimeError in motor_torque \(.*test_bad_input.py:\d+\): the motor model broke"),
+    ("constraints-raise", lambda tmp: _slider(constraints=lambda q, q_dot, t: 1 / 0, n_c=1), ValueError,
+     r"^constraints: .*<lambda> raised ZeroDivisionError"),
+    ("constraints-shape", lambda tmp: _slider(constraints=lambda q, q_dot, t: [0.0, 0.0], n_c=1), ValueError,
+     r"^constraints \(.*\) at t = 0: expected shape \(1,\)"),
+    ("user-joint-not-a-rotation", lambda tmp: _slider(pose=lambda q, t: (np.diag([2.0, 1, 1]), np.array([q[0], 0, 0]))),
+     ValueError, r"^pose A: is not a rotation matrix .*\|AᵀA − I\| = 3"),
+    ("beam-quadrature", lambda tmp: pq.RitzBeam(1.0, 1.0, 1.0, n_v=6, quadrature_order=2), ValueError,
+     r"^quadrature_order: 2 Gauss points .* degree 3 .* reach degree 14; give at least 8"),
+    ("beam-derivatives", lambda tmp: pq.RitzBeam(1.0, 1.0, 1.0, n_v=3, n_w=0, family=_shifted_derivative_family),
+     ValueError, r"^family: Φ′ of the Ritz functions \[0, 1, 2\] for v is not the derivative of Φ"),
+    ("beam-memory", lambda tmp: pq.RitzBeam(1.0, 1.0, 1.0, n_v=100_000), ValueError,
+     r"^n_v, n_w, n_u, n_beta: 100004 Ritz functions make each n_y × n_y matrix of the beam 74.5 GiB"),
+    ("beam-count-text", lambda tmp: pq.RitzBeam(1.0, 1.0, 1.0, n_v="four"), ValueError,
+     r"^n_v: number of Ritz functions must be a non-negative integer, got 'four'"),
+    ("beam-axis-moves-nothing", lambda tmp: _run(pq.System({"b": pq.RitzBeam(1.0, 1.0, 1.0, n_v=2, n_w=2)},
+                                                           {"b": pq.Revolute(axis="x")})),
+     pq.SingularMassError, r"joint 'b' is singular .* minimal velocities \[1.0, 0.0, 0.0, 0.0, 0.0\] moves no mass"),
+    ("nan-state-pivot", lambda tmp: pq.scenes.chain(3).evaluator("recursive").accelerations(
+        np.array([0.1, np.nan, 0.2]), np.zeros(3), 0.0), FloatingPointError, r"is not finite .* NaN or overflowed"),
+    ("eigenvalue-sweep-empty", lambda tmp: pq.eigenvalue_sweep(lambda v: _pendulum(), []), ValueError,
+     r"^values: the sweep is empty"),
+    ("joint-spring-q-ref", lambda tmp: _pendulum(forces=[pq.JointSpring("bob", 1.0, q_ref=[0.0, 1.0])]), ValueError,
+     r"^q_ref: joint 'bob' has 1 coordinate\(s\); give one number or 1, got shape \(2,\)"),
+    ("load-foreign", lambda tmp: _load(tmp, "foreign"), ValueError, r"^path: .* is not a projeq Result .* lacks \['meta'"),
+    ("load-random", lambda tmp: _load(tmp, "random"), ValueError, r"^path: .* is not a projeq Result"),
+    ("load-truncated", lambda tmp: _load(tmp, "truncated"), ValueError, r"^path: .* is a truncated or damaged archive"),
+    ("load-inconsistent", lambda tmp: _load(tmp, "inconsistent"), ValueError,
+     r"^path: .* is inconsistent: t has shape \(5,\) but \{'q': \(3, 1\)\}"),
+]
+
+
+@pytest.mark.parametrize("call, error, words", [row[1:] for row in BAD_INPUT], ids=[row[0] for row in BAD_INPUT])
+def test_bad_input_is_refused_by_name(tmp_path, call, error, words):
+    """Passes if each bad input of the table raises its exception with a message that names the
+    parameter, the value and what is expected (issue 20: 11 silently accepted, 34 unclear)."""
+    with pytest.raises(error, match=words):
+        call(tmp_path)
+
+
+def test_sweep_output_out_of_range_is_named_per_point():
+    """Passes if an output q<i> beyond a point's coordinates fails that point with a message
+    naming the output and the valid range (chain(n) has n coordinates: q2 exists for n = 3 only)."""
+    table = pq.sweep("chain", grid={"n": [2, 3]}, outputs=["q2"], t_end=0.01, progress=False, workers=1)
+    assert table["status"].tolist() == [-1, 0]
+    assert table["error"][0] == "ValueError: outputs: 'q2' asks for q[2], but this point's model has 2 (q0 … q1)"

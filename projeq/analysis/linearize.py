@@ -238,6 +238,9 @@ def eigenvalue_sweep(build, values, **options) -> NDArray:
         Row k: the eigenvalues at ``values[k]``, sorted by decreasing real part (rows are
         sorted independently; branches are not tracked).
     """
+    values = list(values)
+    if not values:
+        raise ValueError("values: the sweep is empty; give at least one parameter value")
     rows = []
     for value in values:
         built = build(value)

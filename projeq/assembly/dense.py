@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.assembly.linalg import mass_scale, solve_spd
+from projeq.assembly.linalg import mass_scale, solve_spd, warn_if_ill_conditioned
 from projeq.assembly.kinematics import forward, gauss_terms
 
 
@@ -26,7 +26,7 @@ class DenseEvaluator:
         self.system = system
         self.P = [system.joint_s_columns(n) for n in range(len(system.joints))]
         self.scale = mass_scale(system)
-        self.n_calls = 0
+        self.n_calls, self.conditioned = 0, False
 
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
         """M(q) and b(q, ṡ, t) with M s̈ + b = 0."""
@@ -52,6 +52,10 @@ class DenseEvaluator:
         return M, b
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """s̈ = −M⁻¹ b."""
+        """s̈ = −M⁻¹ b; the first call warns when M is too ill-conditioned for it (see
+        :func:`projeq.assembly.linalg.warn_if_ill_conditioned`)."""
         M, b = self.gauss_form(q, s_dot, t)
+        if not self.conditioned:  # once per evaluator
+            self.conditioned = True
+            warn_if_ill_conditioned(M, "the dense evaluator's mass matrix M(q)")
         return -solve_spd(M, b[:, None], "system mass matrix M(q)", self.scale)[:, 0]

@@ -144,6 +144,9 @@ class FastEvaluator:
             self._n_cols, self._parent, self._s_index, self._T, self._zeta, self._F,
             self._M_hat, self._h_hat, self._pivot_min, s_ddot,
         )
+        if failed >= 0 and not (np.all(np.isfinite(q)) and np.all(np.isfinite(s_dot))):
+            raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no pivot D_n "
+                                     "can be formed, which no mass matrix explains")
         if failed >= 0:
             raise SingularMassError(
                 f"D_n = F_nᵀ M̂_n F_n of joint {self.system.names[failed]!r} is singular: "

@@ -16,10 +16,10 @@ def bench_arguments(parser) -> None:
     parser.description = plain(bench.__doc__)
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
-    parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per chain length (default 0.5)")
+    parser.add_argument("--budget", type=_non_negative_seconds, default=0.5, help="seconds of timing per chain length (default 0.5)")
     parser.add_argument("--sizes", type=_sizes, default=QUICK_SIZES, metavar="N,N,...",
                         help=f"chain lengths (default {','.join(map(str, QUICK_SIZES))})")
-    parser.add_argument("--total", type=float, default=TOTAL_BUDGET,
+    parser.add_argument("--total", type=_seconds, default=TOTAL_BUDGET,
                         help=f"wall-time budget in s for everything; the quick studies share what the chain part "
                              f"leaves and stop when it is spent (default {TOTAL_BUDGET:g})")
     parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
@@ -45,6 +45,28 @@ def run_benchmarks(args) -> int:
 
 def _show(text: str) -> None:
     print(text, flush=True)
+
+
+def _seconds(text: str) -> float:
+    """A positive, finite number of seconds; argparse names the option in its error (exit code 2)."""
+    try:
+        seconds = _non_negative_seconds(text)
+        if seconds == 0.0:
+            raise argparse.ArgumentTypeError
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}") from None
+    return seconds
+
+
+def _non_negative_seconds(text: str) -> float:
+    """A finite number of seconds ≥ 0 (0: time each evaluator once)."""
+    try:
+        seconds = float(text)
+        if not 0.0 <= seconds < float("inf"):
+            raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds >= 0, got {text!r}") from None
+    return seconds
 
 
 def _sizes(text: str) -> tuple:

@@ -22,6 +22,9 @@ from projeq.checks import state_vector
 CONSTRAINT_TOLERANCE = 1e-8
 # condition number of K or F above which the configuration is treated as singular
 SINGULAR_CONDITION = 1e10
+# ... and above which a run is stopped as approaching a coordinate singularity: the minimal
+# velocities' gain from K or F reaches 1e5, so ṡ grows like 1/distance and steps shrink to nothing
+NEAR_SINGULAR_CONDITION = 1e5
 
 
 def _joint_rows(system, n):
@@ -58,6 +61,16 @@ def initial_speeds(system, q, q_dot, t: float = 0.0, tol: float = CONSTRAINT_TOL
             f"{np.array2string(mismatch, precision=4)}); they violate the constraints built into K"
         )
     return s_dot
+
+
+def near_singularity(system, q, t: float) -> None:
+    """During a run: ValueError when the state at t has come near a coordinate singularity
+    (a condition number of K or F above :data:`NEAR_SINGULAR_CONDITION`), naming the joint."""
+    try:
+        check_configuration(system, q, t, NEAR_SINGULAR_CONDITION)
+    except ValueError as exc:
+        raise ValueError(f"q: the run approaches a coordinate singularity at t = {t:.6g}, where the minimal "
+                         f"velocities grow without bound and the steps shrink to nothing: {exc}") from None
 
 
 def check_configuration(system, q, t: float = 0.0, max_condition: float = SINGULAR_CONDITION) -> None:

@@ -242,6 +242,12 @@ class ConstrainedSystem(Model):
         kept, redundant = [], []
         for i in range(self.n_c):  # a row is redundant if it lies in the span of the rows kept before it
             (kept if np.linalg.matrix_rank(A_s[kept + [i]], tol) > len(kept) else redundant).append(i)
+        if redundant and _full_rank_nearby(lambda q: self.constraint_matrix(q)[0], q0, self.n_c, tol):
+            raise ValueError(
+                f"q0: a singular pose of the constraints (rank {len(kept)} of {self.n_c} at q0 = "
+                f"{np.round(q0, 6).tolist()}, full rank nearby): rows {redundant} lose their direction here "
+                "(a dead-centre or aligned-links position); start the mechanism away from it"
+            )
         if redundant:
             raise ValueError(
                 f"phi: the constraint rows are rank-deficient at q0 (rank {len(kept)} of {self.n_c}): rows "
@@ -592,3 +598,11 @@ def _pivoted_dependent(A_s: NDArray, n_c: int) -> NDArray:
 def _pfaffian_residual(system: ConstrainedSystem, q_t, q_dot) -> NDArray:
     A, b = system._pfaffian(*q_t)
     return A @ q_dot - b
+
+
+def _full_rank_nearby(matrix, q0: NDArray, rank: int, tol: float) -> bool:
+    """Whether ``matrix(q)`` has ``rank`` at two points 1e-3 from q0 (q0 is then a singular
+    pose, not a set of redundant rows, which lose rank everywhere)."""
+    rng = np.random.default_rng(1)
+    return all(np.linalg.matrix_rank(matrix(q0 + 1e-3 * rng.standard_normal(len(q0))), tol) == rank
+               for _ in range(2))

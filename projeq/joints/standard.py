@@ -7,6 +7,8 @@ kinematics, its ``compiled_kind``; see :mod:`projeq.joints.base` for the contrac
 
 from __future__ import annotations
 
+import math
+
 from typing import Callable
 
 import numpy as np
@@ -218,9 +220,27 @@ class Prescribed(Joint):
         super().__init__(joint.parent, joint.r_pn, joint.orientation)
         self.joint = joint
         self.motion = motion if callable(motion) else _time_function(motion)
+        try:  # the callable's signature, shape and finiteness, checked once here
+            self.angles(0.0)
+        except TypeError as exc:
+            raise ValueError(f"motion: {_label(self.motion)} must be callable as motion(t): {exc}") from exc
+
+    def angles(self, t: float) -> tuple[float, float, float]:
+        """(θ, θ̇, θ̈) at t, checked: ValueError naming the motion and t when they are not three
+        finite numbers."""
+        values = self.motion(t)
+        try:
+            theta, theta_dot, theta_ddot = (float(v) for v in values)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"motion: {_label(self.motion)} must return three numbers (θ, θ̇, θ̈) at t = {t:.6g}, "
+                             f"got {values!r}") from exc
+        if not (math.isfinite(theta) and math.isfinite(theta_dot) and math.isfinite(theta_ddot)):
+            raise ValueError(f"motion: {_label(self.motion)} returned (θ, θ̇, θ̈) = {(theta, theta_dot, theta_ddot)} "
+                             f"at t = {t:.6g}; they must be finite")
+        return theta, theta_dot, theta_ddot
 
     def relative(self, q_n, s_dot_n, t):
-        theta, theta_dot, theta_ddot = self.motion(t)
+        theta, theta_dot, theta_ddot = self.angles(t)
         inner = self.joint.relative(np.array([theta]), np.array([theta_dot]), t)
         zeta = inner.zeta + inner.F[:, 0] * theta_ddot
         return Relative(inner.A, inner.r, Fixed._F, inner.w, zeta)
@@ -232,9 +252,17 @@ class Prescribed(Joint):
                                 sp.zeros(0, 1))
 
 
+def _label(motion) -> str:
+    return f"the prescribed motion {getattr(motion, '__qualname__', type(motion).__name__)}"
+
+
 def _time_function(expr) -> Callable:
     t = sp.Symbol("t")
-    expr = sp.sympify(expr)
+    try:
+        expr = sp.sympify(expr)
+    except (sp.SympifyError, SyntaxError, TypeError) as exc:
+        raise ValueError(f"motion: cannot read {expr!r} as an expression in t (a sympy expression or "
+                         "a string such as '0.5*sin(2*t)'), or give a callable t -> (θ, θ̇, θ̈)") from exc
     extra = expr.free_symbols - {t}
     if extra:
         raise ValueError(f"motion: depends on {sorted(map(str, extra))}; only t is allowed")

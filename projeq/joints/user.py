@@ -77,7 +77,13 @@ class UserJoint(Joint):
     def constraint_residual(self, q_n, q_dot_n, t):
         if self._constraints is None:
             return np.zeros(0)
-        return np.asarray(self._constraints(q_n, q_dot_n, t), dtype=float).ravel()
+        try:
+            residual = self._constraints(q_n, q_dot_n, t)
+        except Exception as exc:  # noqa: BLE001 - the user's callable, reported by name
+            raise ValueError(f"constraints: {_qualname(self._constraints)} raised {type(exc).__name__}: {exc} "
+                             f"at t = {t:.6g}, q = {np.round(q_n, 6).tolist()}") from exc
+        return finite_array(f"constraints ({_qualname(self._constraints)}) at t = {t:.6g}",
+                            np.ravel(residual), (self.n_c,))
 
     @classmethod
     def from_sympy(
@@ -149,3 +155,7 @@ class UserJoint(Joint):
             cls, n_q, n_s, pose, F, K, f=f, k=k, parent=parent, q0=q0, r_pn=r_pn,
             orientation=orientation, constraints=constraints, n_c=n_c,
         )
+
+
+def _qualname(function) -> str:
+    return getattr(function, "__qualname__", type(function).__name__)

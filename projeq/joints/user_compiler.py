@@ -12,7 +12,7 @@ import numpy as np
 import sympy as sp
 
 from projeq.analysis.differentiation import derivative_along
-from projeq.checks import finite_array
+from projeq.checks import check_rotation, finite_array
 from projeq.joints import Relative, pose_twist_mismatch
 from projeq.spatial import numeric
 
@@ -134,6 +134,7 @@ def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, or
     joint = cls(parent, n_q, n_s, relative, K, q_dot, q0=q0, r_pn=r_pn, orientation=orientation,
                 constraints=constraints, n_c=n_c)
     _check_callables(joint, pose, F, f, k)
+    joint.constraint_residual(joint.default_q(), np.zeros(n_q), 0.0)  # ValueError naming constraints
     _check_shapes(joint)
     _check_pose(joint)
     return joint
@@ -197,6 +198,7 @@ def _check_pose(joint) -> None:
     rng = np.random.default_rng(0)
     for q_n in (joint.default_q(), joint.default_q() + 0.1 * rng.standard_normal(joint.n_q)):
         s_dot = rng.standard_normal(joint.n_s)
+        check_rotation("pose A", joint.relative(q_n, s_dot, 0.3).A, f"at q = {np.round(q_n, 4).tolist()}, t = 0.3")
         error = pose_twist_mismatch(joint, q_n, s_dot, 0.3)
         scale = 1.0 + np.abs(joint.relative(q_n, s_dot, 0.3).w).max()
         if not error <= _POSE_TOLERANCE * scale:

@@ -14,9 +14,10 @@ m1 = 2.0 kg
 from __future__ import annotations
 
 import ast
-import difflib
 import inspect
 from typing import NamedTuple
+
+from projeq.checks import closest
 
 #: SI unit of each parameter name used by the built-in scenes ("-": dimensionless or a count).
 UNITS = {
@@ -58,12 +59,6 @@ def scene_parameters(scene) -> list[Parameter]:
         for p in inspect.signature(scene.build).parameters.values()
         if p.default is not inspect.Parameter.empty
     ]
-
-
-def closest(name: str, known) -> str:
-    """`` (did you mean 'x'?)`` for the closest known name, or an empty string."""
-    match = difflib.get_close_matches(name, list(known), n=1)
-    return f" (did you mean {match[0]!r}?)" if match else ""
 
 
 def check_names(scene, overrides: dict) -> None:

@@ -16,7 +16,11 @@ and :func:`_failure` the :class:`SimulationError`.
 
 from __future__ import annotations
 
+import inspect
+import os
 import time as _time
+import traceback
+import warnings
 from collections import deque
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
@@ -28,16 +32,18 @@ from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
 from projeq.analysis.jacobians import differentiate, state_derivative
 from projeq.assembly import EVALUATORS
-from projeq.checks import count, finite_array, positive, state_vector
+from projeq.checks import closest, count, finite_array, positive, state_vector
 from projeq.simulation.integrators import EXPLICIT, PROJECTED, projected_solver, warn_if_stiff
 from projeq.simulation.result import Result, SimulationError
+from projeq.constraints.nonholonomic import near_singularity
 from projeq.system import Model, check_model
 
-__all__ = ["INTEGRATORS", "Result", "SimulationError", "simulate"]
+__all__ = ["INTEGRATORS", "Result", "SimulationError", "ValidityWarning", "simulate"]
 
 
 INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # the methods of solve_ivp
 IMPLICIT = ("Radau", "BDF", "LSODA")  # they solve with ∂ẋ/∂x: given exactly (jac="exact") unless told otherwise
+MONITOR_EVERY = 200  # right-hand sides between checks of the state's distance to a coordinate singularity
 
 
 def _check_method(method) -> None:
@@ -50,9 +56,38 @@ def _check_method(method) -> None:
     )
 
 
-def _event_wrapper(event, n_q):
+# the keyword options of scipy's own solvers (solve_ivp passes them on; unknown ones only warn)
+SOLVER_OPTIONS = {
+    "RK45": ("first_step", "max_step"), "RK23": ("first_step", "max_step"), "DOP853": ("first_step", "max_step"),
+    "Radau": ("first_step", "max_step", "jac_sparsity"), "BDF": ("first_step", "max_step", "jac_sparsity"),
+    "LSODA": ("first_step", "max_step", "min_step", "lband", "uband"),
+}
+
+
+_SOLVE_IVP_OWN = ("fun", "t0", "y0", "t_bound", "rtol", "atol", "vectorized")  # set by solve_ivp itself
+
+
+def _check_options(method, options: dict) -> None:
+    """ValueError naming an option the integrator does not know (solve_ivp would ignore it)."""
+    if isinstance(method, str):
+        known = SOLVER_OPTIONS[PROJECTED[method].__name__ if method in PROJECTED else method]
+    else:
+        parameters = inspect.signature(method).parameters.values()
+        known = tuple(p.name for p in parameters if p.kind is not p.VAR_KEYWORD and p.name not in _SOLVE_IVP_OWN)
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        hint = "".join(closest(name, known) for name in unknown[:1])
+        raise ValueError(f"options: unknown option{'s' * (len(unknown) > 1)} {unknown} for method {method!r}{hint}; "
+                         f"it takes {list(known)} (simulate's own: t_start, t_eval, n_points, dense_output, "
+                         "evaluator, n_segments, progress, jac)")
+
+
+def _event_wrapper(event, n_q, label):
     def wrapped(t, x):
-        return event(t, x[:n_q], x[n_q:])
+        value = event(t, x[:n_q], x[n_q:])
+        if not np.isfinite(value):
+            raise FloatingPointError(f"{label}: returned {value} at t = {t:.6g}; an event function must be finite")
+        return value
 
     for attr in ("terminal", "direction"):
         if hasattr(event, attr):
@@ -119,7 +154,8 @@ def simulate(
         the default; exact to round-off, n complex evaluations per Jacobian, counted in
         ``Result.njev``), by scipy's finite differences ("differences"), or the user's.
     **options
-        Further options for the integrator (max_step, first_step, ...).
+        Further options for the integrator (max_step, first_step, ...; see ``SOLVER_OPTIONS``): an option the method does not take is a ValueError naming the
+        valid ones (solve_ivp would ignore it).
 
     Returns
     -------
@@ -129,11 +165,16 @@ def simulate(
         the time reached; Ctrl-C returns the partial trajectory with ``status = 2``. Bad
         arguments raise ``ValueError`` naming the argument before the run starts, and a
         model that cannot be evaluated at the initial state raises its own error there
-        (:class:`projeq.SingularMassError`, a force law's ``ValueError``).
+        (:class:`projeq.SingularMassError`, a force law's ``ValueError``). During the run a
+        NaN from a user function, an exception in one (named with its file and line) or a
+        state approaching a coordinate singularity (K or F with condition number above 1e5,
+        checked every ``MONITOR_EVERY`` right-hand sides) is such a failure; a subsystem
+        leaving the range its model describes (a beam beyond moderate deflections) gets a
+        :class:`ValidityWarning`.
     """
     run = _Run(system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
                evaluator, n_segments, progress, jac, options)
-    started, stiff_warned = _time.perf_counter(), False  # one StiffnessWarning per run at most
+    started, stiff_warned, checked = _time.perf_counter(), False, 0  # one StiffnessWarning per run at most
     with run.stopping():
         segments = deque(zip(run.bounds[:-1], run.bounds[1:]))  # a model event splits one
         while segments:
@@ -149,9 +190,14 @@ def simulate(
                 run.status, run.message = segment.status, segment.message
                 break
             else:
-                stiff_warned = stiff_warned or warn_if_stiff(run.rhs, segment, method, rtol)
+                run.steps += len(segment.sol.ts) - 1
+                if not stiff_warned and run.steps >= 2 * checked:  # ρ at most log₂(steps) times per run
+                    checked = run.steps
+                    stiff_warned = warn_if_stiff(run.rhs, run.steps, run.t_start, b, segment.sol(b), method, rtol)
                 run.end_segment(segment, b)
     result = _assemble(run, _time.perf_counter() - started, dense_output)
+    if not run.out_of_range and len(result.t) and result.q.shape[1] == system.tree.n_q:
+        warn_out_of_range(system.tree, result.q, result.t[-1])
     if run.status == -1:
         raise _failure(run, result) from run.cause
     return result
@@ -183,12 +229,15 @@ class _Run:
         if not t_end > t_start:
             raise ValueError(f"t_end: must be after t_start = {t_start}, got {t_end}")
         self.rtol, self.atol = positive("rtol", rtol), positive("atol", atol)
+        if self.rtol >= 1.0:
+            raise ValueError(f"rtol: a relative tolerance must be below 1 (1 allows 100 % error), got {rtol}")
         _check_method(method)
+        _check_options(method, options)
         self.t_eval = _output_times(t_start, t_end, t_eval, count("n_points", n_points, 2))
         self.bounds = np.linspace(t_start, t_end, count("n_segments", n_segments) + 1)
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable progress(t), got {progress!r}")
-        self.events = _checked_events(events)
+        self.events = _checked_events(events, t_start, q0, s_dot0)
         self.model = self.user_model = system
         self.choice, self.ev = evaluator, _evaluator(system, evaluator)
         system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
@@ -197,7 +246,8 @@ class _Run:
         self.solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
         self.jac = _jac_option(method, jac)
-        self.pieces, self.nfev, self.njev, self.cause = [], 0, 0, None
+        self.pieces, self.nfev, self.njev, self.cause, self.steps, self.calls = [], 0, 0, None, 0, 0
+        self.out_of_range = False  # warned that a subsystem left the range of its model
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
 
@@ -206,6 +256,12 @@ class _Run:
         self.reached = t
         n_q = self.model.n_q
         q, s_dot = x[:n_q], x[n_q:]
+        if not np.all(np.isfinite(x)):
+            raise FloatingPointError(f"the state is not finite at t = {t:.6g} (q = {q}, s_dot = {s_dot}): the "
+                                     "solution blew up (or a tolerance too loose let it)")
+        self.calls += 1
+        if self.calls % MONITOR_EVERY == 0:
+            near_singularity(self.model.tree, q, t)
         x_dot = np.concatenate((self.model.q_dot(q, s_dot, t), self.ev.accelerations(q, s_dot, t)))
         if not np.all(np.isfinite(x_dot)):
             raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
@@ -224,8 +280,10 @@ class _Run:
         t_eval = self.t_eval
         inside = t_eval[(t_eval > a) & (t_eval <= b)] if self.pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
         n_q = self.model.n_q
-        events = [_event_wrapper(e, n_q) for e in self.events + list(self.model.events())]
         jac = {"jac": self.jacobian if self.jac == "exact" else self.jac} if self.method in IMPLICIT else {}
+        labels = [f"events[{i}] ({_name(e)})" for i, e in enumerate(self.events)]
+        labels += [f"the model's event {_name(e)}" for e in self.model.events()]
+        events = [_event_wrapper(e, n_q, label) for e, label in zip(self.events + list(self.model.events()), labels)]
         segment = solve_ivp(self.rhs, (a, b), self.x, method=self.solver, t_eval=inside, rtol=self.rtol,
                             atol=self.atol, events=events or None, dense_output=True, **jac, **self.options)
         self.nfev += segment.nfev
@@ -268,6 +326,8 @@ class _Run:
         self.x = segment.sol(b).copy()
         n_q = self.model.n_q
         self.x[:n_q] = self.model.normalized(self.x[:n_q])
+        near_singularity(self.model.tree, self.x[:n_q], b)
+        self.out_of_range = self.out_of_range or warn_out_of_range(self.model.tree, self.x[None, :n_q], b)
         if self.progress is not None:
             self.progress(b)
 
@@ -281,7 +341,7 @@ class _Run:
         except (FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
             self.status, self.message, self.cause = -1, str(exc), exc
         except Exception as exc:  # noqa: BLE001 - a user's force law or event failed: keep the trajectory
-            self.status, self.message, self.cause = -1, f"{type(exc).__name__}: {exc}", exc
+            self.status, self.message, self.cause = -1, f"{type(exc).__name__} in {_raised_in(exc)}: {exc}", exc
 
 
 def _jac_option(method, jac):
@@ -293,11 +353,55 @@ def _jac_option(method, jac):
     return None if jac == "differences" else jac
 
 
-def _checked_events(events) -> list:
+class ValidityWarning(UserWarning):
+    """A run left the range its model describes (a beam beyond moderate deflections)."""
+
+
+def warn_out_of_range(tree, q_rows: NDArray, t: float) -> bool:
+    """Warn (:class:`ValidityWarning`) for each subsystem of ``tree`` whose internal
+    coordinates in the rows ``q_rows`` (up to time t) leave its model's range; True if one did."""
+    warned = False
+    for n, sub in enumerate(tree.subsystems):
+        check = getattr(sub, "out_of_range", None)  # a duck-typed user subsystem may have none
+        problem = check(q_rows[:, tree.e_q_slice[n]]) if sub.n_e and check else None
+        if problem:
+            warnings.warn(f"{tree.names[n]!r} by t = {t:.6g} s: {problem}", ValidityWarning, stacklevel=3)
+            warned = True
+    return warned
+
+
+def _raised_in(exc: BaseException) -> str:
+    """Where ``exc`` was raised: the innermost frame outside projeq, numpy and scipy (the
+    user's function), as 'name (file:line)'."""
+    frames = [f for f, _ in traceback.walk_tb(exc.__traceback__)]
+    mine = [f for f in frames if not any(part in f.f_code.co_filename for part in _LIBRARIES)] or frames[-1:]
+    code = mine[-1].f_code
+    return f"{getattr(code, 'co_qualname', code.co_name)} ({code.co_filename}:{mine[-1].f_lineno})"
+
+
+_LIBRARIES = (f"{os.sep}projeq{os.sep}", f"{os.sep}numpy{os.sep}", f"{os.sep}scipy{os.sep}", f"{os.sep}sympy{os.sep}")
+
+
+def _name(function) -> str:
+    return getattr(function, "__qualname__", type(function).__name__)
+
+
+def _checked_events(events, t, q, s_dot) -> list:
+    """The user's events, each called once at the initial state: a callable event(t, q, s_dot)
+    returning one finite number."""
     events = [] if events is None else (list(events) if isinstance(events, (list, tuple)) else [events])
     for i, e in enumerate(events):
         if not callable(e):
             raise ValueError(f"events[{i}]: expected a callable event(t, q, s_dot), got {e!r}")
+        try:
+            value = e(t, q.copy(), s_dot.copy())
+        except TypeError as exc:
+            raise ValueError(f"events[{i}] ({_name(e)}): calling it as event(t, q, s_dot) at t = {t} failed: {exc}") from exc
+        if np.ndim(value) != 0 or not np.isrealobj(value):
+            raise ValueError(f"events[{i}] ({_name(e)}): must return one real number, returned {value!r}")
+        if not np.isfinite(value):
+            raise ValueError(f"events[{i}] ({_name(e)}): returned {value} at the initial state t = {t}; "
+                             "an event function must be finite")
     return events
 
 

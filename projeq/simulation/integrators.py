@@ -14,8 +14,8 @@ Two concerns of the numerics at the extremes (issue 7, item 4):
   grows linearly, as for the base method.
 * **Stiffness.** An explicit method on a stiff model (a beam whose axial modes are 10³
   times faster than its bending modes) does not fail: it crawls at the step its stability
-  region allows. :func:`warn_if_stiff` recognises such a crawl after a segment of
-  :func:`projeq.simulate` and warns (:class:`StiffnessWarning`) with the suggestion of an
+  region allows. :func:`warn_if_stiff` recognises such a crawl over the steps of a run of
+  :func:`projeq.simulate` so far (whatever its segments) and warns (:class:`StiffnessWarning`) with the suggestion of an
   implicit method.
 
 ``PROJECTED`` maps the method names :func:`projeq.simulate` accepts to their base method.
@@ -211,24 +211,22 @@ def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32) -> float:
     return float(np.exp(np.mean(logs[-2 * (iterations // 4):])))
 
 
-def warn_if_stiff(fun, segment, method, rtol: float) -> bool:
-    """Warn (:class:`StiffnessWarning`) if an explicit ``method``'s steps in ``segment``
-    (a solve_ivp result with dense output) sit at its stability limit; True if it warned.
+def warn_if_stiff(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rtol: float) -> bool:
+    """Warn (:class:`StiffnessWarning`) if an explicit ``method``'s ``n_steps`` steps from t0
+    to t (all of a run's segments so far, whatever the segmenting) sit at its stability
+    limit; ``x`` is the state at t. True if it warned.
 
-    The criterion: mean step h with ρ h ≥ 1 (ρ = :func:`spectral_radius` at the segment's
-    end), over at least 50 steps, at rtol ≤ 1e-5. At such tolerances a mode with ρ h ≥ 1
-    would be integrated with a local error of order (ρh)⁵ ≫ rtol, so the error control can
-    only accept these steps because the fast mode is hardly excited: the step is set by
+    The criterion: mean step h with ρ h ≥ 1 (ρ = :func:`spectral_radius` at (t, x)), over at
+    least 50 steps, at rtol ≤ 1e-5. At such tolerances a mode with ρ h ≥ 1 would be
+    integrated with a local error of order (ρh)⁵ ≫ rtol, so the error control can only
+    accept these steps because the fast mode is hardly excited: the step is set by
     stability, the definition of stiffness, and an implicit method could take far larger
     ones.
     """
-    if method not in EXPLICIT or rtol > 1e-5:
+    if method not in EXPLICIT or rtol > 1e-5 or n_steps < 50:
         return False
-    n_steps = len(segment.sol.ts) - 1
-    if n_steps < 50:
-        return False
-    h = (segment.sol.ts[-1] - segment.sol.ts[0]) / n_steps
-    rho = spectral_radius(fun, segment.sol.ts[-1], segment.sol(segment.sol.ts[-1]))
+    h = (t - t0) / n_steps
+    rho = spectral_radius(fun, t, x)
     if rho * h < 1.0:
         return False
     warnings.warn(

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+import zipfile
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
@@ -124,16 +125,52 @@ class Result:
 
     @classmethod
     def load(cls, path) -> "Result":
-        """Read a Result written by :meth:`save` (without dense output)."""
-        with np.load(path) as data:
-            meta = json.loads(str(data["meta"]))
-            events = {name: _numbered(data, name) for name in _EVENT_ARRAYS}
-            arrays = {k: data[k] for k in data.files if k != "meta" and not k.startswith(_EVENT_ARRAYS)}
+        """Read a Result written by :meth:`save` (without dense output). ValueError saying what
+        the file is and what is wrong when it is not one: not an .npz archive (random or
+        truncated bytes), an archive without a Result's arrays, or arrays whose lengths differ."""
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                meta, events, arrays = _read(data, path)
+        except (EOFError, zipfile.BadZipFile) as exc:
+            raise ValueError(f"path: {str(path)!r} is a truncated or damaged archive, not a readable projeq "
+                             f"Result (.npz written by Result.save): {exc}") from exc
+        except ValueError as exc:  # numpy's words for bytes that are no .npy/.npz, or the checks of _read
+            raise ValueError(f"path: {str(path)!r} is not a projeq Result (.npz written by Result.save): {exc}") from exc
         meta["names"] = tuple(meta["names"])
         meta["partitions"] = tuple((t, tuple(independent)) for t, independent in meta.get("partitions", ()))
         for key in ("coordinates", "velocities"):  # absent from files of earlier versions
             meta[key] = tuple(tuple(pair) for pair in meta.get(key, ()))
+        _check_rows(arrays, path)
         return cls(**arrays, **meta, **events)
+
+
+def _read(data, path) -> tuple[dict, dict, dict]:
+    """meta, events and arrays of an open archive; ValueError for a file that is not one."""
+    if not hasattr(data, "files"):
+        raise ValueError(f"it holds a single array of shape {data.shape}, not an .npz archive")
+    missing = [name for name in ("meta", *_ROWS) if name not in data.files]
+    if missing:
+        raise ValueError(f"the archive lacks {missing} (it holds {sorted(data.files)[:10]})")
+    try:
+        meta = json.loads(str(data["meta"]))
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"its metadata is not the JSON Result.save writes: {exc}") from exc
+    events = {name: _numbered(data, name) for name in _EVENT_ARRAYS}
+    arrays = {k: data[k] for k in data.files if k != "meta" and not k.startswith(_EVENT_ARRAYS)}
+    return meta, events, arrays
+
+
+_ROWS = ("t", "q", "s_dot", "kinetic", "potential", "constraint_residual")  # one row per output time
+
+
+def _check_rows(arrays: dict, path) -> None:
+    """Every per-time array has one row per entry of t."""
+    n = len(arrays["t"])
+    wrong = {name: arrays[name].shape for name in _ROWS if arrays[name].ndim == 0 or len(arrays[name]) != n}
+    if arrays["t"].ndim != 1 or wrong:
+        raise ValueError(f"path: {str(path)!r} is inconsistent: t has shape {arrays['t'].shape} but "
+                         f"{wrong} (one row per output time expected); the file was not written by "
+                         "Result.save or was altered")
 
 
 def _numbered(data, name: str) -> tuple:

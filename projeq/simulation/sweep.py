@@ -82,7 +82,11 @@ def output_value(result, name: str) -> float:
         return float(BUILTIN_OUTPUTS[name](result))
     if column[0] == "named":
         column = _named_column(result.coordinates, result.velocities, name)
-    return float(getattr(result, column[0])[-1, column[1]])
+    values = getattr(result, column[0])
+    if column[1] >= values.shape[1]:
+        raise ValueError(f"outputs: {name!r} asks for {column[0]}[{column[1]}], but this point's model has "
+                         f"{values.shape[1]} ({column[0]}0 … {column[0]}{values.shape[1] - 1})")
+    return float(values[-1, column[1]])
 
 
 def _named_column(coordinates, velocities, name: str) -> tuple[str, int]:

@@ -125,6 +125,12 @@ class Subsystem:
         in the reference frame (for drawing and export)."""
         raise NotImplementedError(f"{type(self).__name__} does not deform (deforms is False)")
 
+    def out_of_range(self, q_e: NDArray) -> str | None:
+        """Where the rows of internal coordinates ``q_e`` leave the range the subsystem's
+        model describes (a beam's moderate deflections), and what to do; None inside it (a
+        rigid body: always)."""
+        return None
+
     def deflection(self, result, x: float) -> NDArray:
         """(``deforms``) Displacement (u, v, w) of the centre line at station x, one row per
         time point of a simulated ``result``."""

@@ -232,6 +232,17 @@ def test_usage_errors_exit_2_without_raising(capsys):
     assert "invalid choice: 'no-such-command'" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("option, value", [("--total", "-5"), ("--total", "0"), ("--budget", "nan"), ("--budget", "-1"),
+                                           ("--budget", "inf")])
+def test_bench_budgets_must_be_positive_seconds(option, value, capsys):
+    """Passes if a negative, NaN or infinite time budget of projeq bench (or a zero --total) is a
+    usage error (exit 2) naming the option and the value, before anything is timed (issue 20:
+    --total -5 ran); --budget 0 times each evaluator once (tests/studies/test_bench_cli.py)."""
+    assert main(["bench", option, value, "--chain-only", "--sizes", "2"]) == 2
+    expected = "a positive number of seconds" if option == "--total" else "a number of seconds >= 0"
+    assert f"argument {option}: expected {expected}, got '{value}'" in capsys.readouterr().err
+
+
 def test_sweep_writes_one_table(tmp_path, capsys):
     """projeq sweep: a 3-point grid of the Atwood machine, final angles = closed form."""
     argv = ["sweep", "atwood", "--grid", "m1=1:3:3", "--t-end", "0.5", "--rtol", "1e-10", "--outputs", "q0",

@@ -187,3 +187,11 @@ def test_cut_named_like_a_subsystem(four_bar_pin):
     system, pin = four_bar_pin
     with pytest.raises(ValueError, match=r"cuts: names \['rocker'\] are subsystem names"):
         joint_reactions(system, system.q0, [1.0], cuts={"rocker": pin})
+
+
+def test_a_singular_pose_is_not_called_redundant(tree):
+    """Passes if Φ = x z at q0 = (0, 0), whose gradient (z, x) vanishes there only, is named a
+    singular pose (full rank nearby), not a set of redundant rows to remove."""
+    with pytest.raises(ValueError, match=r"^q0: a singular pose of the constraints \(rank 0 of 1 at q0 = \[0.0, 0.0\], "
+                                         r"full rank nearby\)"):
+        ConstrainedSystem(tree, phi=lambda q, t: [q[0] * q[1]], q0=(0.0, 0.0))

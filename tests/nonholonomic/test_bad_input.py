@@ -79,6 +79,32 @@ def test_singular_F_of_the_knife_edge_disc_at_flat_tilt():
         pq.scenes.knife_edge_disc(q0=(0.0, 0.0, 0.0, np.pi / 2, 0.0))
 
 
+@pytest.mark.parametrize("distance", [1e-11, 1e-9])
+def test_knife_edge_disc_near_flat_tilt_is_singular(distance):
+    """Slide 29: F's ψ̇- and θ̇-columns differ by O(cos ϕ), so cond F ≈ 2.8 / (π/2 − ϕ) (measured:
+    2.83e11 at 1e-11 rad); a tilt 1e-11 and 1e-9 rad from flat (cond 2.8e11, 2.8e9) must still
+    be refused as singular at the start (threshold 1e10, far above any regular pose)."""
+    if distance < 1e-10:
+        with pytest.raises(ValueError, match=r"F\(q\) loses rank \(condition number 2.8\de\+11\)"):
+            pq.scenes.knife_edge_disc(q0=(0.0, 0.0, 0.0, np.pi / 2 - distance, 0.0))
+    else:  # cond 2.8e9 < 1e10: a pose one may start from (the run's own monitor stops it early)
+        pq.scenes.knife_edge_disc(q0=(0.0, 0.0, 0.0, np.pi / 2 - distance, 0.0))
+
+
+def test_knife_edge_disc_started_near_flat_stops_within_seconds():
+    """Passes if the disc started 1e-4 rad from flat (issue 20: 460k evaluations, never finished
+    its first segment) stops with a SimulationError naming the coordinate singularity, within
+    5 s, the trajectory kept: its spin rates grow like 1/(π/2 − ϕ) as ϕ → π/2 (slide 29) and the
+    run is stopped once cond F passes 1e5, i.e. about 3e-5 rad from flat."""
+    import time
+
+    system = pq.scenes.knife_edge_disc(q0=(0.0, 0.0, 0.0, np.pi / 2 - 1e-4, 0.0))
+    started = time.perf_counter()
+    with pytest.raises(pq.SimulationError, match=r"approaches a coordinate singularity at t = .*condition number 1"):
+        pq.simulate(system, 10.0)
+    assert time.perf_counter() - started < 5.0
+
+
 def test_initial_rates_violating_the_constraints():
     """Slide 30's rolling constraints and Barhorst's ẏ − y² ẋ = 0: rates that violate them
     are refused with the residual; rates that satisfy them give the minimal velocities."""

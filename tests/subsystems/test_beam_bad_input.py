@@ -124,3 +124,14 @@ def test_unstiffened_spin_up_warns_once_with_the_critical_speed():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         stiffened.gauss_terms(y_dot, np.eye(3), np.zeros(3), np.zeros(stiffened.n_e))
+
+
+@pytest.mark.parametrize("x", [-1e-9, 1.0 + 1e-9, 1.5, -0.5])
+def test_probe_stations_must_lie_on_the_beam(x):
+    """Passes if a station a hair (1e-9 L) or far off the 1 m beam is refused by name, while the
+    ends themselves are probed: Φ(0) = 0 (clamped) and the tip of Φ₁ = (x/L)² is 1."""
+    beam = pq.RitzBeam(1.0, 1.0, 1.0, n_v=2, n_w=0)
+    with pytest.raises(ValueError, match=r"^x: stations must lie on the beam, 0 ≤ x ≤ 1.0"):
+        beam.displacement(np.array([1.0, 0.0]), [x])
+    ends = beam.displacement(np.array([1.0, 0.0]), [0.0, 1.0])
+    assert ends[0, 1] == 0.0 and ends[1, 1] == pytest.approx(1.0, rel=1e-14)

@@ -37,7 +37,7 @@ from projeq.checks import count, finite_array, non_negative, positive
 from projeq.joints import Relative
 from projeq.spatial import cross, rotation_x, rotation_y, rotation_z, skew, skew_stack
 from projeq.subsystems.beam import shapes
-from projeq.subsystems.beam.checks import family_shapes, per_length
+from projeq.subsystems.beam.checks import beam_memory, family_shapes, per_length
 from projeq.subsystems.beam.integrals import PrecomputedIntegrals, Quadrature
 from projeq.subsystems.base import Subsystem
 from projeq.subsystems.beam.probes import BeamProbes
@@ -128,12 +128,13 @@ class RitzBeam(BeamProbes, Subsystem):
     ):
         self.length = L = positive("length", length)
         for name, n in (("n_v", n_v), ("n_w", n_w), ("n_u", n_u), ("n_beta", n_beta)):
-            if int(n) != n or n < 0:
+            if isinstance(n, bool) or not isinstance(n, (int, np.integer, float)) or int(n) != n or n < 0:
                 raise ValueError(f"{name}: number of Ritz functions must be a non-negative integer, got {n!r}")
         self.n_u, self.n_v, self.n_w, self.n_beta = int(n_u), int(n_v), int(n_w), int(n_beta)
         self.n_e = self.n_u + self.n_v + self.n_w + self.n_beta
         if self.n_e == 0:
             raise ValueError("n_v, n_w, n_u, n_beta: a beam needs at least one Ritz function")
+        beam_memory(6 + self.n_e)
         if self.n_u and EA is None:
             raise ValueError("EA: axial deformation (n_u > 0) needs the axial stiffness EA")
         if self.n_beta and GI_t is None:
@@ -150,6 +151,13 @@ class RitzBeam(BeamProbes, Subsystem):
         default_order = 2 * max(self.n_u, self.n_v, self.n_w, self.n_beta) + 6
         order = default_order if quadrature_order is None else quadrature_order
         self.order = order = count("quadrature_order", order)
+        n_max = max(self.n_u, self.n_v, self.n_w, self.n_beta)
+        if order < n_max + 2:  # Gauss with p points is exact up to degree 2p − 1
+            raise ValueError(
+                f"quadrature_order: {order} Gauss points integrate polynomials up to degree {2 * order - 1} "
+                f"exactly, but the products of {n_max} Ritz functions reach degree {2 * n_max + 2}; give at "
+                f"least {n_max + 2} (default {default_order})"
+            )
         t, w = np.polynomial.legendre.leggauss(order)
         self.x = x = 0.5 * L * (t + 1.0)
         self.weights = 0.5 * L * w

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from projeq.analysis.differentiation import richardson
 from projeq.checks import finite_array
 
 _DERIVATIVES = ("Φ", "Φ′", "Φ″", "Φ‴")
@@ -58,7 +59,40 @@ def family_shapes(family, table: dict, n: int, L: float, key: str):
         message = f"family: the Ritz family for {key} failed as family(n, L)(x): {exc!r}"
         raise ValueError(message) from exc
     _check_arrays(arrays, n, len(probe), key)
+    _check_derivatives(shapes, n, L, key)
     return shapes
+
+
+def _check_derivatives(shapes, n: int, L: float, key: str, tol: float = 1e-5) -> None:
+    """Φ′ and Φ″ of a user family must be the derivatives of Φ and Φ′: compared with
+    :func:`~projeq.analysis.differentiation.richardson` differences (step 1e-3 L, truncation
+    ~1e-12 relative for smooth shapes) at interior stations."""
+    x = np.linspace(0.2, 0.9, 4) * L
+    h = 1e-3 * L
+    for k, (what, derivative) in enumerate(zip(_DERIVATIVES, _DERIVATIVES[1:3])):
+        given = np.asarray(shapes(x)[k + 1], dtype=float)
+        estimate = richardson(lambda e: np.asarray(shapes(x + e)[k], dtype=float), h)
+        error = np.abs(given - estimate).max(axis=1)
+        bad = np.flatnonzero(error > tol * (np.abs(estimate).max(axis=1) + np.abs(given).max(axis=1) + 1e-300))
+        if bad.size:
+            raise ValueError(
+                f"family: {derivative} of the Ritz functions {bad.tolist()} for {key} is not the derivative of "
+                f"{what} (differs by up to {error[bad].max():.3g} from a finite difference): the shapes' "
+                "derivatives must be consistent with their values"
+            )
+
+
+def beam_memory(n_y: int, limit: float = 2.0**30) -> None:
+    """Refuse a beam whose (n_y × n_y) matrices would not fit: each takes 8 n_y² bytes, and the
+    beam keeps several (mass, stiffness, Gram matrix, integrals)."""
+    need = 8.0 * n_y * n_y
+    if need > limit:
+        raise ValueError(
+            f"n_v, n_w, n_u, n_beta: {n_y - 6} Ritz functions make each n_y × n_y matrix of the beam "
+            f"{need / 2**30:.3g} GiB (8 n_y² bytes, n_y = {n_y}), and the beam keeps several: more memory than "
+            f"sensible (limit {limit / 2**30:.3g} GiB per matrix); a few dozen functions converge (use "
+            "family='clamped_free')"
+        )
 
 
 def _check_arrays(arrays, n: int, n_x: int, key: str) -> None:

@@ -12,6 +12,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+MODERATE_DEFLECTION = 0.1  # deflections and axial displacements up to 10 % of the length
+MODERATE_ROTATION = 0.2  # slopes up to 0.2 rad: their square 0.04 is small against 1
+
 
 class BeamProbes:
     """Mixin of RitzBeam: probes at stations (needs ``station_data``, ``slices`` and the
@@ -25,6 +28,26 @@ class BeamProbes:
         q_e = np.asarray(q_e, dtype=float)
         rows = [self.slices(q, x, data)[0] - np.outer(x, (1.0, 0.0, 0.0)) for q in np.atleast_2d(q_e)]
         return np.array(rows) if q_e.ndim == 2 else rows[0]
+
+    def out_of_range(self, q_e) -> str | None:
+        """Where the rows of ``q_e`` leave the moderate-deflection range of the beam's
+        second-order theory (deflections small against L, rotations whose square is small
+        against 1: Bremer, *Elastic Multibody Dynamics*, 2008, §6.2): what was reached and what
+        to do, or None. Limits: lateral deflection or axial displacement 10 % of L, a slope
+        of the centre line 0.2 rad."""
+        x = np.linspace(0.0, self.length, 21)
+        d = self.displacement(np.atleast_2d(q_e), x)
+        lateral = np.hypot(d[..., 1], d[..., 2])
+        reached = {"lateral deflection": lateral.max() / self.length,
+                   "axial displacement": np.abs(d[..., 0]).max() / self.length}
+        rotation = np.abs(np.diff(lateral, axis=1) / np.diff(x)).max()
+        if max(reached.values()) <= MODERATE_DEFLECTION and rotation <= MODERATE_ROTATION:
+            return None
+        sizes = ", ".join(f"{name} {value:.3g} L" for name, value in reached.items())
+        return (f"{sizes}, rotation {rotation:.3g} rad: beyond the moderate-deflection range of the beam's "
+                f"second-order theory ({MODERATE_DEFLECTION:g} L, {MODERATE_ROTATION:g} rad), where its "
+                "results mean nothing; use more Ritz functions, a slower manoeuvre, or a finer model "
+                "(several shorter beams in a chain, each deflecting moderately)")
 
     def _stations(self, x) -> NDArray:
         x = np.atleast_1d(np.asarray(x, dtype=float))
