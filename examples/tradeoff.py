@@ -1,6 +1,6 @@
 """Work-precision: the cheapest integrator setting for an accuracy (``projeq.studies.tradeoff``).
 
-The knife-edge disc (lecture 001, slides 28-37) integrated by DOP853 at two relative
+The knife-edge disc (Orsino (2020), slides 28-37) integrated by DOP853 at two relative
 tolerances, each run's error measured against a converged reference (DOP853 at rtol 1e-13,
 ``projeq.studies.tradeoff``'s reference run). The checked fact: an error-controlled integrator
 meets the request — the error at the end is within a small multiple of rtol times the

@@ -1,6 +1,6 @@
 """Linearisation of the equations of motion about an equilibrium or a steady motion.
 
-The state is x = (q, ṡ) with ẋ = f(x, τ) = (K(q) ṡ + k, s̈(q, ṡ, t, τ)) (THEORY §5, §7);
+The state is x = (q, ṡ) with ẋ = f(x, τ) = (K(q) ṡ + k, s̈(q, ṡ, t, τ)) (docs/theory.md §5, §7);
 :func:`linearize` returns δẋ = A δx + B δτ. For non-holonomic systems ṡ are already the
 minimal velocities (the constraints are in K and F), so A is the linearisation on the
 constraint manifold, not of an unconstrained Lagrangian system with multipliers.
@@ -75,7 +75,7 @@ class Linearization(tuple):
 
 def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, inputs=()) -> NDArray:
     """ẋ = (q̇, s̈) at x = (q, ṡ); ``tau`` are generalized forces on the joints ``inputs``
-    (added to Q of the Gauss form M s̈ + b = Q, THEORY §5; for a ConstrainedSystem projected
+    (added to Q of the Gauss form M s̈ + b = Q, docs/theory.md §5; for a ConstrainedSystem projected
     with its F, Fᵀ Q_tree, §7)."""
     q, s_dot = x[: system.n_q], x[system.n_q :]
     if tau is None or not len(inputs):

@@ -1,8 +1,8 @@
-"""The order-n passes of THEORY §6 in one compiled loop over flat arrays ("fast").
+"""The order-n passes of docs/theory.md §6 in one compiled loop over flat arrays ("fast").
 
 The System stays frozen; :class:`FastEvaluator` packs its tree once into arrays (parents,
 joint kinds, axes, joint frames, masses, r_c, I_c, M_n) and each call runs
-:func:`projeq.assembly.kernels.chain_terms` (T_np, ζ_n, F_n, h_n; THEORY §3–4) and
+:func:`projeq.assembly.kernels.chain_terms` (T_np, ζ_n, F_n, h_n; docs/theory.md §3–4) and
 :func:`projeq.assembly.kernels.passes` (Bremer's backward and forward passes, §6).
 Both are compiled by numba (``pip install 'projeq[fast]'``) on first use (cached on
 disk); ``method="fast"`` is this kernel or a ValueError saying why not (numba missing, or
@@ -92,7 +92,7 @@ class FastEvaluator:
         self._f, self._M_hat, self._h_hat = np.zeros((N, 6)), np.zeros((N, 6, 6)), np.zeros((N, 6))
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """s̈ at (q, ṡ, t) (THEORY §6); raises SingularMassError for a zero pivot D_n."""
+        """s̈ at (q, ṡ, t) (docs/theory.md §6); raises SingularMassError for a zero pivot D_n."""
         self.n_calls += 1
         q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
         self._chain_terms(

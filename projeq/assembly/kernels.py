@@ -1,4 +1,4 @@
-"""The loops of the fast evaluator on flat arrays: THEORY §4 (kinematics) and §6 (passes).
+"""The loops of the fast evaluator on flat arrays: docs/theory.md §4 (kinematics) and §6 (passes).
 
 Plain Python on scalars and small arrays, written so that numba can compile it
 (:func:`kernel` with ``compiled=True`` applies ``numba.njit(cache=True)``); the same source
@@ -6,7 +6,7 @@ runs interpreted with ``compiled=False``, so both are the same algorithm.
 
 Joint kinds: ``FIXED`` (no dof), ``REVOLUTE`` (F⁶ = [0; e]), ``PRISMATIC`` (F⁶ = [e; 0]),
 about a unit axis e in joint-frame coordinates; subsystems: rigid bodies (M_n = M6,
-h_n of THEORY §3). Twists are (v_O, ω) in body coordinates; index −1 is the ground.
+h_n of docs/theory.md §3). Twists are (v_O, ω) in body coordinates; index −1 is the ground.
 
 Compiled twins. numba compiles scalar loops, not the array functions of
 :mod:`projeq.spatial`, so four formulas have a second, scalar form here and only here:
@@ -42,7 +42,7 @@ def has_numba() -> bool:
 
 def chain_terms(kind, parent, axis, orientation, offset, q_index, m, r_c, I_c, gravity, q, s_dot,
                 T, zeta, f, h):
-    """T_np, ζ_n, F_n (as a 6-vector f_n) and h_n = Q_n − G_n ẏ_n of every body (THEORY §3–4).
+    """T_np, ζ_n, F_n (as a 6-vector f_n) and h_n = Q_n − G_n ẏ_n of every body (docs/theory.md §3–4).
 
     A_pn = A_pJ A_Jn, r_pn = r_pJ + A_pJ r_Jn, T_np = [[A_np, −A_np r̃_pn], [0, A_np]],
     u = T_np ẏ_p, w = f_n ṡ_n, ẏ_n = u + w, ζ_n = u × w (motion cross product).
@@ -116,7 +116,7 @@ def _cross3(a, b):
 
 
 def _rigid_h(m, r_c, I_c, twist, g_body, out):
-    """h = [m g − ω̃ p ; r̃_c (m g − ω̃ p) − ω̃ I_c ω], p = m (v + ω × r_c) (THEORY §3), written
+    """h = [m g − ω̃ p ; r̃_c (m g − ω̃ p) − ω̃ I_c ω], p = m (v + ω × r_c) (docs/theory.md §3), written
     into ``out``; compiled twin of :func:`projeq.subsystems.rigid.rigid_h`."""
     omega = twist[3:]
     p_c = m * (twist[:3] + _cross3(omega, r_c))
@@ -127,7 +127,7 @@ def _rigid_h(m, r_c, I_c, twist, g_body, out):
 
 
 def passes(kind, parent, q_index, T, zeta, f, M_hat, h_hat, pivot_min, s_ddot):
-    """Backward and forward pass of THEORY §6 for one-dof and fixed joints; writes s̈.
+    """Backward and forward pass of docs/theory.md §6 for one-dof and fixed joints; writes s̈.
 
     Backward: U = M̂_n f_n, D_n = f_nᵀ U, M̄_n = M̂_n − U Uᵀ / D_n,
     h̄_n = c − U (f_nᵀ c) / D_n with c = ĥ_n − M̂_n ζ_n; M̂_p += T_npᵀ M̄_n T_np, ĥ_p += T_npᵀ h̄_n.
