@@ -4,13 +4,13 @@ and the python blocks of each docs page run in order in one namespace.
 
 Commands run in-process (``projeq.cli.commands.main``) in a temporary directory, shortened
 where the command's own options allow it, so that the check costs seconds instead of the
-documented runs' minutes: ``--t-end`` at most 0.5 s for run, sweep and tradeoff (the scene
+documented runs' minutes: ``--t-end`` at most 0.1 s for run, sweep and tradeoff (the scene
 is built and checked, the parameters validated, the outputs written as documented),
 tradeoff on two tolerances of DOP853 with the recursive evaluator, compare without simulation
 and one repeat, bench on the chain of 10 bodies only; a Dask scheduler address becomes a local
 in-process cluster. A command that another test already runs in full as documented is named
 in COVERED_ELSEWHERE with that test. Lines that install packages are not run.
-The python blocks run as written except that ``projeq.simulate`` stops at 0.5 s of simulated
+The python blocks run as written except that ``projeq.simulate`` stops at 0.1 s of simulated
 time (the tutorials' own scripts in examples/ run in full in tests/test_examples.py).
 """
 import re
@@ -28,7 +28,7 @@ PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), *sorted((ROO
 #: doctests of the modules) and the architecture page (tests/test_docs.py); README.md's block
 #: by tests/test_readme.py.
 CODE_RUN_ELSEWHERE = ("README.md", "api.md", "architecture.md")
-QUICK_T_END = 0.5
+QUICK_T_END = 0.1
 #: Commands run verbatim by another test (checked to exist): command -> (test file, test name).
 COVERED_ELSEWHERE = {
     "run whipple_bicycle --set speed=3 --set roll=0.05":
