@@ -1,7 +1,9 @@
 """The System: a validated, immutable tree of subsystems, joints and forces; and the Model
 protocol that it shares with :class:`~projeq.constraints.partitioned.ConstrainedSystem`.
 
-Subsystems are numbered in topological order (``parent[n] < n``; ``GROUND = -1``). Each
+Subsystems are numbered in topological order (``parent[n] < n``; ``GROUND = -1``): the
+declared order when each parent is declared before its children (else a UserWarning says
+the order q follows; :meth:`Model.coordinates` names its entries). Each
 joint owns a slice of the coordinates q and of the minimal velocities ṡ (``q_slice[n]``,
 ``s_slice[n]``) unless it is *coupled* (gears, ropes), in which case its coordinate is a
 linear combination of other joints' coordinates and ∂ẏ/∂ṡ is no longer block-triangular
@@ -13,6 +15,7 @@ All validation happens here, where input enters; the kernels trust what they get
 from __future__ import annotations
 
 import copy
+import warnings
 from abc import ABC, abstractmethod
 
 import numpy as np
@@ -42,7 +45,7 @@ class Model(ABC):
     Attributes
     ----------
     names : tuple of str
-        The tree's subsystem names in topological order.
+        The tree's subsystem names in topological order (the order of q and ṡ).
     n_q, n_s : int
         Lengths of q and ṡ.
     n_c : int
@@ -112,6 +115,51 @@ class Model(ABC):
             names["s_dot"] = [names["s_dot"][i] for i in self.partition]
         return names["q"] + names["s_dot"]
 
+    def coordinates(self) -> tuple:
+        """(name, unit) of each entry of q, in the order of q: ``"<subsystem>.<coordinate>"``
+        as its joint and the subsystem declare them (:meth:`projeq.joints.Joint.coordinates`,
+        :meth:`projeq.Subsystem.coordinates`), e.g. ``("elbow.angle", "rad")``,
+        ``("forearm.v[2]", "m")``; a coupled joint owns none."""
+        return self.tree.named_coordinates[0]
+
+    def velocities(self) -> tuple:
+        """(name, unit) of each entry of ṡ, as :meth:`coordinates` (``"elbow.angle_dot"``,
+        ``"forearm.v[2]_dot"``); a ConstrainedSystem's are the tree velocities of its
+        :attr:`partition`."""
+        names = self.tree.named_coordinates[1]
+        return names if self.partition is None else tuple(names[i] for i in self.partition)
+
+    def q_index(self, name: str):
+        """Where ``name`` sits in q: the index of a coordinate ``"<subsystem>.<coordinate>"``
+        (:meth:`coordinates`), or the slice of all of a subsystem's coordinates. For
+        functions of q that should not depend on the tree's order, e.g. a constraint
+        ``phi = lambda q, t: [q[i] - q[j]]`` with ``i = tree.q_index("crank.angle")``."""
+        return _index_by_name("q", self.coordinates(), name)
+
+    def s_index(self, name: str):
+        """Where ``name`` sits in ṡ (:meth:`velocities`), as :meth:`q_index`."""
+        return _index_by_name("s_dot", self.velocities(), name)
+
+    def state(self, q=None, s_dot=None, **by_subsystem) -> tuple[NDArray, NDArray]:
+        """(q, ṡ): the default initial state (``q0``, ``s_dot0``) with entries set by name,
+        for :func:`projeq.simulate`.
+
+        ``by_subsystem``: ``elbow=0.3`` sets the coordinates of subsystem ``elbow`` (a number
+        when it has one, else a sequence of all of them); ``q`` and ``s_dot``: dicts by
+        subsystem name or by full name (:meth:`coordinates`, :meth:`velocities`), e.g.
+        ``s_dot={"elbow": 1.0, "forearm.v[2]_dot": 0.0}``. An unknown name is a ValueError
+        listing the valid ones. A ConstrainedSystem's q must still close its loops (or be
+        given to it with ``project_q0=True``).
+
+        >>> import projeq as pq
+        >>> q0, s_dot0 = pq.scenes.double_pendulum().state(bob1=0.3, s_dot={"bob2.angle_dot": -1.0})
+        >>> q0.tolist(), s_dot0.tolist()
+        ([0.3, 0.0], [0.0, -1.0])
+        """
+        q_values = dict(q or {}) | by_subsystem
+        return (_set_by_name("q", np.array(self.q0, dtype=float), self.coordinates(), q_values),
+                _set_by_name("s_dot", np.array(self.s_dot0, dtype=float), self.velocities(), dict(s_dot or {})))
+
     # -- kinematics -----------------------------------------------------------------------
     @abstractmethod
     def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
@@ -179,6 +227,57 @@ class Model(ABC):
         return [self] * len(result.t)
 
 
+def _rows_by_name(kind: str, named: tuple, key: str) -> list[int]:
+    """The entries of q or ṡ (``kind``) called ``key`` (a full name) or belonging to the
+    subsystem ``key``; ValueError listing the valid names when there are none."""
+    full = [name for name, _ in named]
+    rows = [i for i, name in enumerate(full) if name == key or name.partition(".")[0] == key]
+    if not rows:
+        subsystems = list(dict.fromkeys(name.partition(".")[0] for name in full))
+        raise ValueError(f"{key}: no entry of {kind} has that name; valid are the subsystems {subsystems} "
+                         f"and the entries {full}")
+    return rows
+
+
+def _index_by_name(kind: str, named: tuple, key: str):
+    """An entry's index, or the slice of a subsystem's entries (:func:`_rows_by_name`)."""
+    rows = _rows_by_name(kind, named, key)
+    return rows[0] if named[rows[0]][0] == key else slice(rows[0], rows[-1] + 1)
+
+
+def _set_by_name(kind: str, vector: NDArray, named: tuple, values: dict) -> NDArray:
+    """``vector`` with the entries named in ``values`` (by full name, or by subsystem: all of
+    its entries) replaced; ValueError for an unknown name or a wrong number of values."""
+    for key, value in values.items():
+        rows = _rows_by_name(kind, named, key)
+        vector[rows] = state_vector(f"{kind}[{key!r}]", np.atleast_1d(np.asarray(value, dtype=float)), len(rows))
+    return vector
+
+
+def _named_coordinates(system) -> tuple[tuple, tuple]:
+    """((name, unit) of q, (name, unit) of ṡ) of a System from its joints' and subsystems'
+    declarations (elastic velocities: ``"<name>_dot"``, unit per second); ValueError for a
+    declaration of the wrong length or a name used twice."""
+    q_named, s_named = [], []
+    for name, joint, sub in zip(system.names, system.joints, system.subsystems):
+        own_q, own_s = ((), ()) if joint.coupling else (tuple(joint.coordinates()), tuple(joint.velocities()))
+        elastic = tuple(sub.coordinates())
+        for where, declared, n in ((f"joints[{name!r}].coordinates()", own_q, 0 if joint.coupling else joint.n_q),
+                                   (f"joints[{name!r}].velocities()", own_s, 0 if joint.coupling else joint.n_s),
+                                   (f"subsystems[{name!r}].coordinates()", elastic, sub.n_e)):
+            if len(declared) != n or not all(isinstance(c, str) and isinstance(u, str) for _, (c, u) in
+                                             zip(range(n), declared)):
+                raise ValueError(f"{where}: declares {declared!r}; expected {n} (name, unit) pairs of strings")
+        q_named += [(f"{name}.{c}", u) for c, u in own_q + elastic]
+        s_named += [(f"{name}.{c}", u) for c, u in own_s]
+        s_named += [(f"{name}.{c}_dot", f"{u}/s" if u else "") for c, u in elastic]
+    for named in (q_named, s_named):
+        repeated = sorted({n for n, _ in named if [m for m, _ in named].count(n) > 1})
+        if repeated:
+            raise ValueError(f"joints: the coordinate names {repeated} are declared twice within one subsystem")
+    return tuple(q_named), tuple(s_named)
+
+
 def check_model(model) -> None:
     """ValueError unless ``model`` is a :class:`Model` (a System or a ConstrainedSystem)."""
     if not isinstance(model, Model):
@@ -223,6 +322,7 @@ class System(Model):
     def __init__(self, subsystems: dict, joints: dict, gravity=(0.0, 0.0, 0.0), forces=(), q0=None, s_dot0=None):
         _check_names(subsystems, joints)
         order = _topological_order(joints)
+        _warn_if_reordered(list(subsystems), order)
         self.names = tuple(order)
         self._index = {name: n for n, name in enumerate(order)}
         self.subsystems = tuple(subsystems[name] for name in order)
@@ -231,6 +331,7 @@ class System(Model):
         self.S = tuple(s.S for s in self.subsystems) + (_GROUND_S,)
         self.gravity = finite_array("gravity", gravity, (3,))
         self._layout_coordinates()
+        self.named_coordinates = _named_coordinates(self)  # ((name, unit) of q, of ṡ): coordinates()
         self.coupled = any(j.coupling for j in self.joints)
         self.forces = tuple(copy.copy(f).bind(self) for f in _check_forces(forces))
         self.q0 = self.normalized(self.check_q("q0", self._default_q() if q0 is None else q0))
@@ -549,21 +650,33 @@ def _cycle(joints: dict, start: str) -> list[str]:
     return loop + loop[:1]
 
 
+def _warn_if_reordered(declared: list, order: list) -> None:
+    """A UserWarning when the tree's order (parents first), which q and ṡ follow, is not the
+    order in which the user declared the subsystems: a function of q written in the declared
+    order (a constraint Φ(q)) would read the wrong entries."""
+    if declared != order:
+        warnings.warn(
+            f"System: q and s_dot follow the subsystems parents first, {order}, not in the declared order "
+            f"{declared}; address coordinates by name (System.q_index, System.state, Result.coordinates) "
+            "or declare each parent before its children", UserWarning, stacklevel=3)
+
+
 def _topological_order(joints: dict) -> list[str]:
-    """Names ordered so that every parent precedes its children (stable); cycles raise."""
+    """Names ordered so that every parent precedes its children: the declared order wherever
+    it does so already (each step takes the first pending name whose parent is placed);
+    cycles raise."""
     order, placed, pending = [], set(), list(joints)
     while pending:
-        ready = [n for n in pending if joints[n].parent is None or joints[n].parent in placed]
-        if not ready:
+        ready = next((n for n in pending if joints[n].parent is None or joints[n].parent in placed), None)
+        if ready is None:
             loop = " -> ".join(repr(n) for n in _cycle(joints, pending[0]))
             raise ValueError(
                 f"joints: the parents form a cycle (following parents: {loop}); "
                 "a system must be a tree"
             )
-        for name in ready:
-            order.append(name)
-            placed.add(name)
-        pending = [n for n in pending if n not in placed]
+        order.append(ready)
+        placed.add(ready)
+        pending.remove(ready)
     return order
 
 

@@ -43,7 +43,8 @@ def _spatial_four_bar() -> ConstrainedSystem:
     )
     theta2, theta3 = four_bar_angles(0.7, a, b, c, d)
     pin = PinClosure(tree, "coupler", (b, 0, 0), "rocker", (c, 0, 0), axes="xy")
-    return ConstrainedSystem(tree, phi=pin, q0=[0.7, theta3, theta2 - 0.7], independent=[0])
+    q0, _ = tree.state(crank=0.7, coupler=theta2 - 0.7, rocker=theta3)
+    return ConstrainedSystem(tree, phi=pin, q0=q0, independent=[0])
 
 
 def test_both_kinds_are_models():

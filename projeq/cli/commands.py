@@ -32,6 +32,7 @@ OK, FAILED, BAD_ARGUMENTS = 0, 1, 2
 COMMANDS = {
     "list": (run.list_arguments, "list the scenes, or one scene's parameters"),
     "run": (run.run_arguments, "simulate a scene and write the results"),
+    "export": (run.export_arguments, "write ParaView files of a saved run (its .npz)"),
     "sweep": (sweep.sweep_arguments, "simulate a scene on a parameter grid, in parallel"),
     "compare": (studies.compare_arguments, "compare derivations of one system (Projection Equation, Lagrange, Kane ...)"),
     "bench": (bench.bench_arguments, "run the performance benchmarks"),
@@ -57,6 +58,7 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
         args = parser().parse_args(argv)
+        args.argv = argv  # the command line, for run records
     except SystemExit as exit_:  # --help (0) or a usage error (2), printed by argparse
         return OK if exit_.code is None else int(exit_.code)
     try:

@@ -16,15 +16,50 @@ def scene_settings_option(parser: argparse.ArgumentParser) -> None:
                         help="override a scene parameter (see projeq list SCENE); repeatable")
 
 
-def simulation_options(parser: argparse.ArgumentParser) -> None:
-    """The options of ``projeq run`` and ``projeq sweep``: scene settings, end time, integrator,
-    rtol, output directory, quiet."""
+def jsonable(value):
+    """``default`` of ``json.dumps``: numpy arrays and numbers as JSON values, anything else
+    (a tuple default, a sympy expression) as its text."""
+    import numpy as np
+
+    if isinstance(value, (np.ndarray, np.generic)):
+        return value.tolist()
+    return str(value)
+
+
+def json_option(parser: argparse.ArgumentParser) -> None:
+    """``--json``: one JSON document on standard output instead of text."""
+    parser.add_argument("--json", action="store_true", help="print one JSON document instead of text")
+
+
+def simulation_options(parser: argparse.ArgumentParser, out: str = "projeq-out") -> None:
+    """The options of every subcommand that simulates a scene (``projeq run``, ``projeq
+    sweep``): scene settings, end time, integrator, tolerances, evaluator, output directory,
+    quiet, JSON; :func:`simulate_options` turns them into :func:`projeq.simulate`'s keywords."""
+    from projeq.assembly import EVALUATORS
+    from projeq.simulation.driver import INTEGRATORS
+    from projeq.simulation.integrators import PROJECTED
+
     scene_settings_option(parser)
     parser.add_argument("--t-end", type=float, default=None, help="end time in s (default: the scene's)")
-    parser.add_argument("--method", default="DOP853", help="solve_ivp method (default DOP853)")
+    parser.add_argument("--method", default="DOP853", choices=[*INTEGRATORS, *PROJECTED], metavar="METHOD",
+                        help=f"integrator: {', '.join([*INTEGRATORS, *PROJECTED])} (default DOP853)")
     parser.add_argument("--rtol", type=float, default=1e-9, help="relative tolerance (default 1e-9)")
-    parser.add_argument("--out", default="projeq-out", help="output directory (default ./projeq-out)")
+    parser.add_argument("--atol", type=float, default=1e-11, help="absolute tolerance (default 1e-11)")
+    parser.add_argument("--evaluator", choices=list(EVALUATORS), default=None,
+                        help="how the accelerations are computed (default: the model's own choice)")
+    parser.add_argument("--out", default=out, help=f"output directory (default ./{out})")
     parser.add_argument("--quiet", action="store_true", help="no progress bar, print nothing but errors")
+    json_option(parser)
+
+
+def simulate_options(args) -> dict:
+    """The keywords of :func:`projeq.simulate` given by :func:`simulation_options`."""
+    return {"method": args.method, "rtol": args.rtol, "atol": args.atol, "evaluator": args.evaluator}
+
+
+def scene_label(scene: str) -> str:
+    """The name of the scene in file names: itself, or ``FILE-FUNCTION`` for ``FILE.py:FUNCTION``."""
+    return "".join(c if c.isalnum() or c in "_-" else "-" for c in Path(scene.replace(".py:", "-")).name)
 
 
 def output_directory(text: str) -> Path:

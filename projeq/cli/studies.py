@@ -9,11 +9,12 @@ far are written).
 
 from __future__ import annotations
 
+import json
 import sys
 
 import numpy as np
 
-from projeq.cli.options import number, output_directory, scene_settings_option
+from projeq.cli.options import json_option, jsonable, number, output_directory, scene_settings_option
 from projeq.studies.compare import COMPARISONS, compare
 from projeq.studies.effort import DERIVATION_REPEATS
 from projeq.studies.tradeoff import METHODS, QUICK_TOLERANCES, format_table, get_study, plot, save_csv, tradeoff
@@ -28,13 +29,18 @@ def compare_arguments(parser) -> None:
     parser.add_argument("--formulation", action="append", help="restrict to these rows (repeatable)")
     parser.add_argument("--repeats", type=int, default=DERIVATION_REPEATS,
                         help=f"derivations per row, median reported (default {DERIVATION_REPEATS})")
+    json_option(parser)
     parser.set_defaults(execute=compare_formulations)
 
 
 def compare_formulations(args) -> int:
     table = compare(args.name, args.formulation, simulate=not args.no_simulate, t_end=args.t_end,
                     repeats=args.repeats)
-    print(table.format())
+    if args.json:
+        print(json.dumps({"name": table.name, "rows": table.rows, "effort": table.effort, "claims": table.claims},
+                         indent=2, default=jsonable))
+    else:
+        print(table.format())
     if args.csv:
         table.to_csv(args.csv)
     return 0

@@ -13,13 +13,14 @@ unless ``--allow-large``.
 from __future__ import annotations
 
 import contextlib
+import json
 import math
 import os
 import sys
 
 import numpy as np
 
-from projeq.cli.options import output_directory, simulation_options
+from projeq.cli.options import output_directory, scene_label, simulate_options, simulation_options
 
 
 MAX_POINTS = 100_000  # a larger grid needs --allow-large
@@ -42,10 +43,10 @@ def sweep_arguments(parser) -> None:
 
 
 def sweep_scene(args) -> int:
-    from projeq.scenes import get_scene, parse_settings
+    from projeq.scenes import parse_settings, resolve_scene
     from projeq.simulation.sweep import sweep
 
-    scene = get_scene(args.scene)
+    scene, label = resolve_scene(args.scene), scene_label(args.scene)
     fixed = parse_settings(scene, args.set)
     grid = _grid(scene, args.grid, fixed, args.allow_large)
     n_points = math.prod(len(values) for values in grid.values())
@@ -53,19 +54,24 @@ def sweep_scene(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers: expected a positive count, got {args.workers}")
     client = _dask_client(args.scheduler, args.scheduler_timeout) if args.scheduler else None
-    options = {"method": args.method, "rtol": args.rtol}
+    options = simulate_options(args)
+    quiet = args.quiet or args.json
     with client if client is not None else contextlib.nullcontext():  # a Dask client is closed also when --out is refused
         out = output_directory(args.out)
-        if not args.quiet:
+        if not quiet:
             where = f"the Dask scheduler at {args.scheduler}" if client else f"{args.workers or os.cpu_count()} local processes"
             print(f"sweep {args.scene}: {n_points} points on {where}; each is appended to "
-                  f"{out / f'sweep_{args.scene}.csv'} as it finishes", flush=True)
+                  f"{out / f'sweep_{label}.csv'} as it finishes", flush=True)
         table = sweep(scene, grid=grid, outputs=args.outputs.split(","), executor=client, t_end=args.t_end,
-                      progress=not args.quiet, path=out / f"sweep_{args.scene}", resume=args.resume,
+                      progress=not quiet, path=out / f"sweep_{label}", resume=args.resume,
                       workers=None if client else args.workers, **options)
-    files = [out / f"sweep_{args.scene}.csv", out / f"sweep_{args.scene}.npz"]
+    files = [out / f"sweep_{label}.csv", out / f"sweep_{label}.npz"]
     failed, partial = int((table["status"] == -1).sum()), int((table["status"] == 2).sum())
-    if not args.quiet:
+    if args.json:
+        print(json.dumps({"scene": args.scene, "options": options, "points": len(table["status"]), "failed": failed,
+                          "interrupted": partial, "files": [str(f) for f in files],
+                          "table": {k: np.asarray(v).tolist() for k, v in table.items()}}, indent=2, default=repr))
+    elif not args.quiet:
         print(f"{len(table['status'])} points, {failed} failed or not run, {partial} interrupted with partial results; "
               "wrote " + ", ".join(str(f) for f in files))
     for i in np.flatnonzero(table["status"] == -1):

@@ -122,6 +122,16 @@ class Joint:
         """q̇_n = K_n(q) ṡ_n + k_n(q, t)."""
         return self.K(q_n, t) @ s_dot_n
 
+    def coordinates(self) -> tuple:
+        """(name, unit) of each coordinate q_n, in order: what results, tables and plots call
+        them (``"<subsystem>.<name>"``). Default ``("q[i]", "")``, unit unknown; the standard
+        joints state theirs (a revolute joint's ``("angle", "rad")``)."""
+        return tuple((f"q[{i}]", "") for i in range(self.n_q))
+
+    def velocities(self) -> tuple:
+        """(name, unit) of each minimal velocity ṡ_n, in order (default ``("s_dot[i]", "")``)."""
+        return tuple((f"s_dot[{i}]", "") for i in range(self.n_s))
+
     def default_q(self) -> NDArray:
         """Coordinates of the reference configuration (zero unless a joint says otherwise)."""
         return np.zeros(self.n_q)

@@ -46,6 +46,12 @@ class Revolute(_OneAxis):
 
     compiled_kind = "revolute"
 
+    def coordinates(self):
+        return (("angle", "rad"),)
+
+    def velocities(self):
+        return (("angle_dot", "rad/s"),)
+
     def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
         super().__init__(parent, axis, r_pn, orientation, coupling)
         self._spin = axis_spin(self.axis)
@@ -64,6 +70,12 @@ class Prismatic(_OneAxis):
     """Translation x along the unit axis e: F⁶ = [e; 0], r = e x (docs/theory.md §4)."""
 
     compiled_kind = "prismatic"
+
+    def coordinates(self):
+        return (("position", "m"),)
+
+    def velocities(self):
+        return (("position_dot", "m/s"),)
 
     def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None, coupling=None):
         super().__init__(parent, axis, r_pn, orientation, coupling)
@@ -115,6 +127,12 @@ class Planar(Joint):
         self._F = np.zeros((6, 3))
         self._F[:3, 0], self._F[:3, 1], self._F[3:, 2] = a, b, n
 
+    def coordinates(self):
+        return (("a", "m"), ("b", "m"), ("angle", "rad"))
+
+    def velocities(self):  # the velocity of O_n along the child's axes a, b and the spin
+        return (("v_a", "m/s"), ("v_b", "m/s"), ("omega", "rad/s"))
+
     def _A(self, theta):
         return rodrigues(self._spin, theta)
 
@@ -160,6 +178,12 @@ class Free(Joint):
         """With the quaternion taken as unit (the numeric joint normalises it)."""
         A = algebra.quaternion_matrix(q_n[3:])
         return _scleronomic(A, sp.Matrix(q_n[:3]), sp.eye(6), sp.diag(A, algebra.quaternion_rate_matrix(q_n[3:])))
+
+    def coordinates(self):
+        return tuple((f"r_{a}", "m") for a in "xyz") + tuple((f"quat_{a}", "") for a in "wxyz")
+
+    def velocities(self):  # (v, ω) of the child in child coordinates
+        return tuple((f"v_{a}", "m/s") for a in "xyz") + tuple((f"omega_{a}", "rad/s") for a in "xyz")
 
     def default_q(self):
         return np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])

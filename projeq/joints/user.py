@@ -63,6 +63,17 @@ class UserJoint(Joint):
     def default_q(self):
         return self._q0.copy()
 
+    def coordinates(self):
+        """A joint from sympy: its symbols' names (units unknown); else the default q[i]."""
+        if self.symbols is None:
+            return super().coordinates()
+        return tuple((str(symbol), "") for symbol in self.symbols["q"])
+
+    def velocities(self):
+        if self.symbols is None:
+            return super().velocities()
+        return tuple((str(symbol), "") for symbol in self.symbols["s"])
+
     def constraint_residual(self, q_n, q_dot_n, t):
         if self._constraints is None:
             return np.zeros(0)

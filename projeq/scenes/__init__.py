@@ -7,6 +7,9 @@ maps the names the CLI knows to these functions.
 
 from __future__ import annotations
 
+import importlib.util
+import sys
+from pathlib import Path
 from typing import Callable, NamedTuple
 
 import numpy as np
@@ -134,6 +137,42 @@ def get_scene(name: str) -> Scene:
     return SCENES[name]
 
 
+def resolve_scene(text: str) -> Scene:
+    """The scene ``text`` names: a registered scene (:func:`get_scene`), or ``FILE.py:FUNCTION``,
+    a function in the user's file returning a System or ConstrainedSystem, whose keyword
+    parameters (with defaults) are the scene's parameters, its docstring's first line the
+    description and its attribute ``t_end`` (default 10) the end time in s. ValueError
+    naming what is missing."""
+    path, sep, function = text.rpartition(":")
+    if not sep or not path.endswith(".py"):
+        return get_scene(text)
+    module = _load_file(Path(path))
+    build = getattr(module, function, None)
+    if not callable(build):
+        found = [n for n, f in vars(module).items() if callable(f) and getattr(f, "__module__", None) == module.__name__]
+        raise ValueError(f"scene: {path} has no function {function!r}; its functions: {', '.join(found) or 'none'}")
+    description = (build.__doc__ or f"{function} from {path}").strip().splitlines()[0]
+    return Scene(build, description, float(getattr(build, "t_end", 10.0)))
+
+
+def _load_file(path: Path):
+    """The module of the Python file ``path``, loaded once (registered in sys.modules under
+    a name of its own, so that worker processes and pickles find its functions)."""
+    if not path.is_file():
+        raise ValueError(f"scene: no file {str(path)!r}")
+    name = "projeq_user_scene_" + "".join(c if c.isalnum() else "_" for c in str(path.resolve()))
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        try:
+            spec.loader.exec_module(module)
+        except Exception:
+            del sys.modules[name]
+            raise
+    return sys.modules[name]
+
+
 def build_scene(name: str, **overrides) -> System:
     """Build the registered scene ``name`` with parameters overridden by keyword.
 
@@ -149,5 +188,5 @@ __all__ = [
     "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed", "rolling_disk_inertia",
     "barhorst_particle", "nonholonomic_particle", "whipple_bicycle", "whipple_eigenvalues",
     "quick_return", "four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",
-    "Scene", "SCENES", "DEFAULT_SCENE", "get_scene", "build_scene", "scene_parameters", "parse_settings", "Parameter",
+    "Scene", "SCENES", "DEFAULT_SCENE", "get_scene", "resolve_scene", "build_scene", "scene_parameters", "parse_settings", "Parameter",
 ]

@@ -75,13 +75,13 @@ def four_bar(a: float = 0.3, b: float = 1.0, c: float = 0.8, d: float = 1.0, m=(
     rate q̇3, which degenerates at the rocker's extreme positions).
     """
     tree = System(
-        {"crank": _rod(m[0], a), "coupler": _rod(m[1], b), "rocker": _rod(m[2], c)},
-        {"crank": Revolute(axis="z"), "coupler": Revolute(parent="crank", axis="z", r_pn=(a, 0.0, 0.0)),
-         "rocker": Revolute(axis="z", r_pn=(d, 0.0, 0.0))},
+        {"crank": _rod(m[0], a), "rocker": _rod(m[2], c), "coupler": _rod(m[1], b)},
+        {"crank": Revolute(axis="z"), "rocker": Revolute(axis="z", r_pn=(d, 0.0, 0.0)),
+         "coupler": Revolute(parent="crank", axis="z", r_pn=(a, 0.0, 0.0))},
         gravity=(0.0, -g, 0.0),
     )
 
-    def closure(q, t):  # q = (q1, q3, q2): the tree orders crank, rocker (both on the ground), coupler
+    def closure(q, t):  # q = (q1, q3, q2): crank, rocker (both on the ground), coupler (parents first)
         return [a * np.cos(q[0]) + b * np.cos(q[0] + q[2]) - d - c * np.cos(q[1]),
                 a * np.sin(q[0]) + b * np.sin(q[0] + q[2]) - c * np.sin(q[1])]
 

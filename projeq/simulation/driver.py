@@ -324,7 +324,9 @@ def _assemble(run: _Run, wall_time: float, dense_output: bool) -> Result:
         constraint_residual=residual, nfev=int(run.nfev), wall_time=wall_time,
         status=int(run.status), message=str(run.message), t_events=t_events, q_events=q_events,
         s_dot_events=s_dot_events, names=system.names, method=getattr(run.method, "__name__", str(run.method)),
-        partitions=partitions, sol=_dense_solution(pieces, n_q) if dense_output and pieces else None, system=system,
+        partitions=partitions, coordinates=system.coordinates(),
+        velocities=system.velocities() if len(partitions) < 2 else tuple((f"s_dot[{i}]", "") for i in range(n_s)),
+        sol=_dense_solution(pieces, n_q) if dense_output and pieces else None, system=system,
     )
 
 

@@ -1,10 +1,13 @@
 """Results for other tools: a VTU time series for ParaView (via meshio).
 
-Each output time becomes one ``.vtu`` file with the system drawn in inertial coordinates:
-beam centre lines as polylines (subsystems that ``deform``, ``centre_line``) and every other
-subsystem as a small frame glyph (three line segments along its axes). Point data:
-``displacement`` (from the first time) and ``velocity`` (exact, from the kinematics);
-a ``.pvd`` collection file ties the steps together with their times.
+Each output time becomes two ``.vtu`` files in inertial coordinates. The bodies: beam centre
+lines as polylines (subsystems that ``deform``, ``centre_line``) and every other subsystem
+as a small frame glyph (three line segments along its axes), with the point data
+``displacement`` (from the first time) and ``velocity`` (exact, from the kinematics). The
+mechanism: a line from each subsystem's joint to its children's joints and to its centre of
+mass, with the cell data ``body`` (numbers named in ``<name>_bodies.csv``). A ``.pvd``
+collection file ties the steps together with their times. :func:`system_of` rebuilds the
+model of a Result loaded from a file from its run record, so a saved run can be exported.
 
 Every file is written through :func:`written_atomically`: under a temporary name in its
 directory, renamed when complete, so a full disk or a killed process never leaves a
@@ -64,26 +67,79 @@ def _draw(system, q, s_dot, t, stations: int, frame_size: float):
     return np.vstack(points), np.vstack(velocities), np.array(lines)
 
 
-def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21, frame_size: float = 0.1) -> Path:
-    """Write ``result`` as ``directory/name_####.vtu`` files and ``directory/name.pvd``.
+def _skeleton(system, q, s_dot, t):
+    """Points and line cells of the mechanism at one state, with the cell data ``body`` (the
+    subsystem's number in ``system.names``) and ``kind``: 0 a line from a subsystem's joint
+    to the joint of a child, 1 from its joint to its centre of mass (rigid bodies: from
+    ``rigid_inertia``). Deforming subsystems are left to their centre lines (:func:`_draw`)."""
+    tree, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
+    kin = poses(tree, q, s_dot, t)
+    points, lines, body, kind = [np.asarray(r, dtype=float) for r in kin.r[: len(tree.names)]], [], [], []
+    for n, sub in enumerate(tree.subsystems):
+        if sub.deforms:
+            continue
+        for child in (c for c, p in enumerate(tree.parent) if p == n):
+            lines.append((n, child)), body.append(n), kind.append(0)
+        if sub.rigid_inertia is not None and np.any(sub.rigid_inertia[1] != 0):
+            points.append(kin.r[n] + kin.R[n] @ sub.rigid_inertia[1])
+            lines.append((n, len(points) - 1)), body.append(n), kind.append(1)
+    return np.vstack(points), np.array(lines, dtype=int).reshape(-1, 2), np.array(body), np.array(kind)
 
-    Needs ``result.system`` (a Result returned by :func:`projeq.simulate`). Returns the
-    path of the ``.pvd`` file, which ParaView opens as a time series.
+
+def system_of(result):
+    """The model of ``result``: ``result.system`` (a Result from :func:`projeq.simulate`), or
+    for a Result loaded from a file the scene its run record names, built again with the
+    recorded parameters (``result.metadata``, written by ``projeq run``); ValueError when
+    neither is there."""
+    if result.system is not None:
+        return result.system
+    record = result.metadata or {}
+    if "scene" not in record:
+        raise ValueError("result: has no system and no run record naming its scene (saved by an earlier version, "
+                         "or by Result.save without metadata); export a Result from simulate()")
+    from projeq.scenes import resolve_scene
+
+    try:
+        return resolve_scene(record["scene"]).build(**record.get("parameters", {}))
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"result: cannot rebuild its scene {record['scene']!r} from the recorded parameters: {exc}") from None
+
+
+def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21, frame_size: float = 0.1,
+                     system=None) -> Path:
+    """Write ``result`` as ``directory/name_####.vtu`` files (the bodies: beam centre lines,
+    frame glyphs), ``directory/name_mechanism_####.vtu`` (the mechanism: lines joining each
+    subsystem's joint to its children's joints and to its centre of mass, cell data ``body``
+    and ``kind``, :func:`_skeleton`), ``directory/name_bodies.csv`` (body number, subsystem
+    name, joint type) and ``directory/name.pvd``, which ParaView opens as a time series of
+    the two parts.
+
+    ``system``: the model (default :func:`system_of` the result: its own, or the scene its
+    run record names, so that a saved run can be exported later). Returns the ``.pvd`` path.
     """
-    system = result.system
-    if system is None:
-        raise ValueError("result: has no system (loaded from a file?); export a Result from simulate()")
+    system = system if system is not None else system_of(result)
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     entries, reference = [], None
     for k, (model, t, q, s_dot) in enumerate(zip(system.row_models(result), result.t, result.q, result.s_dot)):
         points, velocity, lines = _draw(model, q, s_dot, t, stations, frame_size)
         reference = points if reference is None else reference
-        path = directory / f"{name}_{k:04d}.vtu"
-        mesh = meshio.Mesh(points, [("line", lines)], point_data={"displacement": points - reference, "velocity": velocity})
-        with written_atomically(path) as temporary:
-            mesh.write(temporary)
-        entries.append(f'    <DataSet timestep="{t:.12g}" part="0" file={quoteattr(path.name)}/>')
+        meshes = {
+            0: (f"{name}_{k:04d}.vtu", meshio.Mesh(points, [("line", lines)],
+                                                    point_data={"displacement": points - reference, "velocity": velocity})),
+        }
+        joints, links, body, kind = _skeleton(model, q, s_dot, t)
+        if len(links):
+            meshes[1] = (f"{name}_mechanism_{k:04d}.vtu",
+                         meshio.Mesh(joints, [("line", links)], cell_data={"body": [body], "kind": [kind]}))
+        for part, (file, mesh) in meshes.items():
+            with written_atomically(directory / file) as temporary:
+                mesh.write(temporary)
+            entries.append(f'    <DataSet timestep="{t:.12g}" part="{part}" file={quoteattr(file)}/>')
+    tree = system.tree
+    with written_atomically(directory / f"{name}_bodies.csv") as temporary:
+        temporary.write_text("body,name,joint\n" + "".join(
+            f"{n},{label},{type(joint).__name__}\n" for n, (label, joint) in enumerate(zip(tree.names, tree.joints))))
     pvd = directory / f"{name}.pvd"
     with written_atomically(pvd) as temporary:  # last: it names only files already complete
         temporary.write_text(

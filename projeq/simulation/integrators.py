@@ -59,14 +59,17 @@ def energy_manifold(system, q0, s_dot0, t0: float = 0.0):
     True
     """
     n_q = system.n_q
-
-    def energy(x: NDArray, t: float) -> tuple[float, float]:
-        T, V = system.energy(system.normalized(x[:n_q]), x[n_q:], t)
-        return T + V, abs(T) + abs(V)
-
+    energy = _energy_function(system)
     x0 = np.concatenate((np.asarray(q0, dtype=float), np.asarray(s_dot0, dtype=float)))
     E0 = energy(x0, t0)[0]
-    _check_conservative(system, x0, t0, energy)
+    change = _energy_change(system, x0, t0, energy)
+    if change is not None:
+        raise ValueError(
+            f"method: the projected integrators keep the energy constant, but this system's energy "
+            f"changes along its motion (dE/dt = {change[0]:.3g} at t = {change[1]:.3g}); it is not conservative "
+            "and scleronomic (a driven or prescribed joint, a damper or a time-dependent load): use a "
+            "method of solve_ivp"
+        )
 
     def project(t: float, x) -> NDArray:
         x = np.array(x, dtype=float)
@@ -87,11 +90,31 @@ def energy_manifold(system, q0, s_dot0, t0: float = 0.0):
     return project
 
 
-def _check_conservative(system, x0: NDArray, t0: float, energy) -> None:
-    """ValueError unless dE/dt = ∇E · ẋ + ∂E/∂t ≈ 0, relative to the size of its terms
-    |∇E| |ẋ| + |∂E/∂t| (central differences are good to ~1e-10 of it), at the initial
-    state and at probes: later times (a prescribed motion may start from rest, with zero
-    drive power at t0) and perturbed velocities (a damper does no work at rest)."""
+def conserves_energy(system, q0, s_dot0, t0: float = 0.0) -> bool:
+    """Whether the energy T + V of ``system`` stays constant along its motions: False for a
+    prescribed (driven) motion, a damper or a time-dependent load, detected as dE/dt ≠ 0 at
+    (q0, ṡ0, t0) or at the probes of :func:`_energy_change`."""
+    x0 = np.concatenate((np.asarray(q0, dtype=float), np.asarray(s_dot0, dtype=float)))
+    return _energy_change(system, x0, t0, _energy_function(system)) is None
+
+
+def _energy_function(system):
+    """x ↦ (E, |T| + |V|) at time t, with q normalised."""
+    n_q = system.n_q
+
+    def energy(x: NDArray, t: float) -> tuple[float, float]:
+        T, V = system.energy(system.normalized(x[:n_q]), x[n_q:], t)
+        return T + V, abs(T) + abs(V)
+
+    return energy
+
+
+def _energy_change(system, x0: NDArray, t0: float, energy) -> tuple[float, float] | None:
+    """(dE/dt, t) where dE/dt = ∇E · ẋ + ∂E/∂t is distinguishable from 0, relative to the
+    size of its terms |∇E| |ẋ| + |∂E/∂t| (central differences are good to ~1e-10 of it), at
+    the initial state and at probes: later times (a prescribed motion may start from rest,
+    with zero drive power at t0) and perturbed velocities (a damper does no work at rest);
+    None where it is zero at all of them."""
     n_q = system.n_q
     rng = np.random.default_rng(0)
     s_dot_probe = x0[n_q:] + 0.1 * (1.0 + np.abs(x0[n_q:])) * rng.standard_normal(len(x0) - n_q)
@@ -99,12 +122,8 @@ def _check_conservative(system, x0: NDArray, t0: float, energy) -> None:
         for x in (x0, np.concatenate((x0[:n_q], s_dot_probe))):
             E_dot = _energy_rate(system, x, t, energy)
             if E_dot is not None:
-                raise ValueError(
-                    f"method: the projected integrators keep the energy constant, but this system's energy "
-                    f"changes along its motion (dE/dt = {E_dot:.3g} at t = {t:.3g}); it is not conservative "
-                    "and scleronomic (a driven or prescribed joint, a damper or a time-dependent load): use a "
-                    "method of solve_ivp"
-                )
+                return E_dot, t
+    return None
 
 
 def _energy_rate(system, x: NDArray, t: float, energy) -> float | None:

@@ -9,27 +9,72 @@ from __future__ import annotations
 import numpy as np
 
 
-def _figure(rows: int = 1):
+ROUND_OFF = 1e-16  # the lowest constraint residual shown: below it is round-off
+
+
+def _figure(rows: int = 1, width: float = 7.0):
     from matplotlib.figure import Figure  # a Figure without pyplot: no GUI backend, no global state
 
-    fig = Figure(figsize=(7.0, 2.6 * rows + 0.8), layout="constrained")
+    fig = Figure(figsize=(width, 2.6 * rows + 0.8), layout="constrained")
     return fig, fig.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
 
 
+def _legend_outside(ax) -> None:
+    """The legend right of the axes, where it hides no data."""
+    ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+
+
 def time_history(result, names=None):
-    """q(t) (top) and ṡ(t) (bottom); ``names`` labels the coordinates (default q0, q1, ...)."""
-    fig, (ax_q, ax_s) = _figure(2)
-    names = names or [f"q{i}" for i in range(result.q.shape[1])]
-    for i, name in enumerate(names):
+    """q(t) (top) and ṡ(t) (bottom), each line labelled by its name (``names`` for q, default
+    the result's, :meth:`projeq.Result.column_names`); :func:`grouped_history` separates
+    angles, translations and elastic coordinates."""
+    fig, (ax_q, ax_s) = _figure(2, width=9.0)
+    q_names, s_names = result.column_names(units=True)
+    for i, name in enumerate(names or q_names):
         ax_q.plot(result.t, result.q[:, i], label=name)
-    for i in range(result.s_dot.shape[1]):
-        ax_s.plot(result.t, result.s_dot[:, i], label=f"ṡ{i}")
-    ax_q.set_ylabel("q (rad or m)")
-    ax_s.set_ylabel("ṡ (rad/s or m/s)")
+    for i, name in enumerate(s_names):
+        ax_s.plot(result.t, result.s_dot[:, i], label=name)
+    ax_q.set_ylabel("q")
+    ax_s.set_ylabel("ṡ")
     ax_s.set_xlabel("t (s)")
     for ax in (ax_q, ax_s):
         ax.grid(alpha=0.3)
-        ax.legend(fontsize="small", ncol=min(6, max(1, len(ax.lines))), loc="upper right")
+        _legend_outside(ax)
+    return fig
+
+
+def _group(name: str, unit: str, elastic: bool, velocity: bool) -> tuple[str, str]:
+    """(kind, unit) of one column: the axes it is drawn on."""
+    if elastic:
+        return ("elastic velocities" if velocity else "elastic coordinates"), unit or "unit unknown"
+    kinds = {"rad": "joint angles", "m": "translations", "rad/s": "angular velocities", "m/s": "velocities"}
+    return kinds.get(unit, "velocities" if velocity else "coordinates"), unit or "unit unknown"
+
+
+def grouped_history(result):
+    """q(t) and ṡ(t) on one axes per kind and unit: joint angles (rad), translations (m),
+    elastic coordinates (a deforming subsystem's, from ``result.system``), others by unit,
+    then their velocities; legends outside the data."""
+    system = result.system.tree if result.system is not None else None
+    elastic_q = set(i for sl in (system.e_q_slice if system else ()) for i in range(sl.start, sl.stop))
+    elastic_s = set(i for sl in (system.e_s_slice if system else ()) for i in range(sl.start, sl.stop))
+    if result.system is not None and result.system.partition is not None:
+        elastic_s = {k for k, i in enumerate(result.system.partition) if i in elastic_s}
+    q_names, s_names = result.column_names()
+    groups: dict = {}
+    for values, names, named, elastic, velocity in ((result.q, q_names, result.coordinates, elastic_q, False),
+                                                    (result.s_dot, s_names, result.velocities, elastic_s, True)):
+        for i, name in enumerate(names):
+            unit = named[i][1] if i < len(named) else ""
+            groups.setdefault(_group(name, unit, i in elastic, velocity), []).append((name, values[:, i]))
+    fig, axes = _figure(max(1, len(groups)), width=9.0)
+    for ax, ((kind, unit), lines) in zip(axes, groups.items()):
+        for name, values in lines:
+            ax.plot(result.t, values, label=name)
+        ax.set_ylabel(f"{kind}\n({unit})")
+        ax.grid(alpha=0.3)
+        _legend_outside(ax)
+    axes[-1].set_xlabel("t (s)")
     return fig
 
 
@@ -47,16 +92,24 @@ def planar_trajectory(result, x: int = 0, y: int = 1):
     return fig
 
 
-def drift(result):
-    """Energy change E(t) − E(0) (top) and the largest velocity-constraint residual (bottom)."""
-    fig, (ax_e, ax_c) = _figure(2)
-    ax_e.plot(result.t, result.energy - result.energy[0])
-    ax_e.set_ylabel("E(t) − E(0) (J)")
-    residual = np.abs(result.constraint_residual).max(axis=1) if result.constraint_residual.size else 0 * result.t
-    ax_c.semilogy(result.t, np.maximum(residual, 1e-300))
-    ax_c.set_ylabel("max |constraint residual|")
-    ax_c.set_xlabel("t (s)")
-    for ax in (ax_e, ax_c):
+def drift(result, energy_conserved: bool | None = None):
+    """Energy change E(t) − E(0) (top) and, for a model with constraints, the largest
+    velocity-constraint residual (bottom, its axis floored at round-off, :data:`ROUND_OFF`).
+    ``energy_conserved=False`` titles the energy panel with why it need not be constant
+    (:func:`projeq.simulation.integrators.conserves_energy`)."""
+    constrained = result.constraint_residual.size > 0
+    fig, axes = _figure(2 if constrained else 1)
+    axes[0].plot(result.t, result.energy - result.energy[0])
+    axes[0].set_ylabel("E(t) − E(0) (J)")
+    if energy_conserved is False:
+        axes[0].set_title("energy not conserved: a prescribed motion or non-conservative forces", fontsize="small")
+    if constrained:
+        residual = np.abs(result.constraint_residual).max(axis=1)
+        axes[1].semilogy(result.t, np.maximum(residual, 1e-300))
+        axes[1].set_ylim(bottom=ROUND_OFF, top=max(10 * ROUND_OFF, 2 * residual.max()))
+        axes[1].set_ylabel("max |constraint residual|")
+    axes[-1].set_xlabel("t (s)")
+    for ax in axes:
         ax.grid(alpha=0.3)
     return fig
 

@@ -37,6 +37,11 @@ class Result:
     fired and the states (k, n_q) and (k, n_s) there. A terminal event's state is also the
     last row: the output ends at the event, not at the last output time before it.
     names : subsystem names; sol : dense output ``sol(t) -> (q, s_dot)`` or None
+    coordinates, velocities : (name, unit) of each column of q and of s_dot
+    (:meth:`projeq.system.Model.coordinates`, e.g. ``("elbow.angle", "rad")``); a run that
+    changed its partition has velocities ``("s_dot[i]", "")`` (see ``partitions``)
+    metadata : what the caller records with the run (the command line: scene, parameters,
+    tolerances, method, evaluator, projeq version), saved with it
     partitions : ((t_k, independent_k), ...) of a ConstrainedSystem, one per partition used
     (more than one if it re-pivoted): rows (and ``sol(t)``) with t_k < t ≤ t_k+1 hold the
     tree velocities independent_k in ``s_dot`` (:mod:`projeq.constraints.partitioned`); empty for other systems
@@ -58,6 +63,9 @@ class Result:
     names: tuple = ()
     method: str = ""
     partitions: tuple = ()
+    coordinates: tuple = ()
+    velocities: tuple = ()
+    metadata: dict = field(default_factory=dict)
     sol: object = field(default=None, repr=False, compare=False)
     system: object = field(default=None, repr=False, compare=False)  # in memory only, not saved
 
@@ -75,6 +83,16 @@ class Result:
         scale = max(np.abs(self.kinetic).max(), np.abs(self.potential).max(), 1e-300)
         return float(np.abs(self.energy - self.energy[0]).max() / scale)
 
+    def column_names(self, units: bool = False) -> tuple[list[str], list[str]]:
+        """(names of q's columns, names of ṡ's columns), ``"elbow.angle"`` or with
+        ``units`` ``"elbow.angle (rad)"``; ``q[i]``, ``s_dot[i]`` where none are known."""
+        def label(named, i, default):
+            name, unit = named[i] if i < len(named) else (default, "")
+            return f"{name} ({unit})" if units and unit else name
+
+        return ([label(self.coordinates, i, f"q[{i}]") for i in range(self.q.shape[1])],
+                [label(self.velocities, i, f"s_dot[{i}]") for i in range(self.s_dot.shape[1])])
+
     @property
     def success(self) -> bool:
         """True when the run reached its end or a terminal event."""
@@ -89,6 +107,8 @@ class Result:
             "nfev": self.nfev, "wall_time": self.wall_time, "status": self.status,
             "message": self.message, "names": list(self.names), "method": self.method,
             "partitions": [[t, list(independent)] for t, independent in self.partitions],
+            "coordinates": [list(c) for c in self.coordinates], "velocities": [list(v) for v in self.velocities],
+            "metadata": self.metadata,
         }
         events = {f"{name}_{i}": np.asarray(e) for name in _EVENT_ARRAYS for i, e in enumerate(getattr(self, name))}
         if hasattr(path, "write"):  # an open file
@@ -109,6 +129,8 @@ class Result:
             arrays = {k: data[k] for k in data.files if k != "meta" and not k.startswith(_EVENT_ARRAYS)}
         meta["names"] = tuple(meta["names"])
         meta["partitions"] = tuple((t, tuple(independent)) for t, independent in meta.get("partitions", ()))
+        for key in ("coordinates", "velocities"):  # absent from files of earlier versions
+            meta[key] = tuple(tuple(pair) for pair in meta.get(key, ()))
         return cls(**arrays, **meta, **events)
 
 

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from projeq.checks import drop_inherited_twins
 
 REQUIRED = ("n_y", "gauss_terms", "kinetic_energy", "potential_energy")  # no default
-DEFAULTS = ("S", "n_e", "rigid_inertia", "elastic_terms", "port_at")  # optional members with a default
+DEFAULTS = ("S", "n_e", "rigid_inertia", "elastic_terms", "port_at", "coordinates")  # optional members with a default
 _ABSENT = object()
 DERIVED = ("rigid_inertia", "elastic_terms")  # derived from gauss_terms: reset where it is restated
 CAPABILITIES = {"has_ports": ("port",), "deforms": ("centre_line", "deflection")}  # flag: its methods
@@ -100,6 +100,12 @@ class Subsystem:
         coordinates of a subsystem on a hub of given motion need (M_ee q̈_e = h_e − M_eR ζ)."""
         M, h = self.gauss_terms(y_dot, R, gravity, q_e)
         return M[-self.n_e :], h[-self.n_e :]
+
+    def coordinates(self) -> tuple:
+        """(name, unit) of each internal coordinate q_e, in order (results, tables and plots
+        call them ``"<subsystem>.<name>"``; their velocities ṡ_e = q̇_e ``"<name>_dot"``).
+        Default ``("e[i]", "")``, unit unknown; a beam states its Ritz amplitudes."""
+        return tuple((f"e[{i}]", "") for i in range(self.n_e))
 
     def port(self, point: NDArray, q_e: NDArray, q_e_dot: NDArray):
         """(``has_ports``) The frame at the station ``point`` (reference-frame coordinates of

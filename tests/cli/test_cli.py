@@ -55,10 +55,11 @@ def test_run_writes_results_that_load_back(tmp_path, capsys):
     the ParaView series written."""
     assert main(["run", "--t-end", "0.2", "--out", str(tmp_path), "--quiet"]) == 0
     assert capsys.readouterr().out == ""
-    result = pq.Result.load(tmp_path / "spin_up_beam.npz")
-    table = np.loadtxt(tmp_path / "spin_up_beam.csv", delimiter=",", skiprows=1)
-    assert np.allclose(table[:, 0], result.t) and (tmp_path / "paraview" / "spin_up_beam.pvd").exists()
-    assert {p.name for p in tmp_path.glob("*.png")} == {
+    run, = tmp_path.iterdir()  # the run's own folder
+    result = pq.Result.load(run / "spin_up_beam.npz")
+    table = np.loadtxt(run / "spin_up_beam.csv", delimiter=",", skiprows=1)
+    assert np.allclose(table[:, 0], result.t) and (run / "paraview" / "spin_up_beam.pvd").exists()
+    assert {p.name for p in run.glob("*.png")} == {
         "spin_up_beam_history.png", "spin_up_beam_drift.png", "spin_up_beam_tip_beam.png"}
 
 
@@ -67,7 +68,7 @@ def test_set_overrides_a_parameter(tmp_path, capsys):
     (constant acceleration; rtol 1e-10 gives ~1e-10, checked to 1e-8 relative)."""
     assert main(["run", "atwood", "--set", "m1=3", "--t-end", "0.5", "--rtol", "1e-10", "--out", str(tmp_path)]) == 0
     assert "energy" in capsys.readouterr().out
-    result = pq.Result.load(tmp_path / "atwood.npz")
+    result = pq.Result.load(next(tmp_path.rglob("atwood.npz")))
     assert result.q[-1, 0] == pytest.approx(atwood_angle(3.0, 0.5), rel=1e-8)
 
 
@@ -82,7 +83,7 @@ def test_failed_run_exits_1_with_partial_results(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(projeq.simulation.driver, "simulate", failing)
     assert main(["run", "chain", "--t-end", "0.2", "--out", str(tmp_path), "--quiet"]) == 1
     assert "failed at t = 0.1" in capsys.readouterr().err
-    assert pq.Result.load(tmp_path / "chain.npz").t[-1] == pytest.approx(0.1)
+    assert pq.Result.load(next(tmp_path.rglob("chain.npz"))).t[-1] == pytest.approx(0.1)
 
 
 def test_ctrl_c_exits_1_and_keeps_the_trajectory(tmp_path, capsys, monkeypatch):
@@ -101,7 +102,7 @@ def test_ctrl_c_exits_1_and_keeps_the_trajectory(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(projeq.simulation.driver, "simulate", interrupted)
     assert main(["run", "chain", "--t-end", "1", "--out", str(tmp_path), "--quiet"]) == 1
     assert "interrupted at t = " in capsys.readouterr().err
-    saved = pq.Result.load(tmp_path / "chain.npz")
+    saved = pq.Result.load(next(tmp_path.rglob("chain.npz")))
     assert saved.status == 2 and 0.1 < saved.t[-1] < 1.0
 
 
@@ -146,7 +147,7 @@ def test_a_real_ctrl_c_during_run_writes_the_trajectory_so_far(tmp_path):
     finished segment (1 % of the run) are written and load back."""
     code, err = ctrl_c(["run", "chain", "--set", "n=1", "--t-end", "1000", "--out", str(tmp_path), "--quiet"])
     assert code == 1 and "interrupted at t = " in err and "Traceback" not in err
-    saved = pq.Result.load(tmp_path / "chain.npz")
+    saved = pq.Result.load(next(tmp_path.rglob("chain.npz")))
     assert saved.status == 2 and 10.0 <= saved.t[-1] < 1000.0
 
 

@@ -4,6 +4,7 @@ import xml.etree.ElementTree as ET
 
 import meshio
 import numpy as np
+import pytest
 
 import projeq as pq
 from projeq.simulation.export import write_vtu_series
@@ -17,8 +18,9 @@ def test_vtu_series_of_an_elastic_arm(tmp_path):
     system = elastic_arm(n_shapes=2)
     result = pq.simulate(system, 0.05, method="RK45", rtol=1e-8, atol=1e-10, n_points=3)
     pvd = write_vtu_series(result, tmp_path, name="arm", stations=5)
-    files = [d.attrib["file"] for d in ET.parse(pvd).getroot().iter("DataSet")]
-    times = [float(d.attrib["timestep"]) for d in ET.parse(pvd).getroot().iter("DataSet")]
+    bodies = [d for d in ET.parse(pvd).getroot().iter("DataSet") if d.attrib["part"] == "0"]  # part 1: the mechanism
+    files = [d.attrib["file"] for d in bodies]
+    times = [float(d.attrib["timestep"]) for d in bodies]
     assert len(files) == 3 and np.allclose(times, result.t)
     mesh = meshio.read(tmp_path / files[-1])
     # layout: link1 frame (4 points), beam centre line (5 points), tip frame (4 points)
@@ -33,3 +35,42 @@ def test_vtu_series_of_an_elastic_arm(tmp_path):
     assert np.allclose(mesh.points[8], expected_tip, atol=1e-12)
     assert np.allclose(mesh.point_data["velocity"][0], 0.0, atol=1e-12)
     assert mesh.cells_dict["line"].shape == (3 + 4 + 3, 2)
+
+
+def test_the_double_pendulums_mechanism_joins_its_joints_by_1_m_links(tmp_path):
+    """The mechanism part of the ParaView series: a line from the upper joint (the origin) to
+    the lower joint and from each joint to its bob (point masses at 1 m): three line cells
+    of length l1 = l2 = 1 m, the lower joint at r = l1 (−sin θ1, 0, −cos θ1), the first rod
+    (along −z at θ1 = 0) turned by θ1 about +y."""
+    system = pq.scenes.double_pendulum()
+    result = pq.simulate(system, 0.3, n_points=4)
+    pvd = write_vtu_series(result, tmp_path, name="dp")
+    mechanism = [d.attrib["file"] for d in ET.parse(pvd).getroot().iter("DataSet") if d.attrib["part"] == "1"]
+    assert len(mechanism) == 4
+    mesh = meshio.read(tmp_path / mechanism[-1])
+    lines = mesh.cells_dict["line"]
+    lengths = np.linalg.norm(mesh.points[lines[:, 1]] - mesh.points[lines[:, 0]], axis=1)
+    assert lines.shape == (3, 2) and np.allclose(lengths, 1.0, rtol=0, atol=1e-12)
+    theta1 = result.q[-1, 0]
+    assert np.allclose(mesh.points[1], [-np.sin(theta1), 0.0, -np.cos(theta1)], atol=1e-12)
+    assert mesh.cell_data["body"][0].tolist() == [0, 0, 1] and mesh.cell_data["kind"][0].tolist() == [0, 1, 1]
+    assert (tmp_path / "dp_bodies.csv").read_text().splitlines() == ["body,name,joint", "0,bob1,Revolute",
+                                                                     "1,bob2,Revolute"]
+
+
+def test_a_saved_run_is_exported_from_its_run_record(tmp_path):
+    """A Result loaded from a file has no system; its run record (metadata: scene and
+    parameters) rebuilds it, and the export equals the one of the Result in memory."""
+    system = pq.scenes.double_pendulum(l1=0.5)
+    result = pq.simulate(system, 0.2, n_points=3)
+    path = tmp_path / "dp.npz"
+    from dataclasses import replace
+
+    replace(result, metadata={"scene": "double_pendulum", "parameters": {"l1": 0.5}}).save(path)
+    later = write_vtu_series(pq.Result.load(path), tmp_path / "later", name="dp")
+    now = write_vtu_series(result, tmp_path / "now", name="dp")
+    for part in ("dp_0002.vtu", "dp_mechanism_0002.vtu"):
+        assert np.array_equal(meshio.read(later.parent / part).points, meshio.read(now.parent / part).points)
+    pq.Result.save(result, tmp_path / "bare.npz")
+    with pytest.raises(ValueError, match="no run record"):
+        write_vtu_series(pq.Result.load(tmp_path / "bare.npz"), tmp_path / "bare")

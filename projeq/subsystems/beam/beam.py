@@ -298,6 +298,12 @@ class RitzBeam(BeamProbes, Subsystem):
             M += np.einsum("ka,kai,kaj->ij", self.rotary, Phi_theta, Phi_theta)
         return M
 
+    def coordinates(self) -> tuple:
+        """The Ritz amplitudes in the order of q_e: axial u[i], bending v[i] and w[i] (m, the
+        shape functions are dimensionless) and torsion beta[i] (rad)."""
+        groups = (("u", self.n_u, "m"), ("v", self.n_v, "m"), ("w", self.n_w, "m"), ("beta", self.n_beta, "rad"))
+        return tuple((f"{name}[{i}]", unit) for name, n, unit in groups for i in range(n))
+
     # -- slice kinematics ------------------------------------------------------------------
     def slices(self, q_e: NDArray, x: NDArray | None = None, data=None):
         """r(x) and Φ_r(x, q_e) at the quadrature stations (or at ``x`` with its

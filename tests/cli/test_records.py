@@ -1,0 +1,133 @@
+"""Run records and CLI conventions: a folder per run with run.json, named CSV columns, --json
+on list, run, sweep and compare, the simulation options on run and sweep, user scenes from
+a file, ParaView files of a saved run."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import projeq as pq
+import projeq.cli.studies
+from projeq.cli.commands import main
+
+
+def run_folder(out):
+    folder, = out.iterdir()
+    return folder
+
+
+def test_each_run_gets_a_folder_with_its_record(tmp_path, capsys):
+    """Two runs of the same scene into the same --out: two folders, nothing overwritten; the
+    record names scene, parameters, tolerances, method, evaluator, version and command line;
+    the NPZ carries the same record, and its last state is the record's."""
+    argv = ["run", "double_pendulum", "--t-end", "0.2", "--rtol", "1e-8", "--atol", "1e-10", "--method", "RK45",
+            "--evaluator", "dense", "--set", "l1=0.5", "--out", str(tmp_path), "--quiet"]
+    assert main(argv) == 0 and main(argv) == 0
+    folders = sorted(tmp_path.iterdir())
+    assert len(folders) == 2 and all(f.name.startswith("double_pendulum-") for f in folders)
+    record = json.loads((folders[0] / "run.json").read_text())
+    assert record["scene"] == "double_pendulum" and record["parameters"]["l1"] == 0.5
+    assert record["parameters"]["m2"] == 1.0  # defaults recorded too
+    assert record["tolerances"] == {"rtol": 1e-8, "atol": 1e-10} and record["method"] == "RK45"
+    assert record["evaluator"] == "dense" and record["projeq_version"] == pq.__version__
+    assert record["command_line"] == ["projeq", *argv] and record["status"] == "finished"
+    assert record["exit_code"] == 0 and record["cpu_time"] > 0 and record["wall_time"] > 0
+    assert "double_pendulum.npz" in record["files"] and record["energy"]["conserved"] is True
+    result = pq.Result.load(folders[0] / "double_pendulum.npz")
+    assert result.metadata["scene"] == "double_pendulum" and result.metadata["tolerances"]["atol"] == 1e-10
+    assert record["final_q"] == {"bob1.angle": result.q[-1, 0], "bob2.angle": result.q[-1, 1]}
+
+
+def test_the_csv_names_its_columns_with_units(tmp_path):
+    """``projeq run double_pendulum``: the CSV header is t, the joint angles and their rates by
+    name with units, the energies; its columns are the NPZ's arrays."""
+    assert main(["run", "double_pendulum", "--t-end", "0.1", "--out", str(tmp_path), "--quiet"]) == 0
+    folder = run_folder(tmp_path)
+    with (folder / "double_pendulum.csv").open() as stream:
+        header = next(csv.reader(stream))
+    assert header == ["t (s)", "bob1.angle (rad)", "bob2.angle (rad)", "bob1.angle_dot (rad/s)",
+                      "bob2.angle_dot (rad/s)", "kinetic (J)", "potential (J)"]
+    table = np.loadtxt(folder / "double_pendulum.csv", delimiter=",", skiprows=1)
+    result = pq.Result.load(folder / "double_pendulum.npz")
+    assert np.array_equal(table[:, 1:3], result.q) and np.array_equal(table[:, 3:5], result.s_dot)
+
+
+def test_the_summary_names_the_state_and_says_why_energy_changes(tmp_path, capsys):
+    """The spin-up beam (a prescribed hub motion): final q by name in m, the always-zero
+    w amplitudes (the spin is about the beam's normal, it bends in v only) left out and
+    counted, and the energy caveat; the double pendulum (conservative) has no caveat."""
+    assert main(["run", "spin_up_beam", "--t-end", "0.05", "--out", str(tmp_path / "beam")]) == 0
+    out = capsys.readouterr().out
+    assert "final q: beam.v[0] = " in out and "beam.w[0]" not in out and "(4 zero throughout: not shown)" in out
+    assert "not conserved here: a prescribed motion" in out
+    assert all(len(line) <= 100 for line in out.splitlines() if not line.startswith(("wrote", "energy")))
+    assert main(["run", "double_pendulum", "--t-end", "0.05", "--out", str(tmp_path / "dp")]) == 0
+    assert "not conserved" not in capsys.readouterr().out
+
+
+def test_json_documents_of_list_run_sweep_and_compare(tmp_path, capsys, monkeypatch):
+    assert main(["list", "--json"]) == 0
+    assert set(json.loads(capsys.readouterr().out)) == set(pq.scenes.SCENES)
+    assert main(["list", "atwood", "--json"]) == 0
+    assert {p["name"] for p in json.loads(capsys.readouterr().out)["parameters"]} >= {"m1", "m2"}
+    assert main(["run", "atwood", "--t-end", "0.1", "--out", str(tmp_path / "run"), "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    assert document["status"] == "finished" and document["final_q"].keys() == {"pulley.angle"}
+    assert json.loads((run_folder(tmp_path / "run") / "run.json").read_text())["final_q"] == document["final_q"]
+    assert main(["sweep", "atwood", "--grid", "m1=1.5:2:2", "--t-end", "0.1", "--workers", "1", "--outputs", "q0",
+                 "--atol", "1e-9", "--out", str(tmp_path / "sweep"), "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    assert document["points"] == 2 and document["options"]["atol"] == 1e-9 and document["table"]["m1"] == [1.5, 2.0]
+    monkeypatch.setattr(projeq.cli.studies, "compare", lambda *a, **k: pq.ComparisonTable("car", rows=[{"x": 1.0}]))
+    assert main(["compare", "car", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["rows"] == [{"x": 1.0}]
+
+
+def test_a_user_scene_from_a_file(tmp_path, capsys):
+    """``projeq run my_model.py:build --set length=2``: the user's function with its keyword
+    parameters, docstring and t_end; the trajectory is simulate()'s of the same function with
+    the same options (a second path to the same numbers); an unknown function or parameter is
+    a bad argument (exit 2) naming it."""
+    model = tmp_path / "my_model.py"
+    model.write_text(
+        "import projeq as pq\n\n"
+        "def build(length: float = 1.0):\n"
+        "    '''A pendulum of the given length.'''\n"
+        "    return pq.System({'bob': pq.PointMass(1.0, (0, 0, -length))}, {'bob': pq.Revolute(axis='y')},\n"
+        "                     gravity=(0, 0, -9.81), q0=[0.4])\n"
+        "build.t_end = 0.3\n")
+    assert main(["list", f"{model}:build"]) == 0
+    assert "A pendulum of the given length" in capsys.readouterr().out
+    assert main(["run", f"{model}:build", "--set", "length=2", "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    folder = run_folder(tmp_path / "out")
+    assert folder.name.startswith("my_model-build-")
+    result = pq.Result.load(folder / "my_model-build.npz")
+    from importlib import util
+
+    spec = util.spec_from_file_location("check_model", model)
+    module = util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    direct = pq.simulate(module.build(length=2.0), 0.3, method="DOP853", rtol=1e-9, atol=1e-11, n_points=201)
+    assert result.t[-1] == 0.3 and np.allclose(result.q, direct.q, rtol=0, atol=1e-9)
+    assert main(["run", f"{model}:missing", "--out", str(tmp_path)]) == 2
+    assert "has no function 'missing'" in capsys.readouterr().err
+    assert main(["run", f"{model}:build", "--set", "lenght=2", "--out", str(tmp_path)]) == 2
+    assert "did you mean 'length'" in capsys.readouterr().err
+
+
+def test_projeq_export_writes_paraview_files_of_a_saved_run(tmp_path, capsys):
+    assert main(["run", "double_pendulum", "--t-end", "0.1", "--out", str(tmp_path), "--quiet"]) == 0
+    npz = run_folder(tmp_path) / "double_pendulum.npz"
+    assert main(["export", str(npz), "--out", str(tmp_path / "later")]) == 0
+    assert (tmp_path / "later" / "double_pendulum.pvd").exists()
+    assert (tmp_path / "later" / "double_pendulum_mechanism_0000.vtu").exists()
+    assert main(["export", str(tmp_path / "none.npz")]) == 2
+
+
+@pytest.mark.parametrize("command", [["run", "atwood"], ["sweep", "atwood", "--grid", "m1=1:2:2"]])
+def test_every_simulating_command_takes_the_simulation_options(command, tmp_path):
+    """The same options on run and sweep (one home: projeq.cli.options), refused alike."""
+    assert main([*command, "--evaluator", "nonsense", "--out", str(tmp_path)]) == 2
+    assert main([*command, "--method", "Euler", "--out", str(tmp_path)]) == 2
