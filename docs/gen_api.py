@@ -33,6 +33,26 @@ GROUPS = (
                                   "compare", "ComparisonTable")),
     ("Scenes and symbolic derivations", ("scenes", "symbolic")),
 )
+#: Hand-written introductions of groups (Markdown), placed under the group's heading.
+INTROS = {
+    "Building a system": """Coordinates by name. Every joint and subsystem declares the (name, unit) of its
+coordinates (`Joint.coordinates`, `Joint.velocities`, `Subsystem.coordinates`; defaults
+`q[i]`, `s_dot[i]`, `e[i]` with unknown units, so user plug-ins work unchanged), and every
+model lists them as `"subsystem.coordinate"` in the order of q and ṡ
+(`Model.coordinates()`, `Model.velocities()`; a Result carries them, and its
+`column_names()`). The tree keeps the order in which the subsystems were declared whenever
+each parent comes before its children (else a warning names the order q follows), and
+`Model.state`, `Model.q_index` address entries by name:
+
+```python
+import projeq as pq
+system = pq.scenes.chain(3)
+q0, s_dot0 = system.state(link2=0.2, s_dot={"link1.angle_dot": 1.5})
+result = pq.simulate(system, 1.0, q0=q0, s_dot0=s_dot0)
+i = system.q_index("link2.angle")   # 1: for functions of q such as constraints Φ(q)
+```
+""",
+}
 #: Plug-in contracts documented besides projeq.__all__ (module, name); name None: the module.
 CONTRACTS = (("projeq.system", "Model"), ("projeq.joints.base", "Relative"),
              ("projeq.joints.base", "SymbolicRelative"), ("projeq.simulation.integrators", None))
@@ -257,6 +277,8 @@ def page() -> str:
         present = [n for n in names if n in projeq.__all__]
         if present:
             text.append(f"## {title}\n")
+            if title in INTROS:
+                text.append(INTROS[title])
             text += [document(f"projeq.{name}", getattr(projeq, name)) for name in present]
     text.append("## Plug-in contracts\n\nSee [the architecture](architecture.md) for how to add a joint, "
                 "a subsystem or a force law.\n")

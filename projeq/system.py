@@ -302,8 +302,9 @@ class System(Model):
         Gravitational acceleration in inertial coordinates (m/s²).
     forces : sequence
         Force laws (:mod:`projeq.forces`).
-    q0, s_dot0 : arrays, optional
-        Default initial state used by :func:`projeq.simulate` (zero configuration and rest).
+    q0, s_dot0 : arrays or dicts, optional
+        Default initial state used by :func:`projeq.simulate` (zero configuration and rest);
+        a dict sets entries by name as :meth:`Model.state` does (``{"upper": 0.3}``).
 
     Examples
     --------
@@ -334,6 +335,10 @@ class System(Model):
         self.named_coordinates = _named_coordinates(self)  # ((name, unit) of q, of ṡ): coordinates()
         self.coupled = any(j.coupling for j in self.joints)
         self.forces = tuple(copy.copy(f).bind(self) for f in _check_forces(forces))
+        if isinstance(q0, dict):  # by name, the rest at the joints' defaults
+            q0 = _set_by_name("q0", self._default_q(), self.named_coordinates[0], q0)
+        if isinstance(s_dot0, dict):
+            s_dot0 = _set_by_name("s_dot0", np.zeros(self.n_s), self.named_coordinates[1], s_dot0)
         self.q0 = self.normalized(self.check_q("q0", self._default_q() if q0 is None else q0))
         self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
         for a in (self.gravity, self.q0, self.s_dot0):

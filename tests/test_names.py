@@ -114,3 +114,19 @@ def test_conserves_energy_tells_a_driven_model_from_a_free_one():
     pendulum, beam = pq.scenes.double_pendulum(), pq.scenes.spin_up_beam()
     assert conserves_energy(pendulum, pendulum.q0, pendulum.s_dot0)
     assert not conserves_energy(beam, beam.q0, beam.s_dot0)
+
+
+def test_initial_states_and_sweep_outputs_by_name(tmp_path):
+    """A System's q0 and s_dot0 as dicts by name; a sweep's outputs by name are the final
+    values of those columns (the same as q<i> / s_dot<i>)."""
+    from projeq.simulation.sweep import sweep
+
+    system = pq.System({"a": rod(), "b": rod()},
+                       {"a": pq.Revolute(axis="y"), "b": pq.Revolute(parent="a", axis="y", r_pn=(1, 0, 0))},
+                       q0={"b.angle": 0.4}, s_dot0={"a": 1.0})
+    assert system.q0.tolist() == [0.0, 0.4] and system.s_dot0.tolist() == [1.0, 0.0]
+    table = sweep("double_pendulum", grid={"l1": [0.5, 1.0]}, outputs=["bob2.angle_dot", "s_dot1"], t_end=0.05,
+                  workers=1, progress=False)
+    assert np.array_equal(table["bob2.angle_dot"], table["s_dot1"]) and np.all(table["status"] == 0)
+    with pytest.raises(ValueError, match="no coordinate or velocity 'elbow.angle'"):
+        sweep("double_pendulum", grid={"l1": [0.5]}, outputs=["elbow.angle"], progress=False)

@@ -1,5 +1,5 @@
 """The ``projeq`` command: :func:`main` (:mod:`.commands`, the parser and the exit codes), one
-module per group of subcommands (:mod:`.run`: list, run; :mod:`.sweep`; :mod:`.studies`:
+module per group of subcommands (:mod:`.run`: list, run, export; :mod:`.sweep`; :mod:`.studies`:
 compare, tradeoff; :mod:`.bench`) and the options they share (:mod:`.options`)."""
 
 from projeq.cli.commands import main

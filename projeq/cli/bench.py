@@ -7,12 +7,13 @@ from __future__ import annotations
 import argparse
 import json
 
+from projeq.cli.options import plain
 from projeq.studies import bench
 from projeq.studies.bench import EXACT_UP_TO, QUICK_SIZES, TOTAL_BUDGET
 
 
 def bench_arguments(parser) -> None:
-    parser.description = bench.__doc__
+    parser.description = plain(bench.__doc__)
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.add_argument("--json", action="store_true", help="print one JSON document instead of tables")
     parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per chain length (default 0.5)")

@@ -7,6 +7,7 @@ exit code 2.
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 
@@ -14,6 +15,12 @@ def scene_settings_option(parser: argparse.ArgumentParser) -> None:
     """``--set NAME=VALUE`` (repeatable): scene parameters, parsed by the scene."""
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help="override a scene parameter (see projeq list SCENE); repeatable")
+
+
+def plain(text: str) -> str:
+    """A docstring as help text: reStructuredText roles (``:mod:`x```) and literals
+    (````x````) as the plain names."""
+    return re.sub(r":\w+:`~?([^`]+)`", r"\1", text or "").replace("``", "")
 
 
 def jsonable(value):

@@ -10,9 +10,9 @@ CPU time, status, files), ``<scene>.npz`` (the Result with the same record,
 :meth:`projeq.Result.load`), ``<scene>.csv`` (named columns with units), PNG plots
 ``<scene>_history.png`` ... and a ParaView series ``paraview/<scene>.pvd`` (a scene given as
 ``FILE.py:FUNCTION`` is called ``FILE-FUNCTION``). A failed or interrupted run (Ctrl-C or SIGTERM) writes
-its results up to where it stopped and exits 1. Each file is written under a temporary
-name and renamed when complete, and the folder is created again if it was deleted during
-the run.
+its results up to where it stopped and exits 1. ``--out`` is checked before the run, the
+run's folder made when its results are written; each file is written under a temporary
+name and renamed when complete.
 """
 
 from __future__ import annotations

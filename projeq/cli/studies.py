@@ -15,7 +15,7 @@ import sys
 import numpy as np
 
 from projeq.cli.options import json_option, jsonable, number, output_directory, scene_settings_option
-from projeq.studies.compare import COMPARISONS, compare
+from projeq.studies.compare import COMPARISONS, TEXT_WIDTH, compare
 from projeq.studies.effort import DERIVATION_REPEATS
 from projeq.studies.tradeoff import METHODS, QUICK_TOLERANCES, format_table, get_study, plot, save_csv, tradeoff
 from projeq.studies.tradeoff_studies import STUDIES
@@ -58,6 +58,7 @@ def tradeoff_arguments(parser) -> None:
     parser.add_argument("--timeout", default="120", help="CPU seconds allowed per run (default 120)")
     parser.add_argument("--out", default="projeq-tradeoff", help="output directory (default ./projeq-tradeoff)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar and no table")
+    parser.add_argument("--wide", action="store_true", help=f"print the table uncut (default: {TEXT_WIDTH} columns)")
     parser.set_defaults(execute=tradeoff_study)
 
 
@@ -70,7 +71,7 @@ def tradeoff_study(args) -> int:
         files.append(out / f"tradeoff_{args.scene}.png")
         plot(table).savefig(files[-1], dpi=110)
     if not args.quiet:
-        print(format_table(table))
+        print(format_table(table, width=None if args.wide else TEXT_WIDTH))
     print(f"wrote {', '.join(str(f) for f in files)}")
     if not table["complete"]:
         print(f"projeq tradeoff: interrupted after {len(table['method'])} settings; those are written", file=sys.stderr)

@@ -31,7 +31,8 @@ def sweep_arguments(parser) -> None:
     parser.add_argument("--grid", action="append", default=[], metavar="NAME=A:B:N", required=True,
                         help="N values from A to B (linspace) for parameter NAME; repeat for a product grid")
     parser.add_argument("--outputs", default="energy_drift,t_reached",
-                        help="comma-separated outputs: energy_drift, constraint_residual, t_reached, wall_time, nfev, q<i>, s_dot<i>")
+                        help="comma-separated outputs: energy_drift, constraint_residual, t_reached, wall_time, nfev, q<i>, s_dot<i>, "
+                             "or a coordinate or velocity by name (bob1.angle, bob1.angle_dot)")
     parser.add_argument("--scheduler", help="address of a Dask scheduler, e.g. tcp://host:8786 (default: local processes)")
     parser.add_argument("--scheduler-timeout", type=float, default=10.0, help="seconds to wait for the scheduler (default 10)")
     parser.add_argument("--workers", type=int, default=None, help="local worker processes (default: one per CPU)")

@@ -61,22 +61,39 @@ def _column(name: str):
     """(array name, index) of a ``q<i>`` / ``s_dot<i>`` output, None for a built-in one."""
     if name in BUILTIN_OUTPUTS:
         return None
+    if "." in name:  # a coordinate or velocity by name: "bob1.angle", "bob1.angle_dot"
+        return "named", name
     for prefix in ("s_dot", "q"):
         if name.startswith(prefix) and name[len(prefix):].isdigit():
             return prefix, int(name[len(prefix):])
-    raise ValueError(f"outputs: unknown output {name!r}; expected one of {', '.join(BUILTIN_OUTPUTS)}, q<i>, s_dot<i>")
+    raise ValueError(f"outputs: unknown output {name!r}; expected one of {', '.join(BUILTIN_OUTPUTS)}, q<i>, s_dot<i> "
+                     "or a coordinate or velocity by name (subsystem.coordinate)")
 
 
 def output_value(result, name: str) -> float:
     """A named output of a Result: a :data:`BUILTIN_OUTPUTS` key, or ``q<i>`` / ``s_dot<i>``
-    for the final value of coordinate / minimal velocity i; NaN when no time step was
+    for the final value of coordinate / minimal velocity i, or that of a coordinate or
+    velocity by name (``"bob1.angle"``, :meth:`projeq.system.Model.coordinates`); NaN when no time step was
     completed (a run interrupted or failed in its first segment)."""
     if not len(result.t):
         return np.nan
     column = _column(name)
     if column is None:
         return float(BUILTIN_OUTPUTS[name](result))
+    if column[0] == "named":
+        column = _named_column(result.coordinates, result.velocities, name)
     return float(getattr(result, column[0])[-1, column[1]])
+
+
+def _named_column(coordinates, velocities, name: str) -> tuple[str, int]:
+    """("q", i) or ("s_dot", i) of the coordinate or velocity called ``name``; ValueError
+    listing the names."""
+    for array, named in (("q", coordinates), ("s_dot", velocities)):
+        names = [n for n, _ in named]
+        if name in names:
+            return array, names.index(name)
+    raise ValueError(f"outputs: no coordinate or velocity {name!r}; the model's are "
+                     f"{[n for n, _ in coordinates] + [n for n, _ in velocities]}")
 
 
 INTERRUPT_GRACE = 10.0  # s to wait, after Ctrl-C, for the running points to return their partial results
@@ -288,7 +305,8 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     samples : list of dicts or dict name -> equal-length sequences, optional
         Explicit points (e.g. Monte Carlo draws). Give exactly one of grid and samples.
     outputs : sequence of str
-        Names understood by :func:`output_value` (final ``q<i>``, ``s_dot<i>``, ``energy_drift`` ...).
+        Names understood by :func:`output_value` (final ``q<i>``, ``s_dot<i>``, a coordinate or
+        velocity by name such as ``bob1.angle``, ``energy_drift`` ...).
     executor : concurrent.futures.Executor or dask.distributed.Client, optional
         Default: a local process pool of ``workers`` processes.
     t_end : float, optional
@@ -326,8 +344,11 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     for p in points:
         check_names(scene, p)
     outputs = list(outputs)
-    for name in outputs:
-        _column(name)
+    named = [name for name in outputs if _column(name) is not None and _column(name)[0] == "named"]
+    if named:  # checked on the model of the first point, before any run
+        model = scene.build(**points[0])
+        for name in named:
+            _named_column(model.coordinates(), model.velocities(), name)
     t_end = scene.t_end if t_end is None else float(t_end)
     if resume and path is None:
         raise ValueError("resume: needs path, the table of the sweep to resume")

@@ -121,13 +121,21 @@ class Table:
         with Path(path).open(newline="") as stream:
             return list(csv.DictReader(stream))
 
-    def to_text(self) -> str:
-        """The table as aligned plain text."""
+    def to_text(self, max_width: int | None = None) -> str:
+        """The table as aligned plain text; with ``max_width`` the last column of text (not
+        numbers) is cut, with …, so that the lines fit ``max_width`` characters."""
         header = [f"{name} ({self.units[name]})" if self.units.get(name) else name for name in self.columns]
         cells = [[self._text_cell(name, value) for name, value in zip(self.columns, row)] for row in self.rows]
         numeric = [all(_is_number(row[k]) for row in self.rows if row[k] is not None) and
                    any(row[k] is not None for row in self.rows) for k in range(len(self.columns))]
         widths = [max([len(header[k])] + [len(row[k]) for row in cells]) for k in range(len(self.columns))]
+        text_columns = [k for k in range(len(self.columns)) if not numeric[k]]
+        excess = sum(widths) + 2 * (len(widths) - 1) - (max_width or 0)
+        if max_width and excess > 0 and text_columns:
+            k = text_columns[-1]
+            widths[k] = max(len(header[k]), widths[k] - excess)
+            for row in cells:
+                row[k] = row[k] if len(row[k]) <= widths[k] else row[k][: widths[k] - 1] + "…"
 
         def line(texts):
             return "  ".join(t.rjust(w) if right else t.ljust(w) for t, w, right in zip(texts, widths, numeric)).rstrip()

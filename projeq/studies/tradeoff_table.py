@@ -74,15 +74,16 @@ def _setting(table: dict, i: int) -> str:
     return f"{table['method'][i]} rtol={table['rtol'][i]:.0e} [{table['knob'][i]}]"
 
 
-def format_table(table: dict, levels=ERROR_LEVELS) -> str:
-    """The table as text, followed by the cheapest setting for each error level."""
+def format_table(table: dict, levels=ERROR_LEVELS, width: int | None = None) -> str:
+    """The table as text (its free-text column cut to ``width`` characters per line, when
+    given), followed by the cheapest setting for each error level."""
     notes = [failure or warning for failure, warning in zip(table["failure"], table["warning"])]
     text = Table.from_columns(
         {"knob": table["knob"], "method": table["method"], "rtol": table["rtol"], "error": table["error"],
          "cpu": table["cpu"], "evals": table["n_evaluations"], "failure / warning": notes},
         units={"cpu": "s"}, formats={"rtol": ".0e", "error": ".2e"},
     )
-    lines = [text.to_text()]
+    lines = [text.to_text(width)]
     if "measure" in table:
         lines.append(f"error = {table['measure']}")
     for level, i in cheapest(table, levels).items():

@@ -131,3 +131,18 @@ def test_every_simulating_command_takes_the_simulation_options(command, tmp_path
     """The same options on run and sweep (one home: projeq.cli.options), refused alike."""
     assert main([*command, "--evaluator", "nonsense", "--out", str(tmp_path)]) == 2
     assert main([*command, "--method", "Euler", "--out", str(tmp_path)]) == 2
+
+
+def test_text_fits_100_columns_and_help_has_no_markup(capsys):
+    """``projeq list`` lines and a table with a long note fit 100 columns (the note cut with
+    …, numbers untouched); ``projeq bench --help`` shows no reStructuredText roles."""
+    from projeq.studies.table import Table
+
+    assert main(["list"]) == 0
+    assert max(len(line) for line in capsys.readouterr().out.splitlines()) <= 100
+    table = Table(["rtol", "failure / warning"], [[1e-3, "x" * 300], [1e-6, "ok"]])
+    lines = table.to_text(100).splitlines()
+    assert max(map(len, lines)) == 100 and lines[2].endswith("…") and lines[2].startswith("0.001")
+    assert table.to_text().splitlines()[2].endswith("x" * 300)
+    assert main(["bench", "--help"]) == 0
+    assert ":mod:" not in (help_text := capsys.readouterr().out) and "``" not in help_text
