@@ -13,6 +13,7 @@ in COVERED_ELSEWHERE with that test. Lines that install packages are not run.
 The python blocks run as written except that ``projeq.simulate`` stops at 0.1 s of simulated
 time (the tutorials' own scripts in examples/ run in full in tests/test_examples.py).
 """
+import glob
 import re
 import shlex
 from pathlib import Path
@@ -40,13 +41,21 @@ def blocks(path, language):
     return re.findall(rf"^```{language}\n(.*?)^```", path.read_text(encoding="utf-8"), re.S | re.M)
 
 
+def page_commands(path):
+    """The ``projeq ...`` lines of a page's bash blocks, as argument lists."""
+    return [shlex.split(line, comments=True)[1:] for block in blocks(path, "bash")
+            for line in block.splitlines() if line.startswith("projeq ")]
+
+
 def documented_commands():
     for path in PAGES:
-        for block in blocks(path, "bash"):
-            for line in block.splitlines():
-                if line.startswith("projeq "):
-                    yield pytest.param(shlex.split(line, comments=True)[1:],
-                                       id=f"{path.relative_to(ROOT)}: {line.split('#')[0].strip()}")
+        for argv in page_commands(path):
+            yield pytest.param(argv, id=f"{path.relative_to(ROOT)}: {shlex.join(argv)}")
+
+
+def expand(argv):
+    """Shell globs in the arguments, as the shell would expand them (in the current folder)."""
+    return [match for arg in argv for match in (sorted(glob.glob(arg)) or [arg] if "*" in arg else [arg])]
 
 
 def option(argv, name, value):
@@ -75,22 +84,28 @@ def quick(argv, tmp_path):
     return argv
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("argv", list(documented_commands()))
-def test_documented_command_exits_0(argv, tmp_path, monkeypatch):
+def run_command(argv, tmp_path):
     if " ".join(argv) in COVERED_ELSEWHERE:
         path, name = COVERED_ELSEWHERE[" ".join(argv)]
         assert f"def {name}(" in (ROOT / path).read_text(encoding="utf-8")
-        return
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("MPLBACKEND", "Agg")
-    argv = quick(argv, tmp_path)
+        return 0
+    argv = quick(expand(argv), tmp_path)
     if "--scheduler" in argv:
         distributed = pytest.importorskip("dask.distributed")
         with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
-            assert main(option(argv, "--scheduler", cluster.scheduler_address)) == 0
-        return
-    assert main(argv) == 0
+            return main(option(argv, "--scheduler", cluster.scheduler_address))
+    return main(argv)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("page", [pytest.param(p, id=str(p.relative_to(ROOT))) for p in PAGES if page_commands(p)])
+def test_documented_commands_exit_0(page, tmp_path, monkeypatch):
+    """A page's commands in order in one folder (a later one may read an earlier one's output,
+    e.g. ``projeq export`` of a ``projeq run``)."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    codes = {shlex.join(argv): run_command(argv, tmp_path) for argv in page_commands(page)}
+    assert {command: code for command, code in codes.items() if code != 0} == {}
 
 
 def test_the_commands_are_found():
