@@ -534,12 +534,13 @@ class System(Model):
     def evaluator(self, method: str | None = None):
         """The cached evaluator ``"recursive"``, ``"dense"``, ``"fast"`` (compiled order n,
         :mod:`projeq.assembly.fast`), ``"hub_beam"`` or ``"auto"`` (the best of them available,
-        :mod:`projeq.assembly.auto`) (``None``: recursive, or dense when minimal velocities
-        are shared by coupled joints). One that cannot evaluate this system raises why."""
+        :mod:`projeq.assembly.auto`; also ``None``, the default: the compiled evaluator where it
+        knows every piece, else the reference one with one warning naming the piece). One
+        that cannot evaluate this system raises why."""
         from projeq.assembly import EVALUATORS
 
         if method is None:
-            method = "dense" if self.coupled else "recursive"
+            method = "auto"
         if method not in EVALUATORS:
             raise ValueError(f"method: unknown evaluator {method!r}; use one of {sorted(EVALUATORS)}")
         if method not in self._evaluators:

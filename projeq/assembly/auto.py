@@ -1,22 +1,29 @@
-"""``method="auto"``: the best evaluator available for a System, picked once.
+"""``method="auto"``, the default evaluator: the best evaluator available for a System, picked once.
 
 In this order: ``"fast"`` (the compiled order-n kernel, :mod:`projeq.assembly.fast`) when
-numba is installed and the kernel knows every joint and subsystem; ``"hub_beam"``
+the kernel knows every joint, subsystem and force law; ``"hub_beam"``
 (:mod:`projeq.assembly.beam_fast`) for one RitzBeam on a prescribed or fixed hub; else the
-general evaluators, ``"dense"`` when joints share minimal velocities (coupled) and
-``"recursive"`` otherwise. Each of them evaluates its systems or refuses them with the
-reason; "auto" is the only place that chooses, and it says what it chose. The choice is
-by cost per call: the compiled kernel is compiled on its first use in a fresh environment
-(seconds; cached on disk afterwards), which the default evaluator (``method=None``:
-recursive, or dense when coupled) never pays.
+reference evaluators, ``"dense"`` when joints share minimal velocities (coupled) and
+``"recursive"`` otherwise, with one :class:`InterpretedWarning` per System naming the piece
+the kernel does not know — the fall-back is never silent. Each evaluator evaluates its
+systems or refuses them with the reason; "auto" is the only place that chooses, and it
+says what it chose (``name``, ``reason``). The compiled kernel is compiled on its first
+use and cached on disk (numba's ``cache=True``): a fresh environment pays the compilation
+once (``projeq bench`` reports the first-call latency), later processes load it.
 
->>> import projeq as pq
->>> ev = AutoEvaluator(pq.scenes.atwood())
+>>> import warnings, projeq as pq
+>>> with warnings.catch_warnings(record=True) as said:
+...     warnings.simplefilter("always")
+...     ev = AutoEvaluator(pq.scenes.atwood())
 >>> ev.name, ev.reason
 ('dense', "the fast kernel cannot evaluate it: joint 'mass1' is coupled (shared minimal velocities)")
+>>> [str(w.message) for w in said]  # doctest: +NORMALIZE_WHITESPACE
+["system: evaluated by the interpreted 'dense' evaluator, not the compiled one: joint 'mass1' is coupled (shared minimal velocities)"]
 """
 
 from __future__ import annotations
+
+import warnings
 
 from numpy.typing import NDArray
 
@@ -25,18 +32,29 @@ from projeq.assembly.beam_fast import hub_beam_unsupported
 from projeq.assembly.fast import unsupported
 
 
+class InterpretedWarning(UserWarning):
+    """The default evaluator fell back to an interpreted reference evaluator (the message
+    names the joint, subsystem or force law the compiled kernel does not know)."""
+
+
+def why_not_compiled(system) -> str | None:
+    """Why the compiled kernel cannot evaluate ``system`` (None if it can)."""
+    return unsupported(system) or (None if kernels.has_numba() else "numba is not installed")
+
+
 def pick(system) -> tuple[str, str]:
     """(name, reason): the evaluator "auto" picks for ``system`` and why (module docstring)."""
-    why_not_fast = unsupported(system) or (None if kernels.has_numba() else "numba is not installed")
+    why_not_fast = why_not_compiled(system)
     if why_not_fast is None:
-        return "fast", "the compiled order-n kernel knows every joint and subsystem"
+        return "fast", "the compiled order-n kernel knows every joint, subsystem and force law"
     if hub_beam_unsupported(system) is None:
         return "hub_beam", "one RitzBeam on a prescribed or fixed hub"
     return ("dense" if system.coupled else "recursive"), f"the fast kernel cannot evaluate it: {why_not_fast}"
 
 
 class AutoEvaluator:
-    """The evaluator :func:`pick` chooses for ``system`` (the System's cached one), and which.
+    """The evaluator :func:`pick` chooses for ``system`` (the System's cached one), and which;
+    warns once (:class:`InterpretedWarning`) when that is an interpreted reference evaluator.
 
     Attributes: ``name`` (of the picked evaluator: "fast", "hub_beam", "dense" or
     "recursive"), ``reason`` (why), ``evaluator`` (the picked evaluator, which counts the calls).
@@ -45,6 +63,11 @@ class AutoEvaluator:
     def __init__(self, system):
         self.name, self.reason = pick(system)
         self.evaluator = system.evaluator(self.name)
+        if self.name in ("dense", "recursive"):
+            warnings.warn(
+                f"system: evaluated by the interpreted {self.name!r} evaluator, not the compiled one: "
+                f"{why_not_compiled(system)}", InterpretedWarning, stacklevel=3,
+            )
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """s̈ at (q, ṡ, t) by the picked evaluator."""

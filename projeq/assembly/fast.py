@@ -4,7 +4,7 @@ The System stays frozen; :class:`FastEvaluator` packs its tree once into arrays 
 joint kinds, axes, joint frames, masses, r_c, I_c, M_n) and each call runs
 :func:`projeq.assembly.kernels.chain_terms` (T_np, ζ_n, F_n, h_n; docs/theory.md §3–4) and
 :func:`projeq.assembly.kernels.passes` (Bremer's backward and forward passes, §6).
-Both are compiled by numba (``pip install 'projeq[fast]'``) on first use (cached on
+Both are compiled by numba (a dependency) on first use (cached on
 disk); ``method="fast"`` is this kernel or a ValueError saying why not (numba missing, or
 a piece of the system the kernel does not know). ``compiled=False`` runs the same kernel
 source interpreted (for testing: correct, but slower than the recursive evaluator).
@@ -13,13 +13,18 @@ another one where it cannot.
 
 Supported: trees of subsystems with rigid-body terms and no selection (``rigid_inertia``
 and ``S = None``: :class:`~projeq.RigidBody`, :class:`~projeq.PointMass`, :class:`~projeq.Frame`)
-on joints whose ``compiled_kind`` the kernel has (:class:`~projeq.Revolute`,
-:class:`~projeq.Prismatic`, :class:`~projeq.Fixed`; no coupling), under gravity, without
-force laws. One :class:`~projeq.RitzBeam` on a prescribed or fixed hub has its own fast
-evaluator, ``method="hub_beam"`` (:mod:`projeq.assembly.beam_fast`); any other system
-(beams in chains, planar bodies, free or user — e.g. non-holonomic — joints, couplings,
-forces) is refused with the piece named: it is evaluated by the general ones (recursive,
-or dense for coupled joints).
+on any uncoupled joint: the kernel computes the relative motion of the joints whose
+``compiled_kind`` it has (:class:`~projeq.Revolute`, :class:`~projeq.Prismatic`,
+:class:`~projeq.Fixed`); every other joint (Planar, Free, Spherical, Screw, Prescribed,
+UserJoint — non-holonomic ones too) states it by its own ``relative`` before each call, which
+the kernel reads (kind ``GIVEN``, 0–6 minimal velocities). Under gravity and any force laws:
+between the compiled kinematics and the compiled passes each law adds its loads by its own
+``add_to`` (the one statement the reference evaluators call) to the kernel's h_n, reading
+poses, twists, F_n and T̃_np from the kernel's workspace. One :class:`~projeq.RitzBeam` on a
+prescribed or fixed hub has its own fast evaluator, ``method="hub_beam"``
+(:mod:`projeq.assembly.beam_fast`); any other system (beams in chains, planar bodies,
+coupled joints) is refused with the piece named: it is evaluated by the reference ones
+(recursive, or dense for coupled joints).
 
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.chain(3)
@@ -38,6 +43,7 @@ from numpy.typing import NDArray
 
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import hub_beam_unsupported
+from projeq.assembly.kinematics import Kinematics
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.subsystems.rigid import rigid_mass_matrix
 
@@ -78,32 +84,64 @@ class FastEvaluator:
         """Flat arrays of the tree (built once) and the workspace."""
         N = len(system.joints)
         joints, bodies = system.joints, system.subsystems
-        self._kind = np.array([kernels.KINDS[j.compiled_kind] for j in joints], dtype=np.int64)
+        self._kind = np.array([kernels.KINDS.get(j.compiled_kind, kernels.GIVEN) for j in joints], dtype=np.int64)
+        self._given = [n for n in range(N) if self._kind[n] == kernels.GIVEN]
+        self._n_cols = np.array([j.n_s for j in joints], dtype=np.int64)
         self._parent = np.array(system.parent, dtype=np.int64)
-        self._axis = np.array([np.zeros(3) if k == kernels.FIXED else j.axis for k, j in zip(self._kind, joints)])
+        self._axis = np.array([j.axis if k in (kernels.REVOLUTE, kernels.PRISMATIC) else np.zeros(3)
+                               for k, j in zip(self._kind, joints)])
         self._orientation = np.array([j.orientation for j in joints])
         self._offset = np.array([j.r_pn for j in joints])
         self._q_index = np.array([system.q_slice[n].start for n in range(N)], dtype=np.int64)
+        self._s_index = np.array([system.s_slice[n].start for n in range(N)], dtype=np.int64)
         self._m, self._r_c, self._I_c = (np.array(part) for part in zip(*(b.rigid_inertia for b in bodies)))
         self._M6 = np.array([rigid_mass_matrix(*b.rigid_inertia) for b in bodies])
         self._gravity = np.asarray(system.gravity, dtype=float)
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
+        self._given_A, self._given_r = np.zeros((N, 3, 3)), np.zeros((N, 3))
+        self._given_w, self._given_zeta = np.zeros((N, 6)), np.zeros((N, 6))
         self._T, self._zeta = np.zeros((N, 6, 6)), np.zeros((N, 6))
-        self._f, self._M_hat, self._h_hat = np.zeros((N, 6)), np.zeros((N, 6, 6)), np.zeros((N, 6))
+        self._F, self._M_hat, self._h_hat = np.zeros((N, 6, 6)), np.zeros((N, 6, 6)), np.zeros((N + 1, 6))
+        self._R, self._r, self._twist = np.zeros((N + 1, 3, 3)), np.zeros((N + 1, 3)), np.zeros((N + 1, 6))
+        self._kin = _kinematics(self._n_cols, self._R, self._r, self._twist, self._F) if system.forces else None
+
+    def _relative_motions(self, q: NDArray, s_dot: NDArray, t: float) -> None:
+        """A, r, F⁶, w and ζ of the joints of kind GIVEN, by their own ``relative`` (the
+        statement the reference evaluators call)."""
+        system = self.system
+        for n in self._given:
+            rel = system.joints[n].relative(system._q_get[n](q), system._s_get[n](s_dot), t)
+            self._given_A[n], self._given_r[n], self._given_w[n], self._given_zeta[n] = rel.A, rel.r, rel.w, rel.zeta
+            self._F[n, :, : self._n_cols[n]] = rel.F
+
+    def _add_forces(self, q: NDArray, s_dot: NDArray, t: float) -> None:
+        """The force laws' own ``add_to`` (the statement the reference evaluators call) on the
+        kernel's kinematics: T̃_np = [[T_np, ζ_n], [0, 1]] is filled from the workspace."""
+        kin = self._kin
+        kin.T_aug[:-1, :6, :6] = self._T
+        kin.T_aug[:-1, :6, 6] = self._zeta
+        self._h_hat[-1] = 0.0  # the ground's row: reactions land there, nothing reads them
+        for force in self.system.forces:
+            force.add_to(self._h_hat, kin, t, q, s_dot)
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """s̈ at (q, ṡ, t) (docs/theory.md §6); raises SingularMassError for a zero pivot D_n."""
+        """s̈ at (q, ṡ, t) (docs/theory.md §6); raises SingularMassError for a zero pivot of D_n."""
         self.n_calls += 1
         q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
+        if self._given:
+            self._relative_motions(q, s_dot, t)
         self._chain_terms(
-            self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index,
+            self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index, self._s_index,
             self._m, self._r_c, self._I_c, self._gravity, q, s_dot,
-            self._T, self._zeta, self._f, self._h_hat,
+            self._given_A, self._given_r, self._given_w, self._given_zeta,
+            self._T, self._zeta, self._F, self._h_hat[:-1], self._R, self._r, self._twist,
         )
+        if self._kin is not None:
+            self._add_forces(q, s_dot, t)
         self._M_hat[:] = self._M6
         s_ddot = np.empty(self.system.n_s)
         failed = self._passes(
-            self._kind, self._parent, self._q_index, self._T, self._zeta, self._f,
+            self._n_cols, self._parent, self._s_index, self._T, self._zeta, self._F,
             self._M_hat, self._h_hat, self._pivot_min, s_ddot,
         )
         if failed >= 0:
@@ -117,14 +155,18 @@ class FastEvaluator:
 def unsupported(system) -> str | None:
     """Why the fast kernel cannot evaluate ``system`` (None if it can)."""
     for name, joint, body in zip(system.names, system.joints, system.subsystems):
-        if joint.compiled_kind not in kernels.KINDS:
-            return (f"joint {name!r} is a {type(joint).__name__}, which has no compiled kind "
-                    f"(the kernel knows {', '.join(kernels.KINDS)})")
         if joint.coupling:
             return f"joint {name!r} is coupled (shared minimal velocities)"
         if body.rigid_inertia is None or body.S is not None:
             return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of spatial "
                     "rigid bodies, rigid_inertia with S = None)")
-    if system.forces:
-        return "the system has force laws (the kernel knows gravity only)"
     return None
+
+
+def _kinematics(n_cols, R, r, twist, F) -> Kinematics:
+    """The :class:`~projeq.assembly.kinematics.Kinematics` the force laws read, as views of the
+    kernel's workspace (poses, twists = ẏ_n, the n_s columns of F_n) and a
+    T̃_np stack that :meth:`FastEvaluator._add_forces` fills (the ground's row last)."""
+    T_aug = np.zeros((len(n_cols) + 1, 7, 7))
+    T_aug[:, 6, 6] = 1.0
+    return Kinematics(R, r, twist, twist, T_aug, [F[n, :, :k] for n, k in enumerate(n_cols)])

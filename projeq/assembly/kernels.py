@@ -5,8 +5,10 @@ Plain Python on scalars and small arrays, written so that numba can compile it
 runs interpreted with ``compiled=False``, so both are the same algorithm.
 
 Joint kinds: ``FIXED`` (no dof), ``REVOLUTE`` (F⁶ = [0; e]), ``PRISMATIC`` (F⁶ = [e; 0]),
-about a unit axis e in joint-frame coordinates; subsystems: rigid bodies (M_n = M6,
-h_n of docs/theory.md §3). Twists are (v_O, ω) in body coordinates; index −1 is the ground.
+about a unit axis e in joint-frame coordinates, and ``GIVEN``: any other joint, whose
+relative motion (A, r, F⁶, w, ζ of :class:`projeq.joints.base.Relative`) its own
+``relative`` computes before each call (0–6 minimal velocities: the passes solve
+D_n = F_nᵀ M̂_n F_n by Cholesky); subsystems: rigid bodies (M_n = M6, h_n of docs/theory.md §3). Twists are (v_O, ω) in body coordinates; index −1 is the ground.
 
 Compiled twins. numba compiles scalar loops, not the array functions of
 :mod:`projeq.spatial`, so four formulas have a second, scalar form here and only here:
@@ -23,7 +25,7 @@ import types
 
 import numpy as np
 
-FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
+FIXED, REVOLUTE, PRISMATIC, GIVEN = 0, 1, 2, 3
 KINDS = {"fixed": FIXED, "revolute": REVOLUTE, "prismatic": PRISMATIC}  # a joint's compiled_kind -> its code here
 
 
@@ -36,49 +38,71 @@ def _numba():
 
 
 def has_numba() -> bool:
-    """Whether numba is installed (``pip install 'projeq[fast]'``)."""
+    """Whether numba (a dependency of projeq) can be imported."""
     return _numba() is not None
 
 
-def chain_terms(kind, parent, axis, orientation, offset, q_index, m, r_c, I_c, gravity, q, s_dot,
-                T, zeta, f, h):
-    """T_np, ζ_n, F_n (as a 6-vector f_n) and h_n = Q_n − G_n ẏ_n of every body (docs/theory.md §3–4).
+def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, m, r_c, I_c, gravity, q, s_dot,
+                given_A, given_r, given_w, given_zeta, T, zeta, F, h, R, r_O, twist):
+    """T_np, ζ_n, F_n and h_n = Q_n − G_n ẏ_n of every body (docs/theory.md §3–4), and the poses
+    R_n, r_n and twists ẏ_n (row N of R, r_O, twist: the ground, at rest).
 
     A_pn = A_pJ A_Jn, r_pn = r_pJ + A_pJ r_Jn, T_np = [[A_np, −A_np r̃_pn], [0, A_np]],
-    u = T_np ẏ_p, w = f_n ṡ_n, ẏ_n = u + w, ζ_n = u × w (motion cross product).
+    u = T_np ẏ_p, ẏ_n = u + w, ζ_n = u × w (motion cross product) + Ḟ ṡ + ḟ,
+    R_n = R_p A_pn, r_n = r_p + R_p r_pn. The joint's relative motion (A_Jn, r_Jn, its
+    twist w and its own part of ζ) comes from the kernel for the kinds it knows (F⁶ = [0; e]
+    or [e; 0], w = F⁶ ṡ_n) and from ``given_*`` (and the columns of F set by the caller)
+    for a joint of kind ``GIVEN``.
     Scalar loops only (no temporaries per body), which is what numba compiles best.
     """
     N = kind.shape[0]
-    twist = np.zeros((N + 1, 6))  # row N: the ground, at rest
+    twist[N] = 0.0
+    R[N] = 0.0
+    r_O[N] = 0.0
+    for a in range(3):
+        R[N, a, a] = 1.0
     g_body = np.zeros((N + 1, 3))
     g_body[N] = gravity
-    A_rel, A_np, r, u, w = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty(6), np.empty(6)
+    A_rel, A_np, r_rel, r, u, w = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(6), np.empty(6)
     for n in range(N):
         e, k, p = axis[n], kind[n], parent[n] if parent[n] >= 0 else N
-        x = q[q_index[n]] if k != FIXED else 0.0
-        _relative_rotation(k, e, x, A_rel)
-        for a in range(3):  # A_np = (A_pJ A_Jn)ᵀ, r_pn = r_pJ + A_pJ e x
-            r[a] = offset[n, a]
+        if k == GIVEN:
+            A_rel[:, :] = given_A[n]
+            r_rel[:] = given_r[n]
+            w[:] = given_w[n]
+        else:
+            x = q[q_index[n]] if k != FIXED else 0.0
+            _relative_rotation(k, e, x, A_rel)
+            F[n] = 0.0
+            if k == REVOLUTE:
+                F[n, 3:, 0] = e
+            elif k == PRISMATIC:
+                F[n, :3, 0] = e
+            sd = s_dot[s_index[n]] if k != FIXED else 0.0
+            for a in range(3):
+                r_rel[a] = e[a] * x if k == PRISMATIC else 0.0
+            for a in range(6):
+                w[a] = F[n, a, 0] * sd
+        for a in range(3):  # A_np = (A_pJ A_Jn)ᵀ, r_pn = r_pJ + A_pJ r_Jn
+            r[a] = offset[n, a] + orientation[n, a, 0] * r_rel[0] + orientation[n, a, 1] * r_rel[1] + orientation[n, a, 2] * r_rel[2]
             for b in range(3):
                 A_np[b, a] = orientation[n, a, 0] * A_rel[0, b] + orientation[n, a, 1] * A_rel[1, b] + orientation[n, a, 2] * A_rel[2, b]
-                if k == PRISMATIC:
-                    r[a] += orientation[n, a, b] * e[b] * x
+        for a in range(3):  # R_n = R_p A_pn, r_n = r_p + R_p r_pn
+            r_O[n, a] = r_O[p, a] + R[p, a, 0] * r[0] + R[p, a, 1] * r[1] + R[p, a, 2] * r[2]
+            for b in range(3):
+                R[n, a, b] = R[p, a, 0] * A_np[b, 0] + R[p, a, 1] * A_np[b, 1] + R[p, a, 2] * A_np[b, 2]
         v_p, w_p = twist[p, :3] + _cross3(twist[p, 3:], r), twist[p, 3:]
         for a in range(3):  # u = T_np ẏ_p, g_n = A_np g_p
             u[a] = A_np[a, 0] * v_p[0] + A_np[a, 1] * v_p[1] + A_np[a, 2] * v_p[2]
             u[a + 3] = A_np[a, 0] * w_p[0] + A_np[a, 1] * w_p[1] + A_np[a, 2] * w_p[2]
             g_body[n, a] = A_np[a, 0] * g_body[p, 0] + A_np[a, 1] * g_body[p, 1] + A_np[a, 2] * g_body[p, 2]
-        f[n] = 0.0
-        if k == REVOLUTE:
-            f[n, 3:] = e
-        elif k == PRISMATIC:
-            f[n, :3] = e
-        sd = s_dot[q_index[n]] if k != FIXED else 0.0
         for a in range(6):
-            w[a] = f[n, a] * sd
             twist[n, a] = u[a] + w[a]
         zeta[n, :3] = _cross3(u[3:], w[:3]) + _cross3(u[:3], w[3:])
         zeta[n, 3:] = _cross3(u[3:], w[3:])
+        if k == GIVEN:
+            for a in range(6):
+                zeta[n, a] += given_zeta[n, a]
         _chain_matrix(A_np, r, T[n])
         _rigid_h(m[n], r_c[n], I_c[n], twist[n], g_body[n], h[n])
 
@@ -126,49 +150,101 @@ def _rigid_h(m, r_c, I_c, twist, g_body, out):
     out[3:] = _cross3(r_c, force) - _cross3(omega, L_c)
 
 
-def passes(kind, parent, q_index, T, zeta, f, M_hat, h_hat, pivot_min, s_ddot):
-    """Backward and forward pass of docs/theory.md §6 for one-dof and fixed joints; writes s̈.
+def passes(n_cols, parent, s_index, T, zeta, F, M_hat, h_hat, pivot_min, s_ddot):
+    """Backward and forward pass of docs/theory.md §6 for joints with ``n_cols[n]`` = 0…6 minimal
+    velocities (the first n_cols columns of F[n]); writes s̈.
 
-    Backward: U = M̂_n f_n, D_n = f_nᵀ U, M̄_n = M̂_n − U Uᵀ / D_n,
-    h̄_n = c − U (f_nᵀ c) / D_n with c = ĥ_n − M̂_n ζ_n; M̂_p += T_npᵀ M̄_n T_np, ĥ_p += T_npᵀ h̄_n.
-    Forward: a = T_np ÿ_p + ζ_n, s̈_n = (f_nᵀ ĥ_n − Uᵀ a) / D_n, ÿ_n = a + f_n s̈_n.
-    ``M_hat`` and ``h_hat`` enter as M_n and h_n and are overwritten. Returns −1, or the
-    index of the first body whose pivot D_n is not above ``pivot_min``.
+    Backward: U = M̂_n F_n, D_n = F_nᵀ U = L Lᵀ (Cholesky), M̄_n = M̂_n − U D_n⁻¹ Uᵀ,
+    h̄_n = c − U D_n⁻¹ F_nᵀ c with c = ĥ_n − M̂_n ζ_n; M̂_p += T_npᵀ M̄_n T_np, ĥ_p += T_npᵀ h̄_n.
+    Forward: a = T_np ÿ_p + ζ_n, s̈_n = D_n⁻¹ (F_nᵀ ĥ_n − Uᵀ a), ÿ_n = a + F_n s̈_n.
+    ``M_hat`` and ``h_hat`` enter as M_n and h_n and are overwritten (``h_hat`` may have a
+    ground row N that collects, never read). Returns −1, or the index of the first body
+    with a pivot of D_n (a squared diagonal entry of L) not above ``pivot_min``.
     """
-    N = kind.shape[0]
-    U, D, f_h = np.zeros((N, 6)), np.ones(N), np.zeros(N)
-    c, MT = np.empty(6), np.empty((6, 6))
+    N = n_cols.shape[0]
+    U, L, f_h = np.zeros((N, 6, 6)), np.zeros((N, 6, 6)), np.zeros((N, 6))
+    c, g, MT = np.empty(6), np.empty(6), np.empty((6, 6))
     for n in range(N - 1, -1, -1):  # backward: leaves → root
-        M = M_hat[n]
+        M, k = M_hat[n], n_cols[n]
         for a in range(6):
             c[a] = h_hat[n, a] - _dot6(M[a], zeta[n])
-        if kind[n] != FIXED:
+        if k > 0:
             for a in range(6):
-                U[n, a] = _dot6(M[a], f[n])
-            D[n] = _dot6(f[n], U[n])
-            if not D[n] > pivot_min:
+                for j in range(k):
+                    U[n, a, j] = _dot6(M[a], F[n, :, j])
+            for i in range(k):
+                for j in range(k):
+                    L[n, i, j] = _dot6(F[n, :, i], U[n, :, j])  # D_n, factored in place
+                f_h[n, i] = _dot6(F[n, :, i], h_hat[n])
+                g[i] = _dot6(F[n, :, i], c)
+            if not _cholesky(L[n], k, pivot_min):
                 return n
-            f_h[n] = _dot6(f[n], h_hat[n])
-            f_c = _dot6(f[n], c) / D[n]
+            _cholesky_solve(L[n], k, g)  # D_n⁻¹ F_nᵀ c
             for a in range(6):
-                c[a] -= U[n, a] * f_c
+                for j in range(k):
+                    c[a] -= U[n, a, j] * g[j]
+            for j in range(k):  # M̄ = M̂ − (U L⁻ᵀ)(U L⁻ᵀ)ᵀ, one column of U L⁻ᵀ at a time
+                for a in range(6):
+                    total = U[n, a, j]
+                    for i in range(j):
+                        total -= MT[a, i] * L[n, j, i]
+                    MT[a, j] = total / L[n, j, j]
+            for a in range(6):
                 for b in range(6):
-                    M[a, b] -= U[n, a] * U[n, b] / D[n]
+                    total = 0.0
+                    for j in range(k):
+                        total += MT[a, j] * MT[b, j]
+                    M[a, b] -= total
         p = parent[n]
         if p >= 0:
             _add_congruence(T[n], M, c, MT, M_hat[p], h_hat[p])
     y_ddot = np.zeros((N, 6))
     for n in range(N):  # forward: root → leaves
-        p = parent[n]
+        p, k = parent[n], n_cols[n]
         a = y_ddot[n]
         for i in range(6):
             a[i] = zeta[n, i] + (_dot6(T[n, i], y_ddot[p]) if p >= 0 else 0.0)
-        if kind[n] != FIXED:
-            x = (f_h[n] - _dot6(U[n], a)) / D[n]
-            s_ddot[q_index[n]] = x
-            for i in range(6):
-                a[i] += f[n, i] * x
+        if k > 0:
+            for j in range(k):
+                g[j] = f_h[n, j] - _dot6(U[n, :, j], a)
+            _cholesky_solve(L[n], k, g)
+            for j in range(k):
+                s_ddot[s_index[n] + j] = g[j]
+                for i in range(6):
+                    a[i] += F[n, i, j] * g[j]
     return -1
+
+
+def _cholesky(D, k, pivot_min):
+    """D[:k, :k] = L Lᵀ in place (L in the lower triangle); False if a pivot L_jj² is not
+    above ``pivot_min``."""
+    for j in range(k):
+        pivot = D[j, j]
+        for i in range(j):
+            pivot -= D[j, i] * D[j, i]
+        if not pivot > pivot_min:
+            return False
+        D[j, j] = np.sqrt(pivot)
+        for i in range(j + 1, k):
+            total = D[i, j]
+            for l in range(j):
+                total -= D[i, l] * D[j, l]
+            D[i, j] = total / D[j, j]
+    return True
+
+
+def _cholesky_solve(L, k, b):
+    """b[:k] ← (L Lᵀ)⁻¹ b[:k] by two triangular solves."""
+    for i in range(k):
+        total = b[i]
+        for l in range(i):
+            total -= L[i, l] * b[l]
+        b[i] = total / L[i, i]
+    for i in range(k - 1, -1, -1):
+        total = b[i]
+        for l in range(i + 1, k):
+            total -= L[l, i] * b[l]
+        b[i] = total / L[i, i]
 
 
 def _dot6(a, b):
@@ -201,13 +277,13 @@ def kernel(compiled: bool = True):
         return chain_terms, passes
     if not has_numba():
         raise ValueError(
-            "compiled: numba is not installed (pip install 'projeq[fast]'); compiled=False runs the same "
+            "compiled: numba is not installed (pip install numba); compiled=False runs the same "
             "kernel interpreted, method='auto' picks the best evaluator available"
         )
     return _compiled()
 
 
-_CALLEES = (_relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _add_congruence)
+_CALLEES = (_relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _add_congruence, _cholesky, _cholesky_solve)
 
 
 @functools.cache

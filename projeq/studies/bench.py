@@ -36,6 +36,8 @@ from projeq.subsystems import inertia
 from projeq.studies.bench_beam import convergence
 from projeq.studies.bench_derivation import derivation_effort
 from projeq.studies.bench_exact import chain_s_ddot
+from projeq.studies.bench_scenes import scene_costs
+from projeq.studies.timing import time_per_call
 
 QUICK_SIZES = (10, 30, 100)
 OURS = ("recursive", "fast", "dense")
@@ -107,41 +109,6 @@ def evaluators(n: int, peers: bool = True) -> dict:
 def _s_ddot(evaluator):
     """(q, ṡ) ↦ s̈ of one of projeq's evaluators, at t = 0."""
     return lambda q, s_dot: evaluator.accelerations(q, s_dot, 0.0)
-
-
-def time_per_call(funcs: dict, q, s_dot, budget: float, clock=time.process_time, batch: float = 2e-3) -> dict:
-    """Minimum CPU time of one call per function, alternating them until ``budget``
-    seconds are spent (at least 3 rounds, after one warm-up call each).
-
-    Each function is timed in batches of repeated calls lasting about ``batch`` seconds, so
-    that the clock's granularity (a CPU-time clock may tick in coarse steps on virtual
-    machines) cannot round a short call to zero; the result is the fastest batch's mean.
-
-    By default CPU time of this process (``time.process_time``), not wall time: on a loaded
-    machine a call that is preempted would otherwise count the other processes' time
-    slices, which hits long calls more often than short ones and biases the slopes
-    upwards. CPU time counts every thread, though, so calls into multithreaded BLAS (the
-    dense evaluator at n ≳ 100) are better timed with ``clock=time.perf_counter``.
-    """
-    best = dict.fromkeys(funcs, np.inf)
-    repeats = {name: _repeats(f, q, s_dot, batch) for name, f in funcs.items()}
-    started, rounds = time.perf_counter(), 0
-    while rounds < 3 or time.perf_counter() - started < budget:
-        for name, f in funcs.items():
-            t0 = clock()
-            for _ in range(repeats[name]):
-                f(q, s_dot)
-            best[name] = min(best[name], (clock() - t0) / repeats[name])
-        rounds += 1
-    return best
-
-
-def _repeats(f, q, s_dot, batch: float) -> int:
-    """How many calls of f (after a warm-up call) take about ``batch`` seconds of wall time."""
-    f(q, s_dot)
-    t0 = time.perf_counter()
-    f(q, s_dot)
-    return max(1, int(batch / max(time.perf_counter() - t0, 1e-9)))
 
 
 def measure(sizes, budget: float = 1.0, peers: bool = True, exact_up_to: int = EXACT_UP_TO) -> list[dict]:
@@ -235,8 +202,14 @@ def quick_beam_convergence(deadline: float = math.inf, show=None) -> tuple[dict,
     return report, report["complete"]
 
 
+def quick_scene_costs(deadline: float = math.inf, show=None) -> tuple[list, bool]:
+    """Every scene's s̈ with the default evaluator against chain(k)
+    (:func:`projeq.studies.bench_scenes.scene_costs`): (rows, complete)."""
+    return scene_costs(0.2, deadline, show)
+
+
 #: the quick studies after the chain part, cheapest first: name → function (deadline, show) ↦ (report, complete)
-QUICK_STUDIES = {"derivation": quick_derivation, "beam_convergence": quick_beam_convergence}
+QUICK_STUDIES = {"scenes": quick_scene_costs, "derivation": quick_derivation, "beam_convergence": quick_beam_convergence}
 
 
 def quick_suite(sizes=QUICK_SIZES, budget: float = 0.5, total: float = TOTAL_BUDGET, peers: bool = True,

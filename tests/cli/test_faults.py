@@ -25,13 +25,13 @@ from projeq.simulation.sweep import SweepTable
 def faulty(k: int = 0, kill: int = -1, fail: int = -1, slow: int = -1):
     """A scene for fault injection: a one-link chain, except that point ``k == kill`` kills
     its own process (SIGKILL, as the out-of-memory killer does), ``k == fail`` raises an
-    error whose message has a comma and two lines, and ``k == slow`` is a 60-link chain
-    (seconds per simulated second)."""
+    error whose message has a comma and two lines, and ``k == slow`` is a 60-link planar chain
+    (seconds per simulated second: planar bodies run on the interpreted evaluator)."""
     if k == kill:
         os.kill(os.getpid(), signal.SIGKILL)
     if k == fail:
         raise ValueError("bad point, on purpose\nsecond line of the message")
-    return build_scene("chain", n=60 if k == slow else 1)
+    return build_scene("chain", n=60, planar=True) if k == slow else build_scene("chain", n=1)
 
 
 FAULTY = Scene(faulty, "a chain with injected faults", 0.05)

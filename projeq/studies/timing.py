@@ -1,0 +1,44 @@
+"""CPU time of one call of several functions, timed alternately in one run, so that their
+ratios hold on a loaded machine (:func:`time_per_call`, used by every benchmark of
+:mod:`projeq.studies`)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+
+def time_per_call(funcs: dict, q, s_dot, budget: float, clock=time.process_time, batch: float = 2e-3) -> dict:
+    """Minimum CPU time of one call per function, alternating them until ``budget``
+    seconds are spent (at least 3 rounds, after one warm-up call each).
+
+    Each function is timed in batches of repeated calls lasting about ``batch`` seconds, so
+    that the clock's granularity (a CPU-time clock may tick in coarse steps on virtual
+    machines) cannot round a short call to zero; the result is the fastest batch's mean.
+
+    By default CPU time of this process (``time.process_time``), not wall time: on a loaded
+    machine a call that is preempted would otherwise count the other processes' time
+    slices, which hits long calls more often than short ones and biases the slopes
+    upwards. CPU time counts every thread, though, so calls into multithreaded BLAS (the
+    dense evaluator at n ≳ 100) are better timed with ``clock=time.perf_counter``.
+    """
+    best = dict.fromkeys(funcs, np.inf)
+    repeats = {name: _repeats(f, q, s_dot, batch) for name, f in funcs.items()}
+    started, rounds = time.perf_counter(), 0
+    while rounds < 3 or time.perf_counter() - started < budget:
+        for name, f in funcs.items():
+            t0 = clock()
+            for _ in range(repeats[name]):
+                f(q, s_dot)
+            best[name] = min(best[name], (clock() - t0) / repeats[name])
+        rounds += 1
+    return best
+
+
+def _repeats(f, q, s_dot, batch: float) -> int:
+    """How many calls of f (after a warm-up call) take about ``batch`` seconds of wall time."""
+    f(q, s_dot)
+    t0 = time.perf_counter()
+    f(q, s_dot)
+    return max(1, int(batch / max(time.perf_counter() - t0, 1e-9)))
