@@ -11,7 +11,7 @@ prescribed motion). Its Newton absolute tolerance is raised from 1e-10 to 1e-6 N
 ``exudyn_tip_deflection``); with the default it cuts its steps to 1e-6 s and needs ~50×
 the CPU time. Its beam is extensible (EA = 2.8e7 N) and its curvature is exact; projeq's
 default is inextensible with the linear curvature v″ and the second-order axial field u₂
-(THEORY §10). ``--study`` adds Exudyn runs with 32 elements and h = 5e-4 (its discretisation
+(docs/theory.md §10). ``--study`` adds Exudyn runs with 32 elements and h = 5e-4 (its discretisation
 error). Measured: Exudyn differs from projeq's reference by 2.9e-4 m at Ωs = 4, 3.3e-5 m at
 Ωs = 2, 4.1e-6 m at Ωs = 1 rad/s — as the cube of the deflection (ratios 8 and 64), the
 signature of the geometric terms beyond projeq's second-order beam theory (exact curvature

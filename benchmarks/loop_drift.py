@@ -1,6 +1,6 @@
 """Loop-closure drift of Barhorst's quick-return mechanism versus the correction method.
 
-``scenes.mechanisms.quick_return`` (seed 000 §3.3) runs 10 s with zero drive, once per
+``scenes.mechanisms.quick_return`` (Barhorst §3.3) runs 10 s with zero drive, once per
 position correction of :class:`projeq.constraints.partitioned.ConstrainedSystem`:
 
 - ``none``: q̇ = K (F ṡ + f) only; the velocity constraint holds exactly, so Φ drifts by

@@ -2,11 +2,11 @@
 
 Two tables, both from runs made now (nothing is copied from elsewhere):
 
-1. Reference cases computed here: projeq's value next to a closed form from the seeds,
+1. Reference cases computed here: projeq's value next to a closed form from the literature,
    with the error.
-2. Every validation test (:data:`VALIDATION_TESTS`: the closed forms of the seeds, the
+2. Every validation test (:data:`VALIDATION_TESTS`: the closed forms of the literature, the
    non-holonomic scenes, loops and contacts, the Whipple bicycle against KanesMethod, the
-   symbolic derivations against each other and the seeds): its outcome when run now
+   symbolic derivations against each other and the literature): its outcome when run now
    (pytest), its duration and the reference its docstring cites (each test asserts projeq
    against that reference within the tolerance stated in the test). Bad-input tests are
    left out: they check messages, not physics.
@@ -33,14 +33,14 @@ def reference_cases():
     m1, m2, M, a = 2.0, 1.0, 0.5, 0.1
     atwood = pq.scenes.atwood(m1, m2, M, a, G)
     yield ("Atwood machine, depth acceleration of mass 1 (m/s²)",
-           "Problem 1, eq. (4), seed 003: (m1 − m2) g / (m1 + m2 + I/a²)",
+           "Problem 1, eq. (4), the Lagrange seminars: (m1 − m2) g / (m1 + m2 + I/a²)",
            -a * atwood.accelerations([0.0], [0.0])[0], (m1 - m2) * G / (m1 + m2 + 0.5 * M))
     A, _ = pq.linearize(pq.scenes.chain(1), q=[0.0], s_dot=[0.0])
     I_O = (3 * 0.01**2 + 1.0) / 12 + 0.25
     yield ("one-link chain, small-oscillation ω² (1/s²)", "compound pendulum m g d / I_O",
            -A[1, 0], G * 0.5 / I_O)
     run = pq.simulate(pq.scenes.atwood(m1, m2, M, a, G), 1.0, rtol=1e-10, atol=1e-12)
-    yield ("Atwood machine, pulley angle after 1 s from rest (rad)", "Problem 1, eq. (4), seed 003: θ = −½ ẍ t²/a",
+    yield ("Atwood machine, pulley angle after 1 s from rest (rad)", "Problem 1, eq. (4), the Lagrange seminars: θ = −½ ẍ t²/a",
            run.q[-1, 0], -0.5 * (m1 - m2) * G / (m1 + m2 + 0.5 * M) / a)
     car = pq.simulate(pq.scenes.car(), 10.0, method="DOP853", rtol=1e-10, atol=1e-12)
     yield ("car (B(5)-(12)), energy after 10 s without forces (J)", "conservation law: E(0)",

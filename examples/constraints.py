@@ -1,7 +1,7 @@
 """Constraint equations: a closed loop (scene ``four_bar``) and the Whipple bicycle (``whipple_bicycle``).
 
 A :class:`projeq.ConstrainedSystem` is a tree plus constraint equations Φ(q, t) = 0 and
-A(q, t) q̇ = b; coordinate partitioning inserts them before the projection (THEORY §7).
+A(q, t) q̇ = b; coordinate partitioning inserts them before the projection (docs/theory.md §7).
 
 1. The four-bar linkage swings under gravity from the crank turning at 3 rad/s. The ideal
    loop closure does no work, so the energy is conserved (a conservation law), and the

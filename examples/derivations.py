@@ -1,8 +1,8 @@
 """Comparing derivations: recursive order-n, compiled order-n ("fast"), dense Gauss form, sympy.
 
 All evaluate the Projection Equation Σ (∂ẏ_n/∂ṡ)ᵀ(M_n ÿ_n + G_n ẏ_n − Q_n) = 0 for the
-same chain: by the O(n) recursion (THEORY §6) in numpy and compiled, by assembling M(q)
-and solving (THEORY §5), and symbolically (``projeq.symbolic.gauss_form``: M(q) s̈ = rhs
+same chain: by the O(n) recursion (docs/theory.md §6) in numpy and compiled, by assembling M(q)
+and solving (docs/theory.md §5), and symbolically (``projeq.symbolic.gauss_form``: M(q) s̈ = rhs
 in sympy, lambdified). Formulations of the same equations must give the same
 accelerations to round-off, and trajectories that agree to the integration tolerance.
 

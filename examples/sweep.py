@@ -2,7 +2,7 @@
 
 Mass 1 (m1) and mass 2 (1 kg) hang on a rope over a pulley (0.5 kg disk, radius 0.1 m).
 From rest the pulley turns with constant angular acceleration, so after t the angle is
-θ = −½ ẍ t²/a with ẍ = (m1 − m2) g / (m1 + m2 + I/a²) (Problem 1, eq. (4) of seed 003).
+θ = −½ ẍ t²/a with ẍ = (m1 − m2) g / (m1 + m2 + I/a²) (Problem 1, eq. (4) of the Lagrange seminars).
 On a cluster pass ``executor=dask.distributed.Client("tcp://scheduler:8786")``.
 
 Run: python examples/sweep.py

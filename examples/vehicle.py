@@ -1,4 +1,4 @@
-"""A non-holonomic vehicle: Bremer's car (scene ``car``, B(5)-(12) of seed 004).
+"""A non-holonomic vehicle: Bremer's car (scene ``car``, B(5)-(12) of Bremer (2009)).
 
 The rear axle cannot slide sideways: q = (x, y, γ) has three coordinates but only two
 minimal velocities ṡ = (forward speed, yaw rate), q̇ = K(q) ṡ. Without driving forces the

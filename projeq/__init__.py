@@ -2,6 +2,11 @@
 
 Σ_n (∂ẏ_n/∂ṡ)ᵀ (M_n ÿ_n + G_n ẏ_n − Q_n) = 0, assembled densely (Gauss form) or solved
 recursively in order n. See docs/theory.md and docs/architecture.md.
+
+Docstrings cite equations as B(n), eq. (n) of H. Bremer (2009), "Problems in Fast Moving
+Non-Holonomic Elastic Systems", and K(n), eq. (n) of R. M. M. Orsino (2020), "Non-Holonomic
+Systems; Lagrange Multipliers"; other publications by the short keys of the References in
+docs/theory.md, and that page by its numbered sections ("docs/theory.md §6").
 """
 
 from projeq.subsystems import inertia

@@ -1,13 +1,13 @@
 """Spatial kinematics: spin matrices, rotations, quaternions and rigid chain matrices.
 
-Pure functions on numpy arrays, in Bremer's notation (THEORY §1, §4):
+Pure functions on numpy arrays, in Bremer's notation (docs/theory.md §1, §4):
 
 - ``skew(a)`` is the spin matrix ã with ã b = a × b;
 - ``A_np`` rotates coordinates of frame p into frame n; ``R`` (no subscript) is a
   rotation whose columns are a body's axes in inertial coordinates (body → inertial);
 - a *twist* is the 6-vector (v_O, ω) of a frame's origin velocity and angular velocity,
   both in that frame's own coordinates; ``T_np`` maps the twist of p to the part of the
-  twist of n that p's motion causes (B(15), THEORY §4).
+  twist of n that p's motion causes (B(15), docs/theory.md §4).
 
 This is the one numeric home of these formulas. Every function is complex-safe: complex
 input gives the complex result of the same formula (no float-only buffers), so complex-step
@@ -136,7 +136,7 @@ def quaternion_rate_matrix(quat: NDArray) -> NDArray:
 
 
 def chain_matrix(A_np: NDArray, r_pn: NDArray) -> NDArray:
-    """Rigid T_np = [[A_np, −A_np r̃_pn], [0, A_np]] (THEORY §4), or a stack of them for
+    """Rigid T_np = [[A_np, −A_np r̃_pn], [0, A_np]] (docs/theory.md §4), or a stack of them for
     stacks A_np (..., 3, 3) and r_pn (..., 3).
 
     ``r_pn`` is O_p → O_n in p-coordinates; ẏ_n = T_np ẏ_p is the twist of a frame n
@@ -162,7 +162,7 @@ def cross_motion(u: NDArray, w: NDArray) -> NDArray:
     (row-wise for stacks of shape (..., 6)).
 
     With u = T_np ẏ_p and w the joint's relative twist, it is the part Ṫ_np ẏ_p of
-    ζ_n that stems from the joint's rotation and translation (THEORY §4).
+    ζ_n that stems from the joint's rotation and translation (docs/theory.md §4).
     """
     u_v, u_w, w_v, w_w = u[..., :3], u[..., 3:], w[..., :3], w[..., 3:]
     return np.concatenate((cross(u_w, w_v) + cross(u_v, w_w), cross(u_w, w_w)), axis=-1)

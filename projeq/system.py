@@ -7,7 +7,7 @@ the order q follows; :meth:`Model.coordinates` names its entries). Each
 joint owns a slice of the coordinates q and of the minimal velocities ṡ (``q_slice[n]``,
 ``s_slice[n]``) unless it is *coupled* (gears, ropes), in which case its coordinate is a
 linear combination of other joints' coordinates and ∂ẏ/∂ṡ is no longer block-triangular
-(THEORY §4): such systems are evaluated by the dense Gauss form.
+(docs/theory.md §4): such systems are evaluated by the dense Gauss form.
 
 All validation happens here, where input enters; the kernels trust what they get.
 """
@@ -568,12 +568,12 @@ class System(Model):
         return Q
 
     def gauss_form(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
-        """M(q) and b(q, ṡ, t) of the Gauss form M s̈ + b = 0 (THEORY §5)."""
+        """M(q) and b(q, ṡ, t) of the Gauss form M s̈ + b = 0 (docs/theory.md §5)."""
         q, s_dot = self.check_state(q, s_dot, t)
         return self.evaluator("dense").gauss_form(q, s_dot, float(t))
 
     def mass_matrix(self, q, t: float = 0.0) -> NDArray:
-        """M(q) = Σ J_nᵀ M_n J_n (THEORY §5)."""
+        """M(q) = Σ J_nᵀ M_n J_n (docs/theory.md §5)."""
         return self.gauss_form(q, np.zeros(self.n_s), t)[0]
 
     def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:

@@ -1,7 +1,7 @@
 """Every script in examples/ runs (quickly, PROJEQ_QUICK=1) and checks a physical fact.
 
 Each example asserts its own fact with its provenance in its docstring (a closed form from
-the seeds or tables, a second formulation, or a conservation law); an example that leaves
+the literature or tables, a second formulation, or a conservation law); an example that leaves
 a ``result`` of a conservative scene is also checked for energy conservation here.
 """
 

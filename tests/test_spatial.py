@@ -1,6 +1,6 @@
 """Spatial kinematics (projeq.spatial): spin matrices, rotations, quaternions, chain matrices.
 
-Notation of THEORY §1 and §4: ``skew(a) b = a × b``; ``A_np`` rotates p- into n-coordinates;
+Notation of docs/theory.md §1 and §4: ``skew(a) b = a × b``; ``A_np`` rotates p- into n-coordinates;
 ``T_np = [[A_np, −A_np r̃_pn], [0, A_np]]`` carries the twist (v, ω) of a frame p to the
 twist of a frame n rigidly attached to it (Bremer B(15): ẏ_n = T_np ẏ_p + F_n ṡ_n,
 T_31 = T_32 T_21).
@@ -55,7 +55,7 @@ def _close(a, b, scale=1.0, rtol=RTOL):
 # -- spin matrices -----------------------------------------------------------------------
 @given(seeds)
 def test_skew_times_b_is_the_cross_product(seed):
-    """ã b = a × b (THEORY §1), against numpy's cross product; ã is skew-symmetric."""
+    """ã b = a × b (docs/theory.md §1), against numpy's cross product; ã is skew-symmetric."""
     rng = np.random.default_rng(seed)
     a, b = rng.uniform(-10, 10, (2, 3))
     assert _close(skew(a) @ b, np.cross(a, b), np.abs(a).max() * np.abs(b).max())
@@ -209,7 +209,7 @@ def _derivative(f, x0, h=1e-3):
 @pytest.mark.parametrize("kind", ["revolute", "prismatic"])
 @given(seed=seeds)
 def test_cross_motion_is_the_derivative_of_the_chain_matrix(kind, seed):
-    """u × w = Ṫ_np ẏ_p (THEORY §4, kinematics.forward) with u = T_np ẏ_p, w = F ṡ the joint's
+    """u × w = Ṫ_np ẏ_p (docs/theory.md §4, kinematics.forward) with u = T_np ẏ_p, w = F ṡ the joint's
     relative twist. The joint frame sits at r_pn with orientation A_pJ; a revolute turns the
     child by θ about e (A_pn = A_pJ R(e, θ), offset fixed), a prismatic slides it by x along e
     (A_pn = A_pJ, r_pn = r_0 + A_pJ e x). ẏ_p is held fixed and Ṫ_np ẏ_p = dT/dθ θ̇ ẏ_p is

@@ -1,6 +1,6 @@
 """Linearisation of the equations of motion about an equilibrium or a steady motion.
 
-The state is x = (q, ṡ) with ẋ = f(x, τ) = (K(q) ṡ + k, s̈(q, ṡ, t, τ)) (THEORY §5, §7);
+The state is x = (q, ṡ) with ẋ = f(x, τ) = (K(q) ṡ + k, s̈(q, ṡ, t, τ)) (docs/theory.md §5, §7);
 :func:`linearize` returns δẋ = A δx + B δτ. For non-holonomic systems ṡ are already the
 minimal velocities (the constraints are in K and F), so A is the linearisation on the
 constraint manifold, not of an unconstrained Lagrangian system with multipliers.

@@ -1,5 +1,5 @@
 """The evaluator of a beam on a moving hub, ``method="hub_beam"``: one RitzBeam whose root
-follows a prescribed motion (a rheonomic hub, THEORY §4) or is fixed to the ground — the
+follows a prescribed motion (a rheonomic hub, docs/theory.md §4) or is fixed to the ground — the
 spin-up beam.
 
 Then the beam's reference frame moves as given, ẏ = (w(t), q̇_e) with the hub's twist w
@@ -8,7 +8,7 @@ Projection Equation B(14) projected on the only minimal velocities ṡ = q̇_e,
 
     M_ee q̈_e = h_e − M_eR ζ,
 
-needs neither the kinematic chain nor the passes of THEORY §6: the beam's terms and one
+needs neither the kinematic chain nor the passes of docs/theory.md §6: the beam's terms and one
 n_e × n_e solve. With precomputed shape integrals (:mod:`projeq.subsystems.beam.integrals`)
 and no rotary inertia only the elastic rows (M_ee, M_eR, h_e) are formed
 (:meth:`~projeq.subsystems.beam.beam.RitzBeam.elastic_terms`). M_ee = ∫ Φ_rᵀ Φ_r dm is

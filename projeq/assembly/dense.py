@@ -1,4 +1,4 @@
-"""The dense Gauss form M(q) s̈ + b(q, ṡ, t) = 0 (THEORY §5; B(14)–(15)).
+"""The dense Gauss form M(q) s̈ + b(q, ṡ, t) = 0 (docs/theory.md §5; B(14)–(15)).
 
 The functional matrix J_n = ∂ẏ_n/∂ṡ = T_np J_p + F_n P_n and ζ̄_n = J̇_n ṡ = T_np ζ̄_p + ζ_n
 are built root to leaves; then

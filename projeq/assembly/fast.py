@@ -1,8 +1,8 @@
-"""The order-n passes of THEORY §6 in one compiled loop over flat arrays ("fast").
+"""The order-n passes of docs/theory.md §6 in one compiled loop over flat arrays ("fast").
 
 The System stays frozen; :class:`FastEvaluator` packs its tree once into arrays (parents,
 joint kinds, axes, joint frames, masses, r_c, I_c, M_n) and each call runs
-:func:`projeq.assembly.kernels.chain_terms` (T_np, ζ_n, F_n, h_n; THEORY §3–4) and
+:func:`projeq.assembly.kernels.chain_terms` (T_np, ζ_n, F_n, h_n; docs/theory.md §3–4) and
 :func:`projeq.assembly.kernels.passes` (Bremer's backward and forward passes, §6).
 Both are compiled by numba (a dependency) on first use (cached on
 disk); ``method="fast"`` is this kernel or a ValueError saying why not (numba missing, or
@@ -125,7 +125,7 @@ class FastEvaluator:
             force.add_to(self._h_hat, kin, t, q, s_dot)
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """s̈ at (q, ṡ, t) (THEORY §6); raises SingularMassError for a zero pivot of D_n."""
+        """s̈ at (q, ṡ, t) (docs/theory.md §6); raises SingularMassError for a zero pivot of D_n."""
         self.n_calls += 1
         q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
         if self._given:

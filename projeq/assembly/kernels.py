@@ -1,4 +1,4 @@
-"""The loops of the fast evaluator on flat arrays: THEORY §4 (kinematics) and §6 (passes).
+"""The loops of the fast evaluator on flat arrays: docs/theory.md §4 (kinematics) and §6 (passes).
 
 Plain Python on scalars and small arrays, written so that numba can compile it
 (:func:`kernel` with ``compiled=True`` applies ``numba.njit(cache=True)``); the same source
@@ -8,7 +8,7 @@ Joint kinds: ``FIXED`` (no dof), ``REVOLUTE`` (F⁶ = [0; e]), ``PRISMATIC`` (F�
 about a unit axis e in joint-frame coordinates, and ``GIVEN``: any other joint, whose
 relative motion (A, r, F⁶, w, ζ of :class:`projeq.joints.base.Relative`) its own
 ``relative`` computes before each call (0–6 minimal velocities: the passes solve
-D_n = F_nᵀ M̂_n F_n by Cholesky); subsystems: rigid bodies (M_n = M6, h_n of THEORY §3). Twists are (v_O, ω) in body coordinates; index −1 is the ground.
+D_n = F_nᵀ M̂_n F_n by Cholesky); subsystems: rigid bodies (M_n = M6, h_n of docs/theory.md §3). Twists are (v_O, ω) in body coordinates; index −1 is the ground.
 
 Compiled twins. numba compiles scalar loops, not the array functions of
 :mod:`projeq.spatial`, so four formulas have a second, scalar form here and only here:
@@ -44,7 +44,7 @@ def has_numba() -> bool:
 
 def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, m, r_c, I_c, gravity, q, s_dot,
                 given_A, given_r, given_w, given_zeta, T, zeta, F, h, R, r_O, twist):
-    """T_np, ζ_n, F_n and h_n = Q_n − G_n ẏ_n of every body (THEORY §3–4), and the poses
+    """T_np, ζ_n, F_n and h_n = Q_n − G_n ẏ_n of every body (docs/theory.md §3–4), and the poses
     R_n, r_n and twists ẏ_n (row N of R, r_O, twist: the ground, at rest).
 
     A_pn = A_pJ A_Jn, r_pn = r_pJ + A_pJ r_Jn, T_np = [[A_np, −A_np r̃_pn], [0, A_np]],
@@ -140,7 +140,7 @@ def _cross3(a, b):
 
 
 def _rigid_h(m, r_c, I_c, twist, g_body, out):
-    """h = [m g − ω̃ p ; r̃_c (m g − ω̃ p) − ω̃ I_c ω], p = m (v + ω × r_c) (THEORY §3), written
+    """h = [m g − ω̃ p ; r̃_c (m g − ω̃ p) − ω̃ I_c ω], p = m (v + ω × r_c) (docs/theory.md §3), written
     into ``out``; compiled twin of :func:`projeq.subsystems.rigid.rigid_h`."""
     omega = twist[3:]
     p_c = m * (twist[:3] + _cross3(omega, r_c))
@@ -151,7 +151,7 @@ def _rigid_h(m, r_c, I_c, twist, g_body, out):
 
 
 def passes(n_cols, parent, s_index, T, zeta, F, M_hat, h_hat, pivot_min, s_ddot):
-    """Backward and forward pass of THEORY §6 for joints with ``n_cols[n]`` = 0…6 minimal
+    """Backward and forward pass of docs/theory.md §6 for joints with ``n_cols[n]`` = 0…6 minimal
     velocities (the first n_cols columns of F[n]); writes s̈.
 
     Backward: U = M̂_n F_n, D_n = F_nᵀ U = L Lᵀ (Cholesky), M̄_n = M̂_n − U D_n⁻¹ Uᵀ,

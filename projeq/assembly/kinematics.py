@@ -1,4 +1,4 @@
-"""One forward pass over the tree: poses, describing velocities and chain terms (THEORY §4).
+"""One forward pass over the tree: poses, describing velocities and chain terms (docs/theory.md §4).
 
 :func:`forward` gives all of them (:class:`Kinematics`, what the evaluators need);
 :func:`poses` only the poses, twists and ẏ_n (:class:`Poses`, what energies, exports and
@@ -35,7 +35,7 @@ from projeq.subsystems.rigid import RigidGroup
 class Plan:
     """Per-System preparation of the forward pass (built once, by the System's constructor).
 
-    - ``groups``: subsystems whose terms are the rigid-body terms of THEORY §3
+    - ``groups``: subsystems whose terms are the rigid-body terms of docs/theory.md §3
       (``rigid_inertia``), one :class:`RigidGroup` per selection S, as (indices, group);
       ``singles``: the others, whose own ``gauss_terms`` are called one by one;
     - ``S_aug[n]`` = blockdiag(S_n, 1), and [0 … 0 1] for the ground, so that
@@ -171,7 +171,7 @@ def _poses_and_twists(system, prep: Plan, q: NDArray, s_dot: NDArray, t: float) 
 def _port(system, station, p, q, s_dot, R, r, twist):
     """The frame ``station`` (``Plan.stations``) of a joint on its deforming parent p: its
     pose, its twist, and P̃ = [[T⁶_port Sₚᵀ + F_port Eₑᵀ, ζ_port], [0, 1]], the map
-    (ÿ_p; 1) ↦ (port acceleration; 1) that T̃_np composes with (THEORY §10, last line)."""
+    (ÿ_p; 1) ↦ (port acceleration; 1) that T̃_np composes with (docs/theory.md §10, last line)."""
     port = station.relative(q[system.e_q_slice[p]], s_dot[system.e_s_slice[p]])
     T6 = chain_matrix(port.A.T, port.r)
     u = T6 @ twist[p]

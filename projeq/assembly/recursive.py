@@ -1,4 +1,4 @@
-"""Order-n solution of the Projection Equation: Bremer's Gaussian elimination (THEORY §6).
+"""Order-n solution of the Projection Equation: Bremer's Gaussian elimination (docs/theory.md §6).
 
 Backward pass, leaves to root, with h_n = Q_n − G_n ẏ_n:
 
@@ -20,7 +20,7 @@ for which the two lines of M̄_n and h̄_n are one Schur complement and one cong
     Ã_p += T̃_npᵀ Ā_n T̃_np,
 
 and the forward pass acts on (ÿ_n; 1) = T̃_np (ÿ_p; 1) + F̃_n s̈_n. The last column of
-T̃ᵀ Ā T̃ is −T_npᵀ h̄_n with h̄_n exactly as above (THEORY §6 expands this).
+T̃ᵀ Ā T̃ is −T_npᵀ h̄_n with h̄_n exactly as above (docs/theory.md §6 expands this).
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ class RecursiveEvaluator:
         self.n_calls = 0
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """s̈ by the backward and forward passes of THEORY §6."""
+        """s̈ by the backward and forward passes of docs/theory.md §6."""
         self.n_calls += 1
         system, scale = self.system, self.scale
         kin = forward(system, q, s_dot, t)

@@ -1,4 +1,4 @@
-"""Constraints (THEORY §7): closed loops and Pfaffian constraints given as equations on a tree.
+"""Constraints (docs/theory.md §7): closed loops and Pfaffian constraints given as equations on a tree.
 
 - :mod:`.partitioned`: :class:`ConstrainedSystem`, the partitioned model with minimal velocities;
 - :mod:`.tangent`: :class:`TangentSystem`, minimal velocities in the constraints' null space (through

@@ -1,4 +1,4 @@
-"""Cut joints of closed loops: a point of one body held on a point of another (THEORY §7).
+"""Cut joints of closed loops: a point of one body held on a point of another (docs/theory.md §7).
 
 A loop is cut open at a joint that pins point P_a of subsystem a to point P_b of subsystem
 b (or of the ground): a revolute joint of a planar loop, a spherical joint in space. Its

@@ -1,4 +1,4 @@
-"""Constraints given as equations: closed loops and Pfaffian constraints on a tree (THEORY §7).
+"""Constraints given as equations: closed loops and Pfaffian constraints on a tree (docs/theory.md §7).
 
 A tree :class:`~projeq.System` keeps its own (now redundant) coordinates q and velocities
 ṡ_tree; the user adds holonomic constraints Φ(q, t) = 0 and/or Pfaffian ones

@@ -1,4 +1,4 @@
-"""Reaction forces of constraints given as equations, and an event when a contact lets go (THEORY §7).
+"""Reaction forces of constraints given as equations, and an event when a contact lets go (docs/theory.md §7).
 
 With the constraint inserted before the projection, Fᵀ(M s̈_tree + b) = 0 leaves the
 residual M s̈_tree + b of the tree's Gauss form in the constrained directions, the
@@ -69,7 +69,7 @@ def joint_reactions(system, q, s_dot, t: float = 0.0, cuts=None) -> dict:
     """{name: W_n}: the wrench each joint transmits to its subsystem (and the subtree
     beyond), in the subsystem's ẏ coordinates (a rigid body's [force; moment about O_n] in
     body axes), from W_n = r_n + Σ_c T_cnᵀ W_c with r_n = M_n ÿ_n − h_n − w_n and
-    ÿ_n = T_np ÿ_p + F_n s̈_n + ζ_n (B(14); THEORY §7).
+    ÿ_n = T_np ÿ_p + F_n s̈_n + ζ_n (B(14); docs/theory.md §7).
 
     For a :class:`~projeq.constraints.partitioned.ConstrainedSystem`, ``cuts`` is a dict
     {name: :class:`~projeq.constraints.cut_joints.PinClosure`} of the cut joints whose closures make up

@@ -1,4 +1,4 @@
-"""How subsystems connect: the kinematic chain ẏ_n = T_np ẏ_p + F_n ṡ_n (THEORY §4).
+"""How subsystems connect: the kinematic chain ẏ_n = T_np ẏ_p + F_n ṡ_n (docs/theory.md §4).
 
 - :mod:`.base`: the joint contract (:class:`Joint`, :class:`Relative`, :class:`SymbolicRelative`)
   and the pose/twist check;

@@ -1,4 +1,4 @@
-"""How subsystems connect: the kinematic chain ẏ_n = T_np ẏ_p + F_n ṡ_n (THEORY §4).
+"""How subsystems connect: the kinematic chain ẏ_n = T_np ẏ_p + F_n ṡ_n (docs/theory.md §4).
 
 A joint describes the motion of the child frame n relative to a *joint frame* J fixed in
 the parent p (placed at ``r_pn`` with ``orientation`` J → p). Every joint returns, at
@@ -76,7 +76,7 @@ class Joint:
         ``{joint_name: ratio}``: the joint has no coordinate of its own; its coordinate is
         Σ ratio · (that joint's coordinate) — gears, pulleys and ropes. Only for one-dof
         joints with q̇ = ṡ. Shared minimal velocities make ∂ẏ/∂ṡ non-triangular, so such
-        systems are evaluated by the dense Gauss form (THEORY §4).
+        systems are evaluated by the dense Gauss form (docs/theory.md §4).
     """
 
     n_q = 0

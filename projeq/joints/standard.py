@@ -1,4 +1,4 @@
-"""The standard joints: Revolute, Prismatic, Fixed, Planar, Free and Prescribed (THEORY §4).
+"""The standard joints: Revolute, Prismatic, Fixed, Planar, Free and Prescribed (docs/theory.md §4).
 
 Each states its relative kinematics (A, r, F⁶, w, ζ) in ``relative``, next to it their
 sympy form in ``symbolic_relative`` and, where the compiled kernel has the same
@@ -41,7 +41,7 @@ class _OneAxis(Joint):
 
 
 class Revolute(_OneAxis):
-    """Rotation θ about the unit axis e through O_n: F⁶ = [0; e] (THEORY §4).
+    """Rotation θ about the unit axis e through O_n: F⁶ = [0; e] (docs/theory.md §4).
 
     θ is positive by the right-hand rule about e; q = ṡ-integral = (θ,).
     """
@@ -69,7 +69,7 @@ class Revolute(_OneAxis):
 
 
 class Prismatic(_OneAxis):
-    """Translation x along the unit axis e: F⁶ = [e; 0], r = e x (THEORY §4)."""
+    """Translation x along the unit axis e: F⁶ = [e; 0], r = e x (docs/theory.md §4)."""
 
     compiled_kind = "prismatic"
 
@@ -200,7 +200,7 @@ class Free(Joint):
 class Prescribed(Joint):
     """A one-dof joint whose coordinate is a given function of time (rheonomic).
 
-    ẏ_n = T_np ẏ_p + f⁶(t) with f⁶ = F⁶ θ̇(t), and ζ_n gains F⁶ θ̈(t) (THEORY §4). The
+    ẏ_n = T_np ẏ_p + f⁶(t) with f⁶ = F⁶ θ̇(t), and ζ_n gains F⁶ θ̈(t) (docs/theory.md §4). The
     joint adds no coordinate and no minimal velocity.
 
     Parameters

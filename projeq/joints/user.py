@@ -1,4 +1,4 @@
-"""User-defined joints: the door for non-holonomic minimal velocities (THEORY §4).
+"""User-defined joints: the door for non-holonomic minimal velocities (docs/theory.md §4).
 
 The pose, F, K (and the rheonomic f, k) are given as sympy expressions or as callables and
 compiled once by :mod:`projeq.joints.user_compiler`.

@@ -6,7 +6,7 @@ fork with handlebar H, front wheel F; axes x forward, z *down*, origin at the re
 in the upright reference configuration (the table's coordinates are used as given).
 
 Design: a tree plus constraint equations (:class:`~projeq.constraints.partitioned.ConstrainedSystem`,
-THEORY §7). The rolling constraints couple the speeds of all four bodies (the yaw rate
+docs/theory.md §7). The rolling constraints couple the speeds of all four bodies (the yaw rate
 follows from steer, roll and the rear wheel's speed; the front wheel's spin from all of
 them), so no choice of minimal velocities fits the tree's one-joint-one-slice layout that
 :class:`~projeq.joints.UserJoint` scenes (car, rolling disk) use. Instead the tree is

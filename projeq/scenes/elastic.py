@@ -85,7 +85,7 @@ def elastic_arm(
     rod) and an elastic second link (a RitzBeam of ``length``, ρA, EI, ``n_shapes``
     functions per plane) carrying a tip mass at its end. The tip mass hangs on a station
     of the beam (``Fixed(parent="beam", r_pn=(length, 0, 0))``), so its chain matrix T
-    depends on the beam's elastic coordinates (THEORY §10). Units SI; ``gravity`` along −z
+    depends on the beam's elastic coordinates (docs/theory.md §10). Units SI; ``gravity`` along −z
     is off by default. Initial state: the first joint spinning at ``omega0`` rad/s, the
     beam slightly bent (1 cm tip deflection in the plane)."""
     n_shapes = count("n_shapes", n_shapes)
@@ -123,7 +123,7 @@ def spinning_beam(
     family: str = "clamped_free",
 ) -> System:
     """A cantilever spinning about its own axis x at the constant rate ``omega`` (the
-    beam of B(16)–(23), THEORY §9): the root turns by α = Ω t (prescribed); v, w bend in
+    beam of B(16)–(23), docs/theory.md §9): the root turns by α = Ω t (prescribed); v, w bend in
     the co-rotating frame with ``n_shapes`` functions each; ``rho_I`` (per length, kg m)
     adds the rotary inertia ρI of both bending axes (polar 2ρI, circular section)."""
     n_shapes, omega = count("n_shapes", n_shapes), float(finite_array("omega", omega, ()))

@@ -1,4 +1,4 @@
-"""Closed loops and contacts given as constraint equations on a tree (THEORY §7).
+"""Closed loops and contacts given as constraint equations on a tree (docs/theory.md §7).
 
 Each scene returns a :class:`projeq.constraints.partitioned.ConstrainedSystem`: a tree cut open at one
 joint (or a free body on sliders) plus the constraint equations that close it.
@@ -22,15 +22,15 @@ def slender_rod(m: float, L: float) -> PlanarBody:
 
 def quick_return(A: float = 1.0, H: float = 1.0 / 3.0, m_a: float = 0.5, m_b: float = 1.0, g: float = 9.81,
                  q0=(9 * np.pi / 20, 2.80729, 1.0034), **options) -> ConstrainedSystem:
-    """Barhorst's planar quick-return mechanism (seed 000, §3.3, Fig. 9, eqs. (106)–(116)).
+    """Barhorst's planar quick-return mechanism (Barhorst §3.3, Fig. 9, eqs. (106)–(116)).
 
     A crank (mass ``m_a``, length H) turns q1 about a_o; a slotted follower (mass ``m_b``,
     length B = A + 1.5 H) turns q2 about b_o at distance A; the crank pin slides in the
     slot at q3 from b_o (massless slider). Loop closures (107): c1 = A − H cos q1 + q3 cos q2,
     c2 = q3 sin q2 − H sin q1; the crank angle q1 is the independent velocity. Gravity g
     along −y gives V = ½ m_b g B sin q2 + ½ m_a g H sin q1 (110). Both links are taken as
-    uniform slender rods (centroidal moments m L²/12: the seed does not print A_i33, B_i33).
-    Default q0: the seed's printed configuration (q1 = 9π/20, q2 = 2.80729, q3 = 1.0034,
+    uniform slender rods (centroidal moments m L²/12: Barhorst does not print A_i33, B_i33).
+    Default q0: Barhorst's printed configuration (q1 = 9π/20, q2 = 2.80729, q3 = 1.0034,
     given to 5 digits), projected onto the loop closures; at rest, no drive (T_m = T_d = 0).
     ``options`` go to :class:`~projeq.constraints.partitioned.ConstrainedSystem` (``correction``, ``beta``).
     """

@@ -1,15 +1,15 @@
 """Non-holonomic scenes: velocity constraints in *before* the derivation, through F.
 
 Every system here is one or two bodies on a :class:`projeq.UserJoint` whose minimal
-velocities ṡ already satisfy the non-holonomic constraint (THEORY §2, §7; Bremer,
-``shared/seeds/004_…`` §2 and conclusions): the constrained direction is simply left out
+velocities ṡ already satisfy the non-holonomic constraint (docs/theory.md §2, §7;
+Bremer (2009) §2 and conclusions): the constrained direction is simply left out
 of F, and the same order-n assembler (and the dense Gauss form) handles the system. The
 original constraints are declared on the joint, so every simulated ``Result`` reports
 their residual (``result.constraint_residual``).
 
 - :func:`car`: Bremer's car, B(5)–(12);
-- :func:`knife_edge_disc`: the knife-edge disc of the lecture ``seeds/001_…`` (slides 28–37);
-- :func:`rolling_disk`: Barhorst's thin rolling disk with an eccentric mass (``seeds/000_…`` §3.2);
+- :func:`knife_edge_disc`: the knife-edge disc of Orsino (2020) (slides 28–37);
+- :func:`rolling_disk`: Barhorst's thin rolling disk with an eccentric mass (Barhorst §3.2);
 - :func:`barhorst_particle`: Barhorst's planar particle with ẏ − y²ẋ = 0 (§3.1);
 - :func:`nonholonomic_particle`: the particle in space with ẏ + z ẋ = 0 (§3.1, footnote 6).
 
@@ -48,7 +48,7 @@ def _twist_F(A: sp.Matrix, r: sp.Matrix, q, K: sp.Matrix, s) -> sp.Matrix:
 # -- Bremer's car ------------------------------------------------------------------------
 def car(m: float = 1200.0, C0: float = 3228.0, c: float = 1.2, f_x=0.0, M_z=0.0, f_y=0.0,
         q0=(0.0, 0.0, 0.0), s_dot0=(10.0, 0.2)) -> System:
-    """Bremer's car (``seeds/004_…`` §2.1–2.2, B(5)–(12)): a rigid body in the x–y plane
+    """Bremer's car (Bremer (2009) §2.1–2.2, B(5)–(12)): a rigid body in the x–y plane
     whose rear axle does not slide sideways, v_y = 0 in the body frame B.
 
     q = (x, y, γ) of the body frame's origin O (the rear-axle point) and its heading;
@@ -90,7 +90,7 @@ def _vec3(value, index: int):
     return e * float(value)
 
 
-# -- the knife-edge disc (lecture seeds/001) -------------------------------------------
+# -- the knife-edge disc (Orsino (2020)) -------------------------------------------
 @cache
 def _disc_joint_lecture():
     """The knife-edge disc's joint in the lecture's coordinates (slides 28–30).
@@ -126,7 +126,7 @@ def _disc_joint_lecture():
 
 def knife_edge_disc(m: float = 1.0, r: float = 1.0, I: float = 0.25, J: float = 0.5, g: float = 1.0,
                     q0=(0.0, 0.0, 0.0, 0.2, 0.0), s_dot0=(0.0, 0.0, -3.0), q_dot0=None) -> System:
-    """The knife-edge disc of the lecture ``seeds/001_…`` (slides 28–37): a rigid disc of
+    """The knife-edge disc of Orsino (2020) (slides 28–37): a rigid disc of
     radius ``r`` and mass ``m`` rolling without slipping on a plane; ``I`` its moment of
     inertia about a diameter, ``J`` about its axis (kg m²), gravity ``g``.
 
@@ -241,7 +241,7 @@ def rolling_disk(m_disk: float = 0.030, R: float = 0.015, m_ecc: float = 0.001, 
                  g: float = 9.81, drag: float = 0.0, inertia="disk",
                  q0=(0.0, 0.15, 0.0, 0.0, 0.0), s_dot0=(0.0, 20.0, 0.0), q_dot0=None) -> System:
     """Barhorst's thin disk rolling without slip, with an optional eccentric point mass
-    (``seeds/000_…`` §3.2; his parameters converted to SI are the defaults: m_r = 30 g,
+    (Barhorst §3.2; his parameters converted to SI are the defaults: m_r = 30 g,
     R = 1.5 cm, m_s = 1 g at r = 0.95 R in the disk plane, g = 981 cm/s², tilt
     q2(0) = 0.15 rad, q̇3(0) = 20 rad/s).
 
@@ -306,7 +306,7 @@ def rolling_disk(m_disk: float = 0.030, R: float = 0.015, m_ecc: float = 0.001, 
 def rolling_disk_critical_speed(m: float, R: float, I: float, J: float, g: float) -> float:
     """Critical forward speed of the upright, straight rolling of a symmetric disk.
 
-    Linearising the angular-momentum equations of slide 37 (``seeds/001_…``) about ϕ = 0,
+    Linearising the angular-momentum equations of slide 37 (Orsino (2020)) about ϕ = 0,
     ψ̇ = ϕ̇ = 0, θ̇ = −Ω gives ψ̈ = (J/I) Ω ϕ̇ and
     (I + m R²) ϕ̈ = −Ω (J + m R²) ψ̇ + m g R ϕ; eliminating ψ̇ = (J/I) Ω ϕ (+ const):
 
@@ -320,7 +320,7 @@ def rolling_disk_critical_speed(m: float, R: float, I: float, J: float, g: float
 
 # -- Barhorst's particles -------------------------------------------------------------------
 def barhorst_particle(m: float = 1.0, g: float = 10.0, q0=(2.0, 2.0), s_dot0=(0.0,), q_dot0=None) -> System:
-    """Barhorst's particle in the x–y plane with ẏ − y² ẋ = 0 (``seeds/000_…`` §3.1),
+    """Barhorst's particle in the x–y plane with ẏ − y² ẋ = 0 (Barhorst §3.1),
     gravity −g n̂2 (so E = m g y, 20 units at the start (2, 2) at rest).
 
     q = (x, y), ṡ = (ẋ,): ẏ = y² ẋ goes into F and K. (Barhorst takes ẏ independent,
@@ -344,7 +344,7 @@ def barhorst_particle(m: float = 1.0, g: float = 10.0, q0=(2.0, 2.0), s_dot0=(0.
 
 def nonholonomic_particle(m: float = 1.0, g: float = 10.0, q0=(0.0, 0.0, 1.0), s_dot0=(1.0, 2.0),
                           q_dot0=None) -> System:
-    """The truly non-holonomic particle in space with ẏ + z ẋ = 0 (``seeds/000_…``
+    """The truly non-holonomic particle in space with ẏ + z ẋ = 0 (Barhorst
     §3.1, footnote 6), gravity −g n̂3.
 
     q = (x, y, z), ṡ = (ẋ, ż); ẏ = −z ẋ. The constraint is not integrable (its

@@ -45,7 +45,7 @@ class FullCoordinates:
 
 
 def car_multiplier_system(values):
-    """The car in (x, y, γ) with −sin γ ẋ + cos γ ẏ = 0 (seed 001, K(7); B(6))."""
+    """The car in (x, y, γ) with −sin γ ẋ + cos γ ẏ = 0 (Orsino (2020), K(7); B(6))."""
     from sympy.physics.mechanics import dynamicsymbols
 
     from projeq.symbolic import t as time_symbol
@@ -78,8 +78,8 @@ def multiplier_rows(formulations, build, system, coordinates: FullCoordinates, s
 
 
 def multiplier_row(form: str, name: str, build, system, coordinates: FullCoordinates, reference) -> dict:
-    """Lagrange or Hamilton canonical equations with multipliers (seed 001, K(7) and K(23)–(26)),
-    or Barhorst's Lagrangian canonical form (seed 000, eqs. 45–52), in full coordinates;
+    """Lagrange or Hamilton canonical equations with multipliers (Orsino (2020), K(7) and K(23)–(26)),
+    or Barhorst's Lagrangian canonical form (Barhorst, eqs. 45–52), in full coordinates;
     compared by their motion with the ``reference`` run of the scene (None: not simulated)."""
     from projeq.symbolic.canonical import lagrangian_canonical
 

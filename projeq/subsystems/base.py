@@ -39,7 +39,7 @@ class Subsystem:
     S : ndarray of shape (n_y, 6), or None (default)
         Selection of ẏ_n from the twist (v_O, ω) of the subsystem's reference frame R_n,
         ẏ_n = S · twist + [0; ṡ_e] (``None`` means ẏ_n *is* the twist). Joints act through
-        it: F_n = [S F⁶, [0; E]], T_np = S T⁶_np Sₚᵀ (THEORY §4). Planar bodies select
+        it: F_n = [S F⁶, [0; E]], T_np = S T⁶_np Sₚᵀ (docs/theory.md §4). Planar bodies select
         three rows; a subsystem with internal coordinates has zero rows for them.
     n_e : int (default 0)
         Internal coordinates q_e (elastic coordinates of a beam, an absorber's travel),
@@ -110,7 +110,7 @@ class Subsystem:
     def port(self, point: NDArray, q_e: NDArray, q_e_dot: NDArray):
         """(``has_ports``) The frame at the station ``point`` (reference-frame coordinates of
         the undeformed subsystem) as a :class:`projeq.joints.Relative` of the reference
-        frame: its pose, twist F q̇_e and ζ = Ḟ q̇_e (THEORY §10)."""
+        frame: its pose, twist F q̇_e and ζ = Ḟ q̇_e (docs/theory.md §10)."""
         raise NotImplementedError(f"{type(self).__name__} has no ports (has_ports is False)")
 
     def port_at(self, point: NDArray) -> "Port":

@@ -1,4 +1,4 @@
-"""Rigid subsystems: the Gauss-form terms of THEORY §3, written once.
+"""Rigid subsystems: the Gauss-form terms of docs/theory.md §3, written once.
 
 ẏ = (v_O, ω) in the body-fixed frame with origin O; ``r_c`` is O → mass centre and
 ``I_c`` the inertia tensor about the mass centre, both in body coordinates.
@@ -26,7 +26,7 @@ _ZERO3.flags.writeable = _ZERO3x3.flags.writeable = False
 
 
 def rigid_mass_matrix(m: float, r_c: NDArray, I_c: NDArray) -> NDArray:
-    """M = [[m E, −m r̃_c], [m r̃_c, I_c − m r̃_c r̃_c]] (THEORY §3)."""
+    """M = [[m E, −m r̃_c], [m r̃_c, I_c − m r̃_c r̃_c]] (docs/theory.md §3)."""
     rc = skew(r_c)
     M = np.zeros((6, 6))
     M[:3, :3] = m * np.eye(3)
@@ -37,7 +37,7 @@ def rigid_mass_matrix(m: float, r_c: NDArray, I_c: NDArray) -> NDArray:
 
 
 def rigid_h(m, r_c: NDArray, I_c: NDArray, twist: NDArray, g_body: NDArray) -> NDArray:
-    """h = Q − G ẏ of a rigid body with gravity g (body coordinates), THEORY §3.
+    """h = Q − G ẏ of a rigid body with gravity g (body coordinates), docs/theory.md §3.
 
     With the momentum p = m v_c: h = [m g − ω̃ p ; r̃_c (m g − ω̃ p) − ω̃ I_c ω].
     Works on one body or row-wise on stacks: m (...), r_c (..., 3), I_c (..., 3, 3),
@@ -73,7 +73,7 @@ class RigidGroup:
 
 
 class RigidBody(Subsystem):
-    """A spatial rigid body: the subsystem of THEORY §3 with ẏ = (v_O, ω).
+    """A spatial rigid body: the subsystem of docs/theory.md §3 with ẏ = (v_O, ω).
 
     Parameters
     ----------
@@ -109,12 +109,12 @@ class RigidBody(Subsystem):
 
     @property
     def rigid_inertia(self) -> tuple:
-        """(m, r_c, I_c): :meth:`gauss_terms` are THEORY §3's of these (a subclass that
+        """(m, r_c, I_c): :meth:`gauss_terms` are docs/theory.md §3's of these (a subclass that
         overrides ``gauss_terms`` has ``rigid_inertia = None``, :class:`Subsystem`)."""
         return self.m, self.r_c, self.I_c
 
     def gauss_terms(self, y_dot: NDArray, R: NDArray, gravity: NDArray, q_e=None):
-        """(M_n, h_n) of THEORY §3; ``R`` body → inertial, ``gravity`` inertial (a rigid
+        """(M_n, h_n) of docs/theory.md §3; ``R`` body → inertial, ``gravity`` inertial (a rigid
         body has no internal coordinates q_e)."""
         return self.M6, rigid_h(self.m, self.r_c, self.I_c, y_dot, R.T @ gravity)
 

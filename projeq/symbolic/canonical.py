@@ -1,4 +1,4 @@
-"""Barhorst's two canonical momentum forms: ODEs in (q, p) without multipliers (THEORY §11).
+"""Barhorst's two canonical momentum forms: ODEs in (q, p) without multipliers (docs/theory.md §11).
 
 A. A. Barhorst, "Generalized momenta in constrained non-holonomic systems — another perspective on the
 canonical equations of motion": with independent speeds u and q̇ = K(q) u + J(q, t) (dependent speeds

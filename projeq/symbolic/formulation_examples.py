@@ -1,8 +1,8 @@
 """The knife-edge disc and Barhorst's particle in the input forms of the Lagrange/Hamilton and
 canonical modules (for the tests, the formulation benchmark and comparisons).
 
-Same bodies as projeq's scenes ``knife_edge_disc`` (lecture ``seeds/001_…`` slides 28–37) and
-``barhorst_particle`` (``seeds/000_…`` §3.1), written as L, A for :func:`multiplier_system` and as
+Same bodies as projeq's scenes ``knife_edge_disc`` (Orsino (2020) slides 28–37) and
+``barhorst_particle`` (Barhorst §3.1), written as L, A for :func:`multiplier_system` and as
 bodies for :func:`projective_canonical`.
 """
 
@@ -88,7 +88,7 @@ def projection_disc():
 
 @cache
 def particle() -> MultiplierSystem:
-    """Barhorst's particle (seed 000 §3.1): L = m(ẋ² + ẏ²)/2 − m g y with ẏ − y² ẋ = 0, m = 1, g = 10."""
+    """Barhorst's particle (Barhorst §3.1): L = m(ẋ² + ẏ²)/2 − m g y with ẏ − y² ẋ = 0, m = 1, g = 10."""
     x, y = q = dynamicsymbols("x y")
     return multiplier_system((x.diff(t) ** 2 + y.diff(t) ** 2) / 2 - 10 * y, q, t, A=[[-y**2, 1]])
 

@@ -1,4 +1,4 @@
-"""Hamel's equations for minimal velocities ṡ = H(q) q̇ (B(3)–(4) of seed 004, THEORY §8).
+"""Hamel's equations for minimal velocities ṡ = H(q) q̇ (B(3)–(4) of Bremer (2009), docs/theory.md §8).
 
 Index map (0-based, as in the code) of Hamel's coefficients: ``beta[nu, mu, n]`` is
 β_{ν+1}^{μ+1, n+1} of B(4), i.e. ν the row of H being differentiated, μ the speed that
@@ -86,7 +86,7 @@ def hamel_equations(T, q, s, H, Q, s_ddot=None, t=sp.Symbol("t"), parameters=())
 
     Every symbol in T, H, Q must be a coordinate, a speed, t or in ``parameters``.
     Constraints among the speeds (such as v_y = 0 for the car) go in *after* this
-    derivation (THEORY §8).
+    derivation (docs/theory.md §8).
     """
     q, s = symbol_vector("q", q), symbol_vector("s", s)
     H, Q = matrix("H", H), matrix("Q", Q)

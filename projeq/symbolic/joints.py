@@ -1,4 +1,4 @@
-"""The joints of a System in sympy: each joint's own ``symbolic_relative`` (THEORY §4).
+"""The joints of a System in sympy: each joint's own ``symbolic_relative`` (docs/theory.md §4).
 
 Every joint class states its relative kinematics in sympy next to the numeric ones
 (:meth:`projeq.joints.Joint.symbolic_relative`, a :class:`SymbolicRelative`: ``A``, ``r``,

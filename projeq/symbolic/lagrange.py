@@ -1,7 +1,7 @@
-"""Lagrange's equations with multipliers and Hamilton's canonical equations with multipliers (THEORY §11).
+"""Lagrange's equations with multipliers and Hamilton's canonical equations with multipliers (docs/theory.md §11).
 
 For a Lagrangian L(t, q, q̇), generalized forces Q and Pfaffian constraints A(t, q) q̇ = b(t, q)
-(lecture ``seeds/001_…`` slides 16–26):
+(Orsino (2020) slides 16–26):
 
 * Lagrange, K(7):   d/dt ∂L/∂q̇ − ∂L/∂q = Q + Aᵀλ,   A q̇ = b;
 * Hamilton, K(23)–(26):   q̇ = ∂H/∂p,   ṗ = −∂H/∂q + Q + Aᵀλ,   A ∂H/∂p = b,
@@ -223,7 +223,7 @@ class MultiplierSystem:
 
 def multiplier_system(L, q: Sequence, t: sp.Symbol, A=None, b=None, Q=None,
                       parameters: Mapping | None = None) -> MultiplierSystem:
-    """Lagrangian system with Pfaffian constraints A(t, q) q̇ = b(t, q) (lecture ``seeds/001_…`` K(1)).
+    """Lagrangian system with Pfaffian constraints A(t, q) q̇ = b(t, q) (Orsino (2020) K(1)).
 
     Parameters
     ----------

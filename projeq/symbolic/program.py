@@ -1,6 +1,6 @@
-"""Program constraints: the generalized program motion equations (GPME), THEORY §11.
+"""Program constraints: the generalized program motion equations (GPME), docs/theory.md §11.
 
-Jarzębowska's algorithm (``seeds/002_…`` eqs. 6.29–6.33) for constraints of order p,
+Jarzębowska's algorithm (Jarzębowska (2002) eqs. 6.29–6.33) for constraints of order p,
 ``c(t, q, q̇, …, q^(p)) = 0``, linear in the p-th derivatives:
 
 * solve the constraints for n − l dependent p-th derivatives (6.29),
@@ -85,7 +85,7 @@ def choose_dependent(J: sp.Matrix, q: Sequence, dependent, rng=np.random.default
 
 @dataclass(frozen=True)
 class ProgramEquations:
-    """The GPME of ``seeds/002_…`` eqs. 6.29–6.33 and their constraints.
+    """The GPME of Jarzębowska (2002) eqs. 6.29–6.33 and their constraints.
 
     Attributes
     ----------
@@ -139,7 +139,7 @@ class ProgramEquations:
     def simulate(self, x0, t_span, t_eval=None, rtol: float = 1e-10, atol: float = 1e-12):
         """Integrate from ``x0 = (q, q̇, …, q^(m−1))`` at ``t_span[0]`` (DOP853).
 
-        As in the seed (§6.4), the initial state includes the accelerations when p = 3;
+        As in Jarzębowska (2002), §6.4, the initial state includes the accelerations when p = 3;
         it need not satisfy the constraint c = 0 itself: only its derivative of order
         m − p is imposed, so c keeps its initial value (Fig. 3).
         """
@@ -153,7 +153,7 @@ class ProgramEquations:
 def program_motion_equations(T, q: Sequence, constraints: Sequence, t: sp.Symbol, Q: Sequence | None = None,
                              parameters: Mapping | None = None, dependent: Sequence | None = None,
                              differentiate: bool = False) -> ProgramEquations:
-    """Generalized program motion equations for constraints of order p (``seeds/002_…`` 6.30–6.33).
+    """Generalized program motion equations for constraints of order p (Jarzębowska (2002) 6.30–6.33).
 
     Parameters
     ----------
@@ -165,7 +165,7 @@ def program_motion_equations(T, q: Sequence, constraints: Sequence, t: sp.Symbol
     parameters : values of the other symbols, ``{symbol: number}``.
     dependent : the coordinates q_ρ solved for in (6.29) (default: the first possible).
     differentiate : differentiate constraints in time until linear in their highest
-        derivatives (as the seed does with the curvature constraint (4.3)).
+        derivatives (as Jarzębowska (2002) does with the curvature constraint (4.3)).
 
     Examples
     --------

@@ -1,4 +1,4 @@
-"""The Projection Equation in sympy, from mass-centre velocities (B(10)–(12) of seed 004, THEORY §2).
+"""The Projection Equation in sympy, from mass-centre velocities (B(10)–(12) of Bremer (2009), docs/theory.md §2).
 
 For each body, with all vectors in the coordinates of a reference frame R rotating with
 ω_IR, p = m v_c and L = I_c ω_c (B(10)):
@@ -60,7 +60,7 @@ class Body:
 
 @dataclass(frozen=True)
 class GaussForm:
-    """M(q) s̈ = rhs(q, ṡ, t), sympy matrices (THEORY §5); ``q``, ``s`` the symbols, ``t`` time,
+    """M(q) s̈ = rhs(q, ṡ, t), sympy matrices (docs/theory.md §5); ``q``, ``s`` the symbols, ``t`` time,
     ``K`` the kinematics q̇ = K ṡ, ``parameters`` the symbols left for the evaluator."""
 
     M: sp.Matrix

@@ -1,13 +1,13 @@
 """``gauss_form(system)``: the symbolic Projection Equation of a numeric :class:`projeq.System`.
 
-The chain of THEORY §4 is written out in sympy in body coordinates, as the numeric
+The chain of docs/theory.md §4 is written out in sympy in body coordinates, as the numeric
 evaluators do: for each subsystem n with predecessor p (ẏ = (v_O, ω) in n's frame)
 
     ẏ_n = T_np ẏ_p + F_n ṡ_n + f_n,        ÿ_n = T_np ÿ_p + F_n s̈_n + ζ_n,
     ζ_n = T_np ζ_p + Ṫ_np ẏ_p + Ḟ_n ṡ_n + ḟ_n   (Ṫ_np ẏ_p = (T_np ẏ_p) × w_n, w_n the joint's twist),
 
-and Σ J_nᵀ (M_n ÿ_n − h_n) = 0 (B(10), THEORY §2) is assembled by the backward recursion
-of THEORY §6 instead of the products J_nᵀ M_n J_n: the composite inertias
+and Σ J_nᵀ (M_n ÿ_n − h_n) = 0 (B(10), docs/theory.md §2) is assembled by the backward recursion
+of docs/theory.md §6 instead of the products J_nᵀ M_n J_n: the composite inertias
 M̄_p = M_p + Σ T_npᵀ M̄_n T_np give M(q) column block by column block, and the bias forces
 β_p = M_p ζ_p − h_p + Σ T_npᵀ β_n give rhs = −F_nᵀ β_n (+ joint forces τ). Every rotation
 then acts on a vector or on a composite inertia (m, first moment, I_O) by the
@@ -67,7 +67,7 @@ class _Inertia:
     I_O: sp.Matrix
 
     def __mul__(self, twist: sp.Matrix) -> sp.Matrix:
-        """M ẏ = (m v − c × ω ; c × v + I_O ω) for M = [[m E, −c̃], [c̃, I_O]] (THEORY §3)."""
+        """M ẏ = (m v − c × ω ; c × v + I_O ω) for M = [[m E, −c̃], [c̃, I_O]] (docs/theory.md §3)."""
         v, omega = twist[:3, :], twist[3:, :]
         return sp.Matrix.vstack(self.m * v - cross(self.c, omega), cross(self.c, v) + mul(self.I_O, omega))
 
@@ -84,7 +84,7 @@ class _Inertia:
 
 
 def gauss_form(system, parameters=None) -> GaussForm:
-    """M(q) s̈ = rhs(q, ṡ, t) of ``system`` in sympy (B(10), THEORY §2–4, §6), nothing inverted.
+    """M(q) s̈ = rhs(q, ṡ, t) of ``system`` in sympy (B(10), docs/theory.md §2–4, §6), nothing inverted.
 
     ``.q`` = (q_1, …), ``.s`` = (s_1, …) in the system's order of coordinates and minimal
     velocities; time is ``.t``; ``.K`` is K(q) of q̇ = K ṡ (+ k). See the module docstring
@@ -131,7 +131,7 @@ def _d_dt(x: sp.Matrix, q_dot: dict) -> sp.Matrix:
 
 
 def _carry(link: _Link, twist: sp.Matrix) -> sp.Matrix:
-    """T_np ẏ_p = (A_np (v_p + ω_p × r_pn), A_np ω_p) (THEORY §4)."""
+    """T_np ẏ_p = (A_np (v_p + ω_p × r_pn), A_np ω_p) (docs/theory.md §4)."""
     v, omega = twist[:3, :], twist[3:, :]
     return sp.Matrix.vstack(mul(link.A, v + cross(omega, link.r_pn)), mul(link.A, omega))
 
@@ -172,13 +172,13 @@ def _rigid(body, name: str, parameters) -> tuple:
 
 
 def _inertia(rigid) -> _Inertia:
-    """M_n as (m, c = m r_c, I_O = I_c − m r̃_c r̃_c) (THEORY §3)."""
+    """M_n as (m, c = m r_c, I_O = I_c − m r̃_c r̃_c) (docs/theory.md §3)."""
     m, r_c, I_c = rigid
     return _Inertia(m, m * r_c, I_c - m * mul(skew(r_c), skew(r_c)))
 
 
 def _h(rigid, link: _Link) -> sp.Matrix:
-    """h = Q − G ẏ = (m g − ω × p ; r_c × (m g − ω × p) − ω × I_c ω), p = m (v + ω × r_c) (THEORY §3):
+    """h = Q − G ẏ = (m g − ω × p ; r_c × (m g − ω × p) − ω × I_c ω), p = m (v + ω × r_c) (docs/theory.md §3):
     the symbolic twin of :func:`projeq.subsystems.rigid.rigid_h`."""
     m, r_c, I_c = rigid
     v, omega = link.twist[:3, :], link.twist[3:, :]

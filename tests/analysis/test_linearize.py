@@ -1,11 +1,11 @@
 """projeq.linearize and eigenvalue_sweep against closed forms.
 
-- simple and double pendulum: ω² = g/l and ω² = (g/l)(2 ± √2) (``shared/seeds/003_…``
+- simple and double pendulum: ω² = g/l and ω² = (g/l)(2 ± √2) (the Lagrange seminars
   Problem 8, equal masses and lengths);
-- Bremer's car (``shared/seeds/004_…`` B(9)): x, y, γ are detected as ignorable and the
+- Bremer's car (Bremer (2009) B(9)): x, y, γ are detected as ignorable and the
   straight run's A follows from linearising B(9);
 - the rolling disk's critical speed (``scenes.rolling_disk_critical_speed``, from the
-  linearised slide-37 equations of ``seeds/001_…``) found by root finding over a sweep;
+  linearised slide-37 equations of Orsino (2020)) found by root finding over a sweep;
 - steady motions that are not equilibria of (q, ṡ) raise NotSteadyError.
 """
 
@@ -44,7 +44,7 @@ def test_pendulum_matches_closed_form_beyond_central_differences():
 
 @pytest.mark.parametrize("l", [1.0, 0.3])
 def test_double_pendulum_normal_modes(l):
-    """seeds/003 Problem 8: two equal masses on equal rods, ω² = (g/l)(2 ± √2). The
+    """the Lagrange seminars Problem 8: two equal masses on equal rods, ω² = (g/l)(2 ± √2). The
     eigenvalues of A are ±iω; error bound 1e-12 (measured ≤ 1.1e-15, plain central
     differences h = 1e-6: 1.2e-12)."""
     lin = linearize(pq.scenes.double_pendulum(l1=l, l2=l, q0=(0.0, 0.0)))
@@ -54,7 +54,7 @@ def test_double_pendulum_normal_modes(l):
 
 
 def test_car_drops_position_and_heading():
-    """Bremer's car on a straight run v_x = v, ω_z = 0 (seeds/004 B(9)):
+    """Bremer's car on a straight run v_x = v, ω_z = 0 (Bremer (2009) B(9)):
     m v̇_x − m c ω_z² = f_x, C° ω̇_z + m c v_x ω_z = M_z linearise to
     A = [[0, 0], [0, −m c v / C°]]; x, y, γ do not enter s̈ (and γ enters only ẋ, ẏ),
     so all three are dropped and the straight run is an equilibrium of (v_x, ω_z)."""
@@ -81,7 +81,7 @@ def test_moving_coordinates_kept_are_not_a_steady_motion():
 
 
 def test_body_fixed_speeds_are_flagged():
-    """Barhorst's upright rolling disk in body-fixed speeds u (seeds/000 §3.2): at q2 = 0 the
+    """Barhorst's upright rolling disk in body-fixed speeds u (Barhorst §3.2): at q2 = 0 the
     roll angle q3's column of A vanishes and the kept states are at rest, but u1, u3 are
     components in the rolling frame C, so A rotates with q3 = Ω t: linearising at one q3
     would predict instability above v_c (measured λ² = 443 s⁻² at Ω = 20 rad/s). The
@@ -91,7 +91,7 @@ def test_body_fixed_speeds_are_flagged():
 
 
 def test_rolling_disk_critical_speed_by_root_finding():
-    """The knife-edge disc in Euler rates (seeds/001 slides 28–37), upright at spin Ω:
+    """The knife-edge disc in Euler rates (Orsino (2020) slides 28–37), upright at spin Ω:
     x, y, ψ, θ are ignorable, A is 4 × 4 with eigenvalues 0, 0, ±λ where
     λ² = [m g R − Ω² J (J + m R²)/I]/(I + m R²) (rolling_disk_critical_speed's derivation).
     Σλ_i²/2 = λ² changes sign at the critical speed: brentq on it over eigenvalue_sweep

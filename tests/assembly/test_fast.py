@@ -1,5 +1,5 @@
-"""The fast evaluator (projeq/assembly/fast.py, THEORY §6 in one compiled loop) equals the
-dense Gauss form (THEORY §5, an independent O(N³) formulation) on random trees, with the
+"""The fast evaluator (projeq/assembly/fast.py, docs/theory.md §6 in one compiled loop) equals the
+dense Gauss form (docs/theory.md §5, an independent O(N³) formulation) on random trees, with the
 tolerance of tests/assembly/test_recursive_vs_dense.py (1e-10 relative to max(1, |s̈|∞)
 while κ∞(M) ≤ 1e4, the forward-error bound 1e-14 κ∞(M) max(1, |s̈|∞) beyond; both are
 backward stable, see that module's docstring). Both the numba-compiled kernel and the
@@ -99,7 +99,7 @@ def test_the_kernel_twins_equal_their_array_forms(seed):
     """The kernel's scalar twins (projeq/assembly/kernels.py, "Compiled twins") equal the
     one numeric home of each formula: Rodrigues' rotation (projeq.spatial.rotation; E for
     prismatic and fixed joints), T_np (spatial.chain_matrix), a × b (spatial.cross) and the
-    rigid-body h of THEORY §3 (projeq.subsystems.rigid.rigid_h)."""
+    rigid-body h of docs/theory.md §3 (projeq.subsystems.rigid.rigid_h)."""
     rng = np.random.default_rng(seed)
     e = rng.standard_normal(3)
     e /= np.linalg.norm(e)
@@ -234,7 +234,7 @@ def test_hub_beam_path_equals_recursive(build):
     """One RitzBeam on a prescribed or fixed hub goes through its own evaluator
     (method="hub_beam", projeq/assembly/beam_fast.py: M_ee q̈ = h_e − M_eR ζ, no chain, no
     passes), which "auto" picks and "fast" (the rigid-body kernel) refuses, and equals the
-    recursive evaluator (THEORY §6) to round-off (1e-10 of max(1, |s̈|∞)) at deformed,
+    recursive evaluator (docs/theory.md §6) to round-off (1e-10 of max(1, |s̈|∞)) at deformed,
     moving states and several times."""
     system = build()
     assert system.evaluator("auto").name == "hub_beam"

@@ -1,17 +1,17 @@
 """Identities from physics and from the structure of the Projection Equation, at single
 random states of random trees (STYLE §4.8 habits 3 and 10).
 
-- Kinetic energy: ½ ṡᵀ M ṡ = Σ_n ½ ẏ_nᵀ M_n ẏ_n for scleronomic systems (THEORY §5,
+- Kinetic energy: ½ ṡᵀ M ṡ = Σ_n ½ ẏ_nᵀ M_n ẏ_n for scleronomic systems (docs/theory.md §5,
   M = Σ J_nᵀ M_n J_n with ẏ_n = J_n ṡ).
-- The functional matrix J_n = ∂ẏ_n/∂ṡ of the chain (J_n = T_np J_p + F_n P_n, THEORY §5,
+- The functional matrix J_n = ∂ẏ_n/∂ṡ of the chain (J_n = T_np J_p + F_n P_n, docs/theory.md §5,
   B(15)) is the coefficient matrix of ẏ_n in ṡ (Bremer B(11): "nothing but the coefficient
   matrix of the cartesian velocities w.r.t. the minimal velocities").
 - Power balance: d(T + V)/dt = ṡᵀ Q_nc along the motion (q̇ = K ṡ, s̈ from the evaluator),
   zero for a conservative system; also for non-holonomic ṡ.
-- The chain's accelerations: ÿ_n = T_np ÿ_p + F_n s̈_n + ζ_n (THEORY §4) is the time
+- The chain's accelerations: ÿ_n = T_np ÿ_p + F_n s̈_n + ζ_n (docs/theory.md §4) is the time
   derivative of ẏ_n along (q̇, s̈, t).
 - Evaluator reuse: a workspace overwritten by every call gives bit-identical answers.
-- ``scenes.chain(n, planar=True)`` equals ``planar=False`` (THEORY §3: a planar body is the
+- ``scenes.chain(n, planar=True)`` equals ``planar=False`` (docs/theory.md §3: a planar body is the
   spatial one restricted to its plane).
 """
 
@@ -35,7 +35,7 @@ def _scleronomic_trees(max_n=10, forces=True):
 
 
 def _chain_J(system, kin):
-    """J_n = T_np J_p + F_n P_n, root to leaves (THEORY §5)."""
+    """J_n = T_np J_p + F_n P_n, root to leaves (docs/theory.md §5)."""
     J = {-1: np.zeros((0, system.n_s))}
     for n, p in enumerate(system.parent):
         cols, P = system.joint_s_columns(n)
@@ -93,7 +93,7 @@ def _d_dt(f, h=H):
 
 @given(any_plane.flatmap(lambda planar: trees(max_n=8, planar=planar, forces=False)))
 def test_chain_accelerations_are_the_derivative_of_the_velocities(tree):
-    """ÿ_n = T_np ÿ_p + F_n s̈_n + ζ_n (THEORY §4, with ζ_n = Ṫ_np ẏ_p + Ḟ_n ṡ_n + ḟ_n from
+    """ÿ_n = T_np ÿ_p + F_n s̈_n + ζ_n (docs/theory.md §4, with ζ_n = Ṫ_np ẏ_p + Ḟ_n ṡ_n + ḟ_n from
     ``kinematics.forward``) equals d/dt ẏ_n along the straight path (q + τ q̇, ṡ + τ s̈,
     t + τ) for an arbitrary s̈ — a check of every ζ_n, the cross-motion term included.
 
@@ -259,7 +259,7 @@ def test_planar_chain_equals_spatial_chain(n, seed):
 @given(any_plane.flatmap(lambda planar: trees(max_n=10, planar=planar, forces=False)))
 def test_q_dot_is_K_s_dot(tree):
     """System.q_dot (q̇ = ṡ in one step for the identity joints, joint by joint elsewhere)
-    equals the block-diagonal K(q) ṡ assembled joint by joint (THEORY §3), to round-off."""
+    equals the block-diagonal K(q) ṡ assembled joint by joint (docs/theory.md §3), to round-off."""
     system, q, s_dot, t = tree.system, tree.q, tree.s_dot, tree.t
     expected = system.K(q, t) @ s_dot
     np.testing.assert_allclose(system.q_dot(q, s_dot, t), expected, rtol=0, atol=1e-14 * np.max(np.abs(expected), initial=1.0))

@@ -35,7 +35,7 @@ def _state(system, seed):
 
 @pytest.mark.parametrize("seed", range(3))
 def test_kinetic_energy_from_M_equals_the_sum_over_subsystems(seed):
-    """½ ṡᵀ M(q) ṡ = Σ ½ ẏ_nᵀ M_n ẏ_n for a scleronomic system (THEORY §5 with J_n)."""
+    """½ ṡᵀ M(q) ṡ = Σ ½ ẏ_nᵀ M_n ẏ_n for a scleronomic system (docs/theory.md §5 with J_n)."""
     system = _mixed_tree()
     q, s_dot = _state(system, seed)
     kinetic, _ = system.energy(q, s_dot)
@@ -63,7 +63,7 @@ def test_power_balance_of_a_conservative_system(seed):
 
 @pytest.mark.parametrize("seed", range(3))
 def test_rigid_terms_match_newton_euler_about_the_mass_centre(seed):
-    """THEORY §3 against Newton–Euler written independently: with v_c = v + ω × r_c,
+    """docs/theory.md §3 against Newton–Euler written independently: with v_c = v + ω × r_c,
     f = m (v̇_c + ω × v_c) − m g and M_c = I_c ω̇ + ω × I_c ω, the wrench about O is
     (f, M_c + r_c × f); it must equal M ÿ − h for any ÿ (1e-12 relative)."""
     rng = np.random.default_rng(seed)

@@ -1,4 +1,4 @@
-"""Planar trees equal their spatial twins (THEORY §3: a planar body is the spatial body
+"""Planar trees equal their spatial twins (docs/theory.md §3: a planar body is the spatial body
 restricted to the plane), on random trees, in both evaluators. Recursive = dense on
 general random trees is tests/assembly/test_recursive_vs_dense.py.
 """
@@ -23,7 +23,7 @@ def _random_inertia(rng):
 def test_planar_trees_agree_with_their_spatial_twins(seed, n_bodies):
     """Planar bodies in the x–y plane on revolute (z) and prismatic (in-plane) joints: the
     recursive and dense evaluators agree, and both equal the same tree built from spatial
-    bodies (the planar body is the spatial one restricted to the plane, THEORY §3)."""
+    bodies (the planar body is the spatial one restricted to the plane, docs/theory.md §3)."""
     rng = np.random.default_rng(seed)
     planar, spatial, joints = {}, {}, {}
     for i in range(n_bodies):

@@ -1,4 +1,4 @@
-"""Recursive (THEORY §6, Bremer's Gaussian elimination, O(N)) = dense (THEORY §5, Gauss
+"""Recursive (docs/theory.md §6, Bremer's Gaussian elimination, O(N)) = dense (docs/theory.md §5, Gauss
 form M s̈ + b = 0 of B(15), O(N³)) on random trees (STYLE §4.8 habit 1).
 
 The trees come from ``tests/strategies.py``: up to 30 bodies, random topology (chains and
@@ -51,7 +51,7 @@ def _agree(tree, method_a="recursive", method_b="dense"):
 
 @given(trees(max_n=30))
 def test_recursive_equals_dense_on_spatial_trees(tree):
-    """s̈ by THEORY §6 equals −M⁻¹ b by THEORY §5 on spatial trees of 1–30 bodies."""
+    """s̈ by docs/theory.md §6 equals −M⁻¹ b by docs/theory.md §5 on spatial trees of 1–30 bodies."""
     _agree(tree)
 
 

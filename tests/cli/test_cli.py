@@ -18,7 +18,7 @@ from projeq.cli.commands import main
 
 def atwood_angle(m1, t, m2=1.0, pulley_mass=0.5, a=0.1, g=9.81):
     """Pulley angle of ``atwood`` from rest: θ = −½ ẍ t²/a, ẍ = (m1 − m2) g / (m1 + m2 + I/a²),
-    I = ½ M a² (Problem 1, eq. (4) of ../shared/seeds/003_13b1ca6faae9f37e.txt)."""
+    I = ½ M a² (Problem 1, eq. (4) of the Lagrange seminars)."""
     return -0.5 * (m1 - m2) * g / (m1 + m2 + 0.5 * pulley_mass) * t**2 / a
 
 

@@ -1,4 +1,4 @@
-"""Cut joints: the wrench of a loop's cut joint from its multipliers (issue 4, item 2; THEORY §7)."""
+"""Cut joints: the wrench of a loop's cut joint from its multipliers (issue 4, item 2; docs/theory.md §7)."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Closed loops given as constraint equations (issue 4, items 1–2; THEORY §7)."""
+"""Closed loops given as constraint equations (issue 4, items 1–2; docs/theory.md §7)."""
 
 import numpy as np
 import pytest
@@ -13,7 +13,7 @@ RTOL, ATOL = 1e-9, 1e-11
 
 
 def test_quick_return_conserves_energy_and_closes_its_loop():
-    """Barhorst's quick-return mechanism (seed 000 §3.3: A = 1, H = A/3, B = A + 1.5 H,
+    """Barhorst's quick-return mechanism (Barhorst §3.3: A = 1, H = A/3, B = A + 1.5 H,
     m_a = 1/2, m_b = 1, g = 9.81, T_m = T_d = 0, q1(0) = 9π/20, 10 s as in his Fig. 10):
     with zero drive the energy T + V of (110)–(111) is conserved, and the loop residuals
     c1, c2 of (107), reported in ``Result.constraint_residual``, stay at round-off level
@@ -80,7 +80,7 @@ def test_four_bar_agrees_with_the_explicitly_solved_loop():
 
 def test_pendulum_rod_tension_from_the_multiplier():
     """The rod tension of a pendulum whose rod is the constraint √(x² + z²) = l equals the
-    closed form m (g cos θ + l θ̇²) (radial Newton's law; e.g. seed 003, Seminar 5, Lagrange
+    closed form m (g cos θ + l θ̇²) (radial Newton's law; e.g. the Lagrange seminars, Seminar 5, Lagrange
     multipliers); the multiplier is minus the tension."""
     l, m, g = 1.2, 0.7, 9.81
     system = slider_pendulum(l=l, m=m, g=g, theta0=1.0)

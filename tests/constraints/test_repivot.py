@@ -1,4 +1,4 @@
-"""Re-pivoting a coordinate partition during a run (issue 4, item 1; THEORY §7).
+"""Re-pivoting a coordinate partition during a run (issue 4, item 1; docs/theory.md §7).
 
 A crank–rocker four-bar whose independent velocity is the rocker's rate q̇3: at the rocker's
 extreme positions dq3/dq1 = 0 and the dependent block (crank, coupler) becomes singular.

@@ -1,4 +1,4 @@
-"""Joints (THEORY §4): the relative kinematics (A, r, F⁶, w = F⁶ ṡ + f⁶, ζ = Ḟ⁶ ṡ + ḟ⁶) of
+"""Joints (docs/theory.md §4): the relative kinematics (A, r, F⁶, w = F⁶ ṡ + f⁶, ζ = Ḟ⁶ ṡ + ḟ⁶) of
 every joint type, checked against derivatives of the joint's own pose and twist, and the
 two ways of defining a user joint against each other.
 
@@ -7,7 +7,7 @@ For a joint with coordinates q_n, minimal velocities ṡ_n and q̇_n = K ṡ_n +
 - the relative twist w must be the time derivative of the pose (A, r) along q̇
   (``projeq.joints.pose_twist_mismatch``): v = Aᵀ ṙ, ω̃ = Aᵀ Ȧ;
 - ζ must be the time derivative of w = F ṡ + f along (q̇, t) at *fixed* ṡ — the joint's own
-  part of ζ_n = Ṫ_np ẏ_p + Ḟ_n ṡ_n + ḟ_n (THEORY §4);
+  part of ζ_n = Ṫ_np ẏ_p + Ḟ_n ṡ_n + ḟ_n (docs/theory.md §4);
 - ``UserJoint.from_sympy`` (symbolic ζ) and ``UserJoint.from_functions`` (complex-step ζ)
   must describe the same joint, e.g. Bremer's car B(6), B(11).
 
@@ -72,7 +72,7 @@ def test_twist_is_the_derivative_of_the_pose(kind, seed):
 @pytest.mark.parametrize("kind", KINDS)
 @given(seed=seeds)
 def test_zeta_is_the_derivative_of_the_twist_at_fixed_velocities(kind, seed):
-    """ζ = Ḟ ṡ + ḟ = d/dt (F(q, t) ṡ + f(q, t)) along (q̇, 1) with ṡ held fixed (THEORY §4),
+    """ζ = Ḟ ṡ + ḟ = d/dt (F(q, t) ṡ + f(q, t)) along (q̇, 1) with ṡ held fixed (docs/theory.md §4),
     by the fourth-order difference of ``_d_dt`` along q(τ) = normalized(q + τ q̇), t + τ."""
     rng = np.random.default_rng(seed)
     joint = _joint(kind, rng)
@@ -199,7 +199,7 @@ def test_car_joint_is_bremers_functional_matrix():
 
 def test_prescribed_motion_as_sympy_expression_equals_callable():
     """Prescribed(motion=sp.sin(2t)) and the callable t ↦ (sin 2t, 2 cos 2t, −4 sin 2t) give the
-    same relative kinematics, and ζ carries F θ̈ (THEORY §4)."""
+    same relative kinematics, and ζ carries F θ̈ (docs/theory.md §4)."""
     t_sym = sp.Symbol("t")
     inner = pq.Revolute(None, (0.0, 0.6, 0.8))
     a = pq.Prescribed(inner, motion=sp.sin(2 * t_sym))
@@ -216,7 +216,7 @@ def test_prescribed_motion_as_sympy_expression_equals_callable():
 @given(data=st.data())
 def test_chain_matrices_equal_those_of_the_absolute_poses(planar, data):
     """T_np from ``kinematics.forward`` equals S_n T⁶(A_np, r_pn) S_pᵀ built from the absolute
-    poses alone: A_np = R_nᵀ R_p, r_pn = R_pᵀ (r_n − r_p) (THEORY §4; composing the joint frame
+    poses alone: A_np = R_nᵀ R_p, r_pn = R_pᵀ (r_n − r_p) (docs/theory.md §4; composing the joint frame
     and the joint's relative pose must give the same frames), and ẏ_n = T_np ẏ_p + F_n ṡ_n + S_n f_n."""
     tree = data.draw(S.trees(max_n=8, planar=planar, forces=False), label="tree")
     system = tree.system

@@ -3,8 +3,8 @@
 - a user-defined joint whose F has the wrong shape, or depends on symbols that are not
   coordinates, time or declared parameters (named in the message), or on the speeds;
 - K(q) singular at the start: Barhorst's Euler angles at tilt q2 = π/2
-  (``seeds/000_…`` §3.2, eq. 96, "the singularity near q2 = π/2"); the knife-edge disc's
-  F at ϕ = π/2 (lecture ``seeds/001_…`` slide 31: the 1/cos²ϕ of the Hamiltonian);
+  (Barhorst §3.2, eq. 96, "the singularity near q2 = π/2"); the knife-edge disc's
+  F at ϕ = π/2 (Orsino (2020) slide 31: the 1/cos²ϕ of the Hamiltonian);
 - initial rates q̇₀ that violate the constraints they are meant to satisfy.
 """
 

@@ -1,4 +1,4 @@
-"""Barhorst's particles (``shared/seeds/000_3d4483f33eada135.txt`` §3.1 and footnote 6).
+"""Barhorst's particles (Barhorst §3.1 and footnote 6).
 
 - the planar particle with ẏ − y² ẋ = 0 under gravity −g n̂2, m = 1, g = 10, released at
   (2, 2) at rest (his 3.1.1–3.1.5, figures 1–3: energy 20 units, the constraint held);

@@ -1,4 +1,4 @@
-"""Bremer's car (``shared/seeds/004_e8c95cc2ec0226a1.txt`` §2.1–2.2, B(5)–(12)).
+"""Bremer's car (Bremer (2009) §2.1–2.2, B(5)–(12)).
 
 The non-holonomic constraint v_y = 0 goes into F *before* the derivation (B(11)); the
 Projection Equation then gives B(9) directly (B(12)). Hamel's route (B(3)–(8)) needs the
@@ -71,7 +71,7 @@ def test_gauss_form_is_B9_and_B12_at_random_states():
 
 
 def test_hamel_route_B3_B8_needs_v_y_until_the_end():
-    """B(3)–(8) and THEORY §8 with ``projeq.symbolic.hamel``: with ṡ = H(q) q̇ of B(6),
+    """B(3)–(8) and docs/theory.md §8 with ``projeq.symbolic.hamel``: with ṡ = H(q) q̇ of B(6),
     β₂^{3,1} = −1 and β₁^{1,3} = 0 (B(7)); Hamel's equations with all three velocities,
     after inserting v_y = 0, are B(9) with f_y at the mass centre (the load of
     ``scenes.car``). Inserting v_y = 0 into T first loses the −m c ω_z² term (B(2.1) text:

@@ -1,4 +1,4 @@
-"""The knife-edge disc of the lecture ``shared/seeds/001_652544d2ada24f5f.txt`` (slides 28–37).
+"""The knife-edge disc of Orsino (2020) (slides 28–37).
 
 projeq's model (``scenes.knife_edge_disc``) uses the lecture's coordinates
 q = (x, y, ψ, ϕ, θ) and the minimal velocities ṡ = (ψ̇, ϕ̇, θ̇): the two rolling

@@ -1,5 +1,5 @@
 """Barhorst's thin disk rolling without slip with an eccentric mass
-(``shared/seeds/000_3d4483f33eada135.txt`` §3.2, eqs. 88–104; his parameters are the
+(Barhorst §3.2, eqs. 88–104; his parameters are the
 scene's defaults, in SI units).
 
 - cross-check against sympy.physics.mechanics.KanesMethod (test-only dependency) at random
@@ -11,7 +11,7 @@ scene's defaults, in SI units).
 - stability of upright straight rolling of the symmetric disk above the critical speed
   v_c = √(m g R³ I / (J (J + m R²))) (= √(g R / 3) for a uniform thin disk), derived in
   ``scenes.rolling_disk_critical_speed`` from the linearised slide-37 equations of the
-  knife-edge lecture ``seeds/001_…``.
+  knife-edge Orsino (2020).
 """
 
 from functools import cache

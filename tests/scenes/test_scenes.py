@@ -61,7 +61,7 @@ def test_every_scene_parameter_has_a_documented_unit():
 
 def test_build_scene_overrides_reach_the_model():
     """atwood with m1 = 3 kg: θ̈ = −ẍ/a, ẍ = (m1 − m2) g / (m1 + m2 + I/a²), I = ½ M a²
-    (Problem 1, eq. (4) of ../shared/seeds/003_13b1ca6faae9f37e.txt); one linear solve:
+    (Problem 1, eq. (4) of the Lagrange seminars); one linear solve:
     1e-12 relative is a few hundred ulps."""
     system = pq.scenes.build_scene("atwood", m1=3.0)
     x_ddot = (3.0 - 1.0) * 9.81 / (3.0 + 1.0 + 0.5 * 0.5)

@@ -144,7 +144,7 @@ def test_projected_method_keeps_the_pendulum_energy_at_round_off():
 
 
 def test_projected_method_on_the_rolling_disk():
-    """Passes if, over two revolutions of Barhorst's rolling disk (seed 000 §3.2), the
+    """Passes if, over two revolutions of Barhorst's rolling disk (Barhorst §3.2), the
     rolling constraints hold to round-off for both methods (minimal velocities: q̇ = K ṡ
     satisfies them identically), and the projected method keeps the energy (conserved:
     ideal rolling constraints, gravity only) at round-off where RK45's drifts."""
@@ -241,7 +241,7 @@ def test_mass_ratios_evaluators_agree(masses):
     """Passes if dense = recursive = fast for link masses in ratios 1e6 and 1e-6 to
     10 κ(M) ε relative (the perturbation bound of the linear solve M s̈ = −b, the
     dense evaluator's and the reference: the recursive and fast ones are order-n
-    eliminations of the same equations, THEORY §6), at three states."""
+    eliminations of the same equations, docs/theory.md §6), at three states."""
     system = mass_ratio_chain(masses)
     for seed in range(3):
         rng = np.random.default_rng(seed)

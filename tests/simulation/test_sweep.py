@@ -22,7 +22,7 @@ M1 = [1.0, 1.5, 3.0]
 def atwood_angle(m1, m2=1.0, pulley_mass=0.5, a=0.1, t=T_END):
     """Pulley angle of the scene ``atwood`` released from rest: mass 1 sinks with
     ẍ = (m1 − m2) g / (m1 + m2 + I/a²) (Problem 1, eq. (4) of
-    ../shared/seeds/003_13b1ca6faae9f37e.txt), I = ½ M a², and θ = −x/a (the scene's docstring)."""
+    the Lagrange seminars), I = ½ M a², and θ = −x/a (the scene's docstring)."""
     x_ddot = (m1 - m2) * G / (m1 + m2 + 0.5 * pulley_mass)
     return -0.5 * x_ddot * t**2 / a
 

@@ -22,7 +22,7 @@ def test_help_describes_the_benchmarks(capsys):
 def test_quick_chain_part_is_one_json_report_whose_evaluators_agree(capsys):
     """The chain part of ``projeq bench`` without peers, timed once (budget 0 s): its JSON
     report holds every evaluator at every size and their s̈ agree with the dense Gauss form
-    (a second formulation of the same Projection Equation, THEORY §5 vs §6). Tolerance
+    (a second formulation of the same Projection Equation, docs/theory.md §5 vs §6). Tolerance
     1e-11 relative: the two solutions differ by about cond(M)·ε (docs/theory.md, "Accuracy
     of the two evaluators"), measured 6e-13 at n = 10. Each row also holds every evaluator's
     deviation from the exact s̈ (projeq.studies.bench_exact); the order-n ones are within 10 n ε of

@@ -139,7 +139,7 @@ ORDER_N = {
 
 @pytest.mark.parametrize("accelerations", ORDER_N.values(), ids=ORDER_N.keys())
 def test_order_n_evaluators_are_exact_to_a_few_n_eps(references, accelerations):
-    """chain(30) at three random states: the order-n evaluators (THEORY §6) within
+    """chain(30) at three random states: the order-n evaluators (docs/theory.md §6) within
     10 n ε = 6.7e-14 of the reference. Their error is not governed by κ(M) of the
     relative-angle Gauss form; measured over 20 random states: at most 3.8 n ε (recursive),
     2.5 n ε (fast, both kernels), typically below n ε, so the bound has a margin ≥ 2.6."""
@@ -149,7 +149,7 @@ def test_order_n_evaluators_are_exact_to_a_few_n_eps(references, accelerations):
 
 
 def test_dense_error_is_its_forward_error_bound_and_explains_fast_vs_dense(references):
-    """chain(30): the dense Gauss form (THEORY §5, one LU of M) is backward stable, so its
+    """chain(30): the dense Gauss form (docs/theory.md §5, one LU of M) is backward stable, so its
     s̈ is within κ∞(M) ε of the reference (measured ≤ 0.06 κ∞(M) ε over 20 states,
     κ∞(M) ≈ 2e6 here); and its error is over ten times the fast evaluator's (measured
     ≥ 60×), i.e. the fast − dense difference is the dense evaluator's error."""

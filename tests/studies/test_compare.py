@@ -150,7 +150,7 @@ def test_every_row_says_how_it_follows_from_the_central_equation(car_table):
 
 def test_car_multiplier_forms_give_the_same_motion(car_table):
     """Lagrange and Hamilton canonical equations with a multiplier for −sin γ ẋ + cos γ ẏ = 0
-    (seed 001, K(7), K(23)–(26)) and Barhorst's Lagrangian canonical form (seed 000, eqs.
+    (Orsino (2020), K(7), K(23)–(26)) and Barhorst's Lagrangian canonical form (Barhorst, eqs.
     45–52, no multiplier) move the car as the Projection Equation's B(9) does."""
     for name in ("lagrange + multipliers", "hamilton canonical + multipliers", "barhorst lagrangian canonical"):
         row = _row(car_table, name)

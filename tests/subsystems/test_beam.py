@@ -21,12 +21,12 @@ def _frequencies_at_rest(beam):
 
 
 def _reference(k):
-    """ω_k = (β_k L)² √(EI/(ρA L⁴)), β_k L = 1.8751041, 4.6940911, … (VALIDATION.md)."""
+    """ω_k = (β_k L)² √(EI/(ρA L⁴)), β_k L = 1.8751041, 4.6940911, … (Blevins (1979), Table 8-1)."""
     return clamped_free_roots(k) ** 2 * np.sqrt(EI / (RHO_A * L**4))
 
 
 def test_clamped_free_roots_match_the_catalogue():
-    """β_k L of VALIDATION.md to its 8 digits."""
+    """β_k L of Blevins (1979), Table 8-1 to its 8 digits."""
     assert np.allclose(clamped_free_roots(4), [1.8751041, 4.6940911, 7.8547574, 10.9955407], atol=5e-8)
 
 
@@ -135,7 +135,7 @@ def _free_hub_with_beam(stiffening=True):
 
 
 def _assert_recursive_equals_dense(system, seed, q_range):
-    """THEORY §5 = §6 at three random states (round-off relative to |s̈|: 1e-10)."""
+    """docs/theory.md §5 = §6 at three random states (round-off relative to |s̈|: 1e-10)."""
     rng = np.random.default_rng(seed)
     for _ in range(3):
         q, s_dot = rng.uniform(-q_range, q_range, system.n_q), rng.uniform(-1, 1, system.n_s)
@@ -146,7 +146,7 @@ def _assert_recursive_equals_dense(system, seed, q_range):
 
 @pytest.mark.parametrize("stiffening", [True, False])
 def test_recursive_equals_dense_with_a_beam(stiffening):
-    """THEORY §5 = §6 with an elastic subsystem."""
+    """docs/theory.md §5 = §6 with an elastic subsystem."""
     _assert_recursive_equals_dense(_free_hub_with_beam(stiffening), seed=7, q_range=0.05)
 
 
@@ -244,7 +244,7 @@ def _arm_with_offset_tip_body():
 
 
 def test_body_on_a_beam_station_recursive_equals_dense():
-    """THEORY §5 = §6 when T_np depends on the parent's elastic coordinates."""
+    """docs/theory.md §5 = §6 when T_np depends on the parent's elastic coordinates."""
     _assert_recursive_equals_dense(_arm_with_offset_tip_body(), seed=1, q_range=0.1)
 
 
@@ -280,7 +280,7 @@ def test_elastic_arm_conserves_energy():
 @pytest.mark.parametrize("omega", [0.5, 2.0, 7.0])
 def test_spinning_shaft_frequencies_split_by_the_spin(omega):
     """An isotropic shaft spinning about its own axis, without rotary inertia, vibrates in
-    the co-rotating frame at ω_k ± Ω (VALIDATION.md "spinning shaft"; with z = v + i w the
+    the co-rotating frame at ω_k ± Ω (the isotropic spinning shaft without rotary inertia; with z = v + i w the
     equations ρA(z̈ + 2iΩż − Ω²z) + EI z'''' = 0 of B(23) give λ = i(−Ω ± ω_k)). ω_k from
     the same discretisation at rest, so only round-off and the linearisation's central
     differences remain: 1e-7 relative."""

@@ -99,7 +99,7 @@ def test_unstiffened_critical_speed_is_the_first_bending_frequency():
     differences: measured 1e-13 ω₁, asserted < 1e-6 ω₁)."""
     beam, _ = _steady_spin_eigenvalues(1.0)
     critical = beam.first_frequency
-    exact = 3.51601527 * np.sqrt(1.4e4 / (1.2 * 1e4))  # (β₁L)² √(EI/(ρAL⁴)), VALIDATION.md
+    exact = 3.51601527 * np.sqrt(1.4e4 / (1.2 * 1e4))  # (β₁L)² √(EI/(ρAL⁴)), Blevins (1979), Table 8-1
     assert critical == pytest.approx(exact, rel=1e-5)  # Ritz with n = 4 polynomials: 1.5e-6
     _, below = _steady_spin_eigenvalues(0.99 * critical)
     _, above = _steady_spin_eigenvalues(1.01 * critical)

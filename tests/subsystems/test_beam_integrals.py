@@ -52,7 +52,7 @@ def test_monomial_derivatives():
 
 
 def test_recursive_equals_dense_in_the_precomputed_mode():
-    """THEORY §5 = §6 hold for either mode (both assemblers call the same terms): 1e-10."""
+    """docs/theory.md §5 = §6 hold for either mode (both assemblers call the same terms): 1e-10."""
     _, beam = _pair()
     system = pq.System(
         {"hub": pq.RigidBody(1.0, (0, 0, 0), np.diag([0.5, 0.5, 0.2])), "beam": beam},

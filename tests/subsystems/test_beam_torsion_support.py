@@ -82,7 +82,7 @@ def test_energy_is_conserved_with_torsion():
 
 
 def test_recursive_equals_dense_with_torsion():
-    """THEORY §5 = §6 with a twisting beam carrying an offset body (relative 1e-10)."""
+    """docs/theory.md §5 = §6 with a twisting beam carrying an offset body (relative 1e-10)."""
     system = _hub_with_twisting_beam()
     rng = np.random.default_rng(3)
     for _ in range(3):

@@ -64,7 +64,7 @@ def _co_rotating_frequencies(omega, rho_I, n_shapes, count=4):
 
 def test_rayleigh_shaft_determinant_reduces_to_the_euler_bernoulli_cantilever():
     """Without rotary inertia the roots are (β_k L)² of 1 + cos βL cosh βL = 0
-    (VALIDATION.md: 3.5160153, 22.034492): 1e-7 (the catalogue's 8 digits)."""
+    (Blevins (1979), Table 8-1: 3.5160153, 22.034492): 1e-7 (the catalogue's 8 digits)."""
     roots = _rayleigh_shaft_frequencies(0.0, 0.0)
     assert np.allclose(roots[::2], np.array([1.8751041, 4.6940911]) ** 2, rtol=1e-7)
 

@@ -1,6 +1,6 @@
-"""Rigid subsystems (THEORY §3): Gauss terms M_n, G_n ẏ_n, Q_n against independent physics.
+"""Rigid subsystems (docs/theory.md §3): Gauss terms M_n, G_n ẏ_n, Q_n against independent physics.
 
-THEORY §3, with ẏ = (v_O, ω) in the body frame, origin O, r_c = O → mass centre:
+docs/theory.md §3, with ẏ = (v_O, ω) in the body frame, origin O, r_c = O → mass centre:
 
     M = [[m E, −m r̃_c], [m r̃_c, I_O]],  G ẏ = [m ω̃ v_c ; m r̃_c ω̃ v_c + ω̃ I_c ω],  Q = [f ; r̃_c f]
 
@@ -65,7 +65,7 @@ def _random_motion(rng, n=6):
 
 @given(seeds)
 def test_gauss_terms_equal_newton_euler_about_the_mass_centre(seed):
-    """M ÿ − h = M ÿ + G ẏ − Q equals the Newton–Euler residual (THEORY §3) at a random
+    """M ÿ − h = M ÿ + G ẏ − Q equals the Newton–Euler residual (docs/theory.md §3) at a random
     state, acceleration, orientation and gravity."""
     rng = np.random.default_rng(seed)
     body = _body(rng)
@@ -126,7 +126,7 @@ def test_mass_matrix_is_symmetric_positive_definite(kind, seed):
 @pytest.mark.parametrize("plane", PLANES)
 @given(seed=seeds)
 def test_planar_body_equals_the_spatial_body_restricted_to_its_plane(plane, seed):
-    """THEORY §3: for ẏ in the plane (the out-of-plane twist components zero), the planar
+    """docs/theory.md §3: for ẏ in the plane (the out-of-plane twist components zero), the planar
     body's (M, h) are the spatial body's in-plane rows and columns, at a random
     orientation and gravity (any direction: its in-plane part is what acts)."""
     rng = np.random.default_rng(seed)

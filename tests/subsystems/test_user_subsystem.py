@@ -78,7 +78,7 @@ def test_internal_coordinates_are_laid_out_after_the_joints():
 
 @pytest.mark.parametrize("seed", range(5))
 def test_recursive_equals_dense(seed):
-    """THEORY §5 = §6 for a subsystem with its own minimal velocity (round-off: 1e-12)."""
+    """docs/theory.md §5 = §6 for a subsystem with its own minimal velocity (round-off: 1e-12)."""
     system = _pendulum_with_absorber()
     rng = np.random.default_rng(seed)
     q, s_dot = rng.uniform(-1, 1, 3), rng.uniform(-2, 2, 3)

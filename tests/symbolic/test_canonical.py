@@ -1,4 +1,4 @@
-"""Barhorst's canonical momentum forms (``seeds/000_3d4483f33eada135.txt`` eqs. 28–37 and 45–52) against
+"""Barhorst's canonical momentum forms (Barhorst eqs. 28–37 and 45–52) against
 projeq's numeric Projection-Equation simulation, for the knife-edge disc and Barhorst's particle."""
 
 
@@ -101,7 +101,7 @@ def test_initial_state_sizes_are_checked():
 
 
 def test_barhorst_particle_projective_equations_are_his_74_to_77():
-    """Barhorst's own choice u = ẏ (A12 = 1/y², seed 000 §3.1.3): p₂ = m u₂ (1 + 1/y⁴) (74), Q₂ = −m g (76),
+    """Barhorst's own choice u = ẏ (A12 = 1/y², Barhorst §3.1.3): p₂ = m u₂ (1 + 1/y⁴) (74), Q₂ = −m g (76),
     P₂ = L · d/dt(n̂₂ + n̂₁/y²) = −2 m u₂²/y⁵ (77); the Lagrangian form (45) gives the same p₂ and ṗ₂."""
     qx, qy, u2, mass, grav = sp.symbols("x y u_2 m g")
     body = Body(v_c=(u2 / qy**2, u2, 0), omega=(0, 0, 0), m=mass, I_c=sp.zeros(3, 3), f=(0, -mass * grav, 0))

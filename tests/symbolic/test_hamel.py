@@ -1,4 +1,4 @@
-"""Hamel's coefficients and equations (seed ``004_e8c95cc2ec0226a1.txt`` B(3)–(9), THEORY §8)."""
+"""Hamel's coefficients and equations (Bremer (2009) B(3)–(9), docs/theory.md §8)."""
 
 import pytest
 import sympy as sp
@@ -67,7 +67,7 @@ def test_car_equations_are_B8_and_after_v_y_0_B9_as_the_projection_equation():
 
 
 def test_inserting_v_y_0_before_hamel_is_wrong():
-    """THEORY §8, B(8) text: with v_y = 0 put into T first, ∂T/∂v_y loses its m c ω_z, and
+    """docs/theory.md §8, B(8) text: with v_y = 0 put into T first, ∂T/∂v_y loses its m c ω_z, and
     the first equation misses the centripetal term −m c ω_z² of B(9)."""
     right = car_hamel(T_CAR)[0].subs({v_y: 0, S_DDOT[1]: 0})
     wrong = car_hamel(T_CAR.subs(v_y, 0))[0].subs({v_y: 0, S_DDOT[1]: 0})

@@ -1,4 +1,4 @@
-"""Lagrange and Hamilton's canonical equations with multipliers (lecture ``seeds/001_652544d2ada24f5f.txt``)
+"""Lagrange and Hamilton's canonical equations with multipliers (Orsino (2020))
 against the lecture's explicit equations and projeq's numeric Projection-Equation simulation."""
 
 from functools import cache
@@ -67,7 +67,7 @@ def test_disc_multiplier_forms_follow_the_projection_equation(form):
 
 @pytest.mark.parametrize("form, alpha", [("lagrange", 0.0), ("hamilton", 0.0), ("lagrange", 10.0)])
 def test_barhorst_particle_multiplier_forms_follow_the_projection_equation(form, alpha):
-    """Barhorst's particle (seed 000 §3.1, L = ½(ẋ² + ẏ²) − 10 y, ẏ − y² ẋ = 0). From (2, 2) with
+    """Barhorst's particle (Barhorst §3.1, L = ½(ẋ² + ẏ²) − 10 y, ẏ − y² ẋ = 0). From (2, 2) with
     ẋ = 0.5: the multiplier forms (with and without Baumgarte, α = 10/s) match projeq's
     scene ``barhorst_particle`` to 1000 × rtol over 0.3 s (the particle reaches y ≈ 4 before the curve
     y = 1/(2.5 − x) steepens), and conserve E = ½(ẋ² + ẏ²) + 10 y (the constraint force does no work)."""

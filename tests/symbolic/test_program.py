@@ -1,4 +1,4 @@
-"""Program constraints (GPME), ``seeds/002_4198c96bbf12952b.txt`` §4.2 and §6.3–6.4."""
+"""Program constraints (GPME), Jarzębowska (2002) §4.2 and §6.3–6.4."""
 
 from functools import cache
 
@@ -12,26 +12,26 @@ from projeq.symbolic.program import _gpme_gradient, program_motion_equations
 t = sp.Symbol("t")
 x, y = dynamicsymbols("x y")
 xd, yd, xdd, ydd = x.diff(t), y.diff(t), x.diff(t, 2), y.diff(t, 2)
-T = (xd**2 + yd**2) / 2  # particle of mass m = 1 (seed §6.4)
+T = (xd**2 + yd**2) / 2  # particle of mass m = 1 (Jarzębowska (2002) §6.4)
 N = xd * ydd - xdd * yd  # the determinant of (4.3)
 RTOL, ATOL = 1e-10, 1e-12
 
 
 def curvature(state):
-    """Signed curvature (ẋÿ − ẏẍ)/(ẋ² + ẏ²)^{3/2} of the simulated path (seed §6.4, 1/ro_p)."""
+    """Signed curvature (ẋÿ − ẏẍ)/(ẋ² + ẏ²)^{3/2} of the simulated path (Jarzębowska (2002) §6.4, 1/ro_p)."""
     _, _, u, v, a, b = state
     return (u * b - v * a) / (u * u + v * v) ** 1.5
 
 
 @cache
 def squared_curvature_gpme(Phi):
-    """Constraint (4.3), κ² = Φ², differentiated once (p = 3) as in the seed."""
+    """Constraint (4.3), κ² = Φ², differentiated once (p = 3) as in Jarzębowska (2002)."""
     return program_motion_equations(T, [x, y], [N**2 - Phi**2 * (xd**2 + yd**2) ** 3], t, differentiate=True)
 
 
 def test_seed_equation_6_34a_reproduced_symbolically():
     """(6.33) for (4.3) with forces Q_x, Q_y gives (6.34a): ÿ + (ẍ − Q_x) ẋ/ẏ = Q_y, with ẍ dependent and
-    a_ρλ = ẋ/ẏ (seed §6.4)."""
+    a_ρλ = ẋ/ẏ (Jarzębowska (2002) §6.4)."""
     Qx, Qy = sp.symbols("Q_x Q_y")
     gpme = program_motion_equations(T, [x, y], [N**2 - 25 * (xd**2 + yd**2) ** 3], t, Q=[Qx, Qy],
                                     parameters={Qx: 0.0, Qy: 0.0}, differentiate=True)

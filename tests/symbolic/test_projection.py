@@ -1,4 +1,4 @@
-"""The symbolic Projection Equation B(10)–(12) of seed ``004_e8c95cc2ec0226a1.txt`` (THEORY §2)."""
+"""The symbolic Projection Equation B(10)–(12) of Bremer (2009) (docs/theory.md §2)."""
 
 import numpy as np
 import pytest
@@ -68,7 +68,7 @@ def chain_values():
 
 def test_n_link_pendulum_equals_scenes_chain_dense_and_recursive():
     """Symbolic == numeric: the 4-link pendulum from mass-centre velocities (inertial frame,
-    q-dependent I_c) equals ``scenes.chain(4)`` (joint chain T_np, F_n, THEORY §4) in M and s̈
+    q-dependent I_c) equals ``scenes.chain(4)`` (joint chain T_np, F_n, docs/theory.md §4) in M and s̈
     at random states, for both numeric evaluators."""
     rng = np.random.default_rng(RNG_SEED)
     bodies, q, s, parameters = n_link_pendulum(4)
@@ -87,7 +87,7 @@ def test_n_link_pendulum_equals_scenes_chain_dense_and_recursive():
 
 def _pendulum_gauss_form(route: str, n: int):
     """The n-link pendulum's Gauss form from its velocity expressions (B(10)) or from the
-    numeric ``scenes.chain(n)`` with symbolic parameters (the recursive chain, THEORY §6)."""
+    numeric ``scenes.chain(n)`` with symbolic parameters (the recursive chain, docs/theory.md §6)."""
     if route == "velocities":
         bodies, q, s, parameters = n_link_pendulum(n)
         return projection_equation(bodies, q, s, parameters=parameters)
@@ -97,7 +97,7 @@ def _pendulum_gauss_form(route: str, n: int):
 @pytest.mark.parametrize("route, reference", [("velocities", "kane"), ("system", "kane"), ("system", "lagrange")])
 def test_n_link_pendulum_equals_kanes_and_lagranges_method(route, reference):
     """Projection Equation == sympy.physics.mechanics KanesMethod and LagrangesMethod
-    (VALIDATION.md, N-link pendulum, N = 3): M and rhs (M u̇ = forcing) agree at random
+    (the N-link pendulum, N = 3): M and rhs (M u̇ = forcing) agree at random
     states and random parameters, for both symbolic routes (Lagrange once: it is slow)."""
     rng = np.random.default_rng(RNG_SEED)
     gauss = _pendulum_gauss_form(route, 3)

@@ -93,7 +93,7 @@ def test_prescribed_joint_and_massless_frame():
     """A rheonomic arm: a revolute joint whose angle is prescribed as θ(t) = 0.5 sin 2t
     carries, through a massless Frame on a slider, a pendulum bob. The motion is given to
     ``gauss_form`` as a sympy expression (the joint keeps only its compiled function);
-    symbolic = numeric dense and recursive at t = 0.7 (the f⁶, ζ terms of THEORY §4)."""
+    symbolic = numeric dense and recursive at t = 0.7 (the f⁶, ζ terms of docs/theory.md §4)."""
     time = sp.Symbol("t")
     motion = sp.sin(2 * time) / 2
     system = pq.System(

@@ -27,8 +27,8 @@ def models():
 
 
 def test_hamilton_reproduces_B18():
-    """Hamilton's principle with the Cardan rates of B(17) gives B(18) (seed 004), with
-    ρA α̈ v in the w equation: the seed's printed α̈v/2 is a transcription slip (it would
+    """Hamilton's principle with the Cardan rates of B(17) gives B(18) of Bremer (2009), with
+    ρA α̈ v in the w equation: Bremer's printed α̈v/2 is a transcription slip (it would
     make the ρA α̈ coupling non-skew, contradicting the text under B(18))."""
     for derived, expected in zip(sb.hamilton_field_equations(), printed.expected_B18()):
         assert sp.simplify(derived - expected) == 0
@@ -37,7 +37,7 @@ def test_hamilton_reproduces_B18():
 
 
 def test_projection_reproduces_B23():
-    """Newton–Euler in the co-rotating frame projected by D̄ of B(22) gives THEORY §9's B(23)."""
+    """Newton–Euler in the co-rotating frame projected by D̄ of B(22) gives docs/theory.md §9's B(23)."""
     for derived, expected in zip(sb.projection_field_equations(), printed.expected_B23()):
         assert sp.simplify(derived - expected) == 0
 

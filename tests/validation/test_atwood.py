@@ -1,4 +1,4 @@
-"""Atwood machines: Problems 1 and 2 of ../shared/seeds/003_13b1ca6faae9f37e.txt.
+"""Atwood machines: Problems 1 and 2 of the Lagrange seminars.
 
 The rope is inextensible and does not slip: projeq models it by *coupled* joints (one
 joint's coordinate is a fixed linear combination of others), evaluated by the dense
@@ -30,7 +30,7 @@ def atwood_acceleration(m1, m2, I, a, g=G):
 
 @pytest.mark.parametrize("m1, m2, pulley_mass, a", ATWOOD_CASES, ids=ATWOOD_IDS)
 def test_atwood_scene_acceleration(m1, m2, pulley_mass, a):
-    """Problem 1, eqs. (2)–(4) of ../shared/seeds/003_13b1ca6faae9f37e.txt: the claim of
+    """Problem 1, eqs. (2)–(4) of the Lagrange seminars: the claim of
     ``pq.scenes.atwood``'s docstring, ẍ₁ = (m1 − m2) g / (m1 + m2 + I/a²) downwards for
     mass 1, with I = ½ M a² of the disk pulley.
 
@@ -58,7 +58,7 @@ def test_atwood_scene_acceleration(m1, m2, pulley_mass, a):
 
 @pytest.mark.parametrize("m1, m2, pulley_mass, a", ATWOOD_CASES, ids=ATWOOD_IDS)
 def test_atwood_scene_simulated_fall(m1, m2, pulley_mass, a):
-    """Problem 1, eq. (4) of ../shared/seeds/003_13b1ca6faae9f37e.txt, integrated: from
+    """Problem 1, eq. (4) of the Lagrange seminars, integrated: from
     rest x(t) = ½ ẍ t², i.e. θ(t) = −ẍ t² / (2a), and the energy (2) is conserved.
     """
     system = pq.scenes.atwood(m1, m2, pulley_mass, a, G)
@@ -111,11 +111,11 @@ DOUBLE_IDS = ["m1=m,m2=m3=m/2(at-rest)", "1-2-3", "3-1-0.5", "light-m1"]
 
 @pytest.mark.parametrize("m1, m2, m3", DOUBLE_CASES, ids=DOUBLE_IDS)
 def test_double_atwood_accelerations(m1, m2, m3):
-    """Problem 2, eqs. (6), (8), (9), (10) of ../shared/seeds/003_13b1ca6faae9f37e.txt.
+    """Problem 2, eqs. (6), (8), (9), (10) of the Lagrange seminars.
 
     The mass matrix equals that of T in (6), transformed to projeq's coordinates (x, x2)
     by (ẋ, ẋ') = P (ẋ, ẋ2), P = [[1, 0], [1, 1]]; the accelerations equal (9)–(10) and
-    satisfy Lagrange's equations (8); for m1 = m, m2 = m3 = m/2 both vanish (seed remark).
+    satisfy Lagrange's equations (8); for m1 = m, m2 = m3 = m/2 both vanish (a remark of the seminars).
     """
     system = double_atwood(m1, m2, m3)
     x_ddot, xp_ddot = double_atwood_accelerations(m1, m2, m3)
@@ -128,7 +128,7 @@ def test_double_atwood_accelerations(m1, m2, m3):
         got = P @ s_ddot  # (ẍ, ẍ')
         # absolute scale g: in the balanced case the accelerations are 0
         np.testing.assert_allclose(got, [x_ddot, xp_ddot], rtol=0, atol=ALGEBRAIC * G)
-        # eq. (8): Lagrange's equations in the seed's coordinates
+        # eq. (8): Lagrange's equations in the seminars' coordinates
         lhs = M_seed @ got
         np.testing.assert_allclose(lhs, [(m1 - m2 - m3) * G, (m2 - m3) * G], rtol=0,
                                    atol=ALGEBRAIC * G * (m1 + m2 + m3))
@@ -136,7 +136,7 @@ def test_double_atwood_accelerations(m1, m2, m3):
 
 @pytest.mark.parametrize("m1, m2, m3", DOUBLE_CASES, ids=DOUBLE_IDS)
 def test_double_atwood_simulated(m1, m2, m3):
-    """Problem 2, eqs. (9)–(10) of ../shared/seeds/003_13b1ca6faae9f37e.txt, integrated
+    """Problem 2, eqs. (9)–(10) of the Lagrange seminars, integrated
     from rest: x(t) = x0 + ½ ẍ t² and x2(t) = x2,0 + ½ (ẍ' − ẍ) t²; the energy (6) is
     conserved.
     """

@@ -1,9 +1,9 @@
 """Two identical masses between three springs on a line: Problem 4 (Seminar 1) and its
 generalisation in Seminar 6 (outer springs K, coupling spring K') of
-../shared/seeds/003_13b1ca6faae9f37e.txt.
+the Lagrange seminars.
 
 Model: walls at x = 0 and x = 3d, the masses on prismatic joints along x placed at d and
-2d, so the coordinates are the seed's displacements x1, x2 from equilibrium. The springs
+2d, so the coordinates are the seminars' displacements x1, x2 from equilibrium. The springs
 are point-to-point SpringDampers of natural length d (relaxed at q = 0, the equilibrium).
 Gravity acts along −z, across the motion.
 """
@@ -45,7 +45,7 @@ LINEARISATION = 1e-9
 @pytest.mark.parametrize("m, K, Kc", CASES, ids=IDS)
 def test_coupled_oscillator_modes(m, K, Kc):
     """Problem 4, eqs. (23)–(30), and Seminar 6, eqs. (6), (7), (20), (23), (25) of
-    ../shared/seeds/003_13b1ca6faae9f37e.txt.
+    the Lagrange seminars.
 
     T = m E (6), V = [[K + K', −K'], [−K', K + K']] (7); ω₁² = K/m with the in-phase mode
     (1, 1) and ω₂² = (K + 2K')/m with the opposite-phase mode (1, −1) (for K' = K:
@@ -67,7 +67,7 @@ def test_coupled_oscillator_modes(m, K, Kc):
 
 @pytest.mark.parametrize("m, K, Kc", CASES, ids=IDS)
 def test_coupled_oscillator_beats(m, K, Kc):
-    """Seminar 6, eqs. (34)–(36) of ../shared/seeds/003_13b1ca6faae9f37e.txt: released
+    """Seminar 6, eqs. (34)–(36) of the Lagrange seminars: released
     from rest with x1(0) = 0, x2(0) = a, the masses beat,
     x1 = ½ a (cos ω₁t − cos ω₂t), x2 = ½ a (cos ω₁t + cos ω₂t), over one beat period
     2π/(ω₂ − ω₁) (energy passes from mass 2 to mass 1 and back).

@@ -1,4 +1,4 @@
-"""Driven block, Problem 11 of ../shared/seeds/003_13b1ca6faae9f37e.txt: a block B moves
+"""Driven block, Problem 11 of the Lagrange seminars: a block B moves
 vertically by the given law s = A sin Ωt (28) (downwards positive) and a mass m hangs
 from it on a spring of stiffness k and natural length l₀.
 
@@ -6,7 +6,7 @@ The block is a ``Prescribed`` prismatic joint (rheonomic, no coordinate of its o
 mass is modelled twice:
 
 - "absolute": on a prismatic joint from the ground (depth y) with a point-to-point
-  SpringDamper to the block; the seed's q = y − l with l = l₀ + m g/k (31)–(34);
+  SpringDamper to the block; the seminars' q = y − l with l = l₀ + m g/k (31)–(34);
 - "relative": on a prismatic joint *of the block* whose coordinate is the spring length
   l₁, with a JointSpring; q = l₁ + s − l (31).
 """
@@ -52,7 +52,7 @@ OMEGA_IDS = ["Omega=0.5w0", "Omega=1.7w0"]
 @pytest.mark.parametrize("Omega", OMEGAS, ids=OMEGA_IDS)
 @pytest.mark.parametrize("variant", VARIANTS)
 def test_driven_block_equation_of_motion(variant, Omega):
-    """Problem 11, eqs. (39)–(40) of ../shared/seeds/003_13b1ca6faae9f37e.txt:
+    """Problem 11, eqs. (39)–(40) of the Lagrange seminars:
     q̈ + ω₀² q = ω₀² s(t), ω₀² = k/m, at random (q, q̇, t); the block's motion enters
     through the prescribed joint (in the relative model also through its acceleration:
     l̈₁ = q̈ − s̈)."""
@@ -60,7 +60,7 @@ def test_driven_block_equation_of_motion(variant, Omega):
     rng = np.random.default_rng(11)
     for t, dq, v in rng.uniform([0.0, -0.1, -1.0], [3.0, 0.1, 1.0], size=(6, 3)):
         s, s_ddot = A_DRIVE * np.sin(Omega * t), -A_DRIVE * Omega**2 * np.sin(Omega * t)
-        q = dq  # the seed's q
+        q = dq  # the seminars' q
         coordinate = q + L_EQ if variant == "absolute" else q - s + L_EQ
         accel = system.accelerations([coordinate], [v], t=t)[0]
         q_ddot = accel if variant == "absolute" else accel + s_ddot
@@ -73,7 +73,7 @@ def test_driven_block_equation_of_motion(variant, Omega):
 @pytest.mark.parametrize("Omega", OMEGAS, ids=OMEGA_IDS)
 @pytest.mark.parametrize("variant", VARIANTS)
 def test_driven_block_forced_response(variant, Omega):
-    """Problem 11, eqs. (29), (43)–(47) of ../shared/seeds/003_13b1ca6faae9f37e.txt:
+    """Problem 11, eqs. (29), (43)–(47) of the Lagrange seminars:
     q(t) = C sin(ω₀t + φ) + D sin Ωt with D = A ω₀²/(ω₀² − Ω²) (46), and C, φ fixed by
     q(0) = q₀, q̇(0) = v₀: C sin φ = q₀, C ω₀ cos φ = v₀ − D Ω. Checked over several
     periods of both frequencies.

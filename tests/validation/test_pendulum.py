@@ -1,10 +1,10 @@
 """Pendulums: Problems 7 (simple pendulum, large amplitude) and 8 (double pendulum) of
-../shared/seeds/003_13b1ca6faae9f37e.txt, and energy conservation of a conservative
+the Lagrange seminars, and energy conservation of a conservative
 double pendulum over 100 periods.
 
 Both pendulums swing in the x–z plane about revolute joints along y with gravity along
 −z; the bobs are point masses at r_c = (0, 0, −l). A positive angle θ moves the bob to
-x = −l sin θ, the mirror image of the seed's figure; the equations are unchanged.
+x = −l sin θ, the mirror image of the seminars' figure; the equations are unchanged.
 """
 
 import numpy as np
@@ -64,7 +64,7 @@ AMPLITUDES = [0.1, 1.0, 2.0, 2.5, 3.0]  # rad; 3.0 is 8° short of the upright p
 
 
 def test_simple_pendulum_equation_of_motion():
-    """Problem 7, eqs. (1), (4), (5) of ../shared/seeds/003_13b1ca6faae9f37e.txt:
+    """Problem 7, eqs. (1), (4), (5) of the Lagrange seminars:
     m l² θ̈ + m g l sin θ = 0, i.e. θ̈ = −(g/l) sin θ at any state; M = m l²."""
     system = simple_pendulum()
     for theta in np.linspace(-3.0, 3.0, 7):
@@ -76,7 +76,7 @@ def test_simple_pendulum_equation_of_motion():
 
 @pytest.mark.parametrize("theta0", AMPLITUDES, ids=[f"theta0={a}" for a in AMPLITUDES])
 def test_simple_pendulum_period(theta0):
-    """Problem 7, eq. (23) of ../shared/seeds/003_13b1ca6faae9f37e.txt: the period of a
+    """Problem 7, eq. (23) of the Lagrange seminars: the period of a
     swing of amplitude θ₀ is 4 √(l/g) K(sin(θ₀/2)), measured between the first two
     downward zero crossings of θ after release from rest at θ₀.
     """
@@ -94,7 +94,7 @@ def test_simple_pendulum_period(theta0):
 
 
 def test_simple_pendulum_period_default_segments():
-    """Problem 7, eq. (23) of ../shared/seeds/003_13b1ca6faae9f37e.txt, as a user runs it:
+    """Problem 7, eq. (23) of the Lagrange seminars, as a user runs it:
     default segmentation (n_segments = 20) with 31 output times, so that the segment ends
     fall between output times. Same amplitude, tolerances and bound as
     test_simple_pendulum_period[theta0=1.0]."""
@@ -112,7 +112,7 @@ def test_simple_pendulum_period_default_segments():
 
 # --- Problem 8: double pendulum ------------------------------------------------------------
 #
-# The scene's coordinates are q = (θ₁, θ₂) with θ₂ relative to the first rod; the seed's
+# The scene's coordinates are q = (θ₁, θ₂) with θ₂ relative to the first rod; the seminars'
 # are the absolute angles (φ, ψ) = (θ₁, θ₁ + θ₂) = P q with P = [[1, 0], [1, 1]].
 
 M8, L8 = 1.3, 0.7
@@ -134,7 +134,7 @@ def seed_accelerations(phi, psi, phi_dot, psi_dot, g=G, l=L8):
 
 
 def test_double_pendulum_equations_of_motion():
-    """Problem 8, eqs. (35) and (38) of ../shared/seeds/003_13b1ca6faae9f37e.txt, at random
+    """Problem 8, eqs. (35) and (38) of the Lagrange seminars, at random
     states: M = Pᵀ M_seed P with M_seed = m l² [[2, cos(φ − ψ)], [cos(φ − ψ), 1]] from
     T (35), and s̈ = P⁻¹ (φ̈, ψ̈) of (38); recursive and dense evaluators agree."""
     system = double_pendulum()
@@ -154,7 +154,7 @@ def test_double_pendulum_equations_of_motion():
 
 
 def test_double_pendulum_small_oscillations():
-    """Problem 8, eqs. (40)–(52) of ../shared/seeds/003_13b1ca6faae9f37e.txt: the
+    """Problem 8, eqs. (40)–(52) of the Lagrange seminars: the
     linearisation about the hanging position has ω² = (g/l)(2 ∓ √2) (47), the slow mode
     in phase with B = √2 A (49), the fast one in opposition with B = −√2 A (51) (absolute
     amplitudes A of φ, B of ψ), and ω₂/ω₁ = √((2 + √2)/(2 − √2)) = 1 + √2 (52)."""
@@ -172,7 +172,7 @@ def test_double_pendulum_small_oscillations():
 
 
 def test_double_pendulum_slow_mode_period():
-    """Problem 8, eqs. (47) and (49) of ../shared/seeds/003_13b1ca6faae9f37e.txt,
+    """Problem 8, eqs. (47) and (49) of the Lagrange seminars,
     simulated: released from rest in the slow mode, (φ, ψ) = ε (1, √2), the pendulum
     swings with the period 2π/ω₁, ω₁² = (g/l)(2 − √2).
 
@@ -199,8 +199,7 @@ def test_double_pendulum_slow_mode_period():
 @pytest.mark.slow
 def test_double_pendulum_energy_100_periods():
     """Energy conservation of a conservative double pendulum (Problem 8 of
-    ../shared/seeds/003_13b1ca6faae9f37e.txt; ../shared/design/VALIDATION.md, "energy
-    conserved"): equal masses and lengths (m = 1 kg, l = 1 m), released from rest at
+    the Lagrange seminars; an energy-conservation check): equal masses and lengths (m = 1 kg, l = 1 m), released from rest at
     θ₁ = 0.5 rad, θ₂ = 0 (a moderate, non-modal amplitude), integrated by DOP853 at
     rtol = 1e-11 over 100 periods of the slow small oscillation, 100 · 2π/ω₁ with
     ω₁² = (g/l)(2 − √2) (eq. (47)), i.e. 262 s. ``res.energy_drift`` (max |E − E₀| over the
@@ -213,7 +212,7 @@ def test_double_pendulum_energy_100_periods():
     # default segmentation: its restart bug (see test_simple_pendulum_period_default_segments)
     # shifts the trajectory in time, which leaves the energy of this autonomous system alone
     assert res.success
-    # 1e-8 is VALIDATION.md's tolerance for tight integrations. About 1e4 steps
+    # 1e-8 is the tolerance of docs/validation.md's tight integrations. About 1e4 steps
     # (nfev/12), each with a local error ≲ rtol, accumulate like a random walk to
     # ~√1e4 · rtol = 1e-9; a dissipative or energy-injecting error in the Gauss form of
     # even 1e-12 per step would show up as a drift ≥ 1e-8

@@ -1,8 +1,8 @@
-"""Particle inside a rolling tube, Problem 12 of ../shared/seeds/003_13b1ca6faae9f37e.txt.
+"""Particle inside a rolling tube, Problem 12 of the Lagrange seminars.
 
 A thin tube (mass M on its periphery, radius a, I_c = M a², eq. (49)) rolls without
 slipping on a horizontal plane; a particle m slides freely on its inside surface. The
-seed's coordinates: x of the tube's centre and the angle θ of the particle measured
+seminars' coordinates: x of the tube's centre and the angle θ of the particle measured
 downwards from the horizontal through the centre, x_m = x + a cos θ, height
 y_m = a − a sin θ (52). Rolling on a plane is a holonomic constraint, ψ = x/a (50), so
 projeq can model it in two ways:
@@ -12,7 +12,7 @@ projeq can model it in two ways:
   it by ψ = x/a, carrying a ring of mass M/2 with the whole tube's inertia tensor
   (M a² about its axis). Both parts are centred on the axis, so the kinetic energy is
   exactly that of the tube, T_c = ½ M ẋ² + ½ M a² ψ̇² = M ẋ² (51). The particle hangs
-  from the non-spinning carriage by a revolute joint, so its coordinate is the seed's θ.
+  from the non-spinning carriage by a revolute joint, so its coordinate is the seminars' θ.
   (Splitting the mass is needed because projeq has no massless frames: every joint
   carries a body of positive mass.)
 - "rolling joint": the tube is one rigid body on a one-dof ``UserJoint`` whose pose is a
@@ -100,7 +100,7 @@ def seed_accelerations(theta, x_dot, theta_dot, M=M_TUBE, a=A, m=M_P, g=G):
 
 @pytest.mark.parametrize("model", list(MODELS))
 def test_rolling_tube_equations_of_motion(model):
-    """Problem 12, eqs. (56), (66), (67) of ../shared/seeds/003_13b1ca6faae9f37e.txt, at
+    """Problem 12, eqs. (56), (66), (67) of the Lagrange seminars, at
     random states: the mass matrix of the Lagrangian (56),
     [[2M + m, −m a sin θ], [−m a sin θ, m a²]] (transformed by P for the rolling joint),
     and the accelerations (66)–(67)."""
@@ -132,7 +132,7 @@ def bottom_event(P):
 
 @pytest.mark.parametrize("model", list(MODELS))
 def test_rolling_tube_released_particle(model):
-    """Problem 12, eqs. (57)–(62) and (68) of ../shared/seeds/003_13b1ca6faae9f37e.txt:
+    """Problem 12, eqs. (57)–(62) and (68) of the Lagrange seminars:
     released from rest at θ = 0, x = 0 (58), the momentum (57) (2M + m) ẋ − m a sin θ θ̇
     stays 0 and the tube follows x = m a (1 − cos θ)/(2M + m) (62) over several swings;
     at the bottom θ = π/2 the particle's velocity is v_f = ẋ − a θ̇ (68), where (57) gives
@@ -150,7 +150,7 @@ def test_rolling_tube_released_particle(model):
     c = M_P * A / (2 * M_TUBE + M_P)
     assert theta.max() > 3.0  # the particle swings across the bottom to the other side
     # Each model coordinate and velocity may be off by 5 units of the request (5 as in
-    # scipy's solve_ivp tests); the seed's (x, θ) = P q then by |P| of that.
+    # scipy's solve_ivp tests); the seminars' (x, θ) = P q then by |P| of that.
     dx, dtheta = np.abs(P) @ (5 * (atol + rtol * np.abs(res.q))).T
     dx_dot, dtheta_dot = np.abs(P) @ (5 * (atol + rtol * np.abs(res.s_dot))).T
     # (62): r = x − c (1 − cos θ), so |r| ≤ δx + c |sin θ| δθ

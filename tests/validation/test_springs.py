@@ -1,9 +1,9 @@
-"""Masses on springs, Problem 10 of ../shared/seeds/003_13b1ca6faae9f37e.txt: an upper
+"""Masses on springs, Problem 10 of the Lagrange seminars: an upper
 mass 2m hangs from a fixed frame on a spring (stiffness k, natural length l1), a lower
 mass m hangs from it on a second spring (k, l2); vertical motion only.
 
 Model: both masses on prismatic joints from the ground pointing *down* (axis −z, gravity
-along −z), so the coordinates are the seed's depths y1, y2 below the suspension point;
+along −z), so the coordinates are the seminars' depths y1, y2 below the suspension point;
 the springs are point-to-point SpringDampers (ground–upper, upper–lower).
 """
 
@@ -36,7 +36,7 @@ def equilibrium(m=M, k=K, g=G):
 
 def test_two_masses_equilibrium_and_modes():
     """Problem 10, eqs. (1), (6), (11)–(12), (14), (16)–(19) of
-    ../shared/seeds/003_13b1ca6faae9f37e.txt.
+    the Lagrange seminars.
 
     At the equilibrium (12) the accelerations vanish; M = m diag(2, 1) (1); the
     stiffness of (14) is k [[2, −1], [−1, 1]]; ω² = (k/m)(1 ∓ 1/√2) (18) with mode shapes
@@ -60,7 +60,7 @@ def test_two_masses_equilibrium_and_modes():
 
 
 def test_two_masses_released_upper_mass():
-    """Problem 10 (b), eqs. (21)–(27) of ../shared/seeds/003_13b1ca6faae9f37e.txt: the
+    """Problem 10 (b), eqs. (21)–(27) of the Lagrange seminars: the
     upper mass is slowly pulled down by l (so both masses are displaced by l, eq. (22))
     and released. With the amplitudes (26), A1 = (l/2)(1 + 1/√2), A2 = (l/2)(1 − 1/√2),
     ξ1 = A1 cos ω₁t + A2 cos ω₂t and ξ2 = √2 A1 cos ω₁t − √2 A2 cos ω₂t (21), so the lower

@@ -1,9 +1,9 @@
 """Particle sliding on a movable inclined plane: Problem 3 of
-../shared/seeds/003_13b1ca6faae9f37e.txt.
+the Lagrange seminars.
 
 The wedge (mass M) slides on a prismatic joint along the horizontal x axis; the particle
 (mass m) slides on a prismatic joint *of the wedge* along e = (cos α, 0, −sin α), the
-unit vector down the plane. The coordinates are the seed's x (wedge) and x' (particle
+unit vector down the plane. The coordinates are the seminars' x (wedge) and x' (particle
 along the plane, relative to the wedge), eqs. (11)–(12).
 """
 
@@ -56,7 +56,7 @@ def horizontal_momentum(alpha, m, M, s_dot):
 
 @pytest.mark.parametrize("alpha, m, M", CASES, ids=IDS)
 def test_wedge_accelerations(alpha, m, M):
-    """Problem 3, eqs. (14), (20), (21), (22) of ../shared/seeds/003_13b1ca6faae9f37e.txt.
+    """Problem 3, eqs. (14), (20), (21), (22) of the Lagrange seminars.
 
     Mass matrix of T (14): [[M + m, m cos α], [m cos α, m]]; accelerations (21)–(22) at
     any state (they are constant); Lagrange's equations (20) hold.
@@ -79,7 +79,7 @@ def test_wedge_accelerations(alpha, m, M):
 
 @pytest.mark.parametrize("alpha, m, M", CASES, ids=IDS)
 def test_wedge_momentum_conserved(alpha, m, M):
-    """Problem 3, eqs. (19), (21), (22) of ../shared/seeds/003_13b1ca6faae9f37e.txt,
+    """Problem 3, eqs. (19), (21), (22) of the Lagrange seminars,
     integrated from a moving start: the horizontal momentum (19) stays constant and the
     coordinates follow x(t) = x0 + v0 t + ½ ẍ t² (constant accelerations (21)–(22)).
     """

@@ -1,4 +1,4 @@
-"""The elastic beam by a direct Ritz approach (B(19)–(25), THEORY §10).
+"""The elastic beam by a direct Ritz approach (B(19)–(25), docs/theory.md §10).
 
 - :mod:`.beam`: :class:`RitzBeam`, its Gauss-form terms and ports for joints at its stations;
 - :mod:`.shapes`: Ritz shape-function families; :mod:`.integrals`: precomputed shape integrals;

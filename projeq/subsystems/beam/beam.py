@@ -1,4 +1,4 @@
-"""An Euler–Bernoulli beam by a direct Ritz approach (B(19)–(25), THEORY §10).
+"""An Euler–Bernoulli beam by a direct Ritz approach (B(19)–(25), docs/theory.md §10).
 
 The beam hangs in a floating reference frame R (its root, axis x) with describing
 velocities ẏ = (v_R, ω_R, q̇_e). A slice at x sits at r(x) = (x + u + u₂, v, w) with
@@ -11,7 +11,7 @@ the Projection Equation B(19)–(25) for the slices gives
 
 (the bracket is J̇ ẏ + ω̃ v_c − g, the acceleration not proportional to ÿ), plus the rotary
 inertia of the slices (Rayleigh) with ω_c = (E − θ̃) ω + (E − ½θ̃) θ̇ in the slice's frame,
-rotation vector θ = Φ_θᵀ q_e + τ e_x, Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (torsion β, THEORY §10) and
+rotation vector θ = Φ_θᵀ q_e + τ e_x, Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (torsion β, docs/theory.md §10) and
 the geometric twist τ = q_vᵀ T(x) q_w of a beam without torsional strain (second order; it
 carries the spin-up torque's coupling, docs/theory.md). Because
 u₂ is part of the kinematics, the projection of the slices' axial inertia loads on
@@ -222,7 +222,7 @@ class RitzBeam(BeamProbes, Subsystem):
 
     def _stiffness(self, EI_z, EI_y, EA, GI_t) -> None:
         """K_e = ∫ (EA Φ_u′Φ_u′ᵀ + EI_z Φ_v″Φ_v″ᵀ + EI_y Φ_w″Φ_w″ᵀ + GI_t Φ_β′Φ_β′ᵀ) dx
-        (block diagonal, THEORY §10)."""
+        (block diagonal, docs/theory.md §10)."""
         self.K_e = np.zeros((self.n_e, self.n_e))
         blocks = (
             ("u", 1, EA, "EA", self.u_cols),
@@ -240,7 +240,7 @@ class RitzBeam(BeamProbes, Subsystem):
 
     def _rotary(self, rho_I, rho_I_p) -> None:
         """Rotary inertia per station diag(ρI_p, ρI_y, ρI_z) (ρI_p = ρ(I_y + I_z) unless
-        given) and J_ω(x) = [0, E, Φ_θ], Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (THEORY §10)."""
+        given) and J_ω(x) = [0, E, Φ_θ], Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (docs/theory.md §10)."""
         if rho_I is None and rho_I_p is None:
             self.rotary = None
             return
@@ -428,7 +428,7 @@ class RitzBeam(BeamProbes, Subsystem):
     def port(self, point: NDArray, q_e: NDArray, q_e_dot: NDArray) -> Relative:
         """Kinematics of a frame attached at ``point`` of the undeformed beam (station
         x = point[0], cross-section offset c = (0, point[1], point[2])), relative to the
-        beam's reference frame, as a joint would give them (THEORY §10, last line):
+        beam's reference frame, as a joint would give them (docs/theory.md §10, last line):
 
         pose A = R_z(v′) R_y(−w′) R_x(β) (Bremer's Cardan sequence, B(17)), r = r(x) + A c;
         relative twist F q̇_e in port coordinates with F = [[Aᵀ Φ_r − c̃ Φ_ω], [Φ_ω]],

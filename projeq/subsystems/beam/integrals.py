@@ -1,7 +1,7 @@
 """How a RitzBeam integrates the slices' translation terms of B(25), chosen once in its
 constructor (``integration=``): :class:`Quadrature` sums them at the Gauss stations at every
 call; :class:`PrecomputedIntegrals` assembles them from moments of the shape functions
-computed once, exact for the beam's model (THEORY §10, "a speed/accuracy knob").
+computed once, exact for the beam's model (docs/theory.md §10, "a speed/accuracy knob").
 
 Both are built with the beam, ``integration(beam)``, and answer ``terms(y_dot, R,
 gravity, q_e)`` (M_n, h_n of the translation) and ``elastic_rows(...)`` (their last n_e

@@ -1,4 +1,4 @@
-"""Ritz shape-function families for beams: Φ, Φ′, Φ″ at stations x (THEORY §10).
+"""Ritz shape-function families for beams: Φ, Φ′, Φ″ at stations x (docs/theory.md §10).
 
 A family is a callable ``family(n, L)`` returning ``shapes(x) -> (Φ, Φ′, Φ″[, Φ‴])``, each
 of shape (n, len(x)); Φ‴ (for shear forces) is optional in user families. Bending families
