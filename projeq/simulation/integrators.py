@@ -27,7 +27,7 @@ import warnings
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.integrate import DOP853, RK45, DenseOutput, OdeSolver
+from scipy.integrate import DOP853, RK23, RK45, DenseOutput, OdeSolver
 
 from projeq.analysis.differentiation import central, forward, gradient
 
@@ -211,23 +211,44 @@ def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32) -> float:
     return float(np.exp(np.mean(logs[-2 * (iterations // 4):])))
 
 
+def stability_limit(method: str) -> float:
+    """|x| of the explicit Runge–Kutta ``method``'s stability interval [x, 0] on the negative
+    real axis: the root of |R(x)| = 1 for R(z) = 1 + z bᵀ (I − z A)⁻¹ 1 of its Butcher tableau
+    (Hairer & Wanner, Solving ODEs II, §IV.2): RK23 2.51, RK45 3.31, DOP853 6.39."""
+    from scipy.optimize import brentq  # scipy.optimize loads where it is used (import projeq stays fast)
+
+    solver = {"RK23": RK23, "RK45": RK45, "DOP853": DOP853}[PROJECTED[method].__name__ if method in PROJECTED else method]
+    n = solver.n_stages
+    A = np.zeros((n, n))
+    A[:, : min(n, solver.A.shape[1])] = solver.A[:n, :n]
+
+    def amplification(x: float) -> float:
+        return abs(1 + x * solver.B[:n] @ np.linalg.solve(np.eye(n) - x * A, np.ones(n))) - 1.0
+
+    grid = -np.linspace(0.1, 10.0, 991)
+    first = int(np.argmax([amplification(x) > 0 for x in grid]))
+    return -float(brentq(amplification, grid[first - 1], grid[first], xtol=1e-12))
+
+
 def warn_if_stiff(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rtol: float) -> bool:
     """Warn (:class:`StiffnessWarning`) if an explicit ``method``'s ``n_steps`` steps from t0
     to t (all of a run's segments so far, whatever the segmenting) sit at its stability
     limit; ``x`` is the state at t. True if it warned.
 
-    The criterion: mean step h with ρ h ≥ 1 (ρ = :func:`spectral_radius` at (t, x)), over at
-    least 50 steps, at rtol ≤ 1e-5. At such tolerances a mode with ρ h ≥ 1 would be
-    integrated with a local error of order (ρh)⁵ ≫ rtol, so the error control can only
-    accept these steps because the fast mode is hardly excited: the step is set by
-    stability, the definition of stiffness, and an implicit method could take far larger
-    ones.
+    The criterion: mean step h with ρ h at least half the method's :func:`stability_limit`
+    (ρ = :func:`spectral_radius` at (t, x)), over at least 50 steps, at rtol ≤ 1e-5. At such
+    tolerances a mode with ρ h that large would be integrated with a local error ≫ rtol, so
+    the error control can only accept these steps because the fast mode is hardly excited:
+    the step is set by stability, the definition of stiffness, and an implicit method could
+    take far larger ones. (Below half the limit, measured on the spin-up beam at ρh = 1.6 with
+    DOP853, whose limit is 6.39, Radau at equal accuracy was 1.7× slower:
+    benchmarks/default_integrator.py.)
     """
     if method not in EXPLICIT or rtol > 1e-5 or n_steps < 50:
         return False
     h = (t - t0) / n_steps
     rho = spectral_radius(fun, t, x)
-    if rho * h < 1.0:
+    if rho * h < 0.5 * stability_limit(method):
         return False
     warnings.warn(
         f"method: {method!r} is explicit and crawls at its stability limit (mean step {h:.3g} s, "

@@ -279,3 +279,27 @@ def test_thousand_body_chain_short_run():
     result = pq.simulate(system, 5e-3, method="RK45", rtol=rtol, atol=1e-10, evaluator="auto", n_points=3,
                          n_segments=1)
     assert result.energy_drift < result.nfev / 6 * rtol
+
+
+def test_stability_limits_are_the_roots_of_the_stability_polynomials():
+    """Passes if the stability intervals computed from scipy's Butcher tableaus equal the
+    closed forms: every 3-stage order-3 method (RK23, Bogacki–Shampine) has
+    R(x) = 1 + x + x²/2 + x³/6, which reaches −1 at x = −2.5127; Dormand–Prince 5(4) (RK45)
+    has R(x) = Σ_{k≤5} x^k/k! + x⁶/600, which reaches +1 at x = −3.3066 (Hairer, Nørsett &
+    Wanner, Solving ODEs I, §II.5; Hairer & Wanner II, §IV.2). DOP853's is only bracketed:
+    its interval is larger than RK45's (order 8, 12 stages)."""
+    from math import factorial
+
+    from projeq.simulation.integrators import stability_limit
+
+    def real_root(coefficients, value):
+        shifted = np.array(coefficients, dtype=float)
+        shifted[0] -= value
+        roots = np.roots(shifted[::-1])
+        return -max(-r.real for r in roots if abs(r.imag) < 1e-9 and r.real < -1e-9)
+
+    taylor = [1 / factorial(k) for k in range(6)]
+    assert stability_limit("RK23") == pytest.approx(-real_root(taylor[:4], -1.0), rel=1e-9)
+    assert stability_limit("RK45") == pytest.approx(-real_root(taylor + [1 / 600], 1.0), rel=1e-9)
+    assert stability_limit("RK45-projected") == stability_limit("RK45")
+    assert 2 * stability_limit("RK45") > stability_limit("DOP853") > stability_limit("RK45")
