@@ -149,6 +149,24 @@ def _canonical(name, build, q0, u0, note):
     return StudyFormulation(name, build, run, note)
 
 
+def _projective_rows(example, speeds, u, K, q0, u0, independent, notes):
+    """Kane's (projective) form and Barhorst's two canonical forms in the speeds u (q̇ = K u),
+    ``notes`` the equations each row reproduces."""
+    from projeq.symbolic.canonical import lagrangian_canonical, projective_canonical
+    from projeq.symbolic.projection import t
+
+    kane, projective, lagrangian = notes
+    return [
+        _kane(f"kane (projective), {speeds}", example, u, K, q0, u0, note=kane),
+        _canonical(f"barhorst projective canonical, {speeds}",
+                   lambda: projective_canonical(example.bodies_in(u, K), example.q, u, K, t, example.values),
+                   q0, u0, projective),
+        _canonical(f"barhorst lagrangian canonical, {speeds}",
+                   lambda: lagrangian_canonical(example.multiplier_system(), independent=independent), q0, u0,
+                   lagrangian),
+    ]
+
+
 def _compiled_K(example, K):
     K_num = sp.lambdify([example.q], sp.Matrix(K).xreplace({k: sp.Float(v) for k, v in example.values.items()}),
                         modules="numpy")
@@ -254,21 +272,15 @@ def _compare_motions(study: str, rows: list[dict], runs: dict) -> None:
 def _particle(formulations, simulate, t_end):
     """§3.1: the particle from (2, 2) at rest, m = 1, g = 10; u = ẏ independent as Barhorst (A12 = 1/y²)."""
     from projeq.symbolic.barhorst_examples import barhorst_particle
-    from projeq.symbolic.canonical import lagrangian_canonical, projective_canonical
-    from projeq.symbolic.projection import t
 
     example = barhorst_particle()
     u, K = sp.symbols("u2:3"), sp.Matrix([[1 / example.q[1] ** 2], [1]])  # ẋ = u2/y², ẏ = u2 (70)
     q0, q_dot0, u0 = np.array([2.0, 2.0]), np.zeros(2), np.zeros(1)
     available = [
         _hamilton(example, q0, q_dot0),
-        _kane("kane (projective), u = ẏ", example, u, K, q0, u0, note="eqs. 71–72 = B(10)"),
-        _canonical("barhorst projective canonical, u = ẏ",
-                   lambda: projective_canonical(example.bodies_in(u, K), example.q, u, K, t, example.values),
-                   q0, u0, "eqs. 79–80: ṗ2 = −m g − 2 p2² y³/(m (1 + y⁴)²)"),
-        _canonical("barhorst lagrangian canonical, u = ẏ",
-                   lambda: lagrangian_canonical(example.multiplier_system(), independent=[1]), q0, u0,
-                   "eqs. 86–87 (the same equations as eqs. 79–80)"),
+        *_projective_rows(example, "u = ẏ", u, K, q0, u0, [1],
+                          ("eqs. 71–72 = B(10)", "eqs. 79–80: ṗ2 = −m g − 2 p2² y³/(m (1 + y⁴)²)",
+                           "eqs. 86–87 (the same equations as eqs. 79–80)")),
     ]
     return study_rows("barhorst_particle", available, example, formulations, simulate, t_end)
 
@@ -319,8 +331,7 @@ def _rolling_disk(formulations, simulate, t_end):
 def _quick_return(formulations, simulate, t_end):
     """§3.3: undriven quick return from his configuration at rest (T_m = T_d = 0)."""
     from projeq.symbolic.barhorst_examples import quick_return, quick_return_start
-    from projeq.symbolic.canonical import lagrangian_canonical, projective_canonical
-    from projeq.symbolic.projection import t
+    from projeq.symbolic.canonical import lagrangian_canonical
 
     example = quick_return()
     q0, u0 = quick_return_start(example.values), np.zeros(1)
@@ -331,13 +342,8 @@ def _quick_return(formulations, simulate, t_end):
         "not available: the massless slider leaves ∂²L/∂q̇² singular, so p = ∂L/∂q̇ has no inverse (no H)")
     available = [
         unavailable,
-        _kane("kane (projective), u = q̇1", example, u, K, q0, u0, note="B(10) with q̇ = K̄ q̇1 (109)"),
-        _canonical("barhorst projective canonical, u = q̇1",
-                   lambda: projective_canonical(example.bodies_in(u, K), example.q, u, K, t, example.values),
-                   q0, u0, "eqs. 36–37"),
-        _canonical("barhorst lagrangian canonical, u = q̇1",
-                   lambda: lagrangian_canonical(example.multiplier_system(), independent=[0]), q0, u0,
-                   "eqs. 112–116"),
+        *_projective_rows(example, "u = q̇1", u, K, q0, u0, [0],
+                          ("B(10) with q̇ = K̄ q̇1 (109)", "eqs. 36–37", "eqs. 112–116")),
     ]
     wanted = [f.name for f in available] if formulations is None else formulations
     rows = study_rows("quick_return", available[1:], example, [w for w in wanted if w != unavailable.name],
