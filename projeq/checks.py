@@ -18,6 +18,11 @@ def closest(name: str, known) -> str:
     return f" (did you mean {match[0]!r}?)" if match else ""
 
 
+def callable_name(function) -> str:
+    """How a user's function is named in messages: its qualified name (or its type's)."""
+    return getattr(function, "__qualname__", type(function).__name__)
+
+
 def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
     """``value`` as a float array of the given shape with finite entries."""
     try:

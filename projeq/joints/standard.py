@@ -13,6 +13,7 @@ from typing import Callable
 
 import numpy as np
 
+from projeq.checks import callable_name
 from projeq.joints.base import Joint, Relative, SymbolicRelative
 from projeq.spatial import axis_spin, quaternion_matrix, norm, quaternion_rate_matrix, rodrigues, unit_axis
 from projeq.symbolic import lazy_import
@@ -253,7 +254,7 @@ class Prescribed(Joint):
 
 
 def _label(motion) -> str:
-    return f"the prescribed motion {getattr(motion, '__qualname__', type(motion).__name__)}"
+    return f"the prescribed motion {callable_name(motion)}"
 
 
 def _time_function(expr) -> Callable:

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
 
-from projeq.checks import finite_array
+from projeq.checks import callable_name, finite_array
 from projeq.joints.base import Joint, SymbolicRelative
 
 if TYPE_CHECKING:
@@ -80,9 +80,9 @@ class UserJoint(Joint):
         try:
             residual = self._constraints(q_n, q_dot_n, t)
         except Exception as exc:  # noqa: BLE001 - the user's callable, reported by name
-            raise ValueError(f"constraints: {_qualname(self._constraints)} raised {type(exc).__name__}: {exc} "
+            raise ValueError(f"constraints: {callable_name(self._constraints)} raised {type(exc).__name__}: {exc} "
                              f"at t = {t:.6g}, q = {np.round(q_n, 6).tolist()}") from exc
-        return finite_array(f"constraints ({_qualname(self._constraints)}) at t = {t:.6g}",
+        return finite_array(f"constraints ({callable_name(self._constraints)}) at t = {t:.6g}",
                             np.ravel(residual), (self.n_c,))
 
     @classmethod
@@ -155,7 +155,3 @@ class UserJoint(Joint):
             cls, n_q, n_s, pose, F, K, f=f, k=k, parent=parent, q0=q0, r_pn=r_pn,
             orientation=orientation, constraints=constraints, n_c=n_c,
         )
-
-
-def _qualname(function) -> str:
-    return getattr(function, "__qualname__", type(function).__name__)

@@ -32,7 +32,7 @@ from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
 from projeq.analysis.jacobians import differentiate, state_derivative
 from projeq.assembly import EVALUATORS
-from projeq.checks import closest, count, finite_array, positive, state_vector
+from projeq.checks import callable_name, closest, count, finite_array, positive, state_vector
 from projeq.simulation.integrators import EXPLICIT, PROJECTED, projected_solver, warn_if_stiff
 from projeq.simulation.result import Result, SimulationError
 from projeq.constraints.nonholonomic import near_singularity
@@ -281,8 +281,8 @@ class _Run:
         inside = t_eval[(t_eval > a) & (t_eval <= b)] if self.pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
         n_q = self.model.n_q
         jac = {"jac": self.jacobian if self.jac == "exact" else self.jac} if self.method in IMPLICIT else {}
-        labels = [f"events[{i}] ({_name(e)})" for i, e in enumerate(self.events)]
-        labels += [f"the model's event {_name(e)}" for e in self.model.events()]
+        labels = [f"events[{i}] ({callable_name(e)})" for i, e in enumerate(self.events)]
+        labels += [f"the model's event {callable_name(e)}" for e in self.model.events()]
         events = [_event_wrapper(e, n_q, label) for e, label in zip(self.events + list(self.model.events()), labels)]
         segment = solve_ivp(self.rhs, (a, b), self.x, method=self.solver, t_eval=inside, rtol=self.rtol,
                             atol=self.atol, events=events or None, dense_output=True, **jac, **self.options)
@@ -382,10 +382,6 @@ def _raised_in(exc: BaseException) -> str:
 _LIBRARIES = (f"{os.sep}projeq{os.sep}", f"{os.sep}numpy{os.sep}", f"{os.sep}scipy{os.sep}", f"{os.sep}sympy{os.sep}")
 
 
-def _name(function) -> str:
-    return getattr(function, "__qualname__", type(function).__name__)
-
-
 def _checked_events(events, t, q, s_dot) -> list:
     """The user's events, each called once at the initial state: a callable event(t, q, s_dot)
     returning one finite number."""
@@ -396,11 +392,11 @@ def _checked_events(events, t, q, s_dot) -> list:
         try:
             value = e(t, q.copy(), s_dot.copy())
         except TypeError as exc:
-            raise ValueError(f"events[{i}] ({_name(e)}): calling it as event(t, q, s_dot) at t = {t} failed: {exc}") from exc
+            raise ValueError(f"events[{i}] ({callable_name(e)}): calling it as event(t, q, s_dot) at t = {t} failed: {exc}") from exc
         if np.ndim(value) != 0 or not np.isrealobj(value):
-            raise ValueError(f"events[{i}] ({_name(e)}): must return one real number, returned {value!r}")
+            raise ValueError(f"events[{i}] ({callable_name(e)}): must return one real number, returned {value!r}")
         if not np.isfinite(value):
-            raise ValueError(f"events[{i}] ({_name(e)}): returned {value} at the initial state t = {t}; "
+            raise ValueError(f"events[{i}] ({callable_name(e)}): returned {value} at the initial state t = {t}; "
                              "an event function must be finite")
     return events
 
