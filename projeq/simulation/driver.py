@@ -362,8 +362,7 @@ def warn_out_of_range(tree, q_rows: NDArray, t: float) -> bool:
     coordinates in the rows ``q_rows`` (up to time t) leave its model's range; True if one did."""
     warned = False
     for n, sub in enumerate(tree.subsystems):
-        check = getattr(sub, "out_of_range", None)  # a duck-typed user subsystem may have none
-        problem = check(q_rows[:, tree.e_q_slice[n]]) if sub.n_e and check else None
+        problem = sub.out_of_range(q_rows[:, tree.e_q_slice[n]]) if sub.n_e else None
         if problem:
             warnings.warn(f"{tree.names[n]!r} by t = {t:.6g} s: {problem}", ValidityWarning, stacklevel=3)
             warned = True

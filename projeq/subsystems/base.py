@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from projeq.checks import drop_inherited_twins
 
 REQUIRED = ("n_y", "gauss_terms", "kinetic_energy", "potential_energy")  # no default
-DEFAULTS = ("S", "n_e", "rigid_inertia", "elastic_terms", "port_at", "coordinates")  # optional members with a default
+DEFAULTS = ("S", "n_e", "rigid_inertia", "elastic_terms", "port_at", "coordinates", "out_of_range")  # optional members with a default
 _ABSENT = object()
 DERIVED = ("rigid_inertia", "elastic_terms")  # derived from gauss_terms: reset where it is restated
 CAPABILITIES = {"has_ports": ("port",), "deforms": ("centre_line", "deflection")}  # flag: its methods
