@@ -134,6 +134,8 @@ class ConstrainedSystem(Model):
     True
     """
 
+    limit = REPIVOT_CONDITION  # κ of the partition that triggers re-pivoting; per partition once chosen
+
     def __init__(self, system, phi=None, A=None, b=None, independent=None, q0=None, s_dot0=None,
                  project_q0: bool = False, correction: str = "projection", beta: float = 10.0,
                  repivot: bool | None = None):
@@ -362,7 +364,7 @@ class ConstrainedSystem(Model):
         """Whether the constraint rows themselves are nearly dependent at (q, t): every partition's
         κ ≥ cond(A_s), so none can be 10 times below the limit."""
         sigma = np.linalg.svd(self.constraint_matrix(q, t)[0], compute_uv=False)
-        return not sigma[-1] * getattr(self, "limit", REPIVOT_CONDITION) > 10 * sigma[0]
+        return not sigma[-1] * self.limit > 10 * sigma[0]
 
     def _singular_position(self, q, t) -> ValueError:
         return ValueError(

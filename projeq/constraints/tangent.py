@@ -79,6 +79,8 @@ class TangentSystem(ConstrainedSystem):
     True
     """
 
+    _latest = (None, None)  # (key of (q, t), (C, c)) of the latest velocity_constraints call
+
     def _choose_velocities(self, q0, independent, repivot) -> None:
         A_s = self.constraint_matrix(q0)[0]
         self.n_s = self.tree.n_s - numerical_rank(A_s)
@@ -95,7 +97,7 @@ class TangentSystem(ConstrainedSystem):
         """(C, c) of ConstrainedSystem, kept for the latest (q, t): the integrator asks for q̇ and
         s̈ at the same state, and both need them."""
         key = (np.asarray(q, dtype=float).tobytes(), float(t))
-        if getattr(self, "_latest", (None,))[0] != key:
+        if self._latest[0] != key:
             self._latest = (key, super().velocity_constraints(q, t))
         return self._latest[1]
 
