@@ -582,9 +582,9 @@ class System(Model):
         :mod:`projeq.simulation.integrators`)."""
         from projeq.assembly.kinematics import poses
 
-        complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot)
+        complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot) or np.iscomplexobj(t)
         q, s_dot = (np.asarray(q), np.asarray(s_dot)) if complex_step else self.check_state(q, s_dot, t)
-        kin = poses(self, q, s_dot, float(t))
+        kin = poses(self, q, s_dot, t if complex_step else float(t))
         q_e = [q[sl] for sl in self.e_q_slice]
         kinetic = sum(sub.kinetic_energy(kin.y_dot[n], q_e[n]) for n, sub in enumerate(self.subsystems))
         potential = sum(

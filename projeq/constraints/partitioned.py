@@ -435,13 +435,21 @@ class ConstrainedSystem(Model):
 
     def project(self, q: NDArray, t: float = 0.0, max_iter: int = 20) -> NDArray:
         """q moved onto Φ(q, t) = 0 by minimum-norm Gauss–Newton steps (redundant rows: singular
-        values of ∂Φ/∂q below RANK_TOLERANCE σ_max dropped); ValueError if it fails."""
-        q = numeric(np.array(q))  # complex under a complex step: the steps are analytic
+        values of ∂Φ/∂q below RANK_TOLERANCE σ_max dropped); ValueError if it fails.
+
+        Complex-safe (the steps are analytic): for q carrying a complex step, one step more
+        than its real part needs, from the converged point, where the step's Jacobian is the
+        projector E − Φ_q⁺Φ_q onto the tangent of Φ = 0, so that the complex step gives the
+        derivative of the projection (the energy projection's gradient)."""
+        q = numeric(np.array(q))
         tol = POSITION_TOLERANCE * max(1.0, np.abs(q).max())
+        settled = not np.iscomplexobj(q)  # a real q is done where Φ is within tol
         for _ in range(max_iter):
             residual = self.phi(q, t)
-            if not residual.size or np.abs(residual).max() <= tol:
+            converged = not residual.size or np.abs(np.real(residual)).max() <= tol
+            if converged and settled:
                 return q
+            settled = converged
             q = self.tree.normalized(q - minimum_norm_solution(self.phi_q(q, t), residual))
         raise ValueError(
             f"q: cannot be projected onto the constraints Φ(q, t) = 0 (residual "
