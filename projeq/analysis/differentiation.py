@@ -195,7 +195,7 @@ def exact_jacobian(f, z0: NDArray) -> NDArray:
     with warnings.catch_warnings():  # a cast that drops the imaginary part must not pass silently
         warnings.simplefilter("error", np.exceptions.ComplexWarning)
         columns = [complex_step(lambda s, e=e: f(z0 + s * e)) for e in unit]
-    n_f = len(np.atleast_1d(np.real(f(z0))))
+    n_f = np.size(columns[0]) if columns else len(np.atleast_1d(np.real(f(z0))))  # f(z0) only for its size
     return np.array(columns).T.reshape(n_f, len(z0))
 
 
