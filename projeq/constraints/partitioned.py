@@ -606,8 +606,7 @@ def minimum_norm_solution(A: NDArray, c: NDArray, rcond: float = RANK_TOLERANCE,
     if not A0.size:
         return np.zeros(A0.shape[1:] + np.shape(c)[1:], dtype=np.result_type(A, c))
     U, sigma, Vt = np.linalg.svd(A0, full_matrices=False)
-    k = int(np.count_nonzero(sigma > rcond * sigma[0])) if rank is None else min(rank, int(np.count_nonzero(
-        sigma > rcond * sigma[0])))
+    k = min(int(np.count_nonzero(sigma > rcond * sigma[0])), len(sigma) if rank is None else rank)
     P = Vt[:k].T @ (U[:, :k].T / sigma[:k, None])  # A₀⁺
     if not (np.iscomplexobj(A) or np.iscomplexobj(c)):
         return P @ c
