@@ -109,7 +109,7 @@ def test_a_user_scene_from_a_file(tmp_path, capsys):
     spec = util.spec_from_file_location("check_model", model)
     module = util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    direct = pq.simulate(module.build(length=2.0), 0.3, method="DOP853", rtol=1e-9, atol=1e-11, n_points=201)
+    direct = pq.simulate(module.build(length=2.0), 0.3, n_points=201)  # projeq run: simulate's defaults
     assert result.t[-1] == 0.3 and np.allclose(result.q, direct.q, rtol=0, atol=1e-9)
     assert main(["run", f"{model}:missing", "--out", str(tmp_path)]) == 2
     assert "has no function 'missing'" in capsys.readouterr().err
