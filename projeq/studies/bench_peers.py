@@ -21,9 +21,9 @@
   angular velocity, Barhorst (2004) eqs. 92–93) and follows from sympy's u̇ and the
   kinematics. projeq's s̈ also carries the two contact coordinates q4, q5 that sympy's
   model leaves out.
-- **spin-up**: ``simulate(scenes.spin_up_beam(omega_s=4), 20.0)`` with no knobs against Exudyn's
-  nonlinear ANCF cable (:func:`exudyn_tip_deflection`): CPU time and the in-plane tip
-  deflection at 7, 10 and 20 s.
+- **spin-up**: ``simulate(scenes.spin_up_beam(omega_s=4), 20.0)`` with no knobs, and with the
+  scene's settings for ``projeq run``, against Exudyn's nonlinear ANCF cable
+  (:func:`exudyn_tip_deflection`): CPU time and the in-plane tip deflection at 7, 10 and 20 s.
 
 Every timed pair is timed alternately in one run (:func:`projeq.studies.timing.time_per_call`),
 so the ratios hold on a loaded machine; absolute times are this machine's only.
@@ -234,12 +234,15 @@ def projeq_tip_deflection(omega_s: float = 4.0, times=SPIN_UP_TIMES, **options) 
 
 
 def spin_up_row(omega_s: float = 4.0, times=SPIN_UP_TIMES) -> dict:
-    """Tip deflections and CPU times of projeq's defaults and of Exudyn (module docstring)."""
+    """Tip deflections and CPU times of Exudyn and of projeq, by ``simulate``'s defaults and by
+    the scene's settings for ``projeq run`` (:data:`projeq.scenes.SPIN_UP_SETTINGS`)."""
     exudyn_tip, exudyn_cpu = exudyn_tip_deflection(omega_s, times)
-    tip, cpu, run = projeq_tip_deflection(omega_s, times)
-    return {"omega_s": omega_s, "times_s": list(times), "projeq_tip_m": tip.tolist(), "exudyn_tip_m": exudyn_tip.tolist(),
-            "max_difference_m": float(np.abs(tip - exudyn_tip).max()), "projeq_cpu_s": cpu, "exudyn_cpu_s": exudyn_cpu,
-            "cpu_ratio": cpu / exudyn_cpu, **run}
+    row = {"omega_s": omega_s, "times_s": list(times), "exudyn_tip_m": exudyn_tip.tolist(), "exudyn_cpu_s": exudyn_cpu}
+    for name, options in (("defaults", {}), ("scene_settings", scenes.SPIN_UP_SETTINGS)):
+        tip, cpu, run = projeq_tip_deflection(omega_s, times, **options)
+        row[name] = {"options": options, "tip_m": tip.tolist(), "max_difference_m": float(np.abs(tip - exudyn_tip).max()),
+                     "cpu_s": cpu, "cpu_ratio": cpu / exudyn_cpu, **run}
+    return row
 
 
 def peers_report(sizes=CHAIN_SIZES, budget: float = 1.0, spin_up: bool = True, latency: bool = True, show=None) -> dict:
@@ -264,10 +267,13 @@ def peers_report(sizes=CHAIN_SIZES, budget: float = 1.0, spin_up: bool = True, l
          f"angular accelerations differ by {disk['deviation']['sympy']:.1e}")
     if spin_up and "exudyn" not in missing:
         row = report["spin_up"] = spin_up_row()
-        show(f"spin-up Ωs = {row['omega_s']:g} rad/s, simulate(system, {row['times_s'][-1]:g}) defaults: CPU "
-             f"{row['projeq_cpu_s']:.2f} s vs Exudyn {row['exudyn_cpu_s']:.2f} s (ratio {row['cpu_ratio']:.2f}); tip at "
-             f"{row['times_s']} s: {np.round(row['projeq_tip_m'], 6).tolist()} vs {np.round(row['exudyn_tip_m'], 6).tolist()} m, "
-             f"max difference {row['max_difference_m']:.1e} m; {row['nfev']} evaluations; warnings: {row['warnings'] or 'none'}")
+        show(f"spin-up Ωs = {row['omega_s']:g} rad/s to {row['times_s'][-1]:g} s: Exudyn CPU {row['exudyn_cpu_s']:.2f} s, "
+             f"in-plane tip at {row['times_s']} s: {np.round(row['exudyn_tip_m'], 6).tolist()} m")
+        for name in ("defaults", "scene_settings"):
+            run = row[name]
+            show(f"  projeq simulate({run['options'] or 'no options'}): CPU {run['cpu_s']:.2f} s = {run['cpu_ratio']:.2f} "
+                 f"of Exudyn's, tip {np.round(run['tip_m'], 6).tolist()} m, max difference {run['max_difference_m']:.1e} m, "
+                 f"{run['nfev']} evaluations; warnings: {run['warnings'] or 'none'}")
     if missing:
         show(f"not installed (pip install 'projeq[bench]'): {', '.join(missing)}")
     return report
