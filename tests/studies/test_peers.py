@@ -57,3 +57,10 @@ def test_spin_up_tip_equals_exudyns_ancf_cable():
     tip, _, _ = bench_peers.projeq_tip_deflection(4.0, times, method="Radau", rtol=1e-7, atol=1e-9)
     assert np.abs(tip).max() > 0.05  # the beam has deflected
     assert np.abs(tip - exudyn_tip).max() < 1e-5
+
+
+def test_bench_offers_the_peer_comparison(capsys):
+    from projeq.cli.commands import main
+
+    assert main(["bench", "--help"]) == 0
+    assert "--peers" in capsys.readouterr().out
