@@ -116,8 +116,8 @@ class Scene(NamedTuple):
 
 
 #: the spin-up beam's integrator for ``projeq run``: its elastic modes are stiff (an explicit
-#: method crawls at its stability limit: RK45 at simulate's rtol 1e-8 needs 45,700 evaluations
-#: over the 20 s, Radau at rtol 1e-4 3,700), and at rtol 1e-4 the tip deflection at 5, 10, 15,
+#: method crawls at its stability limit: RK45 at simulate's rtol 1e-8 needs about 45,000 evaluations
+#: over the 20 s, Radau at rtol 1e-4 2,500), and at rtol 1e-4 the tip deflection at 5, 10, 15,
 #: 20 s is within 4.2e-5 m of the converged reference of benchmarks/beam_convergence.py (8
 #: clamped–free functions per plane, DOP853 at rtol 1e-10), the same as RK45 at 1e-8 or DOP853
 #: at 1e-9 (all 4.2e-5 m: the error of the scene's 4 polynomial functions, not the integrator's)
