@@ -9,21 +9,31 @@ disk); ``method="fast"`` is this kernel or a ValueError saying why not (numba mi
 a piece of the system the kernel does not know). ``compiled=False`` runs the same kernel
 source interpreted (for testing: correct, but slower than the recursive evaluator).
 ``method="auto"`` (:mod:`projeq.assembly.auto`) picks this evaluator where it can, and
-another one where it cannot.
+another one where it cannot. :meth:`FastEvaluator.gauss_form` gives M(q) and b of the
+Gauss form from the same terms (:func:`projeq.assembly.kernels.gauss_form`, composite
+bodies and Newton–Euler, compiled), for coupled joints and for the constrained models of
+:mod:`projeq.constraints`, which project it.
 
-Supported: trees of subsystems with rigid-body terms and no selection (``rigid_inertia``
-and ``S = None``: :class:`~projeq.RigidBody`, :class:`~projeq.PointMass`, :class:`~projeq.Frame`)
-on any uncoupled joint: the kernel computes the relative motion of the joints whose
-``compiled_kind`` it has (:class:`~projeq.Revolute`, :class:`~projeq.Prismatic`,
-:class:`~projeq.Fixed`); every other joint (Planar, Free, Spherical, Screw, Prescribed,
-UserJoint — non-holonomic ones too) states it by its own ``relative`` before each call, which
-the kernel reads (kind ``GIVEN``, 0–6 minimal velocities). Under gravity and any force laws:
-between the compiled kinematics and the compiled passes each law adds its loads by its own
-``add_to`` (the one statement the reference evaluators call) to the kernel's h_n, reading
-poses, twists, F_n and T̃_np from the kernel's workspace. One :class:`~projeq.RitzBeam` on a
-prescribed or fixed hub has its own fast evaluator, ``method="hub_beam"``
-(:mod:`projeq.assembly.beam_fast`); any other system (beams in chains, planar bodies,
-coupled joints) is refused with the piece named: it is evaluated by the reference ones
+Supported: trees of subsystems with rigid-body terms (``rigid_inertia``: :class:`~projeq.RigidBody`,
+:class:`~projeq.PointMass`, :class:`~projeq.Frame`, and :class:`~projeq.PlanarBody`, whose
+selection S the kernel does not apply: the spatial terms of the same body, projected on
+joint velocities that keep it in its plane — which the System checks when it is built —
+give the same equations as the selected ones, docs/theory.md §3) on any joint: the kernel
+computes the relative motion of the joints whose ``compiled_kind`` it has
+(:class:`~projeq.Revolute`, :class:`~projeq.Prismatic`, :class:`~projeq.Fixed`); every
+other joint (Planar, Free, Spherical, Screw, Prescribed, UserJoint — non-holonomic ones
+too) states it by its own ``relative`` before each call, which the kernel reads (kind
+``GIVEN``, 0–6 minimal velocities). Coupled joints (gears, ropes: shared minimal
+velocities) are evaluated in every joint's own velocities ṡ_all = P ṡ and projected,
+M = Pᵀ M_all P, b = Pᵀ b_all (B(14) with ∂ṡ_all/∂ṡ = P), by the compiled Gauss form.
+Under gravity and any force laws: between the compiled kinematics and the compiled passes
+each law adds its loads by its own ``add_to`` (the one statement the reference evaluators
+call) to the kernel's h_n, reading poses, twists, F_n and T̃_np from the kernel's
+workspace (in the selected coordinates of the bodies that have a selection S, whose loads
+are then carried back by Sᵀ). One :class:`~projeq.RitzBeam` on a prescribed or fixed hub
+has its own fast evaluator, ``method="hub_beam"`` (:mod:`projeq.assembly.beam_fast`);
+any other subsystem without rigid-body terms (beams in chains, a subsystem that overrides
+``gauss_terms``) is refused with the piece named: it is evaluated by the reference ones
 (recursive, or dense for coupled joints).
 
 >>> import numpy as np, projeq as pq
@@ -43,13 +53,14 @@ from numpy.typing import NDArray
 
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import hub_beam_unsupported
-from projeq.assembly.kinematics import Kinematics
-from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
+from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
+from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale, solve_spd
 from projeq.subsystems.rigid import rigid_mass_matrix
 
 
 class FastEvaluator:
-    """s̈ of one System by the order-n kernel.
+    """s̈ of one System by the order-n kernel, and its Gauss form by the compiled
+    composite-body kernel.
 
     Parameters
     ----------
@@ -78,6 +89,7 @@ class FastEvaluator:
         self.n_calls = 0
         self.compiled = bool(compiled)
         self._chain_terms, self._passes = kernels.kernel(self.compiled)
+        self._gauss_form = kernels.gauss_form_kernel(self.compiled)
         self._pack(system)
 
     def _pack(self, system) -> None:
@@ -92,18 +104,23 @@ class FastEvaluator:
                                for k, j in zip(self._kind, joints)])
         self._orientation = np.array([j.orientation for j in joints])
         self._offset = np.array([j.r_pn for j in joints])
-        self._q_index = np.array([system.q_slice[n].start for n in range(N)], dtype=np.int64)
-        self._s_index = np.array([system.s_slice[n].start for n in range(N)], dtype=np.int64)
+        # every joint's own coordinates and velocities, in the order of the joints (q and ṡ
+        # themselves unless joints are coupled: then q_all = P_q q, ṡ_all = P ṡ)
+        self._q_index = np.cumsum([0] + [j.n_q for j in joints[:-1]], dtype=np.int64)
+        self._s_index = np.cumsum([0] + [j.n_s for j in joints[:-1]], dtype=np.int64)
+        self._expansion = _expansion(system) if system.coupled else None
         self._m, self._r_c, self._I_c = (np.array(part) for part in zip(*(b.rigid_inertia for b in bodies)))
         self._M6 = np.array([rigid_mass_matrix(*b.rigid_inertia) for b in bodies])
         self._gravity = np.asarray(system.gravity, dtype=float)
-        self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
+        self._scale = mass_scale(system)
+        self._pivot_min = SINGULAR_PIVOT * self._scale
         self._given_A, self._given_r = np.zeros((N, 3, 3)), np.zeros((N, 3))
         self._given_w, self._given_zeta = np.zeros((N, 6)), np.zeros((N, 6))
         self._T, self._zeta = np.zeros((N, 6, 6)), np.zeros((N, 6))
         self._F, self._M_hat, self._h_hat = np.zeros((N, 6, 6)), np.zeros((N, 6, 6)), np.zeros((N + 1, 6))
         self._R, self._r, self._twist = np.zeros((N + 1, 3, 3)), np.zeros((N + 1, 3)), np.zeros((N + 1, 6))
         self._kin = _kinematics(self._n_cols, self._R, self._r, self._twist, self._F) if system.forces else None
+        self._selected = [n for n in range(N) if system.S[n] is not None]
 
     def _relative_motions(self, q: NDArray, s_dot: NDArray, t: float) -> None:
         """A, r, F⁶, w and ζ of the joints of kind GIVEN, by their own ``relative`` (the
@@ -116,28 +133,70 @@ class FastEvaluator:
 
     def _add_forces(self, q: NDArray, s_dot: NDArray, t: float) -> None:
         """The force laws' own ``add_to`` (the statement the reference evaluators call) on the
-        kernel's kinematics: T̃_np = [[T_np, ζ_n], [0, 1]] is filled from the workspace."""
-        kin = self._kin
+        kernel's kinematics: T̃_np = [[T_np, ζ_n], [0, 1]] is filled from the workspace; bodies
+        with a selection S take their loads in their own coordinates (h_n += Sᵀ h_S)."""
+        kin, h = self._kin, self._h_hat
         kin.T_aug[:-1, :6, :6] = self._T
         kin.T_aug[:-1, :6, 6] = self._zeta
-        self._h_hat[-1] = 0.0  # the ground's row: reactions land there, nothing reads them
+        h[-1] = 0.0  # the ground's row: reactions land there, nothing reads them
+        if self._selected:
+            kin, h = self._selected_kinematics(kin, s_dot)
         for force in self.system.forces:
-            force.add_to(self._h_hat, kin, t, q, s_dot)
+            force.add_to(h, kin, t, q, s_dot)
+        for n in self._selected:
+            self._h_hat[n] += self.system.S[n].T @ h[n]
 
-    def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """s̈ at (q, ṡ, t) (docs/theory.md §6); raises SingularMassError for a zero pivot of D_n."""
-        self.n_calls += 1
-        q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
+    def _selected_kinematics(self, kin: Kinematics, s_dot: NDArray) -> tuple[Kinematics, list]:
+        """The kinematics of the reference evaluators (ẏ_n = S_n twist, F_n = S_n F⁶,
+        T̃_np = S̃_n T̃⁶ S̃_pᵀ, :func:`projeq.assembly.kinematics.selected_chain_terms`) and the h_n
+        they load: zeros for selected bodies, the workspace's rows for the others."""
+        system = self.system
+        T_aug, F = selected_chain_terms(system, system.plan, kin.F, kin.T_aug, [None] * len(kin.F))
+        y_dot = describing_velocities(system, system.plan, kin.twist, s_dot)
+        h = [np.zeros(len(y)) if S is not None else self._h_hat[n] for n, (y, S) in enumerate(zip(y_dot, system.S))]
+        return Kinematics(kin.R, kin.r, kin.twist, y_dot, T_aug, F), h[:-1] + [np.zeros(0)]
+
+    def _terms(self, q: NDArray, s_dot: NDArray, t: float) -> None:
+        """T_np, ζ_n, F_n, h_n (forces included) of every body into the workspace."""
+        q_all, s_all = (q, s_dot) if self._expansion is None else (self._expansion[0] @ q, self._expansion[1] @ s_dot)
         if self._given:
             self._relative_motions(q, s_dot, t)
         self._chain_terms(
             self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index, self._s_index,
-            self._m, self._r_c, self._I_c, self._gravity, q, s_dot,
+            self._m, self._r_c, self._I_c, self._gravity, q_all, s_all,
             self._given_A, self._given_r, self._given_w, self._given_zeta,
             self._T, self._zeta, self._F, self._h_hat[:-1], self._R, self._r, self._twist,
         )
         if self._kin is not None:
             self._add_forces(q, s_dot, t)
+
+    def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
+        """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels."""
+        self.n_calls += 1
+        self._terms(np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), t)
+        return self._assembled()
+
+    def _assembled(self) -> tuple[NDArray, NDArray]:
+        """M and b of the terms in the workspace: :func:`projeq.assembly.kernels.gauss_form` in
+        every joint's own velocities, projected with P for coupled joints."""
+        n = int(self._n_cols.sum())
+        M, b = np.empty((n, n)), np.empty(n)
+        self._gauss_form(self._n_cols, self._parent, self._s_index, self._T, self._zeta, self._F,
+                         self._M6, self._h_hat, M, b)
+        if self._expansion is None:
+            return M, b
+        P = self._expansion[1]
+        return P.T @ M @ P, P.T @ b
+
+    def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
+        """s̈ at (q, ṡ, t) (docs/theory.md §6; −M⁻¹ b for coupled joints); raises
+        SingularMassError for a zero pivot of D_n (of M)."""
+        self.n_calls += 1
+        q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
+        self._terms(q, s_dot, t)
+        if self._expansion is not None:
+            M, b = self._assembled()
+            return -solve_spd(M, b[:, None], "system mass matrix M(q)", self._scale)[:, 0]
         self._M_hat[:] = self._M6
         s_ddot = np.empty(self.system.n_s)
         failed = self._passes(
@@ -157,13 +216,23 @@ class FastEvaluator:
 
 def unsupported(system) -> str | None:
     """Why the fast kernel cannot evaluate ``system`` (None if it can)."""
-    for name, joint, body in zip(system.names, system.joints, system.subsystems):
-        if joint.coupling:
-            return f"joint {name!r} is coupled (shared minimal velocities)"
-        if body.rigid_inertia is None or body.S is not None:
-            return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of spatial "
-                    "rigid bodies, rigid_inertia with S = None)")
+    for name, body in zip(system.names, system.subsystems):
+        if body.rigid_inertia is None:
+            return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of rigid bodies, "
+                    "rigid_inertia, spatial or selected by S)")
     return None
+
+
+def _expansion(system) -> tuple[NDArray, NDArray]:
+    """(P_q, P): q_all = P_q q and ṡ_all = P ṡ, every joint's own coordinates and velocities
+    (a coupled joint's computed from those it follows), read off the System's joint getters
+    (linear maps) at the unit vectors."""
+    def matrix(getters, n):
+        return np.column_stack([np.concatenate([get(e) for get in getters]) for e in np.eye(n)])
+
+    N = len(system.joints)
+    return (matrix([system.joint_q_getter(n) for n in range(N)], system.n_q),
+            matrix([system.joint_s_dot_getter(n) for n in range(N)], system.n_s))
 
 
 def _kinematics(n_cols, R, r, twist, F) -> Kinematics:
