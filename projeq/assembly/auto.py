@@ -12,13 +12,13 @@ says what it chose (``name``, ``reason``). The compiled kernel is compiled on it
 use and cached on disk (numba's ``cache=True``): a fresh environment pays the compilation
 once (``projeq bench`` reports the first-call latency), later processes load it.
 
->>> import warnings, projeq as pq
+>>> import warnings, numpy as np, projeq as pq
 >>> AutoEvaluator(pq.scenes.atwood()).name  # coupled joints: compiled
 'fast'
 >>> class Own(pq.RigidBody):  # its own gauss_terms: the kernel cannot know what they compute
 ...     def gauss_terms(self, y_dot, R, gravity, q_e=None):
 ...         return super().gauss_terms(y_dot, R, gravity, q_e)
->>> system = pq.System({"rod": Own(1.0, (0, 0, -0.5))}, {"rod": pq.Revolute(axis="y")}, gravity=(0, 0, -9.81))
+>>> system = pq.System({"rod": Own(1.0, (0, 0, -0.5), np.eye(3) / 12)}, {"rod": pq.Revolute(axis="y")}, gravity=(0, 0, -9.81))
 >>> with warnings.catch_warnings(record=True) as said:
 ...     warnings.simplefilter("always")
 ...     ev = AutoEvaluator(system)
