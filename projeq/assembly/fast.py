@@ -114,22 +114,29 @@ class FastEvaluator:
         self._gravity = np.asarray(system.gravity, dtype=float)
         self._scale = mass_scale(system)
         self._pivot_min = SINGULAR_PIVOT * self._scale
-        self._given_A, self._given_r = np.zeros((N, 3, 3)), np.zeros((N, 3))
-        self._given_w, self._given_zeta = np.zeros((N, 6)), np.zeros((N, 6))
+        # one row per joint for its relative_values (A, r, w, ζ, F⁶ by columns), read by the kernel
+        # through views: given_A, given_r, given_w, given_zeta and F (F[n, :, j] = column j)
+        values = self._given_values = np.zeros((N, 60))
+        self._given_A, self._given_r = values[:, :9].reshape(N, 3, 3), values[:, 9:12]
+        self._given_w, self._given_zeta = values[:, 12:18], values[:, 18:24]
+        self._F = values[:, 24:].reshape(N, 6, 6).transpose(0, 2, 1)
+        self._given_plan = [
+            (n, joints[n], slice(self._q_index[n], self._q_index[n] + joints[n].n_q),
+             slice(self._s_index[n], self._s_index[n] + joints[n].n_s), 24 + 6 * joints[n].n_s)
+            for n in self._given
+        ]
         self._T, self._zeta = np.zeros((N, 6, 6)), np.zeros((N, 6))
-        self._F, self._M_hat, self._h_hat = np.zeros((N, 6, 6)), np.zeros((N, 6, 6)), np.zeros((N + 1, 6))
+        self._M_hat, self._h_hat = np.zeros((N, 6, 6)), np.zeros((N + 1, 6))
         self._R, self._r, self._twist = np.zeros((N + 1, 3, 3)), np.zeros((N + 1, 3)), np.zeros((N + 1, 6))
         self._kin = _kinematics(self._n_cols, self._R, self._r, self._twist, self._F) if system.forces else None
         self._selected = [n for n in range(N) if system.S[n] is not None]
 
-    def _relative_motions(self, q: NDArray, s_dot: NDArray, t: float) -> None:
-        """A, r, F⁶, w and ζ of the joints of kind GIVEN, by their own ``relative`` (the
-        statement the reference evaluators call)."""
-        system = self.system
-        for n in self._given:
-            rel = system.joints[n].relative(system._q_get[n](q), system._s_get[n](s_dot), t)
-            self._given_A[n], self._given_r[n], self._given_w[n], self._given_zeta[n] = rel.A, rel.r, rel.w, rel.zeta
-            self._F[n, :, : self._n_cols[n]] = rel.F
+    def _relative_motions(self, q_all: NDArray, s_all: NDArray, t: float) -> None:
+        """A, r, w, ζ and F⁶ of the joints of kind GIVEN, by their own ``relative_values`` (the
+        numbers of the ``relative`` the reference evaluators call), one row each."""
+        values = self._given_values
+        for n, joint, q_n, s_n, width in self._given_plan:
+            values[n, :width] = joint.relative_values(q_all[q_n], s_all[s_n], t)
 
     def _add_forces(self, q: NDArray, s_dot: NDArray, t: float) -> None:
         """The force laws' own ``add_to`` (the statement the reference evaluators call) on the
@@ -160,7 +167,7 @@ class FastEvaluator:
         """T_np, ζ_n, F_n, h_n (forces included) of every body into the workspace."""
         q_all, s_all = (q, s_dot) if self._expansion is None else (self._expansion[0] @ q, self._expansion[1] @ s_dot)
         if self._given:
-            self._relative_motions(q, s_dot, t)
+            self._relative_motions(q_all, s_all, t)
         self._chain_terms(
             self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index, self._s_index,
             self._m, self._r_c, self._I_c, self._gravity, q_all, s_all,
