@@ -54,7 +54,7 @@ from numpy.typing import NDArray
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import hub_beam_unsupported
 from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
-from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale, solve_spd
+from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.subsystems.rigid import rigid_mass_matrix
 
 
@@ -89,7 +89,7 @@ class FastEvaluator:
         self.n_calls = 0
         self.compiled = bool(compiled)
         self._chain_terms, self._passes = kernels.kernel(self.compiled)
-        self._gauss_form = kernels.gauss_form_kernel(self.compiled)
+        self._gauss_form, self._projected_accelerations = kernels.gauss_form_kernel(self.compiled)
         self._pack(system)
 
     def _pack(self, system) -> None:
@@ -109,11 +109,12 @@ class FastEvaluator:
         self._q_index = np.cumsum([0] + [j.n_q for j in joints[:-1]], dtype=np.int64)
         self._s_index = np.cumsum([0] + [j.n_s for j in joints[:-1]], dtype=np.int64)
         self._expansion = _expansion(system) if system.coupled else None
+        n_all = int(self._n_cols.sum())
+        self._M_all, self._b_all, self._M = np.zeros((n_all, n_all)), np.zeros(n_all), np.zeros((system.n_s,) * 2)
         self._m, self._r_c, self._I_c = (np.array(part) for part in zip(*(b.rigid_inertia for b in bodies)))
         self._M6 = np.array([rigid_mass_matrix(*b.rigid_inertia) for b in bodies])
         self._gravity = np.asarray(system.gravity, dtype=float)
-        self._scale = mass_scale(system)
-        self._pivot_min = SINGULAR_PIVOT * self._scale
+        self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
         # one row per joint for its relative_values (A, r, w, ζ, F⁶ by columns), read by the kernel
         # through views: given_A, given_r, given_w, given_zeta and F (F[n, :, j] = column j)
         values = self._given_values = np.zeros((N, 60))
@@ -186,12 +187,11 @@ class FastEvaluator:
     def _assembled(self) -> tuple[NDArray, NDArray]:
         """M and b of the terms in the workspace: :func:`projeq.assembly.kernels.gauss_form` in
         every joint's own velocities, projected with P for coupled joints."""
-        n = int(self._n_cols.sum())
-        M, b = np.empty((n, n)), np.empty(n)
+        M, b = self._M_all, self._b_all
         self._gauss_form(self._n_cols, self._parent, self._s_index, self._T, self._zeta, self._F,
                          self._M6, self._h_hat, M, b)
         if self._expansion is None:
-            return M, b
+            return M.copy(), b.copy()
         P = self._expansion[1]
         return P.T @ M @ P, P.T @ b
 
@@ -201,18 +201,23 @@ class FastEvaluator:
         self.n_calls += 1
         q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
         self._terms(q, s_dot, t)
-        if self._expansion is not None:
-            M, b = self._assembled()
-            return -solve_spd(M, b[:, None], "system mass matrix M(q)", self._scale)[:, 0]
-        self._M_hat[:] = self._M6
         s_ddot = np.empty(self.system.n_s)
-        failed = self._passes(
-            self._n_cols, self._parent, self._s_index, self._T, self._zeta, self._F,
-            self._M_hat, self._h_hat, self._pivot_min, s_ddot,
-        )
+        if self._expansion is not None:
+            self._assembled()
+            failed = self._projected_accelerations(self._M_all, self._b_all, self._expansion[1], self._pivot_min,
+                                                   self._M, s_ddot)
+        else:
+            self._M_hat[:] = self._M6
+            failed = self._passes(
+                self._n_cols, self._parent, self._s_index, self._T, self._zeta, self._F,
+                self._M_hat, self._h_hat, self._pivot_min, s_ddot,
+            )
         if failed >= 0 and not (np.all(np.isfinite(q)) and np.all(np.isfinite(s_dot))):
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no pivot D_n "
                                      "can be formed, which no mass matrix explains")
+        if failed >= 0 and self._expansion is not None:
+            raise SingularMassError("system mass matrix M(q) (of the coupled joints' shared velocities) is singular: "
+                                    "a motion along its minimal velocities moves no mass or inertia")
         if failed >= 0:
             raise SingularMassError(
                 f"D_n = F_nᵀ M̂_n F_n of joint {self.system.names[failed]!r} is singular: "

@@ -261,6 +261,33 @@ def gauss_form(n_cols, parent, s_index, T, zeta, F, M_n, h, M, b):
             i = parent[i]
 
 
+def projected_accelerations(M_all, b_all, P, pivot_min, M, s_ddot):
+    """s̈ = −M⁻¹ b with M = Pᵀ M_all P and b = Pᵀ b_all (shared minimal velocities: ṡ_all = P ṡ,
+    B(14) projected once more), M factored by Cholesky in place (``M``: n × n workspace).
+    Returns −1, or 0 when a pivot of M (a squared diagonal entry of its factor) is not above
+    ``pivot_min``."""
+    n_all, n = P.shape
+    PM = np.zeros((n, n_all))
+    for i in range(n):
+        for r in range(n_all):
+            if P[r, i] != 0.0:
+                for c in range(n_all):
+                    PM[i, c] += P[r, i] * M_all[r, c]
+        s_ddot[i] = 0.0
+        for r in range(n_all):
+            s_ddot[i] -= P[r, i] * b_all[r]
+    for i in range(n):
+        for j in range(n):
+            total = 0.0
+            for c in range(n_all):
+                total += PM[i, c] * P[c, j]
+            M[i, j] = total
+    if not _cholesky(M, n, pivot_min):
+        return 0
+    _cholesky_solve(M, n, s_ddot)
+    return -1
+
+
 def _cholesky(D, k, pivot_min):
     """D[:k, :k] = L Lᵀ in place (L in the lower triangle); False if a pivot L_jj² is not
     above ``pivot_min``."""
@@ -339,17 +366,17 @@ def _compiled():
 
 
 def gauss_form_kernel(compiled: bool = True):
-    """:func:`gauss_form`, compiled by numba (as :func:`kernel`; ValueError without it) or
-    with ``compiled=False`` the interpreted function."""
+    """(:func:`gauss_form`, :func:`projected_accelerations`), compiled by numba (as
+    :func:`kernel`; ValueError without it) or with ``compiled=False`` the interpreted functions."""
     if not compiled:
-        return gauss_form
+        return gauss_form, projected_accelerations
     kernel(True)  # the same refusal without numba
     return _compiled_gauss_form()
 
 
 @functools.cache
 def _compiled_gauss_form():
-    return _jit(gauss_form)[0]
+    return _jit(gauss_form, projected_accelerations)
 
 
 def _jit(*kernels):

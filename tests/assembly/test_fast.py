@@ -171,6 +171,30 @@ def test_the_kernel_twins_equal_their_array_forms(seed):
     assert np.abs(h - expected).max() <= TWIN_RTOL * np.abs(expected).max()
 
 
+@pytest.mark.parametrize("name", ["rolling_disk", "knife_edge_disc", "barhorst_particle", "nonholonomic_particle",
+                                  "car"])
+def test_a_sympy_joints_scalar_code_equals_its_relative(name):
+    """A UserJoint from sympy states relative_values (what the kernel reads for a joint of kind
+    GIVEN) as scalar code of the same expressions as its numpy ``relative``: the same numbers
+    to round-off at random states and times; a subclass that restates ``relative`` gets the
+    packed default back (its override is never bypassed)."""
+    joint = pq.scenes.SCENES[name].build().joints[0]
+    rng = np.random.default_rng(8)
+    for _ in range(5):
+        q_n, s_dot_n, t = rng.uniform(-1, 1, joint.n_q), rng.uniform(-2, 2, joint.n_s), rng.uniform(0, 3)
+        rel = joint.relative(q_n, s_dot_n, t)
+        packed = np.concatenate((rel.A.ravel(), rel.r, rel.w, rel.zeta, rel.F.T.ravel()))
+        values = np.asarray(joint.relative_values(q_n, s_dot_n, t), dtype=float)
+        assert values.shape == packed.shape
+        assert np.abs(values - packed).max() <= 1e-14 * max(1.0, np.abs(packed).max())
+
+    class Restated(pq.UserJoint):
+        def relative(self, q_n, s_dot_n, t):
+            return super().relative(q_n, s_dot_n, t)
+
+    assert Restated.relative_values is pq.joints.Joint.relative_values
+
+
 def test_the_kernel_takes_massless_frames():
     """A Frame states rigid-body terms of zero mass (``rigid_inertia``), so a universal joint
     (two revolutes through a Frame) is compiled and equals the recursive evaluator."""
@@ -250,6 +274,15 @@ def test_zero_pivot_raises_singular_mass_error(compiled):
     """A point mass on its own revolute axis moves no inertia: D_n = 0, as in recursive."""
     system = pq.System({"p": pq.PointMass(1.0, (0, 0, 0))}, {"p": pq.Revolute(axis="z")})
     with pytest.raises(SingularMassError, match="'p'"):
+        FastEvaluator(system, compiled=compiled).accelerations(np.zeros(1), np.zeros(1), 0.0)
+
+
+@pytest.mark.parametrize("compiled", [False, True] if HAS_NUMBA else [False])
+def test_zero_pivot_with_coupled_joints_raises_singular_mass_error(compiled):
+    """Two point masses on their revolute axes, one following the other (a gear): M = 0."""
+    system = pq.System({"p": pq.PointMass(1.0), "g": pq.PointMass(2.0)},
+                       {"p": pq.Revolute(axis="z"), "g": pq.Revolute(axis="z", r_pn=(1, 0, 0), coupling={"p": -2.0})})
+    with pytest.raises(SingularMassError, match="system mass matrix M"):
         FastEvaluator(system, compiled=compiled).accelerations(np.zeros(1), np.zeros(1), 0.0)
 
 
