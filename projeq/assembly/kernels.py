@@ -223,7 +223,7 @@ def gauss_form(n_cols, parent, s_index, T, zeta, F, M_n, h, M, b):
     f_n = M_n ζ̄_n − h_n gathered leaves → root (f_p += T_npᵀ f_n), b_n = F_nᵀ f_n. M: the
     composite bodies M^c_n = M_n + Σ_c T_cnᵀ M^c_c T_cn, M_nn = F_nᵀ M^c_n F_n, and for
     each ancestor i of n, M_in = F_iᵀ T_{..i}ᵀ M^c_n F_n with U = M^c_n F_n carried up
-    by U ← T_jpᵀ U (Featherstone, *Rigid Body Dynamics Algorithms*, 2008, §5.3 and
+    by U ← T_jpᵀ U (Featherstone (2008), *Rigid Body Dynamics Algorithms*, §5.3 and
     §6.2, Tables 5.1 and 6.2). Order N d (d: the tree's depth). Writes M (n × n) and b (n).
     """
     N = n_cols.shape[0]

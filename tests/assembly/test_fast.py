@@ -79,7 +79,7 @@ def test_fast_equals_dense_with_coupled_joints(tree):
 @given(trees(max_n=12), st.booleans())
 def test_compiled_gauss_form_equals_the_dense_one(tree, planar_or_coupled):
     """M(q) and b(q, ṡ, t) by the compiled composite-body and Newton–Euler kernel
-    (projeq.assembly.kernels.gauss_form; Featherstone 2008, §5.3, §6.2) equal those of the
+    (projeq.assembly.kernels.gauss_form; Featherstone (2008) §5.3, §6.2) equal those of the
     dense J_nᵀ M_n J_n sums (docs/theory.md §5) to round-off, relative to their largest entries,
     on spatial trees with coupled joints; the interpreted kernel source agrees too."""
     system = with_couplings(tree) if planar_or_coupled else tree.system

@@ -1,6 +1,6 @@
 """Constrained models evaluate their tree with the compiled kernels by default (issue 15): the
 tree's M and b of the Gauss form come from :meth:`projeq.assembly.fast.FastEvaluator.gauss_form`
-(composite bodies and Newton–Euler, Featherstone 2008 §5.3, §6.2), and the constrained s̈ and
+(composite bodies and Newton–Euler, Featherstone (2008) §5.3, §6.2), and the constrained s̈ and
 multipliers λ equal those projected from the dense reference form (Σ J_nᵀ M_n J_n,
 docs/theory.md §5), an independent formulation, to round-off; a tree the kernel does not know
 is projected from the dense form after one InterpretedWarning naming the piece; the complex
