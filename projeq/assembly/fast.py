@@ -48,6 +48,8 @@ True
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -148,21 +150,18 @@ class FastEvaluator:
         kin.T_aug[:-1, :6, 6] = self._zeta
         h[-1] = 0.0  # the ground's row: reactions land there, nothing reads them
         if self._selected:
-            kin, h = self._selected_kinematics(kin, s_dot)
+            kin, h = _SelectedKinematics(self.system, kin, s_dot), self._selected_h()
         for force in self.system.forces:
             force.add_to(h, kin, t, q, s_dot)
         for n in self._selected:
             self._h_hat[n] += self.system.S[n].T @ h[n]
 
-    def _selected_kinematics(self, kin: Kinematics, s_dot: NDArray) -> tuple[Kinematics, list]:
-        """The kinematics of the reference evaluators (ẏ_n = S_n twist, F_n = S_n F⁶,
-        T̃_np = S̃_n T̃⁶ S̃_pᵀ, :func:`projeq.assembly.kinematics.selected_chain_terms`) and the h_n
-        they load: zeros for selected bodies, the workspace's rows for the others."""
+    def _selected_h(self) -> list:
+        """The h_n the force laws load in the reference evaluators' coordinates: zeros of n_y
+        for selected bodies, the workspace's rows for the others, none for the ground."""
         system = self.system
-        T_aug, F = selected_chain_terms(system, system.plan, kin.F, kin.T_aug, [None] * len(kin.F))
-        y_dot = describing_velocities(system, system.plan, kin.twist, s_dot)
-        h = [np.zeros(len(y)) if S is not None else self._h_hat[n] for n, (y, S) in enumerate(zip(y_dot, system.S))]
-        return Kinematics(kin.R, kin.r, kin.twist, y_dot, T_aug, F), h[:-1] + [np.zeros(0)]
+        return [np.zeros(S.shape[0]) if S is not None else self._h_hat[n]
+                for n, S in enumerate(system.S[:-1])] + [np.zeros(0)]
 
     def _terms(self, q: NDArray, s_dot: NDArray, t: float) -> None:
         """T_np, ζ_n, F_n, h_n (forces included) of every body into the workspace."""
@@ -245,6 +244,35 @@ def _expansion(system) -> tuple[NDArray, NDArray]:
     N = len(system.joints)
     return (matrix([system.joint_q_getter(n) for n in range(N)], system.n_q),
             matrix([system.joint_s_dot_getter(n) for n in range(N)], system.n_s))
+
+
+class _SelectedKinematics(Kinematics):
+    """The :class:`~projeq.assembly.kinematics.Kinematics` of the reference evaluators for a
+    tree with selections S (ẏ_n = S_n twist, and F_n = S_n F⁶, T̃_np = S̃_n T̃⁶ S̃_pᵀ by
+    :func:`projeq.assembly.kinematics.selected_chain_terms`) over the kernel's spatial
+    ``kinematics``; ẏ_n and the chain terms are computed when a force law first reads them
+    (a force or torque on a body reads only its pose)."""
+
+    def __init__(self, system, kinematics: Kinematics, s_dot: NDArray):
+        self.R, self.r, self.twist = kinematics.R, kinematics.r, kinematics.twist
+        self._system, self._spatial, self._s_dot = system, kinematics, s_dot
+
+    @functools.cached_property
+    def y_dot(self) -> list:
+        return describing_velocities(self._system, self._system.plan, self.twist, self._s_dot)
+
+    @functools.cached_property
+    def _chain(self) -> tuple[list, list]:
+        spatial = self._spatial
+        return selected_chain_terms(self._system, self._system.plan, spatial.F, spatial.T_aug, [None] * len(spatial.F))
+
+    @property
+    def T_aug(self) -> list:
+        return self._chain[0]
+
+    @property
+    def F(self) -> list:
+        return self._chain[1]
 
 
 def _kinematics(n_cols, R, r, twist, F) -> Kinematics:
