@@ -430,7 +430,7 @@ class ConstrainedSystem(Model):
         """q̇ = K_tree (F ṡ + f) + k, minus β C_Φ⁺ Φ with Baumgarte's correction."""
         q_dot = self.tree.q_dot(q, self.tree_velocities(q, s_dot, t), t)
         if self.correction == "baumgarte" and self.m_h:
-            q_dot -= self.beta * np.linalg.lstsq(self.phi_q(q, t), self.phi(q, t), rcond=RANK_TOLERANCE)[0]
+            q_dot -= self.beta * minimum_norm_solution(self.phi_q(q, t), self.phi(q, t))
         return q_dot
 
     def normalized(self, q: NDArray, t: float = 0.0) -> NDArray:
@@ -441,14 +441,22 @@ class ConstrainedSystem(Model):
 
     def project(self, q: NDArray, t: float = 0.0, max_iter: int = 20) -> NDArray:
         """q moved onto Φ(q, t) = 0 by minimum-norm Gauss–Newton steps (redundant rows: singular
-        values of ∂Φ/∂q below RANK_TOLERANCE σ_max dropped); ValueError if it fails."""
-        q = np.array(q, dtype=float)
+        values of ∂Φ/∂q below RANK_TOLERANCE σ_max dropped); ValueError if it fails.
+
+        Complex-safe (the steps are analytic): for q carrying a complex step, one step more
+        than its real part needs, from the converged point, where the step's Jacobian is the
+        projector E − Φ_q⁺Φ_q onto the tangent of Φ = 0, so that the complex step gives the
+        derivative of the projection (the energy projection's gradient)."""
+        q = numeric(np.array(q))
         tol = POSITION_TOLERANCE * max(1.0, np.abs(q).max())
+        settled = not np.iscomplexobj(q)  # a real q is done where Φ is within tol
         for _ in range(max_iter):
             residual = self.phi(q, t)
-            if not residual.size or np.abs(residual).max() <= tol:
+            converged = not residual.size or np.abs(np.real(residual)).max() <= tol
+            if converged and settled:
                 return q
-            q = self.tree.normalized(q - np.linalg.lstsq(self.phi_q(q, t), residual, rcond=RANK_TOLERANCE)[0])
+            settled = converged
+            q = self.tree.normalized(q - minimum_norm_solution(self.phi_q(q, t), residual))
         raise ValueError(
             f"q: cannot be projected onto the constraints Φ(q, t) = 0 (residual "
             f"{np.array2string(self.phi(q, t), precision=3)} after {max_iter} Gauss–Newton steps)"
@@ -614,6 +622,30 @@ def independent_indices(independent, count: int, n_tree: int, why: str) -> NDArr
         raise ValueError(f"independent: expected {count} distinct indices of ṡ_tree in 0..{n_tree - 1} "
                          f"({why}), got {independent!r}")
     return np.sort(chosen)
+
+
+def minimum_norm_solution(A: NDArray, c: NDArray, rcond: float = RANK_TOLERANCE, rank: int | None = None) -> NDArray:
+    """A⁺ c, the minimum-norm least-squares solution, with A⁺ over the singular values of A above
+    ``rcond`` σ_max (at most ``rank`` of them). Complex-safe: for A = A₀ + i A₁, c carrying a
+    complex step (|A₁| ~ 1e-30) it is (A₀⁺ + i dA⁺) c with the derivative of a pseudo-inverse
+    of constant rank (Golub & Pereyra, "The differentiation of pseudo-inverses and nonlinear
+    least squares problems whose variables separate", SIAM J. Numer. Anal. 10, 1973, Theorem 4.3)
+
+        dA⁺ = −A⁺ dA A⁺ + A⁺A⁺ᵀ dAᵀ (E − A A⁺) + (E − A⁺A) dAᵀ A⁺ᵀA⁺,
+
+    transposes, not conjugates (``np.linalg.lstsq`` conjugates: the complex step through it
+    would be silently wrong), so that the complex step gives the exact derivative."""
+    A0 = np.real(A)
+    if not A0.size:
+        return np.zeros(A0.shape[1:] + np.shape(c)[1:], dtype=np.result_type(A, c))
+    U, sigma, Vt = np.linalg.svd(A0, full_matrices=False)
+    k = min(int(np.count_nonzero(sigma > rcond * sigma[0])), len(sigma) if rank is None else rank)
+    P = Vt[:k].T @ (U[:, :k].T / sigma[:k, None])  # A₀⁺
+    if not (np.iscomplexobj(A) or np.iscomplexobj(c)):
+        return P @ c
+    dA = A - A0
+    dP = -P @ dA @ P + P @ P.T @ dA.T @ (np.eye(len(A0)) - A0 @ P) + (np.eye(A0.shape[1]) - P @ A0) @ dA.T @ P.T @ P
+    return (P + dP) @ c
 
 
 def numerical_rank(A: NDArray) -> int:
