@@ -51,6 +51,10 @@ from projeq.constraints.partitioned import (
 # singular values of A_s below this fraction of the largest do not act in the particular solutions:
 # the errors of the differences (~1e-11) divided by σ stay below ~1e-5 (m/s² per m/s²)
 ACTING = 1e-6
+# singular values of A_s below this fraction of the largest count as near-null: within this distance
+# (relative) of a singular position, N continues the branch's tangent (TangentSystem._branch); far
+# above the distance of integrator stages from the constraint manifold (~1e-4 at rtol 1e-9)
+SEPARATION = 1e-2
 
 
 class TangentSystem(ConstrainedSystem):
@@ -80,6 +84,8 @@ class TangentSystem(ConstrainedSystem):
     """
 
     _latest = (None, None)  # (key of (q, t), (C, c)) of the latest velocity_constraints call
+    _svd = (None, None)  # (key of A_s, its SVD) of the latest decomposition
+    _tangent = None  # N where the null space was last separated: the branch's tangent (_branch)
 
     def _choose_velocities(self, q0, independent, repivot) -> None:
         A_s = self.constraint_matrix(q0)[0]
@@ -102,10 +108,33 @@ class TangentSystem(ConstrainedSystem):
         return self._latest[1]
 
     def _null_space(self, A_s: NDArray) -> NDArray:
-        """N (n_s,tree × n_s): the right singular vectors of A_s of its n_s smallest singular values."""
+        """N (n_s,tree × n_s) of A_s on the motion's branch (:meth:`_branch`)."""
         if not A_s.size:
             return np.eye(self.tree.n_s)
-        return np.linalg.svd(_real(A_s))[2][self.tree.n_s - self.n_s:].T
+        _, sigma, Vt = self._decomposition(A_s)
+        return self._branch(sigma, Vt)
+
+    def _decomposition(self, A_s: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+        """The SVD (U, σ, Vᵀ) of A_s, kept for the latest A_s: F, f and f̄ of one state share it."""
+        key = _real(A_s).tobytes()
+        if self._svd[0] != key:
+            self._svd = (key, np.linalg.svd(A_s))
+        return self._svd[1]
+
+    def _branch(self, sigma: NDArray, Vt: NDArray) -> NDArray:
+        """N from the SVD A_s = U Σ Vᵀ, continued along the motion (module docstring): the right
+        singular vectors of the n_s smallest singular values where they are separated from the
+        others (the next above SEPARATION σ_max; N is kept as the branch's tangent), else the
+        tangent kept last, projected onto the k ≥ n_s right singular vectors below SEPARATION σ_max
+        (the near-null space of a singular position) and orthonormalised."""
+        n = self.tree.n_s
+        sigma = np.concatenate((sigma, np.zeros(n - len(sigma))))  # σ of the columns beyond the rows: 0
+        near = max(self.n_s, int(np.count_nonzero(sigma < SEPARATION * sigma[0])))
+        if near == self.n_s or self._tangent is None:
+            self._tangent = Vt[n - self.n_s:].T
+            return self._tangent
+        V_near = Vt[n - near:].T
+        return np.linalg.qr(V_near @ (V_near.T @ self._tangent))[0]
 
     def _scaled(self, N: NDArray) -> NDArray:
         """F = N N_ind⁻¹ (F[independent] = E)."""
@@ -157,11 +186,10 @@ class TangentSystem(ConstrainedSystem):
         decomposition: A_s x = c with x[independent] = 0, where A_s x = c can hold."""
         if not A_s.size:
             return np.zeros(self.tree.n_s)
-        U, sigma, Vt = np.linalg.svd(_real(A_s))
-        rank = self.tree.n_s - self.n_s
-        acting = min(rank, np.count_nonzero(sigma > ACTING * sigma[0]))
+        U, sigma, Vt = self._decomposition(A_s)
+        acting = min(self.tree.n_s - self.n_s, np.count_nonzero(sigma > ACTING * sigma[0]))
         x0 = Vt[:acting].T @ ((U[:, :acting].T @ c) / sigma[:acting])
-        return x0 - self._scaled(Vt[rank:].T) @ x0[self.independent]
+        return x0 - self._scaled(self._branch(sigma, Vt)) @ x0[self.independent]
 
     def __repr__(self) -> str:
         return f"TangentSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian)"
