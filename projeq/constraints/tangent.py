@@ -26,12 +26,22 @@ Near a singular position the null space of A_s is separated from the vanishing s
 their size (∝ the distance from the singular position), so that F, and with it the motion's branch,
 stays continuous through it: the velocity never leaves the mechanism's one-dimensional tangent
 (the branch is kept by construction; an acceleration-level formulation has to hold it by its
-stabilisation). Known limitation: the explicit integrators evaluate stages off the manifold (by
-the step's curvature error, ~1e-4..1e-3 at rtol 1e-9); within that distance of a singular position
-the null vector is not separated from the directions that come free, and a stage can take the wrong
-one: the double four-bar of IFToMM A02 passes its first singular positions to 2e-7, but runs to
-10 s leave the parallelogram motion at a later crossing (a continuation of the branch from the
-previous step, or an index-3 formulation, is the remedy still to be built). On the constraint manifold the rank of A_s can only drop below its value at a
+stabilisation). Integrator stages, though, lie off the manifold (by the step's curvature error,
+~1e-4..1e-3 at rtol 1e-9), and within that distance of a singular position the null vector is no
+longer the smallest: a stage would take a direction that has come free there. So N is continued
+along the branch, as the tangent of a path is continued in numerical continuation (Allgower &
+Georg, "Introduction to Numerical Continuation Methods", 1990, §2.1): where the n_s smallest
+singular values are separated from the others (the next one above ``separation`` σ_max, 1e-2
+by default, far above the stages' distance from the manifold) N is theirs and is kept as the
+branch's tangent; where more singular values fall below (a singular position within ~1e-2 of
+the state), N is that kept tangent projected onto the right singular vectors of all of them
+and orthonormalised. On the branch the tangent lies in that near-null space, so the projection
+returns it (to the square of the stage's distance from the manifold); the plain smallest
+singular vectors would be off by O(1) there (tests/constraints/test_iftomm.py). Measured on the
+double four-bar of IFToMM A02 to 10 s (``benchmarks/iftomm.py``): point B0 within 7.6e-6 of
+the parallelogram motion at rtol 1e-9 and 4.2e-7 at rtol 1e-10, against 4.3e-5 and 1.3e-5 without
+the continuation (``separation=0``, which has also met step failures and energy jumps at later
+crossings, depending on tolerance). On the constraint manifold the rank of A_s can only drop below its value at a
 regular q0 (at singular positions), never rise, so the n_s directions always exist (q0 must be a
 regular configuration: its rank fixes n_s). Where the independent velocities stop describing the
 motion (a crank at a dead centre, N_ind singular) the independent set is re-chosen as in :mod:`.partitioned`.
@@ -65,6 +75,10 @@ class TangentSystem(ConstrainedSystem):
     The arguments are those of :class:`~projeq.constraints.partitioned.ConstrainedSystem`; its
     n_s is the mobility at q0 (tree velocities minus the rank of the constraints there), and
     ``independent`` (default: column-pivoted QR of the null space) names n_s tree velocities.
+    ``separation`` (default SEPARATION = 1e-2): singular values of A_s below this fraction of the
+    largest count as near-null, where N continues the branch's tangent; 0 takes the n_s smallest
+    singular vectors everywhere (no continuation: an integrator stage off the constraint manifold
+    near a singular position can then take a direction that has come free, module docstring).
 
     Examples
     --------
@@ -86,6 +100,14 @@ class TangentSystem(ConstrainedSystem):
     _latest = (None, None)  # (key of (q, t), (C, c)) of the latest velocity_constraints call
     _svd = (None, None)  # (key of A_s, its SVD) of the latest decomposition
     _tangent = None  # N where the null space was last separated: the branch's tangent (_branch)
+
+    def __init__(self, system, *args, separation: float = SEPARATION, **options):
+        separation = float(separation)
+        if not 0.0 <= separation < 1.0:
+            raise ValueError(f"separation: expected a fraction of the largest singular value in [0, 1) "
+                             f"(0: no continuation of the branch), got {separation!r}")
+        self.separation = separation
+        super().__init__(system, *args, **options)
 
     def _choose_velocities(self, q0, independent, repivot) -> None:
         A_s = self.constraint_matrix(q0)[0]
@@ -124,12 +146,12 @@ class TangentSystem(ConstrainedSystem):
     def _branch(self, sigma: NDArray, Vt: NDArray) -> NDArray:
         """N from the SVD A_s = U Σ Vᵀ, continued along the motion (module docstring): the right
         singular vectors of the n_s smallest singular values where they are separated from the
-        others (the next above SEPARATION σ_max; N is kept as the branch's tangent), else the
-        tangent kept last, projected onto the k ≥ n_s right singular vectors below SEPARATION σ_max
+        others (the next above ``separation`` σ_max; N is kept as the branch's tangent), else the
+        tangent kept last, projected onto the k ≥ n_s right singular vectors below ``separation`` σ_max
         (the near-null space of a singular position) and orthonormalised."""
         n = self.tree.n_s
         sigma = np.concatenate((sigma, np.zeros(n - len(sigma))))  # σ of the columns beyond the rows: 0
-        near = max(self.n_s, int(np.count_nonzero(sigma < SEPARATION * sigma[0])))
+        near = max(self.n_s, int(np.count_nonzero(sigma < self.separation * sigma[0])))
         if near == self.n_s or self._tangent is None:
             self._tangent = Vt[n - self.n_s:].T
             return self._tangent

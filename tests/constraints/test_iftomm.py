@@ -10,6 +10,8 @@ through the singular positions: the bars keep moving as parallelograms), A04 the
 energy and the partitioned formulation with the redundant row removed by hand.
 """
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -22,20 +24,20 @@ from projeq.scenes.iftomm import (
 
 
 @pytest.fixture(scope="module")
-def double_four_bar():  # ~25 s
+def double_four_bar():  # ~10 s CPU
     system = n_four_bar(2)
-    return system, pq.simulate(system, 2.0, n_points=81, rtol=1e-9, atol=1e-11)
+    return system, pq.simulate(system, 10.0, n_points=201, rtol=1e-9, atol=1e-11)
 
 
 def test_double_four_bar_runs_through_its_singular_positions(double_four_bar):
     """A02 with N = 2, all bars 1 m and 1 kg, B0 starting at 1 m/s: over 2 s the cranks pass the
     horizontal (rank 2 of 4 rows, 3 degrees of freedom) twice (θ0 from π/2 to −4.8 rad), and B0's
-    position and velocity stay within 1e-6 of the parallelogram motion (achieved 1.9e-7 at rtol 1e-9).
-    Not yet the benchmark's 10 s: RK stage points off the constraint manifold within ~1e-3 rad of a
-    singular position can take a wrong null vector there (the runs to 10 s at rtol 1e-9 and 1e-10
-    leave the motion at a later crossing; see projeq.constraints.tangent)."""
-    system, r = double_four_bar
-    assert r.status == 0 and r.t[-1] == 2.0
+    position and velocity stay within 1e-6 of the parallelogram motion (achieved 1.9e-7 at rtol 1e-9)."""
+    system, full = double_four_bar
+    assert full.status == 0 and full.t[-1] == 10.0
+    first = full.t <= 2.0
+    r = SimpleNamespace(t=full.t[first], q=full.q[first], s_dot=full.s_dot[first],
+                        constraint_residual=full.constraint_residual[first])
     crossings = np.count_nonzero(np.diff(np.floor(r.q[:, 0] / np.pi)))
     assert crossings == 2
     horizontal = np.array([np.pi] * 3 + [-np.pi] * 2)  # cranks at π, couplers at 0 absolute: bars in line
@@ -44,6 +46,55 @@ def test_double_four_bar_runs_through_its_singular_positions(double_four_bar):
     error = np.abs(point_b0(system, r.q, r.s_dot) - parallelogram_motion(r.t, 2))
     assert error.max() < 1e-6, error.max(axis=0)
     assert np.abs(r.constraint_residual).max() < 1e-10
+
+
+@pytest.mark.slow
+def test_double_four_bar_runs_to_the_benchmarks_horizon(double_four_bar):
+    """A02 to the 10 s of the benchmark (González, Dopico, Lugrís & Cuadrado 2006; the double
+    four-bar as run to 10 s in Bayo & Avello 1994): ten crossings of the singular positions, and
+    B0's position and velocity within 1e-4 of the reference — the issue's bound — all along the
+    run and at 10 s (achieved 7.6e-6 at rtol 1e-9). The published reference file could not be read
+    here (no network); the reference is the motion the benchmark's follows, the parallelogram motion
+    in one coordinate (projeq.scenes.iftomm.parallelogram_motion), which does not use the constraint
+    equations. The energy stays within 1e-5 J of its start (achieved 7.3e-7 J)."""
+    system, r = double_four_bar
+    assert np.count_nonzero(np.diff(np.floor(r.q[:, 0] / np.pi))) == 10
+    error = np.abs(point_b0(system, r.q, r.s_dot) - parallelogram_motion(r.t, 2))
+    assert error.max() < 1e-4 and error[-1].max() < 1e-4, error.max(axis=0)
+    energy = r.kinetic + r.potential
+    assert np.abs(energy - energy[0]).max() < 1e-5
+    assert np.abs(r.constraint_residual).max() < 1e-10
+
+
+def test_tangent_continues_the_branch_off_the_manifold_near_a_singular_position():
+    """Where an integrator stage lies off the constraint manifold (by 1e-4 rad, ~ a step's
+    curvature error) within 3e-3 rad of the singular position, the null vector of A_s is not
+    separated from the directions that come free there: the n_s smallest singular vectors
+    (separation=0) give a motion off the parallelogram branch by up to tens of rad/s per rad/s,
+    the continued tangent (the default) the branch's own, ṡ_tree ∝ (1, 1, 1, −1, −1) for
+    (cranks, couplers), to 1e-6."""
+    rng = np.random.default_rng(0)
+    errors = {}
+    for separation in (1e-2, 0.0):
+        system = n_four_bar(2, separation=separation)
+        tree = system.tree
+        crank = [tree.q_slice[tree.index(f"crank{i}")].start for i in range(3)]
+        coupler = [tree.q_slice[tree.index(f"coupler{i}")].start for i in (1, 2)]
+        branch = np.zeros(5)
+        branch[crank], branch[coupler] = 1.0, -1.0  # F with crank0's rate independent
+        errors[separation] = 0.0
+        for d in (3e-3, 1e-3, 3e-4):
+            for _ in range(20):
+                q = np.zeros(5)
+                q[crank], q[coupler] = np.pi - d, d - np.pi
+                F = system.F(q + 1e-4 * rng.standard_normal(5))[0][:, 0]
+                errors[separation] = max(errors[separation], np.abs(F - branch).max())
+    assert errors[1e-2] < 1e-6 and errors[0.0] > 1.0, errors
+
+
+def test_separation_is_checked():
+    with pytest.raises(ValueError, match="separation"):
+        n_four_bar(2, separation=1.5)
 
 
 def test_partitioned_formulation_stops_at_the_singular_position_saying_so(double_four_bar):
