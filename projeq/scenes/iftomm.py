@@ -223,3 +223,30 @@ def andrews_squeezer(**options) -> TangentSystem:
 def andrews_angles(system, q) -> np.ndarray:
     """The rows of q as Hairer & Wanner's angles (β, Θ, γ, Φ, δ, Ω, ε) (the same for ṡ_tree)."""
     return np.atleast_2d(q)[:, [system.tree.q_slice[system.tree.index(name)].start for name in ANDREWS_ANGLES]]
+
+
+# the published reference solution at t = 0.03 s (t, angles (β, Θ, γ, Φ, δ, Ω, ε) in rad, their rates in
+# rad/s): Mazzia & Magherini, "Test Set for IVP Solvers", release 2.4 (2008), problem "andrews",
+# computed by PSIDE at tolerance 1e-14 — the data of Hairer & Wanner 1996, §VII.7
+ANDREWS_REFERENCE = (
+    0.03,
+    np.array([0.1581077119629904e+02, -0.1575637105984298e+02, 0.4082224013073101e-01, -0.5347301163226948e+00,
+              0.5244099658805304e+00, 0.5347301163226948e+00, 0.1048080741042263e+01]),
+    np.array([0.1139920302151208e+04, -0.1424379294994111e+04, 0.1103291221937134e+02, 0.1929337464421385e+02,
+              0.5735699284790808e+00, -0.1929337464421385e+02, 0.3231791658026955e+00]),
+)
+
+
+def andrews_error(system, q, s_dot) -> float:
+    """The largest relative difference of the angles and rates at q, ṡ (the state at
+    ANDREWS_REFERENCE[0]) from the published reference solution."""
+    t, angles, rates = ANDREWS_REFERENCE
+    ours = andrews_angles(system, q)[0], andrews_angles(system, system.tree_velocities(q, s_dot))[0]
+    return float(max(np.abs(x / ref - 1).max() for x, ref in zip(ours, (angles, rates))))
+
+
+def andrews_balance(system, r) -> np.ndarray:
+    """T + V − E₀ − mom (β − β₀) along a Result of :func:`andrews_squeezer`: the energy balance of the
+    benchmark (zero: the drive's work goes into the mechanism's energy)."""
+    energy, beta = r.kinetic + r.potential, andrews_angles(system, r.q)[:, 0]
+    return energy - energy[0] - ANDREWS["mom"] * (beta - beta[0])
