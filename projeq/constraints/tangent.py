@@ -196,6 +196,36 @@ class TangentSystem(ConstrainedSystem):
         new.repivot = self.repivot if repivot is None else bool(repivot)
         return new
 
+    def singular_positions(self):
+        """An event for :func:`projeq.simulate` (``events=[system.singular_positions()]``, not
+        terminal) that fires where ρ = σ_r / σ_max — the smallest of the r singular values of A_s
+        that act at q0 (r its rank there), relative to the largest — has a minimum along the
+        motion: its rate dρ/dt (central difference along q̇, 1e-10 in q) rises through zero. At a
+        singular position ρ drops to zero with a kink, where the root is found. Pass the Result to
+        :meth:`rank_changes` for the rank and mobility at the positions found."""
+        acting = self.tree.n_s - self.n_s
+
+        def ratio(q, t):
+            sigma = np.linalg.svd(self.constraint_matrix(q, t)[0], compute_uv=False)
+            return sigma[acting - 1] / sigma[0]
+
+        def singular_position(t, q, s_dot):
+            q_dot = self.q_dot(q, s_dot, t)
+            h = 1e-10 / max(np.abs(q_dot).max(), 1e-300)
+            return (ratio(q + h * q_dot, t + h) - ratio(q - h * q_dot, t - h)) / (2 * h)
+
+        singular_position.terminal, singular_position.direction = False, 1
+        return singular_position
+
+    def rank_changes(self, result, event: int = 0) -> tuple:
+        """((t, rank, mobility), ...) where the event ``event`` of ``result`` (the index of
+        :meth:`singular_positions` among the run's events) fired with the rank of A_s below its
+        rank at q0: the singular positions the run passed, with the degrees of freedom there."""
+        rank0 = self.rank(self.q0)
+        found = ((float(t), self.rank(q, t), self.mobility(q, t))
+                 for t, q in zip(result.t_events[event], result.q_events[event]))
+        return tuple(row for row in found if row[1] < rank0)
+
     def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:
         """(F, f) of ṡ_tree = F ṡ + f: F = N N_ind⁻¹, f the particular solution of A_s f = b_s
         with f[independent] = 0 (module docstring)."""

@@ -28,7 +28,8 @@ from projeq.scenes.iftomm import (
 @pytest.fixture(scope="module")
 def double_four_bar():  # ~10 s CPU
     system = n_four_bar(2)
-    return system, pq.simulate(system, 10.0, n_points=201, rtol=1e-9, atol=1e-11)
+    return system, pq.simulate(system, 10.0, n_points=201, rtol=1e-9, atol=1e-11,
+                               events=[system.singular_positions()])
 
 
 def test_double_four_bar_runs_through_its_singular_positions(double_four_bar):
@@ -66,6 +67,19 @@ def test_double_four_bar_runs_to_the_benchmarks_horizon(double_four_bar):
     energy = r.kinetic + r.potential
     assert np.abs(energy - energy[0]).max() < 1e-5
     assert np.abs(r.constraint_residual).max() < 1e-10
+
+
+@pytest.mark.slow
+def test_the_singular_positions_passed_are_reported_with_rank_and_mobility(double_four_bar):
+    """The run records where it passed singular positions (TangentSystem.singular_positions, an
+    event): ten over 10 s, each with the four closure rows of rank 2 and 3 degrees of freedom (the
+    benchmark's N + 1), at the times where B0 of the parallelogram motion crosses y = 0 (the bars
+    horizontal), to 1e-6 m in y."""
+    system, r = double_four_bar
+    changes = system.rank_changes(r)
+    assert [(rank, mobility) for _, rank, mobility in changes] == [(2, 3)] * 10
+    t = np.array([t for t, _, _ in changes])
+    assert np.abs(parallelogram_motion(t, 2)[:, 1]).max() < 1e-6
 
 
 def test_tangent_continues_the_branch_off_the_manifold_near_a_singular_position():
