@@ -49,6 +49,8 @@ motion (a crank at a dead centre, N_ind singular) the independent set is re-chos
 
 from __future__ import annotations
 
+from numbers import Real
+
 import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
@@ -102,11 +104,10 @@ class TangentSystem(ConstrainedSystem):
     _tangent = None  # N where the null space was last separated: the branch's tangent (_branch)
 
     def __init__(self, system, *args, separation: float = SEPARATION, **options):
-        separation = float(separation)
-        if not 0.0 <= separation < 1.0:
+        if isinstance(separation, bool) or not isinstance(separation, Real) or not 0.0 <= separation < 1.0:
             raise ValueError(f"separation: expected a fraction of the largest singular value in [0, 1) "
                              f"(0: no continuation of the branch), got {separation!r}")
-        self.separation = separation
+        self.separation = float(separation)
         super().__init__(system, *args, **options)
 
     def _choose_velocities(self, q0, independent, repivot) -> None:

@@ -109,8 +109,9 @@ def test_tangent_continues_the_branch_off_the_manifold_near_a_singular_position(
 
 
 def test_separation_is_checked():
-    with pytest.raises(ValueError, match="separation"):
-        n_four_bar(2, separation=1.5)
+    for bad in (1.5, -0.1, float("nan"), "0.01", True):
+        with pytest.raises(ValueError, match="separation"):
+            n_four_bar(2, separation=bad)
 
 
 def test_partitioned_formulation_stops_at_the_singular_position_saying_so(double_four_bar):
