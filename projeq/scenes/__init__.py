@@ -197,6 +197,6 @@ __all__ = [
     "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed", "rolling_disk_inertia",
     "barhorst_particle", "nonholonomic_particle", "whipple_bicycle", "whipple_eigenvalues",
     "quick_return", "four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",
-    "simple_pendulum", "n_four_bar", "bricard",
+    "simple_pendulum", "n_four_bar", "bricard", "andrews_squeezer",
     "Scene", "SCENES", "DEFAULT_SCENE", "get_scene", "resolve_scene", "build_scene", "scene_parameters", "parse_settings", "Parameter",
 ]
