@@ -55,7 +55,7 @@ def sweep_scene(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers: expected a positive count, got {args.workers}")
     client = _dask_client(args.scheduler, args.scheduler_timeout) if args.scheduler else None
-    options = simulate_options(args)
+    options = simulate_options(args, scene)
     quiet = args.quiet or args.json
     with client if client is not None else contextlib.nullcontext():  # a Dask client is closed also when --out is refused
         out = output_directory(args.out)

@@ -47,12 +47,18 @@ A user-fixed partition (``repivot=False``) stops the run at the same event with 
 ValueError naming (q, t): integrated on, the solver could step across the degeneracy
 (where ṡ_tree = F ṡ is ∞ · 0) and lose accuracy silently.
 
-Evaluators. The projection Fᵀ M F needs the tree's mass matrix M, which the dense Gauss form
-of the tree gives together with b (the default, ``method="dense"``). With
+Evaluators. The projection Fᵀ M F needs the tree's mass matrix M and b of its Gauss form
+(:meth:`ConstrainedSystem.tree_gauss_form`). By default (``method=None``) both come from the
+compiled kernels where the tree's default evaluator is the compiled one
+(:meth:`projeq.assembly.fast.FastEvaluator.gauss_form`: composite bodies and Newton–Euler
+in numba), else from the dense reference (docs/theory.md §5), after one
+:class:`~projeq.assembly.auto.InterpretedWarning` naming the piece of the tree the kernel does
+not know; ``method="dense"`` takes the dense reference, and so does a complex argument (the
+complex step of :mod:`projeq.analysis.jacobians`: the compiled kernels are real). With
 ``method="recursive"`` or ``"fast"`` b comes from that evaluator's free accelerations of the
-tree, M s̈_free + b = 0, so that M s̈_tree + b = M (s̈_tree − s̈_free): the three agree to
-round-off (a cross-check of the tree's evaluators in the constrained motion), and dense is
-the cheapest.
+tree, M s̈_free + b = 0, so that M s̈_tree + b = M (s̈_tree − s̈_free): all agree to round-off
+(a cross-check of the tree's evaluators in the constrained motion). The constraint equations
+Φ, A and b are the user's Python callables, evaluated and differentiated as such.
 """
 
 from __future__ import annotations
@@ -499,13 +505,30 @@ class ConstrainedSystem(Model):
         A_s = C @ K
         F, f = self.F(q, t, (A_s, c - C @ k))
         s_dot_tree = F @ s_dot + f
-        M, b = self.tree.evaluator("dense").gauss_form(q, s_dot_tree, t)
-        if method not in (None, "dense"):  # M s̈_free + b = 0
-            b = -M @ self.tree.evaluator(method).accelerations(q, s_dot_tree, t)
+        M, b = self.tree_gauss_form(q, s_dot_tree, t, method)
         f_bar = np.zeros(self.tree.n_s, dtype=np.result_type(A_s, M, b))
         if self.n_c:
             f_bar = self.particular(A_s, -self.gamma(q, s_dot_tree, t, C))
         return A_s, F, f_bar, M, b
+
+    def tree_gauss_form(self, q: NDArray, s_dot_tree: NDArray, t: float,
+                        method: str | None = None) -> tuple[NDArray, NDArray]:
+        """M and b of the tree's Gauss form M s̈_tree + b = 0 at ṡ_tree, compiled where the tree's
+        default evaluator is, else (and for ``method="dense"`` or complex arguments) the dense
+        reference; b from the free accelerations of ``method`` = "recursive" or "fast"
+        (module docstring)."""
+        tree = self.tree
+        compiled = self.compiled_tree(method) and not (np.iscomplexobj(q) or np.iscomplexobj(s_dot_tree))
+        M, b = tree.evaluator("fast" if compiled else "dense").gauss_form(q, s_dot_tree, t)
+        if method not in (None, "dense"):  # M s̈_free + b = 0
+            b = -M @ tree.evaluator(method).accelerations(q, s_dot_tree, t)
+        return M, b
+
+    def compiled_tree(self, method: str | None = None) -> bool:
+        """Whether :meth:`tree_gauss_form` takes the compiled kernels for ``method`` (at real
+        arguments): the tree's default evaluator is the compiled one (else it warned once,
+        naming the piece) and ``method`` is not "dense"."""
+        return method != "dense" and self.tree.evaluator("auto").name == "fast"
 
     def gauss_form(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """M_min = FᵀMF and b_min = Fᵀ(M f̄ + b) of M_min s̈ + b_min = 0, the tree's Gauss form
@@ -517,7 +540,7 @@ class ConstrainedSystem(Model):
                            method: str | None = None) -> tuple[NDArray, NDArray]:
         """(s̈_tree, λ): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0, and the
         multipliers λ of M s̈_tree + b = A_sᵀ λ (the constraint forces); ``method`` picks
-        the tree's evaluator (module docstring; None: dense)."""
+        the tree's evaluator (module docstring; None: compiled where the tree is)."""
         A_s, F, f_bar, M, b = self._projected(q, s_dot, t, method)
         M_min, b_min = _minimal(F, f_bar, M, b)
         s_ddot = -solve_spd(M_min, b_min[:, None], "constrained mass matrix FᵀMF",
@@ -529,7 +552,8 @@ class ConstrainedSystem(Model):
         return s_ddot_tree, lam
 
     def evaluator(self, method: str | None = None) -> "PartitionedEvaluator":
-        """s̈ with the tree evaluator ``method`` (None: dense), unchecked: for :func:`projeq.simulate`."""
+        """s̈ with the tree evaluator ``method`` (None: compiled where the tree is, module
+        docstring), unchecked: for :func:`projeq.simulate`."""
         return PartitionedEvaluator(self, method)
 
     def generalized_force(self, q: NDArray, t: float, joint_forces: dict) -> NDArray:
@@ -542,11 +566,20 @@ class ConstrainedSystem(Model):
 
 class PartitionedEvaluator:
     """s̈ = s̈_tree[independent] of a ConstrainedSystem by the tree evaluator ``method``
-    (checked here: an unknown name raises ValueError); the state is not checked."""
+    (checked here: an unknown name raises ValueError); the state is not checked.
+
+    ``name``: ``"partitioned(fast)"`` when the tree's Gauss form is the compiled one,
+    ``"partitioned(dense)"`` when it is the dense reference (``method`` names the tree
+    evaluator that gives b, if any); ``reason``: why."""
 
     def __init__(self, system: ConstrainedSystem, method: str | None):
         if method is not None:
             system.tree.evaluator(method)
+        compiled = system.compiled_tree(method)
+        self.name = f"partitioned({'fast' if compiled else 'dense'})"
+        self.reason = (f"constraint equations projected on the tree's Gauss form M, b by the "
+                       f"{'compiled kernels' if compiled else 'dense reference'}"
+                       + (f", b from the {method!r} evaluator" if method not in (None, "dense") else ""))
         self.system, self.method = system, method
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
