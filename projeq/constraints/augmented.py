@@ -31,9 +31,12 @@ The rank of A_s and the mobility are computed at every evaluation (:meth:`Augmen
 :meth:`AugmentedSystem.mobility`); nothing stops the run at a singular position.
 
 Measured against :class:`~projeq.constraints.tangent.TangentSystem` (``benchmarks/iftomm.py``, double
-four-bar to 2 s at rtol 1e-9): both run through the singular positions; here the released
-directions drift while they are released and the stabilisation pulls them back, so that point B0
-is off the parallelogram motion by 7e-6 (TangentSystem: 2e-7), with 1.8 times the evaluations.
+four-bar to 10 s): both run through the singular positions; here the released directions drift
+while they are released and the stabilisation pulls them back, so that point B0 is off the
+parallelogram motion by 6.6e-6 at rtol 1e-9 (TangentSystem: 7.6e-6) with 1.2 times the
+evaluations, but at rtol 1e-10 the motion leaves the parallelogram branch at a crossing (B0 off
+by 9.4 m, the energy by 35 J, 3 times the evaluations; TangentSystem: 4.2e-7 m, 8e-8 J): the
+branch is held only by the stabilisation, not by construction.
 
 Drift: q is projected onto Φ = 0 wherever :func:`projeq.simulate` normalises it (segment ends,
 outputs), as by the partitioned form; the velocities are held by the stabilisation.

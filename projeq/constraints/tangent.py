@@ -26,18 +26,30 @@ Near a singular position the null space of A_s is separated from the vanishing s
 their size (∝ the distance from the singular position), so that F, and with it the motion's branch,
 stays continuous through it: the velocity never leaves the mechanism's one-dimensional tangent
 (the branch is kept by construction; an acceleration-level formulation has to hold it by its
-stabilisation). Known limitation: the explicit integrators evaluate stages off the manifold (by
-the step's curvature error, ~1e-4..1e-3 at rtol 1e-9); within that distance of a singular position
-the null vector is not separated from the directions that come free, and a stage can take the wrong
-one: the double four-bar of IFToMM A02 passes its first singular positions to 2e-7, but runs to
-10 s leave the parallelogram motion at a later crossing (a continuation of the branch from the
-previous step, or an index-3 formulation, is the remedy still to be built). On the constraint manifold the rank of A_s can only drop below its value at a
+stabilisation). Integrator stages, though, lie off the manifold (by the step's curvature error,
+~1e-4..1e-3 at rtol 1e-9), and within that distance of a singular position the null vector is no
+longer the smallest: a stage would take a direction that has come free there. So N is continued
+along the branch, as the tangent of a path is continued in numerical continuation (Allgower &
+Georg, "Introduction to Numerical Continuation Methods", 1990, §2.1): where the n_s smallest
+singular values are separated from the others (the next one above ``separation`` σ_max, 1e-2
+by default, far above the stages' distance from the manifold) N is theirs and is kept as the
+branch's tangent; where more singular values fall below (a singular position within ~1e-2 of
+the state), N is that kept tangent projected onto the right singular vectors of all of them
+and orthonormalised. On the branch the tangent lies in that near-null space, so the projection
+returns it (to the square of the stage's distance from the manifold); the plain smallest
+singular vectors would be off by O(1) there (tests/constraints/test_iftomm.py). Measured on the
+double four-bar of IFToMM A02 to 10 s (``benchmarks/iftomm.py``): point B0 within 7.6e-6 of
+the parallelogram motion at rtol 1e-9 and 4.2e-7 at rtol 1e-10, against 4.3e-5 and 1.3e-5 without
+the continuation (``separation=0``, which has also met step failures and energy jumps at later
+crossings, depending on tolerance). On the constraint manifold the rank of A_s can only drop below its value at a
 regular q0 (at singular positions), never rise, so the n_s directions always exist (q0 must be a
 regular configuration: its rank fixes n_s). Where the independent velocities stop describing the
 motion (a crank at a dead centre, N_ind singular) the independent set is re-chosen as in :mod:`.partitioned`.
 """
 
 from __future__ import annotations
+
+from numbers import Real
 
 import numpy as np
 import scipy.linalg
@@ -51,6 +63,10 @@ from projeq.constraints.partitioned import (
 # singular values of A_s below this fraction of the largest do not act in the particular solutions:
 # the errors of the differences (~1e-11) divided by σ stay below ~1e-5 (m/s² per m/s²)
 ACTING = 1e-6
+# singular values of A_s below this fraction of the largest count as near-null: within this distance
+# (relative) of a singular position, N continues the branch's tangent (TangentSystem._branch); far
+# above the distance of integrator stages from the constraint manifold (~1e-4 at rtol 1e-9)
+SEPARATION = 1e-2
 
 
 class TangentSystem(ConstrainedSystem):
@@ -61,6 +77,10 @@ class TangentSystem(ConstrainedSystem):
     The arguments are those of :class:`~projeq.constraints.partitioned.ConstrainedSystem`; its
     n_s is the mobility at q0 (tree velocities minus the rank of the constraints there), and
     ``independent`` (default: column-pivoted QR of the null space) names n_s tree velocities.
+    ``separation`` (default SEPARATION = 1e-2): singular values of A_s below this fraction of the
+    largest count as near-null, where N continues the branch's tangent; 0 takes the n_s smallest
+    singular vectors everywhere (no continuation: an integrator stage off the constraint manifold
+    near a singular position can then take a direction that has come free, module docstring).
 
     Examples
     --------
@@ -80,6 +100,15 @@ class TangentSystem(ConstrainedSystem):
     """
 
     _latest = (None, None)  # (key of (q, t), (C, c)) of the latest velocity_constraints call
+    _svd = (None, None)  # (key of A_s, its SVD) of the latest decomposition
+    _tangent = None  # N where the null space was last separated: the branch's tangent (_branch)
+
+    def __init__(self, system, *args, separation: float = SEPARATION, **options):
+        if isinstance(separation, bool) or not isinstance(separation, Real) or not 0.0 <= separation < 1.0:
+            raise ValueError(f"separation: expected a fraction of the largest singular value in [0, 1) "
+                             f"(0: no continuation of the branch), got {separation!r}")
+        self.separation = float(separation)
+        super().__init__(system, *args, **options)
 
     def _choose_velocities(self, q0, independent, repivot) -> None:
         A_s = self.constraint_matrix(q0)[0]
@@ -102,12 +131,35 @@ class TangentSystem(ConstrainedSystem):
         return self._latest[1]
 
     def _null_space(self, A_s: NDArray) -> NDArray:
-        """N (n_s,tree × n_s): the right singular vectors of A_s of its n_s smallest singular
-        values; for A_s carrying a complex step, :func:`_null_space_step` of them."""
+        """N (n_s,tree × n_s) of A_s on the motion's branch (:meth:`_branch`), from the SVD of
+        Re A_s; for A_s carrying a complex step, :func:`_null_space_step` of it."""
         if not A_s.size:
             return np.eye(self.tree.n_s)
-        N = np.linalg.svd(np.real(A_s))[2][self.tree.n_s - self.n_s:].T
+        _, sigma, Vt = self._decomposition(np.real(A_s))
+        N = self._branch(sigma, Vt)
         return _null_space_step(A_s, N, self.tree.n_s - self.n_s) if np.iscomplexobj(A_s) else N
+
+    def _decomposition(self, A_s: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+        """The SVD (U, σ, Vᵀ) of a real A_s, kept for the latest A_s: F, f and f̄ of one state share it."""
+        key = A_s.tobytes()
+        if self._svd[0] != key:
+            self._svd = (key, np.linalg.svd(A_s))
+        return self._svd[1]
+
+    def _branch(self, sigma: NDArray, Vt: NDArray) -> NDArray:
+        """N from the SVD A_s = U Σ Vᵀ, continued along the motion (module docstring): the right
+        singular vectors of the n_s smallest singular values where they are separated from the
+        others (the next above ``separation`` σ_max; N is kept as the branch's tangent), else the
+        tangent kept last, projected onto the k ≥ n_s right singular vectors below ``separation`` σ_max
+        (the near-null space of a singular position) and orthonormalised."""
+        n = self.tree.n_s
+        sigma = np.concatenate((sigma, np.zeros(n - len(sigma))))  # σ of the columns beyond the rows: 0
+        near = max(self.n_s, int(np.count_nonzero(sigma < self.separation * sigma[0])))
+        if near == self.n_s or self._tangent is None:
+            self._tangent = Vt[n - self.n_s:].T
+            return self._tangent
+        V_near = Vt[n - near:].T
+        return np.linalg.qr(V_near @ (V_near.T @ self._tangent))[0]
 
     def _scaled(self, N: NDArray) -> NDArray:
         """F = N N_ind⁻¹ (F[independent] = E)."""
@@ -146,6 +198,36 @@ class TangentSystem(ConstrainedSystem):
         new.s_dot0 = self.tree_velocities(self.q0, self.s_dot0)[new.independent]
         new.repivot = self.repivot if repivot is None else bool(repivot)
         return new
+
+    def singular_positions(self):
+        """An event for :func:`projeq.simulate` (``events=[system.singular_positions()]``, not
+        terminal) that fires where ρ = σ_r / σ_max — the smallest of the r singular values of A_s
+        that act at q0 (r its rank there), relative to the largest — has a minimum along the
+        motion: its rate dρ/dt (central difference along q̇, 1e-10 in q) rises through zero. At a
+        singular position ρ drops to zero with a kink, where the root is found. Pass the Result to
+        :meth:`rank_changes` for the rank and mobility at the positions found."""
+        acting = self.tree.n_s - self.n_s
+
+        def ratio(q, t):
+            sigma = np.linalg.svd(self.constraint_matrix(q, t)[0], compute_uv=False)
+            return sigma[acting - 1] / sigma[0]
+
+        def singular_position(t, q, s_dot):
+            q_dot = self.q_dot(q, s_dot, t)
+            h = 1e-10 / max(np.abs(q_dot).max(), 1e-300)
+            return (ratio(q + h * q_dot, t + h) - ratio(q - h * q_dot, t - h)) / (2 * h)
+
+        singular_position.terminal, singular_position.direction = False, 1
+        return singular_position
+
+    def rank_changes(self, result, event: int = 0) -> tuple:
+        """((t, rank, mobility), ...) where the event ``event`` of ``result`` (the index of
+        :meth:`singular_positions` among the run's events) fired with the rank of A_s below its
+        rank at q0: the singular positions the run passed, with the degrees of freedom there."""
+        rank0 = self.rank(self.q0)
+        found = ((float(t), self.rank(q, t), self.mobility(q, t))
+                 for t, q in zip(result.t_events[event], result.q_events[event]))
+        return tuple(row for row in found if row[1] < rank0)
 
     def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:
         """(F, f) of ṡ_tree = F ṡ + f: F = N N_ind⁻¹, f the particular solution of A_s f = b_s

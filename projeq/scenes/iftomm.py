@@ -18,9 +18,10 @@ from scipy.special import ellipj, ellipk
 
 from projeq.checks import count, positive
 from projeq.constraints.tangent import TangentSystem
+from projeq.forces import JointForce, SpringDamper
 from projeq.joints import Prismatic, Revolute
 from projeq.scenes.mechanisms import slender_rod
-from projeq.subsystems import Frame, PointMass, RigidBody
+from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody
 from projeq.system import System
 
 
@@ -157,3 +158,95 @@ def bricard(m: float = 1.0, L: float = 1.0, side: float = 0.1, g: float = 9.81, 
         return np.concatenate((r + R @ (corners[5] - corners[4]) - corners[5], R[1:, 0]))
 
     return TangentSystem(tree, phi=closure, q0=np.zeros(tree.n_q), **options)
+
+
+# Andrews' squeezing mechanism: the data of Hairer & Wanner, "Solving Ordinary Differential Equations II",
+# 2nd ed. (1996), §VII.7, Table 7.1 (after Schiehlen, "Multibody Systems Handbook", 1990): lengths in m
+ANDREWS = dict(
+    m=(0.04325, 0.00365, 0.02373, 0.00706, 0.07050, 0.00706, 0.05498),  # bodies 1..7: β Θ γ Φ δ Ω ε
+    I=(2.194e-6, 4.410e-7, 5.255e-6, 5.667e-7, 1.169e-5, 5.667e-7, 1.912e-5),
+    xa=-0.06934, ya=-0.00227, xb=-0.03635, yb=0.03273, xc=0.014, yc=0.072,
+    d=28e-3, da=115e-4, e=2e-2, ea=1421e-5, rr=7e-3, ra=92e-5, ss=35e-3, sa=1874e-5, sb=1043e-5,
+    sc=18e-3, sd=2e-2, ta=2308e-5, tb=916e-5, u=4e-2, ua=1228e-5, ub=449e-5, zf=2e-2, zt=4e-2, fa=1421e-5,
+    c0=4530.0, l0=7785e-5, mom=33e-3,
+)
+# the consistent initial angles of Hairer & Wanner (β, Θ, γ, Φ, δ, Ω, ε), at rest
+ANDREWS_Q0 = (-0.0617138900142764496358948458001, 0.0, 0.455279819163070380255912382449,
+              0.222668390165885884674473185609, 0.487364979543842550225598953530,
+              -0.222668390165885884674473185609, 1.23054744454982119249735015568)
+ANDREWS_ANGLES = ("beta", "theta", "gamma", "phi", "delta", "omega", "epsilon")
+
+
+def andrews_squeezer(**options) -> TangentSystem:
+    """IFToMM A03: Andrews' squeezing mechanism, seven planar bodies driven by the torque mom on the
+    crank β against a spring (stiffness c0, rest length l0) from the triangle γ to the ground point
+    C; no gravity (Hairer & Wanner 1996, §VII.7, data of :data:`ANDREWS`). The tree: the crank
+    ``beta`` about O with ``theta`` at its end (angle Θ relative), the triangle ``gamma`` about B,
+    ``delta`` and ``epsilon`` about A with ``phi`` and ``omega`` on them (relative angles Φ, Ω);
+    the three ends of theta, gamma, phi and omega meet at point E (six closure rows, mobility 1).
+    The subsystems are named after Hairer & Wanner's angles (:data:`ANDREWS_ANGLES`), each the one
+    coordinate of its joint; starts at rest at their consistent angles (:data:`ANDREWS_Q0`).
+    ``options`` go to :class:`~projeq.constraints.tangent.TangentSystem`."""
+    a = ANDREWS
+    m, I = dict(zip(ANDREWS_ANGLES, a["m"])), dict(zip(ANDREWS_ANGLES, a["I"]))
+    centre = {"beta": (a["ra"], 0.0), "theta": (-a["da"], 0.0), "gamma": (a["sb"], -a["sa"]),
+              "delta": (a["ta"], a["tb"]), "phi": (0.0, a["ea"] - a["e"]), "epsilon": (-a["ub"], -a["ua"]),
+              "omega": (a["zf"] - a["fa"], 0.0)}
+    joints = {"beta": Revolute(axis="z"), "theta": Revolute(parent="beta", axis="z", r_pn=(a["rr"], 0.0, 0.0)),
+              "gamma": Revolute(axis="z", r_pn=(a["xb"], a["yb"], 0.0)),
+              "delta": Revolute(axis="z", r_pn=(a["xa"], a["ya"], 0.0)),
+              "phi": Revolute(parent="delta", axis="z", r_pn=(a["zt"], 0.0, 0.0)),
+              "epsilon": Revolute(axis="z", r_pn=(a["xa"], a["ya"], 0.0)),
+              "omega": Revolute(parent="epsilon", axis="z", r_pn=(0.0, -a["u"], 0.0))}
+    bodies = {name: PlanarBody(m[name], (*centre[name], 0.0), I[name], plane="xy") for name in joints}
+    forces = [JointForce("beta", [a["mom"]]),
+              SpringDamper("gamma", (a["sd"], -a["sc"], 0.0), None, (a["xc"], a["yc"], 0.0), a["c0"], length=a["l0"])]
+    tree = System(bodies, joints, forces=forces)
+    column = {name: tree.q_slice[tree.index(name)].start for name in ANDREWS_ANGLES}
+
+    def closure(q, t):  # point E from theta minus E from gamma, from phi and from omega (x, y rows)
+        beta, theta, gamma, phi, delta, omega, epsilon = (q[column[name]] for name in ANDREWS_ANGLES)
+        e_x = a["rr"] * np.cos(beta) - a["d"] * np.cos(beta + theta)
+        e_y = a["rr"] * np.sin(beta) - a["d"] * np.sin(beta + theta)
+        return [e_x - a["xb"] - a["ss"] * np.sin(gamma), e_y - a["yb"] + a["ss"] * np.cos(gamma),
+                e_x - a["xa"] - a["zt"] * np.cos(delta) - a["e"] * np.sin(phi + delta),
+                e_y - a["ya"] - a["zt"] * np.sin(delta) + a["e"] * np.cos(phi + delta),
+                e_x - a["xa"] - a["u"] * np.sin(epsilon) - a["zf"] * np.cos(omega + epsilon),
+                e_y - a["ya"] + a["u"] * np.cos(epsilon) - a["zf"] * np.sin(omega + epsilon)]
+
+    q0 = np.zeros(tree.n_q)
+    q0[[column[name] for name in ANDREWS_ANGLES]] = ANDREWS_Q0
+    return TangentSystem(tree, phi=closure, q0=q0, independent=[tree.s_slice[tree.index("beta")].start],
+                         **options)
+
+
+def andrews_angles(system, q) -> np.ndarray:
+    """The rows of q as Hairer & Wanner's angles (β, Θ, γ, Φ, δ, Ω, ε) (the same for ṡ_tree)."""
+    return np.atleast_2d(q)[:, [system.tree.q_slice[system.tree.index(name)].start for name in ANDREWS_ANGLES]]
+
+
+# the published reference solution at t = 0.03 s (t, angles (β, Θ, γ, Φ, δ, Ω, ε) in rad, their rates in
+# rad/s): Mazzia & Magherini, "Test Set for IVP Solvers", release 2.4 (2008), problem "andrews",
+# computed by PSIDE at tolerance 1e-14 — the data of Hairer & Wanner 1996, §VII.7
+ANDREWS_REFERENCE = (
+    0.03,
+    np.array([0.1581077119629904e+02, -0.1575637105984298e+02, 0.4082224013073101e-01, -0.5347301163226948e+00,
+              0.5244099658805304e+00, 0.5347301163226948e+00, 0.1048080741042263e+01]),
+    np.array([0.1139920302151208e+04, -0.1424379294994111e+04, 0.1103291221937134e+02, 0.1929337464421385e+02,
+              0.5735699284790808e+00, -0.1929337464421385e+02, 0.3231791658026955e+00]),
+)
+
+
+def andrews_error(system, q, s_dot) -> float:
+    """The largest relative difference of the angles and rates at q, ṡ (the state at
+    ANDREWS_REFERENCE[0]) from the published reference solution."""
+    t, angles, rates = ANDREWS_REFERENCE
+    ours = andrews_angles(system, q)[0], andrews_angles(system, system.tree_velocities(q, s_dot))[0]
+    return float(max(np.abs(x / ref - 1).max() for x, ref in zip(ours, (angles, rates))))
+
+
+def andrews_balance(system, r) -> np.ndarray:
+    """T + V − E₀ − mom (β − β₀) along a Result of :func:`andrews_squeezer`: the energy balance of the
+    benchmark (zero: the drive's work goes into the mechanism's energy)."""
+    energy, beta = r.kinetic + r.potential, andrews_angles(system, r.q)[:, 0]
+    return energy - energy[0] - ANDREWS["mom"] * (beta - beta[0])
