@@ -44,11 +44,11 @@ def why_not_compiled(system) -> str | None:
 
 def pick(system) -> tuple[str, str]:
     """(name, reason): the evaluator "auto" picks for ``system`` and why (module docstring)."""
+    if hub_beam_unsupported(system) is None:
+        return "hub_beam", "one RitzBeam on a prescribed or fixed hub"
     why_not_fast = why_not_compiled(system)
     if why_not_fast is None:
         return "fast", "the compiled order-n kernel knows every joint, subsystem and force law"
-    if hub_beam_unsupported(system) is None:
-        return "hub_beam", "one RitzBeam on a prescribed or fixed hub"
     return ("dense" if system.coupled else "recursive"), f"the fast kernel cannot evaluate it: {why_not_fast}"
 
 
