@@ -77,8 +77,8 @@ class FastEvaluator:
         self.system = system
         self.n_calls = 0
         self.compiled = bool(compiled)
-        self._chain_terms, self._passes = kernels.kernel(self.compiled)
         self._pack(system)
+        self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=bool(np.all(self._n_y == 6)))
 
     def _pack(self, system) -> None:
         """Flat arrays of the tree (built once) and the workspace; bodies are padded to the
