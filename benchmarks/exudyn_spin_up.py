@@ -8,8 +8,8 @@ Exudyn's beam is clamped at the hub axis by four coordinate constraints on its f
 position (0, 0) and slope (cos θ(t), sin θ(t)) with θ(t) of ``spin_up_motion``, the
 offsets set once per step by a PreStepUserFunction (Exudyn's recommendation for
 prescribed motion). Its Newton absolute tolerance is raised from 1e-10 to 1e-6 N (see
-``exudyn_tip_deflection``); with the default it cuts its steps to 1e-6 s and needs ~50×
-the CPU time. Its beam is extensible (EA = 2.8e7 N) and its curvature is exact; projeq's
+``projeq.studies.bench_peers.exudyn_tip_deflection``, the model); with the default it cuts its
+steps to 1e-6 s and needs ~50× the CPU time. Its beam is extensible (EA = 2.8e7 N) and its curvature is exact; projeq's
 default is inextensible with the linear curvature v″ and the second-order axial field u₂
 (docs/theory.md §10). ``--study`` adds Exudyn runs with 32 elements and h = 5e-4 (its discretisation
 error). Measured: Exudyn differs from projeq's reference by 2.9e-4 m at Ωs = 4, 3.3e-5 m at
@@ -41,62 +41,15 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).parent))
 from beam_convergence import FASTEST, QUICK_REFERENCE, REFERENCE, TIMES, tip_deflection
 
-from projeq.scenes.elastic import spin_up_motion
+from projeq.studies import bench_peers
 
-OMEGA_S, T_S, LENGTH, EI, EA, RHO_A = 4.0, 15.0, 10.0, 1.4e4, 2.8e7, 1.2  # spin_up_beam's defaults
+OMEGA_S = 4.0
 
 
-def exudyn_tip_deflection(omega_s: float = OMEGA_S, n_elements: int = 16, h: float = 1e-3, axial_stiffness: float = EA,
-                          newton_atol: float = 1e-6) -> tuple[np.ndarray, float]:
-    """v(L, t) at TIMES by Exudyn and the CPU time of its time integration."""
-    import exudyn as exu
-    from exudyn.beams import GenerateStraightLineANCFCable2D
-    from exudyn.itemInterface import CoordinateConstraint, MarkerNodeCoordinate, ObjectANCFCable2D, SensorNode
-    from exudyn.solver import SolveDynamic
-
-    motion = spin_up_motion(omega_s, T_S)
-    SC = exu.SystemContainer()
-    mbs = SC.AddSystem()
-    template = ObjectANCFCable2D(physicsMassPerLength=RHO_A, physicsBendingStiffness=EI, physicsAxialStiffness=axial_stiffness)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)  # renamed in Exudyn 1.11, same elements
-        nodes = GenerateStraightLineANCFCable2D(mbs, [0, 0, 0], [LENGTH, 0, 0], n_elements, template)[0]
-    ground = mbs.AddNode(exu.itemInterface.NodePointGround())
-    ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
-    # node 0's coordinates are displacements from the reference (0, 0, 1, 0) of (x, y, x', y'):
-    # position held at the axis, slope (cos θ, sin θ) following the hub
-    clamp = [
-        mbs.AddObject(CoordinateConstraint(markerNumbers=[ground_marker, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=nodes[0], coordinate=k))]))
-        for k in range(4)
-    ]
-
-    def follow_hub(mbs_, t):  # t is the end of the step (Exudyn's PreStepUserFunction)
-        theta = motion(t)[0]
-        mbs_.SetObjectParameter(clamp[2], "offset", np.cos(theta) - 1.0)
-        mbs_.SetObjectParameter(clamp[3], "offset", np.sin(theta))
-        return True
-
-    mbs.SetPreStepUserFunction(follow_hub)
-    tip = mbs.AddSensor(SensorNode(nodeNumber=nodes[-1], storeInternal=True, outputVariableType=exu.OutputVariableType.Position))
-    mbs.Assemble()
-    settings = exu.SimulationSettings()
-    settings.timeIntegration.numberOfSteps = round(float(TIMES[-1]) / h)
-    settings.timeIntegration.endTime = float(TIMES[-1])
-    settings.timeIntegration.verboseMode = 0
-    # the residual of the axially stiff beam at rest is EA × round-off ≈ 3e-9 N, above Exudyn's
-    # default absolute tolerance 1e-10 (Newton then "fails" and cuts the step to 1e-6 s, 50× the
-    # CPU time); 1e-6 N is 1e-9 of the centrifugal root force ρAΩs²L²/2 ≈ 960 N
-    settings.timeIntegration.newton.absoluteTolerance = newton_atol
-    settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = h
-    started = time.process_time()
-    SolveDynamic(mbs, settings, exu.DynamicSolverType.GeneralizedAlpha)
-    cpu = time.process_time() - started
-    data = mbs.GetSensorStoredData(tip)  # rows (t, x, y, z)
-    rows = [np.argmin(np.abs(data[:, 0] - t)) for t in TIMES]
-    theta = np.array([motion(t)[0] for t in TIMES])
-    x, y = data[rows, 1], data[rows, 2]
-    return -np.sin(theta) * x + np.cos(theta) * y, cpu
+def exudyn_tip_deflection(omega_s: float = OMEGA_S, **options) -> tuple[np.ndarray, float]:
+    """v(L, t) at TIMES by Exudyn and the CPU time of its time integration
+    (:func:`projeq.studies.bench_peers.exudyn_tip_deflection`)."""
+    return bench_peers.exudyn_tip_deflection(omega_s, TIMES, **options)
 
 
 def _projeq(knobs: dict) -> tuple[np.ndarray, float]:

@@ -250,7 +250,7 @@ class JointSpring(JointForce):
 
     def potential(self, kin, q) -> float:
         dq = self._q(q) - self._q_ref
-        return 0.5 * self.stiffness * float(dq @ dq)
+        return 0.5 * self.stiffness * (dq @ dq)
 
 
 class SpringDamper(ForceLaw):
@@ -304,7 +304,7 @@ class SpringDamper(ForceLaw):
 
     def potential(self, kin, q) -> float:
         (x_a, _), (x_b, _) = self._ends(kin)
-        return 0.5 * self.stiffness * (np.linalg.norm(x_b - x_a) - self.length) ** 2
+        return 0.5 * self.stiffness * (norm(x_b - x_a) - self.length) ** 2
 
     def symbolic_unsupported(self) -> str | None:
         return None

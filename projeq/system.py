@@ -455,7 +455,7 @@ class System(Model):
 
     def normalized(self, q: NDArray) -> NDArray:
         """q with every joint's coordinates projected onto their manifold (unit quaternions)."""
-        q = np.array(q, dtype=float)
+        q = numeric(np.array(q))  # complex under a complex step (the energy projection's exact gradient)
         for n, joint in enumerate(self.joints):
             sl = slice(self.q_slice[n].start, self.e_q_slice[n].start)
             if sl.stop > sl.start:
@@ -577,17 +577,20 @@ class System(Model):
         return self.gauss_form(q, np.zeros(self.n_s), t)[0]
 
     def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:
-        """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and gravity plus springs."""
+        """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and gravity plus springs; complex for
+        complex (q, ṡ) (unchecked then: a complex step, as for the exact energy gradient of
+        :mod:`projeq.simulation.integrators`)."""
         from projeq.assembly.kinematics import poses
 
-        q, s_dot = self.check_state(q, s_dot, t)
-        kin = poses(self, q, s_dot, float(t))
+        complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot) or np.iscomplexobj(t)
+        q, s_dot = (np.asarray(q), np.asarray(s_dot)) if complex_step else self.check_state(q, s_dot, t)
+        kin = poses(self, q, s_dot, t if complex_step else float(t))
         q_e = [q[sl] for sl in self.e_q_slice]
         kinetic = sum(sub.kinetic_energy(kin.y_dot[n], q_e[n]) for n, sub in enumerate(self.subsystems))
         potential = sum(
             sub.potential_energy(kin.R[n], kin.r[n], self.gravity, q_e[n]) for n, sub in enumerate(self.subsystems)
         ) + sum(f.potential(kin, q) for f in self.forces)
-        return float(kinetic), float(potential)
+        return (complex(kinetic), complex(potential)) if complex_step else (float(kinetic), float(potential))
 
     def _check_planar(self) -> None:
         """A subsystem with a selection S must not be driven out of its plane by its joint

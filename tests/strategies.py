@@ -399,3 +399,21 @@ def trees(
     system = pq.System(subsystems, joints, gravity=gravity, forces=[f for f in laws if f is not None])
     q, s_dot, t = random_state(system, rng)
     return Tree(system, q, s_dot, t, joint_kinds, parents, force_kinds, seed, planar, rng)
+
+
+def with_couplings(tree: Tree, n_coupled: int = 3) -> pq.System:
+    """``tree``'s System with up to ``n_coupled`` more bodies on revolute or prismatic joints
+    (random axes and frames) that are *coupled*: each follows Σ ratio · coordinate of one or
+    two of the tree's own revolute or prismatic joints (gears, ropes: shared minimal
+    velocities, docs/theory.md §4); the tree itself unchanged if it has no such joint."""
+    system, rng = tree.system, tree.rng
+    leaders = [name for name, kind in zip(system.names, tree.kinds) if kind in ("revolute", "prismatic")]
+    subsystems, joints = dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints))
+    for i in range(n_coupled if leaders else 0):
+        name, parent = f"c{i}", str(rng.choice(list(subsystems)))
+        m = random_mass(rng)
+        subsystems[name] = pq.RigidBody(m, rng.uniform(-0.5, 0.5, 3), random_inertia(rng, m))
+        follows = {str(leader): float(rng.uniform(-2, 2)) for leader in rng.choice(leaders, min(2, len(leaders)))}
+        kind = pq.Revolute if rng.random() < 0.5 else pq.Prismatic
+        joints[name] = kind(parent, unit_vector(rng), rng.uniform(-1, 1, 3), random_rotation(rng), coupling=follows)
+    return pq.System(subsystems, joints, gravity=system.gravity, forces=system.forces)

@@ -487,6 +487,9 @@ def _load(tmp_path, kind):
         np.savez(path, a=np.arange(3))
     elif kind == "random":
         path.write_bytes(np.random.default_rng(0).bytes(500))
+    elif kind == "pickled":  # numpy's own format, holding a pickled object
+        path = tmp_path / "run.npy"
+        np.save(path, np.array([object()], dtype=object))
     else:
         result = pq.simulate(_pendulum(), 0.1, n_points=5)
         if kind == "inconsistent":
@@ -503,6 +506,7 @@ BAD_INPUT = [
     ("simulate-misspelt-option", lambda tmp: _run(_pendulum(), max_stepp=0.1), ValueError,
      r"options: unknown option \['max_stepp'\] .* \(did you mean 'max_step'\?\); it takes \['first_step', 'max_step'\]"),
     ("simulate-rtol-above-1", lambda tmp: _run(_pendulum(), rtol=5.0), ValueError, r"^rtol: .* below 1"),
+    ("simulate-rtol-1", lambda tmp: _run(_pendulum(), rtol=1.0), ValueError, r"^rtol: .* below 1 .*got 1.0"),
     ("simulate-a-name", lambda tmp: pq.simulate("chain", 1.0), ValueError, r"^system: expected a System"),
     ("prescribed-nan", lambda tmp: _run(_prescribed(lambda t: (np.nan, 0.0, 0.0))), ValueError,
      r"^motion: the prescribed motion .*<lambda> returned .*nan.* at t = 0; they must be finite"),
@@ -511,6 +515,7 @@ BAD_INPUT = [
     ("prescribed-scalar", lambda tmp: _prescribed(lambda t: 0.1 * t), ValueError,
      r"^motion: .* must return three numbers \(θ, θ̇, θ̈\) at t = 0, got 0.0"),
     ("prescribed-malformed-text", lambda tmp: _prescribed("sin(t"), ValueError, r"^motion: cannot read 'sin\(t'"),
+    ("prescribed-unknown-symbol", lambda tmp: _prescribed("sin(w*t)"), ValueError, r"^motion: depends on \['w'\]; only t"),
     ("event-signature", lambda tmp: _run(_pendulum(), events=lambda t, x: x[0]), ValueError,
      r"^events\[0\] .*: calling it as event\(t, q, s_dot\) at t = 0.0 failed"),
     ("event-nan", lambda tmp: _run(_pendulum(), events=lambda t, q, s_dot: np.nan), ValueError,
@@ -547,6 +552,7 @@ BAD_INPUT = [
     ("load-foreign", lambda tmp: _load(tmp, "foreign"), ValueError, r"^path: .* is not a projeq Result .* lacks \['meta'"),
     ("load-random", lambda tmp: _load(tmp, "random"), ValueError, r"^path: .* is not a projeq Result"),
     ("load-truncated", lambda tmp: _load(tmp, "truncated"), ValueError, r"^path: .* is a truncated or damaged archive"),
+    ("load-pickled-npy", lambda tmp: _load(tmp, "pickled"), ValueError, r"^path: .*run.npy' is not a projeq Result"),
     ("load-inconsistent", lambda tmp: _load(tmp, "inconsistent"), ValueError,
      r"^path: .* is inconsistent: t has shape \(5,\) but \{'q': \(3, 1\)\}"),
 ]
@@ -566,3 +572,46 @@ def test_sweep_output_out_of_range_is_named_per_point():
     table = pq.sweep("chain", grid={"n": [2, 3]}, outputs=["q2"], t_end=0.01, progress=False, workers=1)
     assert table["status"].tolist() == [-1, 0]
     assert table["error"][0] == "ValueError: outputs: 'q2' asks for q[2], but this point's model has 2 (q0 … q1)"
+
+
+def _slip_after_half_a_second(q, q_dot, t):
+    """A velocity constraint's residual that fails after 0.5 s (a slip model out of its range)."""
+    if t > 0.5:
+        raise RuntimeError("the slip model is undefined here")
+    return [q_dot[0]]
+
+
+def _circle_until_x_below(limit):
+    """Φ = |r| − 1 of a pendulum on two sliders, failing once x drops below ``limit``."""
+    def circle(q, t):
+        if np.real(q[0]) < limit:
+            raise RuntimeError("the circle is left")
+        return [np.hypot(q[0], q[1]) - 1.0]
+    return circle
+
+
+def _sliding_pendulum(phi):
+    tree = pq.System({"x": pq.Frame(), "bob": pq.PointMass(1.0)},
+                     {"x": pq.Prismatic(axis="x"), "bob": pq.Prismatic(parent="x", axis="z")}, gravity=(0, 0, -9.81))
+    return pq.ConstrainedSystem(tree, phi=phi, q0=[0.6, -0.8], independent=[0])
+
+
+@pytest.mark.parametrize("system, words, t_kept", [
+    (pq.System({"d": pq.RigidBody(**ROD)}, {"d": _slider(constraints=_slip_after_half_a_second, n_c=1)}),
+     r"^integration failed at t = 0\.6 s .*constraints: _slip_after_half_a_second raised RuntimeError: "
+     r"the slip model is undefined here at t = 0\.6.*the trajectory up to t = 0\.5 s is in \.result", 0.5),
+    (_sliding_pendulum(_circle_until_x_below(0.3)),
+     r"^integration failed at t = 0\.3\d* s .*RuntimeError in _circle_until_x_below.<locals>.circle \(.*test_bad_input.py:\d+\): the circle is "
+     r"left; the trajectory up to t = 0\.3 s is in \.result", 0.3),
+], ids=["user-joint-residual", "constrained-system-phi"])
+def test_a_constraint_function_that_raises_late_fails_the_run_and_keeps_the_trajectory(system, words, t_kept):
+    """A constraint function that raises only late in the run: a UserJoint's residual function
+    (evaluated for the output rows, after the integration) and a ConstrainedSystem's Φ (in the
+    right-hand side). Either way a SimulationError naming the function and the time, with the
+    rows before it in ``.result`` (issue 20: the residual's failure lost the whole run)."""
+    with pytest.raises(pq.SimulationError, match=words) as info:
+        pq.simulate(system, 1.0, n_points=11)
+    result = info.value.result
+    assert result.status == -1 and np.allclose(result.t, np.arange(0.0, t_kept + 0.05, 0.1))
+    assert np.all(np.isfinite(result.q)) and result.constraint_residual.shape == (len(result.t), 1)
+    assert isinstance(info.value.__cause__, (ValueError, RuntimeError))

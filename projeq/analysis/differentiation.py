@@ -126,14 +126,14 @@ def _unit(v: NDArray) -> tuple[NDArray, float]:
     return (v / n if n else v), n
 
 
-def _mixed(f, a: NDArray, u: NDArray, w: NDArray) -> NDArray:
-    """f″(a)(u, w) for real a, u, w: the complex step along w (exact) inside Richardson's
-    stencil along u, both directions normalised, so the error is relative to |f″| whatever
-    the sizes of u and w."""
+def _mixed(f, a: NDArray, u: NDArray, w: NDArray, step: float = MIXED_STEP) -> NDArray:
+    """f″(a)(u, w) for real a, u, w: the complex step along w (exact) inside the sixth-order
+    stencil along u with ``step``, both directions normalised, so the error is relative to
+    |f″| whatever the sizes of u and w."""
     (u_hat, nu), (w_hat, nw) = _unit(u), _unit(w)
     if not nu or not nw:
         return np.zeros_like(np.real(f(a)))
-    return nu * nw * sixth_order(lambda e: complex_step(lambda s: f(a + e * u_hat + s * w_hat)), MIXED_STEP)
+    return nu * nw * sixth_order(lambda e: complex_step(lambda s: f(a + e * u_hat + s * w_hat)), step)
 
 
 def _third(f, a: NDArray, b: NDArray, u: NDArray, w: NDArray) -> NDArray:
@@ -164,14 +164,15 @@ def derivative_along(f, x: NDArray, v: NDArray) -> NDArray:
     return value + 1j * (_mixed(f, a, b, c) + (complex_step(lambda s: f(a + s * d)) if d.any() else 0.0))
 
 
-def second_derivative_along(f, x: NDArray, u: NDArray, w: NDArray) -> NDArray:
-    """f″(x)(u, w) to ≈ 1e-14 relative for real arguments (MIXED_STEP) (:func:`_mixed`); for
-    x, u, w carrying an outer complex step, its first-order imaginary part
+def second_derivative_along(f, x: NDArray, u: NDArray, w: NDArray, step: float = MIXED_STEP) -> NDArray:
+    """f″(x)(u, w) to ≈ 1e-14 relative for real arguments (:func:`_mixed`; ``step`` of its
+    stencil on unit directions, default MIXED_STEP, smaller for an f whose higher derivatives
+    are large); for x, u, w carrying an outer complex step, its first-order imaginary part
     f‴(a)(b, Re u, Re w) + f″(a)(Im u, Re w) + f″(a)(Re u, Im w) by two real stencils around
     the complex step (≈ 1e-10 relative)."""
     x, u, w = np.asarray(x), np.asarray(u), np.asarray(w)
     a, b = np.real(x), np.imag(x)
-    value = _mixed(f, a, np.real(u), np.real(w))
+    value = _mixed(f, a, np.real(u), np.real(w), step)
     if not (b.any() or np.imag(u).any() or np.imag(w).any()):
         return value
     outer = _third(f, a, b, np.real(u), np.real(w)) + _mixed(f, a, np.imag(u), np.real(w)) \
@@ -194,7 +195,7 @@ def exact_jacobian(f, z0: NDArray) -> NDArray:
     with warnings.catch_warnings():  # a cast that drops the imaginary part must not pass silently
         warnings.simplefilter("error", np.exceptions.ComplexWarning)
         columns = [complex_step(lambda s, e=e: f(z0 + s * e)) for e in unit]
-    n_f = len(np.atleast_1d(np.real(f(z0))))
+    n_f = np.size(columns[0]) if columns else len(np.atleast_1d(np.real(f(z0))))  # f(z0) only for its size
     return np.array(columns).T.reshape(n_f, len(z0))
 
 

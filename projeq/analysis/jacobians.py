@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import exact_jacobian, jacobian
+from projeq.assembly.beam_fast import hub_beam_unsupported
 
 DERIVATIVES = ("exact", "differences")
 
@@ -59,10 +60,14 @@ def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, i
 
 
 def interpreted_evaluator(system):
-    """The model's interpreted evaluator, which takes complex arguments (the compiled one does
-    not): recursive, or dense for coupled joints; a ConstrainedSystem's default."""
+    """The model's evaluator that takes complex arguments (the compiled kernel does not): the
+    beam-on-a-hub path where it applies (numpy, :mod:`projeq.assembly.beam_fast`; 2–3× faster
+    than the general path there), else recursive, or dense for coupled joints; a
+    ConstrainedSystem's default."""
     if system.tree is not system:
         return system.evaluator(None)
+    if hub_beam_unsupported(system) is None:
+        return system.evaluator("hub_beam")
     return system.evaluator("dense" if system.coupled else "recursive")
 
 

@@ -1,7 +1,8 @@
 """``method="auto"``, the default evaluator: the best evaluator available for a System, picked once.
 
 In this order: ``"fast"`` (the compiled order-n kernel, :mod:`projeq.assembly.fast`) when
-the kernel knows every joint, subsystem and force law; ``"hub_beam"``
+the kernel knows every subsystem (rigid bodies, spatial or planar, on any joint, coupled
+ones included, under any force law); ``"hub_beam"``
 (:mod:`projeq.assembly.beam_fast`) for one RitzBeam on a prescribed or fixed hub; else the
 reference evaluators, ``"dense"`` when joints share minimal velocities (coupled) and
 ``"recursive"`` otherwise, with one :class:`InterpretedWarning` per System naming the piece
@@ -11,14 +12,21 @@ says what it chose (``name``, ``reason``). The compiled kernel is compiled on it
 use and cached on disk (numba's ``cache=True``): a fresh environment pays the compilation
 once (``projeq bench`` reports the first-call latency), later processes load it.
 
->>> import warnings, projeq as pq
+>>> import warnings, numpy as np, projeq as pq
+>>> AutoEvaluator(pq.scenes.atwood()).name  # coupled joints: compiled
+'fast'
+>>> class Own(pq.RigidBody):  # its own gauss_terms: the kernel cannot know what they compute
+...     def gauss_terms(self, y_dot, R, gravity, q_e=None):
+...         return super().gauss_terms(y_dot, R, gravity, q_e)
+>>> system = pq.System({"rod": Own(1.0, (0, 0, -0.5), np.eye(3) / 12)}, {"rod": pq.Revolute(axis="y")}, gravity=(0, 0, -9.81))
 >>> with warnings.catch_warnings(record=True) as said:
 ...     warnings.simplefilter("always")
-...     ev = AutoEvaluator(pq.scenes.atwood())
->>> ev.name, ev.reason
-('dense', "the fast kernel cannot evaluate it: joint 'mass1' is coupled (shared minimal velocities)")
+...     ev = AutoEvaluator(system)
+>>> ev.name
+'recursive'
 >>> [str(w.message) for w in said]  # doctest: +NORMALIZE_WHITESPACE
-["system: evaluated by the interpreted 'dense' evaluator, not the compiled one: joint 'mass1' is coupled (shared minimal velocities)"]
+["system: evaluated by the interpreted 'recursive' evaluator, not the compiled one: subsystem 'rod' is a
+Own (the kernel knows the terms of rigid bodies, rigid_inertia, spatial or selected by S)"]
 """
 
 from __future__ import annotations

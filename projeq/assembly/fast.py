@@ -9,21 +9,31 @@ disk); ``method="fast"`` is this kernel or a ValueError saying why not (numba mi
 a piece of the system the kernel does not know). ``compiled=False`` runs the same kernel
 source interpreted (for testing: correct, but slower than the recursive evaluator).
 ``method="auto"`` (:mod:`projeq.assembly.auto`) picks this evaluator where it can, and
-another one where it cannot.
+another one where it cannot. :meth:`FastEvaluator.gauss_form` gives M(q) and b of the
+Gauss form from the same terms (:func:`projeq.assembly.kernels.gauss_form`, composite
+bodies and Newton–Euler, compiled), for coupled joints and for the constrained models of
+:mod:`projeq.constraints`, which project it.
 
-Supported: trees of subsystems with rigid-body terms and no selection (``rigid_inertia``
-and ``S = None``: :class:`~projeq.RigidBody`, :class:`~projeq.PointMass`, :class:`~projeq.Frame`)
-on any uncoupled joint: the kernel computes the relative motion of the joints whose
-``compiled_kind`` it has (:class:`~projeq.Revolute`, :class:`~projeq.Prismatic`,
-:class:`~projeq.Fixed`); every other joint (Planar, Free, Spherical, Screw, Prescribed,
-UserJoint — non-holonomic ones too) states it by its own ``relative`` before each call, which
-the kernel reads (kind ``GIVEN``, 0–6 minimal velocities). Under gravity and any force laws:
-between the compiled kinematics and the compiled passes each law adds its loads by its own
-``add_to`` (the one statement the reference evaluators call) to the kernel's h_n, reading
-poses, twists, F_n and T̃_np from the kernel's workspace. One :class:`~projeq.RitzBeam` on a
-prescribed or fixed hub has its own fast evaluator, ``method="hub_beam"``
-(:mod:`projeq.assembly.beam_fast`); any other system (beams in chains, planar bodies,
-coupled joints) is refused with the piece named: it is evaluated by the reference ones
+Supported: trees of subsystems with rigid-body terms (``rigid_inertia``: :class:`~projeq.RigidBody`,
+:class:`~projeq.PointMass`, :class:`~projeq.Frame`, and :class:`~projeq.PlanarBody`, whose
+selection S the kernel does not apply: the spatial terms of the same body, projected on
+joint velocities that keep it in its plane — which the System checks when it is built —
+give the same equations as the selected ones, docs/theory.md §3) on any joint: the kernel
+computes the relative motion of the joints whose ``compiled_kind`` it has
+(:class:`~projeq.Revolute`, :class:`~projeq.Prismatic`, :class:`~projeq.Fixed`); every
+other joint (Planar, Free, Spherical, Screw, Prescribed, UserJoint — non-holonomic ones
+too) states it by its own ``relative`` before each call, which the kernel reads (kind
+``GIVEN``, 0–6 minimal velocities). Coupled joints (gears, ropes: shared minimal
+velocities) are evaluated in every joint's own velocities ṡ_all = P ṡ and projected,
+M = Pᵀ M_all P, b = Pᵀ b_all (B(14) with ∂ṡ_all/∂ṡ = P), by the compiled Gauss form.
+Under gravity and any force laws: between the compiled kinematics and the compiled passes
+each law adds its loads by its own ``add_to`` (the one statement the reference evaluators
+call) to the kernel's h_n, reading poses, twists, F_n and T̃_np from the kernel's
+workspace (in the selected coordinates of the bodies that have a selection S, whose loads
+are then carried back by Sᵀ). One :class:`~projeq.RitzBeam` on a prescribed or fixed hub
+has its own fast evaluator, ``method="hub_beam"`` (:mod:`projeq.assembly.beam_fast`);
+any other subsystem without rigid-body terms (beams in chains, a subsystem that overrides
+``gauss_terms``) is refused with the piece named: it is evaluated by the reference ones
 (recursive, or dense for coupled joints).
 
 >>> import numpy as np, projeq as pq
@@ -38,18 +48,21 @@ True
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numpy.typing import NDArray
 
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import hub_beam_unsupported
-from projeq.assembly.kinematics import Kinematics
+from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.subsystems.rigid import rigid_mass_matrix
 
 
 class FastEvaluator:
-    """s̈ of one System by the order-n kernel.
+    """s̈ of one System by the order-n kernel, and its Gauss form by the compiled
+    composite-body kernel.
 
     Parameters
     ----------
@@ -77,6 +90,7 @@ class FastEvaluator:
         self.system = system
         self.n_calls = 0
         self.compiled = bool(compiled)
+        self._gauss_form, self._projected_accelerations = kernels.gauss_form_kernel(self.compiled)
         self._pack(system)
         self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=bool(np.all(self._n_y == 6)))
 
@@ -95,8 +109,14 @@ class FastEvaluator:
         self._orientation = np.array([j.orientation for j in joints])
         ports = system.plan.port
         self._offset = np.array([np.zeros(3) if ports[n] else j.r_pn for n, j in enumerate(joints)])
-        self._q_index = np.array([system.q_slice[n].start for n in range(N)], dtype=np.int64)
-        self._s_index = np.array([system.s_slice[n].start for n in range(N)], dtype=np.int64)
+        # every joint's own coordinates and velocities (and a body's internal ones after them), in
+        # the order of the joints (q and ṡ themselves unless joints are coupled: then q_all = P_q q,
+        # ṡ_all = P ṡ)
+        self._q_index = np.cumsum([0] + [j.n_q + b.n_e for j, b in zip(joints[:-1], bodies)], dtype=np.int64)
+        self._s_index = np.cumsum([0] + [k for k in self._n_cols[:-1]], dtype=np.int64)
+        self._expansion = _expansion(system) if system.coupled else None
+        n_all = int(self._n_cols.sum())
+        self._M_all, self._b_all, self._M = np.zeros((n_all, n_all)), np.zeros(n_all), np.zeros((system.n_s,) * 2)
         rigid = [b.rigid_inertia or (0.0, np.zeros(3), np.zeros((3, 3))) for b in bodies]
         self._m, self._r_c, self._I_c = (np.array(part) for part in zip(*rigid))
         self._elastic, self._ports = _elastic_fields(system), _port_fields(system)
@@ -105,55 +125,113 @@ class FastEvaluator:
         self._M_n[:, :6, :6] = [rigid_mass_matrix(*inertia) for inertia in rigid]
         self._gravity = np.asarray(system.gravity, dtype=float)
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
-        self._given_A, self._given_r = np.zeros((N, 3, 3)), np.zeros((N, 3))
-        self._given_w, self._given_zeta = np.zeros((N, 6)), np.zeros((N, 6))
+        # one row per joint for its relative_values (A, r, w, ζ, F⁶ by columns), read by the kernel
+        # through views: given_A, given_r, given_w, given_zeta and F (F[n, :, j] = column j); with
+        # elastic bodies F is wider (n_y rows, their q̇_e columns) and takes the given columns
+        values = self._given_values = np.zeros((N, 60))
+        self._given_A, self._given_r = values[:, :9].reshape(N, 3, 3), values[:, 9:12]
+        self._given_w, self._given_zeta = values[:, 12:18], values[:, 18:24]
+        self._given_F = values[:, 24:].reshape(N, 6, 6).transpose(0, 2, 1)
+        self._F = self._given_F if (width, depth) == (6, 6) else np.zeros((N, width, depth))
+        self._given_plan = [
+            (n, joints[n], slice(self._q_index[n], self._q_index[n] + joints[n].n_q),
+             slice(self._s_index[n], self._s_index[n] + joints[n].n_s), 24 + 6 * joints[n].n_s)
+            for n in self._given
+        ]
         self._T, self._zeta = np.zeros((N, width, width)), np.zeros((N, width))
-        self._F, self._M_hat, self._h_hat = np.zeros((N, width, depth)), np.zeros((N, width, width)), np.zeros((N + 1, width))
+        self._M_hat, self._h_hat = np.zeros((N, width, width)), np.zeros((N + 1, width))
         self._R, self._r, self._twist = np.zeros((N + 1, 3, 3)), np.zeros((N + 1, 3)), np.zeros((N + 1, 6))
         self._kin = _kinematics(self._n_cols, self._R, self._r, self._twist, self._F) if system.forces else None
+        self._selected = [n for n in range(N) if system.S[n] is not None]
 
-    def _relative_motions(self, q: NDArray, s_dot: NDArray, t: float) -> None:
-        """A, r, F⁶, w and ζ of the joints of kind GIVEN, by their own ``relative`` (the
-        statement the reference evaluators call)."""
-        system = self.system
-        for n in self._given:
-            rel = system.joints[n].relative(system._q_get[n](q), system._s_get[n](s_dot), t)
-            self._given_A[n], self._given_r[n], self._given_w[n], self._given_zeta[n] = rel.A, rel.r, rel.w, rel.zeta
-            self._F[n, :6, : system.joints[n].n_s] = rel.F
+    def _relative_motions(self, q_all: NDArray, s_all: NDArray, t: float) -> None:
+        """A, r, w, ζ and F⁶ of the joints of kind GIVEN, by their own ``relative_values`` (the
+        numbers of the ``relative`` the reference evaluators call), one row each."""
+        values = self._given_values
+        for n, joint, q_n, s_n, width in self._given_plan:
+            values[n, :width] = joint.relative_values(q_all[q_n], s_all[s_n], t)
+            if self._F is not self._given_F:
+                self._F[n, :6, :6] = self._given_F[n]
 
     def _add_forces(self, q: NDArray, s_dot: NDArray, t: float) -> None:
         """The force laws' own ``add_to`` (the statement the reference evaluators call) on the
-        kernel's kinematics: T̃_np = [[T_np, ζ_n], [0, 1]] is filled from the workspace."""
-        kin = self._kin
-        kin.T_aug[:-1, :6, :6] = self._T[:, :6, :6]
-        kin.T_aug[:-1, :6, 6] = self._zeta[:, :6]
-        self._h_hat[-1] = 0.0  # the ground's row: reactions land there, nothing reads them
+        kernel's kinematics: T̃_np = [[T_np, ζ_n], [0, 1]] is filled from the workspace; bodies
+        with a selection S take their loads in their own coordinates (h_n += Sᵀ h_S)."""
+        kin, h = self._kin, self._h_hat
+        kin.T_aug[:-1, :6, :6] = self._T
+        kin.T_aug[:-1, :6, 6] = self._zeta
+        h[-1] = 0.0  # the ground's row: reactions land there, nothing reads them
+        if self._selected:
+            kin, h = _SelectedKinematics(self.system, kin, s_dot), self._selected_h()
         for force in self.system.forces:
-            force.add_to(self._h_hat, kin, t, q, s_dot)
+            force.add_to(h, kin, t, q, s_dot)
+        for n in self._selected:
+            self._h_hat[n] += self.system.S[n].T @ h[n]
 
-    def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """s̈ at (q, ṡ, t) (docs/theory.md §6); raises SingularMassError for a zero pivot of D_n."""
-        self.n_calls += 1
-        q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
+    def _selected_h(self) -> list:
+        """The h_n the force laws load in the reference evaluators' coordinates: zeros of n_y
+        for selected bodies, the workspace's rows for the others, none for the ground."""
+        system = self.system
+        return [np.zeros(S.shape[0]) if S is not None else self._h_hat[n]
+                for n, S in enumerate(system.S[:-1])] + [np.zeros(0)]
+
+    def _terms(self, q: NDArray, s_dot: NDArray, t: float) -> None:
+        """T_np, ζ_n, F_n, h_n (forces included) of every body into the workspace."""
+        q_all, s_all = (q, s_dot) if self._expansion is None else (self._expansion[0] @ q, self._expansion[1] @ s_dot)
         if self._given:
-            self._relative_motions(q, s_dot, t)
+            self._relative_motions(q_all, s_all, t)
         self._chain_terms(
             self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index, self._s_index,
-            self._n_cols, self._m, self._r_c, self._I_c, self._gravity, q, s_dot,
+            self._n_cols, self._m, self._r_c, self._I_c, self._gravity, q_all, s_all,
             self._given_A, self._given_r, self._given_w, self._given_zeta, self._elastic, self._ports,
             self._T, self._zeta, self._F, self._M_n, self._h_hat[:-1], self._R, self._r, self._twist,
         )
         if self._kin is not None:
             self._add_forces(q, s_dot, t)
-        self._M_hat[:] = self._M_n
+
+    def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
+        """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels (by
+        the dense evaluator for a tree with elastic bodies, which the Gauss-form kernel does not take)."""
+        if self._M_n.shape[1] > 6:
+            return self.system.evaluator("dense").gauss_form(q, s_dot, t)
+        self.n_calls += 1
+        self._terms(np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), t)
+        return self._assembled()
+
+    def _assembled(self) -> tuple[NDArray, NDArray]:
+        """M and b of the terms in the workspace: :func:`projeq.assembly.kernels.gauss_form` in
+        every joint's own velocities, projected with P for coupled joints."""
+        M, b = self._M_all, self._b_all
+        self._gauss_form(self._n_cols, self._parent, self._s_index, self._T, self._zeta, self._F,
+                         self._M_n, self._h_hat, M, b)
+        if self._expansion is None:
+            return M.copy(), b.copy()
+        P = self._expansion[1]
+        return P.T @ M @ P, P.T @ b
+
+    def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
+        """s̈ at (q, ṡ, t) (docs/theory.md §6; −M⁻¹ b for coupled joints); raises
+        SingularMassError for a zero pivot of D_n (of M)."""
+        self.n_calls += 1
+        q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
+        self._terms(q, s_dot, t)
         s_ddot = np.empty(self.system.n_s)
-        failed = self._passes(
-            self._n_cols, self._n_y, self._parent, self._s_index, self._T, self._zeta, self._F,
-            self._M_hat, self._h_hat, self._pivot_min, s_ddot,
-        )
+        if self._expansion is not None:
+            self._assembled()
+            failed = self._projected_accelerations(self._M_all, self._b_all, self._expansion[1], self._pivot_min,
+                                                   self._M, s_ddot)
+        else:
+            self._M_hat[:] = self._M_n
+            failed = self._passes(
+                self._n_cols, self._n_y, self._parent, self._s_index, self._T, self._zeta, self._F,
+                self._M_hat, self._h_hat, self._pivot_min, s_ddot,
+            )
         if failed >= 0 and not (np.all(np.isfinite(q)) and np.all(np.isfinite(s_dot))):
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no pivot D_n "
                                      "can be formed, which no mass matrix explains")
+        if failed >= 0 and self._expansion is not None:
+            raise SingularMassError("system mass matrix M(q) (of the coupled joints' shared velocities) is singular: "
+                                    "a motion along its minimal velocities moves no mass or inertia")
         if failed >= 0:
             raise SingularMassError(
                 f"D_n = F_nᵀ M̂_n F_n of joint {self.system.names[failed]!r} is singular: "
@@ -165,17 +243,16 @@ class FastEvaluator:
 def unsupported(system) -> str | None:
     """Why the fast kernel cannot evaluate ``system`` (None if it can)."""
     for n, (name, joint, body) in enumerate(zip(system.names, system.joints, system.subsystems)):
-        if joint.coupling:
-            return f"joint {name!r} is coupled (shared minimal velocities)"
         if body.n_e:
             reason = _elastic_unsupported(body)
             if reason:
                 return f"subsystem {name!r} is a {type(body).__name__} {reason}"
-            if system.forces:
-                return f"subsystem {name!r} is elastic and the system has force laws (the kernel takes gravity only then)"
-        elif body.rigid_inertia is None or body.S is not None:
-            return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of spatial "
-                    "rigid bodies, rigid_inertia with S = None, and of RitzBeams without rotary inertia)")
+            if system.forces or system.coupled:
+                return (f"subsystem {name!r} is elastic in a system with force laws or coupled joints (the "
+                        "kernel's elastic block takes trees under gravity)")
+        elif body.rigid_inertia is None:
+            return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of rigid bodies, "
+                    "rigid_inertia, spatial or selected by S, and of RitzBeams without rotary inertia)")
         if system.plan.port[n] and not hasattr(system.plan.stations[n], "field"):
             return f"joint {name!r} sits on a port of {type(system.subsystems[system.parent[n]]).__name__} without a field"
     return None
@@ -228,6 +305,47 @@ def _port_fields(system) -> tuple:
         r0[i], Psi[i, :, :e], Q[i, :e, :e], slopes[i, :, :e] = port.field
         c[i] = port.offset
     return slot, r0, Psi, Q, slopes, c
+
+
+def _expansion(system) -> tuple[NDArray, NDArray]:
+    """(P_q, P): q_all = P_q q and ṡ_all = P ṡ, every joint's own coordinates and velocities
+    (a coupled joint's computed from those it follows), read off the System's joint getters
+    (linear maps) at the unit vectors."""
+    def matrix(getters, n):
+        return np.column_stack([np.concatenate([get(e) for get in getters]) for e in np.eye(n)])
+
+    N = len(system.joints)
+    return (matrix([system.joint_q_getter(n) for n in range(N)], system.n_q),
+            matrix([system.joint_s_dot_getter(n) for n in range(N)], system.n_s))
+
+
+class _SelectedKinematics(Kinematics):
+    """The :class:`~projeq.assembly.kinematics.Kinematics` of the reference evaluators for a
+    tree with selections S (ẏ_n = S_n twist, and F_n = S_n F⁶, T̃_np = S̃_n T̃⁶ S̃_pᵀ by
+    :func:`projeq.assembly.kinematics.selected_chain_terms`) over the kernel's spatial
+    ``kinematics``; ẏ_n and the chain terms are computed when a force law first reads them
+    (a force or torque on a body reads only its pose)."""
+
+    def __init__(self, system, kinematics: Kinematics, s_dot: NDArray):
+        self.R, self.r, self.twist = kinematics.R, kinematics.r, kinematics.twist
+        self._system, self._spatial, self._s_dot = system, kinematics, s_dot
+
+    @functools.cached_property
+    def y_dot(self) -> list:
+        return describing_velocities(self._system, self._system.plan, self.twist, self._s_dot)
+
+    @functools.cached_property
+    def _chain(self) -> tuple[list, list]:
+        spatial = self._spatial
+        return selected_chain_terms(self._system, self._system.plan, spatial.F, spatial.T_aug, [None] * len(spatial.F))
+
+    @property
+    def T_aug(self) -> list:
+        return self._chain[0]
+
+    @property
+    def F(self) -> list:
+        return self._chain[1]
 
 
 def _kinematics(n_cols, R, r, twist, F) -> Kinematics:

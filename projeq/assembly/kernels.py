@@ -374,6 +374,79 @@ def passes(n_cols, n_y, parent, s_index, T, zeta, F, M_hat, h_hat, pivot_min, s_
     return -1
 
 
+def gauss_form(n_cols, parent, s_index, T, zeta, F, M_n, h, M, b):
+    """M = Σ J_nᵀ M_n J_n and b = Σ J_nᵀ (M_n ζ̄_n − h_n) of the Gauss form M s̈ + b = 0
+    (docs/theory.md §5) from the kernel's T_np, ζ_n, F_n, M_n and h_n, without the dense J_n.
+
+    b: the Newton–Euler recursion at s̈ = 0 — ζ̄_n = T_np ζ̄_p + ζ_n root → leaves,
+    f_n = M_n ζ̄_n − h_n gathered leaves → root (f_p += T_npᵀ f_n), b_n = F_nᵀ f_n. M: the
+    composite bodies M^c_n = M_n + Σ_c T_cnᵀ M^c_c T_cn, M_nn = F_nᵀ M^c_n F_n, and for
+    each ancestor i of n, M_in = F_iᵀ T_{..i}ᵀ M^c_n F_n with U = M^c_n F_n carried up
+    by U ← T_jpᵀ U (Featherstone (2008), *Rigid Body Dynamics Algorithms*, §5.3 and
+    §6.2, Tables 5.1 and 6.2). Order N d (d: the tree's depth). Writes M (n × n) and b (n).
+    """
+    N = n_cols.shape[0]
+    zeta_bar, f, M_c = np.zeros((N, 6)), np.zeros((N, 6)), M_n.copy()
+    U, V, MT = np.zeros((6, 6)), np.zeros((6, 6)), np.empty((6, 6))
+    for n in range(N):  # root → leaves: ζ̄_n, f_n
+        p = parent[n]
+        for a in range(6):
+            zeta_bar[n, a] = zeta[n, a] + (_dot6(T[n, a], zeta_bar[p]) if p >= 0 else 0.0)
+        for a in range(6):
+            f[n, a] = _dot6(M_n[n, a], zeta_bar[n]) - h[n, a]
+    for n in range(N - 1, -1, -1):  # leaves → root: b_n, M^c_p += T_npᵀ M^c_n T_np, f_p += T_npᵀ f_n
+        for j in range(n_cols[n]):
+            b[s_index[n] + j] = _dot6(F[n, :, j], f[n])
+        if parent[n] >= 0:
+            _add_congruence(T[n], M_c[n], f[n], MT, M_c[parent[n]], f[parent[n]])
+    M[:, :] = 0.0
+    for n in range(N):
+        k = n_cols[n]
+        if k == 0:
+            continue
+        for a in range(6):
+            for j in range(k):
+                U[a, j] = _dot6(M_c[n, a], F[n, :, j])
+        i = n
+        while i >= 0:  # M_in = F_iᵀ U, then U ← T_ipᵀ U
+            for r in range(n_cols[i]):
+                for j in range(k):
+                    M[s_index[i] + r, s_index[n] + j] = M[s_index[n] + j, s_index[i] + r] = _dot6(F[i, :, r], U[:, j])
+            if parent[i] >= 0:
+                for a in range(6):
+                    for j in range(k):
+                        V[a, j] = _dot6(T[i, :, a], U[:, j])
+                U[:, :k] = V[:, :k]
+            i = parent[i]
+
+
+def projected_accelerations(M_all, b_all, P, pivot_min, M, s_ddot):
+    """s̈ = −M⁻¹ b with M = Pᵀ M_all P and b = Pᵀ b_all (shared minimal velocities: ṡ_all = P ṡ,
+    B(14) projected once more), M factored by Cholesky in place (``M``: n × n workspace).
+    Returns −1, or 0 when a pivot of M (a squared diagonal entry of its factor) is not above
+    ``pivot_min``."""
+    n_all, n = P.shape
+    PM = np.zeros((n, n_all))
+    for i in range(n):
+        for r in range(n_all):
+            if P[r, i] != 0.0:
+                for c in range(n_all):
+                    PM[i, c] += P[r, i] * M_all[r, c]
+        s_ddot[i] = 0.0
+        for r in range(n_all):
+            s_ddot[i] -= P[r, i] * b_all[r]
+    for i in range(n):
+        for j in range(n):
+            total = 0.0
+            for c in range(n_all):
+                total += PM[i, c] * P[c, j]
+            M[i, j] = total
+    if not _cholesky(M, n, pivot_min):
+        return 0
+    _cholesky_solve(M, n, s_ddot)
+    return -1
+
+
 def _cholesky(D, k, pivot_min):
     """D[:k, :k] = L Lᵀ in place (L in the lower triangle); False if a pivot L_jj² is not
     above ``pivot_min``."""
@@ -493,24 +566,41 @@ _CALLEES = (_relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _dot, _
 @functools.cache
 def _compiled():
     """chain_terms, passes and the rigid trees' passes (:func:`kernel`) compiled by numba, once
-    per process (and cached on disk).
+    per process (and cached on disk)."""
+    return _jit(chain_terms, passes) + _jit(passes, names=("rigid_passes",), _rows=_six)
+
+
+def gauss_form_kernel(compiled: bool = True):
+    """(:func:`gauss_form`, :func:`projected_accelerations`), compiled by numba (as
+    :func:`kernel`; ValueError without it) or with ``compiled=False`` the interpreted functions."""
+    if not compiled:
+        return gauss_form, projected_accelerations
+    kernel(True)  # the same refusal without numba
+    return _compiled_gauss_form()
+
+
+@functools.cache
+def _compiled_gauss_form():
+    return _jit(gauss_form, projected_accelerations)
+
+
+def _jit(*kernels, names=(), **replaced):
+    """The ``kernels`` compiled by numba (cached on disk, under ``names`` if given).
 
     Compiled code resolves the functions it calls in its globals, so the kernels are
     compiled as copies whose globals are a copy of this module's namespace holding numba's
-    versions of their callees (for the rigid passes, :func:`_six` as ``_rows``); this
-    module's functions stay plain Python (nothing rebound)."""
+    versions of their callees (``replaced``: another function under a callee's name, as
+    :func:`_six` for ``_rows`` in the rigid passes); this module's functions stay plain
+    Python (nothing rebound)."""
     numba = _numba()
+    namespace = dict(globals())
 
-    def compiled_namespace(**replaced):
-        namespace = dict(globals())
-        for f in _CALLEES:
-            namespace[f.__name__] = numba.extending.register_jitable(rebound(replaced.get(f.__name__, f), namespace))
-        return namespace
-
-    def rebound(f, namespace, name=None):
+    def rebound(f, name=None):
         copy = types.FunctionType(f.__code__, namespace, name or f.__name__, f.__defaults__, f.__closure__)
         copy.__qualname__ = name or f.__qualname__  # numba's disk cache is keyed by it
         return copy
 
-    jit, general, six = numba.njit(cache=True), compiled_namespace(), compiled_namespace(_rows=_six)
-    return jit(rebound(chain_terms, general)), jit(rebound(passes, general)), jit(rebound(passes, six, "rigid_passes"))
+    for f in _CALLEES:
+        namespace[f.__name__] = numba.extending.register_jitable(rebound(replaced.get(f.__name__, f)))
+    jit = numba.njit(cache=True)
+    return tuple(jit(rebound(f, name)) for f, name in zip(kernels, names or (None,) * len(kernels)))

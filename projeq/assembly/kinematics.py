@@ -125,14 +125,14 @@ def poses(system, q: NDArray, s_dot: NDArray, t: float) -> Poses:
     """Poses, twists and ẏ_n of every subsystem at (q, ṡ, t), without the chain terms."""
     prep = plan(system)
     R, r, twist = _poses_and_twists(system, prep, q, s_dot, t)[:3]
-    return Poses(R, r, twist, _describing_velocities(system, prep, twist, s_dot))
+    return Poses(R, r, twist, describing_velocities(system, prep, twist, s_dot))
 
 
 def forward(system, q: NDArray, s_dot: NDArray, t: float) -> Kinematics:
     """Poses, ẏ_n, T̃_np (T_np and ζ_n) and F_n of every subsystem at (q, ṡ, t)."""
     prep = plan(system)
     R, r, twist, rels, A_np, r_pn, u, P_aug = _poses_and_twists(system, prep, q, s_dot, t)
-    y_dot = _describing_velocities(system, prep, twist, s_dot)
+    y_dot = describing_velocities(system, prep, twist, s_dot)
     w = np.array([rel.w for rel in rels])
     zeta6 = cross_motion(np.array(u), w) + np.array([rel.zeta for rel in rels])  # Ṫ ẏ_p + Ḟ ṡ + ḟ
     chain = chain_matrix(np.array(A_np), np.array(r_pn))
@@ -140,7 +140,7 @@ def forward(system, q: NDArray, s_dot: NDArray, t: float) -> Kinematics:
     T_aug6[:, :6, :6] = chain
     T_aug6[:, :6, 6] = zeta6
     T_aug6[:, 6, 6] = 1.0
-    T_aug, F = _chain_terms(system, prep, rels, T_aug6, P_aug)
+    T_aug, F = selected_chain_terms(system, prep, [rel.F for rel in rels], T_aug6, P_aug)
     return Kinematics(R, r, twist, y_dot, T_aug, F)
 
 
@@ -185,7 +185,7 @@ def _port(system, station, p, q, s_dot, R, r, twist):
     return R[p] @ port.A, r[p] + R[p] @ port.r, u + port.w, np.zeros(3), P_aug
 
 
-def _describing_velocities(system, prep: Plan, twist, s_dot: NDArray) -> list:
+def describing_velocities(system, prep: Plan, twist, s_dot: NDArray) -> list:
     """ẏ_n = S_n twist_n, plus the internal velocities ṡ_e in the last n_e rows of the
     subsystems that have them; the ground's entry (−1) is empty."""
     N = len(system.joints)
@@ -197,14 +197,15 @@ def _describing_velocities(system, prep: Plan, twist, s_dot: NDArray) -> list:
     return y_dot
 
 
-def _chain_terms(system, prep: Plan, rels, T_aug6, P_aug) -> tuple[list, list]:
-    """Apply the selections S_n: F_n = S_n F⁶ (with [0; E] columns for internal
-    velocities) and T̃_np = S̃_n T̃⁶ S̃_pᵀ (composed with P̃ for joints on a deforming parent)."""
-    N = len(rels)
+def selected_chain_terms(system, prep: Plan, F6, T_aug6, P_aug) -> tuple[list, list]:
+    """Apply the selections S_n to the spatial F⁶ and T̃⁶_np of every joint: F_n = S_n F⁶
+    (with [0; E] columns for internal velocities) and T̃_np = S̃_n T̃⁶ S̃_pᵀ (composed with
+    P̃ for joints on a deforming parent)."""
+    N = len(F6)
     T_aug, F = [None] * N + [np.ones((1, 1))], [None] * N
     for n in range(N):
         S = system.S[n]
-        F[n] = rels[n].F if S is None else S @ rels[n].F
+        F[n] = F6[n] if S is None else S @ F6[n]
         if prep.plain[n]:
             T_aug[n] = T_aug6[n]
         elif prep.port[n]:

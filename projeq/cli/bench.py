@@ -1,6 +1,7 @@
 """``projeq bench``: quick chain scaling, then the quick derivation and beam studies within a
 total wall-time budget (:func:`projeq.studies.bench.quick_suite`); tables or one JSON
-document. Exit code 1 when a study failed or was stopped by the budget."""
+document. Exit code 1 when a study failed or was stopped by the budget. ``--peers``: the
+comparisons with other codes instead (:func:`projeq.studies.bench_peers.peers_report`)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import argparse
 import json
 
 from projeq.cli.options import plain
-from projeq.studies import bench
+from projeq.studies import bench, bench_peers
 from projeq.studies.bench import EXACT_UP_TO, QUICK_SIZES, TOTAL_BUDGET
 
 
@@ -25,6 +26,10 @@ def bench_arguments(parser) -> None:
     parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
     exact_option(parser)
     parser.add_argument("--chain-only", action="store_true", help="skip the quick derivation and beam studies")
+    parser.add_argument("--peers", action="store_true",
+                        help="instead: projeq's defaults against Pinocchio, MuJoCo (chain of --sizes), sympy's "
+                             "KanesMethod (rolling disk) and Exudyn (spin-up beam), each checked to compute the "
+                             "same first (projeq.studies.bench_peers; in full benchmarks/peers.py)")
     parser.set_defaults(execute=run_benchmarks)
 
 
@@ -36,6 +41,11 @@ def exact_option(parser: argparse.ArgumentParser) -> None:
 
 
 def run_benchmarks(args) -> int:
+    if args.peers:
+        report = bench_peers.peers_report(args.sizes, args.budget, show=None if args.json else _show)
+        if args.json:
+            print(json.dumps(report, indent=2))
+        return 0
     document = bench.quick_suite(args.sizes, args.budget, args.total, not args.no_peers, args.exact_up_to,
                                  args.chain_only, show=None if args.json else _show)
     if args.json:

@@ -48,10 +48,13 @@ def simulation_options(parser: argparse.ArgumentParser, out: str = "projeq-out")
 
     scene_settings_option(parser)
     parser.add_argument("--t-end", type=float, default=None, help="end time in s (default: the scene's)")
-    parser.add_argument("--method", default="DOP853", choices=[*INTEGRATORS, *PROJECTED], metavar="METHOD",
-                        help=f"integrator: {', '.join([*INTEGRATORS, *PROJECTED])} (default DOP853)")
-    parser.add_argument("--rtol", type=float, default=1e-9, help="relative tolerance (default 1e-9)")
-    parser.add_argument("--atol", type=float, default=1e-11, help="absolute tolerance (default 1e-11)")
+    parser.add_argument("--method", default=None, choices=[*INTEGRATORS, *PROJECTED], metavar="METHOD",
+                        help=f"integrator: {', '.join([*INTEGRATORS, *PROJECTED])} (default: the scene's setting, "
+                             "else projeq.simulate's choice)")
+    parser.add_argument("--rtol", type=float, default=None,
+                        help="relative tolerance (default: the scene's setting, else projeq.simulate's)")
+    parser.add_argument("--atol", type=float, default=None,
+                        help="absolute tolerance (default: the scene's setting, else projeq.simulate's)")
     parser.add_argument("--evaluator", choices=list(EVALUATORS), default=None,
                         help="how the accelerations are computed (default: the model's own choice)")
     parser.add_argument("--out", default=out, help=f"output directory (default ./{out})")
@@ -59,9 +62,12 @@ def simulation_options(parser: argparse.ArgumentParser, out: str = "projeq-out")
     json_option(parser)
 
 
-def simulate_options(args) -> dict:
-    """The keywords of :func:`projeq.simulate` given by :func:`simulation_options`."""
-    return {"method": args.method, "rtol": args.rtol, "atol": args.atol, "evaluator": args.evaluator}
+def simulate_options(args, scene) -> dict:
+    """The keywords of :func:`projeq.simulate` given by :func:`simulation_options` over the
+    scene's own settings (:class:`projeq.scenes.Scene` ``settings``); what neither gives is
+    left to ``simulate``'s defaults."""
+    given = {name: getattr(args, name) for name in ("method", "rtol", "atol", "evaluator") if getattr(args, name) is not None}
+    return (scene.settings or {}) | given
 
 
 def scene_label(scene: str) -> str:

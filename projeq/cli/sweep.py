@@ -7,7 +7,9 @@ SIGTERM stops the workers and writes the table with the points finished (and the
 ones' partial results). A point that failed or was interrupted makes the exit code 1 (the
 table is written). The grid is checked first: no parameter twice (in ``--grid`` or in both
 ``--grid`` and ``--set``), no repeated values, and at most :data:`MAX_POINTS` points
-unless ``--allow-large``.
+unless ``--allow-large``. The number of points is printed first, and before a large sweep
+(more than :data:`projeq.simulation.sweep.ESTIMATE_ABOVE` points) an estimate of its time
+from its first two points, run here (the second timed) before the others start.
 """
 
 from __future__ import annotations
@@ -55,7 +57,7 @@ def sweep_scene(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers: expected a positive count, got {args.workers}")
     client = _dask_client(args.scheduler, args.scheduler_timeout) if args.scheduler else None
-    options = simulate_options(args)
+    options = simulate_options(args, scene)
     quiet = args.quiet or args.json
     with client if client is not None else contextlib.nullcontext():  # a Dask client is closed also when --out is refused
         out = output_directory(args.out)

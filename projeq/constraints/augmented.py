@@ -134,7 +134,7 @@ class AugmentedSystem(ConstrainedSystem):
         """ṡ moved onto A_s ṡ = b_s mass-orthogonally: ṡ − M⁻¹ A_sᵀ (A_s M⁻¹ A_sᵀ)⁺ (A_s ṡ − b_s),
         in the mass-weighted singular directions (Bayo & Ledesma 1996, eq. (16))."""
         A_s, b_s = self.constraint_matrix(q, t)
-        L = np.linalg.cholesky(self.tree.evaluator("dense").gauss_form(q, np.zeros(self.n_s), t)[0])
+        L = np.linalg.cholesky(self.tree_gauss_form(q, np.zeros(self.n_s), t)[0])
         z, _ = _least_constraint(A_s, L, L.T @ s_dot, b_s, self.penalty, self.iterations)
         return np.linalg.solve(L.T, z)
 
@@ -146,9 +146,7 @@ class AugmentedSystem(ConstrainedSystem):
         C, c = self.velocity_constraints(q, t)
         K, k = self.tree.K(q, t), self.tree.q_dot(q, np.zeros(self.n_s), t)
         A_s, b_s = C @ K, c - C @ k
-        M, b = self.tree.evaluator("dense").gauss_form(q, s_dot, t)
-        if method not in (None, "dense"):  # M s̈_free + b = 0
-            b = -M @ self.tree.evaluator(method).accelerations(q, s_dot, t)
+        M, b = self.tree_gauss_form(q, s_dot, t, method)
         L = np.linalg.cholesky(M)
         z_free = -np.linalg.solve(L, b)
         z, lam = _least_constraint(A_s, L, z_free, self.target(q, s_dot, t, A_s, b_s, C), self.penalty,

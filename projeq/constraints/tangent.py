@@ -44,7 +44,7 @@ import scipy.linalg
 from numpy.typing import NDArray
 
 from projeq.constraints.partitioned import (
-    RANK_TOLERANCE, REPIVOT_CONDITION, ConstrainedSystem, independent_indices, numerical_rank,
+    RANK_TOLERANCE, REPIVOT_CONDITION, ConstrainedSystem, independent_indices, minimum_norm_solution, numerical_rank,
 )
 
 
@@ -96,16 +96,18 @@ class TangentSystem(ConstrainedSystem):
     def velocity_constraints(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """(C, c) of ConstrainedSystem, kept for the latest (q, t): the integrator asks for q̇ and
         s̈ at the same state, and both need them."""
-        key = (np.asarray(q, dtype=float).tobytes(), float(t))
+        key = (np.asarray(q).tobytes(), np.asarray(q).dtype.str, float(t))  # a complex step is another point
         if self._latest[0] != key:
             self._latest = (key, super().velocity_constraints(q, t))
         return self._latest[1]
 
     def _null_space(self, A_s: NDArray) -> NDArray:
-        """N (n_s,tree × n_s): the right singular vectors of A_s of its n_s smallest singular values."""
+        """N (n_s,tree × n_s): the right singular vectors of A_s of its n_s smallest singular
+        values; for A_s carrying a complex step, :func:`_null_space_step` of them."""
         if not A_s.size:
             return np.eye(self.tree.n_s)
-        return np.linalg.svd(_real(A_s))[2][self.tree.n_s - self.n_s:].T
+        N = np.linalg.svd(np.real(A_s))[2][self.tree.n_s - self.n_s:].T
+        return _null_space_step(A_s, N, self.tree.n_s - self.n_s) if np.iscomplexobj(A_s) else N
 
     def _scaled(self, N: NDArray) -> NDArray:
         """F = N N_ind⁻¹ (F[independent] = E)."""
@@ -157,23 +159,21 @@ class TangentSystem(ConstrainedSystem):
         decomposition: A_s x = c with x[independent] = 0, where A_s x = c can hold."""
         if not A_s.size:
             return np.zeros(self.tree.n_s)
-        U, sigma, Vt = np.linalg.svd(_real(A_s))
-        rank = self.tree.n_s - self.n_s
-        acting = min(rank, np.count_nonzero(sigma > ACTING * sigma[0]))
-        x0 = Vt[:acting].T @ ((U[:, :acting].T @ c) / sigma[:acting])
-        return x0 - self._scaled(Vt[rank:].T) @ x0[self.independent]
+        x0 = minimum_norm_solution(A_s, c, ACTING, rank=self.tree.n_s - self.n_s)
+        return x0 - self._scaled(self._null_space(A_s)) @ x0[self.independent]
 
     def __repr__(self) -> str:
         return f"TangentSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian)"
 
 
-def _real(A_s: NDArray) -> NDArray:
-    """A_s itself; a TypeError for complex A_s: the SVD is not complex-analytic (its rotations
-    conjugate), so the complex step through it would be silently wrong and the Jacobians of
-    :mod:`projeq.analysis.jacobians` fall back to differences (reported as such)."""
-    if np.iscomplexobj(A_s):
-        raise TypeError("TangentSystem: the SVD of A_s cannot be differentiated by the complex step")
-    return A_s
+def _null_space_step(A_s: NDArray, N: NDArray, rank: int) -> NDArray:
+    """The null-space basis N₀ of Re A_s (real SVD) carried to A_s = A₀ + i A₁ (a complex
+    step, |A₁| ~ 1e-30) by one Newton step, N = N₀ − A₀⁺ (A_s N₀) = N₀ − i A₀⁺ A₁ N₀ (A₀⁺ over
+    the ``rank`` largest singular values): A_s N = O(|A₁|²) where the rank of A_s is constant
+    (redundant rows included: their left null vectors u satisfy uᵀ A₁ N₀ = 0), the
+    normalisation N₀ᵀ dN = 0. F = N N_ind⁻¹ is then analytic in the step, and the complex step
+    through it gives ∂F exactly (the SVD's own rotations conjugate; issue 16)."""
+    return N - minimum_norm_solution(np.real(A_s), A_s @ N, ACTING, rank)
 
 
 def _pivoted_independent(N: NDArray, n_s: int) -> NDArray:

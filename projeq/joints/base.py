@@ -98,11 +98,20 @@ class Joint:
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         drop_inherited_twins(cls, Joint, ("relative", "K", "q_dot"),
-                             ("symbolic_relative", "symbolic_parameters", "compiled_kind"))
+                             ("symbolic_relative", "symbolic_parameters", "compiled_kind", "relative_values"))
 
     def relative(self, q_n: NDArray, s_dot_n: NDArray, t: float) -> Relative:
         """Relative kinematics (A, r, F⁶, w, ζ) at (q_n, ṡ_n, t)."""
         raise NotImplementedError
+
+    def relative_values(self, q_n: NDArray, s_dot_n: NDArray, t: float):
+        """The numbers of :meth:`relative` at real (q_n, ṡ_n, t) as one flat sequence of
+        24 + 6 n_s floats — A (row by row), r, w, ζ, then F⁶ column by column — which the
+        compiled evaluator reads for a joint whose kinematics it does not compute itself (kind
+        GIVEN, :mod:`projeq.assembly.fast`). By default :meth:`relative`, packed; a joint may
+        state the same numbers faster (a UserJoint from sympy: scalar code of its expressions)."""
+        rel = self.relative(q_n, s_dot_n, t)
+        return np.concatenate((rel.A.ravel(), rel.r, rel.w, rel.zeta, rel.F.T.ravel()))
 
     def symbolic_relative(self, q_n, s_n, t: sp.Symbol, **parameters) -> SymbolicRelative:
         """The same kinematics as :meth:`relative` and :meth:`K` in sympy, at the symbols or

@@ -15,7 +15,7 @@ import numpy as np
 
 from projeq.checks import callable_name
 from projeq.joints.base import Joint, Relative, SymbolicRelative
-from projeq.spatial import axis_spin, quaternion_matrix, norm, quaternion_rate_matrix, rodrigues, unit_axis
+from projeq.spatial import axis_spin, norm, numeric, quaternion_matrix, quaternion_rate_matrix, rodrigues, unit_axis
 from projeq.symbolic import lazy_import
 
 sp = lazy_import("sympy")
@@ -193,8 +193,9 @@ class Free(Joint):
         return np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
 
     def normalized(self, q_n):
-        out = np.array(q_n, dtype=float)
-        out[3:] /= np.linalg.norm(out[3:])
+        """The quaternion divided by its length √(qᵀq) (analytic: a complex step passes)."""
+        out = numeric(np.array(q_n))
+        out[3:] /= norm(out[3:])
         return out
 
 

@@ -74,6 +74,9 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
 
     zeta = d_dt(F) * s_vec + d_dt(f)
     rel = sp.lambdify([q, s, t], [A, r, F, F * s_vec + f, zeta], modules="numpy", cse=True)
+    # the same numbers as one flat list of scalars (Joint.relative_values): for real arguments
+    scalar = _scalar_code([q, s, t], [*A, *r, *(F * s_vec + f), *zeta, *F.T],
+                          ([0.0] * n_q if q0 is None else q0, [1.0] * n_s, 0.3))
     K_fun = sp.lambdify([q, t], K, modules="numpy", cse=True)
     q_dot_fun = sp.lambdify([q, s, t], rates, modules="numpy", cse=True)
 
@@ -93,10 +96,21 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
         lambda q_n, time: numeric(K_fun(q_n, time)),
         lambda q_n, s_dot_n, time: numeric(q_dot_fun(q_n, s_dot_n, time)).ravel(),
         q0=q0, r_pn=r_pn, orientation=orientation, constraints=residual, n_c=n_c,
-        symbols={"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k},
+        symbols={"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k}, values=scalar,
     )
     _check_pose(joint)
     return joint
+
+
+def _scalar_code(args, expressions, at):
+    """The expressions lambdified to scalar code (``math``) for Python floats, or None where
+    it cannot evaluate them (a function ``math`` does not have): then the numpy form serves."""
+    values = sp.lambdify(args, expressions, modules="math", cse=True)
+    try:
+        values(*(list(map(float, a)) if np.ndim(a) else a for a in at))
+    except (NameError, TypeError, ValueError, ZeroDivisionError):
+        return None
+    return values
 
 
 def _compile_constraints(constraints, q, q_dot, t, values):

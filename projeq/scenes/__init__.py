@@ -98,7 +98,11 @@ class Scene(NamedTuple):
     :data:`projeq.scenes.parameters.UNITS`; ``plane`` = the indices (i, j) of q that are a
     position in the ground plane, for a trajectory plot; ``events`` = terminal events
     ``event(t, q, s_dot)`` that end a run for a physical reason, each with a ``description``
-    (``projeq run`` passes them to ``simulate`` and says which one stopped the run).
+    (``projeq run`` passes them to ``simulate`` and says which one stopped the run);
+    ``settings`` = keywords of :func:`projeq.simulate` (integrator, tolerances) that
+    ``projeq run`` and ``projeq sweep`` use for this scene unless told otherwise, where
+    ``simulate``'s own defaults would be slow for the accuracy the scene needs (each
+    documented with its measured accuracy, as :data:`SPIN_UP_SETTINGS`).
     Registering a scene is one entry in ``SCENES``.
     """
 
@@ -108,10 +112,20 @@ class Scene(NamedTuple):
     units: dict | None = None
     plane: tuple | None = None
     events: tuple = ()
+    settings: dict | None = None
 
+
+#: the spin-up beam's integrator for ``projeq run``: its elastic modes are stiff (an explicit
+#: method crawls at its stability limit: RK45 at simulate's rtol 1e-8 needs about 45,000 evaluations
+#: over the 20 s, Radau at rtol 1e-4 2,500), and at rtol 1e-4 the tip deflection at 5, 10, 15,
+#: 20 s is within 4.2e-5 m of the converged reference of benchmarks/beam_convergence.py (8
+#: clamped–free functions per plane, DOP853 at rtol 1e-10), the same as RK45 at 1e-8 or DOP853
+#: at 1e-9 (all 4.2e-5 m: the error of the scene's 4 polynomial functions, not the integrator's)
+SPIN_UP_SETTINGS = {"method": "Radau", "rtol": 1e-4, "atol": 1e-6}
 
 SCENES = {
-    "spin_up_beam": Scene(spin_up_beam, "a cantilever spun up to Ωs = 6 rad/s, with dynamic stiffening", 20.0),
+    "spin_up_beam": Scene(spin_up_beam, "a cantilever spun up to Ωs = 6 rad/s, with dynamic stiffening", 20.0,
+                          settings=SPIN_UP_SETTINGS),
     "spinning_beam": Scene(spinning_beam, "a cantilever spinning about its own axis (B(16)-(23))", 10.0),
     "elastic_arm": Scene(elastic_arm, "rigid link + elastic link with a tip mass, turning freely", 5.0),
     "chain": Scene(chain, "n links on revolute joints hanging from the origin (default n = 5)", 10.0),

@@ -121,7 +121,7 @@ def _rotation(axis: str, angle: float) -> np.ndarray:
     """The rotation by ``angle`` about the coordinate axis ``axis`` ("x", "y" or "z")."""
     k = "xyz".index(axis)
     i, j = (k + 1) % 3, (k + 2) % 3
-    R = np.eye(3)
+    R = np.eye(3, dtype=np.result_type(angle, float))  # complex under a complex step
     R[[i, i, j, j], [i, j, i, j]] = np.cos(angle), -np.sin(angle), np.sin(angle), np.cos(angle)
     return R
 

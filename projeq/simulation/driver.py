@@ -347,10 +347,8 @@ class _Run:
             yield
         except KeyboardInterrupt:
             self.status, self.message = 2, "interrupted (Ctrl-C): the trajectory up to the last finished segment is kept"
-        except (FloatingPointError, ValueError, np.linalg.LinAlgError) as exc:
-            self.status, self.message, self.cause = -1, str(exc), exc
         except Exception as exc:  # noqa: BLE001 - a user's force law or event failed: keep the trajectory
-            self.status, self.message, self.cause = -1, f"{type(exc).__name__} in {_raised_in(exc)}: {exc}", exc
+            self.status, self.message, self.cause = -1, _described(exc), exc
 
 
 FAST_MODE_STEPS = 500  # RK45 steps forced by stability alone beyond which DOP853 is the default
@@ -404,6 +402,15 @@ def warn_out_of_range(tree, q_rows: NDArray, t: float) -> bool:
             warnings.warn(f"{tree.names[n]!r} by t = {t:.6g} s: {problem}", ValidityWarning, stacklevel=3)
             warned = True
     return warned
+
+
+def _described(exc: Exception) -> str:
+    """The message of a failure during a run: projeq's own errors (a NaN, a singular matrix, a
+    user function's bad value, named where they are found) as they are; any other exception
+    of a user's function with its type and where it was raised."""
+    if isinstance(exc, (FloatingPointError, ValueError, np.linalg.LinAlgError)):
+        return str(exc)
+    return f"{type(exc).__name__} in {_raised_in(exc)}: {exc}"
 
 
 def _raised_in(exc: BaseException) -> str:
@@ -464,14 +471,9 @@ def _assemble(run: _Run, wall_time: float, dense_output: bool) -> Result:
     system, pieces = run.user_model, run.pieces
     n_q, n_s = system.n_q, system.n_s
     rows = [(p.model, ti) for p in pieces for ti in p.t]
-    t = np.array([ti for _, ti in rows])
     x = np.vstack([p.x for p in pieces] + [np.zeros((0, n_q + n_s))])
-    q = np.array([s.normalized(xi[:n_q]) for (s, _), xi in zip(rows, x)]).reshape(len(t), n_q)
-    s_dot = x[:, n_q:]
-    energies = np.array([s.energy(qi, si, ti) for (s, ti), qi, si in zip(rows, q, s_dot)]).reshape(len(t), 2)
-    residual = np.array(
-        [s.constraint_residual(qi, s.q_dot(qi, si, ti), ti) for (s, ti), qi, si in zip(rows, q, s_dot)]
-    ).reshape(len(t), system.n_c)
+    q, energies, residual = _row_values(run, rows, x)
+    t, s_dot = np.array([ti for _, ti in rows[:len(q)]]), x[:len(q), n_q:]
     partitions = tuple(
         (float(p.sol.ts[0]), p.model.partition) for i, p in enumerate(pieces)
         if p.model.partition is not None and (i == 0 or p.model is not pieces[i - 1].model)
@@ -489,6 +491,29 @@ def _assemble(run: _Run, wall_time: float, dense_output: bool) -> Result:
         velocities=system.velocities() if len(partitions) < 2 else tuple((f"s_dot[{i}]", "") for i in range(n_s)),
         sol=_dense_solution(pieces, n_q) if dense_output and pieces else None, system=system,
     )
+
+
+def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """Normalised q, (T, V) and constraint residuals (Φ, A q̇ − b) of each output row in its
+    own model, up to the first row where a user function raises (a constraint or residual
+    function that fails only late in the run, evaluated here for the first time at that
+    row): the run is then a failure at that row's time (status, message naming the
+    function, cause) and keeps the rows before it."""
+    system, n_q = run.user_model, run.user_model.n_q
+    q, energies, residual = [], [], []
+    for (model, t), xi in zip(rows, x):
+        try:
+            qi = model.normalized(xi[:n_q])
+            values = model.energy(qi, xi[n_q:], t), model.constraint_residual(qi, model.q_dot(qi, xi[n_q:], t), t)
+        except Exception as exc:  # noqa: BLE001 - a user's function: reported by name with the time
+            run.status, run.cause, run.reached = -1, exc, t
+            run.message = _described(exc) + ("" if f"t = {t:.6g}" in str(exc) else f" (at the output time t = {t:.6g})")
+            break
+        q.append(qi)
+        energies.append(values[0])
+        residual.append(values[1])
+    n = len(q)
+    return (np.reshape(q, (n, n_q)), np.reshape(energies, (n, 2)), np.reshape(residual, (n, system.n_c)))
 
 
 def _failure(run: _Run, result: Result) -> SimulationError:

@@ -29,7 +29,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import DOP853, RK23, RK45, DenseOutput, OdeSolver
 
-from projeq.analysis.differentiation import central, forward, gradient
+from projeq.analysis.differentiation import forward
+from projeq.analysis.jacobians import differentiate
 
 PROJECTED = {"RK45-projected": RK45, "DOP853-projected": DOP853}
 EXPLICIT = ("RK45", "RK23", "DOP853", *PROJECTED)
@@ -44,10 +45,11 @@ def energy_manifold(system, q0, s_dot0, t0: float = 0.0):
 
     E(x) = T + V = ½ṡᵀMṡ + V(q) (:meth:`projeq.System.energy`), E₀ = E(q0, ṡ0). The map
     does simplified Newton steps x ← x − (E(x) − E₀) ∇E/|∇E|² (HLW §IV.4, Algorithm 4.2,
-    with one invariant; ∇E once, at the first iterate, by forward differences) until
-    |E − E₀| is at round-off (≤ 4 ε (|T| + |V|)), at most 4 steps, then normalises q.
-    After a step of an integrator one or two Newton steps suffice: 2 + n_x (+1) energy
-    evaluations for a state of n_x entries.
+    with one invariant; ∇E once, at the first iterate, exact by the complex step through
+    the energy and q's normalisation, :func:`energy_gradient`) until |E − E₀| is at
+    round-off (≤ 4 ε (|T| + |V|)), at most 4 steps, then normalises q. After a step of an
+    integrator one or two Newton steps suffice: 2 real and n_x complex energy evaluations
+    for a state of n_x entries.
     ValueError if E changes along the flow at the initial state (a driven joint or a
     non-conservative force): its energy is not an invariant to project on.
 
@@ -62,7 +64,7 @@ def energy_manifold(system, q0, s_dot0, t0: float = 0.0):
     energy = _energy_function(system)
     x0 = np.concatenate((np.asarray(q0, dtype=float), np.asarray(s_dot0, dtype=float)))
     E0 = energy(x0, t0)[0]
-    change = _energy_change(system, x0, t0, energy)
+    change = _energy_change(system, x0, t0)
     if change is not None:
         raise ValueError(
             f"method: the projected integrators keep the energy constant, but this system's energy "
@@ -79,9 +81,7 @@ def energy_manifold(system, q0, s_dot0, t0: float = 0.0):
             if abs(E - E0) <= 4 * np.finfo(float).eps * max(scale, abs(E0)):
                 break
             if grad is None:  # simplified Newton: ∇E at the first iterate serves all
-                # forward differences (given E): O(h) error, ample for Newton steps, whose
-                # error shrinks by that factor per step
-                grad = gradient(lambda x_: energy(x_, t)[0], x, E)
+                grad = energy_gradient(system, x, t)
             x -= (E - E0) * grad / (grad @ grad)
             E, scale = energy(x, t)
         x[:n_q] = system.normalized(x[:n_q])
@@ -95,7 +95,7 @@ def conserves_energy(system, q0, s_dot0, t0: float = 0.0) -> bool:
     prescribed (driven) motion, a damper or a time-dependent load, detected as dE/dt ≠ 0 at
     (q0, ṡ0, t0) or at the probes of :func:`_energy_change`."""
     x0 = np.concatenate((np.asarray(q0, dtype=float), np.asarray(s_dot0, dtype=float)))
-    return _energy_change(system, x0, t0, _energy_function(system)) is None
+    return _energy_change(system, x0, t0) is None
 
 
 def _energy_function(system):
@@ -109,9 +109,24 @@ def _energy_function(system):
     return energy
 
 
-def _energy_change(system, x0: NDArray, t0: float, energy) -> tuple[float, float] | None:
+def energy_gradient(system, x: NDArray, t: float) -> NDArray:
+    """∇E at (x, t) of E = T + V with q normalised (as the projection evaluates it): exact to
+    round-off by the complex step through the model's energy (complex-safe: the normalisation,
+    a ConstrainedSystem's Gauss–Newton steps onto Φ = 0 and its F included), by Richardson's
+    differences where the model's callables cannot take complex arguments
+    (:func:`projeq.analysis.jacobians.differentiate`)."""
+    return differentiate(lambda x_: _energy_value(system, x_, t), x)[0][0]
+
+
+def _energy_value(system, x: NDArray, t) -> NDArray:
+    """[E(x, t)] with q normalised, complex under a complex step in x or t."""
+    T, V = system.energy(system.normalized(x[:system.n_q]), x[system.n_q:], t)
+    return np.atleast_1d(T + V)
+
+
+def _energy_change(system, x0: NDArray, t0: float) -> tuple[float, float] | None:
     """(dE/dt, t) where dE/dt = ∇E · ẋ + ∂E/∂t is distinguishable from 0, relative to the
-    size of its terms |∇E| |ẋ| + |∂E/∂t| (central differences are good to ~1e-10 of it), at
+    size of its terms |∇E| |ẋ| + |∂E/∂t| (:func:`energy_gradient`: exact to round-off), at
     the initial state and at probes: later times (a prescribed motion may start from rest,
     with zero drive power at t0) and perturbed velocities (a damper does no work at rest);
     None where it is zero at all of them."""
@@ -120,19 +135,20 @@ def _energy_change(system, x0: NDArray, t0: float, energy) -> tuple[float, float
     s_dot_probe = x0[n_q:] + 0.1 * (1.0 + np.abs(x0[n_q:])) * rng.standard_normal(len(x0) - n_q)
     for t in (t0, t0 + 0.37, t0 + 1.9):
         for x in (x0, np.concatenate((x0[:n_q], s_dot_probe))):
-            E_dot = _energy_rate(system, x, t, energy)
+            E_dot = _energy_rate(system, x, t)
             if E_dot is not None:
                 return E_dot, t
     return None
 
 
-def _energy_rate(system, x: NDArray, t: float, energy) -> float | None:
+def _energy_rate(system, x: NDArray, t: float) -> float | None:
     """dE/dt at (t, x) if it is distinguishable from zero, else None."""
     n_q = system.n_q
     q, s_dot = system.normalized(x[:n_q]), x[n_q:]
     x_dot = np.concatenate((system.q_dot(q, s_dot, t), system.accelerations(q, s_dot, t)))
-    E_t = central(lambda eps: energy(x, t + eps)[0], 1e-6 * (1.0 + abs(t)))
-    grad = gradient(lambda x_: energy(x_, t)[0], x)
+    grad = energy_gradient(system, x, t)
+    # ∂E/∂t apart: a prescribed motion or a time-dependent load may take only real times
+    E_t = differentiate(lambda t_: _energy_value(system, x, t_[0]), np.array([t]))[0][0, 0]
     E_dot = grad @ x_dot + E_t
     return E_dot if abs(E_dot) > 1e-6 * (np.linalg.norm(grad) * np.linalg.norm(x_dot) + abs(E_t)) else None
 

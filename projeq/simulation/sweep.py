@@ -35,6 +35,7 @@ import itertools
 import os
 import pickle
 import signal
+import sys
 import threading
 import time
 import warnings
@@ -102,6 +103,9 @@ def _named_column(coordinates, velocities, name: str) -> tuple[str, int]:
 
 INTERRUPT_GRACE = 10.0  # s to wait, after Ctrl-C, for the running points to return their partial results
 PARENT_POLL = 0.5  # s between a worker's checks that the main process is alive
+# a sweep of more points than this (to run) with progress on first runs one of them here, timed,
+# and says how long the rest will take before they start
+ESTIMATE_ABOVE = 1000
 _simulating = False  # in a pool worker: True while run_point simulates
 
 
@@ -316,7 +320,10 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     t_end : float, optional
         End time (s), default the scene's.
     progress : bool
-        A progress bar (tqdm) on a terminal.
+        A progress bar (tqdm) on a terminal. With more than :data:`ESTIMATE_ABOVE` points to
+        run, the first two run in this process first, the second timed (the first compiles),
+        and a line on stdout says how long the sweep will take: "N points, about T (≈ t per
+        point × N / W workers)".
     path : str or Path, optional
         Write the table to ``path.csv`` and ``path.npz`` (path without suffix): each point is
         appended to ``path.csv`` as it finishes, and both files are complete, in input order,
@@ -376,10 +383,13 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
         bar.update()
 
     run = _Run(pool, owned, workers, lambda p: (run_point, scene, p, outputs, t_end, options), len(outputs))
+    todo = [i for i, r in enumerate(rows) if r is None]
     try:
-        with tqdm(total=len(points), initial=sum(r is not None for r in rows), unit="run",
+        with tqdm(total=len(points), initial=len(points) - len(todo), unit="run",
                   disable=None if progress else True) as bar:
-            run.all([i for i, r in enumerate(rows) if r is None], points, record)
+            if progress and len(todo) > ESTIMATE_ABOVE:
+                todo = _probe(run, todo, points, record, lambda message: tqdm.write(message, file=sys.stdout))
+            run.all(todo, points, record)
     finally:
         run.close()
         if log is not None:
@@ -389,6 +399,32 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     if path is not None:
         table.save(path)
     return table
+
+
+def _probe(run: "_Run", todo: list, points: list, record, say) -> list:
+    """Run the first two points of ``todo`` in this process (their rows are kept), the second
+    timed (the first pays for imports and compilation, once per process), and ``say``
+    "N points, about T (≈ t per point × N / W workers)" for the N points to run on the
+    executor's W workers; the points left to run (none after Ctrl-C during the probe)."""
+    try:
+        for i in todo[:2]:
+            started = time.perf_counter()
+            record(i, run_point(*run.task(points[i])[1:]))
+    except KeyboardInterrupt:
+        run.interrupted = True
+        return []
+    per_point, workers = time.perf_counter() - started, run.workers()
+    say(f"{len(todo)} points, about {_duration(per_point * len(todo) / workers)} "
+        f"(≈ {per_point:.3g} s per point × {len(todo)} / {workers} worker{'s' * (workers > 1)})")
+    return todo[2:]
+
+
+def _duration(seconds: float) -> str:
+    """``seconds`` as s, min, h or days, three digits."""
+    for unit, size in (("days", 86400.0), ("h", 3600.0), ("min", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.3g} {unit}"
+    return f"{seconds:.3g} s"
 
 
 class _Run:
@@ -428,6 +464,16 @@ class _Run:
         except KeyboardInterrupt:
             self.interrupted = True
             self._gather(record)
+
+    def workers(self) -> int:
+        """How many points run at once: the owned pool's processes, another executor's
+        ``_max_workers`` or a Dask cluster's workers where known, else 1."""
+        if self.window is not None:
+            return self.window
+        client = getattr(self.pool, "_client", None)  # dask's concurrent.futures view
+        if client is not None and hasattr(client, "scheduler_info"):
+            return max(1, len(client.scheduler_info().get("workers", ())))
+        return max(1, int(getattr(self.pool, "_max_workers", 1) or 1))
 
     def _full(self) -> bool:
         """No room for another point: one per worker, and a point run again runs alone."""

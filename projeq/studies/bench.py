@@ -64,10 +64,11 @@ def pinocchio_chain(n: int):
     return lambda q, s_dot: pin.aba(model, data, q, s_dot, tau)
 
 
-def mujoco_chain(n: int):
+def mujoco_chain(n: int, smooth_only: bool = False):
     """s̈ function of ``scenes.chain(n)`` by MuJoCo's ``mj_forward`` (built with MjSpec —
     a nested MJCF string needs gigabytes to parse at n = 1000 —, no geoms, contacts off),
-    or None without ``mujoco``."""
+    or None without ``mujoco``. ``smooth_only``: instead of ``mj_forward``, only its smooth
+    dynamics, M⁻¹(τ − b) (kinematics, composite inertia, factorisation, RNE bias, solve)."""
     try:
         import mujoco
     except ImportError:
@@ -88,7 +89,17 @@ def mujoco_chain(n: int):
         mujoco.mj_forward(model, data)
         return data.qacc.copy()
 
-    return s_ddot
+    bias, acceleration = np.zeros(n), np.zeros((1, n))
+
+    def smooth_s_ddot(q, s_dot):
+        data.qpos[:], data.qvel[:] = q, s_dot
+        for stage in (mujoco.mj_kinematics, mujoco.mj_comPos, mujoco.mj_crb, mujoco.mj_factorM, mujoco.mj_comVel):
+            stage(model, data)
+        mujoco.mj_rne(model, data, 0, bias)  # b: Coriolis, centrifugal and gravity terms
+        mujoco.mj_solveM(model, data, acceleration, -bias[None, :])
+        return acceleration[0].copy()
+
+    return smooth_s_ddot if smooth_only else s_ddot
 
 
 def evaluators(n: int, peers: bool = True) -> dict:
@@ -125,17 +136,17 @@ def measure(sizes, budget: float = 1.0, peers: bool = True, exact_up_to: int = E
         seconds = time_per_call(funcs, q, s_dot, budget)
         s_ddot = {k: f(q, s_dot) for k, f in funcs.items()}
         reference = s_ddot["dense" if "dense" in funcs else "recursive"]
-        row = {"n": n, "seconds": seconds, "deviation": _deviations(s_ddot, reference)}
+        row = {"n": n, "seconds": seconds, "deviation": deviations(s_ddot, reference)}
         if n <= exact_up_to:
             started = time.process_time()
             exact = chain_s_ddot(q, s_dot)
             row["exact_seconds"] = time.process_time() - started
-            row["exact_deviation"] = _deviations(s_ddot, exact)
+            row["exact_deviation"] = deviations(s_ddot, exact)
         rows.append(row)
     return rows
 
 
-def _deviations(s_ddot: dict, reference) -> dict:
+def deviations(s_ddot: dict, reference) -> dict:
     """Name → |s̈ − reference|∞ / max(1, |reference|∞)."""
     scale = max(1.0, np.abs(reference).max())
     return {k: float(np.abs(x - reference).max() / scale) for k, x in s_ddot.items()}

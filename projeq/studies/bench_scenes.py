@@ -5,7 +5,7 @@ scene at most 3× the cost of chain(k)").
 For each scene (default parameters, its q0 and ṡ0, t = 0): which evaluator the default
 (``method=None``, :mod:`projeq.assembly.auto`) picks — "fast" (compiled), "hub_beam",
 or an interpreted reference ("recursive", "dense"; a ConstrainedSystem projects its tree's
-dense Gauss form: "partitioned") — and the CPU time of one s̈ call next to the
+Gauss form, compiled or dense: "partitioned(fast)", "partitioned(dense)") — and the CPU time of one s̈ call next to the
 compiled chain of the same k, both timed alternately in one run
 (:func:`projeq.studies.timing.time_per_call`), so the ratio holds on a loaded machine.
 
@@ -30,19 +30,18 @@ from projeq.assembly.auto import InterpretedWarning
 from projeq.studies.table import Table
 from projeq.studies.timing import time_per_call
 
-#: the evaluators that are not the interpreted reference path
-COMPILED = ("fast", "hub_beam")
+#: the evaluators that are not the interpreted reference path (a ConstrainedSystem's
+#: "partitioned(fast)" projects the compiled Gauss form of its tree)
+COMPILED = ("fast", "hub_beam", "partitioned(fast)")
 
 
 def default_evaluator(system) -> tuple[str, str]:
-    """(name, reason) of the evaluator a System's default picks (``"partitioned"`` and
-    the tree's for a ConstrainedSystem), without the warning it would show."""
+    """(name, reason) of the evaluator a model's default picks, without the warning it
+    would show."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", InterpretedWarning)
         ev = system.evaluator()
-    if hasattr(ev, "name"):
-        return ev.name, ev.reason
-    return "partitioned", "a ConstrainedSystem: the tree's dense Gauss form, projected"
+    return ev.name, ev.reason
 
 
 def scene_row(name: str, budget: float) -> dict:

@@ -120,11 +120,11 @@ class RigidBody(Subsystem):
 
     def kinetic_energy(self, y_dot: NDArray, q_e=None) -> float:
         """½ ẏᵀ M ẏ."""
-        return 0.5 * float(y_dot @ self.M6 @ y_dot)
+        return 0.5 * (y_dot @ self.M6 @ y_dot)
 
     def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray, q_e=None) -> float:
         """−m g · r_c(inertial)."""
-        return -self.m * float(gravity @ (r + R @ self.r_c))
+        return -self.m * (gravity @ (r + R @ self.r_c))
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(m={self.m}, r_c={self.r_c.tolist()})"
@@ -180,7 +180,7 @@ class PlanarBody(RigidBody):
 
     def kinetic_energy(self, y_dot: NDArray, q_e=None) -> float:
         """½ ẏᵀ M ẏ."""
-        return 0.5 * float(y_dot @ self.M @ y_dot)
+        return 0.5 * (y_dot @ self.M @ y_dot)
 
 
 class Frame(Subsystem):

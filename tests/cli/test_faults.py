@@ -259,3 +259,33 @@ def test_the_sweep_says_how_many_points_it_runs(tmp_path, capsys):
             "--out", str(tmp_path)]
     assert main(argv) == 0
     assert capsys.readouterr().out.startswith("sweep atwood: 4 points on 1 local processes")
+
+
+@pytest.mark.parametrize("api", ["cli", "python"])
+def test_a_large_sweep_says_how_long_it_will_take(api, tmp_path, capsys, monkeypatch):
+    """A sweep with more points than ESTIMATE_ABOVE (lowered to 3 here) runs its first two
+    points in the main process, the second timed, and prints "N points, about T (≈ t per point
+    × N / W workers)" before the others start; their rows are kept (the table is complete, in
+    order), and a small sweep prints no estimate."""
+    import concurrent.futures as cf
+    import re
+
+    import projeq.simulation.sweep as sweep_module
+
+    monkeypatch.setattr(sweep_module, "ESTIMATE_ABOVE", 3)
+    if api == "cli":
+        argv = ["sweep", "atwood", "--grid", "m1=1:2:2", "--grid", "m2=1:2:2", "--t-end", "0.05", "--workers", "1",
+                "--out", str(tmp_path)]
+        assert main(argv) == 0
+        table, workers = SweepTable.load(tmp_path / "sweep_atwood"), "1 worker"
+    else:
+        with cf.ThreadPoolExecutor(2) as pool:
+            table = sweep_module.sweep("atwood", grid={"m1": [1.0, 2.0], "m2": [1.0, 2.0]}, executor=pool,
+                                       t_end=0.05, progress=True)
+        workers = "2 workers"
+    out = capsys.readouterr().out
+    assert re.search(r"^4 points, about \S+ (s|min|h|days) \(≈ \S+ s per point × 4 / " + workers + r"\)$", out, re.M), out
+    assert table["status"].tolist() == [0, 0, 0, 0] and table["m1"].tolist() == [1.0, 1.0, 2.0, 2.0]
+    with cf.ThreadPoolExecutor(1) as pool:
+        sweep_module.sweep("atwood", grid={"m1": [1.0, 2.0]}, executor=pool, t_end=0.05)
+    assert "points, about" not in capsys.readouterr().out

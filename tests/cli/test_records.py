@@ -109,7 +109,7 @@ def test_a_user_scene_from_a_file(tmp_path, capsys):
     spec = util.spec_from_file_location("check_model", model)
     module = util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    direct = pq.simulate(module.build(length=2.0), 0.3, method="DOP853", rtol=1e-9, atol=1e-11, n_points=201)
+    direct = pq.simulate(module.build(length=2.0), 0.3, n_points=201)  # projeq run: simulate's defaults
     assert result.t[-1] == 0.3 and np.allclose(result.q, direct.q, rtol=0, atol=1e-9)
     assert main(["run", f"{model}:missing", "--out", str(tmp_path)]) == 2
     assert "has no function 'missing'" in capsys.readouterr().err
@@ -146,3 +146,21 @@ def test_text_fits_100_columns_and_help_has_no_markup(capsys):
     assert table.to_text().splitlines()[2].endswith("x" * 300)
     assert main(["bench", "--help"]) == 0
     assert ":mod:" not in (help_text := capsys.readouterr().out) and "``" not in help_text
+
+
+def test_run_uses_the_scenes_settings_then_simulates_defaults(tmp_path, capsys):
+    """Without options ``projeq run`` takes the scene's integrator settings (the spin-up beam:
+    Radau at rtol 1e-4, atol 1e-6, projeq.scenes.SPIN_UP_SETTINGS), a scene without settings
+    simulate's own defaults (recorded as "default" and the integrator simulate used), and an
+    option given on the command line wins over both."""
+    assert main(["run", "--t-end", "0.5", "--out", str(tmp_path / "beam"), "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["scene"] == "spin_up_beam" and record["method"] == "Radau"
+    assert record["tolerances"] == {"rtol": 1e-4, "atol": 1e-6}
+    assert main(["run", "--t-end", "0.5", "--rtol", "1e-6", "--out", str(tmp_path / "beam"), "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["method"] == "Radau" and record["tolerances"] == {"rtol": 1e-6, "atol": 1e-6}
+    assert main(["run", "double_pendulum", "--t-end", "0.1", "--out", str(tmp_path / "pendulum"), "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["tolerances"] == {"rtol": "default", "atol": "default"}
+    assert record["method"] == pq.Result.load(next((tmp_path / "pendulum").rglob("*.npz"))).method != "default"

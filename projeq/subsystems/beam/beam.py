@@ -429,12 +429,12 @@ class RitzBeam(BeamProbes, Subsystem):
     def kinetic_energy(self, y_dot: NDArray, q_e: NDArray) -> float:
         """½ ẏᵀ M ẏ (exact for the slice kinematics)."""
         M, _ = self.gauss_terms(y_dot, np.eye(3), np.zeros(3), q_e)
-        return 0.5 * float(y_dot @ M @ y_dot)
+        return 0.5 * (y_dot @ M @ y_dot)
 
     def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray, q_e: NDArray) -> float:
         """Gravity −∫ g·r_slice dm plus the strain energy ½ q_eᵀ K_e q_e."""
         r_x, _ = self.slices(q_e)
-        return float(-self.mass_weights @ (r_x @ R.T + r) @ gravity + 0.5 * q_e @ self.K_e @ q_e)
+        return -self.mass_weights @ (r_x @ R.T + r) @ gravity + 0.5 * q_e @ self.K_e @ q_e
 
     def port(self, point: NDArray, q_e: NDArray, q_e_dot: NDArray) -> Relative:
         """Kinematics of a frame attached at ``point`` of the undeformed beam (station
