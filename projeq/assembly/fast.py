@@ -233,6 +233,7 @@ class FastEvaluator:
             raise SingularMassError("system mass matrix M(q) (of the coupled joints' shared velocities) is singular: "
                                     "a motion along its minimal velocities moves no mass or inertia")
         if failed >= 0:
+            self.system.evaluator("recursive").accelerations(q, s_dot, t)  # raises naming the motion that moves nothing
             raise SingularMassError(
                 f"D_n = F_nᵀ M̂_n F_n of joint {self.system.names[failed]!r} is singular: "
                 "it moves no mass or inertia"
