@@ -1,9 +1,10 @@
 """``method="auto"``, the default evaluator: the best evaluator available for a System, picked once.
 
-In this order: ``"fast"`` (the compiled order-n kernel, :mod:`projeq.assembly.fast`) when
-the kernel knows every subsystem (rigid bodies, spatial or planar, on any joint, coupled
-ones included, under any force law); ``"hub_beam"``
-(:mod:`projeq.assembly.beam_fast`) for one RitzBeam on a prescribed or fixed hub; else the
+In this order: ``"hub_beam"`` (:mod:`projeq.assembly.beam_fast`) for one RitzBeam on a
+prescribed or fixed hub; ``"fast"`` (the compiled order-n kernel, :mod:`projeq.assembly.fast`)
+when the kernel knows every subsystem (rigid bodies, spatial or planar, on any joint, coupled
+ones included, under any force law; RitzBeams without rotary inertia anywhere in a tree
+under gravity); else the
 reference evaluators, ``"dense"`` when joints share minimal velocities (coupled) and
 ``"recursive"`` otherwise, with one :class:`InterpretedWarning` per System naming the piece
 the kernel does not know — the fall-back is never silent. Each evaluator evaluates its
@@ -26,7 +27,8 @@ once (``projeq bench`` reports the first-call latency), later processes load it.
 'recursive'
 >>> [str(w.message) for w in said]  # doctest: +NORMALIZE_WHITESPACE
 ["system: evaluated by the interpreted 'recursive' evaluator, not the compiled one: subsystem 'rod' is a
-Own (the kernel knows the terms of rigid bodies, rigid_inertia, spatial or selected by S)"]
+Own (the kernel knows the terms of rigid bodies, rigid_inertia, spatial or selected by S, and of RitzBeams
+without rotary inertia)"]
 """
 
 from __future__ import annotations
@@ -52,11 +54,11 @@ def why_not_compiled(system) -> str | None:
 
 def pick(system) -> tuple[str, str]:
     """(name, reason): the evaluator "auto" picks for ``system`` and why (module docstring)."""
+    if hub_beam_unsupported(system) is None:
+        return "hub_beam", "one RitzBeam on a prescribed or fixed hub"
     why_not_fast = why_not_compiled(system)
     if why_not_fast is None:
         return "fast", "the compiled order-n kernel knows every joint, subsystem and force law"
-    if hub_beam_unsupported(system) is None:
-        return "hub_beam", "one RitzBeam on a prescribed or fixed hub"
     return ("dense" if system.coupled else "recursive"), f"the fast kernel cannot evaluate it: {why_not_fast}"
 
 

@@ -90,46 +90,56 @@ class FastEvaluator:
         self.system = system
         self.n_calls = 0
         self.compiled = bool(compiled)
-        self._chain_terms, self._passes = kernels.kernel(self.compiled)
         self._gauss_form, self._projected_accelerations = kernels.gauss_form_kernel(self.compiled)
         self._pack(system)
+        self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=bool(np.all(self._n_y == 6)))
 
     def _pack(self, system) -> None:
-        """Flat arrays of the tree (built once) and the workspace."""
+        """Flat arrays of the tree (built once) and the workspace; bodies are padded to the
+        largest n_y (6, or 6 + n_e of an elastic body) and joints to the most columns of F."""
         N = len(system.joints)
         joints, bodies = system.joints, system.subsystems
         self._kind = np.array([kernels.KINDS.get(j.compiled_kind, kernels.GIVEN) for j in joints], dtype=np.int64)
         self._given = [n for n in range(N) if self._kind[n] == kernels.GIVEN]
-        self._n_cols = np.array([j.n_s for j in joints], dtype=np.int64)
+        self._n_cols = np.array([j.n_s + b.n_e for j, b in zip(joints, bodies)], dtype=np.int64)
+        self._n_y = np.array([6 + b.n_e for b in bodies], dtype=np.int64)
         self._parent = np.array(system.parent, dtype=np.int64)
         self._axis = np.array([j.axis if k in (kernels.REVOLUTE, kernels.PRISMATIC) else np.zeros(3)
                                for k, j in zip(self._kind, joints)])
         self._orientation = np.array([j.orientation for j in joints])
-        self._offset = np.array([j.r_pn for j in joints])
-        # every joint's own coordinates and velocities, in the order of the joints (q and ṡ
-        # themselves unless joints are coupled: then q_all = P_q q, ṡ_all = P ṡ)
-        self._q_index = np.cumsum([0] + [j.n_q for j in joints[:-1]], dtype=np.int64)
-        self._s_index = np.cumsum([0] + [j.n_s for j in joints[:-1]], dtype=np.int64)
+        ports = system.plan.port
+        self._offset = np.array([np.zeros(3) if ports[n] else j.r_pn for n, j in enumerate(joints)])
+        # every joint's own coordinates and velocities (and a body's internal ones after them), in
+        # the order of the joints (q and ṡ themselves unless joints are coupled: then q_all = P_q q,
+        # ṡ_all = P ṡ)
+        self._q_index = np.cumsum([0] + [j.n_q + b.n_e for j, b in zip(joints[:-1], bodies)], dtype=np.int64)
+        self._s_index = np.cumsum([0] + [k for k in self._n_cols[:-1]], dtype=np.int64)
         self._expansion = _expansion(system) if system.coupled else None
         n_all = int(self._n_cols.sum())
         self._M_all, self._b_all, self._M = np.zeros((n_all, n_all)), np.zeros(n_all), np.zeros((system.n_s,) * 2)
-        self._m, self._r_c, self._I_c = (np.array(part) for part in zip(*(b.rigid_inertia for b in bodies)))
-        self._M6 = np.array([rigid_mass_matrix(*b.rigid_inertia) for b in bodies])
+        rigid = [b.rigid_inertia or (0.0, np.zeros(3), np.zeros((3, 3))) for b in bodies]
+        self._m, self._r_c, self._I_c = (np.array(part) for part in zip(*rigid))
+        self._elastic, self._ports = _elastic_fields(system), _port_fields(system)
+        width, depth = int(self._n_y.max()), max(6, int(self._n_cols.max()))
+        self._M_n = np.zeros((N, width, width))
+        self._M_n[:, :6, :6] = [rigid_mass_matrix(*inertia) for inertia in rigid]
         self._gravity = np.asarray(system.gravity, dtype=float)
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
         # one row per joint for its relative_values (A, r, w, ζ, F⁶ by columns), read by the kernel
-        # through views: given_A, given_r, given_w, given_zeta and F (F[n, :, j] = column j)
+        # through views: given_A, given_r, given_w, given_zeta and F (F[n, :, j] = column j); with
+        # elastic bodies F is wider (n_y rows, their q̇_e columns) and takes the given columns
         values = self._given_values = np.zeros((N, 60))
         self._given_A, self._given_r = values[:, :9].reshape(N, 3, 3), values[:, 9:12]
         self._given_w, self._given_zeta = values[:, 12:18], values[:, 18:24]
-        self._F = values[:, 24:].reshape(N, 6, 6).transpose(0, 2, 1)
+        self._given_F = values[:, 24:].reshape(N, 6, 6).transpose(0, 2, 1)
+        self._F = self._given_F if (width, depth) == (6, 6) else np.zeros((N, width, depth))
         self._given_plan = [
             (n, joints[n], slice(self._q_index[n], self._q_index[n] + joints[n].n_q),
              slice(self._s_index[n], self._s_index[n] + joints[n].n_s), 24 + 6 * joints[n].n_s)
             for n in self._given
         ]
-        self._T, self._zeta = np.zeros((N, 6, 6)), np.zeros((N, 6))
-        self._M_hat, self._h_hat = np.zeros((N, 6, 6)), np.zeros((N + 1, 6))
+        self._T, self._zeta = np.zeros((N, width, width)), np.zeros((N, width))
+        self._M_hat, self._h_hat = np.zeros((N, width, width)), np.zeros((N + 1, width))
         self._R, self._r, self._twist = np.zeros((N + 1, 3, 3)), np.zeros((N + 1, 3)), np.zeros((N + 1, 6))
         self._kin = _kinematics(self._n_cols, self._R, self._r, self._twist, self._F) if system.forces else None
         self._selected = [n for n in range(N) if system.S[n] is not None]
@@ -140,6 +150,8 @@ class FastEvaluator:
         values = self._given_values
         for n, joint, q_n, s_n, width in self._given_plan:
             values[n, :width] = joint.relative_values(q_all[q_n], s_all[s_n], t)
+            if self._F is not self._given_F:
+                self._F[n, :6, :6] = self._given_F[n]
 
     def _add_forces(self, q: NDArray, s_dot: NDArray, t: float) -> None:
         """The force laws' own ``add_to`` (the statement the reference evaluators call) on the
@@ -170,15 +182,18 @@ class FastEvaluator:
             self._relative_motions(q_all, s_all, t)
         self._chain_terms(
             self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index, self._s_index,
-            self._m, self._r_c, self._I_c, self._gravity, q_all, s_all,
-            self._given_A, self._given_r, self._given_w, self._given_zeta,
-            self._T, self._zeta, self._F, self._h_hat[:-1], self._R, self._r, self._twist,
+            self._n_cols, self._m, self._r_c, self._I_c, self._gravity, q_all, s_all,
+            self._given_A, self._given_r, self._given_w, self._given_zeta, self._elastic, self._ports,
+            self._T, self._zeta, self._F, self._M_n, self._h_hat[:-1], self._R, self._r, self._twist,
         )
         if self._kin is not None:
             self._add_forces(q, s_dot, t)
 
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
-        """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels."""
+        """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels (by
+        the dense evaluator for a tree with elastic bodies, which the Gauss-form kernel does not take)."""
+        if self._M_n.shape[1] > 6:
+            return self.system.evaluator("dense").gauss_form(q, s_dot, t)
         self.n_calls += 1
         self._terms(np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), t)
         return self._assembled()
@@ -188,7 +203,7 @@ class FastEvaluator:
         every joint's own velocities, projected with P for coupled joints."""
         M, b = self._M_all, self._b_all
         self._gauss_form(self._n_cols, self._parent, self._s_index, self._T, self._zeta, self._F,
-                         self._M6, self._h_hat, M, b)
+                         self._M_n, self._h_hat, M, b)
         if self._expansion is None:
             return M.copy(), b.copy()
         P = self._expansion[1]
@@ -206,9 +221,9 @@ class FastEvaluator:
             failed = self._projected_accelerations(self._M_all, self._b_all, self._expansion[1], self._pivot_min,
                                                    self._M, s_ddot)
         else:
-            self._M_hat[:] = self._M6
+            self._M_hat[:] = self._M_n
             failed = self._passes(
-                self._n_cols, self._parent, self._s_index, self._T, self._zeta, self._F,
+                self._n_cols, self._n_y, self._parent, self._s_index, self._T, self._zeta, self._F,
                 self._M_hat, self._h_hat, self._pivot_min, s_ddot,
             )
         if failed >= 0 and not (np.all(np.isfinite(q)) and np.all(np.isfinite(s_dot))):
@@ -218,6 +233,7 @@ class FastEvaluator:
             raise SingularMassError("system mass matrix M(q) (of the coupled joints' shared velocities) is singular: "
                                     "a motion along its minimal velocities moves no mass or inertia")
         if failed >= 0:
+            self.system.evaluator("recursive").accelerations(q, s_dot, t)  # raises naming the motion that moves nothing
             raise SingularMassError(
                 f"D_n = F_nᵀ M̂_n F_n of joint {self.system.names[failed]!r} is singular: "
                 "it moves no mass or inertia"
@@ -227,11 +243,69 @@ class FastEvaluator:
 
 def unsupported(system) -> str | None:
     """Why the fast kernel cannot evaluate ``system`` (None if it can)."""
-    for name, body in zip(system.names, system.subsystems):
-        if body.rigid_inertia is None:
+    for n, (name, joint, body) in enumerate(zip(system.names, system.joints, system.subsystems)):
+        if body.n_e:
+            reason = _elastic_unsupported(body)
+            if reason:
+                return f"subsystem {name!r} is a {type(body).__name__} {reason}"
+            if system.forces or system.coupled:
+                return (f"subsystem {name!r} is elastic in a system with force laws or coupled joints (the "
+                        "kernel's elastic block takes trees under gravity)")
+        elif body.rigid_inertia is None:
             return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of rigid bodies, "
-                    "rigid_inertia, spatial or selected by S)")
+                    "rigid_inertia, spatial or selected by S, and of RitzBeams without rotary inertia)")
+        if system.plan.port[n] and not hasattr(system.plan.stations[n], "field"):
+            return f"joint {name!r} sits on a port of {type(system.subsystems[system.parent[n]]).__name__} without a field"
     return None
+
+
+def _elastic_unsupported(body) -> str | None:
+    """Why the kernel's elastic block (:func:`projeq.assembly.kernels.elastic_body`) cannot take
+    ``body`` (None if it can): it takes bodies with ẏ = (twist, q̇_e) whose terms are the slice
+    sums of their ``slice_field`` with linear restoring forces (a RitzBeam without rotary inertia)."""
+    if not hasattr(body, "slice_field") or body.S is None or not np.array_equal(body.S, np.eye(6 + body.n_e, 6)):
+        return "(the kernel knows elastic bodies by the slice field of a RitzBeam)"
+    if body.rotary is not None:
+        return "with rotary inertia or torsion (the kernel's elastic block has the slices' translation only)"
+    return None
+
+
+def _elastic_fields(system) -> tuple:
+    """(slot, e_index, n_e, m_k, r₀, Ψ, Q, K_e, damping) of :func:`projeq.assembly.kernels.chain_terms`:
+    the station fields of the elastic bodies (:meth:`projeq.RitzBeam.slice_field`), padded to
+    the most stations and internal coordinates (zero masses and columns)."""
+    N, beams = len(system.subsystems), [n for n, b in enumerate(system.subsystems) if b.n_e]
+    slot = np.full(N, -1, dtype=np.int64)
+    e_index = np.array([[system.e_q_slice[n].start, system.e_s_slice[n].start] if system.subsystems[n].n_e else [0, 0]
+                        for n in range(N)], dtype=np.int64).reshape(N, 2)
+    n_e = np.array([b.n_e for b in system.subsystems], dtype=np.int64)
+    K = max([len(system.subsystems[n].mass_weights) for n in beams], default=1)
+    E = max([system.subsystems[n].n_e for n in beams], default=1)
+    B = len(beams)
+    m, r0, Psi, Q = np.zeros((B, K)), np.zeros((B, K, 3)), np.zeros((B, K, 3, E)), np.zeros((B, K, E, E))
+    K_e, damping = np.zeros((B, E, E)), np.zeros(B)
+    for i, n in enumerate(beams):
+        beam = system.subsystems[n]
+        slot[n], k, e = i, len(beam.mass_weights), beam.n_e
+        m[i, :k] = beam.mass_weights
+        r0[i, :k], Psi[i, :k, :, :e], Q[i, :k, :e, :e] = beam.slice_field()
+        K_e[i, :e, :e], damping[i] = beam.K_e, beam.damping
+    return slot, e_index, n_e, m, r0, Psi, Q, K_e, damping
+
+
+def _port_fields(system) -> tuple:
+    """(slot, r₀, Ψ, Q, slopes, c) of :func:`projeq.assembly.kernels.chain_terms`: the fields of
+    the stations that joints sit at (:class:`projeq.subsystems.beam.beam.BeamPort`), padded."""
+    N, stations = len(system.joints), system.plan.stations
+    slot = np.full(N, -1, dtype=np.int64)
+    E = max([system.subsystems[system.parent[n]].n_e for n in stations], default=1)
+    P = len(stations)
+    r0, Psi, Q, slopes, c = np.zeros((P, 3)), np.zeros((P, 3, E)), np.zeros((P, E, E)), np.zeros((P, 2, E)), np.zeros((P, 3))
+    for i, (n, port) in enumerate(stations.items()):
+        slot[n], e = i, port.field[1].shape[1]
+        r0[i], Psi[i, :, :e], Q[i, :e, :e], slopes[i, :, :e] = port.field
+        c[i] = port.offset
+    return slot, r0, Psi, Q, slopes, c
 
 
 def _expansion(system) -> tuple[NDArray, NDArray]:

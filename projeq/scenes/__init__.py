@@ -18,7 +18,7 @@ from projeq.subsystems import inertia
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
 from projeq.scenes.bicycle import fallen_over, whipple_bicycle, whipple_eigenvalues
-from projeq.scenes.elastic import elastic_arm, spin_up_beam, spinning_beam
+from projeq.scenes.elastic import elastic_arm, flexible_arm, spin_up_beam, spinning_beam
 from projeq.scenes.iftomm import andrews_squeezer, bricard, n_four_bar, simple_pendulum
 from projeq.scenes.mechanisms import bar_on_wall, four_bar, quick_return, slider_pendulum, sphere_on_sphere
 from projeq.scenes.parameters import Parameter, check_names, closest, parse_settings, scene_parameters
@@ -207,7 +207,7 @@ def build_scene(name: str, **overrides) -> System:
     return scene.build(**overrides)
 
 __all__ = [
-    "chain", "double_pendulum", "atwood", "spin_up_beam", "spinning_beam", "elastic_arm",
+    "chain", "double_pendulum", "atwood", "spin_up_beam", "spinning_beam", "elastic_arm", "flexible_arm",
     "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed", "rolling_disk_inertia",
     "barhorst_particle", "nonholonomic_particle", "whipple_bicycle", "whipple_eigenvalues",
     "quick_return", "four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",

@@ -113,6 +113,34 @@ def elastic_arm(
     )
 
 
+def flexible_arm(rigid_last_link: bool = False, n_v: int = 4) -> System:
+    """Three links turning about z under gravity along −y, hanging from the origin: links of
+    0.6 m, 2.0 kg and 0.5 m, 1.5 kg (slender rods), and a last link of 0.8 m that is a RitzBeam
+    (ρA = 0.8 kg/m, EI_z = 40 N m², ``n_v`` polynomial bending functions in the plane, n_w = 0)
+    or with ``rigid_last_link`` its rigid twin (a rod of the beam's 0.64 kg); a 0.3 kg point
+    mass at its end (on the beam's end station). Initial state: q = (0.3, −0.4, 0.2, 0, …)
+    from rest. The stiff elastic model of the compiled-by-default benchmark
+    (benchmarks/flexible_arm.py: its default simulation against its rigid twin's)."""
+    n_v = count("n_v", n_v)
+    rod = RigidBody(0.64, (0.4, 0.0, 0.0), inertia.cylinder(0.64, 0.01, 0.8, axis="x"))
+    last = rod if rigid_last_link else RitzBeam(0.8, rho_A=0.8, EI_z=40.0, n_v=n_v, n_w=0)
+    subsystems = {
+        "upper": RigidBody(2.0, (0.3, 0.0, 0.0), inertia.cylinder(2.0, 0.02, 0.6, axis="x")),
+        "fore": RigidBody(1.5, (0.25, 0.0, 0.0), inertia.cylinder(1.5, 0.02, 0.5, axis="x")),
+        "last": last,
+        "tip": PointMass(0.3),
+    }
+    joints = {
+        "upper": Revolute(axis="z"),
+        "fore": Revolute(parent="upper", axis="z", r_pn=(0.6, 0.0, 0.0)),
+        "last": Revolute(parent="fore", axis="z", r_pn=(0.5, 0.0, 0.0)),
+        "tip": Fixed(parent="last", r_pn=(0.8, 0.0, 0.0)),
+    }
+    q0 = np.zeros(3 + (0 if rigid_last_link else n_v))
+    q0[:3] = (0.3, -0.4, 0.2)
+    return System(subsystems, joints, gravity=(0.0, -9.81, 0.0), q0=q0, s_dot0=np.zeros(len(q0)))
+
+
 def spinning_beam(
     omega: float = 2.0,
     length: float = 1.0,

@@ -33,12 +33,14 @@ from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 from projeq.analysis.jacobians import differentiate, state_derivative
 from projeq.assembly import EVALUATORS
 from projeq.checks import callable_name, closest, count, finite_array, positive, state_vector
-from projeq.simulation.integrators import EXPLICIT, PROJECTED, projected_solver, warn_if_stiff
+from projeq.simulation.integrators import (
+    EXPLICIT, PROJECTED, projected_solver, spectral_radius, stability_limit, warn_if_stiff,
+)
 from projeq.simulation.result import Result, SimulationError
 from projeq.constraints.nonholonomic import near_singularity
 from projeq.system import Model, check_model
 
-__all__ = ["INTEGRATORS", "Result", "SimulationError", "ValidityWarning", "simulate"]
+__all__ = ["INTEGRATORS", "Result", "SimulationError", "ValidityWarning", "default_method", "simulate"]
 
 
 INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")  # the methods of solve_ivp
@@ -102,7 +104,7 @@ def simulate(
     t_end: float,
     q0=None,
     s_dot0=None,
-    method="RK45",
+    method=None,
     rtol: float = 1e-8,
     atol: float = 1e-10,
     events=None,
@@ -127,8 +129,11 @@ def simulate(
         End time (s), > t_start.
     q0, s_dot0 : arrays, optional
         Initial coordinates and minimal velocities (default: the system's q0, ṡ0).
-    method : str or scipy OdeSolver class
-        Any method of ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...),
+    method : str or scipy OdeSolver class, optional
+        None (default): chosen by :func:`default_method` from the model's fastest mode
+        measured at the initial state (RK45; DOP853 for fast elastic modes; Radau with the
+        exact Jacobian for very stiff models); ``Result.method`` names the choice. Or any method of
+        ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...),
         or ``"RK45-projected"`` / ``"DOP853-projected"``: that method with each step projected
         onto the initial energy, so that a conservative scleronomic system's energy error
         stays at round-off over long runs (:mod:`projeq.simulation.integrators`; ValueError for a
@@ -193,7 +198,7 @@ def simulate(
                 run.steps += len(segment.sol.ts) - 1
                 if not stiff_warned and run.steps >= 2 * checked:  # ρ at most log₂(steps) times per run
                     checked = run.steps
-                    stiff_warned = warn_if_stiff(run.rhs, run.steps, run.t_start, b, segment.sol(b), method, rtol)
+                    stiff_warned = warn_if_stiff(run.rhs, run.steps, run.t_start, b, segment.sol(b), run.method, rtol)
                 run.end_segment(segment, b)
     result = _assemble(run, _time.perf_counter() - started, dense_output)
     if not run.out_of_range and len(result.t) and result.q.shape[1] == system.tree.n_q:
@@ -231,8 +236,9 @@ class _Run:
         self.rtol, self.atol = positive("rtol", rtol), positive("atol", atol)
         if self.rtol >= 1.0:
             raise ValueError(f"rtol: a relative tolerance must be below 1 (1 allows 100 % error), got {rtol}")
-        _check_method(method)
-        _check_options(method, options)
+        if method is not None:
+            _check_method(method)
+            _check_options(method, options)
         self.t_eval = _output_times(t_start, t_end, t_eval, count("n_points", n_points, 2))
         self.bounds = np.linspace(t_start, t_end, count("n_segments", n_segments) + 1)
         if progress is not None and not callable(progress):
@@ -242,6 +248,9 @@ class _Run:
         self.choice, self.ev = evaluator, _evaluator(system, evaluator)
         system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
         self.ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
+        if method is None:
+            method = default_method(self.ev, system, q0, s_dot0, t_start, t_end)
+            _check_options(method, options)
         self.method, self.progress, self.options = method, progress, options
         self.solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
@@ -340,6 +349,34 @@ class _Run:
             self.status, self.message = 2, "interrupted (Ctrl-C): the trajectory up to the last finished segment is kept"
         except Exception as exc:  # noqa: BLE001 - a user's force law or event failed: keep the trajectory
             self.status, self.message, self.cause = -1, _described(exc), exc
+
+
+FAST_MODE_STEPS = 500  # RK45 steps forced by stability alone beyond which DOP853 is the default
+STIFF_STEPS = 100_000  # DOP853 steps forced by stability alone beyond which Radau is the default
+
+
+def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_end: float) -> str:
+    """simulate's integrator when none is given, from the model's fastest mode measured at the
+    initial state: ρ = the spectral radius of ∂ẋ/∂x (power iteration,
+    :func:`projeq.simulation.integrators.spectral_radius`, 33 evaluations of ``evaluator``)
+    gives the steps an explicit method needs for stability alone, n = ρ (t_end − t0) / |x_s|
+    with |x_s| its stability interval (:func:`~projeq.simulation.integrators.stability_limit`:
+    RK45 3.31, DOP853 6.39). "RK45" while n_RK45 ≤ ``FAST_MODE_STEPS`` (rigid models: n ≤ 60
+    for chains of 5–20 links and the three-link arm over 5 s); "DOP853" beyond (models with
+    fast elastic modes, n = 1200–4750 for the elastic and the flexible arm and the spin-up
+    beam, where the error control must follow the excited fast modes: measured in
+    benchmarks/default_integrator.py, DOP853 needs half RK45's evaluations and 1/5 of
+    Radau's with the exact Jacobian at equal tolerance); "Radau" (exact Jacobian) when even
+    DOP853 would need more than ``STIFF_STEPS`` steps for stability alone."""
+
+    def rhs(t, x):
+        q, s_dot = x[: model.n_q], x[model.n_q :]
+        return np.concatenate((model.q_dot(q, s_dot, t), evaluator.accelerations(q, s_dot, t)))
+
+    rho_T = spectral_radius(rhs, t0, np.concatenate((q0, s_dot0))) * (t_end - t0)
+    if rho_T > STIFF_STEPS * stability_limit("DOP853"):
+        return "Radau"
+    return "DOP853" if rho_T > FAST_MODE_STEPS * stability_limit("RK45") else "RK45"
 
 
 def _jac_option(method, jac):

@@ -199,6 +199,7 @@ class RitzBeam(BeamProbes, Subsystem):
                         f"condition of the {self.support} root ({what} ≠ 0)"
                     )
         self.Phi, self.H = self.station_data(self.x)
+        self._field = self.slice_field()
 
     def station_data(self, x: NDArray) -> tuple[dict, dict]:
         """Φ, Φ′, Φ″ of u, v, w at stations x, and H(x) = ∫₀ˣ Φ′Φ′ᵀ dξ of v and w
@@ -313,26 +314,36 @@ class RitzBeam(BeamProbes, Subsystem):
         return tuple((f"{name}[{i}]", unit) for name, n, unit in groups for i in range(n))
 
     # -- slice kinematics ------------------------------------------------------------------
-    def slices(self, q_e: NDArray, x: NDArray | None = None, data=None):
-        """r(x) and Φ_r(x, q_e) at the quadrature stations (or at ``x`` with its
-        ``station_data``)."""
+    def slice_field(self, x: NDArray | None = None, data=None) -> tuple[NDArray, NDArray, NDArray]:
+        """The slice kinematics at the quadrature stations (or at ``x`` with its
+        ``station_data``) as constants: r(x, q_e) = r₀(x) + Ψ(x) q_e − ½ (q_eᵀ Q(x) q_e) e_x
+        with r₀ = x e_x, Ψ = Φ_r(x, 0) (rows u, v, w of the Ritz functions) and
+        Q = blockdiag(H_v, H_w) when ``stiffening`` (u₂, module docstring), else 0.
+        Returns (r₀, Ψ, Q), stacked over the stations; :meth:`slices` evaluates it, and so
+        does the compiled kernel (:mod:`projeq.assembly.kernels`)."""
         x, (Phi, H) = (self.x, (self.Phi, self.H)) if x is None else (x, data)
         e = self._local  # columns of ẏ → positions within q_e
-        q_u, q_v, q_w = q_e[e(self.u_cols)], q_e[e(self.v_cols)], q_e[e(self.w_cols)]
-        dtype = np.result_type(q_e, float)  # complex for the complex-step derivative of ports
-        r = np.zeros((len(x), 3), dtype=dtype)
-        r[:, 0] = x + q_u @ Phi["u"][0]
-        r[:, 1] = q_v @ Phi["v"][0]
-        r[:, 2] = q_w @ Phi["w"][0]
-        Phi_r = np.zeros((len(x), 3, self.n_e), dtype=dtype)
-        Phi_r[:, 0, e(self.u_cols)] = Phi["u"][0].T
-        Phi_r[:, 1, e(self.v_cols)] = Phi["v"][0].T
-        Phi_r[:, 2, e(self.w_cols)] = Phi["w"][0].T
+        r0 = np.zeros((len(x), 3))
+        r0[:, 0] = x
+        Psi = np.zeros((len(x), 3, self.n_e))
+        Psi[:, 0, e(self.u_cols)] = Phi["u"][0].T
+        Psi[:, 1, e(self.v_cols)] = Phi["v"][0].T
+        Psi[:, 2, e(self.w_cols)] = Phi["w"][0].T
+        Q = np.zeros((len(x), self.n_e, self.n_e))
         if self.stiffening:
-            Hq_v, Hq_w = H["v"] @ q_v, H["w"] @ q_w
-            r[:, 0] -= 0.5 * (Hq_v @ q_v + Hq_w @ q_w)  # u₂
-            Phi_r[:, 0, e(self.v_cols)] = -Hq_v  # ∂u₂/∂q_v
-            Phi_r[:, 0, e(self.w_cols)] = -Hq_w
+            Q[:, e(self.v_cols), e(self.v_cols)] = H["v"]
+            Q[:, e(self.w_cols), e(self.w_cols)] = H["w"]
+        return r0, Psi, Q
+
+    def slices(self, q_e: NDArray, x: NDArray | None = None, data=None):
+        """r(x) and Φ_r(x, q_e) = ∂r/∂q_e = Ψ − e_x (Q q_e)ᵀ at the quadrature stations (or
+        at ``x`` with its ``station_data``): :meth:`slice_field` evaluated at q_e."""
+        r0, Psi, Q = self.slice_field(x, data) if x is not None else self._field
+        Qq = Q @ q_e  # complex for the complex-step derivative of ports
+        r = r0 + Psi @ q_e
+        r[:, 0] -= 0.5 * (Qq @ q_e)  # u₂
+        Phi_r = Psi.astype(Qq.dtype)
+        Phi_r[:, 0, :] -= Qq  # ∂u₂/∂q_e
         return r, Phi_r
 
     def jacobian(self, r: NDArray, Phi_r: NDArray) -> NDArray:
@@ -443,24 +454,25 @@ class RitzBeam(BeamProbes, Subsystem):
         if not 0.0 <= x <= self.length:
             raise ValueError(f"r_pn: a joint on a beam must sit at a station 0 ≤ x ≤ {self.length}, got x = {x}")
         station = np.array([x])
-        return BeamPort(self, (station, self.station_data(station)), np.array([0.0, point[1], point[2]]))
-
-    def _port_terms(self, q_e, data, offset):
-        """(A, r, F) of a port; complex-safe, for the complex-step Ḟ."""
-        x, (Phi, H) = data
-        r_x, Phi_r = self.slices(q_e, x, (Phi, H))
+        data = (station, self.station_data(station))
         e = self._local
-        a = Phi["v"][1][:, 0] @ q_e[e(self.v_cols)]  # v′
-        b = -(Phi["w"][1][:, 0] @ q_e[e(self.w_cols)])  # −w′
-        beta = Phi["beta"][0][:, 0] @ q_e[e(self.beta_cols)]
+        slopes = np.zeros((2, self.n_e))  # ∂v′/∂q_e and ∂(−w′)/∂q_e at the station
+        slopes[0, e(self.v_cols)] = data[1][0]["v"][1][:, 0]
+        slopes[1, e(self.w_cols)] = -data[1][0]["w"][1][:, 0]
+        r0, Psi, Q = self.slice_field(*data)
+        return BeamPort(self, data, np.array([0.0, point[1], point[2]]), (r0[0], Psi[0], Q[0], slopes))
+
+    def _port_terms(self, q_e, port):
+        """(A, r, F) of ``port`` (a :class:`BeamPort`) from its field; complex-safe, for the
+        complex-step Ḟ."""
+        (x, (Phi, H)), offset, slopes = port.data, port.offset, port.field[3]
+        r_x, Phi_r = self.slices(q_e, x, (Phi, H))
+        a, b = slopes @ q_e  # v′, −w′
+        beta = Phi["beta"][0][:, 0] @ q_e[self._local(self.beta_cols)]
         R_x = rotation_x(beta)
         A = rotation_z(a) @ rotation_y(b) @ R_x
-        Phi_omega = np.zeros((3, self.n_e), dtype=A.dtype)
-        Phi_omega[0, e(self.v_cols)] = -np.sin(b) * Phi["v"][1][:, 0]
-        Phi_omega[2, e(self.v_cols)] = np.cos(b) * Phi["v"][1][:, 0]
-        Phi_omega[1, e(self.w_cols)] = -Phi["w"][1][:, 0]
-        Phi_omega = R_x.T @ Phi_omega
-        Phi_omega[0, e(self.beta_cols)] += Phi["beta"][0][:, 0]
+        Phi_omega = R_x.T @ np.array([-np.sin(b) * slopes[0], slopes[1], np.cos(b) * slopes[0]])
+        Phi_omega[0, self._local(self.beta_cols)] += Phi["beta"][0][:, 0]
         F = np.vstack((A.T @ Phi_r[0] - skew(offset) @ Phi_omega, Phi_omega))
         return A, r_x[0] + A @ offset, F
 
@@ -477,12 +489,13 @@ class BeamPort:
     beam: RitzBeam
     data: tuple  # (x as a 1-array, station_data(x))
     offset: NDArray  # c = (0, y, z)
+    field: tuple  # (r₀, Ψ, Q) of RitzBeam.slice_field at x, and the slopes ∂(v′, −w′)/∂q_e
 
     def relative(self, q_e: NDArray, q_e_dot: NDArray) -> Relative:
         """Pose, F q̇_e and Ḟ q̇_e relative to the beam's frame (:meth:`RitzBeam.port`);
         Ḟ q̇_e by complex step."""
-        A, r, F = self.beam._port_terms(q_e, self.data, self.offset)
-        F_dot = derivative_along(lambda q: self.beam._port_terms(q, self.data, self.offset)[2], q_e, q_e_dot)
+        A, r, F = self.beam._port_terms(q_e, self)
+        F_dot = derivative_along(lambda q: self.beam._port_terms(q, self)[2], q_e, q_e_dot)
         return Relative(A, r, F, F @ q_e_dot, F_dot @ q_e_dot)
 
 

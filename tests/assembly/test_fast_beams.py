@@ -1,0 +1,124 @@
+"""RitzBeams anywhere in a tree on the compiled path (projeq/assembly/kernels.py, the elastic block
+and the stations' frames): s̈ equals the dense Gauss form (docs/theory.md §5, an independent
+O(N³) formulation) within the bound of tests/assembly/test_recursive_vs_dense.py, on random
+trees with beams on revolute, prismatic, fixed and prescribed joints (any joint in the rigid part), both integration strategies, children on the beams'
+stations (beams on beams too), and the kernel's twins equal the beam's own statements."""
+
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from strategies import Tree, random_inertia, random_mass, random_rotation, random_state, spatial_joint, trees
+from test_recursive_vs_dense import _agree
+
+import projeq as pq
+from projeq.assembly import InterpretedWarning, kernels
+from projeq.assembly.fast import FastEvaluator
+
+# a beam without rotary inertia has none about its axis x: a joint that may turn it about x
+# alone (free, spherical, planar yz) gives a singular D_n, so the beams sit on these
+BEAM_JOINTS = ("revolute", "prismatic", "fixed", "prescribed")
+
+
+def _beam(rng) -> pq.RitzBeam:
+    """A beam with random bending (and sometimes axial) functions, family, stiffening,
+    damping and integration strategy (no rotary inertia: the kernel's elastic block)."""
+    n_v, n_w, n_u = (int(n) for n in rng.integers(0, 4, 3))
+    n_v = max(n_v, 1)
+    return pq.RitzBeam(
+        float(rng.uniform(0.3, 2.0)), float(rng.uniform(0.5, 5.0)), float(rng.uniform(5.0, 100.0)),
+        EI_y=float(rng.uniform(5.0, 100.0)), EA=float(rng.uniform(1e3, 1e4)), n_v=n_v, n_w=n_w, n_u=n_u % 2,
+        family=("polynomial", "clamped_free")[rng.integers(2)], stiffening=bool(rng.random() < 0.8),
+        damping=float(rng.choice([0.0, 0.01])), precomputed_integrals=bool(rng.random() < 0.5),
+    )
+
+
+def _on_station(beam_name: str, beam: pq.RitzBeam, rng, turns: bool) -> pq.Joint:
+    """A joint at a random station x ∈ [0, L] with a cross-section offset (a Revolute only
+    if ``turns``: a point mass on its own axis moves no inertia)."""
+    r_pn = (float(rng.uniform(0.0, beam.length)), *rng.uniform(-0.1, 0.1, 2))
+    kind = rng.integers(3) if turns else 2 * rng.integers(2)
+    if kind == 0:
+        return pq.Fixed(beam_name, r_pn, random_rotation(rng) if rng.random() < 0.5 else None)
+    axis = rng.standard_normal(3)
+    joint = pq.Revolute if kind == 1 else pq.Prismatic
+    return joint(beam_name, axis / np.linalg.norm(axis), r_pn, random_rotation(rng) if rng.random() < 0.5 else None)
+
+
+@st.composite
+def trees_with_beams(draw):
+    """A random rigid tree (every spatial joint, no force laws) with 1–2 RitzBeams on random
+    bodies by random joints, and 0–2 bodies (rigid, point masses, or a beam) on each beam's
+    stations."""
+    base = draw(trees(max_n=4, forces=False))
+    seed = draw(st.integers(0, 2**32 - 1), label="beam seed")
+    rng = np.random.default_rng(seed)
+    system = base.system
+    subsystems, joints = dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints))
+    beams = []
+    for i in range(int(rng.integers(1, 3))):
+        name, beam = f"beam{i}", _beam(rng)
+        parent = None if rng.random() < 0.2 else system.names[rng.integers(len(system.names))]
+        subsystems[name] = beam
+        joints[name] = spatial_joint(BEAM_JOINTS[rng.integers(len(BEAM_JOINTS))], parent, rng)
+        beams.append((name, beam))
+    for name, beam in list(beams):
+        for j in range(int(rng.integers(0, 3))):
+            child = f"{name}_on{j}"
+            kind = rng.integers(3)
+            m = random_mass(rng)
+            subsystems[child] = (pq.RigidBody(m, rng.uniform(-0.3, 0.3, 3), random_inertia(rng, m)) if kind == 0
+                                 else pq.PointMass(m) if kind == 1 else _beam(rng))
+            joints[child] = _on_station(name, beam, rng, turns=kind != 1)
+    beam_system = pq.System(subsystems, joints, gravity=system.gravity)
+    q, s_dot, t = random_state(beam_system, rng)
+    e = [i for n in range(len(beam_system.names)) for i in range(beam_system.e_q_slice[n].start, beam_system.e_q_slice[n].stop)]
+    q[e] *= 0.05  # moderate deflections: Ritz amplitudes of a few cm
+    return Tree(beam_system, beam_system.normalized(q), s_dot, t, base.kinds, base.parents, [], seed, False, rng)
+
+
+@settings(max_examples=max(10, settings().max_examples // 3), deadline=None)
+@given(trees_with_beams())
+def test_beams_in_trees_are_compiled_and_equal_dense(tree):
+    """The default evaluator of a tree with beams is the compiled kernel (no
+    InterpretedWarning), and its s̈ equals the dense Gauss form (bound of _agree)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InterpretedWarning)
+        warnings.simplefilter("ignore", RuntimeWarning)  # an unstiffened beam spun fast: said once
+        assert tree.system.evaluator().name == "fast"
+        _agree(tree, "auto", "dense")
+
+
+@settings(max_examples=max(5, settings().max_examples // 10), deadline=None)
+@given(trees_with_beams())
+def test_interpreted_kernel_with_beams_equals_recursive(tree):
+    """The kernel's source run interpreted (compiled=False) = the recursive evaluator."""
+    tree.system._evaluators["fast"] = FastEvaluator(tree.system, compiled=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        _agree(tree, "fast", "recursive")
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_the_elastic_twins_equal_the_beams_own_terms(seed):
+    """kernels.elastic_body = the beam's gauss_terms (Quadrature and PrecomputedIntegrals,
+    restoring and damping forces included) and kernels.port_motion = BeamPort.relative
+    (whose Ḟ q̇_e is a complex step), at random deformed, moving states."""
+    rng = np.random.default_rng(seed)
+    beam = _beam(rng)
+    q_e, q_e_dot = 0.05 * rng.standard_normal(beam.n_e), rng.standard_normal(beam.n_e)
+    twist, R, g = rng.standard_normal(6), random_rotation(rng), rng.uniform(-10, 10, 3)
+    y_dot = np.concatenate((twist, q_e_dot))
+    M_ref, h_ref = beam.gauss_terms(y_dot, R, g, q_e)
+    M, h = np.empty((beam.n_y, beam.n_y)), np.empty(beam.n_y)
+    kernels.elastic_body(beam.mass_weights, *beam.slice_field(), beam.K_e, beam.damping, q_e, q_e_dot, twist, R.T @ g, M, h)
+    assert np.abs(M - M_ref).max() <= 1e-12 * np.abs(M_ref).max()
+    assert np.abs(h - h_ref).max() <= 1e-12 * np.abs(h_ref).max()
+    port = beam.port_at(np.array([rng.uniform(0, beam.length), *rng.uniform(-0.1, 0.1, 2)]))
+    rel = port.relative(q_e, q_e_dot)
+    A, r, F, zeta = np.empty((3, 3)), np.empty(3), np.empty((6, beam.n_e)), np.empty(6)
+    kernels.port_motion(*port.field, port.offset, q_e, q_e_dot, A, r, F, zeta)
+    for mine, reference in ((A, rel.A), (r, rel.r), (F, rel.F), (zeta, rel.zeta)):
+        assert np.abs(mine - reference).max() <= 1e-12 * max(1.0, np.abs(reference).max())
