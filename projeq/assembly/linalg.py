@@ -46,7 +46,8 @@ def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
     if k == 1:
         if D[0, 0] > SINGULAR_PIVOT * scale:
             return B / D[0, 0]
-        raise SingularMassError(f"{_name(what)} is singular (pivot {D[0, 0]:.3g}): it moves no mass or inertia")
+        raise SingularMassError(_negative(D, what) if D[0, 0] < -SINGULAR_PIVOT * scale else
+                                f"{_name(what)} is singular (pivot {D[0, 0]:.3g}): it moves no mass or inertia")
     if k == 0:
         return B
     try:
@@ -81,10 +82,21 @@ def _massless(D: NDArray, what: str) -> str:
     """The message for a singular or indefinite D: its smallest eigenvalue and the direction
     of the minimal velocities that moves (almost) no mass or inertia."""
     eigenvalues, vectors = np.linalg.eigh(D)
+    if eigenvalues[0] < -SINGULAR_PIVOT * max(abs(eigenvalues[-1]), 1e-300):
+        return _negative(D, what)
     return (f"{_name(what)} is singular or indefinite (smallest eigenvalue {eigenvalues[0]:.3g} of "
             f"{eigenvalues[-1]:.3g}): the motion along its minimal velocities {np.round(vectors[:, 0], 3).tolist()} "
             "moves no mass or inertia (a joint axis along which the body has none, such as a rotation "
             "about a beam's own axis without rotary inertia rho_I)")
+
+
+def _negative(D: NDArray, what: str) -> str:
+    """The message for a D with a clearly negative eigenvalue: no mass distribution gives one,
+    so the state (or the data) has left the model's range."""
+    return (f"{_name(what)} is indefinite (smallest eigenvalue {np.linalg.eigvalsh(D)[0]:.3g}), which no mass "
+            "distribution gives: the state has left the range the model describes (for example a beam deflected "
+            "far beyond its moderate-deflection theory after the integrator lost stability: tighten rtol or "
+            "use an implicit method) or the inertia data are inconsistent")
 
 
 def _name(what: str) -> str:
