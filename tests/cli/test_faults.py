@@ -41,10 +41,18 @@ def faulty(k: int = 0, kill: int = -1, fail: int = -1, slow: int = -1):
 
 
 def _sluggish_torque(t, q, s_dot):
-    """No torque; after 20 ms for t > 0."""
+    """No torque; after 20 ms for t > 0, the first time saying on stdout (the sweep's, which
+    the pool's workers share) that the slow point is integrating."""
+    global _integrating
     if t > 0:
+        if not _integrating:
+            _integrating = True
+            print("slow point integrating", flush=True)
         time.sleep(0.02)
     return np.zeros(1)
+
+
+_integrating = False  # in a worker: the slow point has said that it integrates
 
 
 FAULTY = Scene(faulty, "a chain with injected faults", 0.05)
@@ -121,11 +129,14 @@ def loaded(tmp_path) -> tuple[SweepTable, dict]:
 
 def test_sigterm_to_a_sweep_keeps_the_finished_points_and_stops_the_workers(tmp_path):
     """SIGTERM to the main process only, once point 0 has finished while the slow point 1
-    runs: the running points are told (SIGINT) and return their partial results (status 2),
+    integrates: the running points are told (SIGINT) and return their partial results (status 2),
     the points not started are marked interrupted, the table is written complete (CSV and NPZ
     agree), exit 1 without a traceback, and no worker process is left."""
     child = start(sweep_argv(tmp_path, "k=0:5:6", "--set", "slow=1"))
-    assert child.stdout.readline() == "point done\n"
+    said = set()
+    while len(said) < 2:  # point 0 finished, and point 1 inside its integration, in either order
+        said.add(child.stdout.readline())
+    assert said == {"point done\n", "slow point integrating\n"}
     os.kill(child.pid, signal.SIGTERM)
     _, err = child.communicate(timeout=120)
     assert child.returncode == 1 and "Traceback" not in err
