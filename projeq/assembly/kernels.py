@@ -426,21 +426,11 @@ def projected_accelerations(M_all, b_all, P, pivot_min, M, s_ddot):
     Returns −1, or 0 when a pivot of M (a squared diagonal entry of its factor) is not above
     ``pivot_min``."""
     n_all, n = P.shape
-    PM = np.zeros((n, n_all))
+    M[:, :] = 0.0
+    s_ddot[:] = 0.0
+    _add_congruence_general(P, M_all, b_all, np.empty((n_all, n)), n_all, n, M, s_ddot)  # Pᵀ M_all P, Pᵀ b_all
     for i in range(n):
-        for r in range(n_all):
-            if P[r, i] != 0.0:
-                for c in range(n_all):
-                    PM[i, c] += P[r, i] * M_all[r, c]
-        s_ddot[i] = 0.0
-        for r in range(n_all):
-            s_ddot[i] -= P[r, i] * b_all[r]
-    for i in range(n):
-        for j in range(n):
-            total = 0.0
-            for c in range(n_all):
-                total += PM[i, c] * P[c, j]
-            M[i, j] = total
+        s_ddot[i] = -s_ddot[i]
     if not _cholesky(M, n, pivot_min):
         return 0
     _cholesky_solve(M, n, s_ddot)
