@@ -13,7 +13,8 @@ D_n = F_nᵀ M̂_n F_n by Cholesky); subsystems: rigid bodies (M_n = M6, h_n of 
 Compiled twins. numba compiles scalar loops, not the array functions of
 :mod:`projeq.spatial`, so four formulas have a second, scalar form here and only here:
 :func:`_relative_rotation` (Rodrigues, :func:`projeq.spatial.rodrigues`), :func:`_chain_matrix`
-(:func:`projeq.spatial.chain_matrix`), :func:`_cross3` (:func:`projeq.spatial.cross`) and
+(:func:`projeq.spatial.chain_matrix`), :func:`_add_cross` (:func:`projeq.spatial.cross`, added
+into an output: the per-body loops allocate no temporaries) and
 :func:`_rigid_h` (:func:`projeq.subsystems.rigid.rigid_h`); tests/assembly/test_fast.py
 checks each against its twin.
 """
@@ -79,6 +80,7 @@ def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, n_col
     A_port, r_port, w_port = np.empty((3, 3)), np.empty(3), np.empty(6)
     F_port = np.empty((6, el_Psi.shape[3]))
     port_R, port_r, port_twist, port_g = np.empty((3, 3)), np.empty(3), np.empty(6), np.empty(3)
+    v_p, work = np.empty(3), np.empty((2, 3))
     for n in range(N):
         e, k, p = axis[n], kind[n], parent[n] if parent[n] >= 0 else N
         j = port_slot[n]
@@ -96,8 +98,7 @@ def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, n_col
             _chain_matrix(A_np, r_port, T_port)
             for a in range(6):
                 u[a] = _dot6(T_port[a], twist[p])
-            zeta_port[:3] += _cross3(u[3:], w_port[:3]) + _cross3(u[:3], w_port[3:])
-            zeta_port[3:] += _cross3(u[3:], w_port[3:])
+            _add_motion_cross(u, w_port, zeta_port)
             for a in range(6):
                 port_twist[a] = u[a] + w_port[a]
             for a in range(3):
@@ -133,15 +134,17 @@ def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, n_col
             r_O[n, a] = r_b[a] + R_b[a, 0] * r[0] + R_b[a, 1] * r[1] + R_b[a, 2] * r[2]
             for b in range(3):
                 R[n, a, b] = R_b[a, 0] * A_np[b, 0] + R_b[a, 1] * A_np[b, 1] + R_b[a, 2] * A_np[b, 2]
-        v_p, w_p = twist_b[:3] + _cross3(twist_b[3:], r), twist_b[3:]
+        v_p[:] = twist_b[:3]  # the parent's twist at the origin of n: v_p + ω_p × r_pn, ω_p
+        _add_cross(twist_b[3:], r, v_p)
+        w_p = twist_b[3:]
         for a in range(3):  # u = T_np ẏ_p, g_n = A_np g_p
             u[a] = A_np[a, 0] * v_p[0] + A_np[a, 1] * v_p[1] + A_np[a, 2] * v_p[2]
             u[a + 3] = A_np[a, 0] * w_p[0] + A_np[a, 1] * w_p[1] + A_np[a, 2] * w_p[2]
             g_body[n, a] = A_np[a, 0] * g_b[0] + A_np[a, 1] * g_b[1] + A_np[a, 2] * g_b[2]
         for a in range(6):
             twist[n, a] = u[a] + w[a]
-        zeta6[:3] = _cross3(u[3:], w[:3]) + _cross3(u[:3], w[3:])
-        zeta6[3:] = _cross3(u[3:], w[3:])
+        zeta6[:] = 0.0
+        _add_motion_cross(u, w, zeta6)
         if k == GIVEN:
             for a in range(6):
                 zeta6[a] += given_zeta[n, a]
@@ -164,7 +167,7 @@ def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, n_col
             elastic_body(el_m[i], el_r0[i], el_Psi[i, :, :, :k_n], el_Q[i, :, :k_n, :k_n], el_K[i, :k_n, :k_n],
                          el_damping[i], q[i0 : i0 + k_n], s_dot[s0 : s0 + k_n], twist[n], g_body[n], M[n], h[n])
         else:
-            _rigid_h(m[n], r_c[n], I_c[n], twist[n], g_body[n], h[n, :6])
+            _rigid_h(m[n], r_c[n], I_c[n], twist[n], g_body[n], h[n, :6], work)
 
 
 def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
@@ -290,19 +293,45 @@ def _chain_matrix(A_np, r, T):
 
 
 def _cross3(a, b):
-    """a × b of two 3-vectors (compiled twin of :func:`projeq.spatial.cross`)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+    """a × b of two 3-vectors, a new array (compiled twin of :func:`projeq.spatial.cross`)."""
+    out = np.zeros(3)
+    _add_cross(a, b, out)
+    return out
 
 
-def _rigid_h(m, r_c, I_c, twist, g_body, out):
+def _add_cross(a, b, out):
+    """out += a × b of two 3-vectors, without a temporary (the form the per-body loops use:
+    numba allocates every array a function returns)."""
+    out[0] += a[1] * b[2] - a[2] * b[1]
+    out[1] += a[2] * b[0] - a[0] * b[2]
+    out[2] += a[0] * b[1] - a[1] * b[0]
+
+
+def _add_motion_cross(u, w, zeta):
+    """ζ += u × w, the motion cross product of two twists (v, ω):
+    (ω_u × v_w + v_u × ω_w, ω_u × ω_w)."""
+    _add_cross(u[3:], w[:3], zeta[:3])
+    _add_cross(u[:3], w[3:], zeta[:3])
+    _add_cross(u[3:], w[3:], zeta[3:])
+
+
+def _rigid_h(m, r_c, I_c, twist, g_body, out, work):
     """h = [m g − ω̃ p ; r̃_c (m g − ω̃ p) − ω̃ I_c ω], p = m (v + ω × r_c) (docs/theory.md §3), written
-    into ``out``; compiled twin of :func:`projeq.subsystems.rigid.rigid_h`."""
-    omega = twist[3:]
-    p_c = m * (twist[:3] + _cross3(omega, r_c))
-    force = m * g_body - _cross3(omega, p_c)
-    L_c = np.array([I_c[a, 0] * omega[0] + I_c[a, 1] * omega[1] + I_c[a, 2] * omega[2] for a in range(3)])
-    out[:3] = force
-    out[3:] = _cross3(r_c, force) - _cross3(omega, L_c)
+    into ``out`` (``work``: 2 × 3 scratch for v_c = v + ω × r_c and I_c ω); compiled twin of
+    :func:`projeq.subsystems.rigid.rigid_h`."""
+    omega, v_c, L_c = twist[3:], work[0], work[1]
+    force, moment = out[:3], out[3:]
+    v_c[:] = twist[:3]
+    _add_cross(omega, r_c, v_c)
+    for a in range(3):
+        L_c[a] = I_c[a, 0] * omega[0] + I_c[a, 1] * omega[1] + I_c[a, 2] * omega[2]
+        force[a] = 0.0
+        moment[a] = 0.0
+    _add_cross(v_c, omega, force)  # −ω̃ v_c, then m (g − ω̃ v_c) = m g − ω̃ p
+    for a in range(3):
+        force[a] = m * (g_body[a] + force[a])
+    _add_cross(r_c, force, moment)
+    _add_cross(L_c, omega, moment)  # − ω̃ I_c ω
 
 
 def passes(n_cols, n_y, parent, s_index, T, zeta, F, M_hat, h_hat, pivot_min, s_ddot):
@@ -549,8 +578,8 @@ def kernel(compiled: bool = True, rigid: bool = False):
     return chain, rigid_passes if rigid else general
 
 
-_CALLEES = (_relative_rotation, _chain_matrix, _cross3, _rigid_h, _dot6, _dot, _rows, _add_congruence,
-            _add_congruence_general, _cholesky, _cholesky_solve, elastic_body, port_motion)
+_CALLEES = (_relative_rotation, _chain_matrix, _cross3, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
+            _add_congruence, _add_congruence_general, _cholesky, _cholesky_solve, elastic_body, port_motion)
 
 
 @functools.cache

@@ -163,10 +163,13 @@ def test_the_kernel_twins_equal_their_array_forms(seed):
     assert np.abs(T - chain_matrix(A, r)).max() <= TWIN_RTOL * np.abs(T).max()
     a, b = rng.uniform(-3, 3, (2, 3))
     assert np.array_equal(kernels._cross3(a, b), cross(a, b))
+    out = np.array([0.5, -1.0, 2.0])
+    kernels._add_cross(a, b, out)
+    assert np.abs(out - ([0.5, -1.0, 2.0] + cross(a, b))).max() <= TWIN_RTOL * 10
     m, r_c, L = 10 ** rng.uniform(-2, 2), rng.uniform(-1, 1, 3), rng.standard_normal((3, 3))
     I_c, twist, g = m * L @ L.T, rng.uniform(-3, 3, 6), rng.uniform(-10, 10, 3)
     h = np.empty(6)
-    kernels._rigid_h(m, r_c, I_c, twist, g, h)
+    kernels._rigid_h(m, r_c, I_c, twist, g, h, np.empty((2, 3)))
     expected = rigid_h(m, r_c, I_c, twist, g)
     assert np.abs(h - expected).max() <= TWIN_RTOL * np.abs(expected).max()
 
