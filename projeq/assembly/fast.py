@@ -92,57 +92,67 @@ class FastEvaluator:
         self.compiled = bool(compiled)
         self._gauss_form, self._projected_accelerations = kernels.gauss_form_kernel(self.compiled)
         self._pack(system)
-        self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=bool(np.all(self._n_y == 6)))
+        rigid = bool(np.all(self._index[:, kernels.N_Y] == 6))
+        self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=rigid)
 
     def _pack(self, system) -> None:
         """Flat arrays of the tree (built once) and the workspace; bodies are padded to the
         largest n_y (6, or 6 + n_e of an elastic body) and joints to the most columns of F."""
         N = len(system.joints)
         joints, bodies = system.joints, system.subsystems
-        self._kind = np.array([kernels.KINDS.get(j.compiled_kind, kernels.GIVEN) for j in joints], dtype=np.int64)
-        self._given = [n for n in range(N) if self._kind[n] == kernels.GIVEN]
-        self._n_cols = np.array([j.n_s + b.n_e for j, b in zip(joints, bodies)], dtype=np.int64)
-        self._n_y = np.array([6 + b.n_e for b in bodies], dtype=np.int64)
-        self._parent = np.array(system.parent, dtype=np.int64)
-        self._axis = np.array([j.axis if k in (kernels.REVOLUTE, kernels.PRISMATIC) else np.zeros(3)
-                               for k, j in zip(self._kind, joints)])
-        self._orientation = np.array([j.orientation for j in joints])
-        ports = system.plan.port
-        self._offset = np.array([np.zeros(3) if ports[n] else j.r_pn for n, j in enumerate(joints)])
+        kind = [kernels.KINDS.get(j.compiled_kind, kernels.GIVEN) for j in joints]
+        self._given = [n for n in range(N) if kind[n] == kernels.GIVEN]
+        n_cols = [j.n_s + b.n_e for j, b in zip(joints, bodies)]
         # every joint's own coordinates and velocities (and a body's internal ones after them), in
         # the order of the joints (q and ṡ themselves unless joints are coupled: then q_all = P_q q,
         # ṡ_all = P ṡ)
-        self._q_index = np.cumsum([0] + [j.n_q + b.n_e for j, b in zip(joints[:-1], bodies)], dtype=np.int64)
-        self._s_index = np.cumsum([0] + [k for k in self._n_cols[:-1]], dtype=np.int64)
+        q_index = np.cumsum([0] + [j.n_q + b.n_e for j, b in zip(joints[:-1], bodies)])
+        s_index = np.cumsum([0] + n_cols[:-1])
+        self._index = np.array([kind, system.parent, q_index, s_index, n_cols, [6 + b.n_e for b in bodies]],
+                               dtype=np.int64).T.copy()  # the columns kernels.KIND ... N_Y
+        ports = system.plan.port
+        self._geometry = np.array([
+            [j.axis if k in (kernels.REVOLUTE, kernels.PRISMATIC) else np.zeros(3),
+             np.zeros(3) if ports[n] else j.r_pn, *j.orientation]
+            for n, (k, j) in enumerate(zip(kind, joints))
+        ], dtype=float).reshape(N, 5, 3)  # the rows kernels.AXIS, OFFSET, ORIENTATION
         self._expansion = _expansion(system) if system.coupled else None
-        n_all = int(self._n_cols.sum())
+        n_all = sum(n_cols)
         self._M_all, self._b_all, self._M = np.zeros((n_all, n_all)), np.zeros(n_all), np.zeros((system.n_s,) * 2)
         rigid = [b.rigid_inertia or (0.0, np.zeros(3), np.zeros((3, 3))) for b in bodies]
-        self._m, self._r_c, self._I_c = (np.array(part) for part in zip(*rigid))
+        self._inertia = np.array([[r_c, *I_c, (m, 0.0, 0.0)] for m, r_c, I_c in rigid],
+                                 dtype=float).reshape(N, 5, 3)  # the rows kernels.CENTRE, INERTIA, MASS
         self._elastic, self._ports = _elastic_fields(system), _port_fields(system)
-        width, depth = int(self._n_y.max()), max(6, int(self._n_cols.max()))
+        width, depth = 6 + max(b.n_e for b in bodies), max(6, max(n_cols))
         self._M_n = np.zeros((N, width, width))
         self._M_n[:, :6, :6] = [rigid_mass_matrix(*inertia) for inertia in rigid]
         self._gravity = np.asarray(system.gravity, dtype=float)
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
         # one row per joint for its relative_values (A, r, w, ζ, F⁶ by columns), read by the kernel
-        # through views: given_A, given_r, given_w, given_zeta and F (F[n, :, j] = column j); with
-        # elastic bodies F is wider (n_y rows, their q̇_e columns) and takes the given columns
-        values = self._given_values = np.zeros((N, 60))
-        self._given_A, self._given_r = values[:, :9].reshape(N, 3, 3), values[:, 9:12]
-        self._given_w, self._given_zeta = values[:, 12:18], values[:, 18:24]
-        self._given_F = values[:, 24:].reshape(N, 6, 6).transpose(0, 2, 1)
+        # (the entries kernels.GIVEN_A ... GIVEN_F); F⁶ through the view given_F (given_F[n, :, j] =
+        # column j), which is F itself unless elastic bodies make F wider (n_y rows, their q̇_e
+        # columns): then F takes the given columns
+        values = self._given_values = np.zeros((N, kernels.GIVEN_F + 36))
+        self._given_F = values[:, kernels.GIVEN_F:].reshape(N, 6, 6).transpose(0, 2, 1)
         self._F = self._given_F if (width, depth) == (6, 6) else np.zeros((N, width, depth))
         self._given_plan = [
-            (n, joints[n], slice(self._q_index[n], self._q_index[n] + joints[n].n_q),
-             slice(self._s_index[n], self._s_index[n] + joints[n].n_s), 24 + 6 * joints[n].n_s)
+            (n, joints[n], slice(q_index[n], q_index[n] + joints[n].n_q),
+             slice(s_index[n], s_index[n] + joints[n].n_s), kernels.GIVEN_F + 6 * joints[n].n_s)
             for n in self._given
         ]
         self._T, self._zeta = np.zeros((N, width, width)), np.zeros((N, width))
         self._M_hat, self._h_hat = np.zeros((N, width, width)), np.zeros((N + 1, width))
         self._R, self._r, self._twist = np.zeros((N + 1, 3, 3)), np.zeros((N + 1, 3)), np.zeros((N + 1, 6))
-        self._kin = _kinematics(self._n_cols, self._R, self._r, self._twist, self._F) if system.forces else None
-        self._selected = [n for n in range(N) if system.S[n] is not None]
+        self._kin = _WorkspaceKinematics(n_cols, self._R, self._r, self._twist, self._F, self._T, self._zeta) \
+            if system.forces else None
+        # the h_n the force laws load in the reference evaluators' coordinates: rows of n_y for
+        # the bodies with a selection S (zeroed before each evaluation), the workspace's rows for
+        # the others, none for the ground
+        S = system.S[:-1]
+        self._selected = [(n, S[n].T) for n in range(N) if S[n] is not None]
+        self._h_S = np.zeros((N, max((S_T.shape[1] for _, S_T in self._selected), default=0)))
+        self._h_loaded = [self._h_S[n, :S[n].shape[0]] if S[n] is not None else self._h_hat[n]
+                          for n in range(N)] + [np.zeros(0)]
 
     def _relative_motions(self, q_all: NDArray, s_all: NDArray, t: float) -> None:
         """A, r, w, ζ and F⁶ of the joints of kind GIVEN, by their own ``relative_values`` (the
@@ -155,25 +165,18 @@ class FastEvaluator:
 
     def _add_forces(self, q: NDArray, s_dot: NDArray, t: float) -> None:
         """The force laws' own ``add_to`` (the statement the reference evaluators call) on the
-        kernel's kinematics: T̃_np = [[T_np, ζ_n], [0, 1]] is filled from the workspace; bodies
-        with a selection S take their loads in their own coordinates (h_n += Sᵀ h_S)."""
+        kernel's kinematics (T̃_np = [[T_np, ζ_n], [0, 1]] from the workspace when a law reads
+        it); bodies with a selection S take their loads in their own coordinates (h_n += Sᵀ h_S)."""
         kin, h = self._kin, self._h_hat
-        kin.T_aug[:-1, :6, :6] = self._T
-        kin.T_aug[:-1, :6, 6] = self._zeta
+        kin.stale = True
         h[-1] = 0.0  # the ground's row: reactions land there, nothing reads them
         if self._selected:
-            kin, h = _SelectedKinematics(self.system, kin, s_dot), self._selected_h()
+            self._h_S[:] = 0.0
+            kin, h = _SelectedKinematics(self.system, kin, s_dot), self._h_loaded
         for force in self.system.forces:
             force.add_to(h, kin, t, q, s_dot)
-        for n in self._selected:
-            self._h_hat[n] += self.system.S[n].T @ h[n]
-
-    def _selected_h(self) -> list:
-        """The h_n the force laws load in the reference evaluators' coordinates: zeros of n_y
-        for selected bodies, the workspace's rows for the others, none for the ground."""
-        system = self.system
-        return [np.zeros(S.shape[0]) if S is not None else self._h_hat[n]
-                for n, S in enumerate(system.S[:-1])] + [np.zeros(0)]
+        for n, S_T in self._selected:
+            self._h_hat[n] += S_T @ h[n]
 
     def _terms(self, q: NDArray, s_dot: NDArray, t: float) -> None:
         """T_np, ζ_n, F_n, h_n (forces included) of every body into the workspace."""
@@ -181,10 +184,9 @@ class FastEvaluator:
         if self._given:
             self._relative_motions(q_all, s_all, t)
         self._chain_terms(
-            self._kind, self._parent, self._axis, self._orientation, self._offset, self._q_index, self._s_index,
-            self._n_cols, self._m, self._r_c, self._I_c, self._gravity, q_all, s_all,
-            self._given_A, self._given_r, self._given_w, self._given_zeta, self._elastic, self._ports,
-            self._T, self._zeta, self._F, self._M_n, self._h_hat[:-1], self._R, self._r, self._twist,
+            self._index, self._geometry, self._inertia, self._gravity, q_all, s_all, self._given_values,
+            self._elastic, self._ports, self._T, self._zeta, self._F, self._M_n, self._h_hat, self._R, self._r,
+            self._twist,
         )
         if self._kin is not None:
             self._add_forces(q, s_dot, t)
@@ -202,8 +204,7 @@ class FastEvaluator:
         """M and b of the terms in the workspace: :func:`projeq.assembly.kernels.gauss_form` in
         every joint's own velocities, projected with P for coupled joints."""
         M, b = self._M_all, self._b_all
-        self._gauss_form(self._n_cols, self._parent, self._s_index, self._T, self._zeta, self._F,
-                         self._M_n, self._h_hat, M, b)
+        self._gauss_form(self._index, self._T, self._zeta, self._F, self._M_n, self._h_hat, M, b)
         if self._expansion is None:
             return M.copy(), b.copy()
         P = self._expansion[1]
@@ -222,10 +223,8 @@ class FastEvaluator:
                                                    self._M, s_ddot)
         else:
             self._M_hat[:] = self._M_n
-            failed = self._passes(
-                self._n_cols, self._n_y, self._parent, self._s_index, self._T, self._zeta, self._F,
-                self._M_hat, self._h_hat, self._pivot_min, s_ddot,
-            )
+            failed = self._passes(self._index, self._T, self._zeta, self._F, self._M_hat, self._h_hat,
+                                  self._pivot_min, s_ddot)
         if failed >= 0 and not (np.all(np.isfinite(q)) and np.all(np.isfinite(s_dot))):
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no pivot D_n "
                                      "can be formed, which no mass matrix explains")
@@ -349,10 +348,24 @@ class _SelectedKinematics(Kinematics):
         return self._chain[1]
 
 
-def _kinematics(n_cols, R, r, twist, F) -> Kinematics:
+class _WorkspaceKinematics(Kinematics):
     """The :class:`~projeq.assembly.kinematics.Kinematics` the force laws read, as views of the
-    kernel's workspace (poses, twists = ẏ_n, the n_s columns of F_n) and a
-    T̃_np stack that :meth:`FastEvaluator._add_forces` fills (the ground's row last)."""
-    T_aug = np.zeros((len(n_cols) + 1, 7, 7))
-    T_aug[:, 6, 6] = 1.0
-    return Kinematics(R, r, twist, twist, T_aug, [F[n, :, :k] for n, k in enumerate(n_cols)])
+    kernel's workspace (poses, twists = ẏ_n, the n_s columns of F_n); the T̃_np stack (the
+    ground's row last) is filled from T_np and ζ_n when a law first reads it after an
+    evaluation (``stale``): most laws read poses and twists only."""
+
+    def __init__(self, n_cols, R, r, twist, F, T, zeta):
+        self.R, self.r, self.twist, self.y_dot = R, r, twist, twist
+        self.F = [F[n, :, :k] for n, k in enumerate(n_cols)]
+        self._T, self._zeta = T, zeta
+        self._T_aug = np.zeros((len(n_cols) + 1, 7, 7))
+        self._T_aug[:, 6, 6] = 1.0
+        self.stale = True
+
+    @property
+    def T_aug(self) -> NDArray:
+        if self.stale:
+            self._T_aug[:-1, :6, :6] = self._T
+            self._T_aug[:-1, :6, 6] = self._zeta
+            self.stale = False
+        return self._T_aug

@@ -28,6 +28,20 @@ import numpy as np
 
 FIXED, REVOLUTE, PRISMATIC, GIVEN = 0, 1, 2, 3
 KINDS = {"fixed": FIXED, "revolute": REVOLUTE, "prismatic": PRISMATIC}  # a joint's compiled_kind -> its code here
+#: the columns of ``index`` (one row per joint n and its body): joint kind, parent p (−1: the
+#: ground), first coordinate and first velocity of the joint in q and ṡ, the joint's columns of
+#: F_n (minimal velocities, with an elastic body's q̇_e) and the body's n_y. The model's
+#: constants travel in few arrays because every array argument of a compiled call costs its
+#: unboxing (about 0.1–0.2 µs each here)
+KIND, PARENT, Q_INDEX, S_INDEX, N_COLS, N_Y = range(6)
+#: the rows of ``geometry[n]`` (3-vectors): the joint axis e, the joint's offset r_pJ in the
+#: parent, then the three rows of its orientation A_pJ; of ``inertia[n]``: r_c, the three rows
+#: of I_c, then (m, 0, 0)
+AXIS, OFFSET, ORIENTATION = 0, 1, 2
+CENTRE, INERTIA, MASS = 0, 1, 4
+#: the entries of ``given[n]`` (:meth:`projeq.joints.base.Joint.relative_values`): A row by row,
+#: r, w, ζ, then F⁶ column by column
+GIVEN_A, GIVEN_R, GIVEN_W, GIVEN_ZETA, GIVEN_F = 0, 9, 12, 18, 24
 
 
 def _numba():
@@ -43,8 +57,7 @@ def has_numba() -> bool:
     return _numba() is not None
 
 
-def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, n_cols, m, r_c, I_c, gravity, q, s_dot,
-                given_A, given_r, given_w, given_zeta, elastic, port, T, zeta, F, M, h, R, r_O, twist):
+def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, port, T, zeta, F, M, h, R, r_O, twist):
     """T_np, ζ_n, F_n, M_n (of the elastic subsystems) and h_n = Q_n − G_n ẏ_n of every body
     (docs/theory.md §3–4), and the poses R_n, r_n and twists of the reference frames
     (row N of R, r_O, twist: the ground, at rest).
@@ -53,8 +66,9 @@ def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, n_col
     u = T_np ẏ_p, ẏ_n = u + w, ζ_n = u × w (motion cross product) + Ḟ ṡ + ḟ,
     R_n = R_p A_pn, r_n = r_p + R_p r_pn. The joint's relative motion (A_Jn, r_Jn, its
     twist w and its own part of ζ) comes from the kernel for the kinds it knows (F⁶ = [0; e]
-    or [e; 0], w = F⁶ ṡ_n) and from ``given_*`` (and the columns of F set by the caller)
-    for a joint of kind ``GIVEN``.
+    or [e; 0], w = F⁶ ṡ_n) and from ``given`` (and the columns of F set by the caller)
+    for a joint of kind ``GIVEN``. ``index``, ``geometry``, ``inertia`` and ``given``: one row
+    per joint and body, columns named by the constants of this module (:data:`KIND` ...).
 
     Elastic subsystems (docs/theory.md §10): ``elastic`` = (slot, e_index, n_e, m_k, r₀, Ψ, Q,
     K_e, damping) — slot[n] ≥ 0 picks the station field of body n (:func:`elastic_body`),
@@ -65,7 +79,11 @@ def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, n_col
     :func:`projeq.assembly.kinematics.forward`).
     Scalar loops only (no temporaries per body), which is what numba compiles best.
     """
-    N = kind.shape[0]
+    N = index.shape[0]
+    kind, parent, q_index, s_index = index[:, KIND], index[:, PARENT], index[:, Q_INDEX], index[:, S_INDEX]
+    n_cols = index[:, N_COLS]
+    axis, offset, orientation = geometry[:, AXIS], geometry[:, OFFSET], geometry[:, ORIENTATION:]
+    m, r_c, I_c = inertia[:, MASS, 0], inertia[:, CENTRE], inertia[:, INERTIA:MASS]
     body, e_index, n_e, el_m, el_r0, el_Psi, el_Q, el_K, el_damping = elastic
     port_slot, port_r0, port_Psi, port_Q, port_slopes, port_c = port
     twist[N] = 0.0
@@ -110,9 +128,12 @@ def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, n_col
         else:
             R_b, r_b, twist_b, g_b = R[p], r_O[p], twist[p], g_body[p]
         if k == GIVEN:
-            A_rel[:, :] = given_A[n]
-            r_rel[:] = given_r[n]
-            w[:] = given_w[n]
+            for a in range(3):
+                r_rel[a] = given[n, GIVEN_R + a]
+                for b in range(3):
+                    A_rel[a, b] = given[n, GIVEN_A + 3 * a + b]
+            for a in range(6):
+                w[a] = given[n, GIVEN_W + a]
         else:
             x = q[q_index[n]] if k != FIXED else 0.0
             _relative_rotation(k, e, x, A_rel)
@@ -147,7 +168,7 @@ def chain_terms(kind, parent, axis, orientation, offset, q_index, s_index, n_col
         _add_motion_cross(u, w, zeta6)
         if k == GIVEN:
             for a in range(6):
-                zeta6[a] += given_zeta[n, a]
+                zeta6[a] += given[n, GIVEN_ZETA + a]
         if j >= 0:  # T_np = T⁶ [T⁶_port, F_port], ζ_n = T⁶ ζ̂_port + ζ⁶
             _chain_matrix(A_np, r, T6)
             for a in range(6):
@@ -334,7 +355,7 @@ def _rigid_h(m, r_c, I_c, twist, g_body, out, work):
     _add_cross(L_c, omega, moment)  # − ω̃ I_c ω
 
 
-def passes(n_cols, n_y, parent, s_index, T, zeta, F, M_hat, h_hat, pivot_min, s_ddot):
+def passes(index, T, zeta, F, M_hat, h_hat, pivot_min, s_ddot):
     """Backward and forward pass of docs/theory.md §6 for bodies with ``n_y[n]`` describing
     velocities (6, or 6 + n_e for an elastic body) and joints with ``n_cols[n]`` minimal
     velocities (the first n_cols columns of F[n]; with an elastic body's q̇_e); writes s̈.
@@ -346,7 +367,8 @@ def passes(n_cols, n_y, parent, s_index, T, zeta, F, M_hat, h_hat, pivot_min, s_
     ground row N that collects, never read). Returns −1, or the index of the first body
     with a pivot of D_n (a squared diagonal entry of L) not above ``pivot_min``.
     """
-    N, width, depth = n_cols.shape[0], M_hat.shape[1], F.shape[2]
+    N, width, depth = index.shape[0], M_hat.shape[1], F.shape[2]
+    n_cols, n_y, parent, s_index = index[:, N_COLS], index[:, N_Y], index[:, PARENT], index[:, S_INDEX]
     rows = _rows
     U, L, f_h = np.zeros((N, width, depth)), np.zeros((N, depth, depth)), np.zeros((N, depth))
     c, g, MT = np.empty(width), np.empty(depth), np.empty((width, max(width, depth)))
@@ -403,7 +425,7 @@ def passes(n_cols, n_y, parent, s_index, T, zeta, F, M_hat, h_hat, pivot_min, s_
     return -1
 
 
-def gauss_form(n_cols, parent, s_index, T, zeta, F, M_n, h, M, b):
+def gauss_form(index, T, zeta, F, M_n, h, M, b):
     """M = Σ J_nᵀ M_n J_n and b = Σ J_nᵀ (M_n ζ̄_n − h_n) of the Gauss form M s̈ + b = 0
     (docs/theory.md §5) from the kernel's T_np, ζ_n, F_n, M_n and h_n, without the dense J_n.
 
@@ -414,7 +436,8 @@ def gauss_form(n_cols, parent, s_index, T, zeta, F, M_n, h, M, b):
     by U ← T_jpᵀ U (Featherstone (2008), *Rigid Body Dynamics Algorithms*, §5.3 and
     §6.2, Tables 5.1 and 6.2). Order N d (d: the tree's depth). Writes M (n × n) and b (n).
     """
-    N = n_cols.shape[0]
+    N = index.shape[0]
+    n_cols, parent, s_index = index[:, N_COLS], index[:, PARENT], index[:, S_INDEX]
     zeta_bar, f, M_c = np.zeros((N, 6)), np.zeros((N, 6)), M_n.copy()
     U, V, MT = np.zeros((6, 6)), np.zeros((6, 6)), np.empty((6, 6))
     for n in range(N):  # root → leaves: ζ̄_n, f_n

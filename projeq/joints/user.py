@@ -34,11 +34,12 @@ class UserJoint(Joint):
     """
 
     def __init__(self, parent, n_q, n_s, relative, K, q_dot, q0=None, r_pn=(0, 0, 0), orientation=None,
-                 constraints=None, n_c=0, symbols: dict | None = None, values=None):
+                 constraints=None, n_c=0, symbols: dict | None = None, values=None, rates=None):
         super().__init__(parent, r_pn, orientation)
         self.n_q, self.n_s, self.n_c = n_q, n_s, n_c
         self._relative, self._K, self._q_dot = relative, K, q_dot
         self._values = values  # (q_n, ṡ_n, t) as lists -> relative_values, or None: relative packed
+        self._rates = rates  # (q_n, ṡ_n, t) as lists -> q̇_n as a list, or None: q_dot alone
         self._constraints = constraints
         self._q0 = np.zeros(n_q) if q0 is None else finite_array("q0", q0, (n_q,))
         self.symbols = symbols
@@ -66,6 +67,11 @@ class UserJoint(Joint):
         return SymbolicRelative(*(symbols[key].xreplace(rename) for key in ("A", "r", "F", "f", "K", "k")))
 
     def q_dot(self, q_n, s_dot_n, t):
+        """q̇_n = K ṡ_n + k; from sympy at real arrays: the same expressions compiled to scalar
+        code (``math``) on Python floats, as :meth:`relative_values` (complex ones, of a complex
+        step, take the numpy form)."""
+        if self._rates is not None and _real(q_n) and _real(s_dot_n) and not isinstance(t, complex):
+            return np.array(self._rates(q_n.tolist(), s_dot_n.tolist(), t))
         return self._q_dot(q_n, s_dot_n, t)
 
     def default_q(self):
@@ -163,3 +169,8 @@ class UserJoint(Joint):
             cls, n_q, n_s, pose, F, K, f=f, k=k, parent=parent, q0=q0, r_pn=r_pn,
             orientation=orientation, constraints=constraints, n_c=n_c,
         )
+
+
+def _real(x) -> bool:
+    """Whether x is a real float array (what the scalar code of a joint from sympy takes)."""
+    return isinstance(x, np.ndarray) and x.dtype == np.float64

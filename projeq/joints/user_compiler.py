@@ -75,8 +75,9 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
     zeta = d_dt(F) * s_vec + d_dt(f)
     rel = sp.lambdify([q, s, t], [A, r, F, F * s_vec + f, zeta], modules="numpy", cse=True)
     # the same numbers as one flat list of scalars (Joint.relative_values): for real arguments
-    scalar = _scalar_code([q, s, t], [*A, *r, *(F * s_vec + f), *zeta, *F.T],
-                          ([0.0] * n_q if q0 is None else q0, [1.0] * n_s, 0.3))
+    at = ([0.0] * n_q if q0 is None else q0, [1.0] * n_s, 0.3)
+    scalar = _scalar_code([q, s, t], [*A, *r, *(F * s_vec + f), *zeta, *F.T], at)
+    scalar_rates = _scalar_code([q, s, t], list(rates), at)  # q̇ = K ṡ + k, the same way
     K_fun = sp.lambdify([q, t], K, modules="numpy", cse=True)
     q_dot_fun = sp.lambdify([q, s, t], rates, modules="numpy", cse=True)
 
@@ -97,6 +98,7 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
         lambda q_n, s_dot_n, time: numeric(q_dot_fun(q_n, s_dot_n, time)).ravel(),
         q0=q0, r_pn=r_pn, orientation=orientation, constraints=residual, n_c=n_c,
         symbols={"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k}, values=scalar,
+        rates=scalar_rates,
     )
     _check_pose(joint)
     return joint

@@ -198,6 +198,22 @@ def test_a_sympy_joints_scalar_code_equals_its_relative(name):
     assert Restated.relative_values is pq.joints.Joint.relative_values
 
 
+@pytest.mark.parametrize("name", ["rolling_disk", "knife_edge_disc", "car"])
+def test_a_sympy_joints_scalar_rates_equal_K_s_dot(name):
+    """q̇ = K ṡ of a UserJoint from sympy, as scalar code at real arrays, equals K(q) ṡ from its
+    own lambdified K; complex arguments (a complex step) take the numpy form and agree."""
+    joint = pq.scenes.SCENES[name].build().joints[0]
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q_n, s_dot_n, t = rng.uniform(-1, 1, joint.n_q), rng.uniform(-2, 2, joint.n_s), rng.uniform(0, 3)
+        expected = joint.K(q_n, t) @ s_dot_n
+        q_dot = joint.q_dot(q_n, s_dot_n, t)
+        assert q_dot.dtype == float and np.abs(q_dot - expected).max() <= 1e-14 * max(1.0, np.abs(expected).max())
+        complex_q_dot = joint.q_dot(q_n + 0j, s_dot_n, t)
+        assert np.iscomplexobj(complex_q_dot) and np.abs(complex_q_dot - expected).max() <= 1e-14 * max(
+            1.0, np.abs(expected).max())
+
+
 def test_the_kernel_takes_massless_frames():
     """A Frame states rigid-body terms of zero mass (``rigid_inertia``), so a universal joint
     (two revolutes through a Frame) is compiled and equals the recursive evaluator."""
