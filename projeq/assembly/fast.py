@@ -222,8 +222,7 @@ class FastEvaluator:
             failed = self._projected_accelerations(self._M_all, self._b_all, self._expansion[1], self._pivot_min,
                                                    self._M, s_ddot)
         else:
-            self._M_hat[:] = self._M_n
-            failed = self._passes(self._index, self._T, self._zeta, self._F, self._M_hat, self._h_hat,
+            failed = self._passes(self._index, self._T, self._zeta, self._F, self._M_n, self._M_hat, self._h_hat,
                                   self._pivot_min, s_ddot)
         if failed >= 0 and not (np.all(np.isfinite(q)) and np.all(np.isfinite(s_dot))):
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no pivot D_n "

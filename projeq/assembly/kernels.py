@@ -355,7 +355,7 @@ def _rigid_h(m, r_c, I_c, twist, g_body, out, work):
     _add_cross(L_c, omega, moment)  # − ω̃ I_c ω
 
 
-def passes(index, T, zeta, F, M_hat, h_hat, pivot_min, s_ddot):
+def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
     """Backward and forward pass of docs/theory.md §6 for bodies with ``n_y[n]`` describing
     velocities (6, or 6 + n_e for an elastic body) and joints with ``n_cols[n]`` minimal
     velocities (the first n_cols columns of F[n]; with an elastic body's q̇_e); writes s̈.
@@ -363,13 +363,14 @@ def passes(index, T, zeta, F, M_hat, h_hat, pivot_min, s_ddot):
     Backward: U = M̂_n F_n, D_n = F_nᵀ U = L Lᵀ (Cholesky), M̄_n = M̂_n − U D_n⁻¹ Uᵀ,
     h̄_n = c − U D_n⁻¹ F_nᵀ c with c = ĥ_n − M̂_n ζ_n; M̂_p += T_npᵀ M̄_n T_np, ĥ_p += T_npᵀ h̄_n.
     Forward: a = T_np ÿ_p + ζ_n, s̈_n = D_n⁻¹ (F_nᵀ ĥ_n − Uᵀ a), ÿ_n = a + F_n s̈_n.
-    ``M_hat`` and ``h_hat`` enter as M_n and h_n and are overwritten (``h_hat`` may have a
-    ground row N that collects, never read). Returns −1, or the index of the first body
+    ``M_hat`` (a workspace) starts as a copy of M_n, ``h_hat`` enters as h_n; both are
+    overwritten (``h_hat`` may have a ground row N that collects, never read). Returns −1, or the index of the first body
     with a pivot of D_n (a squared diagonal entry of L) not above ``pivot_min``.
     """
     N, width, depth = index.shape[0], M_hat.shape[1], F.shape[2]
     n_cols, n_y, parent, s_index = index[:, N_COLS], index[:, N_Y], index[:, PARENT], index[:, S_INDEX]
     rows = _rows
+    M_hat[:] = M_n
     U, L, f_h = np.zeros((N, width, depth)), np.zeros((N, depth, depth)), np.zeros((N, depth))
     c, g, MT = np.empty(width), np.empty(depth), np.empty((width, max(width, depth)))
     for n in range(N - 1, -1, -1):  # backward: leaves → root
