@@ -343,3 +343,27 @@ def flyball_steady_state(K: float = FLYBALL["K"], angular_momentum: float | None
     s = slider_height(alpha)
     I_zz, _, ell = _flyball_geometry(alpha, s, K)
     return {"alpha": alpha, "s": s, "omega": L_z / I_zz, "length": ell}
+
+
+def flyball_spring_rate(q, s_dot) -> np.ndarray:
+    """ℓ̇ of the spring on rod AC of :func:`flyball_governor` for rows of q = (φ, s, α_AC, α_BD) and
+    ṡ, by differentiating the closed form ℓ² = (½L cos α)² + (L − ½L sin α − s)² (E and A both
+    0.05 m from the shaft; independent of the SpringDamper law's kinematics)."""
+    L = FLYBALL["length"]
+    q, s_dot = np.atleast_2d(q), np.atleast_2d(s_dot)
+    s, alpha, s_rate, alpha_rate = q[:, 1], q[:, 2], s_dot[:, 1], s_dot[:, 2]
+    reach, rise = L / 2 * np.cos(alpha), L - L / 2 * np.sin(alpha) - s
+    return (-reach * L / 2 * np.sin(alpha) * alpha_rate - rise * (L / 2 * np.cos(alpha) * alpha_rate + s_rate)) \
+        / np.hypot(reach, rise)
+
+
+def flyball_balance(r, C: float = FLYBALL["C"], samples: int = 20_001) -> np.ndarray:
+    """T + V − E₀ + W_d at the output times of a symmetric run of :func:`flyball_governor` (α_AC = α_BD)
+    with dense output: W_d = ∫ 2 C ℓ̇² dt, the work the two dampers dissipated, by Simpson's rule
+    on ``samples`` points of ``r.sol`` (zero: the energy balance)."""
+    from scipy.integrate import cumulative_simpson
+
+    t = np.linspace(r.t[0], r.t[-1], samples)
+    q, s_dot = (np.asarray(x).T for x in r.sol(t))
+    dissipated = cumulative_simpson(2 * C * flyball_spring_rate(q, s_dot) ** 2, x=t, initial=0.0)
+    return r.energy - r.energy[0] + np.interp(r.t, t, dissipated)
