@@ -150,7 +150,8 @@ SCENES = {
     "andrews_squeezer": Scene(andrews_squeezer, "IFToMM benchmark A03: Andrews' squeezing mechanism, seven bodies "
                               "in one loop (Hairer & Wanner 1996, §VII.7)", 0.05),
     "flyball_governor": Scene(flyball_governor, "IFToMM benchmark A05: the stiff flyball governor, coupler rods "
-                              "replaced by stiff spring-dampers", 10.0),
+                              "replaced by stiff spring-dampers", 10.0,
+                              units={"K": "N/m", "C": "N s/m", "s0": "m", "alpha0": "rad"}),
 }
 DEFAULT_SCENE = "spin_up_beam"
 
