@@ -370,8 +370,10 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
     DOP853 would need more than ``STIFF_STEPS`` steps for stability alone, or when the fastest
     mode decays without oscillating (a real eigenvalue −ρ: a stiff damper) and would force more
     than ``FAST_MODE_STEPS`` RK45 steps — such a mode dies out, so only stability limits an
-    explicit step (IFToMM A05, the stiff flyball governor, ρ = 8117 1/s, over 10 s at rtol 1e-8:
-    DOP853 about 380 s CPU, Radau 28 s; benchmarks/iftomm.py)."""
+    explicit step (IFToMM A05, the stiff flyball governor, ρ = 8117 1/s, over 10 s at rtol 1e-8,
+    one run of benchmarks/iftomm.py: DOP853 155,470 evaluations, 44.7 s CPU, and a
+    StiffnessWarning; Radau 17,655 evaluations and 1,250 Jacobians, 26.4 s; BDF would take 6.5 s
+    but misses the energy balance by 6.4e-5 J where Radau keeps it to 1.1e-7 J)."""
 
     def rhs(t, x):
         q, s_dot = x[: model.n_q], x[model.n_q :]
