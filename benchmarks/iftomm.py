@@ -13,8 +13,14 @@ T + V − E₀ − mom (β − β₀)), and the largest error against a referenc
 (angle, rad), A02 the parallelogram motion (B0's position and velocity, along the run), A03 the
 published reference solution at 0.03 s (Hairer & Wanner 1996, §VII.7; relative, angles and rates),
 A04 none but energy. The benchmark library's reference files are not read (no network here).
-A05 (the flyball governor) is not among them: its geometry is not fully specified in the sources
-at hand.
+
+A05, the stiff flyball governor (a tree with two stiff spring-dampers, no constraint equations),
+has a table of its own: each integrator (simulate's default pick, BDF, and DOP853 — the pick
+before the default looked at whether the fastest mode oscillates — over ``--dop853-t-end``)
+over ``--flyball-t-end`` (the benchmark's 10 s) at ``--rtol``: CPU time, evaluations,
+Jacobians, s at the end, the energy balance T + V − E₀ + W_d (W_d the dampers' dissipated work,
+flyball_balance), the drift of the angular momentum about the free shaft, and the distance of s
+from the relative equilibrium when started there (flyball_steady_state, the amended potential).
 
 A second table measures the choice of formulation on the double four-bar (N = 2): the partitioned
 ConstrainedSystem (re-pivoting), the augmented Lagrangian AugmentedSystem (Bayo & Ledesma 1996),
@@ -22,6 +28,7 @@ TangentSystem without the continuation of the branch (``separation=0``) and Tang
 ``--compare-t-end`` at each of ``--compare-rtol``.
 
     python benchmarks/iftomm.py [--rtol 1e-9] [--n 2 40] [--compare-t-end 10] [--compare-rtol 1e-8 1e-9 1e-10]
+                                [--flyball-t-end 10] [--dop853-t-end 1] [--only flyball]
 
 (about 3 CPU minutes with the defaults, two of them for N = 40; set OMP_NUM_THREADS=1 on a
 shared machine: the 80 × 81 SVDs of N = 40 slow down 40-fold when BLAS threads compete)
@@ -39,8 +46,9 @@ from projeq.constraints.augmented import AugmentedSystem
 from projeq.constraints.partitioned import ConstrainedSystem
 from projeq.constraints.tangent import TangentSystem
 from projeq.scenes.iftomm import (
-    ANDREWS_REFERENCE, andrews_balance, andrews_error, andrews_squeezer, bricard, n_four_bar, parallelogram_motion,
-    pendulum_angle, point_b0, simple_pendulum,
+    ANDREWS_REFERENCE, _flyball_geometry, andrews_balance, andrews_error, andrews_squeezer, bricard, flyball_balance,
+    flyball_governor, flyball_steady_state, n_four_bar, parallelogram_motion, pendulum_angle, point_b0,
+    simple_pendulum,
 )
 
 
@@ -120,15 +128,41 @@ def formulations(args) -> None:
                   f"{row['energy']:>11.1e}")
 
 
+def flyball(args) -> None:
+    steady = flyball_steady_state()
+    print(f"\nA05 stiff flyball governor, rtol {args.rtol:g}; relative equilibrium of the start's angular momentum: "
+          f"s = {steady['s']:.6f} m, α = {np.degrees(steady['alpha']):.4f}°, ω = {steady['omega']:.6f} rad/s")
+    print(f"{'method':<18}{'t_end':>6}{'CPU s':>8}{'nfev':>8}{'njev':>6}{'s(t_end) m':>12}{'max|balance| J':>16}"
+          f"{'max|ΔL/L|':>11}{'steady |Δs| m':>15}")
+    for method, t_end in ((None, args.flyball_t_end), ("BDF", args.flyball_t_end), ("DOP853", args.dop853_t_end)):
+        system = flyball_governor()
+        started = time.process_time()
+        r = pq.simulate(system, t_end, method=method, rtol=args.rtol, atol=args.rtol * 1e-2, n_points=201,
+                        dense_output=True)
+        cpu = time.process_time() - started
+        I_zz = np.array([_flyball_geometry(alpha, s)[0] for s, alpha in r.q[:, 1:3]])
+        L_z = I_zz * r.s_dot[:, 0]
+        held = flyball_governor(s0=steady["s"], alpha0=steady["alpha"], omega0=steady["omega"])
+        at_rest = pq.simulate(held, 1.0, method=r.method, rtol=args.rtol, atol=args.rtol * 1e-2, n_points=11)
+        label = f"{r.method}" + (" (default)" if method is None else "")
+        print(f"{label:<18}{t_end:>6.1f}{cpu:>8.1f}{r.nfev:>8d}{r.njev:>6d}{r.q[-1, 1]:>12.8f}"
+              f"{np.abs(flyball_balance(r)).max():>16.1e}{np.abs(L_z / L_z[0] - 1).max():>11.1e}"
+              f"{np.abs(at_rest.q[:, 1] - steady['s']).max():>15.1e}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rtol", type=float, default=1e-9)
     parser.add_argument("--n", type=int, nargs="+", default=[2, 40], help="four-bars of A02 (the benchmark's: 40)")
     parser.add_argument("--compare-t-end", type=float, default=10.0)
     parser.add_argument("--compare-rtol", type=float, nargs="+", default=[1e-8, 1e-9, 1e-10])
+    parser.add_argument("--flyball-t-end", type=float, default=10.0, help="A05's horizon (the benchmark's: 10 s)")
+    parser.add_argument("--dop853-t-end", type=float, default=1.0, help="A05 with DOP853 (about 4.5 CPU s per simulated s)")
+    parser.add_argument("--only", choices=["problems", "formulations", "flyball"], help="run one table")
     args = parser.parse_args()
-    problems(args)
-    formulations(args)
+    for name, table in (("problems", problems), ("formulations", formulations), ("flyball", flyball)):
+        if args.only in (None, name):
+            table(args)
 
 
 if __name__ == "__main__":

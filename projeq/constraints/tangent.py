@@ -223,7 +223,9 @@ class TangentSystem(ConstrainedSystem):
     def rank_changes(self, result, event: int = 0) -> tuple:
         """((t, rank, mobility), ...) where the event ``event`` of ``result`` (the index of
         :meth:`singular_positions` among the run's events) fired with the rank of A_s below its
-        rank at q0: the singular positions the run passed, with the degrees of freedom there."""
+        rank at q0: the singular positions the run passed, with the degrees of freedom there.
+        (``result.rank`` and ``result.mobility`` hold them at every output time; the event finds
+        the singular positions between the outputs.)"""
         rank0 = self.rank(self.q0)
         found = ((float(t), self.rank(q, t), self.mobility(q, t))
                  for t, q in zip(result.t_events[event], result.q_events[event]))

@@ -19,7 +19,7 @@ from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
 from projeq.scenes.bicycle import fallen_over, whipple_bicycle, whipple_eigenvalues
 from projeq.scenes.elastic import elastic_arm, flexible_arm, spin_up_beam, spinning_beam
-from projeq.scenes.iftomm import andrews_squeezer, bricard, n_four_bar, simple_pendulum
+from projeq.scenes.iftomm import andrews_squeezer, bricard, flyball_governor, n_four_bar, simple_pendulum
 from projeq.scenes.mechanisms import bar_on_wall, four_bar, quick_return, slider_pendulum, sphere_on_sphere
 from projeq.scenes.parameters import Parameter, check_names, closest, parse_settings, scene_parameters
 from projeq.scenes.nonholonomic import (
@@ -149,6 +149,9 @@ SCENES = {
                      10.0),
     "andrews_squeezer": Scene(andrews_squeezer, "IFToMM benchmark A03: Andrews' squeezing mechanism, seven bodies "
                               "in one loop (Hairer & Wanner 1996, §VII.7)", 0.05),
+    "flyball_governor": Scene(flyball_governor, "IFToMM benchmark A05: the stiff flyball governor, coupler rods "
+                              "replaced by stiff spring-dampers", 10.0,
+                              units={"K": "N/m", "C": "N s/m", "s0": "m", "alpha0": "rad"}),
 }
 DEFAULT_SCENE = "spin_up_beam"
 
@@ -211,6 +214,6 @@ __all__ = [
     "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed", "rolling_disk_inertia",
     "barhorst_particle", "nonholonomic_particle", "whipple_bicycle", "whipple_eigenvalues",
     "quick_return", "four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",
-    "simple_pendulum", "n_four_bar", "bricard", "andrews_squeezer",
+    "simple_pendulum", "n_four_bar", "bricard", "andrews_squeezer", "flyball_governor",
     "Scene", "SCENES", "DEFAULT_SCENE", "get_scene", "resolve_scene", "build_scene", "scene_parameters", "parse_settings", "Parameter",
 ]

@@ -1,9 +1,10 @@
 """Problems of the IFToMM library of computational benchmark problems for multibody dynamics
 (M. González, D. Dopico, U. Lugrís, J. Cuadrado, "A benchmarking system for MBS simulation
 software: problem standardization and performance measurement", Multibody System Dynamics 16
-(2006) 179–190; problems A01 simple pendulum, A02 N-four-bar mechanism, A04 Bricard's mechanism),
-as :class:`~projeq.constraints.tangent.TangentSystem` s: trees closed by constraint equations,
-run through singular positions and with redundant constraints.
+(2006) 179–190; problems A01 simple pendulum, A02 N-four-bar mechanism, A03 Andrews' mechanism,
+A04 Bricard's mechanism), as :class:`~projeq.constraints.tangent.TangentSystem` s: trees closed by
+constraint equations, run through singular positions and with redundant constraints; and A05, the
+stiff flyball governor, a tree with two stiff spring-dampers (:func:`flyball_governor`).
 
 Each problem also has a reference that does not use the constraint equations: the pendulum's
 closed form (Jacobi's elliptic functions) and the N-four-bar's parallelogram motion in one
@@ -14,14 +15,15 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 from scipy.special import ellipj, ellipk
 
-from projeq.checks import count, positive
+from projeq.checks import count, non_negative, positive
 from projeq.constraints.tangent import TangentSystem
 from projeq.forces import JointForce, SpringDamper
-from projeq.joints import Prismatic, Revolute
+from projeq.joints import Fixed, Prismatic, Revolute
 from projeq.scenes.mechanisms import slender_rod
-from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody
+from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, inertia
 from projeq.system import System
 
 
@@ -250,3 +252,121 @@ def andrews_balance(system, r) -> np.ndarray:
     benchmark (zero: the drive's work goes into the mechanism's energy)."""
     energy, beta = r.kinetic + r.potential, andrews_angles(system, r.q)[:, 0]
     return energy - energy[0] - ANDREWS["mom"] * (beta - beta[0])
+
+
+# IFToMM A05, the stiff flyball governor: the benchmark's data (González, Dopico, Lugrís & Cuadrado 2006)
+FLYBALL = dict(length=1.0, width=0.01, side=0.1, density=3000.0, ball=5.0, K=8e5, C=4e4, rest=0.5, half_ab=0.05,
+               s0=0.5, alpha0=np.pi / 6, omega0=2 * np.pi, g=9.81)
+
+
+def flyball_governor(K: float = FLYBALL["K"], C: float = FLYBALL["C"], omega0: float = FLYBALL["omega0"],
+                     s0: float = FLYBALL["s0"], alpha0: float = FLYBALL["alpha0"]) -> System:
+    """IFToMM A05, the stiff flyball governor: a vertical shaft (1 × 0.01 × 0.01 m, density
+    3000 kg/m³: 0.3 kg) turning freely about z on the ground at the origin; on it a slider
+    (0.1 m cube, 3 kg, ``slider``: its height s along the shaft) and, hinged at the shaft's top
+    at A, B = (±0.05, 0, 1) m about ±y, two rods (as the shaft, ``rod_ac``, ``rod_bd``: their
+    angle α below the horizontal, outward) with 5 kg point masses at their far ends (``ball_c``,
+    ``ball_d``). The coupler rods of Watt's governor are replaced by spring-dampers (stiffness K,
+    damping C, rest length 0.5 m) from the slider's sides E, F = (±0.05, 0, s) to the rods'
+    midpoints; gravity −z. Starts at the benchmark's s = 0.5 m, α = 30° (the springs at their rest
+    length) with the whole governor turning at ``omega0`` = 2π rad/s. Stiff: the dampers'
+    eigenvalue −C/m ≈ −8000 1/s against the governor's motion of about 1 Hz.
+    (González, Dopico, Lugrís & Cuadrado, Multibody System Dynamics 16 (2006) 179–190, problem
+    A05.) The reference quantity is s(t); :func:`flyball_steady_state` gives where it settles."""
+    d = FLYBALL
+    L, w, rho, a = d["length"], d["width"], d["density"], d["half_ab"]
+    m_bar, m_slider = rho * L * w * w, rho * d["side"] ** 3
+    K, C = positive("K", K), non_negative("C", C)
+    rod = {side: RigidBody(m_bar, (sign * L / 2, 0.0, 0.0), inertia.box(m_bar, L, w, w))
+           for side, sign in (("ac", 1.0), ("bd", -1.0))}
+    subsystems = {"shaft": RigidBody(m_bar, (0.0, 0.0, L / 2), inertia.box(m_bar, w, w, L)),
+                  "slider": RigidBody(m_slider, (0.0, 0.0, 0.0), inertia.box(m_slider, *[d["side"]] * 3)),
+                  "rod_ac": rod["ac"], "ball_c": PointMass(d["ball"]), "rod_bd": rod["bd"], "ball_d": PointMass(d["ball"])}
+    joints = {"shaft": Revolute(axis="z"), "slider": Prismatic(parent="shaft", axis="z"),
+              "rod_ac": Revolute(parent="shaft", axis="y", r_pn=(a, 0.0, L)),
+              "ball_c": Fixed(parent="rod_ac", r_pn=(L, 0.0, 0.0)),
+              "rod_bd": Revolute(parent="shaft", axis=(0.0, -1.0, 0.0), r_pn=(-a, 0.0, L)),
+              "ball_d": Fixed(parent="rod_bd", r_pn=(-L, 0.0, 0.0))}
+    springs = [SpringDamper("slider", (sign * a, 0.0, 0.0), name, (sign * L / 2, 0.0, 0.0), K, C, length=d["rest"])
+               for name, sign in (("rod_ac", 1.0), ("rod_bd", -1.0))]
+    return System(subsystems, joints, gravity=(0.0, 0.0, -d["g"]), forces=springs,
+                  q0=[0.0, positive("s0", s0), alpha0, alpha0], s_dot0=[omega0, 0.0, 0.0, 0.0])
+
+
+def _flyball_geometry(alpha, s, K: float = FLYBALL["K"]):
+    """Of :func:`flyball_governor` at rod angle α and slider height s (complex under a complex
+    step): I_zz (the governor's moment of inertia about the shaft), V (gravity and the springs'
+    potential ½ K (ℓ − ℓ₀)² each) and ℓ (the springs' length)."""
+    d = FLYBALL
+    L, w, a, g = d["length"], d["width"], d["half_ab"], d["g"]
+    m_bar, m_slider, m_ball = d["density"] * L * w * w, d["density"] * d["side"] ** 3, d["ball"]
+    reach = L * np.cos(alpha)  # horizontal reach of a rod from its hinge
+    rod_own = m_bar * (2 * w * w * np.sin(alpha) ** 2 + (L * L + w * w) * np.cos(alpha) ** 2) / 12  # e_zᵀ I_c e_z
+    I_zz = (m_bar * 2 * w * w / 12 + m_slider * 2 * d["side"] ** 2 / 12
+            + 2 * (rod_own + m_bar * (a + reach / 2) ** 2 + m_ball * (a + reach) ** 2))
+    rise = L - L / 2 * np.sin(alpha) - s  # rod midpoint above the slider's centre; E and A both at ±a
+    ell = np.sqrt((reach / 2) ** 2 + rise**2)
+    V = (2 * g * (m_bar * (L - L / 2 * np.sin(alpha)) + m_ball * (L - L * np.sin(alpha)))
+         + m_slider * g * s + m_bar * g * L / 2 + K * (ell - d["rest"]) ** 2)
+    return I_zz, V, ell
+
+
+def flyball_steady_state(K: float = FLYBALL["K"], angular_momentum: float | None = None) -> dict:
+    """Where :func:`flyball_governor` (spring stiffness K) settles once its dampers have taken
+    out the relative motion. The shaft turns freely, so the angular momentum L_z about it is
+    conserved (default: the benchmark start's, I_zz(30°, 0.5 m) · 2π), and the relative
+    equilibria — the governor turning rigidly at ω = L_z / I_zz — are the stationary points of
+    the amended potential V_A(α, s) = V(α, s) + L_z² / (2 I_zz(α)) (Routh's reduction of the
+    cyclic shaft angle; Marsden & Ratiu, "Introduction to Mechanics and Symmetry", 2nd ed.
+    (1999), §8.5, the amended potential): ∂V_A/∂s = 0, the slider's weight against the two
+    spring forces, and ∂V_A/∂α = ∂V/∂α − ½ ω² ∂I_zz/∂α = 0, the rods' gravity and spring moments
+    against the centrifugal one. V and I_zz in closed form (:func:`_flyball_geometry`), their
+    derivatives by the complex step (exact to round-off), the roots by Brent's method, s(α) inside
+    α's. Returns α, s, ω and ℓ (the springs' length) there."""
+    K = positive("K", K)
+    L_z = (_flyball_geometry(FLYBALL["alpha0"], FLYBALL["s0"], K)[0] * FLYBALL["omega0"]
+           if angular_momentum is None else positive("angular_momentum", angular_momentum))
+
+    def amended(alpha, s):
+        I_zz, V, _ = _flyball_geometry(alpha, s, K)
+        return V + L_z * L_z / (2 * I_zz)
+
+    def rate(f, x):  # df/dx by the complex step
+        return f(x + 1e-30j).imag / 1e-30
+
+    def slider_height(alpha):  # ∂V_A/∂s = 0 at this α, between 0.9 m below the rods' midpoints and their height
+        top = FLYBALL["length"] * (1 - np.sin(alpha) / 2)
+        return brentq(lambda s: rate(lambda x: amended(alpha, x), s), top - 0.9, top, xtol=1e-15)
+
+    alpha = brentq(lambda x: rate(lambda y: amended(y, slider_height(y.real)), x), 0.05, np.pi / 2 - 0.05,
+                   xtol=1e-14)
+    s = slider_height(alpha)
+    I_zz, _, ell = _flyball_geometry(alpha, s, K)
+    return {"alpha": alpha, "s": s, "omega": L_z / I_zz, "length": ell}
+
+
+def flyball_spring_rate(q, s_dot) -> np.ndarray:
+    """ℓ̇ of the spring on rod AC of :func:`flyball_governor` for rows of q = (φ, s, α_AC, α_BD) and
+    ṡ, by differentiating the closed form ℓ² = (½L cos α)² + (L − ½L sin α − s)² (E and A both
+    0.05 m from the shaft; independent of the SpringDamper law's kinematics)."""
+    L = FLYBALL["length"]
+    q, s_dot = np.atleast_2d(q), np.atleast_2d(s_dot)
+    s, alpha, s_rate, alpha_rate = q[:, 1], q[:, 2], s_dot[:, 1], s_dot[:, 2]
+    reach, rise = L / 2 * np.cos(alpha), L - L / 2 * np.sin(alpha) - s
+    return (-reach * L / 2 * np.sin(alpha) * alpha_rate - rise * (L / 2 * np.cos(alpha) * alpha_rate + s_rate)) \
+        / np.hypot(reach, rise)
+
+
+def flyball_balance(r, C: float = FLYBALL["C"], samples: int = 20_001) -> np.ndarray:
+    """T + V − E₀ + W_d at the output times of a symmetric run of :func:`flyball_governor` (α_AC = α_BD)
+    with dense output: W_d = ∫ 2 C ℓ̇² dt, the work the two dampers dissipated, by Simpson's rule
+    on ``samples`` points of ``r.sol`` spaced evenly, and as many spaced geometrically from 1e-9 of
+    the run after its start, where the dampers' transient (time constant m/C ≈ 1e-4 s) decays
+    (zero: the energy balance)."""
+    from scipy.integrate import cumulative_simpson
+
+    span = r.t[-1] - r.t[0]
+    t = np.union1d(np.linspace(r.t[0], r.t[-1], samples), r.t[0] + np.geomspace(1e-9 * span, span, samples))
+    q, s_dot = (np.asarray(x).T for x in r.sol(t))
+    dissipated = cumulative_simpson(2 * C * flyball_spring_rate(q, s_dot) ** 2, x=t, initial=0.0)
+    return r.energy - r.energy[0] + np.interp(r.t, t, dissipated)

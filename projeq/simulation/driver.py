@@ -34,7 +34,7 @@ from projeq.analysis.jacobians import differentiate, state_derivative
 from projeq.assembly import EVALUATORS
 from projeq.checks import callable_name, closest, count, finite_array, positive, state_vector
 from projeq.simulation.integrators import (
-    EXPLICIT, PROJECTED, projected_solver, spectral_radius, stability_limit, warn_if_stiff,
+    EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, warn_if_stiff,
 )
 from projeq.simulation.result import Result, SimulationError
 from projeq.constraints.nonholonomic import near_singularity
@@ -358,7 +358,7 @@ STIFF_STEPS = 100_000  # DOP853 steps forced by stability alone beyond which Rad
 def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_end: float) -> str:
     """simulate's integrator when none is given, from the model's fastest mode measured at the
     initial state: ρ = the spectral radius of ∂ẋ/∂x (power iteration,
-    :func:`projeq.simulation.integrators.spectral_radius`, 33 evaluations of ``evaluator``)
+    :func:`projeq.simulation.integrators.fastest_mode`, 33 evaluations of ``evaluator``)
     gives the steps an explicit method needs for stability alone, n = ρ (t_end − t0) / |x_s|
     with |x_s| its stability interval (:func:`~projeq.simulation.integrators.stability_limit`:
     RK45 3.31, DOP853 6.39). "RK45" while n_RK45 ≤ ``FAST_MODE_STEPS`` (rigid models: n ≤ 60
@@ -367,16 +367,24 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
     beam, where the error control must follow the excited fast modes: measured in
     benchmarks/default_integrator.py, DOP853 needs half RK45's evaluations and 1/5 of
     Radau's with the exact Jacobian at equal tolerance); "Radau" (exact Jacobian) when even
-    DOP853 would need more than ``STIFF_STEPS`` steps for stability alone."""
+    DOP853 would need more than ``STIFF_STEPS`` steps for stability alone, or when the fastest
+    mode decays without oscillating (a real eigenvalue −ρ: a stiff damper) and would force more
+    than ``FAST_MODE_STEPS`` RK45 steps — such a mode dies out, so only stability limits an
+    explicit step (IFToMM A05, the stiff flyball governor, ρ = 8117 1/s, over 10 s at rtol 1e-8,
+    one run of benchmarks/iftomm.py: DOP853 155,470 evaluations, 44.7 s CPU, and a
+    StiffnessWarning; Radau 17,655 evaluations and 1,250 Jacobians, 26.4 s; BDF would take 6.5 s
+    but misses the energy balance by 6.4e-5 J where Radau keeps it to 1.1e-7 J)."""
 
     def rhs(t, x):
         q, s_dot = x[: model.n_q], x[model.n_q :]
         return np.concatenate((model.q_dot(q, s_dot, t), evaluator.accelerations(q, s_dot, t)))
 
-    rho_T = spectral_radius(rhs, t0, np.concatenate((q0, s_dot0))) * (t_end - t0)
-    if rho_T > STIFF_STEPS * stability_limit("DOP853"):
+    rho, decays = fastest_mode(rhs, t0, np.concatenate((q0, s_dot0)))
+    rho_T = rho * (t_end - t0)
+    explicit_steps = rho_T / stability_limit("RK45")
+    if rho_T > STIFF_STEPS * stability_limit("DOP853") or (decays and explicit_steps > FAST_MODE_STEPS):
         return "Radau"
-    return "DOP853" if rho_T > FAST_MODE_STEPS * stability_limit("RK45") else "RK45"
+    return "DOP853" if explicit_steps > FAST_MODE_STEPS else "RK45"
 
 
 def _jac_option(method, jac):
@@ -490,7 +498,17 @@ def _assemble(run: _Run, wall_time: float, dense_output: bool) -> Result:
         partitions=partitions, coordinates=system.coordinates(),
         velocities=system.velocities() if len(partitions) < 2 else tuple((f"s_dot[{i}]", "") for i in range(n_s)),
         sol=_dense_solution(pieces, n_q) if dense_output and pieces else None, system=system,
+        **_rank_history(rows, q),
     )
+
+
+def _rank_history(rows: list, q: NDArray) -> dict:
+    """Result's ``rank`` and ``mobility`` of a model with constraint equations: each output row's
+    in its own piece's model (its partition); nothing for other models."""
+    if not rows or not hasattr(rows[0][0], "mobility"):
+        return {}
+    history = np.array([(model.rank(qi, t), model.mobility(qi, t)) for (model, t), qi in zip(rows, q)], dtype=int)
+    return {"rank": history[:, 0], "mobility": history[:, 1]}
 
 
 def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, NDArray]:

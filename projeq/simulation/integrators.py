@@ -206,25 +206,36 @@ class _ProjectedDenseOutput(DenseOutput):
 
 
 def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32) -> float:
-    """ρ(∂f/∂x) at (t, x) by power iteration on finite-difference products
-    Jv ≈ (f(x + εv) − f(x))/ε: the geometric mean growth ‖J v_k‖ over an even number of
-    the last iterations (for an undamped mode, a pair ±iω, the growth alternates between
-    ω²|a|/|b| and |b|/|a| for a vector (a, b) of coordinate and rate: a pair's mean is ω).
-    Costs ``iterations`` + 1 evaluations of f."""
+    """ρ(∂f/∂x) at (t, x) by power iteration (:func:`fastest_mode`); costs ``iterations`` + 1
+    evaluations of f."""
+    return fastest_mode(fun, t, x, iterations)[0]
+
+
+def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32) -> tuple[float, bool]:
+    """(ρ, decays) of ∂f/∂x at (t, x) by power iteration on finite-difference products
+    Jv ≈ (f(x + εv) − f(x))/ε. ρ, the spectral radius: the geometric mean growth ‖J v_k‖ over an
+    even number of the last iterations (for an undamped mode, a pair ±iω, the growth alternates
+    between ω²|a|/|b| and |b|/|a| for a vector (a, b) of coordinate and rate: a pair's mean is ω).
+    ``decays``: the fastest mode is a real eigenvalue λ ≈ −ρ (a stiff damper, not an oscillation):
+    the last iterate v is then an eigenvector, ‖J v − λ v‖ ≤ 0.1 ρ with the Rayleigh quotient
+    λ = vᵀJv ≤ −0.5 ρ; the iterates of a complex pair rotate in its plane and fail the test
+    (Golub & Van Loan, "Matrix Computations", 4th ed. (2013), §7.3.1). Costs ``iterations`` + 1
+    evaluations of f."""
     x = np.asarray(x, dtype=float)
     f0 = fun(t, x)
     v = np.cos(np.arange(len(x)) + 1.0)  # a fixed start with components along every axis
     v /= np.linalg.norm(v)
-    logs = []
+    logs, w = [], v
     for _ in range(iterations):
         eps = np.sqrt(np.finfo(float).eps) * (1.0 + np.linalg.norm(x))
+        v = w / np.linalg.norm(w)
         w = forward(lambda e: fun(t, x + e * v), eps, f0)
         norm = np.linalg.norm(w)
         if not norm > 0:
-            return 0.0
+            return 0.0, False
         logs.append(np.log(norm))
-        v = w / norm
-    return float(np.exp(np.mean(logs[-2 * (iterations // 4):])))
+    rho, rayleigh = float(np.exp(np.mean(logs[-2 * (iterations // 4):]))), float(v @ w)
+    return rho, bool(rayleigh <= -0.5 * rho and np.linalg.norm(w - rayleigh * v) <= 0.1 * rho)
 
 
 def stability_limit(method: str) -> float:

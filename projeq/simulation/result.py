@@ -47,6 +47,13 @@ class Result:
     partitions : ((t_k, independent_k), ...) of a ConstrainedSystem, one per partition used
     (more than one if it re-pivoted): rows (and ``sol(t)``) with t_k < t ≤ t_k+1 hold the
     tree velocities independent_k in ``s_dot`` (:mod:`projeq.constraints.partitioned`); empty for other systems
+    rank, mobility : (n,) integers, for a model with constraint equations (a ConstrainedSystem,
+    TangentSystem, ...): the numerical rank of its constraint matrix A_s at each output time
+    (singular values above RANK_TOLERANCE times the largest,
+    :meth:`projeq.constraints.partitioned.ConstrainedSystem.rank`) and the degrees of freedom
+    there, n_s,tree − rank (:meth:`~projeq.constraints.partitioned.ConstrainedSystem.mobility`):
+    a redundant row keeps the rank below the rows' count all along, a singular position drops it
+    where the run passes; empty for other models and in files saved before they were recorded
     """
 
     t: NDArray
@@ -69,6 +76,8 @@ class Result:
     velocities: tuple = ()
     metadata: dict = field(default_factory=dict)
     njev: int = 0
+    rank: NDArray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    mobility: NDArray = field(default_factory=lambda: np.zeros(0, dtype=int))
     sol: object = field(default=None, repr=False, compare=False)
     system: object = field(default=None, repr=False, compare=False)  # in memory only, not saved
 
