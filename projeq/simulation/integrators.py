@@ -23,6 +23,8 @@ Two concerns of the numerics at the extremes (issue 7, item 4):
 
 from __future__ import annotations
 
+import functools
+
 import warnings
 
 import numpy as np
@@ -227,6 +229,7 @@ def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32) -> float:
     return float(np.exp(np.mean(logs[-2 * (iterations // 4):])))
 
 
+@functools.cache  # ~1000 evaluations of R(x): once per method and process
 def stability_limit(method: str) -> float:
     """|x| of the explicit Runge–Kutta ``method``'s stability interval [x, 0] on the negative
     real axis: the root of |R(x)| = 1 for R(z) = 1 + z bᵀ (I − z A)⁻¹ 1 of its Butcher tableau
