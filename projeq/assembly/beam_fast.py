@@ -130,8 +130,16 @@ class HubBeamEvaluator:
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) at (q, ṡ, t) = (q_e, q̇_e, t)."""
-        if self.compiled and not (np.iscomplexobj(q) or np.iscomplexobj(s_dot)):
-            return self._compiled(q, s_dot, t)
+        if self.compiled and np.asarray(q).dtype.kind != "c" and np.asarray(s_dot).dtype.kind != "c":
+            x = np.concatenate((q, s_dot)).astype(float)
+            x_dot = np.empty(len(x))
+            status = self._compiled(x, x_dot, t)
+            if status >= 0 and not np.all(np.isfinite(x)):
+                raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no mass "
+                                         "matrix M_ee can be formed")
+            if status == 0:
+                self._singular(t)
+            return x_dot[len(q):]
         self.n_calls += 1
         joint = self.joint
         hub = joint.relative(self._empty, self._empty, t)
@@ -140,24 +148,33 @@ class HubBeamEvaluator:
         M_e, h_e = self.beam.elastic_terms(y_dot, R, self.system.gravity, q)
         return np.linalg.solve(M_e[:, 6:], h_e - M_e[:, :6] @ hub.zeta)
 
-    def _compiled(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """:meth:`accelerations` by :func:`projeq.assembly.kernels.hub_beam`: the hub's
-        (θ, θ̇, θ̈) of a Prescribed joint (its checked ``angles``) or the numbers of its
-        ``relative_values``, then one compiled call."""
+    def state_derivative(self, t: float, x: NDArray) -> NDArray | None:
+        """ẋ = (q̇_e, q̈_e) at the state x = (q_e, q̇_e) in one compiled call (q̇ = ṡ: the
+        beam's elastic coordinates are the system's), for :func:`projeq.simulate`'s
+        right-hand side; None when x or ẋ is not finite, or the path is interpreted (the
+        caller's checked path then evaluates, and names what is not finite)."""
+        if not self.compiled or x.dtype.kind != "f":
+            return None
+        x_dot = np.empty(len(x))
+        status = self._compiled(x, x_dot, t)
+        if status == 0:
+            self._singular(t)
+        return x_dot if status < 0 else None
+
+    def _compiled(self, x: NDArray, x_dot: NDArray, t: float) -> int:
+        """:func:`projeq.assembly.kernels.hub_beam` at (x, t) into x_dot: the hub's (θ, θ̇, θ̈) of a
+        Prescribed joint (its checked ``angles``) or the numbers of its ``relative_values``,
+        then one compiled call; its status."""
         self.n_calls += 1
         kind = self._kind
         if kind == kernels.GIVEN:
             self._given[:] = self.joint.relative_values(self._empty, self._empty, t)[:24]
         elif kind != kernels.FIXED:
-            self._angles[:] = self.joint.angles(t)
-        q_e_ddot = np.empty(len(s_dot))
-        failed = self._kernel(kind, self._axis, self._angles, self._given, self._orientation, self._gravity,
-                              *self._field, np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float),
-                              self._pivot_min, self._M, self._h, q_e_ddot)
-        if failed >= 0:
-            if not (np.all(np.isfinite(q)) and np.all(np.isfinite(s_dot))):
-                raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no mass "
-                                         "matrix M_ee can be formed")
-            raise SingularMassError(f"M_ee of subsystem {self.system.names[0]!r} is singular or indefinite at "
-                                    f"t = {t:.6g}: the state has left the range the model describes")
-        return q_e_ddot
+            angles = self._angles
+            angles[0], angles[1], angles[2] = self.joint.angles(t)
+        return self._kernel(kind, self._axis, self._angles, self._given, self._orientation, self._gravity,
+                            *self._field, x, self._pivot_min, self._M, self._h, x_dot)
+
+    def _singular(self, t: float):
+        raise SingularMassError(f"M_ee of subsystem {self.system.names[0]!r} is singular or indefinite at "
+                                f"t = {t:.6g}: the state has left the range the model describes")

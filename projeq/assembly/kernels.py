@@ -223,8 +223,7 @@ def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
             h[6 + i] -= K_e[i, l] * (q_e[l] + damping * q_e_dot[l])
 
 
-def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, pivot_min,
-             M, h, q_e_ddot):
+def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, pivot_min, M, h, x_dot):
     """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) of one elastic body on a hub whose motion is given, its
     reference frame moving with ẏ = (w, q̇_e) and ÿ = (ζ, q̈_e) — B(14) projected on q̇_e
     (:mod:`projeq.assembly.beam_fast`); M_n and h_n by :func:`elastic_body`, M_ee by
@@ -232,8 +231,15 @@ def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e
     ``angles`` = (θ, θ̇, θ̈) (A_Jn by :func:`_relative_rotation`, w = F⁶ θ̇, ζ = F⁶ θ̈: a
     Prescribed joint), FIXED (angles zero), or GIVEN: A, r, w, ζ of the joint's own
     ``relative_values`` in ``given``. R = A_pJ A_Jn (the ground at rest), g_n = Rᵀ g.
-    Writes q_e_ddot; returns −1, or 0 when a pivot of M_ee is not above ``pivot_min``."""
-    k_e, A, w, zeta, g = q_e.shape[0], np.empty((3, 3)), np.zeros(6), np.zeros(6), np.zeros(3)
+    The state x = (q_e, q̇_e), written: ẋ = (q̇_e, q̈_e) (q̇ = ṡ for elastic coordinates).
+    Returns −1; 0 when a pivot of M_ee is not above ``pivot_min``; 1 when x or ẋ is not
+    finite (ẋ written as far as it got)."""
+    k_e, A, w, zeta, g = x.shape[0] // 2, np.empty((3, 3)), np.zeros(6), np.zeros(6), np.zeros(3)
+    for i in range(2 * k_e):
+        if not np.isfinite(x[i]):
+            return 1
+    q_e, q_e_dot, q_e_ddot = x[:k_e], x[k_e:], x_dot[k_e:]
+    x_dot[:k_e] = q_e_dot
     if kind == GIVEN:
         for a in range(3):
             for b in range(3):
@@ -255,6 +261,9 @@ def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e
     if not _cholesky(M_ee, k_e, pivot_min):
         return 0
     _cholesky_solve(M_ee, k_e, q_e_ddot)
+    for i in range(k_e):
+        if not np.isfinite(q_e_ddot[i]):
+            return 1
     return -1
 
 

@@ -245,6 +245,7 @@ class _Run:
         self.events = _checked_events(events, t_start, q0, s_dot0)
         self.model = self.user_model = system
         self.choice, self.ev = evaluator, _evaluator(system, evaluator)
+        self.fused = getattr(self.ev, "state_derivative", None)
         system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
         self.ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
         if method is None:
@@ -261,15 +262,28 @@ class _Run:
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
 
     def rhs(self, t: float, x: NDArray) -> NDArray:
-        """ẋ = (q̇, s̈) of the current model."""
+        """ẋ = (q̇, s̈) of the current model: by the evaluator's ``state_derivative`` where it
+        has one (ẋ in one compiled call, None when x or ẋ is not finite), else (and then) by
+        :meth:`checked_rhs`."""
         self.reached = t
+        x_dot = None if self.fused is None else self.fused(t, x)
+        if x_dot is None:
+            return self.checked_rhs(t, x)
+        self.calls += 1
+        if self.calls % MONITOR_EVERY == 0 and _may_be_singular(self.model.tree):
+            near_singularity(self.model.tree, x[: self.model.n_q], t)
+        return x_dot
+
+    def checked_rhs(self, t: float, x: NDArray) -> NDArray:
+        """ẋ = (q̇, s̈) by the model's q̇ and the evaluator's s̈, FloatingPointError when x or ẋ
+        is not finite; every ``MONITOR_EVERY`` calls the distance to a coordinate singularity."""
         n_q = self.model.n_q
         q, s_dot = x[:n_q], x[n_q:]
         if not np.isfinite(x).all():  # the ufunc and the array's own all(): half the cost of np.all
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (q = {q}, s_dot = {s_dot}): the "
                                      "solution blew up (or a tolerance too loose let it)")
         self.calls += 1
-        if self.calls % MONITOR_EVERY == 0:
+        if self.calls % MONITOR_EVERY == 0 and _may_be_singular(self.model.tree):
             near_singularity(self.model.tree, q, t)
         x_dot = np.concatenate((self.model.q_dot(q, s_dot, t), self.ev.accelerations(q, s_dot, t)))
         if not np.isfinite(x_dot).all():
@@ -340,6 +354,7 @@ class _Run:
         n_q = self.model.n_q
         self.model, s_dot = self.model.after_event(x[:n_q], x[n_q:], t)
         self.x, self.ev = np.concatenate((x[:n_q], s_dot)), _evaluator(self.model, self.choice)
+        self.fused = getattr(self.ev, "state_derivative", None)
         if self.method in PROJECTED:  # the same energy, now in the new partition's s_dot
             self.solver = projected_solver(self.method, self.model, x[:n_q], s_dot, t)
         return t
@@ -391,6 +406,13 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
     if rho_T > STIFF_STEPS * stability_limit("DOP853"):
         return "Radau"
     return "DOP853" if rho_T > FAST_MODE_STEPS * stability_limit("RK45") else "RK45"
+
+
+def _may_be_singular(tree) -> bool:
+    """Whether a joint of ``tree`` has minimal velocities of its own, whose K(q) and F(q)
+    :func:`~projeq.constraints.nonholonomic.near_singularity` checks (a forward pass: 0.5 ms
+    on the spin-up beam, whose prescribed hub has none)."""
+    return any(joint.n_s and not joint.coupling for joint in tree.joints)
 
 
 def _counted(solver, run: _Run) -> type:
