@@ -229,14 +229,18 @@ def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32) -> float:
     return float(np.exp(np.mean(logs[-2 * (iterations // 4):])))
 
 
-@functools.cache  # ~1000 evaluations of R(x): once per method and process
 def stability_limit(method: str) -> float:
     """|x| of the explicit Runge–Kutta ``method``'s stability interval [x, 0] on the negative
     real axis: the root of |R(x)| = 1 for R(z) = 1 + z bᵀ (I − z A)⁻¹ 1 of its Butcher tableau
     (Hairer & Wanner, Solving ODEs II, §IV.2): RK23 2.51, RK45 3.31, DOP853 6.39."""
+    return _stability_interval(PROJECTED[method].__name__ if method in PROJECTED else method)
+
+
+@functools.cache  # ~1000 evaluations of R(x): once per method and process
+def _stability_interval(name: str) -> float:
     from scipy.optimize import brentq  # scipy.optimize loads where it is used (import projeq stays fast)
 
-    solver = {"RK23": RK23, "RK45": RK45, "DOP853": DOP853}[PROJECTED[method].__name__ if method in PROJECTED else method]
+    solver = {"RK23": RK23, "RK45": RK45, "DOP853": DOP853}[name]
     n = solver.n_stages
     A = np.zeros((n, n))
     A[:, : min(n, solver.A.shape[1])] = solver.A[:n, :n]
