@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 
 from projeq.assembly import kernels
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
+from projeq.joints import Prescribed
 
 
 def hub_beam_unsupported(system) -> str | None:
@@ -63,13 +64,22 @@ def hub_beam_unsupported(system) -> str | None:
     return None
 
 
+def elastic_unsupported(body) -> str | None:
+    """Why the kernel's elastic block (:func:`projeq.assembly.kernels.elastic_body`) cannot take
+    ``body`` (None if it can): it takes bodies with ẏ = (twist, q̇_e) whose terms are the slice
+    sums of their ``slice_field`` with linear restoring forces (a RitzBeam without rotary inertia)."""
+    if not hasattr(body, "slice_field") or body.S is None or not np.array_equal(body.S, np.eye(6 + body.n_e, 6)):
+        return "(the kernel knows elastic bodies by the slice field of a RitzBeam)"
+    if body.rotary is not None:
+        return "with rotary inertia or torsion (the kernel's elastic block has the slices' translation only)"
+    return None
+
+
 def compiled_unsupported(system) -> str | None:
     """Why :func:`projeq.assembly.kernels.hub_beam` cannot evaluate ``system``, one subsystem on
     a hub (:func:`hub_beam_unsupported`), (None if it can)."""
-    from projeq.assembly.fast import _elastic_unsupported  # fast.py imports this module
-
     name, body = system.names[0], system.subsystems[0]
-    reason = _elastic_unsupported(body)
+    reason = elastic_unsupported(body)
     if reason is not None:
         return f"subsystem {name!r} is a {type(body).__name__} {reason}"
     return None if kernels.has_numba() else "numba is not installed"
@@ -111,8 +121,6 @@ class HubBeamEvaluator:
     def _pack(self, system) -> None:
         """The kernel's constants: the hub's kind, axis and frame, the beam's slice field
         (:meth:`projeq.RitzBeam.slice_field`), K_e and damping; and its workspace."""
-        from projeq.joints import Prescribed
-
         beam, joint = self.beam, self.joint
         inner = joint.joint if isinstance(joint, Prescribed) else joint
         kind = kernels.KINDS.get(getattr(inner, "compiled_kind", None), kernels.GIVEN)
