@@ -70,6 +70,10 @@ def elastic_unsupported(body) -> str | None:
     sums of their ``slice_field`` with linear restoring forces (a RitzBeam without rotary inertia)."""
     if not hasattr(body, "slice_field") or body.S is None or not np.array_equal(body.S, np.eye(6 + body.n_e, 6)):
         return "(the kernel knows elastic bodies by the slice field of a RitzBeam)"
+    owner = next(c for c in type(body).__mro__ if "slice_field" in vars(c))
+    if type(body).gauss_terms is not owner.gauss_terms:
+        return ("that restates gauss_terms (the kernel knows the terms of the slice field, not the ones "
+                "it adds)")
     if body.rotary is not None:
         return "with rotary inertia or torsion (the kernel's elastic block has the slices' translation only)"
     return None
