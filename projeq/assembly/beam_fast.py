@@ -139,6 +139,9 @@ class HubBeamEvaluator:
         self._M, self._h = np.zeros((n_y, n_y)), np.zeros(n_y)
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
         self._kernel = kernels.hub_beam_kernel(True)
+        # the kernel's arguments before and after the state, packed once (the hub's rows are overwritten in place)
+        self._head = (self._kind, self._axis, self._angles, self._given, self._orientation, self._gravity, *self._field)
+        self._tail = (self._pivot_min, self._M, self._h)
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) at (q, ṡ, t) = (q_e, q̇_e, t)."""
@@ -167,7 +170,7 @@ class HubBeamEvaluator:
         caller's checked path then evaluates, and names what is not finite)."""
         if not self.compiled or x.dtype.kind != "f":
             return None
-        x_dot = np.empty(len(x))
+        x_dot = np.empty(x.shape[0])
         status = self._compiled(x, x_dot, t)
         if status == 0:
             self._singular(t)
@@ -184,8 +187,7 @@ class HubBeamEvaluator:
         elif kind != kernels.FIXED:
             angles = self._angles
             angles[0], angles[1], angles[2] = self.joint.angles(t)
-        return self._kernel(kind, self._axis, self._angles, self._given, self._orientation, self._gravity,
-                            *self._field, x, self._pivot_min, self._M, self._h, x_dot)
+        return self._kernel(*self._head, x, *self._tail, x_dot)
 
     def _singular(self, t: float):
         raise SingularMassError(f"M_ee of subsystem {self.system.names[0]!r} is singular or indefinite at "
