@@ -398,6 +398,8 @@ class System(Model):
         self._q_get = tuple(self.joint_q_getter(n) for n in range(len(self.joints)))
         self._s_get = tuple(self.joint_s_dot_getter(n) for n in range(len(self.joints)))
         self._identity_q, self._identity_s, self._general_kinematics = self._kinematics_split()
+        self._q_dot_is_s_dot = (not self._general_kinematics and np.array_equal(self._identity_q, np.arange(n_q))
+                                and np.array_equal(self._identity_s, np.arange(n_s)))
         self._normalizing = tuple(  # joints whose coordinates live on a manifold (quaternions)
             n for n, j in enumerate(self.joints)
             if type(j).normalized is not Joint.normalized and not j.coupling
@@ -499,6 +501,8 @@ class System(Model):
     def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
         """q̇ = K(q) ṡ + k(q, t): q̇ = ṡ in one step where K = E (revolute and prismatic
         joints, elastic coordinates), joint by joint elsewhere."""
+        if self._q_dot_is_s_dot:  # K = E throughout (one copy: the right-hand side of every step calls it)
+            return np.array(s_dot, dtype=np.result_type(q, s_dot, float))
         q_dot = np.empty(self.n_q, dtype=np.result_type(q, s_dot, float))  # complex for a complex step
         q_dot[self._identity_q] = np.asarray(s_dot)[self._identity_s]
         for n in self._general_kinematics:

@@ -1,7 +1,8 @@
 """``method="auto"``, the default evaluator: the best evaluator available for a System, picked once.
 
-In this order: ``"hub_beam"`` (:mod:`projeq.assembly.beam_fast`) for one RitzBeam on a
-prescribed or fixed hub; ``"fast"`` (the compiled order-n kernel, :mod:`projeq.assembly.fast`)
+In this order: ``"hub_beam"`` (:mod:`projeq.assembly.beam_fast`, compiled) for one RitzBeam on a
+prescribed or fixed hub (interpreted, with one :class:`InterpretedWarning`, for a beam with
+rotary inertia or a user's subsystem there); ``"fast"`` (the compiled order-n kernel, :mod:`projeq.assembly.fast`)
 when the kernel knows every subsystem (rigid bodies, spatial or planar, on any joint, coupled
 ones included, under any force law; RitzBeams without rotary inertia anywhere in a tree
 under gravity); else the
@@ -67,16 +68,26 @@ class AutoEvaluator:
     warns once (:class:`InterpretedWarning`) when that is an interpreted reference evaluator.
 
     Attributes: ``name`` (of the picked evaluator: "fast", "hub_beam", "dense" or
-    "recursive"), ``reason`` (why), ``evaluator`` (the picked evaluator, which counts the calls).
+    "recursive"), ``reason`` (why), ``evaluator`` (the picked evaluator, which counts the calls);
+    ``accelerations`` and, where the picked one has it, ``state_derivative`` are the picked
+    evaluator's own (called without a layer between).
     """
 
     def __init__(self, system):
         self.name, self.reason = pick(system)
         self.evaluator = system.evaluator(self.name)
+        self.accelerations = self.evaluator.accelerations  # the picked one's, called directly (one layer less per s̈)
+        if hasattr(self.evaluator, "state_derivative"):  # ẋ in one call (projeq.simulate's right-hand side)
+            self.state_derivative = self.evaluator.state_derivative
         if self.name in ("dense", "recursive"):
             warnings.warn(
                 f"system: evaluated by the interpreted {self.name!r} evaluator, not the compiled one: "
                 f"{why_not_compiled(system)}", InterpretedWarning, stacklevel=3,
+            )
+        elif self.name == "hub_beam" and not self.evaluator.compiled:
+            warnings.warn(
+                f"system: evaluated by the interpreted 'hub_beam' path, not the compiled one: "
+                f"{self.evaluator.interpreted_reason}", InterpretedWarning, stacklevel=3,
             )
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:

@@ -14,13 +14,23 @@ and no rotary inertia only the elastic rows (M_ee, M_eR, h_e) are formed
 (:meth:`~projeq.subsystems.beam.beam.RitzBeam.elastic_terms`). M_ee = ∫ Φ_rᵀ Φ_r dm is
 positive definite for the independent Ritz functions a RitzBeam accepts, so a plain LU
 solve suffices. Equal to the general evaluators to round-off
-(tests/assembly/test_fast.py). Any other subsystem with internal coordinates and the beam's
-layout ẏ = (twist, q̇_e) takes the same path through its ``elastic_terms``
-(:class:`projeq.Subsystem`: by default the last n_e rows of its own ``gauss_terms``).
+(tests/assembly/test_fast.py).
+
+Compiled by default: a RitzBeam without rotary inertia (the slice field the compiled
+kernel knows, :func:`projeq.assembly.kernels.elastic_body`, the same statement of the
+beam's terms as the order-n kernel's elastic block) on a Prescribed Revolute or Prismatic,
+a Fixed joint or any joint without coordinates (read by its ``relative_values``) is one
+call of :func:`projeq.assembly.kernels.hub_beam` per s̈. Any other subsystem with internal
+coordinates and the beam's layout ẏ = (twist, q̇_e) (a beam with rotary inertia or
+torsion, a user's subsystem) takes the interpreted path through its ``elastic_terms``
+(:class:`projeq.Subsystem`: by default the last n_e rows of its own ``gauss_terms``), and
+so do complex arguments (the complex-step derivatives of :mod:`projeq.analysis.jacobians`).
 
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.spin_up_beam(omega_s=4.0, n_shapes=2, family="clamped_free")
 >>> ev = HubBeamEvaluator(system)
+>>> ev.compiled == pq.assembly.kernels.has_numba()
+True
 >>> q, s_dot = np.array([0.01, 0.0, 0.002, 0.0]), np.array([0.1, 0.0, 0.0, 0.0])
 >>> bool(np.allclose(ev.accelerations(q, s_dot, 3.0), system.accelerations(q, s_dot, 3.0), rtol=1e-12, atol=1e-12))
 True
@@ -30,6 +40,10 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
+
+from projeq.assembly import kernels
+from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
+from projeq.joints import Prescribed
 
 
 def hub_beam_unsupported(system) -> str | None:
@@ -50,6 +64,31 @@ def hub_beam_unsupported(system) -> str | None:
     return None
 
 
+def elastic_unsupported(body) -> str | None:
+    """Why the kernel's elastic block (:func:`projeq.assembly.kernels.elastic_body`) cannot take
+    ``body`` (None if it can): it takes bodies with ẏ = (twist, q̇_e) whose terms are the slice
+    sums of their ``slice_field`` with linear restoring forces (a RitzBeam without rotary inertia)."""
+    if not hasattr(body, "slice_field") or body.S is None or not np.array_equal(body.S, np.eye(6 + body.n_e, 6)):
+        return "(the kernel knows elastic bodies by the slice field of a RitzBeam)"
+    owner = next(c for c in type(body).__mro__ if "slice_field" in vars(c))
+    if type(body).gauss_terms is not owner.gauss_terms:
+        return ("that restates gauss_terms (the kernel knows the terms of the slice field, not the ones "
+                "it adds)")
+    if body.rotary is not None:
+        return "with rotary inertia or torsion (the kernel's elastic block has the slices' translation only)"
+    return None
+
+
+def compiled_unsupported(system) -> str | None:
+    """Why :func:`projeq.assembly.kernels.hub_beam` cannot evaluate ``system``, one subsystem on
+    a hub (:func:`hub_beam_unsupported`), (None if it can)."""
+    name, body = system.names[0], system.subsystems[0]
+    reason = elastic_unsupported(body)
+    if reason is not None:
+        return f"subsystem {name!r} is a {type(body).__name__} {reason}"
+    return None if kernels.has_numba() else "numba is not installed"
+
+
 class HubBeamEvaluator:
     """q̈_e of one RitzBeam on a prescribed or fixed hub (module docstring).
 
@@ -60,13 +99,17 @@ class HubBeamEvaluator:
         through its ``elastic_terms``) on a :class:`~projeq.Prescribed` or
         :class:`~projeq.Fixed` joint to the ground, without force laws; otherwise
         ValueError naming the reason.
+    compiled : bool
+        True (default): by the compiled kernel where it knows the subsystem
+        (:func:`compiled_unsupported` says why not; then interpreted); False: interpreted.
 
-    Attributes: ``name`` ("hub_beam"), ``n_calls``.
+    Attributes: ``name`` ("hub_beam"), ``compiled`` (whether real arguments take the compiled
+    kernel), ``interpreted_reason`` (why not, or None), ``n_calls``.
     """
 
     name = "hub_beam"
 
-    def __init__(self, system):
+    def __init__(self, system, compiled: bool = True):
         reason = hub_beam_unsupported(system)
         if reason is not None:
             raise ValueError(f"system: {reason}")
@@ -74,9 +117,44 @@ class HubBeamEvaluator:
         self.beam, self.joint = system.subsystems[0], system.joints[0]
         self._empty = np.zeros(0)
         self.n_calls = 0
+        self.interpreted_reason = compiled_unsupported(system) if compiled else "compiled=False"
+        self.compiled = self.interpreted_reason is None
+        if self.compiled:
+            self._pack(system)
+
+    def _pack(self, system) -> None:
+        """The kernel's constants: the hub's kind, axis and frame, the beam's slice field
+        (:meth:`projeq.RitzBeam.slice_field`), K_e and damping; and its workspace."""
+        beam, joint = self.beam, self.joint
+        inner = joint.joint if isinstance(joint, Prescribed) else joint
+        kind = kernels.KINDS.get(getattr(inner, "compiled_kind", None), kernels.GIVEN)
+        self._kind = kind if isinstance(joint, Prescribed) or kind == kernels.FIXED else kernels.GIVEN
+        self._axis = np.array(inner.axis if self._kind in (kernels.REVOLUTE, kernels.PRISMATIC) else np.zeros(3),
+                              dtype=float)
+        self._angles, self._given = np.zeros(3), np.zeros(24)
+        self._orientation, self._gravity = np.array(joint.orientation, dtype=float), np.array(system.gravity, float)
+        self._field = (np.array(beam.mass_weights, dtype=float), *(np.ascontiguousarray(a) for a in beam.slice_field()),
+                       np.array(beam.K_e, dtype=float), float(beam.damping))
+        n_y = 6 + beam.n_e
+        self._M, self._h = np.zeros((n_y, n_y)), np.zeros(n_y)
+        self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
+        self._kernel = kernels.hub_beam_kernel(True)
+        # the kernel's arguments before and after the state, packed once (the hub's rows are overwritten in place)
+        self._head = (self._kind, self._axis, self._angles, self._given, self._orientation, self._gravity, *self._field)
+        self._tail = (self._pivot_min, self._M, self._h)
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) at (q, ṡ, t) = (q_e, q̇_e, t)."""
+        if self.compiled and np.asarray(q).dtype.kind != "c" and np.asarray(s_dot).dtype.kind != "c":
+            x = np.concatenate((q, s_dot)).astype(float)
+            x_dot = np.empty(len(x))
+            status = self._compiled(x, x_dot, t)
+            if status >= 0 and not np.all(np.isfinite(x)):
+                raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no mass "
+                                         "matrix M_ee can be formed")
+            if status == 0:
+                self._singular(t)
+            return x_dot[len(q):]
         self.n_calls += 1
         joint = self.joint
         hub = joint.relative(self._empty, self._empty, t)
@@ -84,3 +162,33 @@ class HubBeamEvaluator:
         y_dot = np.concatenate((hub.w, s_dot))
         M_e, h_e = self.beam.elastic_terms(y_dot, R, self.system.gravity, q)
         return np.linalg.solve(M_e[:, 6:], h_e - M_e[:, :6] @ hub.zeta)
+
+    def state_derivative(self, t: float, x: NDArray) -> NDArray | None:
+        """ẋ = (q̇_e, q̈_e) at the state x = (q_e, q̇_e) in one compiled call (q̇ = ṡ: the
+        beam's elastic coordinates are the system's), for :func:`projeq.simulate`'s
+        right-hand side; None when x or ẋ is not finite, or the path is interpreted (the
+        caller's checked path then evaluates, and names what is not finite)."""
+        if not self.compiled or x.dtype.kind != "f":
+            return None
+        x_dot = np.empty(x.shape[0])
+        status = self._compiled(x, x_dot, t)
+        if status == 0:
+            self._singular(t)
+        return x_dot if status < 0 else None
+
+    def _compiled(self, x: NDArray, x_dot: NDArray, t: float) -> int:
+        """:func:`projeq.assembly.kernels.hub_beam` at (x, t) into x_dot: the hub's (θ, θ̇, θ̈) of a
+        Prescribed joint (its checked ``angles``) or the numbers of its ``relative_values``,
+        then one compiled call; its status."""
+        self.n_calls += 1
+        kind = self._kind
+        if kind == kernels.GIVEN:
+            self._given[:] = self.joint.relative_values(self._empty, self._empty, t)[:24]
+        elif kind != kernels.FIXED:
+            angles = self._angles
+            angles[0], angles[1], angles[2] = self.joint.angles(t)
+        return self._kernel(*self._head, x, *self._tail, x_dot)
+
+    def _singular(self, t: float):
+        raise SingularMassError(f"M_ee of subsystem {self.system.names[0]!r} is singular or indefinite at "
+                                f"t = {t:.6g}: the state has left the range the model describes")

@@ -54,7 +54,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.assembly import kernels
-from projeq.assembly.beam_fast import hub_beam_unsupported
+from projeq.assembly.beam_fast import elastic_unsupported, hub_beam_unsupported
 from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.subsystems.rigid import rigid_mass_matrix
@@ -243,7 +243,7 @@ def unsupported(system) -> str | None:
     """Why the fast kernel cannot evaluate ``system`` (None if it can)."""
     for n, (name, joint, body) in enumerate(zip(system.names, system.joints, system.subsystems)):
         if body.n_e:
-            reason = _elastic_unsupported(body)
+            reason = elastic_unsupported(body)
             if reason:
                 return f"subsystem {name!r} is a {type(body).__name__} {reason}"
             if system.forces or system.coupled:
@@ -254,17 +254,6 @@ def unsupported(system) -> str | None:
                     "rigid_inertia, spatial or selected by S, and of RitzBeams without rotary inertia)")
         if system.plan.port[n] and not hasattr(system.plan.stations[n], "field"):
             return f"joint {name!r} sits on a port of {type(system.subsystems[system.parent[n]]).__name__} without a field"
-    return None
-
-
-def _elastic_unsupported(body) -> str | None:
-    """Why the kernel's elastic block (:func:`projeq.assembly.kernels.elastic_body`) cannot take
-    ``body`` (None if it can): it takes bodies with ẏ = (twist, q̇_e) whose terms are the slice
-    sums of their ``slice_field`` with linear restoring forces (a RitzBeam without rotary inertia)."""
-    if not hasattr(body, "slice_field") or body.S is None or not np.array_equal(body.S, np.eye(6 + body.n_e, 6)):
-        return "(the kernel knows elastic bodies by the slice field of a RitzBeam)"
-    if body.rotary is not None:
-        return "with rotary inertia or torsion (the kernel's elastic block has the slices' translation only)"
     return None
 
 

@@ -202,11 +202,11 @@ def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
     n_y = 6 + k_e
     M[:n_y, :n_y] = 0.0
     h[:n_y] = 0.0
-    J, r, r_dot, Qq, c = np.zeros((3, n_y)), np.empty(3), np.empty(3), np.empty(k_e), np.empty(3)
+    J, Qq = np.zeros((3, n_y)), np.empty(k_e)
     for a in range(3):
         J[a, a] = 1.0
-    v, omega = twist[:3], twist[3:]
-    for k in range(m.shape[0]):
+    w0, w1, w2 = twist[3], twist[4], twist[5]
+    for k in range(m.shape[0]):  # scalars only: no temporaries per station
         m_k = m[k]
         quadratic, rate = 0.0, 0.0
         for i in range(k_e):
@@ -216,19 +216,27 @@ def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
                 Qqd += Q[k, i, l] * q_e_dot[l]
             quadratic += Qq[i] * q_e[i]
             rate += Qqd * q_e_dot[i]
-        for a in range(3):
-            r[a] = r0[k, a]
-            r_dot[a] = 0.0
-            for i in range(k_e):
-                J[a, 6 + i] = Psi[k, a, i] - (Qq[i] if a == 0 else 0.0)
-                r[a] += Psi[k, a, i] * q_e[i]
-                r_dot[a] += J[a, 6 + i] * q_e_dot[i]
-        r[0] -= 0.5 * quadratic
-        J[0, 4], J[0, 5], J[1, 3], J[1, 5], J[2, 3], J[2, 4] = r[2], -r[1], -r[2], r[0], r[1], -r[0]  # −r̃
-        c[:] = _cross3(omega, r_dot) + _cross3(omega, v + _cross3(omega, r) + r_dot) - g
-        c[0] -= rate
+        r0_, r1, r2, d0, d1, d2 = r0[k, 0] - 0.5 * quadratic, r0[k, 1], r0[k, 2], 0.0, 0.0, 0.0
+        for i in range(k_e):
+            J[0, 6 + i] = Psi[k, 0, i] - Qq[i]
+            J[1, 6 + i] = Psi[k, 1, i]
+            J[2, 6 + i] = Psi[k, 2, i]
+            r0_ += Psi[k, 0, i] * q_e[i]
+            r1 += Psi[k, 1, i] * q_e[i]
+            r2 += Psi[k, 2, i] * q_e[i]
+            d0 += J[0, 6 + i] * q_e_dot[i]
+            d1 += J[1, 6 + i] * q_e_dot[i]
+            d2 += J[2, 6 + i] * q_e_dot[i]
+        J[0, 4], J[0, 5], J[1, 3], J[1, 5], J[2, 3], J[2, 4] = r2, -r1, -r2, r0_, r1, -r0_  # −r̃
+        # c = ω̃ ṙ + ω̃ (v + ω̃ r + ṙ) − g = ω̃ u − g with u = v + ω̃ r + 2 ṙ
+        u0 = twist[0] + w1 * r2 - w2 * r1 + 2.0 * d0
+        u1 = twist[1] + w2 * r0_ - w0 * r2 + 2.0 * d1
+        u2 = twist[2] + w0 * r1 - w1 * r0_ + 2.0 * d2
+        c0 = w1 * u2 - w2 * u1 - g[0] - rate
+        c1 = w2 * u0 - w0 * u2 - g[1]
+        c2 = w0 * u1 - w1 * u0 - g[2]
         for a in range(n_y):
-            h[a] -= m_k * (J[0, a] * c[0] + J[1, a] * c[1] + J[2, a] * c[2])
+            h[a] -= m_k * (J[0, a] * c0 + J[1, a] * c1 + J[2, a] * c2)
             for b in range(a, n_y):
                 M[a, b] += m_k * (J[0, a] * J[0, b] + J[1, a] * J[1, b] + J[2, a] * J[2, b])
     for a in range(n_y):
@@ -237,6 +245,50 @@ def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
     for i in range(k_e):
         for l in range(k_e):
             h[6 + i] -= K_e[i, l] * (q_e[l] + damping * q_e_dot[l])
+
+
+def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, pivot_min, M, h, x_dot):
+    """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) of one elastic body on a hub whose motion is given, its
+    reference frame moving with ẏ = (w, q̇_e) and ÿ = (ζ, q̈_e) — B(14) projected on q̇_e
+    (:mod:`projeq.assembly.beam_fast`); M_n and h_n by :func:`elastic_body`, M_ee by
+    Cholesky in place. The hub: a Revolute or Prismatic ``kind`` about ``axis`` at
+    ``angles`` = (θ, θ̇, θ̈) (A_Jn by :func:`_relative_rotation`, w = F⁶ θ̇, ζ = F⁶ θ̈: a
+    Prescribed joint), FIXED (angles zero), or GIVEN: A, r, w, ζ of the joint's own
+    ``relative_values`` in ``given``. R = A_pJ A_Jn (the ground at rest), g_n = Rᵀ g.
+    The state x = (q_e, q̇_e), written: ẋ = (q̇_e, q̈_e) (q̇ = ṡ for elastic coordinates).
+    Returns −1; 0 when a pivot of M_ee is not above ``pivot_min``; 1 when x or ẋ is not
+    finite (ẋ written as far as it got)."""
+    k_e, A, w, zeta, g = x.shape[0] // 2, np.empty((3, 3)), np.zeros(6), np.zeros(6), np.zeros(3)
+    for i in range(2 * k_e):
+        if not np.isfinite(x[i]):
+            return 1
+    q_e, q_e_dot, q_e_ddot = x[:k_e], x[k_e:], x_dot[k_e:]
+    x_dot[:k_e] = q_e_dot
+    if kind == GIVEN:
+        for a in range(3):
+            for b in range(3):
+                A[a, b] = given[3 * a + b]
+        w[:] = given[12:18]
+        zeta[:] = given[18:24]
+    else:
+        _relative_rotation(kind, axis, angles[0], A)
+        first = 3 if kind == REVOLUTE else 0  # F⁶ = [0; e] or [e; 0]
+        for a in range(3 if kind != FIXED else 0):
+            w[first + a], zeta[first + a] = axis[a] * angles[1], axis[a] * angles[2]
+    for b in range(3):  # g_n = (A_pJ A_Jn)ᵀ g
+        for a in range(3):
+            g[b] += (orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]) * gravity[a]
+    elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, w, g, M, h)
+    for i in range(k_e):
+        q_e_ddot[i] = h[6 + i] - _dot6(M[6 + i], zeta)
+    M_ee = M[6:, 6:]
+    if not _cholesky(M_ee, k_e, pivot_min):
+        return 0
+    _cholesky_solve(M_ee, k_e, q_e_ddot)
+    for i in range(k_e):
+        if not np.isfinite(q_e_ddot[i]):
+            return 1
+    return -1
 
 
 def port_motion(r0, Psi, Q, slopes, offset, q_e, q_e_dot, A, r, F, zeta):
@@ -620,6 +672,20 @@ def gauss_form_kernel(compiled: bool = True):
         return gauss_form, projected_accelerations
     kernel(True)  # the same refusal without numba
     return _compiled_gauss_form()
+
+
+def hub_beam_kernel(compiled: bool = True):
+    """:func:`hub_beam`, compiled by numba (as :func:`kernel`; ValueError without it) or with
+    ``compiled=False`` the interpreted function."""
+    if not compiled:
+        return hub_beam
+    kernel(True)  # the same refusal without numba
+    return _compiled_hub_beam()[0]
+
+
+@functools.cache
+def _compiled_hub_beam():
+    return _jit(hub_beam)
 
 
 @functools.cache

@@ -178,7 +178,7 @@ def simulate(
         :class:`ValidityWarning`.
     """
     run = _Run(system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
-               evaluator, n_segments, progress, jac, options)
+               evaluator, n_segments, progress, jac, options, dense_output)
     started, stiff_warned, checked = _time.perf_counter(), False, 0  # one StiffnessWarning per run at most
     with run.stopping():
         segments = deque(zip(run.bounds[:-1], run.bounds[1:]))  # a model event splits one
@@ -195,11 +195,10 @@ def simulate(
                 run.status, run.message = segment.status, segment.message
                 break
             else:
-                run.steps += len(segment.sol.ts) - 1
                 if not stiff_warned and run.steps >= 2 * checked:  # ρ at most log₂(steps) times per run
                     checked = run.steps
-                    stiff_warned = warn_if_stiff(run.rhs, run.steps, run.t_start, b, segment.sol(b), run.method, rtol)
-                run.end_segment(segment, b)
+                    stiff_warned = warn_if_stiff(run.rhs, run.steps, run.t_start, b, run.x_end, run.method, rtol)
+                run.end_segment(b)
     result = _assemble(run, _time.perf_counter() - started, dense_output)
     if not run.out_of_range and len(result.t) and result.q.shape[1] == system.tree.n_q:
         warn_out_of_range(system.tree, result.q, result.t[-1])
@@ -225,7 +224,7 @@ class _Run:
     and what the finished segments gave (pieces, the user's events, nfev, status)."""
 
     def __init__(self, system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
-                 evaluator, n_segments, progress, jac, options):
+                 evaluator, n_segments, progress, jac, options, dense_output=False):
         check_model(system)
         q0 = system.normalized(system.check_q("q0", system.q0 if q0 is None else q0))
         s_dot0 = state_vector("s_dot0", system.s_dot0 if s_dot0 is None else s_dot0, system.n_s)
@@ -246,6 +245,7 @@ class _Run:
         self.events = _checked_events(events, t_start, q0, s_dot0)
         self.model = self.user_model = system
         self.choice, self.ev = evaluator, _evaluator(system, evaluator)
+        self.fused = getattr(self.ev, "state_derivative", None)
         system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
         self.ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
         if method is None:
@@ -256,23 +256,37 @@ class _Run:
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
         self.jac = _jac_option(method, jac)
         self.pieces, self.nfev, self.njev, self.cause, self.steps, self.calls = [], 0, 0, None, 0, 0
+        self.dense_output, self.x_end = bool(dense_output), None  # x_end: the state at the end of the last segment
         self.out_of_range = False  # warned that a subsystem left the range of its model
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
 
     def rhs(self, t: float, x: NDArray) -> NDArray:
-        """ẋ = (q̇, s̈) of the current model."""
+        """ẋ = (q̇, s̈) of the current model: by the evaluator's ``state_derivative`` where it
+        has one (ẋ in one compiled call, None when x or ẋ is not finite), else (and then) by
+        :meth:`checked_rhs`."""
         self.reached = t
+        x_dot = None if self.fused is None else self.fused(t, x)
+        if x_dot is None:
+            return self.checked_rhs(t, x)
+        self.calls += 1
+        if self.calls % MONITOR_EVERY == 0 and _may_be_singular(self.model.tree):
+            near_singularity(self.model.tree, x[: self.model.n_q], t)
+        return x_dot
+
+    def checked_rhs(self, t: float, x: NDArray) -> NDArray:
+        """ẋ = (q̇, s̈) by the model's q̇ and the evaluator's s̈, FloatingPointError when x or ẋ
+        is not finite; every ``MONITOR_EVERY`` calls the distance to a coordinate singularity."""
         n_q = self.model.n_q
         q, s_dot = x[:n_q], x[n_q:]
-        if not np.all(np.isfinite(x)):
+        if not np.isfinite(x).all():  # the ufunc and the array's own all(): half the cost of np.all
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (q = {q}, s_dot = {s_dot}): the "
                                      "solution blew up (or a tolerance too loose let it)")
         self.calls += 1
-        if self.calls % MONITOR_EVERY == 0:
+        if self.calls % MONITOR_EVERY == 0 and _may_be_singular(self.model.tree):
             near_singularity(self.model.tree, q, t)
         x_dot = np.concatenate((self.model.q_dot(q, s_dot, t), self.ev.accelerations(q, s_dot, t)))
-        if not np.all(np.isfinite(x_dot)):
+        if not np.isfinite(x_dot).all():
             raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
         return x_dot
 
@@ -285,7 +299,12 @@ class _Run:
 
     def solve(self, a: float, b: float):
         """One segment from the current state at a to b (solve_ivp's result), with the user's
-        events and, last, the model's own; its output rows are kept as a :class:`_Piece`."""
+        events and, last, the model's own; its output rows are kept as a :class:`_Piece`.
+
+        A dense solution is formed only where it is needed — the user's ``dense_output``,
+        events, the steps holding output times — because DOP853's costs three more
+        evaluations per step: without one, the state at b is an extra output time, kept
+        in ``x_end`` and not in the piece."""
         t_eval = self.t_eval
         inside = t_eval[(t_eval > a) & (t_eval <= b)] if self.pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
         n_q = self.model.n_q
@@ -293,9 +312,18 @@ class _Run:
         labels = [f"events[{i}] ({callable_name(e)})" for i, e in enumerate(self.events)]
         labels += [f"the model's event {callable_name(e)}" for e in self.model.events()]
         events = [_event_wrapper(e, n_q, label) for e, label in zip(self.events + list(self.model.events()), labels)]
-        segment = solve_ivp(self.rhs, (a, b), self.x, method=self.solver, t_eval=inside, rtol=self.rtol,
-                            atol=self.atol, events=events or None, dense_output=True, **jac, **self.options)
+        dense = self.dense_output or bool(events)
+        extra = not dense and not (len(inside) and inside[-1] == b)  # b as an output time
+        segment = solve_ivp(self.rhs, (a, b), self.x, method=_counted(self.solver, self),
+                            t_eval=np.append(inside, b) if extra else inside, rtol=self.rtol, atol=self.atol,
+                            events=events or None, dense_output=dense, **jac, **self.options)
         self.nfev += segment.nfev
+        if segment.status == 0:
+            self.x_end = segment.sol(b) if dense else segment.y[:, -1].copy()
+        if extra and segment.status == 0:
+            segment.t, segment.y = segment.t[:-1], segment.y[:, :-1]
+        if not dense:
+            segment.sol = SimpleNamespace(ts=np.array([a, self.reached if segment.status else b]))
         self._keep(segment)
         return segment
 
@@ -326,13 +354,14 @@ class _Run:
         n_q = self.model.n_q
         self.model, s_dot = self.model.after_event(x[:n_q], x[n_q:], t)
         self.x, self.ev = np.concatenate((x[:n_q], s_dot)), _evaluator(self.model, self.choice)
+        self.fused = getattr(self.ev, "state_derivative", None)
         if self.method in PROJECTED:  # the same energy, now in the new partition's s_dot
             self.solver = projected_solver(self.method, self.model, x[:n_q], s_dot, t)
         return t
 
-    def end_segment(self, segment, b: float) -> None:
+    def end_segment(self, b: float) -> None:
         """The next segment starts at b, from the state there (not at the last output time)."""
-        self.x = segment.sol(b).copy()
+        self.x = self.x_end.copy()
         n_q = self.model.n_q
         self.x[:n_q] = self.model.normalized(self.x[:n_q])
         near_singularity(self.model.tree, self.x[:n_q], b)
@@ -385,6 +414,30 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
     if rho_T > STIFF_STEPS * stability_limit("DOP853") or (decays and explicit_steps > FAST_MODE_STEPS):
         return "Radau"
     return "DOP853" if explicit_steps > FAST_MODE_STEPS else "RK45"
+
+
+def _may_be_singular(tree) -> bool:
+    """Whether a joint of ``tree`` has minimal velocities of its own, whose K(q) and F(q)
+    :func:`~projeq.constraints.nonholonomic.near_singularity` checks (a forward pass: 0.5 ms
+    on the spin-up beam, whose prescribed hub has none)."""
+    return any(joint.n_s and not joint.coupling for joint in tree.joints)
+
+
+def _counted(solver, run: _Run) -> type:
+    """``solver`` (a method name of solve_ivp or an OdeSolver class) as a subclass that adds
+    each step it takes to ``run.steps`` (solve_ivp counts steps only in a dense solution)."""
+    import scipy.integrate
+
+    base = getattr(scipy.integrate, solver) if isinstance(solver, str) else solver
+
+    class Counted(base):
+        def step(self):
+            message = super().step()
+            run.steps += self.status != "failed"
+            return message
+
+    Counted.__name__ = Counted.__qualname__ = base.__name__
+    return Counted
 
 
 def _jac_option(method, jac):

@@ -23,6 +23,8 @@ Two concerns of the numerics at the extremes (issue 7, item 4):
 
 from __future__ import annotations
 
+import functools
+
 import warnings
 
 import numpy as np
@@ -242,9 +244,14 @@ def stability_limit(method: str) -> float:
     """|x| of the explicit Runge–Kutta ``method``'s stability interval [x, 0] on the negative
     real axis: the root of |R(x)| = 1 for R(z) = 1 + z bᵀ (I − z A)⁻¹ 1 of its Butcher tableau
     (Hairer & Wanner, Solving ODEs II, §IV.2): RK23 2.51, RK45 3.31, DOP853 6.39."""
+    return _stability_interval(PROJECTED[method].__name__ if method in PROJECTED else method)
+
+
+@functools.cache  # ~1000 evaluations of R(x): once per method and process
+def _stability_interval(name: str) -> float:
     from scipy.optimize import brentq  # scipy.optimize loads where it is used (import projeq stays fast)
 
-    solver = {"RK23": RK23, "RK45": RK45, "DOP853": DOP853}[PROJECTED[method].__name__ if method in PROJECTED else method]
+    solver = {"RK23": RK23, "RK45": RK45, "DOP853": DOP853}[name]
     n = solver.n_stages
     A = np.zeros((n, n))
     A[:, : min(n, solver.A.shape[1])] = solver.A[:n, :n]

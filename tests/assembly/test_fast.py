@@ -337,6 +337,18 @@ def _tilted_hub_beam(precomputed, stiffening=True):
     return pq.System({"beam": beam}, {"beam": hub}, gravity=(0, 0, -9.81))
 
 
+def _tilted_plain_beam(inner):
+    """A beam without rotary inertia (damping, axial, gravity) on a Prescribed Revolute or
+    Prismatic about a tilted axis away from the origin (the compiled hub path's kinds)."""
+    beam = pq.RitzBeam(1.2, 1.5, 25.0, EI_y=35.0, EA=800.0, n_v=3, n_w=2, n_u=1, family="clamped_free",
+                       damping=0.02)
+    tilt = np.linalg.qr(np.random.default_rng(3).standard_normal((3, 3)))[0]
+    tilt *= np.linalg.det(tilt)
+    hub = pq.Prescribed(inner(axis=(0.3, -0.5, 0.8), r_pn=(0.1, 0.2, -0.1), orientation=tilt),
+                        lambda t: (0.4 * t**2, 0.8 * t, 0.8))
+    return pq.System({"beam": beam}, {"beam": hub}, gravity=(0, 0, -9.81))
+
+
 def _clamped_beam():
     """A beam on a Fixed joint to the ground, bent by gravity (precomputed, no rotary)."""
     beam = pq.RitzBeam(2.0, 1.0, 20.0, n_v=2, n_w=3, family="polynomial", precomputed_integrals=True)
@@ -380,6 +392,40 @@ def test_hub_beam_path_equals_recursive(build):
             for method in methods:
                 fast = system.accelerations(q, s_dot, t, method=method)
                 assert np.abs(fast - recursive).max() <= 1e-10 * max(1.0, np.abs(recursive).max())
+
+
+@pytest.mark.parametrize(
+    "build",
+    [lambda: pq.scenes.spin_up_beam(omega_s=4.0), lambda: _tilted_hub_beam(True), _clamped_beam,
+     lambda: pq.scenes.spin_up_beam(omega_s=4.0, n_shapes=3, n_axial=2, gravity=9.81, precomputed_integrals=True),
+     lambda: _tilted_plain_beam(pq.Revolute), lambda: _tilted_plain_beam(pq.Prismatic)],
+    ids=["spin-up", "tilted hub rotary", "fixed root", "spin-up axial, gravity", "tilted revolute", "tilted prismatic"],
+)
+def test_hub_beam_compiled_equals_interpreted(build):
+    """The compiled hub path (projeq/assembly/kernels.py hub_beam: the elastic block's slice
+    sums, M_ee by Cholesky) equals the interpreted one (the beam's elastic_terms by its
+    integration strategy, numpy's solve) to round-off, and its ẋ in one call
+    (``state_derivative``, what simulate calls) is (ṡ, s̈) of ``accelerations``; a beam with
+    rotary inertia is interpreted, and "auto" says so once, naming the piece."""
+    system = build()
+    compiled, interpreted = HubBeamEvaluator(system), HubBeamEvaluator(system, compiled=False)
+    if system.subsystems[0].rotary is not None:
+        assert not compiled.compiled and "rotary inertia" in compiled.interpreted_reason
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            AutoEvaluator(system)
+        assert [type(w.message) for w in said] == [InterpretedWarning] and "rotary inertia" in str(said[0].message)
+        return
+    assert compiled.compiled and not interpreted.compiled
+    rng = np.random.default_rng(11)
+    for t in (0.3, 2.0, 17.0):
+        q, s_dot = 0.05 * rng.standard_normal(system.n_q), rng.standard_normal(system.n_s)
+        reference = interpreted.accelerations(q, s_dot, t)
+        fast = compiled.accelerations(q, s_dot, t)
+        assert np.abs(fast - reference).max() <= 1e-10 * max(1.0, np.abs(reference).max())
+        x_dot = compiled.state_derivative(t, np.concatenate((q, s_dot)))
+        np.testing.assert_array_equal(x_dot, np.concatenate((s_dot, fast)))
+    assert compiled.state_derivative(0.0, np.full(2 * system.n_s, np.nan)) is None  # the driver's checks name it
 
 
 def test_hub_beam_evaluator_refuses_other_systems():
