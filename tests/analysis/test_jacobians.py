@@ -99,6 +99,16 @@ def test_elastic_beam_on_a_hub(precomputed):
     _check_against_differences(system, q, rng.uniform(-1, 1, system.n_s), 0.2)
 
 
+def test_beam_in_a_chain():
+    """The flexible arm (scenes.flexible_arm: a RitzBeam with a tip mass as the third of three
+    links, gravity), bent and moving: the Jacobian the implicit methods get
+    (simulate(..., jac="exact")) against differences, its elastic rows up to ω² ≈ 1e7 1/s²."""
+    system = pq.scenes.flexible_arm()
+    rng = np.random.default_rng(11)
+    q = system.q0 + np.r_[0.0, 0.0, 0.0, 0.01 * rng.uniform(-1, 1, system.n_q - 3)]
+    _check_against_differences(system, q, rng.uniform(-1, 1, system.n_s), 0.0)
+
+
 @pytest.mark.parametrize("scene", ["n_four_bar", "bricard"])
 def test_tangent_system_scenes(scene):
     """TangentSystem (F from the SVD's null space, carried through the complex step by a Newton
