@@ -70,6 +70,7 @@ import scipy.linalg
 from numpy.typing import NDArray
 
 from projeq.assembly.linalg import solve_spd
+from projeq.constraints.batched import batched_closure
 from projeq.checks import positive, state_vector
 from projeq.analysis.differentiation import (derivative_along, derivative_along_differences, is_complex_safe,
                                              second_derivative_along, second_derivative_along_differences)
@@ -164,6 +165,8 @@ class ConstrainedSystem(Model):
             self._constraint_rows("b", b, (q0, 0.0), 1, self.m_p)
         self.n_c = self.n_lambda = self.m_h + self.m_p
         self.exact = self._choose_derivatives(q0)
+        self._closure = batched_closure(phi, self.n_q, np.append(q0, 0.0), self.m_h) if self.exact and self.m_h \
+            else None  # Φ's derivatives from one call at a batch of points (projeq.constraints.batched)
         if correction == "projection" and self.m_h and any(  # simulate normalises q without the time
                 not np.allclose(self.phi(q0, t), self.phi(q0, 0.0), rtol=0, atol=1e-14) for t in (0.37, 1.9)):
             raise ValueError("correction: 'projection' needs Φ independent of t (q is normalised without the "
@@ -212,16 +215,25 @@ class ConstrainedSystem(Model):
 
     def phi_q(self, q: NDArray, t: float = 0.0) -> NDArray:
         """∂Φ/∂q (m_h × n_q), column i = Φ′ along e_i (module docstring)."""
-        x, unit = np.append(q, t), np.eye(self.n_q + 1)
-        columns = [self._d1(self._phi_x, x, unit[i]) for i in range(self.n_q)]
-        return np.array(columns).T.reshape(self.m_h, self.n_q)
+        return self._phi_derivatives(q, t)[0]
+
+    def _phi_derivatives(self, q: NDArray, t: float) -> tuple[NDArray, NDArray]:
+        """(∂Φ/∂q, ∂Φ/∂t): column j of Φ_x = Φ′ along e_j at x = (q, t), all from one call at a
+        batch of points where Φ takes them (:mod:`projeq.constraints.batched`, real arguments)."""
+        x = np.append(q, t)
+        if not self.m_h:
+            return np.zeros((0, self.n_q)), np.zeros(0)
+        if self._closure is not None and not np.iscomplexobj(x):
+            Phi_x = self._closure.jacobian(x)
+        else:
+            Phi_x = np.array([self._d1(self._phi_x, x, e) for e in np.eye(self.n_q + 1)]).T.reshape(self.m_h, -1)
+        return Phi_x[:, :-1], Phi_x[:, -1]
 
     def velocity_constraints(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """(C, c) of C q̇ = c: C = [∂Φ/∂q; A], c = [−∂Φ/∂t; b]."""
         A, b = self._pfaffian(q, t)
-        time = np.eye(self.n_q + 1)[-1]
-        phi_t = self._d1(self._phi_x, np.append(q, t), time) if self.m_h else np.zeros(0)
-        return np.vstack((self.phi_q(q, t), A)), np.concatenate((-phi_t, b))
+        Phi_q, Phi_t = self._phi_derivatives(q, t)
+        return np.vstack((Phi_q, A)), np.concatenate((-Phi_t, b))
 
     def constraint_residual(self, q: NDArray, q_dot: NDArray, t: float = 0.0) -> NDArray:
         """(Φ(q, t), A q̇ − b): loop closures at position level, Pfaffian ones at velocity level."""
@@ -497,13 +509,20 @@ class ConstrainedSystem(Model):
         C = self.velocity_constraints(q, t)[0] if C is None else C
         parts = []
         if self.m_h:
-            v_q, v_t = np.append(q_dot, 0.0), np.eye(len(x))[-1]
-            parts.append(self._d2(self._phi_x, x, v_q, v_q) + 2 * self._d2(self._phi_x, x, v_q, v_t)
-                         + self._d2(self._phi_x, x, v_t, v_t))
+            parts.append(self._phi_second(x, q_dot))
         if self.m_p:
             parts.append(self._d1(lambda y: _pfaffian_residual(self, (y[:n], y[n]), y[n + 1:]), np.append(x, q_dot),
                                   np.append(v, np.zeros(n))))
         return np.concatenate(parts) + C @ q_ddot
+
+    def _phi_second(self, x: NDArray, q_dot: NDArray) -> NDArray:
+        """Φ″(v, v) = Φ″(v_q, v_q) + 2 Φ″(v_q, v_t) + Φ″(v_t, v_t) at x = (q, t), v_q = (q̇, 0),
+        v_t = (0, 1) (:meth:`gamma`), by one call at a batch of points where Φ takes them."""
+        if self._closure is not None and not (np.iscomplexobj(x) or np.iscomplexobj(q_dot)):
+            return self._closure.second(x, q_dot)
+        v_q, v_t = np.append(q_dot, 0.0), np.eye(len(x))[-1]
+        return (self._d2(self._phi_x, x, v_q, v_q) + 2 * self._d2(self._phi_x, x, v_q, v_t)
+                + self._d2(self._phi_x, x, v_t, v_t))
 
     def _projected(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
         """(A_s, F, f̄, M, b) at (q, ṡ, t): ṡ_tree = F ṡ + f, s̈_tree = F s̈ + f̄, and the tree's
