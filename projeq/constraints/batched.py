@@ -74,25 +74,30 @@ class BatchedClosure:
     """Φ_x and Φ″(v, v) of ``phi(q, t)`` (n coordinates) by the complex step on batches of points
     (module docstring); real arguments only."""
 
-    def __init__(self, phi, n: int):
-        self.phi, self.n = phi, n
+    def __init__(self, phi, n: int, m: int):
+        self.phi, self.n, self.m = phi, n, m
+        self._unit = np.eye(n + 1)
 
     def _im(self, X: NDArray) -> NDArray:
         """Im Φ / h at the columns of X ((n + 1) × B complex)."""
         return np.imag(np.asarray(self.phi(X[:-1], X[-1]))) / COMPLEX_STEP
 
-    def jacobian(self, x: NDArray) -> NDArray:
-        """Φ_x = [∂Φ/∂q, ∂Φ/∂t] at x = (q, t): one call at the n + 1 points x + i h e_j."""
-        return self._im(x[:, None] + 1j * COMPLEX_STEP * np.eye(self.n + 1))
+    def jacobian(self, x: NDArray, columns: int) -> NDArray:
+        """The first ``columns`` columns of Φ_x = [∂Φ/∂q, ∂Φ/∂t] at x = (q, t): one call at the
+        points x + i h e_j."""
+        return self._im(x[:, None] + 1j * COMPLEX_STEP * self._unit[:, :columns])
 
-    def second(self, x: NDArray, q_dot: NDArray) -> NDArray:
-        """Φ″(v, v) = Φ″(v_q, v_q) + 2 Φ″(v_q, v_t) + Φ″(v_t, v_t), v_q = (q̇, 0), v_t = (0, 1):
-        each part keeps its own relative accuracy (the first ∝ |q̇|², the rheonomic ones not);
-        one call at the 6 stencil points of each part."""
-        v_q, v_t = np.append(q_dot, 0.0), np.eye(self.n + 1)[-1]
+    def second(self, x: NDArray, q_dot: NDArray, rheonomic: bool) -> NDArray:
+        """Φ″(v, v) = Φ″(v_q, v_q) + 2 Φ″(v_q, v_t) + Φ″(v_t, v_t), v_q = (q̇, 0), v_t = (0, 1)
+        (the rheonomic parts only if ``rheonomic``): each part keeps its own relative accuracy
+        (the first ∝ |q̇|², the rheonomic ones not); one call at the 6 stencil points of each part."""
+        v_q, v_t = np.append(q_dot, 0.0), self._unit[-1]
         speed = float(np.linalg.norm(v_q))
-        pairs = [(v_t, v_t, 1.0)] + ([(v_q / speed, v_q / speed, speed * speed), (v_q / speed, v_t, 2 * speed)]
-                                     if speed else [])
+        pairs = ([(v_t, v_t, 1.0)] if rheonomic else []) + (
+            [(v_q / speed, v_q / speed, speed * speed)] + ([(v_q / speed, v_t, 2 * speed)] if rheonomic else [])
+            if speed else [])
+        if not pairs:
+            return np.zeros(self.m)
         X = np.concatenate([x[:, None] + np.outer(u, NODES) + 1j * COMPLEX_STEP * w[:, None] for u, w, _ in pairs],
                            axis=1)
         im = self._im(X).reshape(-1, len(pairs), len(NODES))
@@ -103,7 +108,7 @@ def batched_closure(phi, n: int, x0: NDArray, m: int) -> BatchedClosure | None:
     """A :class:`BatchedClosure` of ``phi`` if it takes batches (:func:`takes_batches`), else
     None after one :class:`PointwiseWarning` naming it."""
     if takes_batches(phi, n, x0, m):
-        return BatchedClosure(phi, n)
+        return BatchedClosure(phi, n, m)
     warnings.warn(
         f"phi: {getattr(phi, '__qualname__', repr(phi))} does not evaluate a batch of points (q of shape "
         "(n_q, B), t of shape (B,), values (m, B)); its derivatives take one call per stencil point "

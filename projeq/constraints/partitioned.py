@@ -158,6 +158,8 @@ class ConstrainedSystem(Model):
         self.tree, self._phi, self._A, self._b = system, phi, A, b
         self.correction, self.beta = correction, positive("beta", beta)
         self.names, self.subsystems, self.n_q = system.names, system.subsystems, system.n_q
+        # q̇ = ṡ_tree for every joint (revolute, prismatic, elastic coordinates): K = E, k = 0, K̇ = 0
+        self._identity = len(system._identity_q) == system.n_q == system.n_s
         q0 = system.check_q("q0", system.q0 if q0 is None else q0)
         self.m_h = self._constraint_rows("phi", phi, (q0, 0.0), 1)
         self.m_p = self._constraint_rows("A", A, (q0, 0.0), 2)
@@ -171,6 +173,7 @@ class ConstrainedSystem(Model):
                 not np.allclose(self.phi(q0, t), self.phi(q0, 0.0), rtol=0, atol=1e-14) for t in (0.37, 1.9)):
             raise ValueError("correction: 'projection' needs Φ independent of t (q is normalised without the "
                              "time); use correction='baumgarte' for rheonomic constraints")
+        self.rheonomic = correction != "projection"  # else Φ(q) alone: ∂Φ/∂t and its derivatives are 0
         self._choose_velocities(q0, independent, repivot)
         self.q0 = self._initial_q(q0, project_q0)
         self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
@@ -223,11 +226,12 @@ class ConstrainedSystem(Model):
         x = np.append(q, t)
         if not self.m_h:
             return np.zeros((0, self.n_q)), np.zeros(0)
+        n = self.n_q + self.rheonomic  # the columns along q, and along t if Φ depends on it
         if self._closure is not None and not np.iscomplexobj(x):
-            Phi_x = self._closure.jacobian(x)
+            Phi_x = self._closure.jacobian(x, n)
         else:
-            Phi_x = np.array([self._d1(self._phi_x, x, e) for e in np.eye(self.n_q + 1)]).T.reshape(self.m_h, -1)
-        return Phi_x[:, :-1], Phi_x[:, -1]
+            Phi_x = np.array([self._d1(self._phi_x, x, e) for e in np.eye(self.n_q + 1)[:n]]).T.reshape(self.m_h, n)
+        return Phi_x[:, :self.n_q], (Phi_x[:, -1] if self.rheonomic else np.zeros(self.m_h, dtype=Phi_x.dtype))
 
     def velocity_constraints(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """(C, c) of C q̇ = c: C = [∂Φ/∂q; A], c = [−∂Φ/∂t; b]."""
@@ -250,8 +254,13 @@ class ConstrainedSystem(Model):
         self.limit = max(REPIVOT_CONDITION, 10 * self.condition(q0))
 
     def constraint_matrix(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
-        """(A_s, b_s) of A_s ṡ_tree = b_s: A_s = C K, b_s = c − C k."""
-        C, c = self.velocity_constraints(q, t)
+        """(A_s, b_s) of A_s ṡ_tree = b_s: A_s = C K, b_s = c − C k (C, c themselves where K = E, k = 0)."""
+        return self._in_tree_velocities(q, t, *self.velocity_constraints(q, t))
+
+    def _in_tree_velocities(self, q: NDArray, t: float, C: NDArray, c: NDArray) -> tuple[NDArray, NDArray]:
+        """(A_s, b_s) = (C K, c − C k) from (C, c) at (q, t)."""
+        if self._identity:
+            return C, c
         return C @ self.tree.K(q, t), c - C @ self.tree.q_dot(q, np.zeros(self.tree.n_s), t)
 
     def _check_rank(self, q0) -> None:
@@ -503,9 +512,6 @@ class ConstrainedSystem(Model):
         tree, n = self.tree, self.n_q
         q_dot = tree.q_dot(q, s_dot_tree, t)
         x, v = np.append(q, t), np.append(q_dot, 1.0)
-        # frozen arguments ride along in the point with zero rate (they may carry an outer complex step)
-        q_ddot = derivative_along(lambda y: tree.q_dot(y[:n], y[n + 1:], y[n]), np.append(x, s_dot_tree),
-                                  np.append(v, np.zeros(tree.n_s)))  # K̇ ṡ + k̇
         C = self.velocity_constraints(q, t)[0] if C is None else C
         parts = []
         if self.m_h:
@@ -513,24 +519,31 @@ class ConstrainedSystem(Model):
         if self.m_p:
             parts.append(self._d1(lambda y: _pfaffian_residual(self, (y[:n], y[n]), y[n + 1:]), np.append(x, q_dot),
                                   np.append(v, np.zeros(n))))
+        if self._identity:  # K = E: K̇ ṡ + k̇ = 0
+            return np.concatenate(parts)
+        # frozen arguments ride along in the point with zero rate (they may carry an outer complex step)
+        q_ddot = derivative_along(lambda y: tree.q_dot(y[:n], y[n + 1:], y[n]), np.append(x, s_dot_tree),
+                                  np.append(v, np.zeros(tree.n_s)))  # K̇ ṡ + k̇
         return np.concatenate(parts) + C @ q_ddot
 
     def _phi_second(self, x: NDArray, q_dot: NDArray) -> NDArray:
         """Φ″(v, v) = Φ″(v_q, v_q) + 2 Φ″(v_q, v_t) + Φ″(v_t, v_t) at x = (q, t), v_q = (q̇, 0),
-        v_t = (0, 1) (:meth:`gamma`), by one call at a batch of points where Φ takes them."""
+        v_t = (0, 1) (:meth:`gamma`; the rheonomic parts only where Φ depends on t), by one call
+        at a batch of points where Φ takes them."""
         if self._closure is not None and not (np.iscomplexobj(x) or np.iscomplexobj(q_dot)):
-            return self._closure.second(x, q_dot)
+            return self._closure.second(x, q_dot, self.rheonomic)
         v_q, v_t = np.append(q_dot, 0.0), np.eye(len(x))[-1]
-        return (self._d2(self._phi_x, x, v_q, v_q) + 2 * self._d2(self._phi_x, x, v_q, v_t)
-                + self._d2(self._phi_x, x, v_t, v_t))
+        value = self._d2(self._phi_x, x, v_q, v_q)
+        if self.rheonomic:
+            value = value + 2 * self._d2(self._phi_x, x, v_q, v_t) + self._d2(self._phi_x, x, v_t, v_t)
+        return value
 
     def _projected(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
         """(A_s, F, f̄, M, b) at (q, ṡ, t): ṡ_tree = F ṡ + f, s̈_tree = F s̈ + f̄, and the tree's
         Gauss form M s̈_tree + b at ṡ_tree (b by the tree evaluator ``method``, module docstring)."""
         C, c = self.velocity_constraints(q, t)
-        K, k = self.tree.K(q, t), self.tree.q_dot(q, np.zeros(self.tree.n_s), t)
-        A_s = C @ K
-        F, f = self.F(q, t, (A_s, c - C @ k))
+        A_s, b_s = self._in_tree_velocities(q, t, C, c)
+        F, f = self.F(q, t, (A_s, b_s))
         s_dot_tree = F @ s_dot + f
         M, b = self.tree_gauss_form(q, s_dot_tree, t, method)
         f_bar = np.zeros(self.tree.n_s, dtype=np.result_type(A_s, M, b))
@@ -568,15 +581,19 @@ class ConstrainedSystem(Model):
         """(s̈_tree, λ): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0, and the
         multipliers λ of M s̈_tree + b = A_sᵀ λ (the constraint forces); ``method`` picks
         the tree's evaluator (module docstring; None: compiled where the tree is)."""
-        A_s, F, f_bar, M, b = self._projected(q, s_dot, t, method)
-        M_min, b_min = _minimal(F, f_bar, M, b)
-        s_ddot = -solve_spd(M_min, b_min[:, None], "constrained mass matrix FᵀMF",
-                            max(np.abs(np.diag(M_min)).max(initial=0.0), 1e-300))[:, 0]
-        s_ddot_tree = F @ s_ddot + f_bar
+        s_ddot_tree, A_s, M, b = self._tree_accelerations(q, s_dot, t, method)
         lam = np.zeros(0)
         if self.n_c:  # the minimum-norm λ where rows are redundant
             lam = np.linalg.lstsq(A_s.T, M @ s_ddot_tree + b, rcond=RANK_TOLERANCE)[0]
         return s_ddot_tree, lam
+
+    def _tree_accelerations(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
+        """(s̈_tree, A_s, M, b): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0."""
+        A_s, F, f_bar, M, b = self._projected(q, s_dot, t, method)
+        M_min, b_min = _minimal(F, f_bar, M, b)
+        s_ddot = -solve_spd(M_min, b_min[:, None], "constrained mass matrix FᵀMF",
+                            max(np.abs(np.diag(M_min)).max(initial=0.0), 1e-300))[:, 0]
+        return F @ s_ddot + f_bar, A_s, M, b
 
     def evaluator(self, method: str | None = None) -> "PartitionedEvaluator":
         """s̈ with the tree evaluator ``method`` (None: compiled where the tree is, module
@@ -608,9 +625,13 @@ class PartitionedEvaluator:
                        f"{'compiled kernels' if compiled else 'dense reference'}"
                        + (f", b from the {method!r} evaluator" if method not in (None, "dense") else ""))
         self.system, self.method = system, method
+        # the motion needs no multipliers: s̈_tree without λ's least squares, unless a subclass
+        # forms s̈_tree and λ together (the augmented Lagrangian)
+        partitioned = type(system).accelerations_tree is ConstrainedSystem.accelerations_tree
+        self._tree = system._tree_accelerations if partitioned else system.accelerations_tree
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        return self.system.accelerations_tree(q, s_dot, t, self.method)[0][self.system.independent]
+        return self._tree(q, s_dot, t, self.method)[0][self.system.independent]
 
 
 def _minimal(F: NDArray, f_bar: NDArray, M: NDArray, b: NDArray) -> tuple[NDArray, NDArray]:
@@ -629,7 +650,7 @@ def _partition_condition(A_s: NDArray, dependent: NDArray) -> float:
     if not A_s.size:
         return 1.0
     sigma = np.linalg.svd(A_s[:, dependent], compute_uv=False)
-    return float(np.linalg.norm(A_s, 2) / sigma[-1]) if sigma[-1] > 0 else np.inf
+    return float(np.linalg.svd(A_s, compute_uv=False)[0] / sigma[-1]) if sigma[-1] > 0 else np.inf
 
 
 def independent_indices(independent, count: int, n_tree: int, why: str) -> NDArray:
