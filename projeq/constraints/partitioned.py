@@ -362,6 +362,7 @@ class ConstrainedSystem(Model):
         """A copy with the partition ``independent`` (unchecked), starting at q."""
         new = copy.copy(self)
         new.independent, new.dependent = independent, np.setdiff1d(np.arange(self.tree.n_s), independent)
+        new._inverse = (None, None)  # A_dep⁻¹ of the old partition
         new.q0 = np.array(q, dtype=float)
         new.limit = max(REPIVOT_CONDITION, 10 * new.condition(q, t))
         return new
@@ -418,15 +419,35 @@ class ConstrainedSystem(Model):
         F[self.independent] = np.eye(self.n_s)
         f = np.zeros(self.tree.n_s, dtype=F.dtype)
         if self.n_c:
-            self._check_dependent(A_s, q, t)  # the partition degenerates during a run
-            solved = np.linalg.solve(A_s[:, self.dependent], np.column_stack((A_s[:, self.independent], b_s)))
-            F[self.dependent], f[self.dependent] = -solved[:, :-1], solved[:, -1]
+            inverse = self._dependent_inverse(A_s, q, t)  # checked: the partition degenerates during a run
+            F[self.dependent], f[self.dependent] = -inverse @ A_s[:, self.independent], inverse @ b_s
         return F, f
+
+    def _dependent_inverse(self, A_s: NDArray, q: NDArray, t: float) -> NDArray:
+        """A_dep⁻¹, kept for this A_s (F, f and f̄ of one state share it); ValueError where the
+        partition's condition number κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ reaches PARTITION_CONDITION. The
+        Frobenius norms bound κ from above (‖·‖₂ ≤ ‖·‖_F), so κ itself (two SVDs) is computed
+        only where that bound reaches the limit."""
+        if self._inverse[0] is A_s:
+            return self._inverse[1]
+        try:
+            inverse = np.linalg.inv(A_s[:, self.dependent])
+        except np.linalg.LinAlgError:
+            inverse = np.full((self.n_c, self.n_c), np.inf)
+        if not np.linalg.norm(np.real(A_s)) * np.linalg.norm(np.real(inverse)) < PARTITION_CONDITION:
+            self._check_dependent(A_s, q, t)
+        self._inverse = (A_s, inverse)
+        return inverse
+
+    _inverse = (None, None)  # (A_s, A_dep⁻¹) of the latest F
 
     def particular(self, A_s: NDArray, c: NDArray) -> NDArray:
         """The solution x of A_s x = c with x[independent] = 0: [0; A_dep⁻¹ c]."""
         x = np.zeros(self.tree.n_s, dtype=np.result_type(A_s, c))  # complex under the complex step
-        x[self.dependent] = np.linalg.solve(A_s[:, self.dependent], c)
+        if self._inverse[0] is A_s:
+            x[self.dependent] = self._inverse[1] @ c
+        else:
+            x[self.dependent] = np.linalg.solve(A_s[:, self.dependent], c)
         return x
 
     def tree_velocities(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
