@@ -699,14 +699,30 @@ def minimum_norm_solution(A: NDArray, c: NDArray, rcond: float = RANK_TOLERANCE,
     A0 = np.real(A)
     if not A0.size:
         return np.zeros(A0.shape[1:] + np.shape(c)[1:], dtype=np.result_type(A, c))
-    U, sigma, Vt = np.linalg.svd(A0, full_matrices=False)
-    k = min(int(np.count_nonzero(sigma > rcond * sigma[0])), len(sigma) if rank is None else rank)
-    P = Vt[:k].T @ (U[:, :k].T / sigma[:k, None])  # A₀⁺
+    P = _pseudo_inverse(A0, rcond, rank)
     if not (np.iscomplexobj(A) or np.iscomplexobj(c)):
         return P @ c
     dA = A - A0
     dP = -P @ dA @ P + P @ P.T @ dA.T @ (np.eye(len(A0)) - A0 @ P) + (np.eye(A0.shape[1]) - P @ A0) @ dA.T @ P.T @ P
     return (P + dP) @ c
+
+
+_LATEST_PSEUDO_INVERSE = (None, None)  # (key, A₀⁺) of the latest _pseudo_inverse: f and f̄ of one state share A_s
+
+
+def _pseudo_inverse(A0: NDArray, rcond: float, rank: int | None) -> NDArray:
+    """A₀⁺ over the singular values of the real A₀ above ``rcond`` σ_max (at most ``rank`` of
+    them), kept for the latest (A₀, rcond, rank)."""
+    global _LATEST_PSEUDO_INVERSE
+    key = (A0.shape, A0.tobytes(), rcond, rank)
+    latest = _LATEST_PSEUDO_INVERSE  # one read: another thread may replace it
+    if latest[0] == key:
+        return latest[1]
+    U, sigma, Vt = np.linalg.svd(A0, full_matrices=False)
+    k = min(int(np.count_nonzero(sigma > rcond * sigma[0])), len(sigma) if rank is None else rank)
+    P = Vt[:k].T @ (U[:, :k].T / sigma[:k, None])
+    _LATEST_PSEUDO_INVERSE = (key, P)
+    return P
 
 
 def numerical_rank(A: NDArray) -> int:
