@@ -21,7 +21,12 @@ round-off, if the callables take complex arguments (numpy functions do; ``exact`
 else by a sixth-order central stencil. The second derivative in γ is the complex step inside a
 sixth-order stencil on normalised directions, ≈ 1e-14 relative whatever the speed
 (:meth:`~ConstrainedSystem.gamma`; issue 16: fixed-step differences lost the accuracy of slow
-motions, 6e-3 relative at 1/1000 of the four-bar's rates). Position drift of the loop closures Φ = 0 is corrected either by a
+motions, 6e-3 relative at 1/1000 of the four-bar's rates). A Φ written with numpy operations on the
+rows q[i] is evaluated at all points of a stencil in one call (:mod:`projeq.constraints.batched`,
+the same stencils; checked once at q0, else point by point after a warning naming Φ); under
+``correction="projection"`` Φ is independent of t (checked at q0), so ∂Φ/∂t and the rheonomic parts of
+Φ″ are not evaluated, and where every tree joint has q̇ = ṡ_tree (K = E) neither are K, k nor K̇.
+Position drift of the loop closures Φ = 0 is corrected either by a
 Gauss–Newton projection of q onto Φ = 0 wherever :func:`projeq.simulate` normalises q
 (segment ends and outputs; ``correction="projection"``, the default) or by Baumgarte's
 first-order stabilisation q̇ += −β C_Φ⁺ Φ (``correction="baumgarte"``), or not at all
