@@ -433,8 +433,9 @@ class ConstrainedSystem(Model):
         partition's condition number κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ reaches PARTITION_CONDITION. The
         Frobenius norms bound κ from above (‖·‖₂ ≤ ‖·‖_F), so κ itself (two SVDs) is computed
         only where that bound reaches the limit."""
-        if self._inverse[0] is A_s:
-            return self._inverse[1]
+        kept, inverse = self._inverse  # one read: another thread may replace it
+        if kept is A_s:
+            return inverse
         try:
             inverse = np.linalg.inv(A_s[:, self.dependent])
         except np.linalg.LinAlgError:
@@ -449,8 +450,9 @@ class ConstrainedSystem(Model):
     def particular(self, A_s: NDArray, c: NDArray) -> NDArray:
         """The solution x of A_s x = c with x[independent] = 0: [0; A_dep⁻¹ c]."""
         x = np.zeros(self.tree.n_s, dtype=np.result_type(A_s, c))  # complex under the complex step
-        if self._inverse[0] is A_s:
-            x[self.dependent] = self._inverse[1] @ c
+        kept, inverse = self._inverse  # one read: another thread may replace it
+        if kept is A_s:
+            x[self.dependent] = inverse @ c
         else:
             x[self.dependent] = np.linalg.solve(A_s[:, self.dependent], c)
         return x
