@@ -54,7 +54,7 @@ def takes_batches(f, n: int, x0: NDArray, m: int) -> bool:
     as B points: at three complex points about x0 = (q0, t0) its (m × B) values equal, real and
     imaginary parts each to 1e-13 relative, those of one call per point."""
     rng = np.random.default_rng(7)
-    X = x0[:, None] + 0.1 * rng.standard_normal((n + 1, 3)) + 1j * COMPLEX_STEP * rng.standard_normal((n + 1, 3))
+    X = x0[:, None] + 1e-2 * rng.standard_normal((n + 1, 3)) + 1j * COMPLEX_STEP * rng.standard_normal((n + 1, 3))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         try:
