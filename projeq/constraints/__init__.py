@@ -5,6 +5,7 @@
   singular positions, redundant constraints taken as they are);
 - :mod:`.augmented`: :class:`AugmentedSystem`, the augmented Lagrangian formulation (the alternative);
 - :mod:`.cut_joints`: cut joints of closed loops (:class:`PinClosure`);
+- :mod:`.batched`: the loop closures' derivatives from one call at a batch of points;
 - :mod:`.reactions`: reaction forces and the contact event;
 - :mod:`.nonholonomic`: checks of non-holonomic quasi-velocities (singular K, constraint drift).
 """

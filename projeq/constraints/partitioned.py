@@ -21,7 +21,12 @@ round-off, if the callables take complex arguments (numpy functions do; ``exact`
 else by a sixth-order central stencil. The second derivative in γ is the complex step inside a
 sixth-order stencil on normalised directions, ≈ 1e-14 relative whatever the speed
 (:meth:`~ConstrainedSystem.gamma`; issue 16: fixed-step differences lost the accuracy of slow
-motions, 6e-3 relative at 1/1000 of the four-bar's rates). Position drift of the loop closures Φ = 0 is corrected either by a
+motions, 6e-3 relative at 1/1000 of the four-bar's rates). A Φ written with numpy operations on the
+rows q[i] is evaluated at all points of a stencil in one call (:mod:`projeq.constraints.batched`,
+the same stencils; checked once at q0, else point by point after a warning naming Φ); under
+``correction="projection"`` Φ is independent of t (checked at q0), so ∂Φ/∂t and the rheonomic parts of
+Φ″ are not evaluated, and where every tree joint has q̇ = ṡ_tree (K = E) neither are K, k nor K̇.
+Position drift of the loop closures Φ = 0 is corrected either by a
 Gauss–Newton projection of q onto Φ = 0 wherever :func:`projeq.simulate` normalises q
 (segment ends and outputs; ``correction="projection"``, the default) or by Baumgarte's
 first-order stabilisation q̇ += −β C_Φ⁺ Φ (``correction="baumgarte"``), or not at all
@@ -70,6 +75,7 @@ import scipy.linalg
 from numpy.typing import NDArray
 
 from projeq.assembly.linalg import solve_spd
+from projeq.constraints.batched import batched_closure
 from projeq.checks import positive, state_vector
 from projeq.analysis.differentiation import (derivative_along, derivative_along_differences, is_complex_safe,
                                              second_derivative_along, second_derivative_along_differences)
@@ -157,6 +163,8 @@ class ConstrainedSystem(Model):
         self.tree, self._phi, self._A, self._b = system, phi, A, b
         self.correction, self.beta = correction, positive("beta", beta)
         self.names, self.subsystems, self.n_q = system.names, system.subsystems, system.n_q
+        # q̇ = ṡ_tree for every joint (revolute, prismatic, elastic coordinates): K = E, k = 0, K̇ = 0
+        self._identity = len(system._identity_q) == system.n_q == system.n_s
         q0 = system.check_q("q0", system.q0 if q0 is None else q0)
         self.m_h = self._constraint_rows("phi", phi, (q0, 0.0), 1)
         self.m_p = self._constraint_rows("A", A, (q0, 0.0), 2)
@@ -164,10 +172,13 @@ class ConstrainedSystem(Model):
             self._constraint_rows("b", b, (q0, 0.0), 1, self.m_p)
         self.n_c = self.n_lambda = self.m_h + self.m_p
         self.exact = self._choose_derivatives(q0)
+        self._closure = batched_closure(phi, self.n_q, np.append(q0, 0.0), self.m_h) if self.exact and self.m_h \
+            else None  # Φ's derivatives from one call at a batch of points (projeq.constraints.batched)
         if correction == "projection" and self.m_h and any(  # simulate normalises q without the time
                 not np.allclose(self.phi(q0, t), self.phi(q0, 0.0), rtol=0, atol=1e-14) for t in (0.37, 1.9)):
             raise ValueError("correction: 'projection' needs Φ independent of t (q is normalised without the "
                              "time); use correction='baumgarte' for rheonomic constraints")
+        self.rheonomic = correction != "projection"  # else Φ(q) alone: ∂Φ/∂t and its derivatives are 0
         self._choose_velocities(q0, independent, repivot)
         self.q0 = self._initial_q(q0, project_q0)
         self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
@@ -212,16 +223,26 @@ class ConstrainedSystem(Model):
 
     def phi_q(self, q: NDArray, t: float = 0.0) -> NDArray:
         """∂Φ/∂q (m_h × n_q), column i = Φ′ along e_i (module docstring)."""
-        x, unit = np.append(q, t), np.eye(self.n_q + 1)
-        columns = [self._d1(self._phi_x, x, unit[i]) for i in range(self.n_q)]
-        return np.array(columns).T.reshape(self.m_h, self.n_q)
+        return self._phi_derivatives(q, t)[0]
+
+    def _phi_derivatives(self, q: NDArray, t: float) -> tuple[NDArray, NDArray]:
+        """(∂Φ/∂q, ∂Φ/∂t): column j of Φ_x = Φ′ along e_j at x = (q, t), all from one call at a
+        batch of points where Φ takes them (:mod:`projeq.constraints.batched`, real arguments)."""
+        x = np.append(q, t)
+        if not self.m_h:
+            return np.zeros((0, self.n_q)), np.zeros(0)
+        n = self.n_q + self.rheonomic  # the columns along q, and along t if Φ depends on it
+        if self._closure is not None and not np.iscomplexobj(x):
+            Phi_x = self._closure.jacobian(x, n)
+        else:
+            Phi_x = np.array([self._d1(self._phi_x, x, e) for e in np.eye(self.n_q + 1)[:n]]).T.reshape(self.m_h, n)
+        return Phi_x[:, :self.n_q], (Phi_x[:, -1] if self.rheonomic else np.zeros(self.m_h, dtype=Phi_x.dtype))
 
     def velocity_constraints(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """(C, c) of C q̇ = c: C = [∂Φ/∂q; A], c = [−∂Φ/∂t; b]."""
         A, b = self._pfaffian(q, t)
-        time = np.eye(self.n_q + 1)[-1]
-        phi_t = self._d1(self._phi_x, np.append(q, t), time) if self.m_h else np.zeros(0)
-        return np.vstack((self.phi_q(q, t), A)), np.concatenate((-phi_t, b))
+        Phi_q, Phi_t = self._phi_derivatives(q, t)
+        return np.vstack((Phi_q, A)), np.concatenate((-Phi_t, b))
 
     def constraint_residual(self, q: NDArray, q_dot: NDArray, t: float = 0.0) -> NDArray:
         """(Φ(q, t), A q̇ − b): loop closures at position level, Pfaffian ones at velocity level."""
@@ -238,8 +259,13 @@ class ConstrainedSystem(Model):
         self.limit = max(REPIVOT_CONDITION, 10 * self.condition(q0))
 
     def constraint_matrix(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
-        """(A_s, b_s) of A_s ṡ_tree = b_s: A_s = C K, b_s = c − C k."""
-        C, c = self.velocity_constraints(q, t)
+        """(A_s, b_s) of A_s ṡ_tree = b_s: A_s = C K, b_s = c − C k (C, c themselves where K = E, k = 0)."""
+        return self._in_tree_velocities(q, t, *self.velocity_constraints(q, t))
+
+    def _in_tree_velocities(self, q: NDArray, t: float, C: NDArray, c: NDArray) -> tuple[NDArray, NDArray]:
+        """(A_s, b_s) = (C K, c − C k) from (C, c) at (q, t)."""
+        if self._identity:
+            return C, c
         return C @ self.tree.K(q, t), c - C @ self.tree.q_dot(q, np.zeros(self.tree.n_s), t)
 
     def _check_rank(self, q0) -> None:
@@ -341,6 +367,7 @@ class ConstrainedSystem(Model):
         """A copy with the partition ``independent`` (unchecked), starting at q."""
         new = copy.copy(self)
         new.independent, new.dependent = independent, np.setdiff1d(np.arange(self.tree.n_s), independent)
+        new._inverse = (None, None)  # A_dep⁻¹ of the old partition
         new.q0 = np.array(q, dtype=float)
         new.limit = max(REPIVOT_CONDITION, 10 * new.condition(q, t))
         return new
@@ -397,15 +424,37 @@ class ConstrainedSystem(Model):
         F[self.independent] = np.eye(self.n_s)
         f = np.zeros(self.tree.n_s, dtype=F.dtype)
         if self.n_c:
-            self._check_dependent(A_s, q, t)  # the partition degenerates during a run
-            solved = np.linalg.solve(A_s[:, self.dependent], np.column_stack((A_s[:, self.independent], b_s)))
-            F[self.dependent], f[self.dependent] = -solved[:, :-1], solved[:, -1]
+            inverse = self._dependent_inverse(A_s, q, t)  # checked: the partition degenerates during a run
+            F[self.dependent], f[self.dependent] = -inverse @ A_s[:, self.independent], inverse @ b_s
         return F, f
+
+    def _dependent_inverse(self, A_s: NDArray, q: NDArray, t: float) -> NDArray:
+        """A_dep⁻¹, kept for this A_s (F, f and f̄ of one state share it); ValueError where the
+        partition's condition number κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ reaches PARTITION_CONDITION. The
+        Frobenius norms bound κ from above (‖·‖₂ ≤ ‖·‖_F), so κ itself (two SVDs) is computed
+        only where that bound reaches the limit."""
+        kept, inverse = self._inverse  # one read: another thread may replace it
+        if kept is A_s:
+            return inverse
+        try:
+            inverse = np.linalg.inv(A_s[:, self.dependent])
+        except np.linalg.LinAlgError:
+            inverse = np.full((self.n_c, self.n_c), np.inf)
+        if not np.linalg.norm(np.real(A_s)) * np.linalg.norm(np.real(inverse)) < PARTITION_CONDITION:
+            self._check_dependent(A_s, q, t)
+        self._inverse = (A_s, inverse)
+        return inverse
+
+    _inverse = (None, None)  # (A_s, A_dep⁻¹) of the latest F
 
     def particular(self, A_s: NDArray, c: NDArray) -> NDArray:
         """The solution x of A_s x = c with x[independent] = 0: [0; A_dep⁻¹ c]."""
         x = np.zeros(self.tree.n_s, dtype=np.result_type(A_s, c))  # complex under the complex step
-        x[self.dependent] = np.linalg.solve(A_s[:, self.dependent], c)
+        kept, inverse = self._inverse  # one read: another thread may replace it
+        if kept is A_s:
+            x[self.dependent] = inverse @ c
+        else:
+            x[self.dependent] = np.linalg.solve(A_s[:, self.dependent], c)
         return x
 
     def tree_velocities(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
@@ -491,27 +540,38 @@ class ConstrainedSystem(Model):
         tree, n = self.tree, self.n_q
         q_dot = tree.q_dot(q, s_dot_tree, t)
         x, v = np.append(q, t), np.append(q_dot, 1.0)
-        # frozen arguments ride along in the point with zero rate (they may carry an outer complex step)
-        q_ddot = derivative_along(lambda y: tree.q_dot(y[:n], y[n + 1:], y[n]), np.append(x, s_dot_tree),
-                                  np.append(v, np.zeros(tree.n_s)))  # K̇ ṡ + k̇
         C = self.velocity_constraints(q, t)[0] if C is None else C
         parts = []
         if self.m_h:
-            v_q, v_t = np.append(q_dot, 0.0), np.eye(len(x))[-1]
-            parts.append(self._d2(self._phi_x, x, v_q, v_q) + 2 * self._d2(self._phi_x, x, v_q, v_t)
-                         + self._d2(self._phi_x, x, v_t, v_t))
+            parts.append(self._phi_second(x, q_dot))
         if self.m_p:
             parts.append(self._d1(lambda y: _pfaffian_residual(self, (y[:n], y[n]), y[n + 1:]), np.append(x, q_dot),
                                   np.append(v, np.zeros(n))))
+        if self._identity:  # K = E: K̇ ṡ + k̇ = 0
+            return np.concatenate(parts)
+        # frozen arguments ride along in the point with zero rate (they may carry an outer complex step)
+        q_ddot = derivative_along(lambda y: tree.q_dot(y[:n], y[n + 1:], y[n]), np.append(x, s_dot_tree),
+                                  np.append(v, np.zeros(tree.n_s)))  # K̇ ṡ + k̇
         return np.concatenate(parts) + C @ q_ddot
+
+    def _phi_second(self, x: NDArray, q_dot: NDArray) -> NDArray:
+        """Φ″(v, v) = Φ″(v_q, v_q) + 2 Φ″(v_q, v_t) + Φ″(v_t, v_t) at x = (q, t), v_q = (q̇, 0),
+        v_t = (0, 1) (:meth:`gamma`; the rheonomic parts only where Φ depends on t), by one call
+        at a batch of points where Φ takes them."""
+        if self._closure is not None and not (np.iscomplexobj(x) or np.iscomplexobj(q_dot)):
+            return self._closure.second(x, q_dot, self.rheonomic)
+        v_q, v_t = np.append(q_dot, 0.0), np.eye(len(x))[-1]
+        value = self._d2(self._phi_x, x, v_q, v_q)
+        if self.rheonomic:
+            value = value + 2 * self._d2(self._phi_x, x, v_q, v_t) + self._d2(self._phi_x, x, v_t, v_t)
+        return value
 
     def _projected(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
         """(A_s, F, f̄, M, b) at (q, ṡ, t): ṡ_tree = F ṡ + f, s̈_tree = F s̈ + f̄, and the tree's
         Gauss form M s̈_tree + b at ṡ_tree (b by the tree evaluator ``method``, module docstring)."""
         C, c = self.velocity_constraints(q, t)
-        K, k = self.tree.K(q, t), self.tree.q_dot(q, np.zeros(self.tree.n_s), t)
-        A_s = C @ K
-        F, f = self.F(q, t, (A_s, c - C @ k))
+        A_s, b_s = self._in_tree_velocities(q, t, C, c)
+        F, f = self.F(q, t, (A_s, b_s))
         s_dot_tree = F @ s_dot + f
         M, b = self.tree_gauss_form(q, s_dot_tree, t, method)
         f_bar = np.zeros(self.tree.n_s, dtype=np.result_type(A_s, M, b))
@@ -549,15 +609,19 @@ class ConstrainedSystem(Model):
         """(s̈_tree, λ): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0, and the
         multipliers λ of M s̈_tree + b = A_sᵀ λ (the constraint forces); ``method`` picks
         the tree's evaluator (module docstring; None: compiled where the tree is)."""
-        A_s, F, f_bar, M, b = self._projected(q, s_dot, t, method)
-        M_min, b_min = _minimal(F, f_bar, M, b)
-        s_ddot = -solve_spd(M_min, b_min[:, None], "constrained mass matrix FᵀMF",
-                            max(np.abs(np.diag(M_min)).max(initial=0.0), 1e-300))[:, 0]
-        s_ddot_tree = F @ s_ddot + f_bar
+        s_ddot_tree, A_s, M, b = self._tree_accelerations(q, s_dot, t, method)
         lam = np.zeros(0)
         if self.n_c:  # the minimum-norm λ where rows are redundant
             lam = np.linalg.lstsq(A_s.T, M @ s_ddot_tree + b, rcond=RANK_TOLERANCE)[0]
         return s_ddot_tree, lam
+
+    def _tree_accelerations(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
+        """(s̈_tree, A_s, M, b): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0."""
+        A_s, F, f_bar, M, b = self._projected(q, s_dot, t, method)
+        M_min, b_min = _minimal(F, f_bar, M, b)
+        s_ddot = -solve_spd(M_min, b_min[:, None], "constrained mass matrix FᵀMF",
+                            max(np.abs(np.diag(M_min)).max(initial=0.0), 1e-300))[:, 0]
+        return F @ s_ddot + f_bar, A_s, M, b
 
     def evaluator(self, method: str | None = None) -> "PartitionedEvaluator":
         """s̈ with the tree evaluator ``method`` (None: compiled where the tree is, module
@@ -589,9 +653,13 @@ class PartitionedEvaluator:
                        f"{'compiled kernels' if compiled else 'dense reference'}"
                        + (f", b from the {method!r} evaluator" if method not in (None, "dense") else ""))
         self.system, self.method = system, method
+        # the motion needs no multipliers: s̈_tree without λ's least squares, unless a subclass
+        # forms s̈_tree and λ together (the augmented Lagrangian)
+        partitioned = type(system).accelerations_tree is ConstrainedSystem.accelerations_tree
+        self._tree = system._tree_accelerations if partitioned else system.accelerations_tree
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        return self.system.accelerations_tree(q, s_dot, t, self.method)[0][self.system.independent]
+        return self._tree(q, s_dot, t, self.method)[0][self.system.independent]
 
 
 def _minimal(F: NDArray, f_bar: NDArray, M: NDArray, b: NDArray) -> tuple[NDArray, NDArray]:
@@ -610,7 +678,7 @@ def _partition_condition(A_s: NDArray, dependent: NDArray) -> float:
     if not A_s.size:
         return 1.0
     sigma = np.linalg.svd(A_s[:, dependent], compute_uv=False)
-    return float(np.linalg.norm(A_s, 2) / sigma[-1]) if sigma[-1] > 0 else np.inf
+    return float(np.linalg.svd(A_s, compute_uv=False)[0] / sigma[-1]) if sigma[-1] > 0 else np.inf
 
 
 def independent_indices(independent, count: int, n_tree: int, why: str) -> NDArray:
@@ -638,14 +706,30 @@ def minimum_norm_solution(A: NDArray, c: NDArray, rcond: float = RANK_TOLERANCE,
     A0 = np.real(A)
     if not A0.size:
         return np.zeros(A0.shape[1:] + np.shape(c)[1:], dtype=np.result_type(A, c))
-    U, sigma, Vt = np.linalg.svd(A0, full_matrices=False)
-    k = min(int(np.count_nonzero(sigma > rcond * sigma[0])), len(sigma) if rank is None else rank)
-    P = Vt[:k].T @ (U[:, :k].T / sigma[:k, None])  # A₀⁺
+    P = _pseudo_inverse(A0, rcond, rank)
     if not (np.iscomplexobj(A) or np.iscomplexobj(c)):
         return P @ c
     dA = A - A0
     dP = -P @ dA @ P + P @ P.T @ dA.T @ (np.eye(len(A0)) - A0 @ P) + (np.eye(A0.shape[1]) - P @ A0) @ dA.T @ P.T @ P
     return (P + dP) @ c
+
+
+_LATEST_PSEUDO_INVERSE = (None, None)  # (key, A₀⁺) of the latest _pseudo_inverse: f and f̄ of one state share A_s
+
+
+def _pseudo_inverse(A0: NDArray, rcond: float, rank: int | None) -> NDArray:
+    """A₀⁺ over the singular values of the real A₀ above ``rcond`` σ_max (at most ``rank`` of
+    them), kept for the latest (A₀, rcond, rank)."""
+    global _LATEST_PSEUDO_INVERSE
+    key = (A0.shape, A0.tobytes(), rcond, rank)
+    latest = _LATEST_PSEUDO_INVERSE  # one read: another thread may replace it
+    if latest[0] == key:
+        return latest[1]
+    U, sigma, Vt = np.linalg.svd(A0, full_matrices=False)
+    k = min(int(np.count_nonzero(sigma > rcond * sigma[0])), len(sigma) if rank is None else rank)
+    P = Vt[:k].T @ (U[:, :k].T / sigma[:k, None])
+    _LATEST_PSEUDO_INVERSE = (key, P)
+    return P
 
 
 def numerical_rank(A: NDArray) -> int:

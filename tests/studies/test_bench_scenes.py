@@ -8,7 +8,7 @@ A scene that falls back to an interpreted evaluator costs 50–300× chain(k) (t
 2026-11-27 baseline before issue 15's compiled planar bodies, coupled joints and
 constrained trees), a compiled one 1–7× (the hub-beam path 10–13×; the constrained scenes,
 whose constraint equations are the user's Python callables differentiated by the complex
-step, 100–200× with a compiled tree); the ratio check allows 3× its baseline ratio (the
+step, 17–85× with a compiled tree); the ratio check allows 3× its baseline ratio (the
 interleaved minima of a loaded 2-core machine vary by less than 2×), so it catches a
 fall-back or a comparable regression, not noise; the evaluator check catches any fall-back.
 """
