@@ -23,7 +23,7 @@ import os
 import secrets
 from contextlib import contextmanager
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
+from html import escape
 
 import numpy as np
 
@@ -166,7 +166,7 @@ def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21
         for part, (file, text) in meshes.items():
             with written_atomically(directory / file) as temporary:
                 temporary.write_text(text)
-            entries.append(f'    <DataSet timestep="{t:.12g}" part="{part}" file={quoteattr(file)}/>')
+            entries.append(f'    <DataSet timestep="{t:.12g}" part="{part}" file="{escape(file)}"/>')
     tree = system.tree
     with written_atomically(directory / f"{name}_bodies.csv") as temporary:
         temporary.write_text("body,name,joint\n" + "".join(
