@@ -79,11 +79,15 @@ def vtu_lines(points, lines, point_data: dict | None = None, cell_data: dict | N
     )
 
 
-def _draw(system, q, s_dot, t, stations: int, frame_size: float):
-    """Points, velocities (inertial) and line cells of the model at one state: its tree
-    moving with the tree velocities (a ConstrainedSystem's F ṡ + f, a System's ṡ)."""
-    system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
-    kin = poses(system, q, s_dot, t)
+def _tree_poses(system, q, s_dot, t):
+    """(tree, poses) of the model at one state: its tree moving with the tree velocities (a
+    ConstrainedSystem's F ṡ + f, a System's ṡ), computed once for both parts of a frame."""
+    return system.tree, poses(system.tree, q, system.tree_velocities(q, s_dot, t), t)
+
+
+def _draw(system, kin, q, stations: int, frame_size: float):
+    """Points, velocities (inertial) and line cells of the ``system`` (a tree) in the poses
+    ``kin`` (:func:`_tree_poses`)."""
     points, velocities, lines = [], [], []
     for n, sub in enumerate(system.subsystems):
         if sub.deforms:
@@ -101,13 +105,12 @@ def _draw(system, q, s_dot, t, stations: int, frame_size: float):
     return np.vstack(points), np.vstack(velocities), np.array(lines)
 
 
-def _skeleton(system, q, s_dot, t):
+def _skeleton(tree, kin):
     """Points and line cells of the mechanism at one state, with the cell data ``body`` (the
     subsystem's number in ``system.names``) and ``kind``: 0 a line from a subsystem's joint
     to the joint of a child, 1 from its joint to its centre of mass (rigid bodies: from
-    ``rigid_inertia``). Deforming subsystems are left to their centre lines (:func:`_draw`)."""
-    tree, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
-    kin = poses(tree, q, s_dot, t)
+    ``rigid_inertia``). Deforming subsystems are left to their centre lines (:func:`_draw`);
+    ``tree`` and ``kin`` as :func:`_draw`'s."""
     points, lines, body, kind = [np.asarray(r, dtype=float) for r in kin.r[: len(tree.names)]], [], [], []
     for n, sub in enumerate(tree.subsystems):
         if sub.deforms:
@@ -156,11 +159,12 @@ def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21
     directory.mkdir(parents=True, exist_ok=True)
     entries, reference = [], None
     for k, (model, t, q, s_dot) in enumerate(zip(system.row_models(result), result.t, result.q, result.s_dot)):
-        points, velocity, lines = _draw(model, q, s_dot, t, stations, frame_size)
+        tree, kin = _tree_poses(model, q, s_dot, t)
+        points, velocity, lines = _draw(tree, kin, q, stations, frame_size)
         reference = points if reference is None else reference
         meshes = {0: (f"{name}_{k:04d}.vtu", vtu_lines(points, lines, point_data={
             "displacement": points - reference, "velocity": velocity}))}
-        joints, links, body, kind = _skeleton(model, q, s_dot, t)
+        joints, links, body, kind = _skeleton(tree, kin)
         if len(links):
             meshes[1] = (f"{name}_mechanism_{k:04d}.vtu", vtu_lines(joints, links, cell_data={"body": body, "kind": kind}))
         for part, (file, text) in meshes.items():
