@@ -10,7 +10,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import sys
-from collections.abc import Mapping
+from collections.abc import MutableMapping
 from pathlib import Path
 from typing import Callable, NamedTuple
 
@@ -138,9 +138,10 @@ class _Later(NamedTuple):
     make: Callable[[], Scene]
 
 
-class Registry(Mapping):
-    """name → :class:`Scene`, in the order registered; an entry given as :class:`_Later` is made
-    when first looked up (and kept), so that listing the names imports nothing."""
+class Registry(MutableMapping):
+    """name → :class:`Scene`, in the order registered (``SCENES[name] = Scene(...)`` registers
+    one); an entry given as :class:`_Later` is made when first looked up (and kept), so that
+    listing the names imports nothing."""
 
     def __init__(self, entries: dict) -> None:
         self._entries = dict(entries)
@@ -150,6 +151,12 @@ class Registry(Mapping):
         if isinstance(entry, _Later):
             entry = self._entries[name] = entry.make()
         return entry
+
+    def __setitem__(self, name: str, scene: Scene) -> None:
+        self._entries[name] = scene
+
+    def __delitem__(self, name: str) -> None:
+        del self._entries[name]
 
     def __iter__(self):
         return iter(self._entries)
