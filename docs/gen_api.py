@@ -12,6 +12,7 @@ from __future__ import annotations
 import inspect
 import re
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -246,8 +247,9 @@ def document_module(qualified: str, module) -> str:
 
 
 def constant(value) -> str:
-    if isinstance(value, dict):
-        return f"A dict with the keys {', '.join(f'`{k}`' for k in value)}."
+    if isinstance(value, Mapping):
+        kind = "dict" if isinstance(value, dict) else f"mapping ({type(value).__name__})"
+        return f"A {kind} with the keys {', '.join(f'`{k}`' for k in value)}."
     return f"`{value!r}`"
 
 

@@ -22,3 +22,16 @@ def test_a_lazily_imported_sympy_works_for_the_user():
             "print(sympy.diff(sympy.sin(x), x), dynamicsymbols('q'))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert out == ["cos(x)", "q(t)"]
+
+
+def test_projeq_run_imports_no_sympy_matplotlib_or_meshio(tmp_path):
+    """``projeq run`` (issue 15: about a second with no arguments) loads only what it runs: not
+    sympy (the symbolic scenes register lazily), matplotlib (plots only with --plots), meshio
+    (the VTU files are written directly) nor the benchmark and study modules."""
+    code = ("import sys, types\nfrom projeq.cli import main\n"
+            f"assert main(['run', '--t-end', '0.05', '--out', {str(tmp_path)!r}, '--quiet']) == 0\n"
+            "heavy = ('sympy', 'matplotlib', 'meshio', 'projeq.studies.bench', 'projeq.studies.compare', 'projeq.cli.bench', 'projeq.scenes.bicycle')\n"
+            "print(','.join(m for m in heavy if type(sys.modules.get(m)) is types.ModuleType))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    assert out == "", f"projeq run loads {out}"
+    assert len(list(tmp_path.glob("*/paraview/*.vtu"))) > 1

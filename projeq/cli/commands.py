@@ -14,41 +14,46 @@ subcommand alike:
 
 SIGTERM (``kill``, a batch scheduler's time limit) is handled as Ctrl-C: a KeyboardInterrupt
 that each command turns into partial results.
+
+Only the module of the subcommand that runs is imported (:data:`COMMANDS` names it): ``projeq
+run`` does not pay for the benchmark and study modules (sympy, the peers) it never calls.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import signal
 import sys
 import threading
 from contextlib import contextmanager
 
-from projeq.cli import bench, run, studies, sweep
-
 OK, FAILED, BAD_ARGUMENTS = 0, 1, 2
 
-#: name → (function adding the subcommand's arguments, one-line help)
+#: name → (module of projeq.cli, its function adding the subcommand's arguments, one-line help)
 COMMANDS = {
-    "list": (run.list_arguments, "list the scenes, or one scene's parameters"),
-    "run": (run.run_arguments, "simulate a scene and write the results"),
-    "export": (run.export_arguments, "write ParaView files of a saved run (its .npz)"),
-    "sweep": (sweep.sweep_arguments, "simulate a scene on a parameter grid, in parallel"),
-    "compare": (studies.compare_arguments, "compare derivations of one system (Projection Equation, Lagrange, Kane ...)"),
-    "bench": (bench.bench_arguments, "run the performance benchmarks"),
-    "tradeoff": (studies.tradeoff_arguments, "work-precision trade-off of integrators for a scene"),
+    "list": ("run", "list_arguments", "list the scenes, or one scene's parameters"),
+    "run": ("run", "run_arguments", "simulate a scene and write the results"),
+    "export": ("run", "export_arguments", "write ParaView files of a saved run (its .npz)"),
+    "sweep": ("sweep", "sweep_arguments", "simulate a scene on a parameter grid, in parallel"),
+    "compare": ("studies", "compare_arguments", "compare derivations of one system (Projection Equation, Lagrange, Kane ...)"),
+    "bench": ("bench", "bench_arguments", "run the performance benchmarks"),
+    "tradeoff": ("studies", "tradeoff_arguments", "work-precision trade-off of integrators for a scene"),
 }
 
 
-def parser() -> argparse.ArgumentParser:
-    """The parser of ``projeq`` with every subcommand."""
+def parser(argv=None) -> argparse.ArgumentParser:
+    """The parser of ``projeq``: every subcommand, with the arguments of those named in
+    ``argv`` (default: of all), so that only their modules are imported."""
     from projeq import __version__
 
     top = argparse.ArgumentParser(prog="projeq", description="Multibody dynamics by Bremer's Projection Equation.")
     top.add_argument("--version", action="version", version=f"projeq {__version__}")
     sub = top.add_subparsers(dest="command", required=True)
-    for name, (arguments, text) in COMMANDS.items():
-        arguments(sub.add_parser(name, help=text, description=text))
+    for name, (module, arguments, text) in COMMANDS.items():
+        command = sub.add_parser(name, help=text, description=text)
+        if argv is None or name in argv:
+            getattr(importlib.import_module(f"projeq.cli.{module}"), arguments)(command)
     return top
 
 
@@ -57,7 +62,7 @@ def main(argv=None) -> int:
     and returns its exit code (module docstring); never raises SystemExit."""
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        args = parser().parse_args(argv)
+        args = parser(argv).parse_args(argv)
         args.argv = argv  # the command line, for run records
     except SystemExit as exit_:  # --help (0) or a usage error (2), printed by argparse
         return OK if exit_.code is None else int(exit_.code)

@@ -7,9 +7,12 @@ with ``--json``, one JSON document) and writes into a folder of its own,
 ``--out/<scene>-<date>-<time>`` (never over an earlier run): ``run.json`` (the record:
 scene, parameters, tolerances, method, evaluator, projeq version, command line, wall and
 CPU time, status, files), ``<scene>.npz`` (the Result with the same record,
-:meth:`projeq.Result.load`), ``<scene>.csv`` (named columns with units), PNG plots
-``<scene>_history.png`` ... and a ParaView series ``paraview/<scene>.pvd`` (a scene given as
-``FILE.py:FUNCTION`` is called ``FILE-FUNCTION``). A failed or interrupted run (Ctrl-C or SIGTERM) writes
+:meth:`projeq.Result.load`), ``<scene>.csv`` (named columns with units), a ParaView series
+``paraview/<scene>.pvd`` and, with ``--plots``, PNG plots ``<scene>_history.png`` ... (a scene
+given as ``FILE.py:FUNCTION`` is called ``FILE-FUNCTION``). The plots are asked for, not
+written by default: matplotlib's import and drawing cost more CPU time (about 1.2 s) than the
+rest of the default run's writing, and ``projeq run`` with no arguments is meant to take about
+a second. A failed or interrupted run (Ctrl-C or SIGTERM) writes
 its results up to where it stopped and exits 1. ``--out`` is checked before the run, the
 run's folder made when its results are written; each file is written under a temporary
 name and renamed when complete.
@@ -45,6 +48,8 @@ def run_arguments(parser) -> None:
     parser.add_argument("scene", nargs="?", default=DEFAULT_SCENE,
                         help=f"scene name (default {DEFAULT_SCENE}) or FILE.py:FUNCTION, a function returning a System")
     simulation_options(parser)
+    parser.add_argument("--plots", action="store_true",
+                        help="also write PNG plots (time history, drift, path, beam tips; matplotlib, about 1 s more)")
     parser.set_defaults(execute=run_scene)
 
 
@@ -129,7 +134,7 @@ def run_scene(args) -> int:
         code = 1
     out = run_directory(parent, label)
     try:
-        files = _write_all(result, system, scene, out, label)
+        files = _write_all(result, system, scene, out, label, args.plots)
         record.update(_outcome(system, result, code, notes), files=[str(f.relative_to(out)) for f in files])
         files.append(_write_json(out / "run.json", record))
     except OSError:  # nothing half-written: the folder goes too if no file in it is complete
@@ -143,16 +148,19 @@ def run_scene(args) -> int:
         print(f"projeq: {note}")
     if not args.quiet:
         _summary(args.scene, system, result, record, out, files)
+        if not args.plots:
+            print("(PNG plots of the run: add --plots)")
     return code
 
 
-def _write_all(result, system, scene, out: Path, label: str) -> list[Path]:
-    """The NPZ, the CSV and, when there is more than one row, the plots and the ParaView series."""
+def _write_all(result, system, scene, out: Path, label: str, plots: bool) -> list[Path]:
+    """The NPZ, the CSV and, when there is more than one row, the ParaView series and (if
+    ``plots``) the plots."""
     files = _write(result, out, label)
     if len(result.t) > 1:
         from projeq.simulation.export import write_vtu_series
 
-        files += _plots(result, system, scene, out, label)
+        files += _plots(result, system, scene, out, label) if plots else []
         files.append(write_vtu_series(result, out / "paraview", name=label))
     return files
 

@@ -7,8 +7,10 @@ maps the names the CLI knows to these functions.
 
 from __future__ import annotations
 
+import importlib
 import importlib.util
 import sys
+from collections.abc import MutableMapping
 from pathlib import Path
 from typing import Callable, NamedTuple
 
@@ -17,15 +19,10 @@ import numpy as np
 from projeq.subsystems import inertia
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
-from projeq.scenes.bicycle import fallen_over, whipple_bicycle, whipple_eigenvalues
 from projeq.scenes.elastic import elastic_arm, flexible_arm, spin_up_beam, spinning_beam
 from projeq.scenes.iftomm import andrews_squeezer, bricard, flyball_governor, n_four_bar, simple_pendulum
 from projeq.scenes.mechanisms import bar_on_wall, four_bar, quick_return, slider_pendulum, sphere_on_sphere
 from projeq.scenes.parameters import Parameter, check_names, closest, parse_settings, scene_parameters
-from projeq.scenes.nonholonomic import (
-    barhorst_particle, car, knife_edge_circle, knife_edge_disc, nonholonomic_particle, rolling_disk,
-    rolling_disk_critical_speed, rolling_disk_inertia,
-)
 from projeq.system import System
 
 
@@ -115,6 +112,59 @@ class Scene(NamedTuple):
     settings: dict | None = None
 
 
+#: the scenes whose modules import sympy (their joints are derived symbolically, as
+#: :meth:`projeq.UserJoint.from_sympy`) or scipy.optimize: imported on first use, so that
+#: ``projeq run`` of another scene does not pay for them
+_SYMBOLIC = dict.fromkeys(("car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed",
+                           "rolling_disk_inertia", "barhorst_particle", "nonholonomic_particle"),
+                          "projeq.scenes.nonholonomic") | dict.fromkeys(
+    ("fallen_over", "whipple_bicycle", "whipple_eigenvalues"), "projeq.scenes.bicycle")
+
+
+def _symbolic(name: str):
+    """The function ``name`` of the module :data:`_SYMBOLIC` names, imported now."""
+    return getattr(importlib.import_module(_SYMBOLIC[name]), name)
+
+
+def __getattr__(name: str):
+    if name in _SYMBOLIC:
+        return _symbolic(name)
+    raise AttributeError(f"module 'projeq.scenes' has no attribute {name!r}")
+
+
+class _Later(NamedTuple):
+    """A registered scene made on first use (:class:`Registry`)."""
+
+    make: Callable[[], Scene]
+
+
+class Registry(MutableMapping):
+    """name → :class:`Scene`, in the order registered (``SCENES[name] = Scene(...)`` registers
+    one); an entry given as :class:`_Later` is made when first looked up (and kept), so that
+    listing the names imports nothing."""
+
+    def __init__(self, entries: dict) -> None:
+        self._entries = dict(entries)
+
+    def __getitem__(self, name: str) -> Scene:
+        entry = self._entries[name]
+        if isinstance(entry, _Later):
+            entry = self._entries[name] = entry.make()
+        return entry
+
+    def __setitem__(self, name: str, scene: Scene) -> None:
+        self._entries[name] = scene
+
+    def __delitem__(self, name: str) -> None:
+        del self._entries[name]
+
+    def __iter__(self):
+        return iter(self._entries)
+
+    def __len__(self) -> int:
+        return len(self._entries)
+
+
 #: the spin-up beam's integrator for ``projeq run``: its elastic modes are stiff (an explicit
 #: method crawls at its stability limit: RK45 at simulate's rtol 1e-8 needs about 45,000 evaluations
 #: over the 20 s, Radau at rtol 1e-4 2,500), and at rtol 1e-4 the tip deflection at 5, 10, 15,
@@ -123,7 +173,7 @@ class Scene(NamedTuple):
 #: at 1e-9 (all 4.2e-5 m: the error of the scene's 4 polynomial functions, not the integrator's)
 SPIN_UP_SETTINGS = {"method": "Radau", "rtol": 1e-4, "atol": 1e-6}
 
-SCENES = {
+SCENES = Registry({
     "spin_up_beam": Scene(spin_up_beam, "a cantilever spun up to Ωs = 6 rad/s, with dynamic stiffening", 20.0,
                           settings=SPIN_UP_SETTINGS),
     "spinning_beam": Scene(spinning_beam, "a cantilever spinning about its own axis (B(16)-(23))", 10.0),
@@ -131,14 +181,20 @@ SCENES = {
     "chain": Scene(chain, "n links on revolute joints hanging from the origin (default n = 5)", 10.0),
     "double_pendulum": Scene(double_pendulum, "two point masses on massless rods, released horizontally", 10.0),
     "atwood": Scene(atwood, "two masses on a rope over a pulley with inertia (coupled joints)", 2.0),
-    "car": Scene(car, "Bremer's car: a planar body whose rear axle cannot slide (B(5)-(12))", 10.0, plane=(0, 1)),
-    "knife_edge_disc": Scene(knife_edge_disc, "a knife-edge disc rolling without slip (Orsino (2020), slides 28-37)", 20.0, plane=(0, 1)),
-    "rolling_disk": Scene(rolling_disk, "Barhorst's rolling disk with an eccentric mass (Barhorst §3.2)", 10.0,
-                          units={"inertia": "(or 'hoop', or (I, J) in kg m²)"}, plane=(3, 4)),
-    "barhorst_particle": Scene(barhorst_particle, "a particle with the constraint y' - y^2 x' = 0 (Barhorst §3.1)", 10.0),
-    "nonholonomic_particle": Scene(nonholonomic_particle, "a particle in space with y' + z x' = 0 (Barhorst §3.1)", 2.0),
-    "whipple_bicycle": Scene(whipple_bicycle, "the Whipple bicycle of Meijaard et al. (2007), constraint equations", 5.0,
-                             plane=(0, 1), events=(fallen_over,)),
+    "car": _Later(lambda: Scene(_symbolic("car"), "Bremer's car: a planar body whose rear axle cannot slide (B(5)-(12))",
+                                10.0, plane=(0, 1))),
+    "knife_edge_disc": _Later(lambda: Scene(_symbolic("knife_edge_disc"), "a knife-edge disc rolling without slip "
+                                            "(Orsino (2020), slides 28-37)", 20.0, plane=(0, 1))),
+    "rolling_disk": _Later(lambda: Scene(_symbolic("rolling_disk"), "Barhorst's rolling disk with an eccentric mass "
+                                         "(Barhorst §3.2)", 10.0, units={"inertia": "(or 'hoop', or (I, J) in kg m²)"},
+                                         plane=(3, 4))),
+    "barhorst_particle": _Later(lambda: Scene(_symbolic("barhorst_particle"), "a particle with the constraint "
+                                              "y' - y^2 x' = 0 (Barhorst §3.1)", 10.0)),
+    "nonholonomic_particle": _Later(lambda: Scene(_symbolic("nonholonomic_particle"), "a particle in space with "
+                                                  "y' + z x' = 0 (Barhorst §3.1)", 2.0)),
+    "whipple_bicycle": _Later(lambda: Scene(_symbolic("whipple_bicycle"), "the Whipple bicycle of Meijaard et al. "
+                                            "(2007), constraint equations", 5.0, plane=(0, 1),
+                                            events=(_symbolic("fallen_over"),))),
     "quick_return": Scene(quick_return, "Barhorst's quick-return mechanism, a closed loop (Barhorst §3.3)", 5.0),
     "four_bar": Scene(four_bar, "a four-bar linkage closed by a constraint equation", 5.0),
     "simple_pendulum": Scene(simple_pendulum, "IFToMM benchmark A01: a pendulum in natural coordinates",
@@ -152,7 +208,7 @@ SCENES = {
     "flyball_governor": Scene(flyball_governor, "IFToMM benchmark A05: the stiff flyball governor, coupler rods "
                               "replaced by stiff spring-dampers", 10.0,
                               units={"K": "N/m", "C": "N s/m", "s0": "m", "alpha0": "rad"}),
-}
+})
 DEFAULT_SCENE = "spin_up_beam"
 
 

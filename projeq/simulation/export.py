@@ -1,4 +1,4 @@
-"""Results for other tools: a VTU time series for ParaView (via meshio).
+"""Results for other tools: a VTU time series for ParaView.
 
 Each output time becomes two ``.vtu`` files in inertial coordinates. The bodies: beam centre
 lines as polylines (subsystems that ``deform``, ``centre_line``) and every other subsystem
@@ -8,6 +8,9 @@ mechanism: a line from each subsystem's joint to its children's joints and to it
 mass, with the cell data ``body`` (numbers named in ``<name>_bodies.csv``). A ``.pvd``
 collection file ties the steps together with their times. :func:`system_of` rebuilds the
 model of a Result loaded from a file from its run record, so a saved run can be exported.
+The files are VTK's XML UnstructuredGrid format in ASCII (:func:`vtu_lines`; Kitware, "VTK
+File Formats", The VTK User's Guide, 11th ed., 2010, ch. 19), written here directly: a mesh of
+line cells needs no mesh library, and ``projeq run`` does not pay for importing one.
 
 Every file is written through :func:`written_atomically`: under a temporary name in its
 directory, renamed when complete, so a full disk or a killed process never leaves a
@@ -20,9 +23,8 @@ import os
 import secrets
 from contextlib import contextmanager
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
+from html import escape
 
-import meshio
 import numpy as np
 
 from projeq.assembly.kinematics import poses
@@ -45,11 +47,47 @@ def written_atomically(path):
         raise
 
 
-def _draw(system, q, s_dot, t, stations: int, frame_size: float):
-    """Points, velocities (inertial) and line cells of the model at one state: its tree
-    moving with the tree velocities (a ConstrainedSystem's F ṡ + f, a System's ṡ)."""
-    system, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
-    kin = poses(system, q, s_dot, t)
+VTK_LINE = 3  # the VTK cell type of a two-point line
+
+
+def _data_array(name: str, values, kind: str = "Float64") -> str:
+    """One ``<DataArray>`` in ASCII: rows of ``values`` as its tuples, each number as the
+    shortest text that reads back to the same float (``repr``)."""
+    values = np.asarray(values)
+    components = f' NumberOfComponents="{values.shape[1]}"' if values.ndim == 2 else ""
+    text = " ".join(map(repr, values.ravel().tolist()))
+    return f'<DataArray type="{kind}" Name="{name}"{components} format="ascii">{text}</DataArray>\n'
+
+
+def vtu_lines(points, lines, point_data: dict | None = None, cell_data: dict | None = None) -> str:
+    """The text of a ``.vtu`` file: an UnstructuredGrid of the ``points`` (n × 3) joined by line
+    cells (``lines``: pairs of point numbers, VTK cell type :data:`VTK_LINE`), with
+    ``point_data`` (name → n × 3 floats) and ``cell_data`` (name → one integer per line)."""
+    lines = np.asarray(lines, dtype=np.int64).reshape(-1, 2)
+    point_arrays = "".join(_data_array(name, values) for name, values in (point_data or {}).items())
+    cell_arrays = "".join(_data_array(name, values, "Int64") for name, values in (cell_data or {}).items())
+    return (
+        '<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">\n<UnstructuredGrid>\n'
+        f'<Piece NumberOfPoints="{len(points)}" NumberOfCells="{len(lines)}">\n'
+        f"<Points>\n{_data_array('Points', points)}</Points>\n"
+        f"<Cells>\n{_data_array('connectivity', lines.ravel(), 'Int64')}"
+        f"{_data_array('offsets', 2 * np.arange(1, len(lines) + 1), 'Int64')}"
+        f"{_data_array('types', np.full(len(lines), VTK_LINE), 'UInt8')}</Cells>\n"
+        f"<PointData>\n{point_arrays}</PointData>\n<CellData>\n{cell_arrays}</CellData>\n"
+        "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n"
+    )
+
+
+def _tree_poses(system, q, s_dot, t):
+    """(tree, poses) of the model at one state: its tree moving with the tree velocities (a
+    ConstrainedSystem's F ṡ + f, a System's ṡ), computed once for both parts of a frame."""
+    return system.tree, poses(system.tree, q, system.tree_velocities(q, s_dot, t), t)
+
+
+def _draw(system, kin, q, stations: int, frame_size: float):
+    """Points, velocities (inertial) and line cells of the ``system`` (a tree) in the poses
+    ``kin`` (:func:`_tree_poses`)."""
     points, velocities, lines = [], [], []
     for n, sub in enumerate(system.subsystems):
         if sub.deforms:
@@ -67,13 +105,12 @@ def _draw(system, q, s_dot, t, stations: int, frame_size: float):
     return np.vstack(points), np.vstack(velocities), np.array(lines)
 
 
-def _skeleton(system, q, s_dot, t):
+def _skeleton(tree, kin):
     """Points and line cells of the mechanism at one state, with the cell data ``body`` (the
     subsystem's number in ``system.names``) and ``kind``: 0 a line from a subsystem's joint
     to the joint of a child, 1 from its joint to its centre of mass (rigid bodies: from
-    ``rigid_inertia``). Deforming subsystems are left to their centre lines (:func:`_draw`)."""
-    tree, s_dot = system.tree, system.tree_velocities(q, s_dot, t)
-    kin = poses(tree, q, s_dot, t)
+    ``rigid_inertia``). Deforming subsystems are left to their centre lines (:func:`_draw`);
+    ``tree`` and ``kin`` as :func:`_draw`'s."""
     points, lines, body, kind = [np.asarray(r, dtype=float) for r in kin.r[: len(tree.names)]], [], [], []
     for n, sub in enumerate(tree.subsystems):
         if sub.deforms:
@@ -122,20 +159,18 @@ def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21
     directory.mkdir(parents=True, exist_ok=True)
     entries, reference = [], None
     for k, (model, t, q, s_dot) in enumerate(zip(system.row_models(result), result.t, result.q, result.s_dot)):
-        points, velocity, lines = _draw(model, q, s_dot, t, stations, frame_size)
+        tree, kin = _tree_poses(model, q, s_dot, t)
+        points, velocity, lines = _draw(tree, kin, q, stations, frame_size)
         reference = points if reference is None else reference
-        meshes = {
-            0: (f"{name}_{k:04d}.vtu", meshio.Mesh(points, [("line", lines)],
-                                                    point_data={"displacement": points - reference, "velocity": velocity})),
-        }
-        joints, links, body, kind = _skeleton(model, q, s_dot, t)
+        meshes = {0: (f"{name}_{k:04d}.vtu", vtu_lines(points, lines, point_data={
+            "displacement": points - reference, "velocity": velocity}))}
+        joints, links, body, kind = _skeleton(tree, kin)
         if len(links):
-            meshes[1] = (f"{name}_mechanism_{k:04d}.vtu",
-                         meshio.Mesh(joints, [("line", links)], cell_data={"body": [body], "kind": [kind]}))
-        for part, (file, mesh) in meshes.items():
+            meshes[1] = (f"{name}_mechanism_{k:04d}.vtu", vtu_lines(joints, links, cell_data={"body": body, "kind": kind}))
+        for part, (file, text) in meshes.items():
             with written_atomically(directory / file) as temporary:
-                mesh.write(temporary)
-            entries.append(f'    <DataSet timestep="{t:.12g}" part="{part}" file={quoteattr(file)}/>')
+                temporary.write_text(text)
+            entries.append(f'    <DataSet timestep="{t:.12g}" part="{part}" file="{escape(file)}"/>')
     tree = system.tree
     with written_atomically(directory / f"{name}_bodies.csv") as temporary:
         temporary.write_text("body,name,joint\n" + "".join(

@@ -1,12 +1,14 @@
 """The projeq command: list, run, sweep, compare, one exit-code convention, bad input."""
 
 import io
+import json
 import os
 import runpy
 import signal
 import subprocess
 import sys
 
+import matplotlib.image
 import numpy as np
 import pytest
 
@@ -51,16 +53,24 @@ def test_every_real_valued_parameter_has_a_unit(name):
 
 
 def test_run_writes_results_that_load_back(tmp_path, capsys):
-    """A short run of the default scene: exit 0, summary printed, NPZ equal to CSV, plots and
-    the ParaView series written."""
-    assert main(["run", "--t-end", "0.2", "--out", str(tmp_path), "--quiet"]) == 0
+    """A short run of the default scene: exit 0, summary printed, NPZ equal to CSV, the
+    ParaView series written, no plots unless --plots asks (then three PNG images that
+    matplotlib reads back, of the size drawn); run.json lists every file written."""
+    assert main(["run", "--t-end", "0.2", "--out", str(tmp_path / "plain"), "--quiet"]) == 0
+    assert main(["run", "--t-end", "0.2", "--out", str(tmp_path / "plots"), "--quiet", "--plots"]) == 0
     assert capsys.readouterr().out == ""
-    run, = tmp_path.iterdir()  # the run's own folder
-    result = pq.Result.load(run / "spin_up_beam.npz")
-    table = np.loadtxt(run / "spin_up_beam.csv", delimiter=",", skiprows=1)
-    assert np.allclose(table[:, 0], result.t) and (run / "paraview" / "spin_up_beam.pvd").exists()
-    assert {p.name for p in run.glob("*.png")} == {
-        "spin_up_beam_history.png", "spin_up_beam_drift.png", "spin_up_beam_tip_beam.png"}
+    (plain,), (plots,) = (list((tmp_path / kind).iterdir()) for kind in ("plain", "plots"))  # each run's own folder
+    for run in (plain, plots):
+        result = pq.Result.load(run / "spin_up_beam.npz")
+        table = np.loadtxt(run / "spin_up_beam.csv", delimiter=",", skiprows=1)
+        assert np.allclose(table[:, 0], result.t) and (run / "paraview" / "spin_up_beam.pvd").exists()
+        listed = json.loads((run / "run.json").read_text())["files"]
+        assert all((run / f).is_file() for f in listed) and "paraview/spin_up_beam.pvd" in listed
+        assert {f.name for f in run.glob("*.*")} == {f for f in listed if "/" not in f} | {"run.json"}
+    assert list(plain.glob("*.png")) == []
+    pngs = {p.name: matplotlib.image.imread(p) for p in plots.glob("*.png")}
+    assert set(pngs) == {"spin_up_beam_history.png", "spin_up_beam_drift.png", "spin_up_beam_tip_beam.png"}
+    assert all(image.shape[1] == 100 * 9.0 for name, image in pngs.items() if "history" in name)
 
 
 def test_set_overrides_a_parameter(tmp_path, capsys):

@@ -92,3 +92,16 @@ def test_settings_parse_to_the_type_of_the_default():
 def test_bad_scene_input(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_the_registry_makes_a_symbolic_scene_on_first_use_and_takes_new_ones(monkeypatch):
+    """scenes.SCENES lists every name, makes a symbolic scene when it is looked up (the same
+    function as its module's), and registers and removes a user's scene (``projeq run`` not
+    importing sympy: tests/test_import.py)."""
+    assert "whipple_bicycle" in list(pq.scenes.SCENES)
+    from projeq.scenes.bicycle import whipple_bicycle
+
+    assert pq.scenes.SCENES["whipple_bicycle"].build is whipple_bicycle is pq.scenes.whipple_bicycle
+    mine = pq.scenes.Scene(pq.scenes.chain, "a chain of mine", 1.0)
+    monkeypatch.setitem(pq.scenes.SCENES, "mine", mine)
+    assert pq.scenes.get_scene("mine") is mine and list(pq.scenes.SCENES)[-1] == "mine"
