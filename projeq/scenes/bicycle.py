@@ -174,11 +174,15 @@ class Contacts:
     def phi(self, q: NDArray, t: float = 0.0) -> NDArray:
         """Φ(q) = z of the front contact Q (zero on the ground): with the frame's z-row
         e_zᵀA = (−cos φ sin θ, sin φ, cos φ cos θ), the fork's e_zᵀA R_s(δ), a_z its middle
-        entry, and n_z = √(1 − a_z²)."""
+        entry, and n_z = √(1 − a_z²). Written on the rows q[i], so a batch of states (q of shape
+        (8, B)) gives the B heights in one call, the row e_zᵀA R_s(δ) of Rodrigues' formula
+        (:func:`~projeq.spatial.rodrigues`) as e_zᵀA (E + sin δ ẽ + (1 − cos δ) ẽ²)."""
         c_roll, s_roll = np.cos(q[3]), np.sin(q[3])
         frame_z = np.array([-c_roll * np.sin(q[4]), s_roll, c_roll * np.cos(q[4])])
-        fork_z = frame_z @ rodrigues(self.spin_s, q[6])
-        height = -self.r_R * c_roll + frame_z @ self.d_fork + fork_z @ self.d_front
+        E, E2 = self.spin_s
+        fork_z = frame_z + np.sin(q[6]) * np.tensordot(E.T, frame_z, 1) + (1.0 - np.cos(q[6])) * np.tensordot(
+            E2.T, frame_z, 1)
+        height = -self.r_R * c_roll + np.tensordot(self.d_fork, frame_z, 1) + np.tensordot(self.d_front, fork_z, 1)
         return np.array([height + self.r_F * np.sqrt(1.0 - fork_z[1] ** 2)])
 
     def A(self, q: NDArray, t: float = 0.0) -> NDArray:

@@ -120,12 +120,15 @@ _CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, -1, 0], [1, -1, 1], [0, -1, 1], [
 _AXES = "yzxyzx"
 
 
-def _rotation(axis: str, angle: float) -> np.ndarray:
-    """The rotation by ``angle`` about the coordinate axis ``axis`` ("x", "y" or "z")."""
+def _rotation(axis: str, angle) -> np.ndarray:
+    """The rotation by ``angle`` about the coordinate axis ``axis`` ("x", "y" or "z"): a 3 × 3
+    matrix, or 3 × 3 × B for B angles (a batch of states)."""
     k = "xyz".index(axis)
     i, j = (k + 1) % 3, (k + 2) % 3
-    R = np.eye(3, dtype=np.result_type(angle, float))  # complex under a complex step
-    R[[i, i, j, j], [i, j, i, j]] = np.cos(angle), -np.sin(angle), np.sin(angle), np.cos(angle)
+    angle = np.asarray(angle)
+    R = np.zeros((3, 3) + angle.shape, dtype=np.result_type(angle, float))  # complex under a complex step
+    R[k, k] = 1.0
+    R[i, i], R[i, j], R[j, i], R[j, j] = np.cos(angle), -np.sin(angle), np.sin(angle), np.cos(angle)
     return R
 
 
@@ -152,12 +155,14 @@ def bricard(m: float = 1.0, L: float = 1.0, side: float = 0.1, g: float = 9.81, 
     tree = System(subsystems, joints, gravity=(0.0, -g, 0.0))
     columns = [tree.q_slice[tree.index(name)].start for name in names]
 
-    def closure(q, t):  # the chain's forward kinematics to rod5's far end, in closed form
-        R, r = np.eye(3), np.zeros(3)
+    def closure(q, t):  # the chain's forward kinematics to rod5's far end, in closed form (a batch: q (5, B))
+        batch = np.shape(q)[1:]
+        R, r = _rotation("x", np.zeros(batch)), np.zeros((3,) + batch)
         for i, column in enumerate(columns):
-            r = r + R @ (corners[i] - (corners[i - 1] if i else 0.0))
-            R = R @ _rotation(_AXES[i], q[column])
-        return np.concatenate((r + R @ (corners[5] - corners[4]) - corners[5], R[1:, 0]))
+            r = r + np.einsum("ij...,j->i...", R, corners[i] - (corners[i - 1] if i else 0.0))
+            R = np.einsum("ij...,jk...->ik...", R, _rotation(_AXES[i], q[column]))
+        end = r + np.einsum("ij...,j->i...", R, corners[5] - corners[4]) - corners[5].reshape((3,) + (1,) * len(batch))
+        return np.concatenate((end, R[1:, 0]))
 
     return TangentSystem(tree, phi=closure, q0=np.zeros(tree.n_q), **options)
 
