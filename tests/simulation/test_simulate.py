@@ -336,7 +336,8 @@ def test_dense_solution_changes_nothing_but_the_evaluations():
 
 def test_default_method_follows_the_measured_fastest_mode():
     """simulate without a method measures ρ(∂ẋ/∂x) at the initial state: a rigid chain gets
-    RK45 at a loose tolerance and DOP853 at the default rtol 1e-8 (the eighth order pays there),
+    RK45 at a loose tolerance and DOP853 at the default rtol 1e-8 (the eighth order pays there), a
+    model with constraint equations RK45 (its partitions make the right-hand side piecewise),
     the flexible arm over 5 s (four bending functions, ρ ≈ 3.1e3 1/s) DOP853 even at a loose
     tolerance, and a beam 10⁶ times stiffer Radau with the exact Jacobian (njev > 0);
     Result.method records each. The flexible arm and its rigid twin run on the compiled kernel
@@ -348,6 +349,8 @@ def test_default_method_follows_the_measured_fastest_mode():
         warnings.simplefilter("error", InterpretedWarning)
         assert pq.simulate(pq.scenes.chain(3), 0.05, n_points=2, rtol=1e-5).method == "RK45"
         assert pq.simulate(pq.scenes.chain(3), 0.05, n_points=2).method == "DOP853"
+        loop = pq.scenes.four_bar()  # constraint equations: RK45 at the default rtol too (default_method)
+        assert default_method(loop.evaluator(), loop, loop.q0, loop.s_dot0, 0.0, 5.0) == "RK45"
         arm = pq.scenes.flexible_arm()
         assert default_method(arm.evaluator(), arm, arm.q0, arm.s_dot0, 0.0, 5.0, rtol=1e-5) == "DOP853"  # 5 s
         assert pq.simulate(arm, 0.02, n_points=2).nfev > 0 and arm.evaluator().name == "fast"
