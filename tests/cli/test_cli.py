@@ -163,10 +163,12 @@ def test_a_real_ctrl_c_during_run_writes_the_trajectory_so_far(tmp_path):
 
 def test_a_real_ctrl_c_during_sweep_keeps_finished_and_partial_points(tmp_path):
     """Ctrl-C reaches the main process and the pool's workers: the finished point (n = 1) is
-    kept, the running one (n = 60, planar: interpreted, seconds per simulated second) returns as interrupted (status 2), nothing dies with a
-    traceback, and the table is written; exit 1."""
+    kept, the running one (n = 60 by the interpreted recursive evaluator, seconds per simulated
+    second: Python code that a signal interrupts, not a first compilation in a fresh environment)
+    returns as interrupted (status 2), nothing dies with a traceback, and the table is written;
+    exit 1."""
     code, err = ctrl_c(["sweep", "chain", "--set", "planar=true", "--grid", "n=1:60:2", "--t-end", "5", "--rtol", "1e-6",
-                        "--workers", "2", "--outputs", "q0", "--out", str(tmp_path), "--quiet"])
+                        "--evaluator", "recursive", "--workers", "2", "--outputs", "q0", "--out", str(tmp_path), "--quiet"])
     assert code == 1 and "Traceback" not in err
     table = np.load(tmp_path / "sweep_chain.npz", allow_pickle=True)
     assert table["n"].tolist() == [1, 60] and table["status"].tolist() == [0, 2]

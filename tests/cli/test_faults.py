@@ -135,7 +135,9 @@ def test_sigterm_to_a_sweep_keeps_the_finished_points_and_stops_the_workers(tmp_
     child = start(sweep_argv(tmp_path, "k=0:5:6", "--set", "slow=1"))
     said = set()
     while len(said) < 2:  # point 0 finished, and point 1 inside its integration, in either order
-        said.add(child.stdout.readline())
+        line = child.stdout.readline()
+        assert line, f"the sweep ended before both lines: {said}, stderr: {child.communicate(timeout=120)[1][-2000:]}"
+        said.add(line)
     assert said == {"point done\n", "slow point integrating\n"}
     os.kill(child.pid, signal.SIGTERM)
     _, err = child.communicate(timeout=120)
