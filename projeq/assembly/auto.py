@@ -36,8 +36,6 @@ from __future__ import annotations
 
 import warnings
 
-from numpy.typing import NDArray
-
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import hub_beam_unsupported
 from projeq.assembly.fast import unsupported
@@ -89,7 +87,3 @@ class AutoEvaluator:
                 f"system: evaluated by the interpreted 'hub_beam' path, not the compiled one: "
                 f"{self.evaluator.interpreted_reason}", InterpretedWarning, stacklevel=3,
             )
-
-    def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """s̈ at (q, ṡ, t) by the picked evaluator."""
-        return self.evaluator.accelerations(q, s_dot, t)

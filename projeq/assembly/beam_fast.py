@@ -147,13 +147,10 @@ class HubBeamEvaluator:
         """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) at (q, ṡ, t) = (q_e, q̇_e, t)."""
         if self.compiled and np.asarray(q).dtype.kind != "c" and np.asarray(s_dot).dtype.kind != "c":
             x = np.concatenate((q, s_dot)).astype(float)
-            x_dot = np.empty(len(x))
-            status = self._compiled(x, x_dot, t)
+            x_dot, status = self._compiled(x, t)
             if status >= 0 and not np.all(np.isfinite(x)):
                 raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no mass "
                                          "matrix M_ee can be formed")
-            if status == 0:
-                self._singular(t)
             return x_dot[len(q):]
         self.n_calls += 1
         joint = self.joint
@@ -170,16 +167,13 @@ class HubBeamEvaluator:
         caller's checked path then evaluates, and names what is not finite)."""
         if not self.compiled or x.dtype.kind != "f":
             return None
-        x_dot = np.empty(x.shape[0])
-        status = self._compiled(x, x_dot, t)
-        if status == 0:
-            self._singular(t)
+        x_dot, status = self._compiled(x, t)
         return x_dot if status < 0 else None
 
-    def _compiled(self, x: NDArray, x_dot: NDArray, t: float) -> int:
-        """:func:`projeq.assembly.kernels.hub_beam` at (x, t) into x_dot: the hub's (θ, θ̇, θ̈) of a
-        Prescribed joint (its checked ``angles``) or the numbers of its ``relative_values``,
-        then one compiled call; its status."""
+    def _compiled(self, x: NDArray, t: float) -> tuple[NDArray, int]:
+        """(ẋ, status) of :func:`projeq.assembly.kernels.hub_beam` at (x, t): the hub's (θ, θ̇, θ̈) of
+        a Prescribed joint (its checked ``angles``) or the numbers of its ``relative_values``,
+        then one compiled call; SingularMassError where it finds M_ee singular (status 0)."""
         self.n_calls += 1
         kind = self._kind
         if kind == kernels.GIVEN:
@@ -187,8 +181,9 @@ class HubBeamEvaluator:
         elif kind != kernels.FIXED:
             angles = self._angles
             angles[0], angles[1], angles[2] = self.joint.angles(t)
-        return self._kernel(*self._head, x, *self._tail, x_dot)
-
-    def _singular(self, t: float):
-        raise SingularMassError(f"M_ee of subsystem {self.system.names[0]!r} is singular or indefinite at "
-                                f"t = {t:.6g}: the state has left the range the model describes")
+        x_dot = np.empty(x.shape[0])
+        status = self._kernel(*self._head, x, *self._tail, x_dot)
+        if status == 0:
+            raise SingularMassError(f"M_ee of subsystem {self.system.names[0]!r} is singular or indefinite at "
+                                    f"t = {t:.6g}: the state has left the range the model describes")
+        return x_dot, status

@@ -270,10 +270,15 @@ class _Run:
         x_dot = None if self.fused is None else self.fused(t, x)
         if x_dot is None:
             return self.checked_rhs(t, x)
+        self._monitor(x[: self.model.n_q], t)
+        return x_dot
+
+    def _monitor(self, q: NDArray, t: float) -> None:
+        """Count a right-hand side; every ``MONITOR_EVERY`` calls the distance of q to a
+        coordinate singularity (where a joint has minimal velocities of its own)."""
         self.calls += 1
         if self.calls % MONITOR_EVERY == 0 and _may_be_singular(self.model.tree):
-            near_singularity(self.model.tree, x[: self.model.n_q], t)
-        return x_dot
+            near_singularity(self.model.tree, q, t)
 
     def checked_rhs(self, t: float, x: NDArray) -> NDArray:
         """ẋ = (q̇, s̈) by the model's q̇ and the evaluator's s̈, FloatingPointError when x or ẋ
@@ -283,9 +288,7 @@ class _Run:
         if not np.isfinite(x).all():  # the ufunc and the array's own all(): half the cost of np.all
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (q = {q}, s_dot = {s_dot}): the "
                                      "solution blew up (or a tolerance too loose let it)")
-        self.calls += 1
-        if self.calls % MONITOR_EVERY == 0 and _may_be_singular(self.model.tree):
-            near_singularity(self.model.tree, q, t)
+        self._monitor(q, t)
         x_dot = np.concatenate((self.model.q_dot(q, s_dot, t), self.ev.accelerations(q, s_dot, t)))
         if not np.isfinite(x_dot).all():
             raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
