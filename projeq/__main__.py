@@ -1,5 +1,5 @@
-"""``python -m projeq`` runs the command line (:func:`projeq.cli.main`)."""
+"""``python -m projeq`` runs the command line (:func:`projeq.cli.command`)."""
 
-from projeq.cli import main
+from projeq.cli import command
 
-raise SystemExit(main())
+raise SystemExit(command())

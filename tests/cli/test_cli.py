@@ -1,5 +1,6 @@
 """The projeq command: list, run, sweep, compare, one exit-code convention, bad input."""
 
+import gc
 import io
 import json
 import os
@@ -7,6 +8,7 @@ import runpy
 import signal
 import subprocess
 import sys
+from pathlib import Path
 
 import matplotlib.image
 import numpy as np
@@ -15,7 +17,7 @@ import pytest
 import projeq as pq
 import projeq.cli.studies
 import projeq.simulation.driver
-from projeq.cli.commands import main
+from projeq.cli.commands import command, main
 
 
 def atwood_angle(m1, t, m2=1.0, pulley_mass=0.5, a=0.1, g=9.81):
@@ -122,7 +124,7 @@ _CHILD = """
 import signal, sys
 signal.signal(signal.SIGINT, signal.default_int_handler)
 import projeq.simulation.driver, projeq.simulation.sweep
-from projeq.cli.commands import main
+from projeq.cli.commands import command, main
 simulate, finished = projeq.simulation.driver.simulate, projeq.simulation.sweep._finished
 
 def reporting_simulate(system, t_end, progress=None, **options):  # projeq run passes a progress bar
@@ -275,9 +277,36 @@ def test_unreachable_scheduler_writes_nothing(tmp_path, capsys):
 def test_python_dash_m_is_the_same_command(capsys, monkeypatch):
     monkeypatch.setattr(sys, "argv", ["projeq", "list"])
     monkeypatch.delitem(sys.modules, "projeq.__main__", raising=False)
-    with pytest.raises(SystemExit) as exit_:
-        runpy.run_module("projeq", run_name="__main__")
+    try:
+        with pytest.raises(SystemExit) as exit_:
+            runpy.run_module("projeq", run_name="__main__")
+    finally:
+        gc.unfreeze()  # the command froze this test process's objects, as at the end of a command
     assert exit_.value.code == 0 and capsys.readouterr().out.split()[0] == next(iter(pq.scenes.SCENES))
+
+
+def test_the_command_freezes_what_is_alive_and_returns_main_s_code(monkeypatch):
+    """``projeq`` (:func:`projeq.cli.command`) exits without the interpreter's collection of
+    numba's and scipy's objects (gc.freeze); the exit code is main's, a usage error's too."""
+    monkeypatch.setattr(sys, "argv", ["projeq", "run", "no_such_scene"])
+    try:
+        assert command() == main(["run", "no_such_scene"]) == 2
+        assert gc.get_freeze_count() > 0
+    finally:
+        gc.unfreeze()
+
+
+def test_files_are_complete_after_the_command_s_exit(tmp_path):
+    """With the objects frozen at the end of ``python -m projeq run`` (no final collection), every
+    file the record names is written, and the NPZ holds the run that the CSV holds."""
+    done = subprocess.run([sys.executable, "-m", "projeq", "run", "atwood", "--t-end", "0.5", "--out", str(tmp_path),
+                           "--json"], capture_output=True, text=True, check=True)
+    record = json.loads(done.stdout)
+    folder = Path(record["folder"])
+    assert all((folder / name).is_file() for name in record["files"])
+    result = pq.Result.load(folder / "atwood.npz")
+    table = np.loadtxt(folder / "atwood.csv", delimiter=",", skiprows=1)
+    assert np.array_equal(table[:, 0], result.t) and np.array_equal(table[:, 1], result.q[:, 0])
 
 
 class Terminal(io.StringIO):

@@ -1,0 +1,192 @@
+"""Where the time of ``projeq run`` (no arguments: the spin-up beam) goes, in fresh processes.
+
+Three views of the same command, ``python -m projeq run --quiet --out TMP``:
+
+1. phases (``--repeat`` processes, the median of each phase): the run's own functions timed
+   from inside the process (CPU and wall): Python's start (interpreter, site), the parser
+   (importing the CLI, the scenes and what they import), the scene's build, ``simulate``
+   (with, inside it, numba's import, numba's target initialisation — its compiler's
+   registries, which it loads on the first cached function — and the loads of projeq's
+   kernels from numba's disk cache), the files (NPZ + CSV, ParaView series, run.json) and the
+   interpreter's exit (the process's CPU time less the child's own at the end of ``main``:
+   atexit handlers, module teardown);
+2. ``-X importtime``: the import self-times summed by package (``scipy.linalg``, ``numba``,
+   ``projeq`` ...), and the slowest cumulative imports;
+3. ``--cprofile``: the run under cProfile, the functions with the largest own time (the
+   profiler's overhead inflates Python-heavy code such as imports: for orientation only).
+
+    PYTHONPATH=. python benchmarks/run_profile.py [--repeat 5] [--cprofile] [SCENE ...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections import defaultdict
+
+#: the child: times the run's phases by wrapping the functions that do them, runs ``main``
+PHASES = r"""
+import json, sys, time
+clock = lambda: (time.process_time(), time.perf_counter())
+start = clock()  # CPU since the process started: Python's own start
+spent = {}
+
+stack = []  # the timed calls in progress: [label, time of the timed calls inside it]
+
+def timed(function, label):
+    # function, its own time (less that of the timed calls inside it) added to spent[label]
+    def wrapper(*args, **kwargs):
+        before = clock()
+        stack.append([label, [0.0, 0.0]])
+        try:
+            return function(*args, **kwargs)
+        finally:
+            after = clock()
+            _, inner = stack.pop()
+            elapsed = [b - a for a, b in zip(before, after)]
+            total = spent.setdefault(label, [0.0, 0.0])
+            for i in (0, 1):
+                total[i] += elapsed[i] - inner[i]
+                if stack:
+                    stack[-1][1][i] += elapsed[i]
+    return wrapper
+
+def patch(owner, name, label):
+    setattr(owner, name, timed(getattr(owner, name), label))
+
+import projeq.cli.commands as commands
+projeq_import = [b - a for a, b in zip(start, clock())]
+patch(commands, "parser", "parser: CLI, scenes, their imports")
+before = clock()
+import numba.core.base, numba.core.caching  # imported here to wrap them: numba's import timed apart
+numba_import = [b - a for a, b in zip(before, clock())]
+patch(numba.core.base.BaseContext, "refresh", "  numba's target initialisation")
+patch(numba.core.caching.Cache, "load_overload", "  kernels loaded from numba's cache")
+before = clock()
+import projeq.scenes, projeq.simulation.driver, projeq.simulation.export, projeq.cli.run
+preimport = [b - a for a, b in zip(before, clock())]  # the parser's imports, done here to wrap them
+
+def resolve_scene(text, resolve=projeq.scenes.resolve_scene):
+    scene = resolve(text)
+    return scene._replace(build=timed(scene.build, "scene build"))
+
+projeq.scenes.resolve_scene = resolve_scene
+patch(projeq.simulation.driver, "simulate", "simulate")
+patch(projeq.cli.run, "_write", "write NPZ + CSV")
+patch(projeq.simulation.export, "write_vtu_series", "write ParaView series")
+patch(projeq.cli.run, "_write_json", "write run.json")
+before_main = clock()
+code = commands.command() if hasattr(commands, "command") else commands.main(sys.argv[1:])  # as the installed command
+end = clock()
+print(json.dumps({"code": code, "python_start": start, "end": end, "projeq_import": projeq_import, "numba_import": numba_import,
+                  "preimport": preimport, "main": [end[0] - before_main[0], end[1] - before_main[1]],
+                  "phases": spent}))
+"""
+
+
+def child(argv: list, env: dict | None = None) -> tuple[float, float, subprocess.CompletedProcess]:
+    """(CPU s, wall s, the completed process) of one fresh Python process."""
+    before, wall = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+    done = subprocess.run([sys.executable, *argv], capture_output=True, text=True, env=env)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    if done.returncode:
+        raise RuntimeError(f"{argv}: exit {done.returncode}\n{done.stderr[-2000:]}")
+    return cpu, time.perf_counter() - wall, done
+
+
+def phases(scene: list, out: str) -> dict:
+    """One fresh process of ``projeq run SCENE --quiet``: its phases, name → (CPU s, wall s).
+
+    The child imports what the parser would import and numba before ``main`` (to wrap their
+    functions); those imports are timed there, numba's apart (in a run it happens inside
+    ``simulate``, on the first compiled evaluator; a scene that uses no compiled kernel does
+    not pay it)."""
+    cpu, wall, done = child(["-c", PHASES, "run", *scene, "--quiet", "--out", out])
+    record = json.loads(done.stdout)
+    spent, nan = record["phases"], float("nan")
+    parser = spent.pop("parser: CLI, scenes, their imports")
+    rows = {"Python's start (interpreter, site)": [record["python_start"][0], nan],
+            "import projeq (numpy)": record["projeq_import"],
+            "imports of the CLI, scenes, driver (scipy)": [a + b for a, b in zip(record["preimport"], parser)],
+            "scene build": spent.get("scene build", [0.0, 0.0]),
+            "simulate": spent["simulate"],
+            "  numba's import": record["numba_import"]}
+    inside = [k for k in spent if k.startswith("  ")]  # self-times: simulate's is the integration's
+    rows["simulate"] = [spent["simulate"][i] + sum(spent[k][i] for k in inside) for i in (0, 1)]
+    rows |= {k: spent[k] for k in inside}
+    rows["  integration (the rest of simulate)"] = spent["simulate"]
+    rows |= {k: v for k, v in spent.items() if k.startswith("write")}
+    rows["rest of main (record, summary, checks)"] = [record["main"][0] - sum(v[0] for v in spent.values())
+                                                      - parser[0], nan]
+    rows["Python's exit (atexit, teardown)"] = [cpu - record["end"][0], nan]
+    rows["process (all)"] = [cpu, wall]
+    return rows
+
+
+def import_times(scene: list, out: str, top: int = 25) -> tuple[dict, list]:
+    """``python -X importtime -m projeq run SCENE``: self-time (s) by package, and the ``top``
+    slowest cumulative imports (name, s, depth)."""
+    _, _, done = child(["-X", "importtime", "-m", "projeq", "run", *scene, "--quiet", "--out", out])
+    by_package, cumulative = defaultdict(float), []
+    for line in done.stderr.splitlines():
+        if not line.startswith("import time:") or "self [us]" in line:
+            continue
+        own, total, name = line[len("import time:"):].split("|")
+        module = name.strip()
+        depth = (len(name) - len(name.lstrip()) - 1) // 2
+        parts = module.split(".")
+        package = ".".join(parts[:2]) if parts[0] in ("scipy", "projeq", "numpy") and len(parts) > 1 else parts[0]
+        by_package[package] += int(own) / 1e6
+        cumulative.append((module, int(total) / 1e6, depth))
+    cumulative.sort(key=lambda row: -row[1])
+    return dict(sorted(by_package.items(), key=lambda kv: -kv[1])), cumulative[:top]
+
+
+def cprofile(scene: list, out: str, top: int = 30) -> str:
+    """The run under cProfile: the ``top`` functions by own time."""
+    with tempfile.NamedTemporaryFile(suffix=".prof") as stats:
+        child(["-m", "cProfile", "-o", stats.name, "-m", "projeq", "run", *scene, "--quiet", "--out", out])
+        code = (f"import pstats; pstats.Stats({stats.name!r}).sort_stats('tottime').print_stats({top})")
+        return child(["-c", code])[2].stdout
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scene", nargs="*", help="scene and options of projeq run (default: none, the spin-up beam)")
+    parser.add_argument("--repeat", type=int, default=5, help="fresh processes for the phases (median)")
+    parser.add_argument("--cprofile", action="store_true", help="also print the cProfile top 30 by own time")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as out:
+        child(["-m", "projeq", "run", *args.scene, "--quiet", "--out", out])  # numba's cache filled
+        runs = [phases(args.scene, out) for _ in range(args.repeat)]
+        packages, slowest = import_times(args.scene, out)
+        profile = cprofile(args.scene, out) if args.cprofile else ""
+    load = os.getloadavg()[0]
+    print(f"projeq run {' '.join(args.scene)} --quiet: median of {args.repeat} fresh processes, CPU s (wall s); "
+          f"load average {load:.1f}")
+    for name in runs[0]:
+        cpu = statistics.median(r[name][0] for r in runs)
+        wall = statistics.median(r[name][1] for r in runs)
+        print(f"  {name:<45} {cpu:6.3f}" + ("" if wall != wall else f" ({wall:.3f})"))
+    print("\nimport self-time by package (-X importtime, s; the instrumentation inflates it):")
+    for package, seconds in list(packages.items())[:20]:
+        print(f"  {package:<30} {seconds:6.3f}")
+    print(f"  {'all':<30} {sum(packages.values()):6.3f}")
+    print("\nslowest cumulative imports (s):")
+    for module, seconds, depth in slowest:
+        print(f"  {'  ' * depth}{module:<{50 - 2 * depth}} {seconds:6.3f}")
+    if profile:
+        print("\ncProfile, by own time:\n" + profile)
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    main()
