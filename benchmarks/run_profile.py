@@ -15,7 +15,14 @@ Three views of the same command, ``python -m projeq run --quiet --out TMP``:
 3. ``--cprofile``: the run under cProfile, the functions with the largest own time (the
    profiler's overhead inflates Python-heavy code such as imports: for orientation only).
 
-    PYTHONPATH=. python benchmarks/run_profile.py [--repeat 5] [--cprofile] [SCENE ...]
+Also, asked for: ``--alternatives`` times what the fixed costs' alternatives would save (numba
+initialised in a background thread beside scipy's import; numba's cache load without its
+target refresh, through numba's private API, not used by projeq; an integrator needing only
+scipy.linalg instead of scipy.integrate); ``--compare TREE`` runs this tree's ``projeq run``
+and another checkout's alternately (before/after a change, in one run).
+
+    PYTHONPATH=. python benchmarks/run_profile.py [--repeat 5] [--cprofile] [--alternatives] [SCENE ...]
+    PYTHONPATH=. python benchmarks/run_profile.py --compare /path/to/other/checkout [--repeat 5]
 """
 
 from __future__ import annotations
@@ -158,12 +165,110 @@ def cprofile(scene: list, out: str, top: int = 30) -> str:
         return child(["-c", code])[2].stdout
 
 
+#: the alternatives for the fixed costs, each timed in fresh processes (``--alternatives``)
+THREAD = """
+import sys, time
+wall = time.perf_counter()
+import numpy
+def numba_ready():  # numba's import and its target initialisation (what loading a cached kernel does first)
+    import numba
+    from numba.core.registry import cpu_target
+    cpu_target.target_context.refresh()
+if sys.argv[1] == "thread":
+    import threading
+    worker = threading.Thread(target=numba_ready)
+    worker.start()
+    import scipy.integrate
+    worker.join()
+else:
+    import scipy.integrate
+    numba_ready()
+print(time.perf_counter() - wall)
+"""
+
+NO_REFRESH = """
+import sys, time
+import numba.core.caching as caching
+from numba.core.runtime import rtsys
+if sys.argv[1] == "skip":  # NOT what projeq does: numba's private API, to measure what the refresh costs
+    def load_overload(self, sig, target_context):
+        rtsys.initialize(target_context)
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+    caching.Cache.load_overload = load_overload
+from projeq import scenes
+system = scenes.spin_up_beam()
+evaluator = system.evaluator()
+cpu = time.process_time()
+s_ddot = evaluator.accelerations(system.q0, system.s_dot0 + 0.3, 0.1)
+print(time.process_time() - cpu, evaluator.name, repr(s_ddot.tolist()))
+"""
+
+IMPORTS = """
+import importlib, sys, time
+cpu = time.process_time()
+for module in sys.argv[1:]:
+    importlib.import_module(module)
+print(time.process_time() - cpu)
+"""
+
+
+def alternatives(repeat: int) -> None:
+    """The fixed costs' alternatives, measured (medians of ``repeat`` interleaved fresh processes)."""
+    def median(argvs):
+        runs = [[child(argv) for argv in argvs] for _ in range(repeat)]
+        return [[statistics.median(r[i][k] for r in runs) for k in (0, 1)] for i in range(len(argvs))], runs
+
+    (seq, thread), _ = median([["-c", THREAD, "sequential"], ["-c", THREAD, "thread"]])
+    print(f"numba's import + target initialisation beside scipy.integrate's import: sequential {seq[0]:.3f} "
+          f"CPU s ({seq[1]:.3f} wall), numba in a background thread {thread[0]:.3f} ({thread[1]:.3f}): "
+          f"wall ratio thread / sequential {thread[1] / seq[1]:.2f}")
+    runs = [[float(child(["-c", NO_REFRESH, mode])[2].stdout.split()[0]) for mode in ("normal", "skip")]
+            for _ in range(repeat)]
+    same = len({child(["-c", NO_REFRESH, mode])[2].stdout.split(maxsplit=2)[2] for mode in ("normal", "skip")}) == 1
+    normal, skip = (statistics.median(r[i] for r in runs) for i in (0, 1))
+    print(f"first s̈ of the spin-up beam in a fresh process (numba imported before): {normal:.3f} CPU s; with numba's "
+          f"cache load skipping the target refresh (private API, not used) {skip:.3f}; s̈ identical: {same}")
+    chains = {"numpy": ["numpy"], "numpy, scipy.linalg": ["numpy", "scipy.linalg"],
+              "numpy, scipy.integrate": ["numpy", "scipy.integrate"], "numpy, numba": ["numpy", "numba"]}
+    costs = {name: statistics.median(float(child(["-c", IMPORTS, *modules])[2].stdout) for _ in range(repeat))
+             for name, modules in chains.items()}
+    print("imports, CPU s: " + ", ".join(f"{name} {cost:.3f}" for name, cost in costs.items()) +
+          f"; an integrator needing only scipy.linalg would save {costs['numpy, scipy.integrate'] - costs['numpy, scipy.linalg']:.3f}")
+
+
+def compare(other: str, scene: list, repeat: int) -> None:
+    """``python -m projeq run SCENE --quiet`` of this tree and of the tree ``other`` (another
+    checkout's root), alternately in fresh processes: medians of CPU and wall time."""
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    trees = {"this tree": here, other: os.path.abspath(other)}
+    times = {name: [] for name in trees}
+    with tempfile.TemporaryDirectory() as out:
+        for _ in range(repeat + 1):  # the first round fills numba's caches and the bytecode
+            for name, root in trees.items():
+                env = os.environ | {"PYTHONPATH": root}
+                times[name].append(child(["-m", "projeq", "run", *scene, "--quiet", "--out", out], env)[:2])
+    medians = {name: [statistics.median(t[k] for t in runs[1:]) for k in (0, 1)] for name, runs in times.items()}
+    for name, (cpu, wall) in medians.items():
+        print(f"  {name:<40} {cpu:6.3f} CPU s ({wall:.3f} wall)")
+    (cpu_a, wall_a), (cpu_b, wall_b) = medians.values()
+    print(f"  this tree / {other}: CPU {cpu_a / cpu_b:.2f}, wall {wall_a / wall_b:.2f} "
+          f"(median of {repeat} alternate runs each; load average {os.getloadavg()[0]:.1f})")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scene", nargs="*", help="scene and options of projeq run (default: none, the spin-up beam)")
     parser.add_argument("--repeat", type=int, default=5, help="fresh processes for the phases (median)")
     parser.add_argument("--cprofile", action="store_true", help="also print the cProfile top 30 by own time")
+    parser.add_argument("--alternatives", action="store_true",
+                        help="also time the alternatives for the fixed costs (numba in a thread, numba's cache load "
+                             "without its target refresh, scipy.linalg instead of scipy.integrate)")
+    parser.add_argument("--compare", metavar="TREE", help="only: this tree's projeq run against another checkout's")
     args = parser.parse_args()
+    if args.compare:
+        print(f"projeq run {' '.join(args.scene)} --quiet, fresh processes, alternately:")
+        return compare(args.compare, args.scene, args.repeat)
     with tempfile.TemporaryDirectory() as out:
         child(["-m", "projeq", "run", *args.scene, "--quiet", "--out", out])  # numba's cache filled
         runs = [phases(args.scene, out) for _ in range(args.repeat)]
@@ -185,8 +290,12 @@ def main() -> None:
         print(f"  {'  ' * depth}{module:<{50 - 2 * depth}} {seconds:6.3f}")
     if profile:
         print("\ncProfile, by own time:\n" + profile)
+    if args.alternatives:
+        print()
+        alternatives(args.repeat)
 
 
 if __name__ == "__main__":
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)  # the modules' bytecode cached, as an installed package's is
     main()
