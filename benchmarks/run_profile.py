@@ -18,8 +18,8 @@ Three views of the same command, ``python -m projeq run --quiet --out TMP``:
 Also, asked for: ``--alternatives`` times what the fixed costs' alternatives would save (numba
 initialised in a background thread beside scipy's import; numba's cache load without its
 target refresh, through numba's private API, not used by projeq; an integrator needing only
-scipy.linalg instead of scipy.integrate); ``--compare TREE`` runs this tree's ``projeq run``
-and another checkout's alternately (before/after a change, in one run).
+scipy.linalg instead of scipy.integrate); ``--compare TREE`` times the phases of this tree's
+``projeq run`` and another checkout's alternately (before/after a change, in one run).
 
     PYTHONPATH=. python benchmarks/run_profile.py [--repeat 5] [--cprofile] [--alternatives] [SCENE ...]
     PYTHONPATH=. python benchmarks/run_profile.py --compare /path/to/other/checkout [--repeat 5]
@@ -66,16 +66,25 @@ def timed(function, label):
     return wrapper
 
 def patch(owner, name, label):
-    setattr(owner, name, timed(getattr(owner, name), label))
+    wrapper = timed(getattr(owner, name), label)
+    wrapper.__wrapped__ = getattr(owner, name)
+    setattr(owner, name, wrapper)
 
 import projeq.cli.commands as commands
 projeq_import = [b - a for a, b in zip(start, clock())]
 patch(commands, "parser", "parser: CLI, scenes, their imports")
-before = clock()
-import numba.core.base, numba.core.caching  # imported here to wrap them: numba's import timed apart
-numba_import = [b - a for a, b in zip(before, clock())]
-patch(numba.core.base.BaseContext, "refresh", "  numba's target initialisation")
-patch(numba.core.caching.Cache, "load_overload", "  kernels loaded from numba's cache")
+import projeq.assembly.kernels as kernels
+
+def load_numba(load=kernels._numba):  # numba's import where the run does it, then its functions wrapped
+    numba = load()
+    if numba is not None:
+        import numba.core.base, numba.core.caching
+    if numba is not None and not hasattr(numba.core.caching.Cache.load_overload, "__wrapped__"):
+        patch(numba.core.base.BaseContext, "refresh", "  numba's target initialisation")
+        patch(numba.core.caching.Cache, "load_overload", "  kernels loaded from numba's cache")
+    return numba
+
+kernels._numba = timed(load_numba, "  numba's import")
 before = clock()
 import projeq.scenes, projeq.simulation.driver, projeq.simulation.export, projeq.cli.run
 preimport = [b - a for a, b in zip(before, clock())]  # the parser's imports, done here to wrap them
@@ -92,16 +101,19 @@ patch(projeq.cli.run, "_write_json", "write run.json")
 before_main = clock()
 code = commands.command() if hasattr(commands, "command") else commands.main(sys.argv[1:])  # as the installed command
 end = clock()
-print(json.dumps({"code": code, "python_start": start, "end": end, "projeq_import": projeq_import, "numba_import": numba_import,
+print(json.dumps({"code": code, "python_start": start, "end": end, "projeq_import": projeq_import,
                   "preimport": preimport, "main": [end[0] - before_main[0], end[1] - before_main[1]],
                   "phases": spent}))
 """
 
 
 def child(argv: list, env: dict | None = None) -> tuple[float, float, subprocess.CompletedProcess]:
-    """(CPU s, wall s, the completed process) of one fresh Python process."""
+    """(CPU s, wall s, the completed process) of one fresh Python process, started in the
+    root of the tree its PYTHONPATH names (``python -c`` puts the working directory first on
+    sys.path)."""
     before, wall = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
-    done = subprocess.run([sys.executable, *argv], capture_output=True, text=True, env=env)
+    root = (env or os.environ).get("PYTHONPATH", "").split(os.pathsep)[0] or None
+    done = subprocess.run([sys.executable, *argv], capture_output=True, text=True, env=env, cwd=root)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
     if done.returncode:
@@ -109,14 +121,15 @@ def child(argv: list, env: dict | None = None) -> tuple[float, float, subprocess
     return cpu, time.perf_counter() - wall, done
 
 
-def phases(scene: list, out: str) -> dict:
+def phases(scene: list, out: str, env: dict | None = None) -> dict:
     """One fresh process of ``projeq run SCENE --quiet``: its phases, name → (CPU s, wall s).
 
-    The child imports what the parser would import and numba before ``main`` (to wrap their
-    functions); those imports are timed there, numba's apart (in a run it happens inside
-    ``simulate``, on the first compiled evaluator; a scene that uses no compiled kernel does
-    not pay it)."""
-    cpu, wall, done = child(["-c", PHASES, "run", *scene, "--quiet", "--out", out])
+    The child imports what the parser would import before ``main`` (to wrap its functions),
+    timed there; numba's import is timed where the run does it (inside ``simulate``, on the
+    first compiled evaluator; a scene that uses no compiled kernel does not pay it), and its
+    functions are wrapped then (imported earlier, numba would change the order of the
+    interpreter's teardown, and with it the exit's cost)."""
+    cpu, wall, done = child(["-c", PHASES, "run", *scene, "--quiet", "--out", out], env)
     record = json.loads(done.stdout)
     spent, nan = record["phases"], float("nan")
     parser = spent.pop("parser: CLI, scenes, their imports")
@@ -124,8 +137,7 @@ def phases(scene: list, out: str) -> dict:
             "import projeq (numpy)": record["projeq_import"],
             "imports of the CLI, scenes, driver (scipy)": [a + b for a, b in zip(record["preimport"], parser)],
             "scene build": spent.get("scene build", [0.0, 0.0]),
-            "simulate": spent["simulate"],
-            "  numba's import": record["numba_import"]}
+            "simulate": spent["simulate"]}
     inside = [k for k in spent if k.startswith("  ")]  # self-times: simulate's is the integration's
     rows["simulate"] = [spent["simulate"][i] + sum(spent[k][i] for k in inside) for i in (0, 1)]
     rows |= {k: spent[k] for k in inside}
@@ -238,22 +250,25 @@ def alternatives(repeat: int) -> None:
 
 
 def compare(other: str, scene: list, repeat: int) -> None:
-    """``python -m projeq run SCENE --quiet`` of this tree and of the tree ``other`` (another
-    checkout's root), alternately in fresh processes: medians of CPU and wall time."""
+    """The phases of ``projeq run SCENE --quiet`` (:func:`phases`) of this tree and of the tree
+    ``other`` (another checkout's root), alternately in fresh processes: medians, side by side."""
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    trees = {"this tree": here, other: os.path.abspath(other)}
-    times = {name: [] for name in trees}
+    trees = {"this tree": here, "other": os.path.abspath(other)}
+    runs = {name: [] for name in trees}
     with tempfile.TemporaryDirectory() as out:
-        for _ in range(repeat + 1):  # the first round fills numba's caches and the bytecode
+        for round_ in range(repeat + 1):  # the first round fills numba's caches and the bytecode
             for name, root in trees.items():
-                env = os.environ | {"PYTHONPATH": root}
-                times[name].append(child(["-m", "projeq", "run", *scene, "--quiet", "--out", out], env)[:2])
-    medians = {name: [statistics.median(t[k] for t in runs[1:]) for k in (0, 1)] for name, runs in times.items()}
-    for name, (cpu, wall) in medians.items():
-        print(f"  {name:<40} {cpu:6.3f} CPU s ({wall:.3f} wall)")
-    (cpu_a, wall_a), (cpu_b, wall_b) = medians.values()
-    print(f"  this tree / {other}: CPU {cpu_a / cpu_b:.2f}, wall {wall_a / wall_b:.2f} "
-          f"(median of {repeat} alternate runs each; load average {os.getloadavg()[0]:.1f})")
+                rows = phases(scene, out, os.environ | {"PYTHONPATH": root})
+                if round_:
+                    runs[name].append(rows)
+    print(f"projeq run {' '.join(scene)} --quiet: CPU s, median of {repeat} fresh processes per tree, alternately "
+          f"(load average {os.getloadavg()[0]:.1f}); other = {other}")
+    print(f"  {'':<45} {'this tree':>10} {'other':>10} {'ratio':>7}")
+    for row in runs["this tree"][0]:
+        here_, there = (statistics.median(r[row][0] for r in runs[name]) for name in trees)
+        print(f"  {row:<45} {here_:10.3f} {there:10.3f} {here_ / there if there else float('nan'):7.2f}")
+    walls = [statistics.median(r["process (all)"][1] for r in runs[name]) for name in trees]
+    print(f"  {'process wall':<45} {walls[0]:10.3f} {walls[1]:10.3f} {walls[0] / walls[1]:7.2f}")
 
 
 def main() -> None:
@@ -267,7 +282,6 @@ def main() -> None:
     parser.add_argument("--compare", metavar="TREE", help="only: this tree's projeq run against another checkout's")
     args = parser.parse_args()
     if args.compare:
-        print(f"projeq run {' '.join(args.scene)} --quiet, fresh processes, alternately:")
         return compare(args.compare, args.scene, args.repeat)
     with tempfile.TemporaryDirectory() as out:
         child(["-m", "projeq", "run", *args.scene, "--quiet", "--out", out])  # numba's cache filled
