@@ -139,4 +139,5 @@ def main() -> dict:
 
 if __name__ == "__main__":
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # also for the child processes: single-threaded CPU times
+    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)  # the children's modules from bytecode, as an installed package's
     main()
