@@ -95,6 +95,8 @@ def resolve_scene(text, resolve=projeq.scenes.resolve_scene):
 
 projeq.scenes.resolve_scene = resolve_scene
 patch(projeq.simulation.driver, "simulate", "simulate")
+if hasattr(projeq.simulation.driver, "differentiate"):  # the implicit methods' ∂ẋ/∂x, where the driver forms it
+    patch(projeq.simulation.driver, "differentiate", "  Jacobians ∂ẋ/∂x (implicit methods)")
 patch(projeq.cli.run, "_write", "write NPZ + CSV")
 patch(projeq.simulation.export, "write_vtu_series", "write ParaView series")
 patch(projeq.cli.run, "_write_json", "write run.json")
