@@ -6,8 +6,9 @@ Three views of the same command, ``python -m projeq run --quiet --out TMP``:
    from inside the process (CPU and wall): Python's start (interpreter, site), the parser
    (importing the CLI, the scenes and what they import), the scene's build, ``simulate``
    (with, inside it, numba's import, numba's target initialisation — its compiler's
-   registries, which it loads on the first cached function — and the loads of projeq's
-   kernels from numba's disk cache), the files (NPZ + CSV, ParaView series, run.json) and the
+   registries, which it loads on the first cached function —, the loads of projeq's
+   kernels from numba's disk cache, the implicit methods' Jacobians, the output rows'
+   energies and the validity checks), the files (NPZ + CSV, ParaView series, run.json) and the
    interpreter's exit (the process's CPU time less the child's own at the end of ``main``:
    atexit handlers, module teardown);
 2. ``-X importtime``: the import self-times summed by package (``scipy.linalg``, ``numba``,
@@ -95,8 +96,11 @@ def resolve_scene(text, resolve=projeq.scenes.resolve_scene):
 
 projeq.scenes.resolve_scene = resolve_scene
 patch(projeq.simulation.driver, "simulate", "simulate")
-if hasattr(projeq.simulation.driver, "differentiate"):  # the implicit methods' ∂ẋ/∂x, where the driver forms it
-    patch(projeq.simulation.driver, "differentiate", "  Jacobians ∂ẋ/∂x (implicit methods)")
+for name, label in (("differentiate", "  Jacobians ∂ẋ/∂x (implicit methods)"),  # where the driver has them
+                    ("_row_values", "  output rows' q, energies, residuals"),
+                    ("warn_out_of_range", "  validity checks (each segment)")):
+    if hasattr(projeq.simulation.driver, name):
+        patch(projeq.simulation.driver, name, label)
 patch(projeq.cli.run, "_write", "write NPZ + CSV")
 patch(projeq.simulation.export, "write_vtu_series", "write ParaView series")
 patch(projeq.cli.run, "_write_json", "write run.json")
