@@ -38,7 +38,7 @@ from projeq.spatial import numeric
 sp = lazy_import("sympy")
 algebra = lazy_import("projeq.symbolic.algebra")
 
-_ZERO = np.zeros(3)  # the torque of a force, the force and point of a torque
+_ZERO = (0.0, 0.0, 0.0)  # the torque of a force, the force and point of a torque
 
 
 def body_wrench(R, force, point, torque, world, wrench) -> None:
@@ -48,8 +48,8 @@ def body_wrench(R, force, point, torque, world, wrench) -> None:
     of :class:`Force` and :class:`Torque` (and of each end of a :class:`SpringDamper`)."""
     for a in range(3):
         if world:
-            wrench[a] = R[0, a] * force[0] + R[1, a] * force[1] + R[2, a] * force[2]
-            wrench[3 + a] = R[0, a] * torque[0] + R[1, a] * torque[1] + R[2, a] * torque[2]
+            wrench[a] = R[0][a] * force[0] + R[1][a] * force[1] + R[2][a] * force[2]
+            wrench[3 + a] = R[0][a] * torque[0] + R[1][a] * torque[1] + R[2][a] * torque[2]
         else:
             wrench[a] = force[a]
             wrench[3 + a] = torque[a]
@@ -65,12 +65,13 @@ def spring_end(R, r, twist, point) -> tuple:
     u0 = twist[0] + twist[4] * point[2] - twist[5] * point[1]
     u1 = twist[1] + twist[5] * point[0] - twist[3] * point[2]
     u2 = twist[2] + twist[3] * point[1] - twist[4] * point[0]
-    return (r[0] + R[0, 0] * point[0] + R[0, 1] * point[1] + R[0, 2] * point[2],
-            r[1] + R[1, 0] * point[0] + R[1, 1] * point[1] + R[1, 2] * point[2],
-            r[2] + R[2, 0] * point[0] + R[2, 1] * point[1] + R[2, 2] * point[2],
-            R[0, 0] * u0 + R[0, 1] * u1 + R[0, 2] * u2,
-            R[1, 0] * u0 + R[1, 1] * u1 + R[1, 2] * u2,
-            R[2, 0] * u0 + R[2, 1] * u1 + R[2, 2] * u2)
+    R0, R1, R2 = R[0], R[1], R[2]
+    return (r[0] + R0[0] * point[0] + R0[1] * point[1] + R0[2] * point[2],
+            r[1] + R1[0] * point[0] + R1[1] * point[1] + R1[2] * point[2],
+            r[2] + R2[0] * point[0] + R2[1] * point[1] + R2[2] * point[2],
+            R0[0] * u0 + R0[1] * u1 + R0[2] * u2,
+            R1[0] * u0 + R1[1] * u1 + R1[2] * u2,
+            R2[0] * u0 + R2[1] * u1 + R2[2] * u2)
 
 
 def spring_damper(R_a, r_a, twist_a, point_a, R_b, r_b, twist_b, point_b, stiffness, damping, length,
@@ -83,7 +84,7 @@ def spring_damper(R_a, r_a, twist_a, point_a, R_b, r_b, twist_b, point_b, stiffn
     xa0, xa1, xa2, va0, va1, va2 = spring_end(R_a, r_a, twist_a, point_a)
     xb0, xb1, xb2, vb0, vb1, vb2 = spring_end(R_b, r_b, twist_b, point_b)
     d0, d1, d2 = xb0 - xa0, xb1 - xa1, xb2 - xa2
-    ell = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    ell = (d0 * d0 + d1 * d1 + d2 * d2) ** 0.5
     if abs(ell.real) < 1e-12:
         return False
     e0, e1, e2 = d0 / ell, d1 / ell, d2 / ell
@@ -96,40 +97,40 @@ def spring_damper(R_a, r_a, twist_a, point_a, R_b, r_b, twist_b, point_b, stiffn
 def spring_force(stiffness, damping, q_n, q_ref, s_n, tau) -> None:
     """τ = −k (q_n − q_ref) − d ṡ_n of a linear spring-damper on a joint's coordinates
     (q̇_n = ṡ_n), written into ``tau``: the statement of :class:`JointSpring`."""
-    for i in range(tau.shape[0]):
+    for i in range(len(tau)):
         tau[i] = -stiffness * (q_n[i] - q_ref[i]) - damping * s_n[i]
 
 
-def joint_wrench(F, T, tau, h_n, h_p) -> None:
+def joint_wrench(F, T, tau, L, y, w_n, w_p) -> None:
     """A generalized force τ on a joint's minimal velocities as an equal and opposite pair
-    (module docstring, B(14)): h_n += w and h_p −= Tᵀ w (T = T_np, h_p the parent's) with
-    w = F (FᵀF)⁻¹ τ, so F_nᵀ w = τ; FᵀF = L Lᵀ by Cholesky (F: n_y × k, full column rank)."""
-    m, k = F.shape
-    L, y = np.empty((k, k), dtype=F.dtype), np.empty(k, dtype=h_n.dtype)
-    for i in range(k):  # L Lᵀ = FᵀF column by column, y = L⁻¹ τ
+    (module docstring, B(14)): w_n += w and w_p −= Tᵀ w (T = T_np, w_p on the parent) with
+    w = F (FᵀF)⁻¹ τ, so F_nᵀ w = τ (F: n_y × k, full column rank); FᵀF = L Lᵀ by Cholesky
+    and y = (FᵀF)⁻¹ τ in the scratch ``L`` (k × k) and ``y`` (k)."""
+    m, k = len(F), len(tau)
+    for i in range(k):  # L Lᵀ = FᵀF row by row, y = L⁻¹ τ
         for j in range(i + 1):
             total = 0.0
             for a in range(m):
-                total += F[a, i] * F[a, j]
+                total += F[a][i] * F[a][j]
             for l in range(j):
-                total -= L[i, l] * L[j, l]
-            L[i, j] = np.sqrt(total) if i == j else total / L[j, j]
+                total -= L[i][l] * L[j][l]
+            L[i][j] = np.sqrt(total) if i == j else total / L[j][j]
         total = tau[i]
         for l in range(i):
-            total -= L[i, l] * y[l]
-        y[i] = total / L[i, i]
+            total -= L[i][l] * y[l]
+        y[i] = total / L[i][i]
     for i in range(k - 1, -1, -1):  # y = L⁻ᵀ y = (FᵀF)⁻¹ τ
         total = y[i]
         for l in range(i + 1, k):
-            total -= L[l, i] * y[l]
-        y[i] = total / L[i, i]
+            total -= L[l][i] * y[l]
+        y[i] = total / L[i][i]
     for a in range(m):
-        w_a = 0.0
+        w_a, F_a, T_a = 0.0, F[a], T[a]
         for j in range(k):
-            w_a += F[a, j] * y[j]
-        h_n[a] += w_a
-        for b in range(h_p.shape[0]):
-            h_p[b] -= T[a, b] * w_a
+            w_a += F_a[j] * y[j]
+        w_n[a] += w_a
+        for b in range(len(w_p)):
+            w_p[b] -= T_a[b] * w_a
 
 
 def _load(name: str, value, shape: tuple) -> Callable:
@@ -254,10 +255,10 @@ class Force(_BodyLoad):
         self.point = finite_array("point", point, (3,))
 
     def wrench(self, R, t, q, s_dot) -> NDArray:
-        f = self.force(t, q, s_dot)
-        wrench = np.empty(6, dtype=np.result_type(R, f))
-        body_wrench(R, f, self.point, _ZERO, self.frame == "world", wrench)
-        return wrench
+        wrench = [0.0] * 6
+        body_wrench(R.tolist(), self.force(t, q, s_dot).tolist(), self.point.tolist(), _ZERO, self.frame == "world",
+                    wrench)
+        return np.array(wrench)
 
     def compiled_terms(self) -> tuple | None:
         if self.force.constant is None:
@@ -281,10 +282,9 @@ class Torque(_BodyLoad):
         self.torque = _load("torque", torque, (3,))
 
     def wrench(self, R, t, q, s_dot) -> NDArray:
-        tau = self.torque(t, q, s_dot)
-        wrench = np.empty(6, dtype=np.result_type(R, tau))
-        body_wrench(R, _ZERO, _ZERO, tau, self.frame == "world", wrench)
-        return wrench
+        wrench = [0.0] * 6
+        body_wrench(R.tolist(), _ZERO, _ZERO, self.torque(t, q, s_dot).tolist(), self.frame == "world", wrench)
+        return np.array(wrench)
 
     def compiled_terms(self) -> tuple | None:
         if self.torque.constant is None:
@@ -319,8 +319,13 @@ class JointForce(ForceLaw):
         return self._tau(t, q, s_dot)
 
     def add_to(self, h, kin, t, q, s_dot) -> None:
-        n = self.index
-        joint_wrench(kin.F[n], kin.T_aug[n][:-1, :-1], self.generalized_force(t, q, s_dot), h[n], h[self.parent])
+        n, k = self.index, self.n_s
+        F, T = kin.F[n], kin.T_aug[n][:-1, :-1]
+        w_n, w_p = [0.0] * F.shape[0], [0.0] * T.shape[1]
+        joint_wrench(F.tolist(), T.tolist(), self.generalized_force(t, q, s_dot).tolist(), [[0.0] * k for _ in range(k)],
+                     [0.0] * k, w_n, w_p)
+        h[n] += w_n
+        h[self.parent] += w_p  # the reaction −T_npᵀ w
 
     def compiled_terms(self) -> tuple | None:
         if self._tau.constant is None:
@@ -363,10 +368,9 @@ class JointSpring(JointForce):
         return self
 
     def generalized_force(self, t, q, s_dot) -> NDArray:
-        q_n, s_n = self._q(q), self._s(s_dot)
-        tau = np.empty(self.n_s, dtype=np.result_type(q_n, s_n))
-        spring_force(self.stiffness, self.damping, q_n, self._q_ref, s_n, tau)
-        return tau
+        tau = [0.0] * self.n_s
+        spring_force(self.stiffness, self.damping, self._q(q).tolist(), self._q_ref.tolist(), self._s(s_dot).tolist(), tau)
+        return np.array(tau)
 
     def compiled_terms(self) -> tuple | None:
         return "joint_spring", (self.index, self.parent), np.concatenate(([self.stiffness, self.damping], self._q_ref))
@@ -406,13 +410,12 @@ class SpringDamper(ForceLaw):
         return self
 
     def _poses(self, kin) -> list:
-        """(R, r, twist, point) of both ends (the ground's: index −1 of ``kin``)."""
-        return [(kin.R[n], kin.r[n], kin.twist[n], point) for n, point in zip(self.index, self.points)]
+        """R, r, twist and point of end a, then of end b (the ground's: index −1 of ``kin``), as lists."""
+        return [x.tolist() for n, point in zip(self.index, self.points) for x in (kin.R[n], kin.r[n], kin.twist[n], point)]
 
     def add_to(self, h, kin, t, q, s_dot) -> None:
-        ends = self._poses(kin)
-        wrenches = np.empty((2, 6), dtype=np.result_type(*(x for end in ends for x in end[:3])))
-        if not spring_damper(*ends[0], *ends[1], self.stiffness, self.damping, self.length, *wrenches):
+        wrenches = ([0.0] * 6, [0.0] * 6)
+        if not spring_damper(*self._poses(kin), self.stiffness, self.damping, self.length, *wrenches):
             raise ValueError(f"SpringDamper between {self.bodies}: the two points coincide, no direction")
         for n, S, wrench in zip(self.index, self.S, wrenches):
             if n >= 0:
@@ -422,7 +425,8 @@ class SpringDamper(ForceLaw):
         return "spring_damper", self.index, np.concatenate((*self.points, [self.stiffness, self.damping, self.length]))
 
     def potential(self, kin, q) -> float:
-        x_a, x_b = (np.array(spring_end(*end)[:3]) for end in self._poses(kin))
+        ends = self._poses(kin)
+        x_a, x_b = (np.array(spring_end(*ends[i : i + 4])[:3]) for i in (0, 4))
         d = x_b - x_a
         return 0.5 * self.stiffness * (np.sqrt(d @ d) - self.length) ** 2
 

@@ -57,7 +57,8 @@ def add_loads(laws, constants, index, q, s_dot, R, r, twist, F, T, h):
     twists, F_n of ``index[n, N_COLS]`` columns, T_np: :func:`projeq.assembly.kernels.chain_terms`;
     q and ṡ: every joint's own coordinates and velocities). Returns −1, or the row of a
     spring-damper whose two points coincide (no direction: its ``add_to`` says so)."""
-    wrench_a, wrench_b, tau = np.empty(6, dtype=h.dtype), np.empty(6, dtype=h.dtype), np.empty(6, dtype=h.dtype)
+    work, L = np.empty((4, 6), dtype=h.dtype), np.empty((6, 6), dtype=F.dtype)
+    wrench_a, wrench_b, tau, y = work[0], work[1], work[2], work[3]
     for i in range(laws.shape[0]):
         kind, a, b, c = laws[i, KIND], laws[i, FIRST], laws[i, SECOND], constants[i]
         if kind == WRENCH:
@@ -78,7 +79,7 @@ def add_loads(laws, constants, index, q, s_dot, R, r, twist, F, T, h):
                 spring_force(c[0], c[1], q[q0 : q0 + k], c[2 : 2 + k], s_dot[s0 : s0 + k], tau[:k])
             else:
                 tau[:k] = c[:k]
-            joint_wrench(F[a, :6, :k], T[a, :6, :6], tau[:k], h[a, :6], h[b, :6])
+            joint_wrench(F[a, :6, :k], T[a, :6, :6], tau[:k], L, y, h[a, :6], h[b, :6])
     return -1
 
 
