@@ -22,6 +22,8 @@ checks each against its twin.
 from __future__ import annotations
 
 import functools
+import hashlib
+import inspect
 import types
 
 import numpy as np
@@ -696,8 +698,11 @@ def _compiled_gauss_form():
 def jit(*functions, callees=()):
     """``functions`` of another module compiled by numba as this module's kernels are
     (:func:`_jit`): with their module's names, this module's callees and ``callees`` (the
-    plain functions they call besides, compiled with them)."""
-    return _jit(*functions, callees=callees)
+    plain functions they call besides, compiled with them). numba's disk cache checks the
+    file of a compiled function only, so each is cached under its name and a digest of its
+    callees' source: an edit to a callee in another file compiles it anew."""
+    digest = hashlib.sha1("".join(inspect.getsource(f) for f in callees).encode()).hexdigest()[:12]
+    return _jit(*functions, names=tuple(f"{f.__name__}_{digest}" for f in functions), callees=callees)
 
 
 def _jit(*kernels, names=(), callees=(), **replaced):
