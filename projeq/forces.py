@@ -20,8 +20,10 @@ numba compiles (:func:`body_wrench`, :func:`spring_end`, :func:`spring_damper`,
 :func:`spring_force`, :func:`joint_wrench`): a law's ``add_to`` calls them (the reference
 evaluators), and the compiled evaluator calls the same source from its loop over the laws'
 rows (:mod:`projeq.assembly.loads`), which each law with constant loads or stated terms
-gives by ``compiled_terms``. They take complex arrays too (a complex step), so they
-compare real parts only.
+gives by ``compiled_terms``. They index matrices as ``R[i][j]``, so ``add_to`` hands them
+nested lists of Python numbers (several times faster interpreted than numpy scalars) and
+the compiled loop arrays; they take complex numbers too (a complex step), so they compare
+real parts only.
 """
 
 from __future__ import annotations
