@@ -91,6 +91,13 @@ class Doubled(pq.Force):
         return 2.0 * super().wrench(R, t, q, s_dot)
 
 
+class Stiffer(pq.JointSpring):
+    """A user's joint spring twice as stiff and damped (restates ``generalized_force``)."""
+
+    def generalized_force(self, t, q, s_dot):
+        return 2.0 * super().generalized_force(t, q, s_dot)
+
+
 class Quiet(pq.SpringDamper):
     """A user's subclass that restates none of the numbers: it keeps the compiled row."""
 
@@ -102,7 +109,7 @@ def _pendulum(*forces) -> pq.System:
 
 
 def test_a_user_law_and_a_callable_load_keep_their_python_on_the_fast_evaluator():
-    """A subclass that restates ``wrench`` loses the compiled row it inherits (its override is
+    """A subclass that restates ``wrench`` or ``generalized_force`` loses the compiled row it inherits (its override is
     never bypassed) and a callable load has none: the fast evaluator calls their ``add_to``, and
     gives the reference's numbers — which differ from the plain Force's (the override counts).
     A subclass that restates nothing keeps its row."""
@@ -116,6 +123,11 @@ def test_a_user_law_and_a_callable_load_keep_their_python_on_the_fast_evaluator(
     fast = system.accelerations(q, s_dot, t, method="fast")
     assert np.allclose(fast, system.accelerations(q, s_dot, t, method="recursive"), rtol=1e-12, atol=1e-12)
     assert not np.allclose(fast, plain.accelerations(q, s_dot, t, method="fast"), rtol=1e-3)
+    stiffer, spring = _pendulum(Stiffer("b", 5.0, 0.5, 0.2)), _pendulum(pq.JointSpring("b", 5.0, 0.5, 0.2))
+    assert stiffer.forces[0].compiled_terms() is None
+    fast = stiffer.accelerations(q, s_dot, t, method="fast")
+    assert np.allclose(fast, stiffer.accelerations(q, s_dot, t, method="dense"), rtol=1e-12, atol=1e-12)
+    assert not np.allclose(fast, spring.accelerations(q, s_dot, t, method="fast"), rtol=1e-3)
     quiet = _pendulum(Quiet("a", (0.1, 0, 0), None, (0.5, 0.5, 0.5), 30.0, 2.0, 0.2))
     assert quiet.forces[0].compiled_terms() is not None
     assert np.allclose(quiet.accelerations(q, s_dot, t, method="fast"),
