@@ -324,8 +324,8 @@ class JointForce(ForceLaw):
         n, k = self.index, self.n_s
         F, T = kin.F[n], kin.T_aug[n][:-1, :-1]
         w_n, w_p = [0.0] * F.shape[0], [0.0] * T.shape[1]
-        joint_wrench(F.tolist(), T.tolist(), self.generalized_force(t, q, s_dot).tolist(), [[0.0] * k for _ in range(k)],
-                     [0.0] * k, w_n, w_p)
+        tau = self.generalized_force(t, q, s_dot).tolist()
+        joint_wrench(F.tolist(), T.tolist(), tau, [[0.0] * k for _ in range(k)], [0.0] * k, w_n, w_p)
         h[n] += w_n
         h[self.parent] += w_p  # the reaction −T_npᵀ w
 
@@ -371,7 +371,8 @@ class JointSpring(JointForce):
 
     def generalized_force(self, t, q, s_dot) -> NDArray:
         tau = [0.0] * self.n_s
-        spring_force(self.stiffness, self.damping, self._q(q).tolist(), self._q_ref.tolist(), self._s(s_dot).tolist(), tau)
+        q_n, s_n = self._q(q).tolist(), self._s(s_dot).tolist()
+        spring_force(self.stiffness, self.damping, q_n, self._q_ref.tolist(), s_n, tau)
         return np.array(tau)
 
     def compiled_terms(self) -> tuple | None:
@@ -413,7 +414,8 @@ class SpringDamper(ForceLaw):
 
     def _poses(self, kin) -> list:
         """R, r, twist and point of end a, then of end b (the ground's: index −1 of ``kin``), as lists."""
-        return [x.tolist() for n, point in zip(self.index, self.points) for x in (kin.R[n], kin.r[n], kin.twist[n], point)]
+        return [x.tolist() for n, point in zip(self.index, self.points)
+                for x in (kin.R[n], kin.r[n], kin.twist[n], point)]
 
     def add_to(self, h, kin, t, q, s_dot) -> None:
         wrenches = ([0.0] * 6, [0.0] * 6)

@@ -113,8 +113,10 @@ def test_a_user_law_and_a_callable_load_keep_their_python_on_the_fast_evaluator(
     inherits (its override is never bypassed) and a callable load has none: the fast evaluator
     calls their ``add_to`` and gives the reference's numbers — which differ from the plain
     law's (the override counts). A subclass that restates nothing keeps its row."""
-    doubled, callable_load = Doubled("b", (1.0, -2.0, 0.5), (0.2, 0.1, 0.0)), pq.Force("a", lambda t, q, s: (t, q[1], s[0]))
-    assert Doubled.compiled_terms is pq.ForceLaw.compiled_terms and Quiet.compiled_terms is pq.SpringDamper.compiled_terms
+    doubled = Doubled("b", (1.0, -2.0, 0.5), (0.2, 0.1, 0.0))
+    callable_load = pq.Force("a", lambda t, q, s: (t, q[1], s[0]))
+    assert Doubled.compiled_terms is pq.ForceLaw.compiled_terms
+    assert Quiet.compiled_terms is pq.SpringDamper.compiled_terms
     q, s_dot, t = np.array([0.4, -0.7]), np.array([1.1, -0.3]), 0.8
     plain = _pendulum(pq.Force("b", (1.0, -2.0, 0.5), (0.2, 0.1, 0.0)), callable_load)
     system = _pendulum(doubled, callable_load)
