@@ -258,9 +258,13 @@ def unsupported(system) -> str | None:
             reason = elastic_unsupported(body)
             if reason:
                 return f"subsystem {name!r} is a {type(body).__name__} {reason}"
-            if system.forces or system.coupled:
-                return (f"subsystem {name!r} is elastic in a system with force laws or coupled joints (the "
-                        "kernel's elastic block takes trees under gravity)")
+            if system.coupled:
+                return (f"subsystem {name!r} is elastic in a system with coupled joints (the kernel's elastic "
+                        "block takes trees, not shared velocities)")
+            python = [type(law).__name__ for law in system.forces if law.compiled_terms() is None]
+            if python:
+                return (f"subsystem {name!r} is elastic in a system with force laws the kernel cannot compile "
+                        f"({', '.join(python)}: a callable load or a user's law)")
         elif body.rigid_inertia is None:
             return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of rigid bodies, "
                     "rigid_inertia, spatial or selected by S, and of RitzBeams without rotary inertia)")

@@ -18,6 +18,9 @@ The kinds and their rows (``laws``: kind, first, second; ``constants``):
   :func:`projeq.forces.spring_force` of the joint's coordinates and velocities (read at
   its places in q and ṡ, ``index``), then :func:`projeq.forces.joint_wrench`.
 
+On an elastic body (a RitzBeam) the loads act on its reference frame (the first six rows of
+h_n, as its S = [E; 0] selects them in the reference); a joint's pair takes the n_y rows of
+F_n and T_np, so the reaction reaches an elastic parent's q̇_e rows.
 Loads land in the spatial h_n of the kernel, also on bodies with a selection S (which the
 kernel evaluates by their spatial terms, :mod:`projeq.assembly.fast`): the reference adds
 Sᵀ S w, whose difference (E − SᵀS) w, out of the body's plane, no joint velocity that keeps
@@ -32,7 +35,7 @@ import functools
 import numpy as np
 
 from projeq.assembly import kernels
-from projeq.assembly.kernels import N_COLS, Q_INDEX, S_INDEX
+from projeq.assembly.kernels import N_COLS, N_Y, Q_INDEX, S_INDEX
 from projeq.forces import body_wrench, joint_wrench, spring_damper, spring_end, spring_force
 
 WRENCH, SPRING_DAMPER, JOINT_FORCE, JOINT_SPRING = range(4)
@@ -72,14 +75,15 @@ def add_loads(laws, constants, index, q, s_dot, R, r, twist, F, T, h):
             for j in range(6):
                 h[a, j] += wrench_a[j]
                 h[b, j] += wrench_b[j]
-        else:
-            k = index[a, N_COLS]
+        else:  # F_n, T_np of n_y rows; k = the joint's own columns of F_n (an elastic body's q̇_e follow)
+            n_y, n_y_p = index[a, N_Y], index[b, N_Y] if b >= 0 else 6
+            k = index[a, N_COLS] - n_y + 6
             if kind == JOINT_SPRING:
                 q0, s0 = index[a, Q_INDEX], index[a, S_INDEX]
                 spring_force(c[0], c[1], q[q0 : q0 + k], c[2 : 2 + k], s_dot[s0 : s0 + k], tau[:k])
             else:
                 tau[:k] = c[:k]
-            joint_wrench(F[a, :6, :k], T[a, :6, :6], tau[:k], L, y, h[a, :6], h[b, :6])
+            joint_wrench(F[a, :n_y, :k], T[a, :n_y, :n_y_p], tau[:k], L, y, h[a, :n_y], h[b, :n_y_p])
     return -1
 
 

@@ -10,15 +10,17 @@ are those of tests/assembly/test_recursive_vs_dense.py (``_agree``).
 """
 
 import types
+import warnings
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from strategies import FORCE_KINDS, _force, random_state, trees
+from test_fast_beams import trees_with_beams
 from test_recursive_vs_dense import _agree
 
 import projeq as pq
-from projeq.assembly import kernels, loads
+from projeq.assembly import InterpretedWarning, kernels, loads
 from projeq.assembly.fast import FastEvaluator
 
 pytestmark = pytest.mark.skipif(not kernels.has_numba(), reason="numba is not installed")
@@ -28,7 +30,8 @@ def _with_every_law(tree) -> pq.System:
     """``tree``'s System carrying one more law of every kind with constant loads (and a
     force and a torque in the other frame than the first ones drawn), damped."""
     system, rng = tree.system, tree.rng
-    laws = [_force(kind, list(system.names), tree.kinds, rng, tree.planar, damped=True, constant=True)
+    kinds = tree.kinds + [type(joint).__name__.lower() for joint in system.joints[len(tree.kinds):]]  # beams' joints
+    laws = [_force(kind, list(system.names), kinds, rng, tree.planar, damped=True, constant=True)
             for kind in FORCE_KINDS + ("force", "torque", "spring_damper")]
     return pq.System(dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints)),
                      gravity=system.gravity, forces=list(system.forces) + [law for law in laws if law is not None])
@@ -55,6 +58,22 @@ def test_compiled_laws_equal_dense_and_recursive_on_planar_trees(tree):
     """Planar bodies (a selection S: the reference loads them in their own coordinates,
     h_n += Sᵀ S w; the kernel adds the spatial w, whose difference no in-plane motion sees)."""
     _check(_with_every_law(tree), tree.rng)
+
+
+@settings(max_examples=max(10, settings().max_examples // 3), deadline=None)
+@given(trees_with_beams())
+def test_compiled_laws_on_trees_with_beams_equal_dense_and_recursive(tree):
+    """RitzBeams in the tree (on its bodies and on the beams' stations): the loads act on the
+    bodies' reference frames (the first six rows of h_n, S = [E; 0]); a joint force's pair
+    reaches an elastic parent's q̇_e rows through T_np. Compiled, without a warning."""
+    system = _with_every_law(tree)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InterpretedWarning)
+        warnings.simplefilter("ignore", RuntimeWarning)  # an unstiffened beam spun fast: said once
+        assert system.evaluator().name == "fast"
+        state = types.SimpleNamespace(system=system, q=tree.q, s_dot=tree.s_dot, t=tree.t)
+        _agree(state, "fast", "dense")
+        _agree(state, "fast", "recursive")
 
 
 @settings(max_examples=10)
