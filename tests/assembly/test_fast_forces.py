@@ -188,3 +188,25 @@ def test_the_compiled_loop_takes_a_complex_step():
     real = loads.kernel(True)
     central = (loads_at(1e-6, real) - loads_at(-1e-6, real)) / 2e-6
     assert np.allclose(h_complex.imag / 1e-30, central, rtol=1e-6, atol=1e-6)
+
+
+@pytest.mark.parametrize("joint", ["l0", "beam", "tip"])
+def test_a_joint_force_is_tau_on_its_own_velocity_with_beams_in_the_tree(joint):
+    """B(14): the pair h_n += w, h_p −= T_npᵀ w projects to exactly τ on the joint's minimal
+    velocity, so at rest, without gravity and deflection, M s̈ = τ e_j (M from
+    ``mass_matrix``, which no load enters) — on the joint of a beam (F_n carries q̇_e columns
+    after the joint's own) and on a joint at a beam's station (the reaction on the beam)."""
+    beam = pq.RitzBeam(0.8, rho_A=0.8, EI_z=40.0, n_v=3, n_w=0)
+    system = pq.System(
+        {"l0": pq.RigidBody(2.0, (0.3, 0, 0), np.diag([1e-3, 0.06, 0.06])), "beam": beam,
+         "tip": pq.RigidBody(0.3, (0.05, 0, 0), np.diag([1e-4, 2e-4, 2e-4]))},
+        {"l0": pq.Revolute(axis="z"), "beam": pq.Revolute("l0", "z", (0.6, 0, 0)),
+         "tip": pq.Revolute("beam", "z", (0.8, 0, 0))},
+        forces=[pq.JointForce(joint, [1.7])])
+    q, s_dot = np.array([0.3, -0.4, 0.0, 0.0, 0.0, 0.2]), np.zeros(system.n_s)
+    e_j = np.zeros(system.n_s)
+    e_j[system.s_slice[system.index(joint)].start] = 1.7
+    expected = np.linalg.solve(system.mass_matrix(q, 0.0), e_j)
+    assert system.evaluator().name == "fast"
+    for method in ("fast", "recursive", "dense"):
+        assert np.allclose(system.accelerations(q, s_dot, 0.0, method=method), expected, rtol=1e-10, atol=1e-10)
