@@ -14,6 +14,16 @@ Each law states its symbolic form next to its numeric one (:class:`ForceLaw`):
 ``symbolic_wrenches`` (body wrenches) or ``symbolic_joint_forces`` (τ on minimal
 velocities), which :func:`projeq.symbolic.gauss_form` adds; a law that has none says why
 in ``symbolic_unsupported`` (a load given as a callable has values, not expressions).
+
+The numeric terms are stated once, as plain functions on arrays and scalars in the style
+numba compiles (:func:`body_wrench`, :func:`spring_end`, :func:`spring_damper`,
+:func:`spring_force`, :func:`joint_wrench`): a law's ``add_to`` calls them (the reference
+evaluators), and the compiled evaluator calls the same source from its loop over the laws'
+rows (:mod:`projeq.assembly.loads`), which each law with constant loads or stated terms
+gives by ``compiled_terms``. They index matrices as ``R[i][j]``, so ``add_to`` hands them
+nested lists of Python numbers (several times faster interpreted than numpy scalars) and
+the compiled loop arrays; they take complex numbers too (a complex step), so they compare
+real parts only.
 """
 
 from __future__ import annotations
@@ -25,10 +35,104 @@ from numpy.typing import NDArray
 
 from projeq.checks import drop_inherited_twins, finite_array, non_negative
 from projeq.symbolic import lazy_import
-from projeq.spatial import cross, norm, numeric
+from projeq.spatial import numeric
 
 sp = lazy_import("sympy")
 algebra = lazy_import("projeq.symbolic.algebra")
+
+_ZERO = (0.0, 0.0, 0.0)  # the torque of a force, the force and point of a torque
+
+
+def body_wrench(R, force, point, torque, world, wrench) -> None:
+    """The wrench (f; M_O) = (f; p × f + τ) about a body's origin, in its coordinates, of a
+    force f at its point p and a torque τ: f = Rᵀ f_world and τ = Rᵀ τ_world when given in
+    world coordinates (``world``), else as given; written into ``wrench`` (6). The statement
+    of :class:`Force` and :class:`Torque` (and of each end of a :class:`SpringDamper`)."""
+    for a in range(3):
+        if world:
+            wrench[a] = R[0][a] * force[0] + R[1][a] * force[1] + R[2][a] * force[2]
+            wrench[3 + a] = R[0][a] * torque[0] + R[1][a] * torque[1] + R[2][a] * torque[2]
+        else:
+            wrench[a] = force[a]
+            wrench[3 + a] = torque[a]
+    wrench[3] += point[1] * wrench[2] - point[2] * wrench[1]
+    wrench[4] += point[2] * wrench[0] - point[0] * wrench[2]
+    wrench[5] += point[0] * wrench[1] - point[1] * wrench[0]
+
+
+def spring_end(R, r, twist, point) -> tuple:
+    """(x, v) of a body's point p as six scalars: its world position x = r + R p and
+    velocity v = R (v_O + ω × p), the body's pose (R, r) and twist (v_O, ω) in its own
+    coordinates (the ground: R = E, r = 0, twist = 0, p in world coordinates)."""
+    u0 = twist[0] + twist[4] * point[2] - twist[5] * point[1]
+    u1 = twist[1] + twist[5] * point[0] - twist[3] * point[2]
+    u2 = twist[2] + twist[3] * point[1] - twist[4] * point[0]
+    R0, R1, R2 = R[0], R[1], R[2]
+    return (r[0] + R0[0] * point[0] + R0[1] * point[1] + R0[2] * point[2],
+            r[1] + R1[0] * point[0] + R1[1] * point[1] + R1[2] * point[2],
+            r[2] + R2[0] * point[0] + R2[1] * point[1] + R2[2] * point[2],
+            R0[0] * u0 + R0[1] * u1 + R0[2] * u2,
+            R1[0] * u0 + R1[1] * u1 + R1[2] * u2,
+            R2[0] * u0 + R2[1] * u1 + R2[2] * u2)
+
+
+def spring_damper(R_a, r_a, twist_a, point_a, R_b, r_b, twist_b, point_b, stiffness, damping, length,
+                  wrench_a, wrench_b) -> bool:
+    """The wrenches of a linear spring-damper between the point p_a of body a and p_b of body b
+    (:func:`spring_end`): the tension k (ℓ − ℓ₀) + d ℓ̇ along e = (x_b − x_a)/ℓ, ℓ = |x_b − x_a|,
+    ℓ̇ = e · (v_b − v_a), pulls a towards b (force tension·e at p_a) and b towards a
+    (:func:`body_wrench`, world coordinates); written into ``wrench_a`` and ``wrench_b``.
+    False (nothing written) when the points coincide: no direction."""
+    xa0, xa1, xa2, va0, va1, va2 = spring_end(R_a, r_a, twist_a, point_a)
+    xb0, xb1, xb2, vb0, vb1, vb2 = spring_end(R_b, r_b, twist_b, point_b)
+    d0, d1, d2 = xb0 - xa0, xb1 - xa1, xb2 - xa2
+    ell = (d0 * d0 + d1 * d1 + d2 * d2) ** 0.5
+    if abs(ell.real) < 1e-12:
+        return False
+    e0, e1, e2 = d0 / ell, d1 / ell, d2 / ell
+    tension = stiffness * (ell - length) + damping * (e0 * (vb0 - va0) + e1 * (vb1 - va1) + e2 * (vb2 - va2))
+    body_wrench(R_a, (tension * e0, tension * e1, tension * e2), point_a, (0.0, 0.0, 0.0), True, wrench_a)
+    body_wrench(R_b, (-tension * e0, -tension * e1, -tension * e2), point_b, (0.0, 0.0, 0.0), True, wrench_b)
+    return True
+
+
+def spring_force(stiffness, damping, q_n, q_ref, s_n, tau) -> None:
+    """τ = −k (q_n − q_ref) − d ṡ_n of a linear spring-damper on a joint's coordinates
+    (q̇_n = ṡ_n), written into ``tau``: the statement of :class:`JointSpring`."""
+    for i in range(len(tau)):
+        tau[i] = -stiffness * (q_n[i] - q_ref[i]) - damping * s_n[i]
+
+
+def joint_wrench(F, T, tau, L, y, w_n, w_p) -> None:
+    """A generalized force τ on a joint's minimal velocities as an equal and opposite pair
+    (module docstring, B(14)): w_n += w and w_p −= Tᵀ w (T = T_np, w_p on the parent) with
+    w = F (FᵀF)⁻¹ τ, so F_nᵀ w = τ (F: n_y × k, full column rank); FᵀF = L Lᵀ by Cholesky
+    and y = (FᵀF)⁻¹ τ in the scratch ``L`` (k × k) and ``y`` (k)."""
+    m, k = len(F), len(tau)
+    for i in range(k):  # L Lᵀ = FᵀF row by row, y = L⁻¹ τ
+        for j in range(i + 1):
+            total = 0.0
+            for a in range(m):
+                total += F[a][i] * F[a][j]
+            for l in range(j):
+                total -= L[i][l] * L[j][l]
+            L[i][j] = np.sqrt(total) if i == j else total / L[j][j]
+        total = tau[i]
+        for l in range(i):
+            total -= L[i][l] * y[l]
+        y[i] = total / L[i][i]
+    for i in range(k - 1, -1, -1):  # y = L⁻ᵀ y = (FᵀF)⁻¹ τ
+        total = y[i]
+        for l in range(i + 1, k):
+            total -= L[l][i] * y[l]
+        y[i] = total / L[i][i]
+    for a in range(m):
+        w_a, F_a, T_a = 0.0, F[a], T[a]
+        for j in range(k):
+            w_a += F_a[j] * y[j]
+        w_n[a] += w_a
+        for b in range(len(w_p)):
+            w_p[b] -= T_a[b] * w_a
 
 
 def _load(name: str, value, shape: tuple) -> Callable:
@@ -76,15 +180,16 @@ class ForceLaw:
     reports its potential energy (:meth:`potential`).
 
     Its symbolic form: :meth:`symbolic_wrenches` and :meth:`symbolic_joint_forces`, and
-    :meth:`symbolic_unsupported` (None when it has one). A subclass that restates
-    ``add_to``, ``wrench`` or ``generalized_force`` loses the symbolic form it inherits
-    unless it restates it too, so an override is never bypassed.
+    :meth:`symbolic_unsupported` (None when it has one); its row of the compiled evaluator:
+    :meth:`compiled_terms`. A subclass that restates ``add_to``, ``wrench`` or
+    ``generalized_force`` loses the symbolic form and the compiled row it inherits unless
+    it restates them too, so an override is never bypassed.
     """
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         drop_inherited_twins(cls, ForceLaw, ("add_to", "wrench", "generalized_force"),
-                             ("symbolic_unsupported", "symbolic_wrenches", "symbolic_joint_forces"))
+                             ("symbolic_unsupported", "symbolic_wrenches", "symbolic_joint_forces", "compiled_terms"))
 
     def bind(self, system) -> "ForceLaw":
         """Resolve the names the law was given in ``system`` (indices, selections) and return
@@ -98,6 +203,13 @@ class ForceLaw:
     def potential(self, kin, q) -> float:
         """Potential energy of the law at the kinematic state ``kin`` (0 for a law without one)."""
         return 0.0
+
+    def compiled_terms(self) -> tuple | None:
+        """(kind, indices, constants) of the bound law for the compiled evaluator's loop
+        (:mod:`projeq.assembly.loads`, which names the kinds and their layouts), the same
+        statement its ``add_to`` calls; None (the default, and a law with a callable load):
+        the compiled evaluator calls ``add_to``."""
+        return None
 
     def symbolic_unsupported(self) -> str | None:
         """Why the law has no symbolic form (completing "forces[i] (Law) ..."), else None."""
@@ -145,9 +257,15 @@ class Force(_BodyLoad):
         self.point = finite_array("point", point, (3,))
 
     def wrench(self, R, t, q, s_dot) -> NDArray:
-        f = self.force(t, q, s_dot)
-        f = R.T @ f if self.frame == "world" else f
-        return np.concatenate((f, cross(self.point, f)))
+        wrench = [0.0] * 6
+        body_wrench(R.tolist(), self.force(t, q, s_dot).tolist(), self.point.tolist(), _ZERO, self.frame == "world",
+                    wrench)
+        return np.array(wrench)
+
+    def compiled_terms(self) -> tuple | None:
+        if self.force.constant is None:
+            return None
+        return "wrench", (self.index, self.frame == "world"), np.concatenate((self.force.constant, self.point, _ZERO))
 
     def symbolic_unsupported(self) -> str | None:
         return _callable("force", self.force)
@@ -166,8 +284,14 @@ class Torque(_BodyLoad):
         self.torque = _load("torque", torque, (3,))
 
     def wrench(self, R, t, q, s_dot) -> NDArray:
-        tau = self.torque(t, q, s_dot)
-        return np.concatenate((np.zeros(3), R.T @ tau if self.frame == "world" else tau))
+        wrench = [0.0] * 6
+        body_wrench(R.tolist(), _ZERO, _ZERO, self.torque(t, q, s_dot).tolist(), self.frame == "world", wrench)
+        return np.array(wrench)
+
+    def compiled_terms(self) -> tuple | None:
+        if self.torque.constant is None:
+            return None
+        return "wrench", (self.index, self.frame == "world"), np.concatenate((_ZERO, _ZERO, self.torque.constant))
 
     def symbolic_unsupported(self) -> str | None:
         return _callable("torque", self.torque)
@@ -197,11 +321,18 @@ class JointForce(ForceLaw):
         return self._tau(t, q, s_dot)
 
     def add_to(self, h, kin, t, q, s_dot) -> None:
-        n, F = self.index, kin.F[self.index]
-        tau = self.generalized_force(t, q, s_dot)
-        w = F @ np.linalg.solve(F.T @ F, tau)  # F_nᵀ w = τ
-        h[n] += w
-        h[self.parent] -= kin.T_aug[n][:-1, :-1].T @ w  # reaction on p: −T_npᵀ w
+        n, k = self.index, self.n_s
+        F, T = kin.F[n], kin.T_aug[n][:-1, :-1]
+        w_n, w_p = [0.0] * F.shape[0], [0.0] * T.shape[1]
+        tau = self.generalized_force(t, q, s_dot).tolist()
+        joint_wrench(F.tolist(), T.tolist(), tau, [[0.0] * k for _ in range(k)], [0.0] * k, w_n, w_p)
+        h[n] += w_n
+        h[self.parent] += w_p  # the reaction −T_npᵀ w
+
+    def compiled_terms(self) -> tuple | None:
+        if self._tau.constant is None:
+            return None
+        return "joint_force", (self.index, self.parent), self._tau.constant
 
     def symbolic_unsupported(self) -> str | None:
         return _callable("tau", self._tau)
@@ -239,7 +370,13 @@ class JointSpring(JointForce):
         return self
 
     def generalized_force(self, t, q, s_dot) -> NDArray:
-        return -self.stiffness * (self._q(q) - self._q_ref) - self.damping * self._s(s_dot)
+        tau = [0.0] * self.n_s
+        q_n, s_n = self._q(q).tolist(), self._s(s_dot).tolist()
+        spring_force(self.stiffness, self.damping, q_n, self._q_ref.tolist(), s_n, tau)
+        return np.array(tau)
+
+    def compiled_terms(self) -> tuple | None:
+        return "joint_spring", (self.index, self.parent), np.concatenate(([self.stiffness, self.damping], self._q_ref))
 
     def symbolic_unsupported(self) -> str | None:
         return None
@@ -275,36 +412,27 @@ class SpringDamper(ForceLaw):
             raise ValueError(f"body_b: a spring-damper needs two distinct bodies, not {self.bodies[1]!r} twice")
         return self
 
-    def _ends(self, kin):
-        """World position and velocity of both attachment points."""
-        ends = []
-        for n, point in zip(self.index, self.points):
-            if n < 0:
-                ends.append((point, np.zeros(3)))
-                continue
-            v_O, omega = kin.twist[n][:3], kin.twist[n][3:]
-            R = kin.R[n]
-            ends.append((kin.r[n] + R @ point, R @ (v_O + cross(omega, point))))
-        return ends
+    def _poses(self, kin) -> list:
+        """R, r, twist and point of end a, then of end b (the ground's: index −1 of ``kin``), as lists."""
+        return [x.tolist() for n, point in zip(self.index, self.points)
+                for x in (kin.R[n], kin.r[n], kin.twist[n], point)]
 
     def add_to(self, h, kin, t, q, s_dot) -> None:
-        (x_a, v_a), (x_b, v_b) = self._ends(kin)
-        d = x_b - x_a
-        length = norm(d)
-        if abs(length) < 1e-12:
+        wrenches = ([0.0] * 6, [0.0] * 6)
+        if not spring_damper(*self._poses(kin), self.stiffness, self.damping, self.length, *wrenches):
             raise ValueError(f"SpringDamper between {self.bodies}: the two points coincide, no direction")
-        e = d / length
-        tension = self.stiffness * (length - self.length) + self.damping * (e @ (v_b - v_a))
-        for n, point, S, sign in zip(self.index, self.points, self.S, (1.0, -1.0)):
-            if n < 0:
-                continue
-            f = kin.R[n].T @ (sign * tension * e)  # pulls a towards b and b towards a
-            wrench = np.concatenate((f, cross(point, f)))
-            h[n] += wrench if S is None else S @ wrench
+        for n, S, wrench in zip(self.index, self.S, wrenches):
+            if n >= 0:
+                h[n] += wrench if S is None else S @ wrench
+
+    def compiled_terms(self) -> tuple | None:
+        return "spring_damper", self.index, np.concatenate((*self.points, [self.stiffness, self.damping, self.length]))
 
     def potential(self, kin, q) -> float:
-        (x_a, _), (x_b, _) = self._ends(kin)
-        return 0.5 * self.stiffness * (norm(x_b - x_a) - self.length) ** 2
+        ends = self._poses(kin)
+        x_a, x_b = (np.array(spring_end(*ends[i : i + 4])[:3]) for i in (0, 4))
+        d = x_b - x_a
+        return 0.5 * self.stiffness * (np.sqrt(d @ d) - self.length) ** 2
 
     def symbolic_unsupported(self) -> str | None:
         return None

@@ -5,7 +5,7 @@ prescribed or fixed hub (interpreted, with one :class:`InterpretedWarning`, for 
 rotary inertia or a user's subsystem there); ``"fast"`` (the compiled order-n kernel, :mod:`projeq.assembly.fast`)
 when the kernel knows every subsystem (rigid bodies, spatial or planar, on any joint, coupled
 ones included, under any force law; RitzBeams without rotary inertia anywhere in a tree
-under gravity); else the
+under gravity and the force laws the kernel compiles); else the
 reference evaluators, ``"dense"`` when joints share minimal velocities (coupled) and
 ``"recursive"`` otherwise, with one :class:`InterpretedWarning` per System naming the piece
 the kernel does not know — the fall-back is never silent. Each evaluator evaluates its

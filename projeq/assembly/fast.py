@@ -27,10 +27,12 @@ too) states it by its own ``relative`` before each call, which the kernel reads 
 velocities) are evaluated in every joint's own velocities ṡ_all = P ṡ and projected,
 M = Pᵀ M_all P, b = Pᵀ b_all (B(14) with ∂ṡ_all/∂ṡ = P), by the compiled Gauss form.
 Under gravity and any force laws: between the compiled kinematics and the compiled passes
-each law adds its loads by its own ``add_to`` (the one statement the reference evaluators
-call) to the kernel's h_n, reading poses, twists, F_n and T̃_np from the kernel's
-workspace (in the selected coordinates of the bodies that have a selection S, whose loads
-are then carried back by Sᵀ). One :class:`~projeq.RitzBeam` on a prescribed or fixed hub
+the laws add their loads to the kernel's h_n — those with constant loads or stated terms
+(every law of :mod:`projeq.forces` without a callable load) in compiled code, by the
+statement their ``add_to`` calls (:mod:`projeq.assembly.loads`); any other (a callable
+load, a user's own law) by its own ``add_to``, reading poses, twists, F_n and T̃_np from
+the kernel's workspace (in the selected coordinates of the bodies that have a selection
+S, whose loads are then carried back by Sᵀ). One :class:`~projeq.RitzBeam` on a prescribed or fixed hub
 has its own fast evaluator, ``method="hub_beam"`` (:mod:`projeq.assembly.beam_fast`);
 any other subsystem without rigid-body terms (beams in chains, a subsystem that overrides
 ``gauss_terms``) is refused with the piece named: it is evaluated by the reference ones
@@ -53,7 +55,7 @@ import functools
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.assembly import kernels
+from projeq.assembly import kernels, loads
 from projeq.assembly.beam_fast import elastic_unsupported, hub_beam_unsupported
 from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
@@ -94,6 +96,7 @@ class FastEvaluator:
         self._pack(system)
         rigid = bool(np.all(self._index[:, kernels.N_Y] == 6))
         self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=rigid)
+        self._add_loads = loads.kernel(self.compiled) if len(self._laws) else None
 
     def _pack(self, system) -> None:
         """Flat arrays of the tree (built once) and the workspace; bodies are padded to the
@@ -143,8 +146,11 @@ class FastEvaluator:
         self._T, self._zeta = np.zeros((N, width, width)), np.zeros((N, width))
         self._M_hat, self._h_hat = np.zeros((N, width, width)), np.zeros((N + 1, width))
         self._R, self._r, self._twist = np.zeros((N + 1, 3, 3)), np.zeros((N + 1, 3)), np.zeros((N + 1, 6))
+        terms = [law.compiled_terms() for law in system.forces]
+        self._laws, self._law_constants = loads.table([row for row in terms if row is not None])
+        self._python_laws = [law for law, row in zip(system.forces, terms) if row is None]  # their own add_to
         self._kin = _WorkspaceKinematics(n_cols, self._R, self._r, self._twist, self._F, self._T, self._zeta) \
-            if system.forces else None
+            if self._python_laws else None
         # the h_n the force laws load in the reference evaluators' coordinates: rows of n_y for
         # the bodies with a selection S (zeroed before each evaluation), the workspace's rows for
         # the others, none for the ground
@@ -164,8 +170,8 @@ class FastEvaluator:
                 self._F[n, :6, :6] = self._given_F[n]
 
     def _add_forces(self, q: NDArray, s_dot: NDArray, t: float) -> None:
-        """The force laws' own ``add_to`` (the statement the reference evaluators call) on the
-        kernel's kinematics (T̃_np = [[T_np, ζ_n], [0, 1]] from the workspace when a law reads
+        """The own ``add_to`` of the laws without a compiled row (a callable load, a user's
+        law) on the kernel's kinematics (T̃_np = [[T_np, ζ_n], [0, 1]] from the workspace when a law reads
         it); bodies with a selection S take their loads in their own coordinates (h_n += Sᵀ h_S)."""
         kin, h = self._kin, self._h_hat
         kin.stale = True
@@ -173,7 +179,7 @@ class FastEvaluator:
         if self._selected:
             self._h_S[:] = 0.0
             kin, h = _SelectedKinematics(self.system, kin, s_dot), self._h_loaded
-        for force in self.system.forces:
+        for force in self._python_laws:
             force.add_to(h, kin, t, q, s_dot)
         for n, S_T in self._selected:
             self._h_hat[n] += S_T @ h[n]
@@ -188,6 +194,12 @@ class FastEvaluator:
             self._elastic, self._ports, self._T, self._zeta, self._F, self._M_n, self._h_hat, self._R, self._r,
             self._twist,
         )
+        if self._add_loads is not None:
+            failed = self._add_loads(self._laws, self._law_constants, self._index, q_all, s_all, self._R, self._r,
+                                     self._twist, self._F, self._T, self._h_hat)
+            if failed >= 0:
+                self.system.evaluator("recursive").accelerations(q, s_dot, t)  # the law's add_to says why
+                raise ValueError(f"forces: law {failed} of the compiled ones cannot be evaluated at t = {t:.6g}")
         if self._kin is not None:
             self._add_forces(q, s_dot, t)
 
@@ -246,9 +258,13 @@ def unsupported(system) -> str | None:
             reason = elastic_unsupported(body)
             if reason:
                 return f"subsystem {name!r} is a {type(body).__name__} {reason}"
-            if system.forces or system.coupled:
-                return (f"subsystem {name!r} is elastic in a system with force laws or coupled joints (the "
-                        "kernel's elastic block takes trees under gravity)")
+            if system.coupled:
+                return (f"subsystem {name!r} is elastic in a system with coupled joints (the kernel's elastic "
+                        "block takes trees, not shared velocities)")
+            python = [type(law).__name__ for law in system.forces if law.compiled_terms() is None]
+            if python:
+                return (f"subsystem {name!r} is elastic in a system with force laws the kernel cannot compile "
+                        f"({', '.join(python)}: a callable load or a user's law)")
         elif body.rigid_inertia is None:
             return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of rigid bodies, "
                     "rigid_inertia, spatial or selected by S, and of RitzBeams without rotary inertia)")

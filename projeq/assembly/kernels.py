@@ -22,6 +22,8 @@ checks each against its twin.
 from __future__ import annotations
 
 import functools
+import hashlib
+import inspect
 import types
 
 import numpy as np
@@ -693,23 +695,33 @@ def _compiled_gauss_form():
     return _jit(gauss_form, projected_accelerations)
 
 
-def _jit(*kernels, names=(), **replaced):
+def jit(*functions, callees=()):
+    """``functions`` of another module compiled by numba as this module's kernels are
+    (:func:`_jit`): with their module's names, this module's callees and ``callees`` (the
+    plain functions they call besides, compiled with them). numba's disk cache checks the
+    file of a compiled function only, so each is cached under its name and a digest of its
+    callees' source: an edit to a callee in another file compiles it anew."""
+    digest = hashlib.sha1("".join(inspect.getsource(f) for f in callees).encode()).hexdigest()[:12]
+    return _jit(*functions, names=tuple(f"{f.__name__}_{digest}" for f in functions), callees=callees)
+
+
+def _jit(*kernels, names=(), callees=(), **replaced):
     """The ``kernels`` compiled by numba (cached on disk, under ``names`` if given).
 
     Compiled code resolves the functions it calls in its globals, so the kernels are
-    compiled as copies whose globals are a copy of this module's namespace holding numba's
-    versions of their callees (``replaced``: another function under a callee's name, as
-    :func:`_six` for ``_rows`` in the rigid passes); this module's functions stay plain
-    Python (nothing rebound)."""
+    compiled as copies whose globals are a copy of this module's namespace (and of the
+    kernels' own module's) holding numba's versions of their callees (``replaced``: another
+    function under a callee's name, as :func:`_six` for ``_rows`` in the rigid passes;
+    ``callees``: more of them); the functions stay plain Python (nothing rebound)."""
     numba = _numba()
-    namespace = dict(globals())
+    namespace = {**globals(), **kernels[0].__globals__}
 
     def rebound(f, name=None):
         copy = types.FunctionType(f.__code__, namespace, name or f.__name__, f.__defaults__, f.__closure__)
         copy.__qualname__ = name or f.__qualname__  # numba's disk cache is keyed by it
         return copy
 
-    for f in _CALLEES:
+    for f in _CALLEES + callees:
         namespace[f.__name__] = numba.extending.register_jitable(rebound(replaced.get(f.__name__, f)))
     jit = numba.njit(cache=True)
     return tuple(jit(rebound(f, name)) for f, name in zip(kernels, names or (None,) * len(kernels)))

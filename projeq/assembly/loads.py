@@ -1,0 +1,101 @@
+"""The force laws of a System in the fast evaluator's compiled code: one loop over a table of
+bound laws that calls each law's own numeric statement (:mod:`projeq.forces`).
+
+Each law with constant loads or stated terms gives its row by ``compiled_terms`` — (kind,
+indices, constants) — which :func:`table` packs into two arrays (as the joints travel in
+:mod:`projeq.assembly.kernels`); :func:`add_loads` adds the loads of every row to the
+kernel's h_n, reading the poses, twists, F_n and T_np of its workspace, by the functions the
+laws' ``add_to`` call for the reference evaluators (plain Python in the style numba
+compiles; :func:`kernel` compiles it, ``compiled=False`` runs the same source interpreted).
+The kinds and their rows (``laws``: kind, first, second; ``constants``):
+
+- ``"wrench"`` (:class:`~projeq.Force`, :class:`~projeq.Torque`): body n, world frame (1) or
+  body frame (0); (f, p, τ) — :func:`projeq.forces.body_wrench`;
+- ``"spring_damper"``: bodies a and b (−1: the ground); (p_a, p_b, k, d, ℓ₀) —
+  :func:`projeq.forces.spring_damper`;
+- ``"joint_force"``: joint n and its parent p; τ — :func:`projeq.forces.joint_wrench`;
+- ``"joint_spring"``: joint n and its parent p; (k, d, q_ref) — τ by
+  :func:`projeq.forces.spring_force` of the joint's coordinates and velocities (read at
+  its places in q and ṡ, ``index``), then :func:`projeq.forces.joint_wrench`.
+
+On an elastic body (a RitzBeam) the loads act on its reference frame (the first six rows of
+h_n, as its S = [E; 0] selects them in the reference); a joint's pair takes the n_y rows of
+F_n and T_np, so the reaction reaches an elastic parent's q̇_e rows.
+Loads land in the spatial h_n of the kernel, also on bodies with a selection S (which the
+kernel evaluates by their spatial terms, :mod:`projeq.assembly.fast`): the reference adds
+Sᵀ S w, whose difference (E − SᵀS) w, out of the body's plane, no joint velocity that keeps
+the body in its plane sees, so s̈ is the same. Index −1 (the ground) is the workspace's last
+row (R = E, r = 0, twist = 0; reactions land there and are not read).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from projeq.assembly import kernels
+from projeq.assembly.kernels import N_COLS, N_Y, Q_INDEX, S_INDEX
+from projeq.forces import body_wrench, joint_wrench, spring_damper, spring_end, spring_force
+
+WRENCH, SPRING_DAMPER, JOINT_FORCE, JOINT_SPRING = range(4)
+KINDS = {"wrench": WRENCH, "spring_damper": SPRING_DAMPER, "joint_force": JOINT_FORCE, "joint_spring": JOINT_SPRING}
+#: the columns of ``laws``: the kind, then its two indices
+KIND, FIRST, SECOND = range(3)
+
+
+def table(rows) -> tuple[np.ndarray, np.ndarray]:
+    """(laws, constants): the ``compiled_terms`` rows (kind, indices, constants) as an int
+    array (L × 3: kind code, the two indices) and a float array (L × the most constants,
+    zero-padded)."""
+    laws = np.array([[KINDS[kind], *indices] for kind, indices, _ in rows], dtype=np.int64).reshape(len(rows), 3)
+    constants = np.zeros((len(rows), max((len(c) for _, _, c in rows), default=0)))
+    for i, (_, _, c) in enumerate(rows):
+        constants[i, :len(c)] = c
+    return laws, constants
+
+
+def add_loads(laws, constants, index, q, s_dot, R, r, twist, F, T, h):
+    """h_n += the loads of every row of ``laws`` at the kernel's kinematics (poses R, r,
+    twists, F_n of ``index[n, N_COLS]`` columns, T_np: :func:`projeq.assembly.kernels.chain_terms`;
+    q and ṡ: every joint's own coordinates and velocities). Returns −1, or the row of a
+    spring-damper whose two points coincide (no direction: its ``add_to`` says so)."""
+    work, L = np.empty((4, 6), dtype=h.dtype), np.empty((6, 6), dtype=F.dtype)
+    wrench_a, wrench_b, tau, y = work[0], work[1], work[2], work[3]
+    for i in range(laws.shape[0]):
+        kind, a, b, c = laws[i, KIND], laws[i, FIRST], laws[i, SECOND], constants[i]
+        if kind == WRENCH:
+            body_wrench(R[a], c[0:3], c[3:6], c[6:9], b == 1, wrench_a)
+            for j in range(6):
+                h[a, j] += wrench_a[j]
+        elif kind == SPRING_DAMPER:
+            if not spring_damper(R[a], r[a], twist[a], c[0:3], R[b], r[b], twist[b], c[3:6], c[6], c[7], c[8],
+                                 wrench_a, wrench_b):
+                return i
+            for j in range(6):
+                h[a, j] += wrench_a[j]
+                h[b, j] += wrench_b[j]
+        else:  # F_n, T_np of n_y rows; k = the joint's own columns of F_n (an elastic body's q̇_e follow)
+            n_y, n_y_p = index[a, N_Y], index[b, N_Y] if b >= 0 else 6
+            k = index[a, N_COLS] - n_y + 6
+            if kind == JOINT_SPRING:
+                q0, s0 = index[a, Q_INDEX], index[a, S_INDEX]
+                spring_force(c[0], c[1], q[q0 : q0 + k], c[2 : 2 + k], s_dot[s0 : s0 + k], tau[:k])
+            else:
+                tau[:k] = c[:k]
+            joint_wrench(F[a, :n_y, :k], T[a, :n_y, :n_y_p], tau[:k], L, y, h[a, :n_y], h[b, :n_y_p])
+    return -1
+
+
+def kernel(compiled: bool = True):
+    """:func:`add_loads`, compiled by numba (as :func:`projeq.assembly.kernels.kernel`;
+    ValueError without it) or with ``compiled=False`` the interpreted function."""
+    if not compiled:
+        return add_loads
+    kernels.kernel(True)  # the same refusal without numba
+    return _compiled()[0]
+
+
+@functools.cache
+def _compiled():
+    return kernels.jit(add_loads, callees=(body_wrench, spring_end, spring_damper, spring_force, joint_wrench))
