@@ -10,13 +10,26 @@ bodies and constraint equations are. Inner derivatives (a user joint's Ḟ, the 
 by the complex step inside a sixth-order stencil
 (:func:`projeq.analysis.differentiation.derivative_along`), ≈ 1e-14 relative.
 
+The evaluation is the model's default one (:meth:`projeq.System.evaluator`): the compiled
+kernels where they take the model (:mod:`projeq.assembly.kernels`, numba's complex128
+specialization of the same source), all n columns in one compiled call where no Python runs
+between the kernels (the evaluator's ``state_jacobian``: trees of revolute, prismatic and
+fixed joints with elastic bodies, the hub beam), else column by column through its
+``accelerations``; the interpreted reference evaluators for the models the kernels do not take
+(their InterpretedWarning says so once) and for constrained systems.
+
 Why the complex step (docs/theory.md, "Exact derivatives", has the measured tables): it
 reuses the evaluation code unchanged (one source for s̈ and its derivatives) and costs n
-complex evaluations, measured at 2.5 (chain of 10), 2.6 (four-bar), 3.3 (Whipple bicycle,
-with its inner derivatives) and 1.1 (elastic arm) real ones each; a symbolic alternative
-costs more before the first number: sympy's KanesMethod derivation of the Whipple bicycle
-(tests/bicycle/kane_whipple.py) took 110 s, projeq's whole exact linearisation 3.4 s, in
-one run (``python benchmarks/jacobians.py`` measures the integrators).
+complex evaluations. Compiled, one ∂ẋ/∂x cost 17 (chain of 10, n = 20), 20 (flexible arm,
+n = 14) and 19 (spin-up beam, n = 16) real compiled evaluations of ẋ in one call, 24 for the
+flyball governor column by column (n = 8, force laws); forward differences on the compiled
+path (n + 1 evaluations, not exact) 35, 42, 50 and 18, the interpreted complex step 2306,
+3844, 689 and 271, in the same run (``python benchmarks/compiled_jacobians.py``). Interpreted, n complex evaluations cost
+2.6 (four-bar) and 3.3 (Whipple bicycle, with its inner derivatives) real interpreted ones
+each. A symbolic alternative costs more before the first number: sympy's KanesMethod
+derivation of the Whipple bicycle (tests/bicycle/kane_whipple.py) took 110 s, projeq's whole
+exact linearisation 3.4 s, in one run (``python benchmarks/jacobians.py`` measures the
+integrators).
 Central differences (``derivatives="differences"``) remain on request, e.g. for user
 callables that cannot take complex arguments (then they are used automatically).
 """

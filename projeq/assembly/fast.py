@@ -36,6 +36,12 @@ any other subsystem without rigid-body terms (beams in chains, a subsystem that 
 ``gauss_terms``) is refused with the piece named: it is evaluated by the reference ones
 (recursive, or dense for coupled joints).
 
+Complex arguments (the complex step of :mod:`projeq.analysis.jacobians`) run the same kernels,
+compiled by numba for complex128, on a complex workspace allocated on first use (force laws
+and joints of kind GIVEN state their numbers on it too); :meth:`FastEvaluator.state_jacobian`
+takes all columns of ∂ẋ/∂x in one compiled call (:func:`projeq.assembly.kernels.tree_jacobian`)
+where no Python runs between the kernels.
+
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.chain(3)
 >>> ev = FastEvaluator(system, compiled=False)
@@ -101,8 +107,9 @@ class FastEvaluator:
             if not (self._given or system.forces or system.coupled) else None
 
     def _pack(self, system) -> None:
-        """Flat arrays of the tree (built once; the workspaces, one per dtype, on first use); bodies are padded to the
-        largest n_y (6, or 6 + n_e of an elastic body) and joints to the most columns of F."""
+        """Flat arrays of the tree (built once) and the real workspace (a complex one on first use,
+        :class:`_Workspace`); bodies are padded to the largest n_y (6, or 6 + n_e of an elastic
+        body) and joints to the most columns of F."""
         N = len(system.joints)
         joints, bodies = system.joints, system.subsystems
         kind = [kernels.KINDS.get(j.compiled_kind, kernels.GIVEN) for j in joints]
@@ -144,6 +151,7 @@ class FastEvaluator:
         self._selected = [(n, S[n].T) for n in range(N) if S[n] is not None]
         self._S_rows = [None if S[n] is None else S[n].shape[0] for n in range(N)]
         self._workspaces = {}
+        self._real = self._workspace(float)
 
     def _workspace(self, dtype) -> _Workspace:
         """The workspace of ``dtype``: float, or complex for the complex step
@@ -201,8 +209,10 @@ class FastEvaluator:
 
     def _state(self, q, s_dot) -> tuple[NDArray, NDArray, _Workspace]:
         """q and ṡ as arrays of one dtype, float or complex (a complex step), and its workspace."""
-        dtype = complex if np.iscomplexobj(q) or np.iscomplexobj(s_dot) else float
-        return np.asarray(q, dtype=dtype), np.asarray(s_dot, dtype=dtype), self._workspace(dtype)
+        q, s_dot = np.asarray(q), np.asarray(s_dot)
+        if q.dtype.kind == "c" or s_dot.dtype.kind == "c":
+            return q.astype(complex, copy=False), s_dot.astype(complex, copy=False), self._workspace(complex)
+        return q.astype(float, copy=False), s_dot.astype(float, copy=False), self._real
 
     def _assembled(self, ws: _Workspace) -> tuple[NDArray, NDArray]:
         """M and b of the terms in the workspace: :func:`projeq.assembly.kernels.gauss_form` in

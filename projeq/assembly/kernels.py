@@ -2,7 +2,10 @@
 
 Plain Python on scalars and small arrays, written so that numba can compile it
 (:func:`kernel` with ``compiled=True`` applies ``numba.njit(cache=True)``); the same source
-runs interpreted with ``compiled=False``, so both are the same algorithm.
+runs interpreted with ``compiled=False``, so both are the same algorithm. The kernels are
+dtype-generic: called with complex128 workspaces (the complex step of
+:mod:`projeq.analysis.jacobians`) numba compiles a second specialization of the same source;
+their temporaries take the workspace's dtype and their pivot checks compare real parts.
 
 Joint kinds: ``FIXED`` (no dof), ``REVOLUTE`` (F⁶ = [0; e]), ``PRISMATIC`` (F⁶ = [e; 0]),
 about a unit axis e in joint-frame coordinates, and ``GIVEN``: any other joint, whose
@@ -708,8 +711,7 @@ def jacobian_kernel(compiled: bool = True, rigid: bool = False):
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
-            _add_congruence, _add_congruence_general, _cholesky, _cholesky_solve, elastic_body, port_motion,
-            chain_terms, passes, hub_beam)
+            _add_congruence, _add_congruence_general, _cholesky, _cholesky_solve, elastic_body, port_motion)
 
 
 @functools.cache
@@ -717,8 +719,11 @@ def _compiled():
     """chain_terms, passes, the rigid trees' passes (:func:`kernel`) and the Jacobians of both
     (:func:`jacobian_kernel`) compiled by numba, once per process (and cached on disk;
     numba compiles each for the dtype it is called with, float64 or complex128, on first use)."""
-    return _jit(chain_terms, passes, tree_jacobian) \
-        + _jit(passes, tree_jacobian, names=("rigid_passes", "rigid_tree_jacobian"), _rows=_six)
+    chain, general = _jit(chain_terms, passes)
+    rigid = _jit(passes, names=("rigid_passes",), _rows=_six)[0]
+    jacobians = [_jit(tree_jacobian, names=(name,), kernels={"chain_terms": chain, "passes": passes_})[0]
+                 for name, passes_ in (("tree_jacobian", general), ("rigid_tree_jacobian", rigid))]
+    return chain, general, jacobians[0], rigid, jacobians[1]
 
 
 def gauss_form_kernel(compiled: bool = True):
@@ -750,7 +755,8 @@ def hub_beam_jacobian_kernel(compiled: bool = True):
 
 @functools.cache
 def _compiled_hub_beam():
-    return _jit(hub_beam, hub_beam_jacobian)
+    kernel = _jit(hub_beam)[0]
+    return kernel, _jit(hub_beam_jacobian, kernels={"hub_beam": kernel})[0]
 
 
 @functools.cache
@@ -758,14 +764,15 @@ def _compiled_gauss_form():
     return _jit(gauss_form, projected_accelerations)
 
 
-def _jit(*kernels, names=(), **replaced):
-    """The ``kernels`` compiled by numba (cached on disk, under ``names`` if given).
+def _jit(*functions, names=(), kernels=None, **replaced):
+    """The ``functions`` compiled by numba (cached on disk, under ``names`` if given).
 
-    Compiled code resolves the functions it calls in its globals, so the kernels are
+    Compiled code resolves the functions it calls in its globals, so the functions are
     compiled as copies whose globals are a copy of this module's namespace holding numba's
     versions of their callees (``replaced``: another function under a callee's name, as
-    :func:`_six` for ``_rows`` in the rigid passes); this module's functions stay plain
-    Python (nothing rebound)."""
+    :func:`_six` for ``_rows`` in the rigid passes) and the compiled ``kernels`` they call by
+    name (the Jacobians call the kernels' own dispatchers: each specialization is compiled
+    once, and shared); this module's functions stay plain Python (nothing rebound)."""
     numba = _numba()
     namespace = dict(globals())
 
@@ -776,5 +783,6 @@ def _jit(*kernels, names=(), **replaced):
 
     for f in _CALLEES:
         namespace[f.__name__] = numba.extending.register_jitable(rebound(replaced.get(f.__name__, f)))
+    namespace.update(kernels or {})
     jit = numba.njit(cache=True)
-    return tuple(jit(rebound(f, name)) for f, name in zip(kernels, names or (None,) * len(kernels)))
+    return tuple(jit(rebound(f, name)) for f, name in zip(functions, names or (None,) * len(functions)))
