@@ -20,13 +20,13 @@ fixed joints with elastic bodies, the hub beam), else column by column through i
 
 Why the complex step (docs/theory.md, "Exact derivatives", has the measured tables): it
 reuses the evaluation code unchanged (one source for s̈ and its derivatives) and costs n
-complex evaluations. Compiled, one ∂ẋ/∂x cost 17 (chain of 10, n = 20), 20 (flexible arm,
-n = 14) and 19 (spin-up beam, n = 16) real compiled evaluations of ẋ in one call, 24 for the
+complex evaluations. Compiled, one ∂ẋ/∂x cost 18 (chain of 10, n = 20), 17 (flexible arm,
+n = 14) and 13 (spin-up beam, n = 16) real compiled evaluations of ẋ in one call, 11 for the
 flyball governor column by column (n = 8, force laws); forward differences on the compiled
-path (n + 1 evaluations, not exact) 35, 42, 50 and 18, the interpreted complex step 2306,
-3844, 689 and 271, in the same run (``python benchmarks/compiled_jacobians.py``). Interpreted, n complex evaluations cost
-2.6 (four-bar) and 3.3 (Whipple bicycle, with its inner derivatives) real interpreted ones
-each. A symbolic alternative costs more before the first number: sympy's KanesMethod
+path (n + 1 evaluations, not exact) 62, 21, 27 and 11, the interpreted complex step 1517,
+1090, 249 and 64, in the same run (``python benchmarks/compiled_jacobians.py``).
+Interpreted, n complex evaluations cost 2.6 (four-bar) and 3.3 (Whipple bicycle, with its
+inner derivatives) real interpreted ones each. A symbolic alternative costs more before the first number: sympy's KanesMethod
 derivation of the Whipple bicycle (tests/bicycle/kane_whipple.py) took 110 s, projeq's whole
 exact linearisation 3.4 s, in one run (``python benchmarks/jacobians.py`` measures the
 integrators).
