@@ -26,10 +26,10 @@ flyball governor column by column (n = 8, force laws); forward differences on th
 path (n + 1 evaluations, not exact) 62, 21, 27 and 11, the interpreted complex step 1517,
 1090, 249 and 64, in the same run (``python benchmarks/compiled_jacobians.py``).
 Interpreted, n complex evaluations cost 2.6 (four-bar) and 3.3 (Whipple bicycle, with its
-inner derivatives) real interpreted ones each. A symbolic alternative costs more before the first number: sympy's KanesMethod
-derivation of the Whipple bicycle (tests/bicycle/kane_whipple.py) took 110 s, projeq's whole
-exact linearisation 3.4 s, in one run (``python benchmarks/jacobians.py`` measures the
-integrators).
+inner derivatives) real interpreted ones each. A symbolic alternative costs more before the
+first number: sympy's KanesMethod derivation of the Whipple bicycle
+(tests/bicycle/kane_whipple.py) took 110 s, projeq's whole exact linearisation 3.4 s, in one
+run (``python benchmarks/jacobians.py`` measures the integrators).
 Central differences (``derivatives="differences"``) remain on request, e.g. for user
 callables that cannot take complex arguments (then they are used automatically).
 """
