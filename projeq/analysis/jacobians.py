@@ -60,7 +60,8 @@ class StateJacobians(NamedTuple):
 def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, inputs=()) -> NDArray:
     """ẋ = (q̇, s̈) at x = (q, ṡ); ``tau`` are generalized forces on the joints ``inputs``
     (added to Q of the Gauss form M s̈ + b = Q; for a ConstrainedSystem projected with its F,
-    Fᵀ Q_tree). Complex-safe."""
+    Fᵀ Q_tree). s̈ by the model's default evaluator (the compiled kernels where they take the
+    model, their complex128 specialization under a complex step). Complex-safe."""
     q, s_dot = x[: system.n_q], x[system.n_q :]
     if tau is None or not len(inputs):
         s_ddot = system.evaluator(None).accelerations(q, s_dot, t)
