@@ -32,7 +32,7 @@ def models():
 
 
 def run(system, method, jac, t_end, rtol):
-    evaluator = system.evaluator()
+    evaluator = system.evaluator().evaluator  # the one "auto" picked: it counts its calls, complex ones too
     before = evaluator.n_calls
     start = time.perf_counter()
     try:

@@ -10,13 +10,26 @@ bodies and constraint equations are. Inner derivatives (a user joint's Ḟ, the 
 by the complex step inside a sixth-order stencil
 (:func:`projeq.analysis.differentiation.derivative_along`), ≈ 1e-14 relative.
 
+The evaluation is the model's default one (:meth:`projeq.System.evaluator`): the compiled
+kernels where they take the model (:mod:`projeq.assembly.kernels`, numba's complex128
+specialization of the same source), all n columns in one compiled call where no Python runs
+between the kernels (the evaluator's ``state_jacobian``: trees of revolute, prismatic and
+fixed joints with elastic bodies, the hub beam), else column by column through its
+``accelerations``; the interpreted reference evaluators for the models the kernels do not take
+(their InterpretedWarning says so once) and for constrained systems.
+
 Why the complex step (docs/theory.md, "Exact derivatives", has the measured tables): it
 reuses the evaluation code unchanged (one source for s̈ and its derivatives) and costs n
-complex evaluations, measured at 2.5 (chain of 10), 2.6 (four-bar), 3.3 (Whipple bicycle,
-with its inner derivatives) and 1.1 (elastic arm) real ones each; a symbolic alternative
-costs more before the first number: sympy's KanesMethod derivation of the Whipple bicycle
-(tests/bicycle/kane_whipple.py) took 110 s, projeq's whole exact linearisation 3.4 s, in
-one run (``python benchmarks/jacobians.py`` measures the integrators).
+complex evaluations. Compiled, one ∂ẋ/∂x cost 18 (chain of 10, n = 20), 17 (flexible arm,
+n = 14) and 13 (spin-up beam, n = 16) real compiled evaluations of ẋ in one call, 11 for the
+flyball governor column by column (n = 8, force laws); forward differences on the compiled
+path (n + 1 evaluations, not exact) 62, 21, 27 and 11, the interpreted complex step 1517,
+1090, 249 and 64, in the same run (``python benchmarks/compiled_jacobians.py``).
+Interpreted, n complex evaluations cost 2.6 (four-bar) and 3.3 (Whipple bicycle, with its
+inner derivatives) real interpreted ones each. A symbolic alternative costs more before the
+first number: sympy's KanesMethod derivation of the Whipple bicycle
+(tests/bicycle/kane_whipple.py) took 110 s, projeq's whole exact linearisation 3.4 s, in one
+run (``python benchmarks/jacobians.py`` measures the integrators).
 Central differences (``derivatives="differences"``) remain on request, e.g. for user
 callables that cannot take complex arguments (then they are used automatically).
 """
@@ -29,7 +42,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import exact_jacobian, jacobian
-from projeq.assembly.beam_fast import hub_beam_unsupported
 
 DERIVATIVES = ("exact", "differences")
 
@@ -48,27 +60,16 @@ class StateJacobians(NamedTuple):
 def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, inputs=()) -> NDArray:
     """ẋ = (q̇, s̈) at x = (q, ṡ); ``tau`` are generalized forces on the joints ``inputs``
     (added to Q of the Gauss form M s̈ + b = Q; for a ConstrainedSystem projected with its F,
-    Fᵀ Q_tree). Complex-safe."""
+    Fᵀ Q_tree). s̈ by the model's default evaluator (the compiled kernels where they take the
+    model, their complex128 specialization under a complex step). Complex-safe."""
     q, s_dot = x[: system.n_q], x[system.n_q :]
     if tau is None or not len(inputs):
-        s_ddot = interpreted_evaluator(system).accelerations(q, s_dot, t)
+        s_ddot = system.evaluator(None).accelerations(q, s_dot, t)
     else:
         M, b = system.gauss_form(q, s_dot, t)
         split = np.split(tau, np.cumsum([system.joint(j).n_s for j in inputs])[:-1])
         s_ddot = np.linalg.solve(M, system.generalized_force(q, t, dict(zip(inputs, split))) - b)
     return np.concatenate((system.q_dot(q, s_dot, t), s_ddot))
-
-
-def interpreted_evaluator(system):
-    """The model's evaluator that takes complex arguments (the compiled kernel does not): the
-    beam-on-a-hub path where it applies (numpy, :mod:`projeq.assembly.beam_fast`; 2–3× faster
-    than the general path there), else recursive, or dense for coupled joints; a
-    ConstrainedSystem's default."""
-    if system.tree is not system:
-        return system.evaluator(None)
-    if hub_beam_unsupported(system) is None:
-        return system.evaluator("hub_beam")
-    return system.evaluator("dense" if system.coupled else "recursive")
 
 
 def differentiate(f, z0: NDArray, derivatives: str = "exact") -> tuple[NDArray, str]:
@@ -86,13 +87,27 @@ def differentiate(f, z0: NDArray, derivatives: str = "exact") -> tuple[NDArray, 
     return jacobian(f, z0), "differences"
 
 
+def state_jacobian(system, x: NDArray, t: float, derivatives: str = "exact") -> tuple[NDArray, str]:
+    """(∂ẋ/∂x at (x, t), the method used) of ẋ = (q̇, s̈) (:func:`state_derivative`): by the
+    complex step through the model's default evaluator — all columns in one compiled call where
+    it has one (its ``state_jacobian``: the order-n kernel without Python between its calls, the
+    hub beam), else column by column through its ``accelerations`` (compiled, complex128, where
+    the kernels take the model) — as :func:`differentiate` says."""
+    if derivatives == "exact":
+        one_call = getattr(system.evaluator(None), "state_jacobian", None)
+        J = None if one_call is None else one_call(t, np.asarray(x, dtype=float))
+        if J is not None:
+            return J, "exact"
+    return differentiate(lambda y: state_derivative(system, y, t), x, derivatives)
+
+
 def state_jacobians(system, q: NDArray, s_dot: NDArray, t: float = 0.0, inputs=(),
                     derivatives: str = "exact") -> StateJacobians:
     """The Jacobians of q̇ and s̈ at (q, ṡ, t) (module docstring); ``inputs`` name the joints
     whose generalized forces τ are differentiated for (∂s̈/∂τ, zero columns without)."""
     q, s_dot = system.check_state(q, s_dot, t)
     x0 = np.concatenate((q, s_dot))
-    J, used = differentiate(lambda x: state_derivative(system, x, t), x0, derivatives)
+    J, used = state_jacobian(system, x0, t, derivatives)
     n_u = sum(system.joint(name).n_s for name in inputs)
     B, used_B = differentiate(lambda u: state_derivative(system, x0, t, u, inputs), np.zeros(n_u), used)
     n_q = system.n_q

@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.analysis.jacobians import differentiate, state_derivative
+from projeq.analysis.jacobians import differentiate, state_derivative, state_jacobian
 from projeq.system import check_model
 
 _TOL = 1e-8  # relative threshold: zero columns of A, and the steady-motion residual
@@ -136,7 +136,7 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
     q, s_dot = system.check_state(q, s_dot, t)
     inputs = _check_inputs(system, inputs)
     x0 = np.concatenate((q, s_dot))
-    A, derivatives = differentiate(lambda x: state_derivative(system, x, t), x0, derivatives)
+    A, derivatives = state_jacobian(system, x0, t, derivatives)
     names = system.state_names()
     dropped = _dropped(system, names, A, ignore, tol)
     kept = [i for i in range(len(x0)) if i not in dropped]
@@ -203,7 +203,7 @@ def _check_invariant(system, x0, x_dot, t, A, dropped, kept, names, derivatives)
     if not np.any(rates):
         return  # an equilibrium: nothing moves
     shifted = x0 + rates / np.abs(rates).max()
-    A_shifted = differentiate(lambda x: state_derivative(system, x, t), shifted, derivatives)[0][np.ix_(kept, kept)]
+    A_shifted = state_jacobian(system, shifted, t, derivatives)[0][np.ix_(kept, kept)]
     change = np.abs(A_shifted - A[np.ix_(kept, kept)]).max()
     if change > 1e-6 * max(1.0, np.abs(A).max()):
         moving = [names[i] for i in dropped if x_dot[i]]

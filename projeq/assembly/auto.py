@@ -67,7 +67,7 @@ class AutoEvaluator:
 
     Attributes: ``name`` (of the picked evaluator: "fast", "hub_beam", "dense" or
     "recursive"), ``reason`` (why), ``evaluator`` (the picked evaluator, which counts the calls);
-    ``accelerations`` and, where the picked one has it, ``state_derivative`` are the picked
+    ``accelerations`` and, where the picked one has them, ``state_derivative`` and ``state_jacobian`` are the picked
     evaluator's own (called without a layer between).
     """
 
@@ -77,6 +77,8 @@ class AutoEvaluator:
         self.accelerations = self.evaluator.accelerations  # the picked one's, called directly (one layer less per s̈)
         if hasattr(self.evaluator, "state_derivative"):  # ẋ in one call (projeq.simulate's right-hand side)
             self.state_derivative = self.evaluator.state_derivative
+        if hasattr(self.evaluator, "state_jacobian"):  # ∂ẋ/∂x in one call (projeq.analysis.jacobians)
+            self.state_jacobian = self.evaluator.state_jacobian
         if self.name in ("dense", "recursive"):
             warnings.warn(
                 f"system: evaluated by the interpreted {self.name!r} evaluator, not the compiled one: "

@@ -23,8 +23,9 @@ a Fixed joint or any joint without coordinates (read by its ``relative_values``)
 call of :func:`projeq.assembly.kernels.hub_beam` per s̈. Any other subsystem with internal
 coordinates and the beam's layout ẏ = (twist, q̇_e) (a beam with rotary inertia or
 torsion, a user's subsystem) takes the interpreted path through its ``elastic_terms``
-(:class:`projeq.Subsystem`: by default the last n_e rows of its own ``gauss_terms``), and
-so do complex arguments (the complex-step derivatives of :mod:`projeq.analysis.jacobians`).
+(:class:`projeq.Subsystem`: by default the last n_e rows of its own ``gauss_terms``).
+Complex arguments (the complex-step derivatives of :mod:`projeq.analysis.jacobians`) take
+the same kernel, compiled for complex128 (a second specialization of the same source).
 
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.spin_up_beam(omega_s=4.0, n_shapes=2, family="clamped_free")
@@ -41,6 +42,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import kernels
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.joints import Prescribed
@@ -136,17 +138,19 @@ class HubBeamEvaluator:
         self._field = (np.array(beam.mass_weights, dtype=float), *(np.ascontiguousarray(a) for a in beam.slice_field()),
                        np.array(beam.K_e, dtype=float), float(beam.damping))
         n_y = 6 + beam.n_e
-        self._M, self._h = np.zeros((n_y, n_y)), np.zeros(n_y)
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
-        self._kernel = kernels.hub_beam_kernel(True)
-        # the kernel's arguments before and after the state, packed once (the hub's rows are overwritten in place)
+        self._kernel, self._jacobian = kernels.hub_beam_kernel(True), kernels.hub_beam_jacobian_kernel(True)
+        # the kernel's arguments before and after the state, packed once (the hub's rows are overwritten in
+        # place); after it the workspace M_n, h_n, one per dtype (complex for the complex step)
         self._head = (self._kind, self._axis, self._angles, self._given, self._orientation, self._gravity, *self._field)
-        self._tail = (self._pivot_min, self._M, self._h)
+        self._tail = {np.dtype(dtype): (self._pivot_min, np.zeros((n_y, n_y), dtype), np.zeros(n_y, dtype))
+                      for dtype in (float, complex)}
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) at (q, ṡ, t) = (q_e, q̇_e, t)."""
-        if self.compiled and np.asarray(q).dtype.kind != "c" and np.asarray(s_dot).dtype.kind != "c":
-            x = np.concatenate((q, s_dot)).astype(float)
+        if self.compiled:
+            x = np.concatenate((q, s_dot))
+            x = x.astype(complex if x.dtype.kind == "c" else float)
             x_dot, status = self._compiled(x, t)
             if status >= 0 and not np.all(np.isfinite(x)):
                 raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no mass "
@@ -170,19 +174,36 @@ class HubBeamEvaluator:
         x_dot, status = self._compiled(x, t)
         return x_dot if status < 0 else None
 
-    def _compiled(self, x: NDArray, t: float) -> tuple[NDArray, int]:
-        """(ẋ, status) of :func:`projeq.assembly.kernels.hub_beam` at (x, t): the hub's (θ, θ̇, θ̈) of
-        a Prescribed joint (its checked ``angles``) or the numbers of its ``relative_values``,
-        then one compiled call; SingularMassError where it finds M_ee singular (status 0)."""
-        self.n_calls += 1
-        kind = self._kind
-        if kind == kernels.GIVEN:
+    def state_jacobian(self, t: float, x: NDArray) -> NDArray | None:
+        """∂ẋ/∂x at the real state x = (q_e, q̇_e) by the complex step through the kernel,
+        :func:`projeq.assembly.kernels.hub_beam_jacobian`: all n_x columns in one call on the
+        complex workspace; None when the path is interpreted or the kernel stops (M_ee singular,
+        x or ẋ not finite: the caller's evaluation then raises, naming it)."""
+        if not self.compiled:
+            return None
+        self._hub(t)
+        self.n_calls += len(x)
+        J = np.empty((len(x), len(x)))
+        status = self._jacobian(*self._head, np.asarray(x, dtype=float), COMPLEX_STEP, *self._tail[np.dtype(complex)], J)
+        return J if status < 0 else None
+
+    def _hub(self, t: float) -> None:
+        """The hub's (θ, θ̇, θ̈) of a Prescribed joint (its checked ``angles``) or the numbers of
+        its ``relative_values`` at t into the kernel's rows."""
+        if self._kind == kernels.GIVEN:
             self._given[:] = self.joint.relative_values(self._empty, self._empty, t)[:24]
-        elif kind != kernels.FIXED:
+        elif self._kind != kernels.FIXED:
             angles = self._angles
             angles[0], angles[1], angles[2] = self.joint.angles(t)
-        x_dot = np.empty(x.shape[0])
-        status = self._kernel(*self._head, x, *self._tail, x_dot)
+
+    def _compiled(self, x: NDArray, t: float) -> tuple[NDArray, int]:
+        """(ẋ, status) of :func:`projeq.assembly.kernels.hub_beam` at (x, t): the hub's motion
+        (:meth:`_hub`), then one compiled call; SingularMassError where it finds M_ee singular
+        (status 0)."""
+        self.n_calls += 1
+        self._hub(t)
+        x_dot = np.empty(x.shape[0], x.dtype)
+        status = self._kernel(*self._head, x, *self._tail[x.dtype], x_dot)
         if status == 0:
             raise SingularMassError(f"M_ee of subsystem {self.system.names[0]!r} is singular or indefinite at "
                                     f"t = {t:.6g}: the state has left the range the model describes")

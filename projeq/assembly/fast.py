@@ -38,6 +38,12 @@ any other subsystem without rigid-body terms (beams in chains, a subsystem that 
 ``gauss_terms``) is refused with the piece named: it is evaluated by the reference ones
 (recursive, or dense for coupled joints).
 
+Complex arguments (the complex step of :mod:`projeq.analysis.jacobians`) run the same kernels,
+compiled by numba for complex128, on a complex workspace allocated on first use (force laws
+and joints of kind GIVEN state their numbers on it too); :meth:`FastEvaluator.state_jacobian`
+takes all columns of ∂ẋ/∂x in one compiled call (:func:`projeq.assembly.kernels.tree_jacobian`)
+where no Python runs between the kernels.
+
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.chain(3)
 >>> ev = FastEvaluator(system, compiled=False)
@@ -55,6 +61,7 @@ import functools
 import numpy as np
 from numpy.typing import NDArray
 
+from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import kernels, loads
 from projeq.assembly.beam_fast import elastic_unsupported, hub_beam_unsupported
 from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
@@ -97,10 +104,15 @@ class FastEvaluator:
         rigid = bool(np.all(self._index[:, kernels.N_Y] == 6))
         self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=rigid)
         self._add_loads = loads.kernel(self.compiled) if len(self._laws) else None
+        # ∂ẋ/∂x in one call where no Python runs between the kernels (no joint of kind GIVEN, no
+        # force law, no coupling): then every joint has q̇ = ṡ (K = E)
+        self._jacobian = kernels.jacobian_kernel(self.compiled, rigid=rigid) \
+            if not (self._given or system.forces or system.coupled) else None
 
     def _pack(self, system) -> None:
-        """Flat arrays of the tree (built once) and the workspace; bodies are padded to the
-        largest n_y (6, or 6 + n_e of an elastic body) and joints to the most columns of F."""
+        """Flat arrays of the tree (built once) and the real workspace (a complex one on first use,
+        :class:`_Workspace`); bodies are padded to the largest n_y (6, or 6 + n_e of an elastic
+        body) and joints to the most columns of F."""
         N = len(system.joints)
         joints, bodies = system.joints, system.subsystems
         kind = [kernels.KINDS.get(j.compiled_kind, kernels.GIVEN) for j in joints]
@@ -120,122 +132,125 @@ class FastEvaluator:
             for n, (k, j) in enumerate(zip(kind, joints))
         ], dtype=float).reshape(N, 5, 3)  # the rows kernels.AXIS, OFFSET, ORIENTATION
         self._expansion = _expansion(system) if system.coupled else None
-        n_all = sum(n_cols)
-        self._M_all, self._b_all, self._M = np.zeros((n_all, n_all)), np.zeros(n_all), np.zeros((system.n_s,) * 2)
+        self._n_all = sum(n_cols)
         rigid = [b.rigid_inertia or (0.0, np.zeros(3), np.zeros((3, 3))) for b in bodies]
         self._inertia = np.array([[r_c, *I_c, (m, 0.0, 0.0)] for m, r_c, I_c in rigid],
                                  dtype=float).reshape(N, 5, 3)  # the rows kernels.CENTRE, INERTIA, MASS
         self._elastic, self._ports = _elastic_fields(system), _port_fields(system)
-        width, depth = 6 + max(b.n_e for b in bodies), max(6, max(n_cols))
-        self._M_n = np.zeros((N, width, width))
-        self._M_n[:, :6, :6] = [rigid_mass_matrix(*inertia) for inertia in rigid]
+        self._width, self._depth = 6 + max(b.n_e for b in bodies), max(6, max(n_cols))
+        self._rigid_M = [rigid_mass_matrix(*inertia) for inertia in rigid]
         self._gravity = np.asarray(system.gravity, dtype=float)
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
-        # one row per joint for its relative_values (A, r, w, ζ, F⁶ by columns), read by the kernel
-        # (the entries kernels.GIVEN_A ... GIVEN_F); F⁶ through the view given_F (given_F[n, :, j] =
-        # column j), which is F itself unless elastic bodies make F wider (n_y rows, their q̇_e
-        # columns): then F takes the given columns
-        values = self._given_values = np.zeros((N, kernels.GIVEN_F + 36))
-        self._given_F = values[:, kernels.GIVEN_F:].reshape(N, 6, 6).transpose(0, 2, 1)
-        self._F = self._given_F if (width, depth) == (6, 6) else np.zeros((N, width, depth))
         self._given_plan = [
             (n, joints[n], slice(q_index[n], q_index[n] + joints[n].n_q),
              slice(s_index[n], s_index[n] + joints[n].n_s), kernels.GIVEN_F + 6 * joints[n].n_s)
             for n in self._given
         ]
-        self._T, self._zeta = np.zeros((N, width, width)), np.zeros((N, width))
-        self._M_hat, self._h_hat = np.zeros((N, width, width)), np.zeros((N + 1, width))
-        self._R, self._r, self._twist = np.zeros((N + 1, 3, 3)), np.zeros((N + 1, 3)), np.zeros((N + 1, 6))
+        self._n_cols = n_cols
         terms = [law.compiled_terms() for law in system.forces]
         self._laws, self._law_constants = loads.table([row for row in terms if row is not None])
         self._python_laws = [law for law, row in zip(system.forces, terms) if row is None]  # their own add_to
-        self._kin = _WorkspaceKinematics(n_cols, self._R, self._r, self._twist, self._F, self._T, self._zeta) \
-            if self._python_laws else None
         # the h_n the force laws load in the reference evaluators' coordinates: rows of n_y for
         # the bodies with a selection S (zeroed before each evaluation), the workspace's rows for
         # the others, none for the ground
         S = system.S[:-1]
         self._selected = [(n, S[n].T) for n in range(N) if S[n] is not None]
-        self._h_S = np.zeros((N, max((S_T.shape[1] for _, S_T in self._selected), default=0)))
-        self._h_loaded = [self._h_S[n, :S[n].shape[0]] if S[n] is not None else self._h_hat[n]
-                          for n in range(N)] + [np.zeros(0)]
+        self._S_rows = [None if S[n] is None else S[n].shape[0] for n in range(N)]
+        self._workspaces = {}
+        self._real = self._workspace(float)
 
-    def _relative_motions(self, q_all: NDArray, s_all: NDArray, t: float) -> None:
+    def _workspace(self, dtype) -> _Workspace:
+        """The workspace of ``dtype``: float, or complex for the complex step
+        (:mod:`projeq.analysis.jacobians`), allocated on first use and overwritten by every call."""
+        dtype = np.dtype(dtype)
+        if dtype not in self._workspaces:
+            self._workspaces[dtype] = _Workspace(self, dtype)
+        return self._workspaces[dtype]
+
+    def _relative_motions(self, ws: _Workspace, q_all: NDArray, s_all: NDArray, t: float) -> None:
         """A, r, w, ζ and F⁶ of the joints of kind GIVEN, by their own ``relative_values`` (the
         numbers of the ``relative`` the reference evaluators call), one row each."""
-        values = self._given_values
+        values = ws.given_values
         for n, joint, q_n, s_n, width in self._given_plan:
             values[n, :width] = joint.relative_values(q_all[q_n], s_all[s_n], t)
-            if self._F is not self._given_F:
-                self._F[n, :6, :6] = self._given_F[n]
+            if ws.F is not ws.given_F:
+                ws.F[n, :6, :6] = ws.given_F[n]
 
-    def _add_forces(self, q: NDArray, s_dot: NDArray, t: float) -> None:
+    def _add_forces(self, ws: _Workspace, q: NDArray, s_dot: NDArray, t: float) -> None:
         """The own ``add_to`` of the laws without a compiled row (a callable load, a user's
         law) on the kernel's kinematics (T̃_np = [[T_np, ζ_n], [0, 1]] from the workspace when a law reads
         it); bodies with a selection S take their loads in their own coordinates (h_n += Sᵀ h_S)."""
-        kin, h = self._kin, self._h_hat
+        kin, h = ws.kin, ws.h_hat
         kin.stale = True
         h[-1] = 0.0  # the ground's row: reactions land there, nothing reads them
         if self._selected:
-            self._h_S[:] = 0.0
-            kin, h = _SelectedKinematics(self.system, kin, s_dot), self._h_loaded
+            ws.h_S[:] = 0.0
+            kin, h = _SelectedKinematics(self.system, kin, s_dot), ws.h_loaded
         for force in self._python_laws:
             force.add_to(h, kin, t, q, s_dot)
         for n, S_T in self._selected:
-            self._h_hat[n] += S_T @ h[n]
+            ws.h_hat[n] += S_T @ h[n]
 
-    def _terms(self, q: NDArray, s_dot: NDArray, t: float) -> None:
-        """T_np, ζ_n, F_n, h_n (forces included) of every body into the workspace."""
+    def _terms(self, ws: _Workspace, q: NDArray, s_dot: NDArray, t: float) -> None:
+        """T_np, ζ_n, F_n, h_n (forces included) of every body into the workspace ``ws``."""
         q_all, s_all = (q, s_dot) if self._expansion is None else (self._expansion[0] @ q, self._expansion[1] @ s_dot)
         if self._given:
-            self._relative_motions(q_all, s_all, t)
+            self._relative_motions(ws, q_all, s_all, t)
         self._chain_terms(
-            self._index, self._geometry, self._inertia, self._gravity, q_all, s_all, self._given_values,
-            self._elastic, self._ports, self._T, self._zeta, self._F, self._M_n, self._h_hat, self._R, self._r,
-            self._twist,
+            self._index, self._geometry, self._inertia, self._gravity, q_all, s_all, ws.given_values,
+            self._elastic, self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist,
         )
         if self._add_loads is not None:
-            failed = self._add_loads(self._laws, self._law_constants, self._index, q_all, s_all, self._R, self._r,
-                                     self._twist, self._F, self._T, self._h_hat)
+            failed = self._add_loads(self._laws, self._law_constants, self._index, q_all, s_all, ws.R, ws.r,
+                                     ws.twist, ws.F, ws.T, ws.h_hat)
             if failed >= 0:
                 self.system.evaluator("recursive").accelerations(q, s_dot, t)  # the law's add_to says why
                 raise ValueError(f"forces: law {failed} of the compiled ones cannot be evaluated at t = {t:.6g}")
-        if self._kin is not None:
-            self._add_forces(q, s_dot, t)
+        if ws.kin is not None:
+            self._add_forces(ws, q, s_dot, t)
 
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
         """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels (by
         the dense evaluator for a tree with elastic bodies, which the Gauss-form kernel does not take)."""
-        if self._M_n.shape[1] > 6:
+        if self._width > 6:
             return self.system.evaluator("dense").gauss_form(q, s_dot, t)
         self.n_calls += 1
-        self._terms(np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), t)
-        return self._assembled()
+        q, s_dot, ws = self._state(q, s_dot)
+        self._terms(ws, q, s_dot, t)
+        return self._assembled(ws)
 
-    def _assembled(self) -> tuple[NDArray, NDArray]:
+    def _state(self, q, s_dot) -> tuple[NDArray, NDArray, _Workspace]:
+        """q and ṡ as arrays of one dtype, float or complex (a complex step), and its workspace."""
+        q, s_dot = np.asarray(q), np.asarray(s_dot)
+        if q.dtype.kind == "c" or s_dot.dtype.kind == "c":
+            return q.astype(complex, copy=False), s_dot.astype(complex, copy=False), self._workspace(complex)
+        return q.astype(float, copy=False), s_dot.astype(float, copy=False), self._real
+
+    def _assembled(self, ws: _Workspace) -> tuple[NDArray, NDArray]:
         """M and b of the terms in the workspace: :func:`projeq.assembly.kernels.gauss_form` in
         every joint's own velocities, projected with P for coupled joints."""
-        M, b = self._M_all, self._b_all
-        self._gauss_form(self._index, self._T, self._zeta, self._F, self._M_n, self._h_hat, M, b)
+        M, b = ws.M_all, ws.b_all
+        self._gauss_form(self._index, ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, M, b)
         if self._expansion is None:
             return M.copy(), b.copy()
         P = self._expansion[1]
         return P.T @ M @ P, P.T @ b
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        """s̈ at (q, ṡ, t) (docs/theory.md §6; −M⁻¹ b for coupled joints); raises
+        """s̈ at (q, ṡ, t) (docs/theory.md §6; −M⁻¹ b for coupled joints), complex for complex
+        arguments (the complex step of :mod:`projeq.analysis.jacobians`); raises
         SingularMassError for a zero pivot of D_n (of M)."""
         self.n_calls += 1
-        q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
-        self._terms(q, s_dot, t)
-        s_ddot = np.empty(self.system.n_s)
+        q, s_dot, ws = self._state(q, s_dot)
+        self._terms(ws, q, s_dot, t)
+        s_ddot = np.empty(self.system.n_s, dtype=q.dtype)
         if self._expansion is not None:
-            self._assembled()
-            failed = self._projected_accelerations(self._M_all, self._b_all, self._expansion[1], self._pivot_min,
-                                                   self._M, s_ddot)
+            self._assembled(ws)
+            failed = self._projected_accelerations(ws.M_all, ws.b_all, self._expansion[1], self._pivot_min, ws.M,
+                                                   s_ddot)
         else:
-            failed = self._passes(self._index, self._T, self._zeta, self._F, self._M_n, self._M_hat, self._h_hat,
-                                  self._pivot_min, s_ddot)
+            failed = self._passes(self._index, ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat, self._pivot_min,
+                                  s_ddot)
         if failed >= 0 and not (np.all(np.isfinite(q)) and np.all(np.isfinite(s_dot))):
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no pivot D_n "
                                      "can be formed, which no mass matrix explains")
@@ -249,6 +264,53 @@ class FastEvaluator:
                 "it moves no mass or inertia"
             )
         return s_ddot
+
+
+    def state_jacobian(self, t: float, x: NDArray) -> NDArray | None:
+        """∂ẋ/∂x at the real state x = (q, ṡ) by the complex step through the kernels,
+        :func:`projeq.assembly.kernels.tree_jacobian`: all n_x columns of ∂s̈/∂x in one call on
+        the complex workspace, ∂q̇/∂x = [0, E] (q̇ = ṡ); None where Python runs between the
+        kernels (joints of kind GIVEN, force laws, coupled joints: the caller takes the complex
+        step column by column through :meth:`accelerations`) or a pivot is singular (the caller's
+        evaluation then raises, naming it)."""
+        if self._jacobian is None:
+            return None
+        self.n_calls += len(x)
+        ws, n_q = self._workspace(complex), self.system.n_q
+        J = np.zeros((len(x), len(x)))
+        J[:n_q, n_q:] = np.eye(n_q)
+        failed = self._jacobian(self._index, self._geometry, self._inertia, self._gravity, np.asarray(x, dtype=float),
+                                n_q, COMPLEX_STEP, ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F,
+                                ws.M_n, ws.M_hat, ws.h_hat, ws.R, ws.r, ws.twist, self._pivot_min, J[n_q:])
+        return J if failed < 0 else None
+
+
+class _Workspace:
+    """The arrays one evaluation of :class:`FastEvaluator` overwrites, of one dtype (float, or
+    complex for the complex step): T_np, ζ_n, F_n, M_n, M̂_n, ĥ_n, the poses and twists, one
+    row per joint of kind GIVEN for its ``relative_values`` (A, r, w, ζ, F⁶ by columns: the
+    entries kernels.GIVEN_A ... GIVEN_F, F⁶ through the view ``given_F``, given_F[n, :, j] =
+    column j, which is F itself unless elastic bodies make F wider (n_y rows, their q̇_e
+    columns): then F takes the given columns), the Gauss form's M and b, and the force laws'
+    kinematics and loads."""
+
+    def __init__(self, ev: FastEvaluator, dtype):
+        N, width, depth = len(ev._rigid_M), ev._width, ev._depth
+        self.M_all, self.b_all = np.zeros((ev._n_all, ev._n_all), dtype), np.zeros(ev._n_all, dtype)
+        self.M = np.zeros((ev.system.n_s,) * 2, dtype)
+        self.M_n = np.zeros((N, width, width), dtype)
+        self.M_n[:, :6, :6] = ev._rigid_M
+        values = self.given_values = np.zeros((N, kernels.GIVEN_F + 36), dtype)
+        self.given_F = values[:, kernels.GIVEN_F:].reshape(N, 6, 6).transpose(0, 2, 1)
+        self.F = self.given_F if (width, depth) == (6, 6) else np.zeros((N, width, depth), dtype)
+        self.T, self.zeta = np.zeros((N, width, width), dtype), np.zeros((N, width), dtype)
+        self.M_hat, self.h_hat = np.zeros((N, width, width), dtype), np.zeros((N + 1, width), dtype)
+        self.R, self.r, self.twist = np.zeros((N + 1, 3, 3), dtype), np.zeros((N + 1, 3), dtype), np.zeros((N + 1, 6), dtype)
+        self.kin = _WorkspaceKinematics(ev._n_cols, self.R, self.r, self.twist, self.F, self.T, self.zeta) \
+            if ev._python_laws else None
+        self.h_S = np.zeros((N, max((S_T.shape[1] for _, S_T in ev._selected), default=0)), dtype)
+        self.h_loaded = [self.h_S[n, :k] if k is not None else self.h_hat[n] for n, k in enumerate(ev._S_rows)] \
+            + [np.zeros(0, dtype)]
 
 
 def unsupported(system) -> str | None:
@@ -362,7 +424,7 @@ class _WorkspaceKinematics(Kinematics):
         self.R, self.r, self.twist, self.y_dot = R, r, twist, twist
         self.F = [F[n, :, :k] for n, k in enumerate(n_cols)]
         self._T, self._zeta = T, zeta
-        self._T_aug = np.zeros((len(n_cols) + 1, 7, 7))
+        self._T_aug = np.zeros((len(n_cols) + 1, 7, 7), T.dtype)
         self._T_aug[:, 6, 6] = 1.0
         self.stale = True
 

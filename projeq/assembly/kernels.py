@@ -2,7 +2,10 @@
 
 Plain Python on scalars and small arrays, written so that numba can compile it
 (:func:`kernel` with ``compiled=True`` applies ``numba.njit(cache=True)``); the same source
-runs interpreted with ``compiled=False``, so both are the same algorithm.
+runs interpreted with ``compiled=False``, so both are the same algorithm. The kernels are
+dtype-generic: called with complex128 workspaces (the complex step of
+:mod:`projeq.analysis.jacobians`) numba compiles a second specialization of the same source;
+their temporaries take the workspace's dtype and their pivot checks compare real parts.
 
 Joint kinds: ``FIXED`` (no dof), ``REVOLUTE`` (F⁶ = [0; e]), ``PRISMATIC`` (F⁶ = [e; 0]),
 about a unit axis e in joint-frame coordinates, and ``GIVEN``: any other joint, whose
@@ -93,14 +96,15 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
     r_O[N] = 0.0
     for a in range(3):
         R[N, a, a] = 1.0
-    g_body = np.zeros((N + 1, 3))
+    dtype = T.dtype  # of the workspace: float, or complex under the complex step
+    g_body = np.zeros((N + 1, 3), dtype)
     g_body[N] = gravity
-    A_rel, A_np, r_rel, r, u, w = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(6), np.empty(6)
-    T6, zeta6, T_port, zeta_port = np.empty((6, 6)), np.empty(6), np.empty((6, 6)), np.empty(6)
-    A_port, r_port, w_port = np.empty((3, 3)), np.empty(3), np.empty(6)
-    F_port = np.empty((6, el_Psi.shape[3]))
-    port_R, port_r, port_twist, port_g = np.empty((3, 3)), np.empty(3), np.empty(6), np.empty(3)
-    v_p, work = np.empty(3), np.empty((2, 3))
+    A_rel, A_np, r_rel, r = np.empty((3, 3), dtype), np.empty((3, 3), dtype), np.empty(3, dtype), np.empty(3, dtype)
+    u, w, T6, zeta6 = np.empty(6, dtype), np.empty(6, dtype), np.empty((6, 6), dtype), np.empty(6, dtype)
+    T_port, zeta_port, A_port, r_port = np.empty((6, 6), dtype), np.empty(6, dtype), np.empty((3, 3), dtype), np.empty(3, dtype)
+    w_port, F_port = np.empty(6, dtype), np.empty((6, el_Psi.shape[3]), dtype)
+    port_R, port_r, port_twist, port_g = np.empty((3, 3), dtype), np.empty(3, dtype), np.empty(6, dtype), np.empty(3, dtype)
+    v_p, work = np.empty(3, dtype), np.empty((2, 3), dtype)
     for n in range(N):
         e, k, p = axis[n], kind[n], parent[n] if parent[n] >= 0 else N
         j = port_slot[n]
@@ -204,7 +208,7 @@ def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
     n_y = 6 + k_e
     M[:n_y, :n_y] = 0.0
     h[:n_y] = 0.0
-    J, Qq = np.zeros((3, n_y)), np.empty(k_e)
+    J, Qq = np.zeros((3, n_y), M.dtype), np.empty(k_e, M.dtype)
     for a in range(3):
         J[a, a] = 1.0
     w0, w1, w2 = twist[3], twist[4], twist[5]
@@ -260,7 +264,8 @@ def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e
     The state x = (q_e, q̇_e), written: ẋ = (q̇_e, q̈_e) (q̇ = ṡ for elastic coordinates).
     Returns −1; 0 when a pivot of M_ee is not above ``pivot_min``; 1 when x or ẋ is not
     finite (ẋ written as far as it got)."""
-    k_e, A, w, zeta, g = x.shape[0] // 2, np.empty((3, 3)), np.zeros(6), np.zeros(6), np.zeros(3)
+    dtype = M.dtype  # of the workspace: float, or complex under the complex step
+    k_e, A, w, zeta, g = x.shape[0] // 2, np.empty((3, 3), dtype), np.zeros(6, dtype), np.zeros(6, dtype), np.zeros(3, dtype)
     for i in range(2 * k_e):
         if not np.isfinite(x[i]):
             return 1
@@ -293,6 +298,26 @@ def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e
     return -1
 
 
+def hub_beam_jacobian(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, step, pivot_min,
+                      M, h, J):
+    """∂ẋ/∂x of :func:`hub_beam` at the real state x by the complex step, column k =
+    Im ẋ(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998), all n_x columns in
+    one call on a complex workspace (``M``, ``h``: complex128); written into J. Returns
+    :func:`hub_beam`'s status (−1: every column written)."""
+    n_x = x.shape[0]
+    z, z_dot = np.empty(n_x, M.dtype), np.empty(n_x, M.dtype)
+    for k in range(n_x):
+        z[:] = x
+        z[k] += 1j * step
+        status = hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, z,
+                          pivot_min, M, h, z_dot)
+        if status >= 0:
+            return status
+        for i in range(n_x):
+            J[i, k] = z_dot[i].imag / step
+    return -1
+
+
 def port_motion(r0, Psi, Q, slopes, offset, q_e, q_e_dot, A, r, F, zeta):
     """The frame at a station of an elastic body relative to its reference frame: A = R_z(a) R_y(b)
     with a = v′ and b = −w′ (slopes · q_e), r = r₀ + Ψ q_e − ½ (q_eᵀ Q q_e) e_x + A c,
@@ -302,7 +327,7 @@ def port_motion(r0, Psi, Q, slopes, offset, q_e, q_e_dot, A, r, F, zeta):
     beam without torsion (whose Ḟ q̇_e is a complex step)."""
     k_e = q_e.shape[0]
     a_, b_, a_dot, b_dot, quadratic, rate = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    Phi_r, r_dot = np.empty((3, k_e)), np.zeros(3)
+    Phi_r, r_dot = np.empty((3, k_e), A.dtype), np.zeros(3, A.dtype)
     for i in range(k_e):
         a_ += slopes[0, i] * q_e[i]
         b_ += slopes[1, i] * q_e[i]
@@ -326,18 +351,22 @@ def port_motion(r0, Psi, Q, slopes, offset, q_e, q_e_dot, A, r, F, zeta):
             r[a] += Psi[a, i] * q_e[i]
             r_dot[a] += Phi_r[a, i] * q_e_dot[i]
     r[0] -= 0.5 * quadratic
-    Phi_w = np.empty(3)
+    Phi_w, c_w, v_rel, Omega = np.empty(3, A.dtype), np.empty(3, A.dtype), np.empty(3, A.dtype), np.empty(3, A.dtype)
     for i in range(k_e):
         Phi_w[0], Phi_w[1], Phi_w[2] = -sb * slopes[0, i], slopes[1, i], cb * slopes[0, i]
-        c_w = _cross3(offset, Phi_w)
+        c_w[:] = 0.0
+        _add_cross(offset, Phi_w, c_w)
         for a in range(3):
             F[a, i] = A[0, a] * Phi_r[0, i] + A[1, a] * Phi_r[1, i] + A[2, a] * Phi_r[2, i] - c_w[a]
             F[3 + a, i] = Phi_w[a]
-    Omega = np.array([-sb * a_dot, b_dot, cb * a_dot])
-    alpha = np.array([-cb * a_dot * b_dot, 0.0, -sb * a_dot * b_dot])
-    v_rel = np.array([A[0, a] * r_dot[0] + A[1, a] * r_dot[1] + A[2, a] * r_dot[2] for a in range(3)])
-    zeta[:3] = -_cross3(Omega, v_rel) - rate * A[0] - _cross3(offset, alpha)
-    zeta[3:] = alpha
+    alpha = zeta[3:]
+    Omega[0], Omega[1], Omega[2] = -sb * a_dot, b_dot, cb * a_dot
+    for a in range(3):
+        v_rel[a] = A[0, a] * r_dot[0] + A[1, a] * r_dot[1] + A[2, a] * r_dot[2]
+        zeta[a] = -rate * A[0, a]
+    _add_cross(v_rel, Omega, zeta[:3])  # − Ω × Aᵀ ṙ
+    alpha[0], alpha[1], alpha[2] = -cb * a_dot * b_dot, 0.0, -sb * a_dot * b_dot
+    _add_cross(alpha, offset, zeta[:3])  # − c × α
 
 
 def _relative_rotation(kind, e, x, A):
@@ -365,13 +394,6 @@ def _chain_matrix(A_np, r, T):
         T[a, 3] = A_np[a, 2] * r[1] - A_np[a, 1] * r[2]  # −A r̃ e_x = A (e_x × r)
         T[a, 4] = A_np[a, 0] * r[2] - A_np[a, 2] * r[0]
         T[a, 5] = A_np[a, 1] * r[0] - A_np[a, 0] * r[1]
-
-
-def _cross3(a, b):
-    """a × b of two 3-vectors, a new array (compiled twin of :func:`projeq.spatial.cross`)."""
-    out = np.zeros(3)
-    _add_cross(a, b, out)
-    return out
 
 
 def _add_cross(a, b, out):
@@ -425,8 +447,9 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
     n_cols, n_y, parent, s_index = index[:, N_COLS], index[:, N_Y], index[:, PARENT], index[:, S_INDEX]
     rows = _rows
     M_hat[:] = M_n
-    U, L, f_h = np.zeros((N, width, depth)), np.zeros((N, depth, depth)), np.zeros((N, depth))
-    c, g, MT = np.empty(width), np.empty(depth), np.empty((width, max(width, depth)))
+    dtype = M_hat.dtype  # of the workspace: float, or complex under the complex step
+    U, L, f_h = np.zeros((N, width, depth), dtype), np.zeros((N, depth, depth), dtype), np.zeros((N, depth), dtype)
+    c, g, MT = np.empty(width, dtype), np.empty(depth, dtype), np.empty((width, max(width, depth)), dtype)
     for n in range(N - 1, -1, -1):  # backward: leaves → root
         M, k, m = M_hat[n], n_cols[n], rows(n_y, n)
         for a in range(m):
@@ -463,7 +486,7 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
             _add_congruence(T[n], M, c, MT, M_hat[p], h_hat[p])
         elif p >= 0:
             _add_congruence_general(T[n], M, c, MT, m, rows(n_y, p), M_hat[p], h_hat[p])
-    y_ddot = np.zeros((N, width))
+    y_ddot = np.zeros((N, width), dtype)
     for n in range(N):  # forward: root → leaves
         p, k, m = parent[n], n_cols[n], rows(n_y, n)
         a = y_ddot[n]
@@ -480,6 +503,29 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
     return -1
 
 
+def tree_jacobian(index, geometry, inertia, gravity, x, n_q, step, given, elastic, port, T, zeta, F, M_n, M_hat,
+                  h_hat, R, r_O, twist, pivot_min, J):
+    """∂s̈/∂x of the order-n kernel at the real state x = (q, ṡ) by the complex step, column
+    k = Im s̈(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998): :func:`chain_terms`
+    and :func:`passes` n_x times in one call on a complex workspace (T ... twist: complex128);
+    written into J (n_s × n_x). For trees whose kinematics the kernel computes itself (no
+    joint of kind GIVEN) without force laws. Returns −1, or the :func:`passes` index of the
+    first singular pivot."""
+    n_x = x.shape[0]
+    z, s_ddot = np.empty(n_x, T.dtype), np.empty(J.shape[0], T.dtype)
+    for k in range(n_x):
+        z[:] = x
+        z[k] += 1j * step
+        chain_terms(index, geometry, inertia, gravity, z[:n_q], z[n_q:], given, elastic, port, T, zeta, F, M_n,
+                    h_hat, R, r_O, twist)
+        failed = passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot)
+        if failed >= 0:
+            return failed
+        for i in range(J.shape[0]):
+            J[i, k] = s_ddot[i].imag / step
+    return -1
+
+
 def gauss_form(index, T, zeta, F, M_n, h, M, b):
     """M = Σ J_nᵀ M_n J_n and b = Σ J_nᵀ (M_n ζ̄_n − h_n) of the Gauss form M s̈ + b = 0
     (docs/theory.md §5) from the kernel's T_np, ζ_n, F_n, M_n and h_n, without the dense J_n.
@@ -493,8 +539,9 @@ def gauss_form(index, T, zeta, F, M_n, h, M, b):
     """
     N = index.shape[0]
     n_cols, parent, s_index = index[:, N_COLS], index[:, PARENT], index[:, S_INDEX]
-    zeta_bar, f, M_c = np.zeros((N, 6)), np.zeros((N, 6)), M_n.copy()
-    U, V, MT = np.zeros((6, 6)), np.zeros((6, 6)), np.empty((6, 6))
+    dtype = M.dtype  # of the workspace: float, or complex under the complex step
+    zeta_bar, f, M_c = np.zeros((N, 6), dtype), np.zeros((N, 6), dtype), M_n.copy()
+    U, V, MT = np.zeros((6, 6), dtype), np.zeros((6, 6), dtype), np.empty((6, 6), dtype)
     for n in range(N):  # root → leaves: ζ̄_n, f_n
         p = parent[n]
         for a in range(6):
@@ -535,7 +582,7 @@ def projected_accelerations(M_all, b_all, P, pivot_min, M, s_ddot):
     n_all, n = P.shape
     M[:, :] = 0.0
     s_ddot[:] = 0.0
-    _add_congruence_general(P, M_all, b_all, np.empty((n_all, n)), n_all, n, M, s_ddot)  # Pᵀ M_all P, Pᵀ b_all
+    _add_congruence_general(P, M_all, b_all, np.empty((n_all, n), M.dtype), n_all, n, M, s_ddot)  # Pᵀ M_all P, Pᵀ b_all
     for i in range(n):
         s_ddot[i] = -s_ddot[i]
     if not _cholesky(M, n, pivot_min):
@@ -551,7 +598,7 @@ def _cholesky(D, k, pivot_min):
         pivot = D[j, j]
         for i in range(j):
             pivot -= D[j, i] * D[j, i]
-        if not pivot > pivot_min:
+        if not pivot.real > pivot_min:  # the real part: a complex step leaves the sign where it is
             return False
         D[j, j] = np.sqrt(pivot)
         for i in range(j + 1, k):
@@ -652,19 +699,33 @@ def kernel(compiled: bool = True, rigid: bool = False):
             "compiled: numba is not installed (pip install numba); compiled=False runs the same "
             "kernel interpreted, method='auto' picks the best evaluator available"
         )
-    chain, general, rigid_passes = _compiled()
+    chain, general, _, rigid_passes = _compiled()[:4]
     return chain, rigid_passes if rigid else general
 
 
-_CALLEES = (_relative_rotation, _chain_matrix, _cross3, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
+def jacobian_kernel(compiled: bool = True, rigid: bool = False):
+    """:func:`tree_jacobian`, compiled by numba (as :func:`kernel`, with the same ``rigid``
+    passes) or with ``compiled=False`` the interpreted function."""
+    if not compiled:
+        return tree_jacobian
+    kernel(True)  # the same refusal without numba
+    return _compiled()[4 if rigid else 2]
+
+
+_CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
             _add_congruence, _add_congruence_general, _cholesky, _cholesky_solve, elastic_body, port_motion)
 
 
 @functools.cache
 def _compiled():
-    """chain_terms, passes and the rigid trees' passes (:func:`kernel`) compiled by numba, once
-    per process (and cached on disk)."""
-    return _jit(chain_terms, passes) + _jit(passes, names=("rigid_passes",), _rows=_six)
+    """chain_terms, passes, the rigid trees' passes (:func:`kernel`) and the Jacobians of both
+    (:func:`jacobian_kernel`) compiled by numba, once per process (and cached on disk;
+    numba compiles each for the dtype it is called with, float64 or complex128, on first use)."""
+    chain, general = _jit(chain_terms, passes)
+    rigid = _jit(passes, names=("rigid_passes",), _rows=_six)[0]
+    jacobians = [_jit(tree_jacobian, names=(name,), kernels={"chain_terms": chain, "passes": passes_})[0]
+                 for name, passes_ in (("tree_jacobian", general), ("rigid_tree_jacobian", rigid))]
+    return chain, general, jacobians[0], rigid, jacobians[1]
 
 
 def gauss_form_kernel(compiled: bool = True):
@@ -685,9 +746,19 @@ def hub_beam_kernel(compiled: bool = True):
     return _compiled_hub_beam()[0]
 
 
+def hub_beam_jacobian_kernel(compiled: bool = True):
+    """:func:`hub_beam_jacobian`, compiled by numba (as :func:`kernel`) or with ``compiled=False``
+    the interpreted function."""
+    if not compiled:
+        return hub_beam_jacobian
+    kernel(True)  # the same refusal without numba
+    return _compiled_hub_beam()[1]
+
+
 @functools.cache
 def _compiled_hub_beam():
-    return _jit(hub_beam)
+    kernel = _jit(hub_beam)[0]
+    return kernel, _jit(hub_beam_jacobian, kernels={"hub_beam": kernel})[0]
 
 
 @functools.cache
@@ -705,16 +776,18 @@ def jit(*functions, callees=()):
     return _jit(*functions, names=tuple(f"{f.__name__}_{digest}" for f in functions), callees=callees)
 
 
-def _jit(*kernels, names=(), callees=(), **replaced):
-    """The ``kernels`` compiled by numba (cached on disk, under ``names`` if given).
+def _jit(*functions, names=(), callees=(), kernels=None, **replaced):
+    """The ``functions`` compiled by numba (cached on disk, under ``names`` if given).
 
-    Compiled code resolves the functions it calls in its globals, so the kernels are
+    Compiled code resolves the functions it calls in its globals, so the functions are
     compiled as copies whose globals are a copy of this module's namespace (and of the
-    kernels' own module's) holding numba's versions of their callees (``replaced``: another
+    functions' own module's) holding numba's versions of their callees (``replaced``: another
     function under a callee's name, as :func:`_six` for ``_rows`` in the rigid passes;
-    ``callees``: more of them); the functions stay plain Python (nothing rebound)."""
+    ``callees``: more of them) and the compiled ``kernels`` they call by name (the Jacobians
+    call the kernels' own dispatchers: each specialization is compiled once, and shared);
+    the functions stay plain Python (nothing rebound)."""
     numba = _numba()
-    namespace = {**globals(), **kernels[0].__globals__}
+    namespace = {**globals(), **functions[0].__globals__}
 
     def rebound(f, name=None):
         copy = types.FunctionType(f.__code__, namespace, name or f.__name__, f.__defaults__, f.__closure__)
@@ -723,5 +796,6 @@ def _jit(*kernels, names=(), callees=(), **replaced):
 
     for f in _CALLEES + callees:
         namespace[f.__name__] = numba.extending.register_jitable(rebound(replaced.get(f.__name__, f)))
+    namespace.update(kernels or {})
     jit = numba.njit(cache=True)
-    return tuple(jit(rebound(f, name)) for f, name in zip(kernels, names or (None,) * len(kernels)))
+    return tuple(jit(rebound(f, name)) for f, name in zip(functions, names or (None,) * len(functions)))

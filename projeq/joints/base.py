@@ -105,11 +105,12 @@ class Joint:
         raise NotImplementedError
 
     def relative_values(self, q_n: NDArray, s_dot_n: NDArray, t: float):
-        """The numbers of :meth:`relative` at real (q_n, ṡ_n, t) as one flat sequence of
-        24 + 6 n_s floats — A (row by row), r, w, ζ, then F⁶ column by column — which the
-        compiled evaluator reads for a joint whose kinematics it does not compute itself (kind
-        GIVEN, :mod:`projeq.assembly.fast`). By default :meth:`relative`, packed; a joint may
-        state the same numbers faster (a UserJoint from sympy: scalar code of its expressions)."""
+        """The numbers of :meth:`relative` at (q_n, ṡ_n, t) as one flat sequence of 24 + 6 n_s
+        floats (complex under a complex step) — A (row by row), r, w, ζ, then F⁶ column by
+        column — which the compiled evaluator reads for a joint whose kinematics it does not
+        compute itself (kind GIVEN, :mod:`projeq.assembly.fast`). By default :meth:`relative`,
+        packed; a joint may state the same numbers faster (a UserJoint from sympy: scalar code
+        of its expressions)."""
         rel = self.relative(q_n, s_dot_n, t)
         return np.concatenate((rel.A.ravel(), rel.r, rel.w, rel.zeta, rel.F.T.ravel()))
 

@@ -51,9 +51,10 @@ class UserJoint(Joint):
         return self._K(q_n, t)
 
     def relative_values(self, q_n, s_dot_n, t):
-        """:meth:`Joint.relative_values`; from sympy: the same expressions as :meth:`relative`,
-        compiled to scalar code (``math``) on Python floats, about ten times faster."""
-        if self._values is None:
+        """:meth:`Joint.relative_values`; from sympy at real arrays: the same expressions as
+        :meth:`relative`, compiled to scalar code (``math``) on Python floats, about ten times
+        faster (complex ones, of a complex step, take the numpy form)."""
+        if self._values is None or not (_real(q_n) and _real(s_dot_n)) or isinstance(t, complex):
             return super().relative_values(q_n, s_dot_n, t)
         return self._values(q_n.tolist(), s_dot_n.tolist(), t)
 

@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
-from projeq.analysis.jacobians import differentiate, state_derivative
+from projeq.analysis.jacobians import state_jacobian
 from projeq.assembly import EVALUATORS
 from projeq.checks import callable_name, closest, count, finite_array, positive, state_vector
 from projeq.simulation.integrators import (
@@ -295,11 +295,11 @@ class _Run:
         return x_dot
 
     def jacobian(self, t: float, x: NDArray) -> NDArray:
-        """∂ẋ/∂x of the current model by the complex step (:mod:`projeq.analysis.jacobians`;
-        the model's own evaluator, which takes complex arguments; differences for user
-        callables that do not), for the implicit methods."""
+        """∂ẋ/∂x of the current model by the complex step (:func:`projeq.analysis.jacobians.state_jacobian`:
+        through the compiled kernels where they take the model; differences for user callables
+        that take no complex arguments), for the implicit methods."""
         self.njev += 1
-        return differentiate(lambda y: state_derivative(self.model, y, t), x)[0]
+        return state_jacobian(self.model, x, t)[0]
 
     def solve(self, a: float, b: float):
         """One segment from the current state at a to b (solve_ivp's result), with the user's
