@@ -175,11 +175,12 @@ def test_the_compiled_loop_takes_a_complex_step():
     q, s_dot = np.array([0.4, -0.7]), np.array([1.1, -0.3])
     ev.accelerations(q, s_dot, 0.0)  # the workspace at (q, ṡ)
     rng = np.random.default_rng(3)
-    direction = {name: rng.standard_normal(getattr(ev, name).shape) for name in ("_R", "_r", "_twist", "_F", "_T")}
+    ws = ev._real  # the real workspace
+    direction = {name: rng.standard_normal(getattr(ws, name).shape) for name in ("R", "r", "twist", "F", "T")}
 
     def loads_at(step, kernel):
-        args = [getattr(ev, name) + step * direction[name] for name in ("_R", "_r", "_twist", "_F", "_T")]
-        h = np.zeros(ev._h_hat.shape, dtype=np.result_type(step, float))
+        args = [getattr(ws, name) + step * direction[name] for name in ("R", "r", "twist", "F", "T")]
+        h = np.zeros(ws.h_hat.shape, dtype=np.result_type(step, float))
         kernel(ev._laws, ev._law_constants, ev._index, q + step * 0.3, s_dot - step * 0.2, *args, h)
         return h
 
