@@ -1,0 +1,371 @@
+"""The constrained s̈ of a closed loop in one compiled call (docs/theory.md §7).
+
+:class:`~projeq.constraints.partitioned.ConstrainedSystem` forms, at every evaluation, the
+Jacobian Φ_q of the loop closures and their second derivative Φ″(q̇, q̇) by the complex step,
+the partition ṡ_tree = F ṡ, s̈_tree = F s̈ + f̄ with F = [E; −A_dep⁻¹ A_ind] and
+f̄ = [0; −A_dep⁻¹ γ], the tree's Gauss form M s̈_tree + b at ṡ_tree, and solves the Projection
+Equation with the constraint inserted before the projection,
+
+    Fᵀ (M (F s̈ + f̄) + b) = 0,
+
+in about fifty numpy calls and two Python calls of Φ. Here the same steps run in one function
+compiled by numba, with the user's Φ itself compiled (``numba.njit`` of the function as it is
+written: a four-bar's ``[a * np.cos(q[0]) + …, …]`` compiles) and called at the same complex
+points: Φ_q e_j = Im Φ(q + i h e_j) / h and Φ″(v, v) = |v|² Σ_k c_k Im Φ(q + ε_k v̂ + i h v̂) / h
+(Martins, Sturdza & Alonso, "The complex-step derivative approximation", ACM TOMS 29, 2003;
+the stencil's nodes ε_k and weights c_k are those of :mod:`projeq.constraints.batched`), and
+the tree's M and b from the kernels of :mod:`projeq.assembly.kernels` (composite bodies and
+Newton–Euler, Featherstone, "Rigid Body Dynamics Algorithms", 2008, §5.3, §6.2) on the fast
+evaluator's workspace. The numbers are those of the numpy path to round-off.
+
+Where it applies (:func:`unsupported` says why not): holonomic constraints only, Φ independent
+of t (``correction="projection"``), q̇ = ṡ_tree (revolute and prismatic joints), a tree whose
+whole Gauss form the compiled kernels compute (no force laws, no joints that state their own
+relative motion, no coupled joints, no elastic bodies), and the coordinate partition itself
+(not the null-space basis of :class:`~projeq.constraints.tangent.TangentSystem`). A Φ numba
+cannot compile, or whose compiled values differ from its own at complex points near q0, keeps
+the numpy path after one :class:`UncompiledClosureWarning` naming it. Where the compiled call
+meets a degenerate partition (κ bound reached) or a singular FᵀMF it returns a flag and the
+numpy path repeats the evaluation, which raises the error that names the cause.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import sys
+import types
+import warnings
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.analysis.differentiation import COMPLEX_STEP
+from projeq.assembly import kernels
+from projeq.assembly.linalg import SINGULAR_PIVOT
+from projeq.constraints.batched import NODES, WEIGHTS
+
+#: flags of :func:`closure_kernel`'s kernel: done; partition bound reached or A_dep singular;
+#: FᵀMF not positive definite (the numpy path then raises the error that names the cause)
+DONE, DEGENERATE, SINGULAR = 0, 1, 2
+
+
+class UncompiledClosureWarning(UserWarning):
+    """A constraint function numba cannot compile: the constrained s̈ takes the numpy path
+    (about ten times slower per call)."""
+
+
+def unsupported(system) -> str | None:
+    """Why the constrained s̈ of ``system`` (a ConstrainedSystem that forms F by coordinate
+    partitioning) cannot be one compiled call (None if it can), module docstring."""
+    tree = system.tree
+    checks = (
+        (system.m_p > 0, "Pfaffian constraints A(q, t) q̇ = b(q, t)"),
+        (system.m_h == 0, "no holonomic constraints"),
+        (system.rheonomic, "Φ may depend on t (correction other than 'projection')"),
+        (not system._identity, "joints with q̇ ≠ ṡ (K ≠ E)"),
+        (not system.exact, "Φ does not take complex arguments (no complex step)"),
+        (not system.compiled_tree(), "the tree's default evaluator is not the compiled one"),
+    )
+    for failed, why in checks:
+        if failed:
+            return why
+    ev = tree.evaluator("fast")
+    if ev._given or ev._kin is not None or ev._expansion is not None or ev._M_n.shape[1] > 6:
+        return "the tree has force laws, joints stating their own relative motion, coupled joints or elastic bodies"
+    return None
+
+
+def compiled_phi(phi, n: int, m: int, q0: NDArray):
+    """``numba.njit(phi)`` if it compiles for q complex (n,), t float and gives Φ's own values,
+    real and imaginary parts each to 1e-13 relative, at three complex points near q0; else None
+    after one :class:`UncompiledClosureWarning` naming ``phi``."""
+    import numba
+
+    rng = np.random.default_rng(11)
+    X = q0[:, None] + 1e-2 * rng.standard_normal((n, 3)) + 1j * COMPLEX_STEP * rng.standard_normal((n, 3))
+    try:
+        jitted = numba.njit(phi)
+        got = np.array([np.asarray(jitted(x.copy(), 0.0), dtype=complex) for x in X.T]).T
+        want = np.array([np.asarray(phi(x.copy(), 0.0), dtype=complex) for x in X.T]).T
+    except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+        why = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+    else:
+        scale = max(1.0, np.abs(want.real).max(initial=0.0))
+        rate = max(1.0, np.abs(want.imag / COMPLEX_STEP).max(initial=0.0))
+        if got.shape == want.shape == (m, 3) and np.all(np.abs(got.real - want.real) <= 1e-13 * scale) \
+                and np.all(np.abs(got.imag - want.imag) / COMPLEX_STEP <= 1e-13 * rate):
+            return jitted
+        why = "its compiled values differ from its own at complex points near q0"
+    warnings.warn(
+        f"phi: numba cannot compile {getattr(phi, '__qualname__', repr(phi))} ({why}); the constrained s̈ "
+        "takes the numpy path (about ten times slower): write Φ with numpy operations on scalars q[i] "
+        "(no Python objects, dicts or calls of uncompiled functions)",
+        UncompiledClosureWarning, stacklevel=4,
+    )
+    return None
+
+
+def _key(phi):
+    """A hashable key of Φ's code and captured values (one compiled kernel for closures of the
+    same source and constants, a scene built twice), else Φ itself."""
+    try:
+        cells = tuple(c.cell_contents for c in (phi.__closure__ or ()))
+        key = (phi.__code__, cells, phi.__defaults__)
+        hash(key)
+    except (AttributeError, TypeError, ValueError):
+        return phi
+    return key
+
+
+_CALLBACKS: dict = {}  # _key(Φ) -> its C callback (numba.cfunc), or None where Φ did not compile
+
+
+def closure_callback(phi, n: int, m: int, q0: NDArray):
+    """Φ (n coordinates, m rows) compiled as a C callback ``into(x, t, value)`` (value ← Φ(x, t),
+    x and value complex), built once per Φ source and constants in a process; None (after one
+    warning) if Φ does not compile (:func:`compiled_phi`)."""
+    key = _key(phi)
+    if key not in _CALLBACKS:
+        jitted = compiled_phi(phi, n, m, q0)
+        _CALLBACKS[key] = None if jitted is None else _callback(jitted, n, m)
+    return _CALLBACKS[key]
+
+
+def _callback(jitted, n: int, m: int):
+    import numba
+    from numba import types as nb
+
+    def into(x_pointer, t, value_pointer):
+        x, value = numba.carray(x_pointer, (n,)), numba.carray(value_pointer, (m,))
+        phi_value = jitted(x, t)
+        for r in range(m):
+            value[r] = phi_value[r]
+
+    pointer = nb.CPointer(nb.complex128)
+    return numba.cfunc(nb.void(pointer, nb.float64, pointer))(into)
+
+
+def _phi_into(phi, x, t, value):
+    """value ← Φ(x, t): in the compiled kernel ``phi`` is the address of Φ's C callback (an
+    intrinsic calls it, :func:`_intrinsic`); interpreted, ``phi`` is Φ itself."""
+    value[:] = np.asarray(phi(x, t))
+
+
+def accelerations(phi, index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist,
+                  q, s_dot, t, independent, dependent, bound, pivot, s_ddot_tree, A, M, b):
+    """The constrained s̈ of the module docstring, from Φ (``phi``: :func:`_phi_into`), the tree's
+    packed arrays and workspace (those of :func:`projeq.assembly.kernels.chain_terms`), q, ṡ, t and
+    the partition; writes s̈_tree, Φ_q (= A_s), M and b, and returns DONE, or DEGENERATE where
+    ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``, or SINGULAR where a squared pivot of FᵀMF
+    is not above ``pivot`` times its largest diagonal entry."""
+    n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
+    x, value = np.empty(n, np.complex128), np.empty(m, np.complex128)
+    for j in range(n):  # A_s = Φ_q: column j = Im Φ(q + i h e_j) / h
+        for i in range(n):
+            x[i] = q[i]
+        x[j] = q[j] + 1j * COMPLEX_STEP
+        _phi_into(phi, x, t, value)
+        for r in range(m):
+            A[r, j] = value[r].imag / COMPLEX_STEP
+    A_dep = np.empty((m, m))
+    for r in range(m):
+        for c in range(m):
+            A_dep[r, c] = A[r, dependent[c]]
+    inv = _inverse(A_dep)
+    if not np.sqrt(np.sum(A * A)) * np.sqrt(np.sum(inv * inv)) < bound:
+        return DEGENERATE
+    F = np.zeros((n, k))  # F = [E; −A_dep⁻¹ A_ind]
+    for c in range(k):
+        F[independent[c], c] = 1.0
+        for r in range(m):
+            total = 0.0
+            for i in range(m):
+                total += inv[r, i] * A[i, independent[c]]
+            F[dependent[r], c] = -total
+    s_dot_tree = np.zeros(n)
+    for i in range(n):
+        for c in range(k):
+            s_dot_tree[i] += F[i, c] * s_dot[c]
+    speed = np.sqrt(np.sum(s_dot_tree * s_dot_tree))
+    gamma = np.zeros(m)  # γ = Φ″(q̇, q̇), q̇ = ṡ_tree: the complex step inside the sixth-order stencil
+    if speed > 0.0:
+        for node in range(NODES.shape[0]):
+            for i in range(n):
+                u = s_dot_tree[i] / speed
+                x[i] = q[i] + u * NODES[node] + 1j * COMPLEX_STEP * u
+            _phi_into(phi, x, t, value)
+            for r in range(m):
+                gamma[r] += WEIGHTS[node] * (value[r].imag / COMPLEX_STEP)
+        for r in range(m):
+            gamma[r] *= speed * speed
+    f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
+    for r in range(m):
+        total = 0.0
+        for i in range(m):
+            total += inv[r, i] * -gamma[i]
+        f_bar[dependent[r]] = total
+    chain_terms(index, geometry, inertia, gravity, q, s_dot_tree, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O,
+                twist)
+    gauss_form(index, T, zeta, F_n, M_n, h, M, b)
+    MF, g = np.zeros((n, k)), b.copy()  # M F and M f̄ + b
+    for i in range(n):
+        for j in range(n):
+            g[i] += M[i, j] * f_bar[j]
+            for c in range(k):
+                MF[i, c] += M[i, j] * F[j, c]
+    M_min, s_ddot = np.zeros((k, k)), np.zeros(k)  # FᵀMF and −Fᵀ(M f̄ + b)
+    for r in range(k):
+        for i in range(n):
+            s_ddot[r] -= F[i, r] * g[i]
+            for c in range(k):
+                M_min[r, c] += F[i, r] * MF[i, c]
+    scale = 1e-300
+    for c in range(k):
+        scale = max(scale, abs(M_min[c, c]))
+    if k == 1:  # a division, as the numpy path's solve
+        if not M_min[0, 0] > pivot * scale:
+            return SINGULAR
+        s_ddot[0] = s_ddot[0] / M_min[0, 0]
+    elif not _cholesky_solve(M_min, s_ddot, pivot * scale):
+        return SINGULAR
+    for i in range(n):
+        s_ddot_tree[i] = f_bar[i]
+        for c in range(k):
+            s_ddot_tree[i] += F[i, c] * s_ddot[c]
+    return DONE
+
+
+chain_terms, gauss_form = kernels.chain_terms, kernels.gauss_form  # interpreted; compiled ones in _compiled_kernel
+
+
+def _inverse(A: NDArray) -> NDArray:
+    """A⁻¹ by Gauss–Jordan elimination with partial pivoting (∞ entries for a singular A)."""
+    m = A.shape[0]
+    work, inv = A.copy(), np.eye(m)
+    for c in range(m):
+        p = c + np.argmax(np.abs(work[c:, c]))
+        if work[p, c] == 0.0:
+            return np.full((m, m), np.inf)
+        for row in (work, inv):
+            for j in range(m):
+                row[c, j], row[p, j] = row[p, j], row[c, j]
+        d = work[c, c]
+        for j in range(m):
+            work[c, j] /= d
+            inv[c, j] /= d
+        for r in range(m):
+            if r != c and work[r, c] != 0.0:
+                e = work[r, c]
+                for j in range(m):
+                    work[r, j] -= e * work[c, j]
+                    inv[r, j] -= e * inv[c, j]
+    return inv
+
+
+def _cholesky_solve(D: NDArray, x: NDArray, pivot_min: float) -> bool:
+    """x ← D⁻¹ x for a symmetric positive definite D by Cholesky (D overwritten by its factor);
+    False where a squared pivot is not above ``pivot_min``."""
+    k = D.shape[0]
+    for j in range(k):
+        d = D[j, j]
+        for i in range(j):
+            d -= D[j, i] * D[j, i]
+        if not d > pivot_min:
+            return False
+        D[j, j] = np.sqrt(d)
+        for r in range(j + 1, k):
+            e = D[r, j]
+            for i in range(j):
+                e -= D[r, i] * D[j, i]
+            D[r, j] = e / D[j, j]
+    for j in range(k):  # L y = x
+        for i in range(j):
+            x[j] -= D[j, i] * x[i]
+        x[j] /= D[j, j]
+    for j in range(k - 1, -1, -1):  # Lᵀ z = y
+        for i in range(j + 1, k):
+            x[j] -= D[i, j] * x[i]
+        x[j] /= D[j, j]
+    return True
+
+
+def compiled_partition(system, bound: float) -> "CompiledPartition | None":
+    """The :class:`CompiledPartition` of a ConstrainedSystem that :func:`unsupported` accepts
+    (``bound``: the limit of ‖A_s‖_F ‖A_dep⁻¹‖_F above which the kernel flags the partition),
+    or None (after one warning) where numba cannot compile its Φ."""
+    callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
+    return None if callback is None else CompiledPartition(system.tree, system.n_c, callback, bound)
+
+
+class CompiledPartition:
+    """s̈_tree, A_s, M and b of a ConstrainedSystem by one call of the compiled kernel
+    (:func:`accelerations`) with Φ's C callback, on the tree's fast evaluator's workspace;
+    ``accelerations`` returns None where the kernel flags a degenerate partition or a singular
+    FᵀMF (the caller repeats the evaluation on the numpy path, which names the cause).
+    ``compiled=False`` runs the same kernel interpreted, with ``callback`` Φ itself (for testing)."""
+
+    def __init__(self, tree, m: int, callback, bound: float, compiled: bool = True):
+        self.callback, self.bound = callback, bound  # the callback lives as long as its address is used
+        self.kernel, self.phi = (_compiled_kernel(), callback.address) if compiled else (accelerations, callback)
+        self.fast = tree.evaluator("fast")
+        self._A, self._s_ddot_tree = np.zeros((m, tree.n_s)), np.zeros(tree.n_s)
+
+    def accelerations(self, q: NDArray, s_dot: NDArray, t: float, independent: NDArray, dependent: NDArray):
+        """(s̈_tree, A_s, M, b) at (q, ṡ, t) in the partition (``independent``, ``dependent``),
+        or None (flagged)."""
+        ev = self.fast
+        M, b = ev._M_all, ev._b_all
+        flag = self.kernel(self.phi, ev._index, ev._geometry, ev._inertia, ev._gravity, ev._given_values,
+                           ev._elastic, ev._ports, ev._T, ev._zeta, ev._F, ev._M_n, ev._h_hat, ev._R, ev._r,
+                           ev._twist, np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), float(t),
+                           independent, dependent, self.bound, SINGULAR_PIVOT, self._s_ddot_tree, self._A, M, b)
+        if flag != DONE:
+            return None
+        return self._s_ddot_tree.copy(), self._A.copy(), M.copy(), b.copy()
+
+
+@functools.cache
+def _compiled_kernel():
+    """:func:`accelerations` compiled by numba (cached on disk) with the compiled kernels of
+    :mod:`projeq.assembly.kernels` and Φ called through its C callback's address by an
+    intrinsic. Compiled code resolves its callees in its globals, so it is compiled as a copy
+    whose globals hold the compiled callees (as :mod:`projeq.assembly.kernels` compiles its
+    own); its name carries a digest of both sources, so that a changed kernel source is
+    compiled anew rather than read stale from the disk cache (which numba keys by the
+    function's own file only)."""
+    import numba
+
+    digest = hashlib.sha1(b"".join(Path(module.__file__).read_bytes() for module in (kernels, sys.modules[__name__])))
+    name = f"accelerations_{digest.hexdigest()[:12]}"
+    namespace = dict(globals())
+    namespace.update(
+        chain_terms=kernels.kernel(True)[0], gauss_form=kernels.gauss_form_kernel(True)[0], _phi_into=_intrinsic(),
+        _inverse=numba.njit(cache=True)(_inverse), _cholesky_solve=numba.njit(cache=True)(_cholesky_solve),
+    )
+    copy = types.FunctionType(accelerations.__code__, namespace, name)
+    copy.__qualname__ = name
+    return numba.njit(cache=True)(copy)
+
+
+def _intrinsic():
+    """The compiled :func:`_phi_into`: calls the C function at address ``phi`` with the data
+    pointers of x and value (numba's own layout of complex128, that of Φ's C callback)."""
+    import numba
+    from llvmlite import ir
+    from numba.extending import intrinsic
+
+    @intrinsic
+    def phi_into(typingctx, phi, x, t, value):
+        def codegen(context, builder, signature, args):
+            address, x_array, t_value, value_array = args
+            x_data = context.make_array(signature.args[1])(context, builder, x_array).data
+            value_data = context.make_array(signature.args[3])(context, builder, value_array).data
+            function = ir.FunctionType(ir.VoidType(), [x_data.type, t_value.type, value_data.type])
+            builder.call(builder.inttoptr(address, function.as_pointer()), [x_data, t_value, value_data])
+            return context.get_dummy_value()
+
+        return numba.types.void(phi, x, t, value), codegen
+
+    return phi_into
