@@ -90,7 +90,8 @@ def compiled_phi(phi, n: int, m: int, q0: NDArray):
         got = np.array([np.asarray(jitted(x.copy(), 0.0), dtype=complex) for x in X.T]).T
         want = np.array([np.asarray(phi(x.copy(), 0.0), dtype=complex) for x in X.T]).T
     except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
-        why = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+        lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+        why = f"{type(exc).__name__}: {' '.join(lines[:3])[:300]}"
     else:
         scale = max(1.0, np.abs(want.real).max(initial=0.0))
         rate = max(1.0, np.abs(want.imag / COMPLEX_STEP).max(initial=0.0))
@@ -111,12 +112,17 @@ def _key(phi):
     """A hashable key of Φ's code and captured values (one compiled kernel for closures of the
     same source and constants, a scene built twice), else Φ itself."""
     try:
-        cells = tuple(c.cell_contents for c in (phi.__closure__ or ()))
+        cells = tuple(_frozen(c.cell_contents) for c in (phi.__closure__ or ()))
         key = (phi.__code__, cells, phi.__defaults__)
         hash(key)
     except (AttributeError, TypeError, ValueError):
         return phi
     return key
+
+
+def _frozen(value):
+    """An array as (dtype, shape, bytes), hashable; anything else as it is."""
+    return (value.dtype.str, value.shape, value.tobytes()) if isinstance(value, np.ndarray) else value
 
 
 _CALLBACKS: dict = {}  # _key(Φ) -> its C callback (numba.cfunc), or None where Φ did not compile
@@ -148,67 +154,72 @@ def _callback(jitted, n: int, m: int):
 
 
 def _phi_into(phi, x, t, value):
-    """value ← Φ(x, t): in the compiled kernel ``phi`` is the address of Φ's C callback (an
+    """value ← Φ(x, t): in the compiled kernels ``phi`` is the address of Φ's C callback (an
     intrinsic calls it, :func:`_intrinsic`); interpreted, ``phi`` is Φ itself."""
     value[:] = np.asarray(phi(x, t))
 
 
-def accelerations(phi, index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist,
-                  q, s_dot, t, independent, dependent, bound, pivot, s_ddot_tree, A, M, b):
-    """The constrained s̈ of the module docstring, from Φ (``phi``: :func:`_phi_into`), the tree's
-    packed arrays and workspace (those of :func:`projeq.assembly.kernels.chain_terms`), q, ṡ, t and
-    the partition; writes s̈_tree, Φ_q (= A_s), M and b, and returns DONE, or DEGENERATE where
-    ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``, or SINGULAR where a squared pivot of FᵀMF
-    is not above ``pivot`` times its largest diagonal entry."""
-    n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
+def _jacobian(phi, q, t, A):
+    """A ← Φ_q: column j = Im Φ(q + i h e_j) / h."""
+    n, m = A.shape[1], A.shape[0]
     x, value = np.empty(n, np.complex128), np.empty(m, np.complex128)
-    for j in range(n):  # A_s = Φ_q: column j = Im Φ(q + i h e_j) / h
+    for j in range(n):
         for i in range(n):
             x[i] = q[i]
         x[j] = q[j] + 1j * COMPLEX_STEP
         _phi_into(phi, x, t, value)
         for r in range(m):
             A[r, j] = value[r].imag / COMPLEX_STEP
-    A_dep = np.empty((m, m))
-    for r in range(m):
-        for c in range(m):
-            A_dep[r, c] = A[r, dependent[c]]
-    inv = _inverse(A_dep)
-    if not np.sqrt(np.sum(A * A)) * np.sqrt(np.sum(inv * inv)) < bound:
-        return DEGENERATE
-    F = np.zeros((n, k))  # F = [E; −A_dep⁻¹ A_ind]
-    for c in range(k):
-        F[independent[c], c] = 1.0
+
+
+def _gamma(phi, q, q_dot, t, m):
+    """γ = Φ″(q̇, q̇) = |q̇|² Σ_k c_k Im Φ(q + ε_k u + i h u) / h, u = q̇/|q̇|: the complex step
+    inside the sixth-order stencil of :mod:`projeq.constraints.batched`."""
+    n = q.shape[0]
+    x, value, gamma = np.empty(n, np.complex128), np.empty(m, np.complex128), np.zeros(m)
+    speed = np.sqrt(np.sum(q_dot * q_dot))
+    if speed == 0.0:
+        return gamma
+    for node in range(NODES.shape[0]):
+        for i in range(n):
+            u = q_dot[i] / speed
+            x[i] = q[i] + u * NODES[node] + 1j * COMPLEX_STEP * u
+        _phi_into(phi, x, t, value)
         for r in range(m):
-            total = 0.0
-            for i in range(m):
-                total += inv[r, i] * A[i, independent[c]]
-            F[dependent[r], c] = -total
-    s_dot_tree = np.zeros(n)
-    for i in range(n):
-        for c in range(k):
-            s_dot_tree[i] += F[i, c] * s_dot[c]
-    speed = np.sqrt(np.sum(s_dot_tree * s_dot_tree))
-    gamma = np.zeros(m)  # γ = Φ″(q̇, q̇), q̇ = ṡ_tree: the complex step inside the sixth-order stencil
-    if speed > 0.0:
-        for node in range(NODES.shape[0]):
-            for i in range(n):
-                u = s_dot_tree[i] / speed
-                x[i] = q[i] + u * NODES[node] + 1j * COMPLEX_STEP * u
-            _phi_into(phi, x, t, value)
-            for r in range(m):
-                gamma[r] += WEIGHTS[node] * (value[r].imag / COMPLEX_STEP)
-        for r in range(m):
-            gamma[r] *= speed * speed
-    f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
+            gamma[r] += WEIGHTS[node] * (value[r].imag / COMPLEX_STEP)
     for r in range(m):
-        total = 0.0
-        for i in range(m):
-            total += inv[r, i] * -gamma[i]
-        f_bar[dependent[r]] = total
+        gamma[r] *= speed * speed
+    return gamma
+
+
+def _matvec(F, v):
+    """F v (loops: the matrices are small, and numba's @ wants contiguous operands)."""
+    out = np.zeros(F.shape[0])
+    for i in range(F.shape[0]):
+        for c in range(F.shape[1]):
+            out[i] += F[i, c] * v[c]
+    return out
+
+
+def _matmul(A, B):
+    """A B (loops, as :func:`_matvec`)."""
+    out = np.zeros((A.shape[0], B.shape[1]))
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            for c in range(B.shape[1]):
+                out[i, c] += A[i, j] * B[j, c]
+    return out
+
+
+def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
+    """The tree's M, b at (q, ṡ_tree) by the compiled kernels, then s̈ from Fᵀ(M (F s̈ + f̄) + b) = 0
+    and s̈_tree ← F s̈ + f̄; DONE, or SINGULAR where a squared pivot of FᵀMF is not above
+    ``pivot`` times its largest diagonal entry."""
+    index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist = tree
     chain_terms(index, geometry, inertia, gravity, q, s_dot_tree, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O,
                 twist)
     gauss_form(index, T, zeta, F_n, M_n, h, M, b)
+    n, k = F.shape
     MF, g = np.zeros((n, k)), b.copy()  # M F and M f̄ + b
     for i in range(n):
         for j in range(n):
@@ -230,14 +241,90 @@ def accelerations(phi, index, geometry, inertia, gravity, given, elastic, port, 
         s_ddot[0] = s_ddot[0] / M_min[0, 0]
     elif not _cholesky_solve(M_min, s_ddot, pivot * scale):
         return SINGULAR
-    for i in range(n):
-        s_ddot_tree[i] = f_bar[i]
-        for c in range(k):
-            s_ddot_tree[i] += F[i, c] * s_ddot[c]
+    s_ddot_tree[:] = _matvec(F, s_ddot) + f_bar
     return DONE
 
 
-chain_terms, gauss_form = kernels.chain_terms, kernels.gauss_form  # interpreted; compiled ones in _compiled_kernel
+def partitioned(phi, tree, q, s_dot, t, independent, dependent, bound, pivot, s_ddot_tree, A, M, b):
+    """The constrained s̈ of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (module
+    docstring) from Φ (``phi``: :func:`_phi_into`), the tree's packed arrays and workspace
+    (``tree``: those of :func:`projeq.assembly.kernels.chain_terms`), q, ṡ, t and the partition;
+    writes s̈_tree, Φ_q (= A_s), M and b; returns DONE, SINGULAR (:func:`_projected`) or
+    DEGENERATE where ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
+    n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
+    _jacobian(phi, q, t, A)
+    A_dep = np.empty((m, m))
+    for r in range(m):
+        for c in range(m):
+            A_dep[r, c] = A[r, dependent[c]]
+    inv = _inverse(A_dep)
+    if not np.sqrt(np.sum(A * A)) * np.sqrt(np.sum(inv * inv)) < bound:
+        return DEGENERATE
+    F = np.zeros((n, k))  # F = [E; −A_dep⁻¹ A_ind]
+    for c in range(k):
+        F[independent[c], c] = 1.0
+        for r in range(m):
+            total = 0.0
+            for i in range(m):
+                total += inv[r, i] * A[i, independent[c]]
+            F[dependent[r], c] = -total
+    s_dot_tree = _matvec(F, s_dot)
+    gamma = _gamma(phi, q, s_dot_tree, t, m)
+    f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
+    minus_gamma = _matvec(inv, -gamma)
+    for r in range(m):
+        f_bar[dependent[r]] = minus_gamma[r]
+    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+
+
+def tangent(phi, tree, q, s_dot, t, independent, rank, separation, acting, kept, pivot, s_ddot_tree, A, M, b):
+    """The constrained s̈ of :class:`~projeq.constraints.tangent.TangentSystem`: F = N N_ind⁻¹ with
+    N the null space of A_s = U Σ Vᵀ continued along the branch (``kept``: the tangent kept last,
+    n × n_s, NaN where none; overwritten where the null space is separated, its rule), f̄ =
+    x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) over the ``rank`` largest singular values above
+    ``acting`` σ_max; otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular."""
+    n, m, k = q.shape[0], A.shape[0], independent.shape[0]
+    _jacobian(phi, q, t, A)
+    U, sigma, Vt = np.linalg.svd(A)
+    padded = np.zeros(n)
+    padded[:sigma.shape[0]] = sigma
+    near = max(k, int(np.sum(padded < separation * padded[0])))
+    if near == k or np.isnan(kept[0, 0]):
+        N = Vt[n - k:].T.copy()
+        kept[:, :] = N
+    else:
+        V_near = Vt[n - near:]  # the near-null space (rows)
+        N = np.linalg.qr(_matmul(V_near.T, _matmul(V_near, kept)))[0]
+    N_ind = np.empty((k, k))
+    for r in range(k):
+        for c in range(k):
+            N_ind[r, c] = N[independent[r], c]
+    inv = _inverse(N_ind)
+    if not np.all(np.isfinite(inv)):
+        return DEGENERATE
+    F = _matmul(N, inv)  # F = N N_ind⁻¹, F[independent] = E
+    for r in range(k):
+        for c in range(k):
+            F[independent[r], c] = 1.0 if r == c else 0.0
+    s_dot_tree = _matvec(F, s_dot)
+    gamma = _gamma(phi, q, s_dot_tree, t, m)
+    count = min(int(np.sum(sigma > acting * sigma[0])), rank)
+    x0 = np.zeros(n)  # A_s⁺ (−γ) = V_k Σ_k⁻¹ U_kᵀ (−γ)
+    for j in range(count):
+        weight = 0.0
+        for r in range(m):
+            weight -= U[r, j] * gamma[r]
+        weight /= sigma[j]
+        for i in range(n):
+            x0[i] += Vt[j, i] * weight
+    x0_ind = np.empty(k)
+    for c in range(k):
+        x0_ind[c] = x0[independent[c]]
+    f_bar = x0 - _matvec(F, x0_ind)
+    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+
+
+chain_terms, gauss_form = kernels.chain_terms, kernels.gauss_form  # interpreted; _compiled holds the compiled ones
 
 
 def _inverse(A: NDArray) -> NDArray:
@@ -291,62 +378,85 @@ def _cholesky_solve(D: NDArray, x: NDArray, pivot_min: float) -> bool:
     return True
 
 
-def compiled_partition(system, bound: float) -> "CompiledPartition | None":
-    """The :class:`CompiledPartition` of a ConstrainedSystem that :func:`unsupported` accepts
-    (``bound``: the limit of ‖A_s‖_F ‖A_dep⁻¹‖_F above which the kernel flags the partition),
-    or None (after one warning) where numba cannot compile its Φ."""
+_HELPERS = (_jacobian, _gamma, _matvec, _matmul, _projected, _inverse, _cholesky_solve)
+
+
+def compiled_partition(system, bound: float) -> "CompiledClosure | None":
+    """The :class:`CompiledClosure` of a ConstrainedSystem (partitioned) that :func:`unsupported`
+    accepts (``bound``: the limit of ‖A_s‖_F ‖A_dep⁻¹‖_F above which the kernel flags the
+    partition), or None (after one warning) where numba cannot compile its Φ."""
     callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
-    return None if callback is None else CompiledPartition(system.tree, system.n_c, callback, bound)
+    return None if callback is None else CompiledClosure(system.tree, system.n_c, callback, "partitioned", (bound,))
 
 
-class CompiledPartition:
-    """s̈_tree, A_s, M and b of a ConstrainedSystem by one call of the compiled kernel
-    (:func:`accelerations`) with Φ's C callback, on the tree's fast evaluator's workspace;
-    ``accelerations`` returns None where the kernel flags a degenerate partition or a singular
-    FᵀMF (the caller repeats the evaluation on the numpy path, which names the cause).
+def compiled_tangent(system, acting: float) -> "CompiledClosure | None":
+    """The :class:`CompiledClosure` of a TangentSystem that :func:`unsupported` accepts
+    (``acting``: singular values below this fraction of the largest do not act in f̄), or None
+    (after one warning) where numba cannot compile its Φ."""
+    callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
+    return None if callback is None else CompiledClosure(system.tree, system.n_c, callback, "tangent", (acting,))
+
+
+class CompiledClosure:
+    """s̈_tree, A_s, M and b of a constrained model by one call of a compiled kernel
+    (:func:`partitioned` or :func:`tangent`) with Φ's C callback, on the tree's fast evaluator's
+    workspace; ``accelerations`` returns None where the kernel flags a degenerate partition or a
+    singular FᵀMF (the caller repeats the evaluation on the numpy path, which names the cause).
     ``compiled=False`` runs the same kernel interpreted, with ``callback`` Φ itself (for testing)."""
 
-    def __init__(self, tree, m: int, callback, bound: float, compiled: bool = True):
-        self.callback, self.bound = callback, bound  # the callback lives as long as its address is used
-        self.kernel, self.phi = (_compiled_kernel(), callback.address) if compiled else (accelerations, callback)
-        self.fast = tree.evaluator("fast")
+    def __init__(self, tree, m: int, callback, rule: str, constants: tuple, compiled: bool = True):
+        self.callback, self.rule, self.constants = callback, rule, constants  # the callback lives while its address is used
+        self.kernel, self.phi = (_compiled()[rule], callback.address) if compiled else (globals()[rule], callback)
+        ev = self.fast = tree.evaluator("fast")
+        self.tree = (ev._index, ev._geometry, ev._inertia, ev._gravity, ev._given_values, ev._elastic, ev._ports,
+                     ev._T, ev._zeta, ev._F, ev._M_n, ev._h_hat, ev._R, ev._r, ev._twist)
         self._A, self._s_ddot_tree = np.zeros((m, tree.n_s)), np.zeros(tree.n_s)
 
-    def accelerations(self, q: NDArray, s_dot: NDArray, t: float, independent: NDArray, dependent: NDArray):
-        """(s̈_tree, A_s, M, b) at (q, ṡ, t) in the partition (``independent``, ``dependent``),
-        or None (flagged)."""
-        ev = self.fast
-        M, b = ev._M_all, ev._b_all
-        flag = self.kernel(self.phi, ev._index, ev._geometry, ev._inertia, ev._gravity, ev._given_values,
-                           ev._elastic, ev._ports, ev._T, ev._zeta, ev._F, ev._M_n, ev._h_hat, ev._R, ev._r,
-                           ev._twist, np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), float(t),
-                           independent, dependent, self.bound, SINGULAR_PIVOT, self._s_ddot_tree, self._A, M, b)
+    def accelerations(self, system, q: NDArray, s_dot: NDArray, t: float):
+        """(s̈_tree, A_s, M, b) of ``system`` (its partition; for a TangentSystem its kept tangent,
+        which the call updates as the numpy path does) at (q, ṡ, t), or None (flagged)."""
+        M, b = self.fast._M_all, self.fast._b_all
+        q, s_dot, t = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), float(t)
+        if self.rule == "partitioned":
+            flag = self.kernel(self.phi, self.tree, q, s_dot, t, system.independent, system.dependent,
+                               self.constants[0], SINGULAR_PIVOT, self._s_ddot_tree, self._A, M, b)
+        else:
+            kept = np.full((system.tree.n_s, system.n_s), np.nan) if system._tangent is None else \
+                np.array(system._tangent, dtype=float)
+            flag = self.kernel(self.phi, self.tree, q, s_dot, t, system.independent, system.tree.n_s - system.n_s,
+                               system.separation, self.constants[0], kept, SINGULAR_PIVOT, self._s_ddot_tree,
+                               self._A, M, b)
+            system._tangent = kept
         if flag != DONE:
             return None
         return self._s_ddot_tree.copy(), self._A.copy(), M.copy(), b.copy()
 
 
 @functools.cache
-def _compiled_kernel():
-    """:func:`accelerations` compiled by numba (cached on disk) with the compiled kernels of
-    :mod:`projeq.assembly.kernels` and Φ called through its C callback's address by an
-    intrinsic. Compiled code resolves its callees in its globals, so it is compiled as a copy
-    whose globals hold the compiled callees (as :mod:`projeq.assembly.kernels` compiles its
-    own); its name carries a digest of both sources, so that a changed kernel source is
-    compiled anew rather than read stale from the disk cache (which numba keys by the
-    function's own file only)."""
+def _compiled() -> dict:
+    """{"partitioned": …, "tangent": …}: the kernels compiled by numba (cached on disk) with the
+    compiled kernels of :mod:`projeq.assembly.kernels` and Φ called through its C callback's
+    address by an intrinsic. Compiled code resolves its callees in its globals, so the kernels
+    are compiled as copies whose globals hold the compiled callees (as
+    :mod:`projeq.assembly.kernels` compiles its own); their names carry a digest of both
+    sources, so that a changed source is compiled anew rather than read stale from the disk
+    cache (which numba keys by a function's own file only)."""
     import numba
 
     digest = hashlib.sha1(b"".join(Path(module.__file__).read_bytes() for module in (kernels, sys.modules[__name__])))
-    name = f"accelerations_{digest.hexdigest()[:12]}"
     namespace = dict(globals())
-    namespace.update(
-        chain_terms=kernels.kernel(True)[0], gauss_form=kernels.gauss_form_kernel(True)[0], _phi_into=_intrinsic(),
-        _inverse=numba.njit(cache=True)(_inverse), _cholesky_solve=numba.njit(cache=True)(_cholesky_solve),
-    )
-    copy = types.FunctionType(accelerations.__code__, namespace, name)
-    copy.__qualname__ = name
-    return numba.njit(cache=True)(copy)
+    namespace.update(chain_terms=kernels.kernel(True)[0], gauss_form=kernels.gauss_form_kernel(True)[0],
+                     _phi_into=_intrinsic())
+
+    def rebound(f, name):
+        copy = types.FunctionType(f.__code__, namespace, name, f.__defaults__, f.__closure__)
+        copy.__qualname__ = name
+        return copy
+
+    for f in _HELPERS:
+        namespace[f.__name__] = numba.extending.register_jitable(rebound(f, f.__name__))
+    return {f.__name__: numba.njit(cache=True)(rebound(f, f"{f.__name__}_{digest.hexdigest()[:12]}"))
+            for f in (partitioned, tangent)}
 
 
 def _intrinsic():

@@ -623,20 +623,24 @@ class ConstrainedSystem(Model):
         by :meth:`_projected_accelerations`."""
         kernel = self.compiled_kernel() if method is None else None
         if kernel is not None and not (np.iscomplexobj(q) or np.iscomplexobj(s_dot)):
-            found = kernel.accelerations(q, s_dot, t, self.independent, self.dependent)
+            found = kernel.accelerations(self, q, s_dot, t)
             if found is not None:
                 return found
         return self._projected_accelerations(q, s_dot, t, method)
 
     def compiled_kernel(self):
-        """The :class:`~projeq.constraints.compiled.CompiledPartition` of this system's Φ and tree
+        """The :class:`~projeq.constraints.compiled.CompiledClosure` of this system's Φ and tree
         (built on first use: numba compiles Φ, and warns once naming it if it cannot), or None
         where the compiled call does not apply (:func:`projeq.constraints.compiled.unsupported`)."""
         if self._compiled is False:
-            own_rule = type(self).F is not ConstrainedSystem.F or type(self).particular is not ConstrainedSystem.particular
-            self._compiled = None if own_rule or unsupported(self) is not None else \
-                compiled_partition(self, PARTITION_CONDITION)
+            self._compiled = None if unsupported(self) is not None else self._compiled_rule()
         return self._compiled
+
+    def _compiled_rule(self):
+        """The compiled kernel of coordinate partitioning, None for a subclass that forms F by its own rule."""
+        if type(self).F is not ConstrainedSystem.F or type(self).particular is not ConstrainedSystem.particular:
+            return None
+        return compiled_partition(self, PARTITION_CONDITION)
 
     _compiled = False  # the CompiledPartition, None where it does not apply; False: not looked at yet
 
