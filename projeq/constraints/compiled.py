@@ -1,38 +1,43 @@
 """The constrained s̈ of a closed loop in one compiled call (docs/theory.md §7).
 
 :class:`~projeq.constraints.partitioned.ConstrainedSystem` forms, at every evaluation, the
-Jacobian Φ_q of the loop closures and their second derivative Φ″(q̇, q̇) by the complex step,
-the partition ṡ_tree = F ṡ, s̈_tree = F s̈ + f̄ with F = [E; −A_dep⁻¹ A_ind] and
-f̄ = [0; −A_dep⁻¹ γ], the tree's Gauss form M s̈_tree + b at ṡ_tree, and solves the Projection
-Equation with the constraint inserted before the projection,
+Jacobian A_s = Φ_q of the loop closures and their second derivative γ = Φ″(q̇, q̇) by the complex
+step, the minimal velocities ṡ_tree = F ṡ, s̈_tree = F s̈ + f̄ — by coordinate partitioning,
+F = [E; −A_dep⁻¹ A_ind], f̄ = [0; −A_dep⁻¹ γ], or in :class:`~projeq.constraints.tangent.TangentSystem`
+by the null space N of A_s = U Σ Vᵀ, F = N N_ind⁻¹, f̄ = x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) —,
+the tree's Gauss form M s̈_tree + b at ṡ_tree, and solves the Projection Equation with the
+constraint inserted before the projection,
 
     Fᵀ (M (F s̈ + f̄) + b) = 0,
 
 in about fifty numpy calls and two Python calls of Φ. Here the same steps run in one function
-compiled by numba, with the user's Φ itself compiled (``numba.njit`` of the function as it is
-written: a four-bar's ``[a * np.cos(q[0]) + …, …]`` compiles) and called at the same complex
+compiled by numba (:func:`partitioned`, :func:`tangent`; cached on disk), with the user's Φ itself
+compiled (``numba.njit`` of the function as written — a four-bar's ``[a * np.cos(q[0]) + …, …]``
+compiles — wrapped as a C callback the kernel calls through its address) at the same complex
 points: Φ_q e_j = Im Φ(q + i h e_j) / h and Φ″(v, v) = |v|² Σ_k c_k Im Φ(q + ε_k v̂ + i h v̂) / h
 (Martins, Sturdza & Alonso, "The complex-step derivative approximation", ACM TOMS 29, 2003;
 the stencil's nodes ε_k and weights c_k are those of :mod:`projeq.constraints.batched`), and
 the tree's M and b from the kernels of :mod:`projeq.assembly.kernels` (composite bodies and
 Newton–Euler, Featherstone, "Rigid Body Dynamics Algorithms", 2008, §5.3, §6.2) on the fast
-evaluator's workspace. The numbers are those of the numpy path to round-off.
+evaluator's workspace. The numbers are those of the numpy path to round-off; the tangent kept
+along the branch is read from and written to the system as the numpy path keeps it.
 
 Where it applies (:func:`unsupported` says why not): holonomic constraints only, Φ independent
 of t (``correction="projection"``), q̇ = ṡ_tree (revolute and prismatic joints), a tree whose
 whole Gauss form the compiled kernels compute (no force laws, no joints that state their own
-relative motion, no coupled joints, no elastic bodies), and the coordinate partition itself
-(not the null-space basis of :class:`~projeq.constraints.tangent.TangentSystem`). A Φ numba
-cannot compile, or whose compiled values differ from its own at complex points near q0, keeps
-the numpy path after one :class:`UncompiledClosureWarning` naming it. Where the compiled call
-meets a degenerate partition (κ bound reached) or a singular FᵀMF it returns a flag and the
-numpy path repeats the evaluation, which raises the error that names the cause.
+relative motion, no coupled joints, no elastic bodies), and F by one of the two rules above (not
+a subclass's own, such as the augmented Lagrangian's). A Φ numba cannot compile, or whose
+compiled values differ from its own at complex points near q0, keeps the numpy path after one
+:class:`UncompiledClosureWarning` naming it. Where the compiled call meets a degenerate partition
+(κ bound reached, or N_ind singular) or a singular FᵀMF it returns a flag and the numpy path
+repeats the evaluation, which raises the error that names the cause.
 """
 
 from __future__ import annotations
 
 import functools
 import hashlib
+import re
 import sys
 import types
 import warnings
@@ -90,7 +95,7 @@ def compiled_phi(phi, n: int, m: int, q0: NDArray):
         got = np.array([np.asarray(jitted(x.copy(), 0.0), dtype=complex) for x in X.T]).T
         want = np.array([np.asarray(phi(x.copy(), 0.0), dtype=complex) for x in X.T]).T
     except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
-        lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+        lines = [line.strip() for line in re.sub(r"\x1b\[[0-9;]*m", "", str(exc)).splitlines() if line.strip()]
         why = f"{type(exc).__name__}: {' '.join(lines[:3])[:300]}"
     else:
         scale = max(1.0, np.abs(want.real).max(initial=0.0))

@@ -18,7 +18,7 @@ from projeq.constraints.partitioned import ConstrainedSystem
 # the same stencils and the same M, b (tests/assembly/test_fast.py: ~1e-15 relative), summed in
 # another order: measured ≤ 2e-15 of max(1, |s̈_tree|∞) on these scenes
 RTOL = 1e-13
-COMPILED_SCENES = ("four_bar", "quick_return", "simple_pendulum", "n_four_bar")
+COMPILED_SCENES = ("four_bar", "quick_return", "simple_pendulum", "n_four_bar", "bricard")
 
 
 def _states(model, count=3):
@@ -111,12 +111,6 @@ def test_models_outside_the_compiled_call_keep_the_numpy_path_saying_why(name, w
         warnings.simplefilter("error", UncompiledClosureWarning)  # not looked at: no warning about Φ
         assert model.compiled_kernel() is None
         assert "one compiled call" not in model.evaluator().reason
-
-
-def test_bricards_closure_of_matrix_products_warns_and_keeps_the_numpy_path():
-    model = pq.scenes.bricard()
-    with pytest.warns(UncompiledClosureWarning, match="bricard"):
-        assert model.compiled_kernel() is None
 
 
 def test_a_degenerate_partition_met_by_the_compiled_call_raises_the_numpy_paths_error():
