@@ -453,15 +453,14 @@ def _compiled() -> dict:
     namespace.update(chain_terms=kernels.kernel(True)[0], gauss_form=kernels.gauss_form_kernel(True)[0],
                      _phi_into=_intrinsic())
 
-    def rebound(f, name):
+    def compiled(f):  # each helper compiled (and cached) once, called by both kernels
+        name = f"{f.__name__}_{digest.hexdigest()[:12]}"
         copy = types.FunctionType(f.__code__, namespace, name, f.__defaults__, f.__closure__)
         copy.__qualname__ = name
-        return copy
+        return numba.njit(cache=True)(copy)
 
-    for f in _HELPERS:
-        namespace[f.__name__] = numba.extending.register_jitable(rebound(f, f.__name__))
-    return {f.__name__: numba.njit(cache=True)(rebound(f, f"{f.__name__}_{digest.hexdigest()[:12]}"))
-            for f in (partitioned, tangent)}
+    namespace.update({f.__name__: compiled(f) for f in _HELPERS})
+    return {f.__name__: compiled(f) for f in (partitioned, tangent)}
 
 
 def _intrinsic():
