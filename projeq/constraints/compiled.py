@@ -290,10 +290,8 @@ def tangent(phi, tree, q, s_dot, t, independent, rank, separation, acting, kept,
     ``acting`` σ_max; otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular."""
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
     _jacobian(phi, q, t, A)
-    U, sigma, Vt = np.linalg.svd(A)
-    padded = np.zeros(n)
-    padded[:sigma.shape[0]] = sigma
-    near = max(k, int(np.sum(padded < separation * padded[0])))
+    U, sigma, Vt = _svd(A)
+    near = max(k, int(np.sum(sigma < separation * sigma[0])))
     if near == k or np.isnan(kept[0, 0]):
         N = Vt[n - k:].T.copy()
         kept[:, :] = N
@@ -327,6 +325,57 @@ def tangent(phi, tree, q, s_dot, t, independent, rank, separation, acting, kept,
         x0_ind[c] = x0[independent[c]]
     f_bar = x0 - _matvec(F, x0_ind)
     return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+
+
+def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """(U, σ, Vᵀ) of A (m × n) with all n singular values, descending (those beyond m zero to
+    round-off), V n × n and U m × n (column j = A v_j / σ_j, zero where σ_j = 0): one-sided
+    Jacobi rotations of the columns of A until they are orthogonal to round-off (Demmel &
+    Veselić, "Jacobi's method is more accurate than QR", SIAM J. Matrix Anal. Appl. 13, 1992,
+    Algorithm 4.1) — for the few rows and columns of a loop's A_s, without LAPACK's calls and
+    workspace."""
+    m, n = A.shape
+    W, V = A.copy(), np.eye(n)
+    for _ in range(100):  # sweeps; quadratic convergence takes a handful
+        rotated = False
+        for p in range(n - 1):
+            for r in range(p + 1, n):
+                alpha, beta, gamma = 0.0, 0.0, 0.0
+                for i in range(m):
+                    alpha += W[i, p] * W[i, p]
+                    beta += W[i, r] * W[i, r]
+                    gamma += W[i, p] * W[i, r]
+                if abs(gamma) <= 1e-16 * np.sqrt(alpha) * np.sqrt(beta):  # orthogonal to round-off (0 included)
+                    continue
+                rotated = True
+                if abs(beta - alpha) > 1e100 * abs(gamma):  # a tiny angle: tan = 1/(2ζ) to round-off
+                    tan = gamma / (beta - alpha)
+                else:
+                    zeta = (beta - alpha) / (2.0 * gamma)
+                    tan = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.hypot(1.0, zeta))
+                cos = 1.0 / np.sqrt(1.0 + tan * tan)
+                sin = cos * tan
+                for X in (W, V):
+                    for i in range(X.shape[0]):
+                        x_p, x_r = X[i, p], X[i, r]
+                        X[i, p], X[i, r] = cos * x_p - sin * x_r, sin * x_p + cos * x_r
+        if not rotated:
+            break
+    norms = np.zeros(n)
+    for j in range(n):
+        for i in range(m):
+            norms[j] += W[i, j] * W[i, j]
+    order = np.argsort(-norms)
+    sigma, U, Vt = np.zeros(n), np.zeros((m, n)), np.zeros((n, n))
+    for c in range(n):
+        j = order[c]
+        sigma[c] = np.sqrt(norms[j])
+        for i in range(n):
+            Vt[c, i] = V[i, j]
+        if sigma[c] > 0.0:
+            for i in range(m):
+                U[i, c] = W[i, j] / sigma[c]
+    return U, sigma, Vt
 
 
 chain_terms, gauss_form = kernels.chain_terms, kernels.gauss_form  # interpreted; _compiled holds the compiled ones
@@ -383,7 +432,7 @@ def _cholesky_solve(D: NDArray, x: NDArray, pivot_min: float) -> bool:
     return True
 
 
-_HELPERS = (_jacobian, _gamma, _matvec, _matmul, _projected, _inverse, _cholesky_solve)
+_HELPERS = (_jacobian, _gamma, _matvec, _matmul, _svd, _projected, _inverse, _cholesky_solve)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":

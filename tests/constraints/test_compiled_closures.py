@@ -127,3 +127,23 @@ def test_a_degenerate_partition_met_by_the_compiled_call_raises_the_numpy_paths_
     assert kernel.accelerations(model, q, np.array([0.5]), 0.0) is None
     with pytest.raises(ValueError, match="independent: the dependent velocities"):
         model.accelerations_tree(q, np.array([0.5]), 0.0)
+
+
+@pytest.mark.parametrize("shape", [(1, 2), (2, 3), (4, 5), (5, 5), (6, 7)])
+def test_the_kernels_jacobi_svd_equals_lapacks(shape):
+    """One-sided Jacobi (Demmel & Veselić 1992) against numpy's LAPACK SVD: the same singular
+    values to round-off (a redundant row: a zero one), U Σ Vᵀ = A, V orthogonal, and the rows of
+    Vᵀ beyond the rank in the null space."""
+    m, n = shape
+    A = np.random.default_rng(m * n).standard_normal(shape)
+    if m == n:
+        A[-1] = A[0] + A[1]  # a redundant row, as Bricard's
+    U, sigma, Vt = compiled._svd(A)
+    expected = np.linalg.svd(A, compute_uv=False)
+    r = len(expected)
+    assert np.abs(sigma[:r] - expected).max() <= 1e-14 * expected[0]
+    assert np.abs(sigma[r:]).max(initial=0.0) <= 1e-14 * expected[0]
+    assert np.abs((U[:, :r] * sigma[:r]) @ Vt[:r] - A).max() <= 1e-14 * expected[0]
+    assert np.abs(Vt @ Vt.T - np.eye(n)).max() <= 1e-14
+    rank = int(np.sum(expected > 1e-12 * expected[0]))
+    assert np.abs(A @ Vt[rank:].T).max(initial=0.0) <= 1e-14 * expected[0]
