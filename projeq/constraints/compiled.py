@@ -336,6 +336,7 @@ def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     workspace."""
     m, n = A.shape
     W, V = A.copy(), np.eye(n)
+    floor = (1e-15 * np.sqrt(np.sum(A * A))) ** 2  # a column below this is A v = 0 to round-off: in the null space
     for _ in range(100):  # sweeps; quadratic convergence takes a handful
         rotated = False
         for p in range(n - 1):
@@ -345,8 +346,8 @@ def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
                     alpha += W[i, p] * W[i, p]
                     beta += W[i, r] * W[i, r]
                     gamma += W[i, p] * W[i, r]
-                if abs(gamma) <= 1e-16 * np.sqrt(alpha) * np.sqrt(beta):  # orthogonal to round-off (0 included)
-                    continue
+                if alpha <= floor or beta <= floor or abs(gamma) <= 1e-15 * np.sqrt(alpha) * np.sqrt(beta):
+                    continue  # orthogonal to round-off
                 rotated = True
                 if abs(beta - alpha) > 1e100 * abs(gamma):  # a tiny angle: tan = 1/(2ζ) to round-off
                     tan = gamma / (beta - alpha)
