@@ -65,19 +65,18 @@ def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, spee
     joints |= {name: Revolute(parent=cranks[i], axis="z", r_pn=(L, 0.0, 0.0))
                for i, name in enumerate(couplers)}
     tree = System(dict.fromkeys(cranks + couplers, rod), joints, gravity=(0.0, -g, 0.0))
-    crank, coupler = (np.array([tree.q_slice[tree.index(name)].start for name in names])
-                      for names in (cranks, couplers))
+    crank, coupler = (tuple(tree.q_slice[tree.index(name)].start for name in names) for names in (cranks, couplers))
 
-    def closure(q, t):  # tip of coupler i − (tip of crank i), i = 1 … n: x rows, then y rows
-        theta, phi = q[crank], q[coupler]
-        absolute = theta[:-1] + phi
-        x = L * (np.cos(theta[:-1]) + np.cos(absolute) - 1.0 - np.cos(theta[1:]))  # pivots 1 apart
-        y = L * (np.sin(theta[:-1]) + np.sin(absolute) - np.sin(theta[1:]))
-        return np.concatenate((x, y))
+    def closure(q, t):  # tip of coupler i − (tip of crank i), i = 1 … n: x rows, then y rows (on the rows q[i])
+        x = [L * (np.cos(q[crank[i]]) + np.cos(q[crank[i]] + q[coupler[i]]) - 1.0 - np.cos(q[crank[i + 1]]))
+             for i in range(n)]  # pivots 1 apart
+        y = [L * (np.sin(q[crank[i]]) + np.sin(q[crank[i]] + q[coupler[i]]) - np.sin(q[crank[i + 1]]))
+             for i in range(n)]
+        return x + y
 
     q0, s_dot0 = np.zeros(tree.n_q), np.zeros(tree.n_s)
-    q0[crank], q0[coupler] = np.pi / 2, -np.pi / 2
-    s_dot0[crank], s_dot0[coupler] = -speed / L, speed / L  # ẋ_B0 = −L sin θ0 θ̇0; couplers translate
+    q0[list(crank)], q0[list(coupler)] = np.pi / 2, -np.pi / 2
+    s_dot0[list(crank)], s_dot0[list(coupler)] = -speed / L, speed / L  # ẋ_B0 = −L sin θ0 θ̇0; couplers translate
     return TangentSystem(tree, phi=closure, q0=q0, independent=[tree.s_slice[tree.index("crank0")].start],
                          s_dot0=[-speed / L], **options)
 
