@@ -250,11 +250,11 @@ def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
     return DONE
 
 
-def partitioned(phi, tree, q, s_dot, t, independent, dependent, bound, pivot, s_ddot_tree, A, M, b):
+def partitioned(phi, tree, q, s_dot, t, independent, dependent, bound, pivot, q_dot, s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (module
     docstring) from Φ (``phi``: :func:`_phi_into`), the tree's packed arrays and workspace
     (``tree``: those of :func:`projeq.assembly.kernels.chain_terms`), q, ṡ, t and the partition;
-    writes s̈_tree, Φ_q (= A_s), M and b; returns DONE, SINGULAR (:func:`_projected`) or
+    writes q̇ = ṡ_tree (K = E), s̈_tree, Φ_q (= A_s), M and b; returns DONE, SINGULAR (:func:`_projected`) or
     DEGENERATE where ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
     n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
     _jacobian(phi, q, t, A)
@@ -274,6 +274,7 @@ def partitioned(phi, tree, q, s_dot, t, independent, dependent, bound, pivot, s_
                 total += inv[r, i] * A[i, independent[c]]
             F[dependent[r], c] = -total
     s_dot_tree = _matvec(F, s_dot)
+    q_dot[:] = s_dot_tree
     gamma = _gamma(phi, q, s_dot_tree, t, m)
     f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
     minus_gamma = _matvec(inv, -gamma)
@@ -282,7 +283,7 @@ def partitioned(phi, tree, q, s_dot, t, independent, dependent, bound, pivot, s_
     return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
-def tangent(phi, tree, q, s_dot, t, independent, rank, separation, acting, kept, pivot, s_ddot_tree, A, M, b):
+def tangent(phi, tree, q, s_dot, t, independent, rank, separation, acting, kept, pivot, q_dot, s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.tangent.TangentSystem`: F = N N_ind⁻¹ with
     N the null space of A_s = U Σ Vᵀ continued along the branch (``kept``: the tangent kept last,
     n × n_s, NaN where none; overwritten where the null space is separated, its rule), f̄ =
@@ -310,6 +311,7 @@ def tangent(phi, tree, q, s_dot, t, independent, rank, separation, acting, kept,
         for c in range(k):
             F[independent[r], c] = 1.0 if r == c else 0.0
     s_dot_tree = _matvec(F, s_dot)
+    q_dot[:] = s_dot_tree
     gamma = _gamma(phi, q, s_dot_tree, t, m)
     count = min(int(np.sum(sigma > acting * sigma[0])), rank)
     x0 = np.zeros(n)  # A_s⁺ (−γ) = V_k Σ_k⁻¹ U_kᵀ (−γ)
@@ -465,26 +467,40 @@ class CompiledClosure:
         ev = self.fast = tree.evaluator("fast")
         self.tree = (ev._index, ev._geometry, ev._inertia, ev._gravity, ev._given_values, ev._elastic, ev._ports,
                      ev._T, ev._zeta, ev._F, ev._M_n, ev._h_hat, ev._R, ev._r, ev._twist)
-        self._A, self._s_ddot_tree = np.zeros((m, tree.n_s)), np.zeros(tree.n_s)
+        self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
 
-    def accelerations(self, system, q: NDArray, s_dot: NDArray, t: float):
-        """(s̈_tree, A_s, M, b) of ``system`` (its partition; for a TangentSystem its kept tangent,
-        which the call updates as the numpy path does) at (q, ṡ, t), or None (flagged)."""
+    def _call(self, system, q: NDArray, s_dot: NDArray, t: float) -> bool:
+        """One kernel call for ``system`` (its partition; for a TangentSystem its kept tangent,
+        which the call updates as the numpy path does) into the workspace; whether it is done."""
         M, b = self.fast._M_all, self.fast._b_all
         q, s_dot, t = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), float(t)
         if self.rule == "partitioned":
             flag = self.kernel(self.phi, self.tree, q, s_dot, t, system.independent, system.dependent,
-                               self.constants[0], SINGULAR_PIVOT, self._s_ddot_tree, self._A, M, b)
+                               self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b)
         else:
             kept = np.full((system.tree.n_s, system.n_s), np.nan) if system._tangent is None else \
                 np.array(system._tangent, dtype=float)
             flag = self.kernel(self.phi, self.tree, q, s_dot, t, system.independent, system.tree.n_s - system.n_s,
-                               system.separation, self.constants[0], kept, SINGULAR_PIVOT, self._s_ddot_tree,
-                               self._A, M, b)
+                               system.separation, self.constants[0], kept, SINGULAR_PIVOT, self._q_dot,
+                               self._s_ddot_tree, self._A, M, b)
             system._tangent = kept
-        if flag != DONE:
+        return flag == DONE
+
+    def accelerations(self, system, q: NDArray, s_dot: NDArray, t: float):
+        """(s̈_tree, A_s, M, b) of ``system`` at (q, ṡ, t), or None (flagged)."""
+        if not self._call(system, q, s_dot, t):
             return None
-        return self._s_ddot_tree.copy(), self._A.copy(), M.copy(), b.copy()
+        return self._s_ddot_tree.copy(), self._A.copy(), self.fast._M_all.copy(), self.fast._b_all.copy()
+
+    def state_derivative(self, system, x: NDArray, t: float):
+        """ẋ = (q̇, s̈) = (ṡ_tree, s̈_tree[independent]) of ``system`` at x = (q, ṡ) (q̇ = ṡ_tree:
+        K = E, and no Baumgarte term where the kernel applies), or None where the kernel flags
+        or ẋ is not finite (the caller's checked path then names the cause)."""
+        n_q = system.n_q
+        if not self._call(system, x[:n_q], x[n_q:], t):
+            return None
+        x_dot = np.concatenate((self._q_dot, self._s_ddot_tree[system.independent]))
+        return x_dot if np.isfinite(x_dot).all() else None
 
 
 @functools.cache

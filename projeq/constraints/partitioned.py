@@ -683,6 +683,8 @@ class PartitionedEvaluator:
         # forms s̈_tree and λ together (the augmented Lagrangian)
         partitioned = type(system).accelerations_tree is ConstrainedSystem.accelerations_tree
         whole = method is None and partitioned and system.compiled_kernel() is not None
+        if whole:  # ẋ = (q̇, s̈) in one compiled call for simulate's right-hand side
+            self.state_derivative = self._state_derivative
         self.reason = ("Φ's derivatives, the partition and the projection of the tree's Gauss form in one "
                        "compiled call" if whole else
                        f"constraint equations projected on the tree's Gauss form M, b by the "
@@ -693,6 +695,10 @@ class PartitionedEvaluator:
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         return self._tree(q, s_dot, t, self.method)[0][self.system.independent]
+
+    def _state_derivative(self, t: float, x: NDArray):
+        """ẋ = (q̇, s̈) by the system's compiled kernel, or None (:meth:`projeq.constraints.compiled.CompiledClosure.state_derivative`)."""
+        return self.system.compiled_kernel().state_derivative(self.system, x, t)
 
 
 def _minimal(F: NDArray, f_bar: NDArray, M: NDArray, b: NDArray) -> tuple[NDArray, NDArray]:
