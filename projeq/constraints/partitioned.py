@@ -689,7 +689,9 @@ class PartitionedEvaluator:
                        "compiled call" if whole else
                        f"constraint equations projected on the tree's Gauss form M, b by the "
                        f"{'compiled kernels' if compiled else 'dense reference'}"
-                       + (f", b from the {method!r} evaluator" if method not in (None, "dense") else ""))
+                       + (f", b from the {method!r} evaluator" if method not in (None, "dense") else "")
+                       + (f"; not in one compiled call: {unsupported(system) or 'Φ does not compile'}"
+                          if method is None and partitioned and not whole else ""))
         self.system, self.method = system, method
         self._tree = system._tree_accelerations if partitioned else system.accelerations_tree
 
