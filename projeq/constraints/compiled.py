@@ -3,8 +3,9 @@
 :class:`~projeq.constraints.partitioned.ConstrainedSystem` forms, at every evaluation, the
 Jacobian A_s = Φ_q of the loop closures and their second derivative γ = Φ″(q̇, q̇) by the complex
 step, the minimal velocities ṡ_tree = F ṡ, s̈_tree = F s̈ + f̄ — by coordinate partitioning,
-F = [E; −A_dep⁻¹ A_ind], f̄ = [0; −A_dep⁻¹ γ], or in :class:`~projeq.constraints.tangent.TangentSystem`
-by the null space N of A_s = U Σ Vᵀ, F = N N_ind⁻¹, f̄ = x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) —,
+F = [E; −A_dep⁻¹ A_ind], f̄ = [0; −A_dep⁻¹ γ], or in
+:class:`~projeq.constraints.tangent.TangentSystem` by the null space N of A_s = U Σ Vᵀ,
+F = N N_ind⁻¹, f̄ = x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) —,
 the tree's Gauss form M s̈_tree + b at ṡ_tree, and solves the Projection Equation with the
 constraint inserted before the projection,
 
@@ -51,8 +52,8 @@ from projeq.assembly import kernels
 from projeq.assembly.linalg import SINGULAR_PIVOT
 from projeq.constraints.batched import NODES, WEIGHTS
 
-#: flags of :func:`closure_kernel`'s kernel: done; partition bound reached or A_dep singular;
-#: FᵀMF not positive definite (the numpy path then raises the error that names the cause)
+#: flags of the kernels (:func:`partitioned`, :func:`tangent`): done; partition bound reached (or
+#: A_dep, N_ind singular); FᵀMF not positive definite (the numpy path then raises the error naming it)
 DONE, DEGENERATE, SINGULAR = 0, 1, 2
 
 
@@ -462,7 +463,8 @@ class CompiledClosure:
     ``compiled=False`` runs the same kernel interpreted, with ``callback`` Φ itself (for testing)."""
 
     def __init__(self, tree, m: int, callback, rule: str, constants: tuple, compiled: bool = True):
-        self.callback, self.rule, self.constants = callback, rule, constants  # the callback lives while its address is used
+        # the callback lives as long as this object, which passes its address
+        self.callback, self.rule, self.constants = callback, rule, constants
         self.kernel, self.phi = (_compiled()[rule], callback.address) if compiled else (globals()[rule], callback)
         ev = self.fast = tree.evaluator("fast")
         self.tree = (ev._index, ev._geometry, ev._inertia, ev._gravity, ev._given_values, ev._elastic, ev._ports,

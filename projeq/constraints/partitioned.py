@@ -642,7 +642,7 @@ class ConstrainedSystem(Model):
             return None
         return compiled_partition(self, PARTITION_CONDITION)
 
-    _compiled = False  # the CompiledPartition, None where it does not apply; False: not looked at yet
+    _compiled = False  # the CompiledClosure, None where it does not apply; False: not looked at yet
 
     def _projected_accelerations(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
         """(s̈_tree, A_s, M, b) by numpy linear algebra on Φ's derivatives and the tree's Gauss
@@ -699,7 +699,8 @@ class PartitionedEvaluator:
         return self._tree(q, s_dot, t, self.method)[0][self.system.independent]
 
     def _state_derivative(self, t: float, x: NDArray):
-        """ẋ = (q̇, s̈) by the system's compiled kernel, or None (:meth:`projeq.constraints.compiled.CompiledClosure.state_derivative`)."""
+        """ẋ = (q̇, s̈) by the system's compiled kernel, or None
+        (:meth:`projeq.constraints.compiled.CompiledClosure.state_derivative`)."""
         return self.system.compiled_kernel().state_derivative(self.system, x, t)
 
 

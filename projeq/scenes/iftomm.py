@@ -76,7 +76,8 @@ def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, spee
 
     q0, s_dot0 = np.zeros(tree.n_q), np.zeros(tree.n_s)
     q0[list(crank)], q0[list(coupler)] = np.pi / 2, -np.pi / 2
-    s_dot0[list(crank)], s_dot0[list(coupler)] = -speed / L, speed / L  # ẋ_B0 = −L sin θ0 θ̇0; couplers translate
+    # ẋ_B0 = −L sin θ0 θ̇0; couplers translate
+    s_dot0[list(crank)], s_dot0[list(coupler)] = -speed / L, speed / L
     return TangentSystem(tree, phi=closure, q0=q0, independent=[tree.s_slice[tree.index("crank0")].start],
                          s_dot0=[-speed / L], **options)
 
