@@ -6,6 +6,7 @@
 - :mod:`.augmented`: :class:`AugmentedSystem`, the augmented Lagrangian formulation (the alternative);
 - :mod:`.cut_joints`: cut joints of closed loops (:class:`PinClosure`);
 - :mod:`.batched`: the loop closures' derivatives from one call at a batch of points;
+- :mod:`.compiled`: the constrained s̈ (Φ compiled, its derivatives, F, the projection) in one compiled call;
 - :mod:`.reactions`: reaction forces and the contact event;
 - :mod:`.nonholonomic`: checks of non-holonomic quasi-velocities (singular K, constraint drift).
 """

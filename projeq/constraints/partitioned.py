@@ -76,6 +76,7 @@ from numpy.typing import NDArray
 
 from projeq.assembly.linalg import solve_spd
 from projeq.constraints.batched import batched_closure
+from projeq.constraints.compiled import compiled_partition, unsupported
 from projeq.checks import positive, state_vector
 from projeq.analysis.differentiation import (derivative_along, derivative_along_differences, is_complex_safe,
                                              second_derivative_along, second_derivative_along_differences)
@@ -616,7 +617,36 @@ class ConstrainedSystem(Model):
         return s_ddot_tree, lam
 
     def _tree_accelerations(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
-        """(s̈_tree, A_s, M, b): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0."""
+        """(s̈_tree, A_s, M, b): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0, in one compiled
+        call by default where it applies (:mod:`projeq.constraints.compiled`), else (and where
+        that call flags a degenerate partition or a singular FᵀMF, to raise the error naming it)
+        by :meth:`_projected_accelerations`."""
+        kernel = self.compiled_kernel() if method is None else None
+        if kernel is not None and not (np.iscomplexobj(q) or np.iscomplexobj(s_dot)):
+            found = kernel.accelerations(self, q, s_dot, t)
+            if found is not None:
+                return found
+        return self._projected_accelerations(q, s_dot, t, method)
+
+    def compiled_kernel(self):
+        """The :class:`~projeq.constraints.compiled.CompiledClosure` of this system's Φ and tree
+        (built on first use: numba compiles Φ, and warns once naming it if it cannot), or None
+        where the compiled call does not apply (:func:`projeq.constraints.compiled.unsupported`)."""
+        if self._compiled is False:
+            self._compiled = None if unsupported(self) is not None else self._compiled_rule()
+        return self._compiled
+
+    def _compiled_rule(self):
+        """The compiled kernel of coordinate partitioning, None for a subclass that forms F by its own rule."""
+        if type(self).F is not ConstrainedSystem.F or type(self).particular is not ConstrainedSystem.particular:
+            return None
+        return compiled_partition(self, PARTITION_CONDITION)
+
+    _compiled = False  # the CompiledClosure, None where it does not apply; False: not looked at yet
+
+    def _projected_accelerations(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
+        """(s̈_tree, A_s, M, b) by numpy linear algebra on Φ's derivatives and the tree's Gauss
+        form (the reference of the compiled call)."""
         A_s, F, f_bar, M, b = self._projected(q, s_dot, t, method)
         M_min, b_min = _minimal(F, f_bar, M, b)
         s_ddot = -solve_spd(M_min, b_min[:, None], "constrained mass matrix FᵀMF",
@@ -649,17 +679,29 @@ class PartitionedEvaluator:
             system.tree.evaluator(method)
         compiled = system.compiled_tree(method)
         self.name = f"partitioned({'fast' if compiled else 'dense'})"
-        self.reason = (f"constraint equations projected on the tree's Gauss form M, b by the "
-                       f"{'compiled kernels' if compiled else 'dense reference'}"
-                       + (f", b from the {method!r} evaluator" if method not in (None, "dense") else ""))
-        self.system, self.method = system, method
         # the motion needs no multipliers: s̈_tree without λ's least squares, unless a subclass
         # forms s̈_tree and λ together (the augmented Lagrangian)
         partitioned = type(system).accelerations_tree is ConstrainedSystem.accelerations_tree
+        whole = method is None and partitioned and system.compiled_kernel() is not None
+        if whole:  # ẋ = (q̇, s̈) in one compiled call for simulate's right-hand side
+            self.state_derivative = self._state_derivative
+        self.reason = ("Φ's derivatives, the partition and the projection of the tree's Gauss form in one "
+                       "compiled call" if whole else
+                       f"constraint equations projected on the tree's Gauss form M, b by the "
+                       f"{'compiled kernels' if compiled else 'dense reference'}"
+                       + (f", b from the {method!r} evaluator" if method not in (None, "dense") else "")
+                       + (f"; not in one compiled call: {unsupported(system) or 'Φ does not compile'}"
+                          if method is None and partitioned and not whole else ""))
+        self.system, self.method = system, method
         self._tree = system._tree_accelerations if partitioned else system.accelerations_tree
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         return self._tree(q, s_dot, t, self.method)[0][self.system.independent]
+
+    def _state_derivative(self, t: float, x: NDArray):
+        """ẋ = (q̇, s̈) by the system's compiled kernel, or None
+        (:meth:`projeq.constraints.compiled.CompiledClosure.state_derivative`)."""
+        return self.system.compiled_kernel().state_derivative(self.system, x, t)
 
 
 def _minimal(F: NDArray, f_bar: NDArray, M: NDArray, b: NDArray) -> tuple[NDArray, NDArray]:

@@ -55,6 +55,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
+from projeq.constraints.compiled import compiled_tangent
 from projeq.constraints.partitioned import (
     RANK_TOLERANCE, REPIVOT_CONDITION, ConstrainedSystem, independent_indices, minimum_norm_solution, numerical_rank,
 )
@@ -230,6 +231,13 @@ class TangentSystem(ConstrainedSystem):
         found = ((float(t), self.rank(q, t), self.mobility(q, t))
                  for t, q in zip(result.t_events[event], result.q_events[event]))
         return tuple(row for row in found if row[1] < rank0)
+
+    def _compiled_rule(self):
+        """The compiled kernel of the tangent space (:func:`projeq.constraints.compiled.tangent`),
+        None for a subclass that forms F by its own rule."""
+        if type(self).F is not TangentSystem.F or type(self).particular is not TangentSystem.particular:
+            return None
+        return compiled_tangent(self, ACTING)
 
     def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:
         """(F, f) of ṡ_tree = F ṡ + f: F = N N_ind⁻¹, f the particular solution of A_s f = b_s

@@ -65,19 +65,19 @@ def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, spee
     joints |= {name: Revolute(parent=cranks[i], axis="z", r_pn=(L, 0.0, 0.0))
                for i, name in enumerate(couplers)}
     tree = System(dict.fromkeys(cranks + couplers, rod), joints, gravity=(0.0, -g, 0.0))
-    crank, coupler = (np.array([tree.q_slice[tree.index(name)].start for name in names])
-                      for names in (cranks, couplers))
+    crank, coupler = (tuple(tree.q_slice[tree.index(name)].start for name in names) for names in (cranks, couplers))
 
-    def closure(q, t):  # tip of coupler i − (tip of crank i), i = 1 … n: x rows, then y rows
-        theta, phi = q[crank], q[coupler]
-        absolute = theta[:-1] + phi
-        x = L * (np.cos(theta[:-1]) + np.cos(absolute) - 1.0 - np.cos(theta[1:]))  # pivots 1 apart
-        y = L * (np.sin(theta[:-1]) + np.sin(absolute) - np.sin(theta[1:]))
-        return np.concatenate((x, y))
+    def closure(q, t):  # tip of coupler i − (tip of crank i), i = 1 … n: x rows, then y rows (on the rows q[i])
+        x = [L * (np.cos(q[crank[i]]) + np.cos(q[crank[i]] + q[coupler[i]]) - 1.0 - np.cos(q[crank[i + 1]]))
+             for i in range(n)]  # pivots 1 apart
+        y = [L * (np.sin(q[crank[i]]) + np.sin(q[crank[i]] + q[coupler[i]]) - np.sin(q[crank[i + 1]]))
+             for i in range(n)]
+        return x + y
 
     q0, s_dot0 = np.zeros(tree.n_q), np.zeros(tree.n_s)
-    q0[crank], q0[coupler] = np.pi / 2, -np.pi / 2
-    s_dot0[crank], s_dot0[coupler] = -speed / L, speed / L  # ẋ_B0 = −L sin θ0 θ̇0; couplers translate
+    q0[list(crank)], q0[list(coupler)] = np.pi / 2, -np.pi / 2
+    # ẋ_B0 = −L sin θ0 θ̇0; couplers translate
+    s_dot0[list(crank)], s_dot0[list(coupler)] = -speed / L, speed / L
     return TangentSystem(tree, phi=closure, q0=q0, independent=[tree.s_slice[tree.index("crank0")].start],
                          s_dot0=[-speed / L], **options)
 
@@ -120,18 +120,6 @@ _CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, -1, 0], [1, -1, 1], [0, -1, 1], [
 _AXES = "yzxyzx"
 
 
-def _rotation(axis: str, angle) -> np.ndarray:
-    """The rotation by ``angle`` about the coordinate axis ``axis`` ("x", "y" or "z"): a 3 × 3
-    matrix, or 3 × 3 × B for B angles (a batch of states)."""
-    k = "xyz".index(axis)
-    i, j = (k + 1) % 3, (k + 2) % 3
-    angle = np.asarray(angle)
-    R = np.zeros((3, 3) + angle.shape, dtype=np.result_type(angle, float))  # complex under a complex step
-    R[k, k] = 1.0
-    R[i, i], R[i, j], R[j, i], R[j, j] = np.cos(angle), -np.sin(angle), np.sin(angle), np.cos(angle)
-    return R
-
-
 def bricard(m: float = 1.0, L: float = 1.0, side: float = 0.1, g: float = 9.81, **options) -> TangentSystem:
     """IFToMM A04: Bricard's overconstrained mechanism, five rods (mass m, length L, square section
     ``side``) in a chain of revolute joints from the ground at the origin (axis y) over the
@@ -153,16 +141,28 @@ def bricard(m: float = 1.0, L: float = 1.0, side: float = 0.1, g: float = 9.81, 
         joints[name] = Revolute(parent=names[i - 1] if i else None, axis=_AXES[i],
                                 r_pn=corners[i] - (corners[i - 1] if i else 0.0))
     tree = System(subsystems, joints, gravity=(0.0, -g, 0.0))
-    columns = [tree.q_slice[tree.index(name)].start for name in names]
+    columns = tuple(tree.q_slice[tree.index(name)].start for name in names)
+    axes = tuple("xyz".index(axis) for axis in _AXES[:5])
+    offsets = tuple(tuple(corners[i] - (corners[i - 1] if i else 0.0)) for i in range(6))  # corner to corner
+    end = tuple(corners[5])
 
-    def closure(q, t):  # the chain's forward kinematics to rod5's far end, in closed form (a batch: q (5, B))
-        batch = np.shape(q)[1:]
-        R, r = _rotation("x", np.zeros(batch)), np.zeros((3,) + batch)
-        for i, column in enumerate(columns):
-            r = r + np.einsum("ij...,j->i...", R, corners[i] - (corners[i - 1] if i else 0.0))
-            R = np.einsum("ij...,jk...->ik...", R, _rotation(_AXES[i], q[column]))
-        end = r + np.einsum("ij...,j->i...", R, corners[5] - corners[4]) - corners[5].reshape((3,) + (1,) * len(batch))
-        return np.concatenate((end, R[1:, 0]))
+    def closure(q, t):
+        """The chain's forward kinematics to rod5's far end in closed form, on the rows q[i] (a
+        point, or a batch of points; compiled by numba as written): r += R ρ_i, then
+        R ← R R_axis(q_i), whose columns (i, j) after the axis k turn as (c R_i + s R_j, −s R_i + c R_j)."""
+        zero = q[columns[0]] * 0.0
+        R = [[zero + 1.0, zero, zero], [zero, zero + 1.0, zero], [zero, zero, zero + 1.0]]  # rows of R
+        r = [zero, zero, zero]
+        for n in range(5):
+            for a in range(3):
+                r[a] = r[a] + R[a][0] * offsets[n][0] + R[a][1] * offsets[n][1] + R[a][2] * offsets[n][2]
+            i, j = (axes[n] + 1) % 3, (axes[n] + 2) % 3
+            c, s = np.cos(q[columns[n]]), np.sin(q[columns[n]])
+            for a in range(3):
+                R_i, R_j = R[a][i], R[a][j]
+                R[a][i], R[a][j] = c * R_i + s * R_j, c * R_j - s * R_i
+        return [r[a] + R[a][0] * offsets[5][0] + R[a][1] * offsets[5][1] + R[a][2] * offsets[5][2] - end[a]
+                for a in range(3)] + [R[1][0], R[2][0]]
 
     return TangentSystem(tree, phi=closure, q0=np.zeros(tree.n_q), **options)
 

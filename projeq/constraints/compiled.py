@@ -1,0 +1,554 @@
+"""The constrained s̈ of a closed loop in one compiled call (docs/theory.md §7).
+
+:class:`~projeq.constraints.partitioned.ConstrainedSystem` forms, at every evaluation, the
+Jacobian A_s = Φ_q of the loop closures and their second derivative γ = Φ″(q̇, q̇) by the complex
+step, the minimal velocities ṡ_tree = F ṡ, s̈_tree = F s̈ + f̄ — by coordinate partitioning,
+F = [E; −A_dep⁻¹ A_ind], f̄ = [0; −A_dep⁻¹ γ], or in
+:class:`~projeq.constraints.tangent.TangentSystem` by the null space N of A_s = U Σ Vᵀ,
+F = N N_ind⁻¹, f̄ = x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) —,
+the tree's Gauss form M s̈_tree + b at ṡ_tree, and solves the Projection Equation with the
+constraint inserted before the projection,
+
+    Fᵀ (M (F s̈ + f̄) + b) = 0,
+
+in about fifty numpy calls and two Python calls of Φ. Here the same steps run in one function
+compiled by numba (:func:`partitioned`, :func:`tangent`; cached on disk), with the user's Φ itself
+compiled (``numba.njit`` of the function as written — a four-bar's ``[a * np.cos(q[0]) + …, …]``
+compiles — wrapped as a C callback the kernel calls through its address) at the same complex
+points: Φ_q e_j = Im Φ(q + i h e_j) / h and Φ″(v, v) = |v|² Σ_k c_k Im Φ(q + ε_k v̂ + i h v̂) / h
+(Martins, Sturdza & Alonso, "The complex-step derivative approximation", ACM TOMS 29, 2003;
+the stencil's nodes ε_k and weights c_k are those of :mod:`projeq.constraints.batched`), and
+the tree's M and b from the kernels of :mod:`projeq.assembly.kernels` (composite bodies and
+Newton–Euler, Featherstone, "Rigid Body Dynamics Algorithms", 2008, §5.3, §6.2) on the fast
+evaluator's workspace. The numbers are those of the numpy path to round-off; the tangent kept
+along the branch is read from and written to the system as the numpy path keeps it.
+
+Where it applies (:func:`unsupported` says why not): holonomic constraints only, Φ independent
+of t (``correction="projection"``), q̇ = ṡ_tree (revolute and prismatic joints), a tree whose
+whole Gauss form the compiled kernels compute (no force laws, no joints that state their own
+relative motion, no coupled joints, no elastic bodies), and F by one of the two rules above (not
+a subclass's own, such as the augmented Lagrangian's). A Φ numba cannot compile, or whose
+compiled values differ from its own at complex points near q0, keeps the numpy path after one
+:class:`UncompiledClosureWarning` naming it. Where the compiled call meets a degenerate partition
+(κ bound reached, or N_ind singular) or a singular FᵀMF it returns a flag and the numpy path
+repeats the evaluation, which raises the error that names the cause.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import re
+import sys
+import types
+import warnings
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from projeq.analysis.differentiation import COMPLEX_STEP
+from projeq.assembly import kernels
+from projeq.assembly.linalg import SINGULAR_PIVOT
+from projeq.constraints.batched import NODES, WEIGHTS
+
+#: flags of the kernels (:func:`partitioned`, :func:`tangent`): done; partition bound reached (or
+#: A_dep, N_ind singular); FᵀMF not positive definite (the numpy path then raises the error naming it)
+DONE, DEGENERATE, SINGULAR = 0, 1, 2
+
+
+class UncompiledClosureWarning(UserWarning):
+    """A constraint function numba cannot compile: the constrained s̈ takes the numpy path
+    (about ten times slower per call)."""
+
+
+def unsupported(system) -> str | None:
+    """Why the constrained s̈ of ``system`` (a ConstrainedSystem that forms F by coordinate
+    partitioning) cannot be one compiled call (None if it can), module docstring."""
+    tree = system.tree
+    checks = (
+        (system.m_p > 0, "Pfaffian constraints A(q, t) q̇ = b(q, t)"),
+        (system.m_h == 0, "no holonomic constraints"),
+        (system.rheonomic, "Φ may depend on t (correction other than 'projection')"),
+        (not system._identity, "joints with q̇ ≠ ṡ (K ≠ E)"),
+        (not system.exact, "Φ does not take complex arguments (no complex step)"),
+        (not system.compiled_tree(), "the tree's default evaluator is not the compiled one"),
+    )
+    for failed, why in checks:
+        if failed:
+            return why
+    ev = tree.evaluator("fast")
+    if ev._given or tree.forces or ev._expansion is not None or ev._width > 6:
+        return "the tree has force laws, joints stating their own relative motion, coupled joints or elastic bodies"
+    return None
+
+
+def compiled_phi(phi, n: int, m: int, q0: NDArray):
+    """``numba.njit(phi)`` if it compiles for q complex (n,), t float and gives Φ's own values,
+    real and imaginary parts each to 1e-13 relative, at three complex points near q0; else None
+    after one :class:`UncompiledClosureWarning` naming ``phi``."""
+    import numba
+
+    rng = np.random.default_rng(11)
+    X = q0[:, None] + 1e-2 * rng.standard_normal((n, 3)) + 1j * COMPLEX_STEP * rng.standard_normal((n, 3))
+    try:
+        jitted = numba.njit(phi)
+        got = np.array([np.asarray(jitted(x.copy(), 0.0), dtype=complex) for x in X.T]).T
+        want = np.array([np.asarray(phi(x.copy(), 0.0), dtype=complex) for x in X.T]).T
+    except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+        lines = [line.strip() for line in re.sub(r"\x1b\[[0-9;]*m", "", str(exc)).splitlines() if line.strip()]
+        why = f"{type(exc).__name__}: {' '.join(lines[:3])[:300]}"
+    else:
+        scale = max(1.0, np.abs(want.real).max(initial=0.0))
+        rate = max(1.0, np.abs(want.imag / COMPLEX_STEP).max(initial=0.0))
+        if got.shape == want.shape == (m, 3) and np.all(np.abs(got.real - want.real) <= 1e-13 * scale) \
+                and np.all(np.abs(got.imag - want.imag) / COMPLEX_STEP <= 1e-13 * rate):
+            return jitted
+        why = "its compiled values differ from its own at complex points near q0"
+    warnings.warn(
+        f"phi: numba cannot compile {getattr(phi, '__qualname__', repr(phi))} ({why}); the constrained s̈ "
+        "takes the numpy path (about ten times slower): write Φ with numpy operations on scalars q[i] "
+        "(no Python objects, dicts or calls of uncompiled functions)",
+        UncompiledClosureWarning, stacklevel=4,
+    )
+    return None
+
+
+def _key(phi):
+    """A hashable key of Φ's code and captured values (one compiled kernel for closures of the
+    same source and constants, a scene built twice), else Φ itself."""
+    try:
+        cells = tuple(_frozen(c.cell_contents) for c in (phi.__closure__ or ()))
+        key = (phi.__code__, cells, phi.__defaults__)
+        hash(key)
+    except (AttributeError, TypeError, ValueError):
+        return phi
+    return key
+
+
+def _frozen(value):
+    """An array as (dtype, shape, bytes), hashable; anything else as it is."""
+    return (value.dtype.str, value.shape, value.tobytes()) if isinstance(value, np.ndarray) else value
+
+
+_CALLBACKS: dict = {}  # _key(Φ) -> its C callback (numba.cfunc), or None where Φ did not compile
+
+
+def closure_callback(phi, n: int, m: int, q0: NDArray):
+    """Φ (n coordinates, m rows) compiled as a C callback ``into(x, t, value)`` (value ← Φ(x, t),
+    x and value complex), built once per Φ source and constants in a process; None (after one
+    warning) if Φ does not compile (:func:`compiled_phi`)."""
+    key = _key(phi)
+    if key not in _CALLBACKS:
+        jitted = compiled_phi(phi, n, m, q0)
+        _CALLBACKS[key] = None if jitted is None else _callback(jitted, n, m)
+    return _CALLBACKS[key]
+
+
+def _callback(jitted, n: int, m: int):
+    import numba
+    from numba import types as nb
+
+    def into(x_pointer, t, value_pointer):
+        x, value = numba.carray(x_pointer, (n,)), numba.carray(value_pointer, (m,))
+        phi_value = jitted(x, t)
+        for r in range(m):
+            value[r] = phi_value[r]
+
+    pointer = nb.CPointer(nb.complex128)
+    return numba.cfunc(nb.void(pointer, nb.float64, pointer))(into)
+
+
+def _phi_into(phi, x, t, value):
+    """value ← Φ(x, t): in the compiled kernels ``phi`` is the address of Φ's C callback (an
+    intrinsic calls it, :func:`_intrinsic`); interpreted, ``phi`` is Φ itself."""
+    value[:] = np.asarray(phi(x, t))
+
+
+def _jacobian(phi, q, t, A):
+    """A ← Φ_q: column j = Im Φ(q + i h e_j) / h."""
+    n, m = A.shape[1], A.shape[0]
+    x, value = np.empty(n, np.complex128), np.empty(m, np.complex128)
+    for j in range(n):
+        for i in range(n):
+            x[i] = q[i]
+        x[j] = q[j] + 1j * COMPLEX_STEP
+        _phi_into(phi, x, t, value)
+        for r in range(m):
+            A[r, j] = value[r].imag / COMPLEX_STEP
+
+
+def _gamma(phi, q, q_dot, t, m):
+    """γ = Φ″(q̇, q̇) = |q̇|² Σ_k c_k Im Φ(q + ε_k u + i h u) / h, u = q̇/|q̇|: the complex step
+    inside the sixth-order stencil of :mod:`projeq.constraints.batched`."""
+    n = q.shape[0]
+    x, value, gamma = np.empty(n, np.complex128), np.empty(m, np.complex128), np.zeros(m)
+    speed = np.sqrt(np.sum(q_dot * q_dot))
+    if speed == 0.0:
+        return gamma
+    for node in range(NODES.shape[0]):
+        for i in range(n):
+            u = q_dot[i] / speed
+            x[i] = q[i] + u * NODES[node] + 1j * COMPLEX_STEP * u
+        _phi_into(phi, x, t, value)
+        for r in range(m):
+            gamma[r] += WEIGHTS[node] * (value[r].imag / COMPLEX_STEP)
+    for r in range(m):
+        gamma[r] *= speed * speed
+    return gamma
+
+
+def _matvec(F, v):
+    """F v (loops: the matrices are small, and numba's @ wants contiguous operands)."""
+    out = np.zeros(F.shape[0])
+    for i in range(F.shape[0]):
+        for c in range(F.shape[1]):
+            out[i] += F[i, c] * v[c]
+    return out
+
+
+def _matmul(A, B):
+    """A B (loops, as :func:`_matvec`)."""
+    out = np.zeros((A.shape[0], B.shape[1]))
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            for c in range(B.shape[1]):
+                out[i, c] += A[i, j] * B[j, c]
+    return out
+
+
+def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
+    """The tree's M, b at (q, ṡ_tree) by the compiled kernels, then s̈ from Fᵀ(M (F s̈ + f̄) + b) = 0
+    and s̈_tree ← F s̈ + f̄; DONE, or SINGULAR where a squared pivot of FᵀMF is not above
+    ``pivot`` times its largest diagonal entry."""
+    index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist = tree
+    chain_terms(index, geometry, inertia, gravity, q, s_dot_tree, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O,
+                twist)
+    gauss_form(index, T, zeta, F_n, M_n, h, M, b)
+    n, k = F.shape
+    MF, g = np.zeros((n, k)), b.copy()  # M F and M f̄ + b
+    for i in range(n):
+        for j in range(n):
+            g[i] += M[i, j] * f_bar[j]
+            for c in range(k):
+                MF[i, c] += M[i, j] * F[j, c]
+    M_min, s_ddot = np.zeros((k, k)), np.zeros(k)  # FᵀMF and −Fᵀ(M f̄ + b)
+    for r in range(k):
+        for i in range(n):
+            s_ddot[r] -= F[i, r] * g[i]
+            for c in range(k):
+                M_min[r, c] += F[i, r] * MF[i, c]
+    scale = 1e-300
+    for c in range(k):
+        scale = max(scale, abs(M_min[c, c]))
+    if k == 1:  # a division, as the numpy path's solve
+        if not M_min[0, 0] > pivot * scale:
+            return SINGULAR
+        s_ddot[0] = s_ddot[0] / M_min[0, 0]
+    elif not _cholesky_solve(M_min, s_ddot, pivot * scale):
+        return SINGULAR
+    s_ddot_tree[:] = _matvec(F, s_ddot) + f_bar
+    return DONE
+
+
+def partitioned(phi, tree, q, s_dot, t, independent, dependent, bound, pivot, q_dot, s_ddot_tree, A, M, b):
+    """The constrained s̈ of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (module
+    docstring) from Φ (``phi``: :func:`_phi_into`), the tree's packed arrays and workspace
+    (``tree``: those of :func:`projeq.assembly.kernels.chain_terms`), q, ṡ, t and the partition;
+    writes q̇ = ṡ_tree (K = E), s̈_tree, Φ_q (= A_s), M and b; returns DONE, SINGULAR (:func:`_projected`) or
+    DEGENERATE where ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
+    n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
+    _jacobian(phi, q, t, A)
+    A_dep = np.empty((m, m))
+    for r in range(m):
+        for c in range(m):
+            A_dep[r, c] = A[r, dependent[c]]
+    inv = _inverse(A_dep)
+    if not np.sqrt(np.sum(A * A)) * np.sqrt(np.sum(inv * inv)) < bound:
+        return DEGENERATE
+    F = np.zeros((n, k))  # F = [E; −A_dep⁻¹ A_ind]
+    for c in range(k):
+        F[independent[c], c] = 1.0
+        for r in range(m):
+            total = 0.0
+            for i in range(m):
+                total += inv[r, i] * A[i, independent[c]]
+            F[dependent[r], c] = -total
+    s_dot_tree = _matvec(F, s_dot)
+    q_dot[:] = s_dot_tree
+    gamma = _gamma(phi, q, s_dot_tree, t, m)
+    f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
+    minus_gamma = _matvec(inv, -gamma)
+    for r in range(m):
+        f_bar[dependent[r]] = minus_gamma[r]
+    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+
+
+def tangent(phi, tree, q, s_dot, t, independent, rank, separation, acting, kept, pivot, q_dot, s_ddot_tree, A, M, b):
+    """The constrained s̈ of :class:`~projeq.constraints.tangent.TangentSystem`: F = N N_ind⁻¹ with
+    N the null space of A_s = U Σ Vᵀ continued along the branch (``kept``: the tangent kept last,
+    n × n_s, NaN where none; overwritten where the null space is separated, its rule), f̄ =
+    x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) over the ``rank`` largest singular values above
+    ``acting`` σ_max; otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular."""
+    n, m, k = q.shape[0], A.shape[0], independent.shape[0]
+    _jacobian(phi, q, t, A)
+    U, sigma, Vt = _svd(A)
+    near = max(k, int(np.sum(sigma < separation * sigma[0])))
+    if near == k or np.isnan(kept[0, 0]):
+        N = Vt[n - k:].T.copy()
+        kept[:, :] = N
+    else:
+        V_near = Vt[n - near:]  # the near-null space (rows)
+        N = np.linalg.qr(_matmul(V_near.T, _matmul(V_near, kept)))[0]
+    N_ind = np.empty((k, k))
+    for r in range(k):
+        for c in range(k):
+            N_ind[r, c] = N[independent[r], c]
+    inv = _inverse(N_ind)
+    if not np.all(np.isfinite(inv)):
+        return DEGENERATE
+    F = _matmul(N, inv)  # F = N N_ind⁻¹, F[independent] = E
+    for r in range(k):
+        for c in range(k):
+            F[independent[r], c] = 1.0 if r == c else 0.0
+    s_dot_tree = _matvec(F, s_dot)
+    q_dot[:] = s_dot_tree
+    gamma = _gamma(phi, q, s_dot_tree, t, m)
+    count = min(int(np.sum(sigma > acting * sigma[0])), rank)
+    x0 = np.zeros(n)  # A_s⁺ (−γ) = V_k Σ_k⁻¹ U_kᵀ (−γ)
+    for j in range(count):
+        weight = 0.0
+        for r in range(m):
+            weight -= U[r, j] * gamma[r]
+        weight /= sigma[j]
+        for i in range(n):
+            x0[i] += Vt[j, i] * weight
+    x0_ind = np.empty(k)
+    for c in range(k):
+        x0_ind[c] = x0[independent[c]]
+    f_bar = x0 - _matvec(F, x0_ind)
+    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+
+
+def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """(U, σ, Vᵀ) of A (m × n) with all n singular values, descending (those beyond m zero to
+    round-off), V n × n and U m × n (column j = A v_j / σ_j, zero where σ_j = 0): one-sided
+    Jacobi rotations of the columns of A until they are orthogonal to round-off (Demmel &
+    Veselić, "Jacobi's method is more accurate than QR", SIAM J. Matrix Anal. Appl. 13, 1992,
+    Algorithm 4.1) — for the few rows and columns of a loop's A_s, without LAPACK's calls and
+    workspace."""
+    m, n = A.shape
+    W, V = A.copy(), np.eye(n)
+    floor = (1e-15 * np.sqrt(np.sum(A * A))) ** 2  # a column below this is A v = 0 to round-off: in the null space
+    for _ in range(100):  # sweeps; quadratic convergence takes a handful
+        rotated = False
+        for p in range(n - 1):
+            for r in range(p + 1, n):
+                alpha, beta, gamma = 0.0, 0.0, 0.0
+                for i in range(m):
+                    alpha += W[i, p] * W[i, p]
+                    beta += W[i, r] * W[i, r]
+                    gamma += W[i, p] * W[i, r]
+                if alpha <= floor or beta <= floor or abs(gamma) <= 1e-15 * np.sqrt(alpha) * np.sqrt(beta):
+                    continue  # orthogonal to round-off
+                rotated = True
+                if abs(beta - alpha) > 1e100 * abs(gamma):  # a tiny angle: tan = 1/(2ζ) to round-off
+                    tan = gamma / (beta - alpha)
+                else:
+                    zeta = (beta - alpha) / (2.0 * gamma)
+                    tan = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.hypot(1.0, zeta))
+                cos = 1.0 / np.sqrt(1.0 + tan * tan)
+                sin = cos * tan
+                for X in (W, V):
+                    for i in range(X.shape[0]):
+                        x_p, x_r = X[i, p], X[i, r]
+                        X[i, p], X[i, r] = cos * x_p - sin * x_r, sin * x_p + cos * x_r
+        if not rotated:
+            break
+    norms = np.zeros(n)
+    for j in range(n):
+        for i in range(m):
+            norms[j] += W[i, j] * W[i, j]
+    order = np.argsort(-norms)
+    sigma, U, Vt = np.zeros(n), np.zeros((m, n)), np.zeros((n, n))
+    for c in range(n):
+        j = order[c]
+        sigma[c] = np.sqrt(norms[j])
+        for i in range(n):
+            Vt[c, i] = V[i, j]
+        if sigma[c] > 0.0:
+            for i in range(m):
+                U[i, c] = W[i, j] / sigma[c]
+    return U, sigma, Vt
+
+
+chain_terms, gauss_form = kernels.chain_terms, kernels.gauss_form  # interpreted; _compiled holds the compiled ones
+
+
+def _inverse(A: NDArray) -> NDArray:
+    """A⁻¹ by Gauss–Jordan elimination with partial pivoting (∞ entries for a singular A)."""
+    m = A.shape[0]
+    work, inv = A.copy(), np.eye(m)
+    for c in range(m):
+        p = c + np.argmax(np.abs(work[c:, c]))
+        if work[p, c] == 0.0:
+            return np.full((m, m), np.inf)
+        for row in (work, inv):
+            for j in range(m):
+                row[c, j], row[p, j] = row[p, j], row[c, j]
+        d = work[c, c]
+        for j in range(m):
+            work[c, j] /= d
+            inv[c, j] /= d
+        for r in range(m):
+            if r != c and work[r, c] != 0.0:
+                e = work[r, c]
+                for j in range(m):
+                    work[r, j] -= e * work[c, j]
+                    inv[r, j] -= e * inv[c, j]
+    return inv
+
+
+def _cholesky_solve(D: NDArray, x: NDArray, pivot_min: float) -> bool:
+    """x ← D⁻¹ x for a symmetric positive definite D by Cholesky (D overwritten by its factor);
+    False where a squared pivot is not above ``pivot_min``."""
+    k = D.shape[0]
+    for j in range(k):
+        d = D[j, j]
+        for i in range(j):
+            d -= D[j, i] * D[j, i]
+        if not d > pivot_min:
+            return False
+        D[j, j] = np.sqrt(d)
+        for r in range(j + 1, k):
+            e = D[r, j]
+            for i in range(j):
+                e -= D[r, i] * D[j, i]
+            D[r, j] = e / D[j, j]
+    for j in range(k):  # L y = x
+        for i in range(j):
+            x[j] -= D[j, i] * x[i]
+        x[j] /= D[j, j]
+    for j in range(k - 1, -1, -1):  # Lᵀ z = y
+        for i in range(j + 1, k):
+            x[j] -= D[i, j] * x[i]
+        x[j] /= D[j, j]
+    return True
+
+
+_HELPERS = (_jacobian, _gamma, _matvec, _matmul, _svd, _projected, _inverse, _cholesky_solve)
+
+
+def compiled_partition(system, bound: float) -> "CompiledClosure | None":
+    """The :class:`CompiledClosure` of a ConstrainedSystem (partitioned) that :func:`unsupported`
+    accepts (``bound``: the limit of ‖A_s‖_F ‖A_dep⁻¹‖_F above which the kernel flags the
+    partition), or None (after one warning) where numba cannot compile its Φ."""
+    callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
+    return None if callback is None else CompiledClosure(system.tree, system.n_c, callback, "partitioned", (bound,))
+
+
+def compiled_tangent(system, acting: float) -> "CompiledClosure | None":
+    """The :class:`CompiledClosure` of a TangentSystem that :func:`unsupported` accepts
+    (``acting``: singular values below this fraction of the largest do not act in f̄), or None
+    (after one warning) where numba cannot compile its Φ."""
+    callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
+    return None if callback is None else CompiledClosure(system.tree, system.n_c, callback, "tangent", (acting,))
+
+
+class CompiledClosure:
+    """s̈_tree, A_s, M and b of a constrained model by one call of a compiled kernel
+    (:func:`partitioned` or :func:`tangent`) with Φ's C callback, on the tree's fast evaluator's
+    workspace; ``accelerations`` returns None where the kernel flags a degenerate partition or a
+    singular FᵀMF (the caller repeats the evaluation on the numpy path, which names the cause).
+    ``compiled=False`` runs the same kernel interpreted, with ``callback`` Φ itself (for testing)."""
+
+    def __init__(self, tree, m: int, callback, rule: str, constants: tuple, compiled: bool = True):
+        # the callback lives as long as this object, which passes its address
+        self.callback, self.rule, self.constants = callback, rule, constants
+        self.kernel, self.phi = (_compiled()[rule], callback.address) if compiled else (globals()[rule], callback)
+        ev = self.fast = tree.evaluator("fast")
+        ws = self._workspace = ev._real
+        self.tree = (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
+                     ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist)
+        self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
+
+    def _call(self, system, q: NDArray, s_dot: NDArray, t: float) -> bool:
+        """One kernel call for ``system`` (its partition; for a TangentSystem its kept tangent,
+        which the call updates as the numpy path does) into the workspace; whether it is done."""
+        M, b = self._workspace.M_all, self._workspace.b_all
+        q, s_dot, t = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), float(t)
+        if self.rule == "partitioned":
+            flag = self.kernel(self.phi, self.tree, q, s_dot, t, system.independent, system.dependent,
+                               self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b)
+        else:
+            kept = np.full((system.tree.n_s, system.n_s), np.nan) if system._tangent is None else \
+                np.array(system._tangent, dtype=float)
+            flag = self.kernel(self.phi, self.tree, q, s_dot, t, system.independent, system.tree.n_s - system.n_s,
+                               system.separation, self.constants[0], kept, SINGULAR_PIVOT, self._q_dot,
+                               self._s_ddot_tree, self._A, M, b)
+            system._tangent = kept
+        return flag == DONE
+
+    def accelerations(self, system, q: NDArray, s_dot: NDArray, t: float):
+        """(s̈_tree, A_s, M, b) of ``system`` at (q, ṡ, t), or None (flagged)."""
+        if not self._call(system, q, s_dot, t):
+            return None
+        return self._s_ddot_tree.copy(), self._A.copy(), self._workspace.M_all.copy(), self._workspace.b_all.copy()
+
+    def state_derivative(self, system, x: NDArray, t: float):
+        """ẋ = (q̇, s̈) = (ṡ_tree, s̈_tree[independent]) of ``system`` at x = (q, ṡ) (q̇ = ṡ_tree:
+        K = E, and no Baumgarte term where the kernel applies), or None where the kernel flags
+        or ẋ is not finite (the caller's checked path then names the cause)."""
+        n_q = system.n_q
+        if not self._call(system, x[:n_q], x[n_q:], t):
+            return None
+        x_dot = np.concatenate((self._q_dot, self._s_ddot_tree[system.independent]))
+        return x_dot if np.isfinite(x_dot).all() else None
+
+
+@functools.cache
+def _compiled() -> dict:
+    """{"partitioned": …, "tangent": …}: the kernels compiled by numba (cached on disk) with the
+    compiled kernels of :mod:`projeq.assembly.kernels` and Φ called through its C callback's
+    address by an intrinsic. Compiled code resolves its callees in its globals, so the kernels
+    are compiled as copies whose globals hold the compiled callees (as
+    :mod:`projeq.assembly.kernels` compiles its own); their names carry a digest of both
+    sources, so that a changed source is compiled anew rather than read stale from the disk
+    cache (which numba keys by a function's own file only)."""
+    import numba
+
+    digest = hashlib.sha1(b"".join(Path(module.__file__).read_bytes() for module in (kernels, sys.modules[__name__])))
+    namespace = dict(globals())
+    namespace.update(chain_terms=kernels.kernel(True)[0], gauss_form=kernels.gauss_form_kernel(True)[0],
+                     _phi_into=_intrinsic())
+
+    def compiled(f):  # each helper compiled (and cached) once, called by both kernels
+        name = f"{f.__name__}_{digest.hexdigest()[:12]}"
+        copy = types.FunctionType(f.__code__, namespace, name, f.__defaults__, f.__closure__)
+        copy.__qualname__ = name
+        return numba.njit(cache=True)(copy)
+
+    namespace.update({f.__name__: compiled(f) for f in _HELPERS})
+    return {f.__name__: compiled(f) for f in (partitioned, tangent)}
+
+
+def _intrinsic():
+    """The compiled :func:`_phi_into`: calls the C function at address ``phi`` with the data
+    pointers of x and value (numba's own layout of complex128, that of Φ's C callback)."""
+    import numba
+    from llvmlite import ir
+    from numba.extending import intrinsic
+
+    @intrinsic
+    def phi_into(typingctx, phi, x, t, value):
+        def codegen(context, builder, signature, args):
+            address, x_array, t_value, value_array = args
+            x_data = context.make_array(signature.args[1])(context, builder, x_array).data
+            value_data = context.make_array(signature.args[3])(context, builder, value_array).data
+            function = ir.FunctionType(ir.VoidType(), [x_data.type, t_value.type, value_data.type])
+            builder.call(builder.inttoptr(address, function.as_pointer()), [x_data, t_value, value_data])
+            return context.get_dummy_value()
+
+        return numba.types.void(phi, x, t, value), codegen
+
+    return phi_into
