@@ -28,6 +28,7 @@ import functools
 import hashlib
 import inspect
 import types
+from pathlib import Path
 
 import numpy as np
 
@@ -289,9 +290,9 @@ def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e
     for i in range(k_e):
         q_e_ddot[i] = h[6 + i] - _dot6(M[6 + i], zeta)
     M_ee = M[6:, 6:]
-    if not _cholesky(M_ee, k_e, pivot_min):
+    if not cholesky(M_ee, k_e, pivot_min):
         return 0
-    _cholesky_solve(M_ee, k_e, q_e_ddot)
+    cholesky_solve(M_ee, k_e, q_e_ddot)
     for i in range(k_e):
         if not np.isfinite(q_e_ddot[i]):
             return 1
@@ -463,9 +464,9 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
                     L[n, i, j] = _dot(F[n, :, i], U[n, :, j], m)  # D_n, factored in place
                 f_h[n, i] = _dot(F[n, :, i], h_hat[n], m)
                 g[i] = _dot(F[n, :, i], c, m)
-            if not _cholesky(L[n], k, pivot_min):
+            if not cholesky(L[n], k, pivot_min):
                 return n
-            _cholesky_solve(L[n], k, g)  # D_n⁻¹ F_nᵀ c
+            cholesky_solve(L[n], k, g)  # D_n⁻¹ F_nᵀ c
             for a in range(m):
                 for j in range(k):
                     c[a] -= U[n, a, j] * g[j]
@@ -495,7 +496,7 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
         if k > 0:
             for j in range(k):
                 g[j] = f_h[n, j] - _dot(U[n, :, j], a, m)
-            _cholesky_solve(L[n], k, g)
+            cholesky_solve(L[n], k, g)
             for j in range(k):
                 s_ddot[s_index[n] + j] = g[j]
                 for i in range(m):
@@ -585,13 +586,13 @@ def projected_accelerations(M_all, b_all, P, pivot_min, M, s_ddot):
     _add_congruence_general(P, M_all, b_all, np.empty((n_all, n), M.dtype), n_all, n, M, s_ddot)  # Pᵀ M_all P, Pᵀ b_all
     for i in range(n):
         s_ddot[i] = -s_ddot[i]
-    if not _cholesky(M, n, pivot_min):
+    if not cholesky(M, n, pivot_min):
         return 0
-    _cholesky_solve(M, n, s_ddot)
+    cholesky_solve(M, n, s_ddot)
     return -1
 
 
-def _cholesky(D, k, pivot_min):
+def cholesky(D, k, pivot_min):
     """D[:k, :k] = L Lᵀ in place (L in the lower triangle); False if a pivot L_jj² is not
     above ``pivot_min``."""
     for j in range(k):
@@ -609,7 +610,7 @@ def _cholesky(D, k, pivot_min):
     return True
 
 
-def _cholesky_solve(L, k, b):
+def cholesky_solve(L, k, b):
     """b[:k] ← (L Lᵀ)⁻¹ b[:k] by two triangular solves."""
     for i in range(k):
         total = b[i]
@@ -713,7 +714,7 @@ def jacobian_kernel(compiled: bool = True, rigid: bool = False):
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
-            _add_congruence, _add_congruence_general, _cholesky, _cholesky_solve, elastic_body, port_motion)
+            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, elastic_body, port_motion)
 
 
 @functools.cache
@@ -766,14 +767,17 @@ def _compiled_gauss_form():
     return _jit(gauss_form, projected_accelerations)
 
 
-def jit(*functions, callees=()):
+def jit(*functions, callees=(), kernels=None):
     """``functions`` of another module compiled by numba as this module's kernels are
-    (:func:`_jit`): with their module's names, this module's callees and ``callees`` (the
-    plain functions they call besides, compiled with them). numba's disk cache checks the
-    file of a compiled function only, so each is cached under its name and a digest of its
-    callees' source: an edit to a callee in another file compiles it anew."""
-    digest = hashlib.sha1("".join(inspect.getsource(f) for f in callees).encode()).hexdigest()[:12]
-    return _jit(*functions, names=tuple(f"{f.__name__}_{digest}" for f in functions), callees=callees)
+    (:func:`_jit`): with their module's names, this module's callees, ``callees`` (the plain
+    functions they call besides, compiled with them) and the compiled ``kernels`` they call by
+    name. numba's disk cache checks the file of a compiled function only, so each is cached
+    under its name and a digest of this module's source and its callees': an edit to either,
+    in another file than the function's, compiles it anew."""
+    sources = Path(__file__).read_text() + "".join(inspect.getsource(f) for f in callees)
+    digest = hashlib.sha1(sources.encode()).hexdigest()[:12]
+    return _jit(*functions, names=tuple(f"{f.__name__}_{digest}" for f in functions), callees=callees,
+                kernels=kernels)
 
 
 def _jit(*functions, names=(), callees=(), kernels=None, **replaced):

@@ -37,18 +37,15 @@ repeats the evaluation, which raises the error that names the cause.
 from __future__ import annotations
 
 import functools
-import hashlib
 import re
-import sys
-import types
 import warnings
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import kernels
+from projeq.assembly.kernels import cholesky, cholesky_solve
 from projeq.assembly.linalg import SINGULAR_PIVOT
 from projeq.constraints.batched import NODES, WEIGHTS
 
@@ -245,7 +242,9 @@ def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
         if not M_min[0, 0] > pivot * scale:
             return SINGULAR
         s_ddot[0] = s_ddot[0] / M_min[0, 0]
-    elif not _cholesky_solve(M_min, s_ddot, pivot * scale):
+    elif cholesky(M_min, k, pivot * scale):
+        cholesky_solve(M_min, k, s_ddot)
+    else:
         return SINGULAR
     s_ddot_tree[:] = _matvec(F, s_ddot) + f_bar
     return DONE
@@ -409,34 +408,7 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-def _cholesky_solve(D: NDArray, x: NDArray, pivot_min: float) -> bool:
-    """x ← D⁻¹ x for a symmetric positive definite D by Cholesky (D overwritten by its factor);
-    False where a squared pivot is not above ``pivot_min``."""
-    k = D.shape[0]
-    for j in range(k):
-        d = D[j, j]
-        for i in range(j):
-            d -= D[j, i] * D[j, i]
-        if not d > pivot_min:
-            return False
-        D[j, j] = np.sqrt(d)
-        for r in range(j + 1, k):
-            e = D[r, j]
-            for i in range(j):
-                e -= D[r, i] * D[j, i]
-            D[r, j] = e / D[j, j]
-    for j in range(k):  # L y = x
-        for i in range(j):
-            x[j] -= D[j, i] * x[i]
-        x[j] /= D[j, j]
-    for j in range(k - 1, -1, -1):  # Lᵀ z = y
-        for i in range(j + 1, k):
-            x[j] -= D[i, j] * x[i]
-        x[j] /= D[j, j]
-    return True
-
-
-_HELPERS = (_jacobian, _gamma, _matvec, _matmul, _svd, _projected, _inverse, _cholesky_solve)
+_HELPERS = (_jacobian, _gamma, _matvec, _matmul, _svd, _projected, _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
@@ -508,28 +480,13 @@ class CompiledClosure:
 
 @functools.cache
 def _compiled() -> dict:
-    """{"partitioned": …, "tangent": …}: the kernels compiled by numba (cached on disk) with the
-    compiled kernels of :mod:`projeq.assembly.kernels` and Φ called through its C callback's
-    address by an intrinsic. Compiled code resolves its callees in its globals, so the kernels
-    are compiled as copies whose globals hold the compiled callees (as
-    :mod:`projeq.assembly.kernels` compiles its own); their names carry a digest of both
-    sources, so that a changed source is compiled anew rather than read stale from the disk
-    cache (which numba keys by a function's own file only)."""
-    import numba
-
-    digest = hashlib.sha1(b"".join(Path(module.__file__).read_bytes() for module in (kernels, sys.modules[__name__])))
-    namespace = dict(globals())
-    namespace.update(chain_terms=kernels.kernel(True)[0], gauss_form=kernels.gauss_form_kernel(True)[0],
-                     _phi_into=_intrinsic())
-
-    def compiled(f):  # each helper compiled (and cached) once, called by both kernels
-        name = f"{f.__name__}_{digest.hexdigest()[:12]}"
-        copy = types.FunctionType(f.__code__, namespace, name, f.__defaults__, f.__closure__)
-        copy.__qualname__ = name
-        return numba.njit(cache=True)(copy)
-
-    namespace.update({f.__name__: compiled(f) for f in _HELPERS})
-    return {f.__name__: compiled(f) for f in (partitioned, tangent)}
+    """{"partitioned": …, "tangent": …}: the kernels compiled by numba (cached on disk) as
+    :func:`projeq.assembly.kernels.jit` compiles another module's kernels, calling the compiled
+    kernels of :mod:`projeq.assembly.kernels` and Φ through its C callback's address by an
+    intrinsic (:func:`_phi_into`)."""
+    compiled = {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True)[0],
+                "_phi_into": _intrinsic()}
+    return dict(zip(("partitioned", "tangent"), kernels.jit(partitioned, tangent, callees=_HELPERS, kernels=compiled)))
 
 
 def _intrinsic():

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import projeq as pq
+from projeq.assembly import kernels
 from projeq.constraints import compiled
 from projeq.constraints.compiled import CompiledClosure, UncompiledClosureWarning
 from projeq.constraints.partitioned import ConstrainedSystem
@@ -69,9 +70,12 @@ def test_the_kernels_linear_algebra_equals_numpys():
         assert np.allclose(compiled._inverse(A), np.linalg.inv(A), rtol=1e-12, atol=1e-12)
         D, x = A @ A.T + m * np.eye(m), rng.standard_normal(m)
         expected = np.linalg.solve(D, x)
-        assert compiled._cholesky_solve(D.copy(), x, 1e-13) and np.allclose(x, expected, rtol=1e-12, atol=1e-14)
+        L = D.copy()
+        assert kernels.cholesky(L, m, 1e-13)
+        kernels.cholesky_solve(L, m, x)
+        assert np.allclose(x, expected, rtol=1e-12, atol=1e-14)
     assert np.all(np.isinf(compiled._inverse(np.array([[1.0, 2.0], [2.0, 4.0]]))))
-    assert not compiled._cholesky_solve(np.array([[1.0, 1.0], [1.0, 1.0]]), np.ones(2), 1e-13)
+    assert not kernels.cholesky(np.array([[1.0, 1.0], [1.0, 1.0]]), 2, 1e-13)
 
 
 def _pendulum(phi):
