@@ -265,7 +265,6 @@ class FastEvaluator:
             )
         return s_ddot
 
-
     def state_jacobian(self, t: float, x: NDArray) -> NDArray | None:
         """∂ẋ/∂x at the real state x = (q, ṡ) by the complex step through the kernels,
         :func:`projeq.assembly.kernels.tree_jacobian`: all n_x columns of ∂s̈/∂x in one call on

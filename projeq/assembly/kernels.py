@@ -700,8 +700,8 @@ def kernel(compiled: bool = True, rigid: bool = False):
             "compiled: numba is not installed (pip install numba); compiled=False runs the same "
             "kernel interpreted, method='auto' picks the best evaluator available"
         )
-    chain, general, _, rigid_passes = _compiled()[:4]
-    return chain, rigid_passes if rigid else general
+    compiled_kernels = _compiled()
+    return compiled_kernels["chain_terms"], compiled_kernels["rigid_passes" if rigid else "passes"]
 
 
 def jacobian_kernel(compiled: bool = True, rigid: bool = False):
@@ -710,7 +710,7 @@ def jacobian_kernel(compiled: bool = True, rigid: bool = False):
     if not compiled:
         return tree_jacobian
     kernel(True)  # the same refusal without numba
-    return _compiled()[4 if rigid else 2]
+    return _compiled()["rigid_tree_jacobian" if rigid else "tree_jacobian"]
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
@@ -719,14 +719,16 @@ _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _r
 
 @functools.cache
 def _compiled():
-    """chain_terms, passes, the rigid trees' passes (:func:`kernel`) and the Jacobians of both
-    (:func:`jacobian_kernel`) compiled by numba, once per process (and cached on disk;
+    """{name: kernel}: chain_terms, passes, the rigid trees' passes (:func:`kernel`) and the
+    Jacobians of both (:func:`jacobian_kernel`) compiled by numba, once per process (and cached on disk;
     numba compiles each for the dtype it is called with, float64 or complex128, on first use)."""
     chain, general = _jit(chain_terms, passes)
     rigid = _jit(passes, names=("rigid_passes",), _rows=_six)[0]
-    jacobians = [_jit(tree_jacobian, names=(name,), kernels={"chain_terms": chain, "passes": passes_})[0]
-                 for name, passes_ in (("tree_jacobian", general), ("rigid_tree_jacobian", rigid))]
-    return chain, general, jacobians[0], rigid, jacobians[1]
+    compiled_kernels = {"chain_terms": chain, "passes": general, "rigid_passes": rigid}
+    for name, passes_ in (("tree_jacobian", general), ("rigid_tree_jacobian", rigid)):
+        callees = {"chain_terms": chain, "passes": passes_}
+        compiled_kernels[name] = _jit(tree_jacobian, names=(name,), kernels=callees)[0]
+    return compiled_kernels
 
 
 def gauss_form_kernel(compiled: bool = True):
