@@ -210,16 +210,22 @@ def andrews_squeezer(**options) -> TangentSystem:
               SpringDamper("gamma", (a["sd"], -a["sc"], 0.0), None, (a["xc"], a["yc"], 0.0), a["c0"], length=a["l0"])]
     tree = System(bodies, joints, forces=forces)
     column = {name: tree.q_slice[tree.index(name)].start for name in ANDREWS_ANGLES}
+    i_beta, i_theta, i_gamma, i_phi, i_delta, i_omega, i_epsilon = (column[name] for name in ANDREWS_ANGLES)
+    rr, d, ss, e, zt, u, zf = (a[key] for key in ("rr", "d", "ss", "e", "zt", "u", "zf"))
+    x_a, y_a, x_b, y_b = (a[key] for key in ("xa", "ya", "xb", "yb"))
 
-    def closure(q, t):  # point E from theta minus E from gamma, from phi and from omega (x, y rows)
-        beta, theta, gamma, phi, delta, omega, epsilon = (q[column[name]] for name in ANDREWS_ANGLES)
-        e_x = a["rr"] * np.cos(beta) - a["d"] * np.cos(beta + theta)
-        e_y = a["rr"] * np.sin(beta) - a["d"] * np.sin(beta + theta)
-        return [e_x - a["xb"] - a["ss"] * np.sin(gamma), e_y - a["yb"] + a["ss"] * np.cos(gamma),
-                e_x - a["xa"] - a["zt"] * np.cos(delta) - a["e"] * np.sin(phi + delta),
-                e_y - a["ya"] - a["zt"] * np.sin(delta) + a["e"] * np.cos(phi + delta),
-                e_x - a["xa"] - a["u"] * np.sin(epsilon) - a["zf"] * np.cos(omega + epsilon),
-                e_y - a["ya"] + a["u"] * np.cos(epsilon) - a["zf"] * np.sin(omega + epsilon)]
+    def closure(q, t):
+        """Point E from theta minus E from gamma, from phi and from omega (x, y rows), on the
+        rows q[i] and captured numbers (compiled by numba as written)."""
+        beta, theta, gamma, phi, delta = q[i_beta], q[i_theta], q[i_gamma], q[i_phi], q[i_delta]
+        omega, epsilon = q[i_omega], q[i_epsilon]
+        e_x = rr * np.cos(beta) - d * np.cos(beta + theta)
+        e_y = rr * np.sin(beta) - d * np.sin(beta + theta)
+        return [e_x - x_b - ss * np.sin(gamma), e_y - y_b + ss * np.cos(gamma),
+                e_x - x_a - zt * np.cos(delta) - e * np.sin(phi + delta),
+                e_y - y_a - zt * np.sin(delta) + e * np.cos(phi + delta),
+                e_x - x_a - u * np.sin(epsilon) - zf * np.cos(omega + epsilon),
+                e_y - y_a + u * np.cos(epsilon) - zf * np.sin(omega + epsilon)]
 
     q0 = np.zeros(tree.n_q)
     q0[[column[name] for name in ANDREWS_ANGLES]] = ANDREWS_Q0
