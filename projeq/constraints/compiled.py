@@ -33,7 +33,8 @@ callable load or a user's own ``add_to`` —, no joints that state their own rel
 coupled joints, no elastic bodies), and F by one of the two rules above (not a subclass's own,
 such as the augmented Lagrangian's). A Φ numba cannot compile, or whose
 compiled values differ from its own at complex points near q0, keeps the numpy path after one
-:class:`UncompiledClosureWarning` naming it. Where the compiled call meets a degenerate partition
+:class:`UncompiledClosureWarning` naming it; so does a model outside the kernel, the warning naming
+the piece (:func:`unsupported`: a Pfaffian row, a joint, a force law, ...) — never silently. Where the compiled call meets a degenerate partition
 (κ bound reached, or N_ind singular) or a singular FᵀMF it returns a flag and the numpy path
 repeats the evaluation, which raises the error that names the cause (so does a force law without
 a value, a spring-damper whose two points coincide).
@@ -61,8 +62,9 @@ DONE, DEGENERATE, SINGULAR, UNLOADED = 0, 1, 2, 3
 
 
 class UncompiledClosureWarning(UserWarning):
-    """A constraint function numba cannot compile: the constrained s̈ takes the numpy path
-    (about ten times slower per call)."""
+    """The constrained s̈ of a model is not one compiled call and takes the numpy path (about ten
+    times slower per call): the message names the piece — a Φ numba cannot compile, or what
+    :func:`unsupported` finds. Said once per model, when its kernel is first looked for."""
 
 
 def unsupported(system) -> str | None:
@@ -73,21 +75,51 @@ def unsupported(system) -> str | None:
         (system.m_p > 0, "Pfaffian constraints A(q, t) q̇ = b(q, t)"),
         (system.m_h == 0, "no holonomic constraints"),
         (system.rheonomic, "Φ may depend on t (correction other than 'projection')"),
-        (not system._identity, "joints with q̇ ≠ ṡ (K ≠ E)"),
+        (not system._identity, _kinematics_piece(tree)),
         (not system.exact, "Φ does not take complex arguments (no complex step)"),
-        (not system.compiled_tree(), "the tree's default evaluator is not the compiled one"),
+        (not system.compiled_tree(), "the tree's default evaluator is not the compiled one "
+                                     f"({tree.evaluator('auto').reason})"),
     )
     for failed, why in checks:
         if failed:
             return why
+    return _tree_piece(tree)
+
+
+def _kinematics_piece(tree) -> str:
+    """The joints with q̇ ≠ ṡ (K ≠ E), named."""
+    names = [f"{tree.names[n]!r} ({type(tree.joints[n]).__name__})" for n in tree._general_kinematics]
+    return f"joints with q̇ ≠ ṡ (K ≠ E){': ' + ', '.join(names) if names else ''}"
+
+
+def _tree_piece(tree) -> str | None:
+    """The first piece of the tree whose terms the kernels do not compute in the closure kernel
+    (named), else None."""
     ev = tree.evaluator("fast")
-    if ev._given or ev._expansion is not None or ev._width > 6:
-        return "the tree has joints stating their own relative motion, coupled joints or elastic bodies"
+    if ev._given:
+        n = ev._given[0]
+        return f"joint {tree.names[n]!r} ({type(tree.joints[n]).__name__}) states its own relative motion"
+    if ev._expansion is not None:
+        return "coupled joints (shared minimal velocities)"
+    if ev._width > 6:
+        name = next(name for name, body in zip(tree.names, tree.subsystems) if body.n_e)
+        return f"subsystem {name!r} is elastic"
     for i, law in enumerate(tree.forces):
         if law.compiled_terms() is None:
             return (f"force law {i} ({type(law).__name__}) has no compiled row (a callable load, or a law "
                     "that states its own add_to)")
     return None
+
+
+def uncompiled(system, why: str) -> None:
+    """One :class:`UncompiledClosureWarning` that the constrained s̈ of ``system`` takes the numpy
+    path, and ``why`` (which the system keeps, ``_uncompiled``); None (no kernel), for the caller
+    that looks once per model."""
+    system._uncompiled = why
+    warnings.warn(
+        f"system: the constrained s̈ of this {type(system).__name__} is not one compiled call ({why}); it "
+        "takes the numpy path (about ten times slower per call)", UncompiledClosureWarning, stacklevel=4,
+    )
 
 
 def compiled_phi(phi, n: int, m: int, q0: NDArray):
@@ -430,16 +462,24 @@ def compiled_partition(system, bound: float) -> "CompiledClosure | None":
     """The :class:`CompiledClosure` of a ConstrainedSystem (partitioned) that :func:`unsupported`
     accepts (``bound``: the limit of ‖A_s‖_F ‖A_dep⁻¹‖_F above which the kernel flags the
     partition), or None (after one warning) where numba cannot compile its Φ."""
-    callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
-    return None if callback is None else CompiledClosure(system.tree, system.n_c, callback, "partitioned", (bound,))
+    return _closure(system, "partitioned", bound)
 
 
 def compiled_tangent(system, acting: float) -> "CompiledClosure | None":
     """The :class:`CompiledClosure` of a TangentSystem that :func:`unsupported` accepts
     (``acting``: singular values below this fraction of the largest do not act in f̄), or None
     (after one warning) where numba cannot compile its Φ."""
+    return _closure(system, "tangent", acting)
+
+
+def _closure(system, rule: str, constant: float) -> "CompiledClosure | None":
+    """The :class:`CompiledClosure` of ``system`` by the kernel ``rule``, or None where numba
+    cannot compile its Φ (:func:`closure_callback` warned, naming it; the system keeps the reason)."""
     callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
-    return None if callback is None else CompiledClosure(system.tree, system.n_c, callback, "tangent", (acting,))
+    if callback is None:
+        system._uncompiled = f"numba cannot compile Φ ({getattr(system._phi, '__qualname__', repr(system._phi))})"
+        return None
+    return CompiledClosure(system.tree, system.n_c, callback, rule, (constant,))
 
 
 class CompiledClosure:
