@@ -522,6 +522,11 @@ class CompiledClosure:
             return None
         return self._s_ddot_tree.copy(), self._A.copy(), self._workspace.M_all.copy(), self._workspace.b_all.copy()
 
+    def minimal_accelerations(self, system, q: NDArray, s_dot: NDArray, t: float):
+        """s̈ = s̈_tree[independent] of ``system`` at (q, ṡ, t) (the evaluator's s̈, without copies of
+        A_s, M and b), or None (flagged)."""
+        return self._s_ddot_tree[system.independent] if self._call(system, q, s_dot, t) else None
+
     def state_derivative(self, system, x: NDArray, t: float):
         """ẋ = (q̇, s̈) = (ṡ_tree, s̈_tree[independent]) of ``system`` at x = (q, ṡ) (q̇ = ṡ_tree:
         K = E, and no Baumgarte term where the kernel applies), or None where the kernel flags

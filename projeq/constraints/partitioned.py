@@ -688,8 +688,8 @@ class PartitionedEvaluator:
         # forms s̈_tree and λ together (the augmented Lagrangian)
         partitioned = type(system).accelerations_tree is ConstrainedSystem.accelerations_tree
         whole = method is None and partitioned and system.compiled_kernel() is not None
-        if whole:  # ẋ = (q̇, s̈) in one compiled call for simulate's right-hand side
-            self.state_derivative = self._state_derivative
+        if whole:  # s̈ and ẋ = (q̇, s̈) (simulate's right-hand side) in one compiled call
+            self.accelerations, self.state_derivative = self._compiled_accelerations, self._state_derivative
         self.reason = ("Φ's derivatives, the partition and the projection of the tree's Gauss form in one "
                        "compiled call" if whole else
                        f"constraint equations projected on the tree's Gauss form M, b by the "
@@ -702,6 +702,16 @@ class PartitionedEvaluator:
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         return self._tree(q, s_dot, t, self.method)[0][self.system.independent]
+
+    def _compiled_accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
+        """s̈ by the system's compiled kernel at real arguments; by the numpy path at complex ones (a
+        complex step) and where the kernel flags (which raises the error naming the cause)."""
+        system = self.system
+        if not (np.iscomplexobj(q) or np.iscomplexobj(s_dot)):
+            s_ddot = system.compiled_kernel().minimal_accelerations(system, q, s_dot, t)
+            if s_ddot is not None:
+                return s_ddot
+        return system._projected_accelerations(q, s_dot, t, None)[0][system.independent]
 
     def _state_derivative(self, t: float, x: NDArray):
         """ẋ = (q̇, s̈) by the system's compiled kernel, or None

@@ -81,6 +81,10 @@ def test_the_compiled_call_gives_the_numpy_paths_accelerations_and_multipliers(n
         dense, lam_dense = model.accelerations_tree(q, s_dot, t, method="dense")
         assert _close(s_ddot_tree, dense) and _close(lam, lam_dense)
         assert np.array_equal(model.accelerations(q, s_dot, t), s_ddot_tree[model.independent])
+        assert np.array_equal(model.evaluator().accelerations(q, s_dot, t), s_ddot_tree[model.independent])
+        # a complex step through the evaluator takes the numpy path (the kernel is real): its imaginary part kept
+        step = model.evaluator().accelerations(q, s_dot + 1e-20j, t)
+        assert np.iscomplexobj(step) and _close(step.real, reference[model.independent])
         x_dot = model.evaluator().state_derivative(t, np.concatenate((q, s_dot)))  # simulate's right-hand side
         assert _close(x_dot, np.concatenate((model.q_dot(q, s_dot, t), reference[model.independent])))
 
