@@ -111,6 +111,11 @@ def _tree_piece(tree) -> str | None:
     return None
 
 
+#: why a subclass of ConstrainedSystem or TangentSystem that restates F or the particular solution
+#: takes the numpy path (the kernels state the two rules of the module docstring)
+OWN_RULE = "F by its own rule: a subclass's F or particular"
+
+
 def uncompiled(system, why: str) -> None:
     """One :class:`UncompiledClosureWarning` that the constrained s̈ of ``system`` takes the numpy
     path, and ``why`` (which the system keeps, ``_uncompiled``); None (no kernel), for the caller

@@ -76,7 +76,7 @@ from numpy.typing import NDArray
 
 from projeq.assembly.linalg import solve_spd
 from projeq.constraints.batched import batched_closure
-from projeq.constraints.compiled import compiled_partition, uncompiled, unsupported
+from projeq.constraints.compiled import OWN_RULE, compiled_partition, uncompiled, unsupported
 from projeq.checks import positive, state_vector
 from projeq.analysis.differentiation import (derivative_along, derivative_along_differences, is_complex_safe,
                                              second_derivative_along, second_derivative_along_differences)
@@ -643,7 +643,7 @@ class ConstrainedSystem(Model):
         """The compiled kernel of coordinate partitioning, None (after one warning) for a subclass
         that forms F by its own rule."""
         if type(self).F is not ConstrainedSystem.F or type(self).particular is not ConstrainedSystem.particular:
-            return uncompiled(self, "F by its own rule: a subclass's F or particular")
+            return uncompiled(self, OWN_RULE)
         return compiled_partition(self, PARTITION_CONDITION)
 
     _compiled = False  # the CompiledClosure, None where it does not apply; False: not looked at yet

@@ -55,7 +55,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
-from projeq.constraints.compiled import compiled_tangent, uncompiled
+from projeq.constraints.compiled import OWN_RULE, compiled_tangent, uncompiled
 from projeq.constraints.partitioned import (
     RANK_TOLERANCE, REPIVOT_CONDITION, ConstrainedSystem, independent_indices, minimum_norm_solution, numerical_rank,
 )
@@ -236,7 +236,7 @@ class TangentSystem(ConstrainedSystem):
         """The compiled kernel of the tangent space (:func:`projeq.constraints.compiled.tangent`),
         None (after one warning) for a subclass that forms F by its own rule."""
         if type(self).F is not TangentSystem.F or type(self).particular is not TangentSystem.particular:
-            return uncompiled(self, "F by its own rule: a subclass's F or particular")
+            return uncompiled(self, OWN_RULE)
         return compiled_tangent(self, ACTING)
 
     def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:
