@@ -706,8 +706,8 @@ class PartitionedEvaluator:
     def _compiled_accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """s̈ by the system's compiled kernel at real arguments; by the numpy path at complex ones (a
         complex step) and where the kernel flags (which raises the error naming the cause)."""
-        system = self.system
-        if not (np.iscomplexobj(q) or np.iscomplexobj(s_dot)):
+        system, q, s_dot = self.system, np.asarray(q), np.asarray(s_dot)
+        if q.dtype.kind != "c" and s_dot.dtype.kind != "c":  # (np.iscomplexobj costs more than the check)
             s_ddot = system.compiled_kernel().minimal_accelerations(system, q, s_dot, t)
             if s_ddot is not None:
                 return s_ddot
