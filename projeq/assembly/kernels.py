@@ -774,9 +774,11 @@ def jit(*functions, callees=(), kernels=None):
     (:func:`_jit`): with their module's names, this module's callees, ``callees`` (the plain
     functions they call besides, compiled with them) and the compiled ``kernels`` they call by
     name. numba's disk cache checks the file of a compiled function only, so each is cached
-    under its name and a digest of this module's source and its callees': an edit to either,
-    in another file than the function's, compiles it anew."""
-    sources = Path(__file__).read_text() + "".join(inspect.getsource(f) for f in callees)
+    under its name and a digest of this module's source, its callees' and its compiled
+    kernels' (their source and their names, which carry the digest of their own callees): an
+    edit to any, in another file than the function's, compiles it anew."""
+    sources = Path(__file__).read_text() + "".join(inspect.getsource(f) for f in callees) + "".join(
+        inspect.getsource(k.py_func) + k.py_func.__qualname__ for k in (kernels or {}).values() if hasattr(k, "py_func"))
     digest = hashlib.sha1(sources.encode()).hexdigest()[:12]
     return _jit(*functions, names=tuple(f"{f.__name__}_{digest}" for f in functions), callees=callees,
                 kernels=kernels)

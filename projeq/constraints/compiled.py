@@ -20,18 +20,24 @@ points: Φ_q e_j = Im Φ(q + i h e_j) / h and Φ″(v, v) = |v|² Σ_k c_k Im Φ
 the stencil's nodes ε_k and weights c_k are those of :mod:`projeq.constraints.batched`), and
 the tree's M and b from the kernels of :mod:`projeq.assembly.kernels` (composite bodies and
 Newton–Euler, Featherstone, "Rigid Body Dynamics Algorithms", 2008, §5.3, §6.2) on the fast
-evaluator's workspace. The numbers are those of the numpy path to round-off; the tangent kept
-along the branch is read from and written to the system as the numpy path keeps it.
+evaluator's workspace, with the loads of the tree's force laws added to h_n by the fast
+evaluator's own compiled loop over the laws' rows (:func:`projeq.assembly.loads.add_loads`: each
+law's terms stated once, in :mod:`projeq.forces`). The numbers are those of the numpy path to
+round-off; the tangent kept along the branch is read from and written to the system as the numpy
+path keeps it.
 
 Where it applies (:func:`unsupported` says why not): holonomic constraints only, Φ independent
 of t (``correction="projection"``), q̇ = ṡ_tree (revolute and prismatic joints), a tree whose
-whole Gauss form the compiled kernels compute (no force laws, no joints that state their own
-relative motion, no coupled joints, no elastic bodies), and F by one of the two rules above (not
-a subclass's own, such as the augmented Lagrangian's). A Φ numba cannot compile, or whose
+whole Gauss form the compiled kernels compute (force laws with compiled rows only — not a
+callable load or a user's own ``add_to`` —, no joints that state their own relative motion, no
+coupled joints, no elastic bodies), and F by one of the two rules above (not a subclass's own,
+such as the augmented Lagrangian's). A Φ numba cannot compile, or whose
 compiled values differ from its own at complex points near q0, keeps the numpy path after one
-:class:`UncompiledClosureWarning` naming it. Where the compiled call meets a degenerate partition
+:class:`UncompiledClosureWarning` naming it; so does a model outside the kernel, the warning naming
+the piece (:func:`unsupported`: a Pfaffian row, a joint, a force law, ...) — never silently. Where the compiled call meets a degenerate partition
 (κ bound reached, or N_ind singular) or a singular FᵀMF it returns a flag and the numpy path
-repeats the evaluation, which raises the error that names the cause.
+repeats the evaluation, which raises the error that names the cause (so does a force law without
+a value, a spring-damper whose two points coincide).
 """
 
 from __future__ import annotations
@@ -44,19 +50,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import COMPLEX_STEP
-from projeq.assembly import kernels
+from projeq.assembly import kernels, loads
 from projeq.assembly.kernels import cholesky, cholesky_solve
 from projeq.assembly.linalg import SINGULAR_PIVOT
 from projeq.constraints.batched import NODES, WEIGHTS
 
 #: flags of the kernels (:func:`partitioned`, :func:`tangent`): done; partition bound reached (or
-#: A_dep, N_ind singular); FᵀMF not positive definite (the numpy path then raises the error naming it)
-DONE, DEGENERATE, SINGULAR = 0, 1, 2
+#: A_dep, N_ind singular); FᵀMF not positive definite; a force law without a value (a spring-damper
+#: whose two points coincide) — the numpy path then raises the error naming it
+DONE, DEGENERATE, SINGULAR, UNLOADED = 0, 1, 2, 3
 
 
 class UncompiledClosureWarning(UserWarning):
-    """A constraint function numba cannot compile: the constrained s̈ takes the numpy path
-    (about ten times slower per call)."""
+    """The constrained s̈ of a model is not one compiled call and takes the numpy path (about ten
+    times slower per call): the message names the piece — a Φ numba cannot compile, or what
+    :func:`unsupported` finds. Said once per model, when its kernel is first looked for."""
 
 
 def unsupported(system) -> str | None:
@@ -67,17 +75,56 @@ def unsupported(system) -> str | None:
         (system.m_p > 0, "Pfaffian constraints A(q, t) q̇ = b(q, t)"),
         (system.m_h == 0, "no holonomic constraints"),
         (system.rheonomic, "Φ may depend on t (correction other than 'projection')"),
-        (not system._identity, "joints with q̇ ≠ ṡ (K ≠ E)"),
+        (not system._identity, _kinematics_piece(tree)),
         (not system.exact, "Φ does not take complex arguments (no complex step)"),
-        (not system.compiled_tree(), "the tree's default evaluator is not the compiled one"),
+        (not system.compiled_tree(), "the tree's default evaluator is not the compiled one "
+                                     f"({tree.evaluator('auto').reason})"),
     )
     for failed, why in checks:
         if failed:
             return why
+    return _tree_piece(tree)
+
+
+def _kinematics_piece(tree) -> str:
+    """The joints with q̇ ≠ ṡ (K ≠ E), named."""
+    names = [f"{tree.names[n]!r} ({type(tree.joints[n]).__name__})" for n in tree._general_kinematics]
+    return f"joints with q̇ ≠ ṡ (K ≠ E){': ' + ', '.join(names) if names else ''}"
+
+
+def _tree_piece(tree) -> str | None:
+    """The first piece of the tree whose terms the kernels do not compute in the closure kernel
+    (named), else None."""
     ev = tree.evaluator("fast")
-    if ev._given or tree.forces or ev._expansion is not None or ev._width > 6:
-        return "the tree has force laws, joints stating their own relative motion, coupled joints or elastic bodies"
+    if ev._given:
+        n = ev._given[0]
+        return f"joint {tree.names[n]!r} ({type(tree.joints[n]).__name__}) states its own relative motion"
+    if ev._expansion is not None:
+        return "coupled joints (shared minimal velocities)"
+    if ev._width > 6:
+        name = next(name for name, body in zip(tree.names, tree.subsystems) if body.n_e)
+        return f"subsystem {name!r} is elastic"
+    for i, law in enumerate(tree.forces):
+        if law.compiled_terms() is None:
+            return (f"force law {i} ({type(law).__name__}) has no compiled row (a callable load, or a law "
+                    "that states its own add_to)")
     return None
+
+
+#: why a subclass of ConstrainedSystem or TangentSystem that restates F or the particular solution
+#: takes the numpy path (the kernels state the two rules of the module docstring)
+OWN_RULE = "F by its own rule: a subclass's F or particular"
+
+
+def uncompiled(system, why: str) -> None:
+    """One :class:`UncompiledClosureWarning` that the constrained s̈ of ``system`` takes the numpy
+    path, and ``why`` (which the system keeps, ``_uncompiled``); None (no kernel), for the caller
+    that looks once per model."""
+    system._uncompiled = why
+    warnings.warn(
+        f"system: the constrained s̈ of this {type(system).__name__} is not one compiled call ({why}); it "
+        "takes the numpy path (about ten times slower per call)", UncompiledClosureWarning, stacklevel=4,
+    )
 
 
 def compiled_phi(phi, n: int, m: int, q0: NDArray):
@@ -215,12 +262,16 @@ def _matmul(A, B):
 
 
 def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
-    """The tree's M, b at (q, ṡ_tree) by the compiled kernels, then s̈ from Fᵀ(M (F s̈ + f̄) + b) = 0
-    and s̈_tree ← F s̈ + f̄; DONE, or SINGULAR where a squared pivot of FᵀMF is not above
-    ``pivot`` times its largest diagonal entry."""
-    index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist = tree
+    """The tree's M, b at (q, ṡ_tree) by the compiled kernels, the loads of its force laws added to
+    h_n by their compiled rows (:func:`projeq.assembly.loads.add_loads`, the loop of the fast
+    evaluator), then s̈ from Fᵀ(M (F s̈ + f̄) + b) = 0 and s̈_tree ← F s̈ + f̄; DONE, UNLOADED where a
+    law cannot be evaluated, or SINGULAR where a squared pivot of FᵀMF is not above ``pivot`` times
+    its largest diagonal entry."""
+    index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist, laws, constants = tree
     chain_terms(index, geometry, inertia, gravity, q, s_dot_tree, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O,
                 twist)
+    if laws.shape[0] and add_loads(laws, constants, index, q, s_dot_tree, R, r_O, twist, F_n, T, h) >= 0:
+        return UNLOADED
     gauss_form(index, T, zeta, F_n, M_n, h, M, b)
     n, k = F.shape
     MF, g = np.zeros((n, k)), b.copy()  # M F and M f̄ + b
@@ -381,7 +432,8 @@ def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     return U, sigma, Vt
 
 
-chain_terms, gauss_form = kernels.chain_terms, kernels.gauss_form  # interpreted; _compiled holds the compiled ones
+# interpreted; _compiled holds the compiled ones
+chain_terms, gauss_form, add_loads = kernels.chain_terms, kernels.gauss_form, loads.add_loads
 
 
 def _inverse(A: NDArray) -> NDArray:
@@ -415,16 +467,24 @@ def compiled_partition(system, bound: float) -> "CompiledClosure | None":
     """The :class:`CompiledClosure` of a ConstrainedSystem (partitioned) that :func:`unsupported`
     accepts (``bound``: the limit of ‖A_s‖_F ‖A_dep⁻¹‖_F above which the kernel flags the
     partition), or None (after one warning) where numba cannot compile its Φ."""
-    callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
-    return None if callback is None else CompiledClosure(system.tree, system.n_c, callback, "partitioned", (bound,))
+    return _closure(system, "partitioned", bound)
 
 
 def compiled_tangent(system, acting: float) -> "CompiledClosure | None":
     """The :class:`CompiledClosure` of a TangentSystem that :func:`unsupported` accepts
     (``acting``: singular values below this fraction of the largest do not act in f̄), or None
     (after one warning) where numba cannot compile its Φ."""
+    return _closure(system, "tangent", acting)
+
+
+def _closure(system, rule: str, constant: float) -> "CompiledClosure | None":
+    """The :class:`CompiledClosure` of ``system`` by the kernel ``rule``, or None where numba
+    cannot compile its Φ (:func:`closure_callback` warned, naming it; the system keeps the reason)."""
     callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
-    return None if callback is None else CompiledClosure(system.tree, system.n_c, callback, "tangent", (acting,))
+    if callback is None:
+        system._uncompiled = f"numba cannot compile Φ ({getattr(system._phi, '__qualname__', repr(system._phi))})"
+        return None
+    return CompiledClosure(system.tree, system.n_c, callback, rule, (constant,))
 
 
 class CompiledClosure:
@@ -441,7 +501,7 @@ class CompiledClosure:
         ev = self.fast = tree.evaluator("fast")
         ws = self._workspace = ev._real
         self.tree = (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
-                     ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist)
+                     ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist, ev._laws, ev._law_constants)
         self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
 
     def _call(self, system, q: NDArray, s_dot: NDArray, t: float) -> bool:
@@ -467,6 +527,11 @@ class CompiledClosure:
             return None
         return self._s_ddot_tree.copy(), self._A.copy(), self._workspace.M_all.copy(), self._workspace.b_all.copy()
 
+    def minimal_accelerations(self, system, q: NDArray, s_dot: NDArray, t: float):
+        """s̈ = s̈_tree[independent] of ``system`` at (q, ṡ, t) (the evaluator's s̈, without copies of
+        A_s, M and b), or None (flagged)."""
+        return self._s_ddot_tree[system.independent] if self._call(system, q, s_dot, t) else None
+
     def state_derivative(self, system, x: NDArray, t: float):
         """ẋ = (q̇, s̈) = (ṡ_tree, s̈_tree[independent]) of ``system`` at x = (q, ṡ) (q̇ = ṡ_tree:
         K = E, and no Baumgarte term where the kernel applies), or None where the kernel flags
@@ -482,10 +547,10 @@ class CompiledClosure:
 def _compiled() -> dict:
     """{"partitioned": …, "tangent": …}: the kernels compiled by numba (cached on disk) as
     :func:`projeq.assembly.kernels.jit` compiles another module's kernels, calling the compiled
-    kernels of :mod:`projeq.assembly.kernels` and Φ through its C callback's address by an
-    intrinsic (:func:`_phi_into`)."""
+    kernels of :mod:`projeq.assembly.kernels`, the force laws' loop of :mod:`projeq.assembly.loads`
+    and Φ through its C callback's address by an intrinsic (:func:`_phi_into`)."""
     compiled = {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True)[0],
-                "_phi_into": _intrinsic()}
+                "add_loads": loads.kernel(True), "_phi_into": _intrinsic()}
     return dict(zip(("partitioned", "tangent"), kernels.jit(partitioned, tangent, callees=_HELPERS, kernels=compiled)))
 
 

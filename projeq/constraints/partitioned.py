@@ -76,7 +76,7 @@ from numpy.typing import NDArray
 
 from projeq.assembly.linalg import solve_spd
 from projeq.constraints.batched import batched_closure
-from projeq.constraints.compiled import compiled_partition, unsupported
+from projeq.constraints.compiled import OWN_RULE, compiled_partition, uncompiled, unsupported
 from projeq.checks import positive, state_vector
 from projeq.analysis.differentiation import (derivative_along, derivative_along_differences, is_complex_safe,
                                              second_derivative_along, second_derivative_along_differences)
@@ -631,18 +631,23 @@ class ConstrainedSystem(Model):
     def compiled_kernel(self):
         """The :class:`~projeq.constraints.compiled.CompiledClosure` of this system's Φ and tree
         (built on first use: numba compiles Φ, and warns once naming it if it cannot), or None
-        where the compiled call does not apply (:func:`projeq.constraints.compiled.unsupported`)."""
+        where the compiled call does not apply, after one
+        :class:`~projeq.constraints.compiled.UncompiledClosureWarning` naming the piece
+        (:func:`projeq.constraints.compiled.unsupported`)."""
         if self._compiled is False:
-            self._compiled = None if unsupported(self) is not None else self._compiled_rule()
+            why = unsupported(self)
+            self._compiled = self._compiled_rule() if why is None else uncompiled(self, why)
         return self._compiled
 
     def _compiled_rule(self):
-        """The compiled kernel of coordinate partitioning, None for a subclass that forms F by its own rule."""
+        """The compiled kernel of coordinate partitioning, None (after one warning) for a subclass
+        that forms F by its own rule."""
         if type(self).F is not ConstrainedSystem.F or type(self).particular is not ConstrainedSystem.particular:
-            return None
+            return uncompiled(self, OWN_RULE)
         return compiled_partition(self, PARTITION_CONDITION)
 
     _compiled = False  # the CompiledClosure, None where it does not apply; False: not looked at yet
+    _uncompiled = None  # why it does not apply (said once, projeq.constraints.compiled.uncompiled)
 
     def _projected_accelerations(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
         """(s̈_tree, A_s, M, b) by numpy linear algebra on Φ's derivatives and the tree's Gauss
@@ -683,20 +688,30 @@ class PartitionedEvaluator:
         # forms s̈_tree and λ together (the augmented Lagrangian)
         partitioned = type(system).accelerations_tree is ConstrainedSystem.accelerations_tree
         whole = method is None and partitioned and system.compiled_kernel() is not None
-        if whole:  # ẋ = (q̇, s̈) in one compiled call for simulate's right-hand side
-            self.state_derivative = self._state_derivative
+        if whole:  # s̈ and ẋ = (q̇, s̈) (simulate's right-hand side) in one compiled call
+            self.accelerations, self.state_derivative = self._compiled_accelerations, self._state_derivative
         self.reason = ("Φ's derivatives, the partition and the projection of the tree's Gauss form in one "
                        "compiled call" if whole else
                        f"constraint equations projected on the tree's Gauss form M, b by the "
                        f"{'compiled kernels' if compiled else 'dense reference'}"
                        + (f", b from the {method!r} evaluator" if method not in (None, "dense") else "")
-                       + (f"; not in one compiled call: {unsupported(system) or 'Φ does not compile'}"
+                       + (f"; not in one compiled call: {system._uncompiled}"
                           if method is None and partitioned and not whole else ""))
         self.system, self.method = system, method
         self._tree = system._tree_accelerations if partitioned else system.accelerations_tree
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         return self._tree(q, s_dot, t, self.method)[0][self.system.independent]
+
+    def _compiled_accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
+        """s̈ by the system's compiled kernel at real arguments; by the numpy path at complex ones (a
+        complex step) and where the kernel flags (which raises the error naming the cause)."""
+        system, q, s_dot = self.system, np.asarray(q), np.asarray(s_dot)
+        if q.dtype.kind != "c" and s_dot.dtype.kind != "c":  # (np.iscomplexobj costs more than the check)
+            s_ddot = system.compiled_kernel().minimal_accelerations(system, q, s_dot, t)
+            if s_ddot is not None:
+                return s_ddot
+        return system._projected_accelerations(q, s_dot, t, None)[0][system.independent]
 
     def _state_derivative(self, t: float, x: NDArray):
         """ẋ = (q̇, s̈) by the system's compiled kernel, or None

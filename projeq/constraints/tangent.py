@@ -55,7 +55,7 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import NDArray
 
-from projeq.constraints.compiled import compiled_tangent
+from projeq.constraints.compiled import OWN_RULE, compiled_tangent, uncompiled
 from projeq.constraints.partitioned import (
     RANK_TOLERANCE, REPIVOT_CONDITION, ConstrainedSystem, independent_indices, minimum_norm_solution, numerical_rank,
 )
@@ -234,9 +234,9 @@ class TangentSystem(ConstrainedSystem):
 
     def _compiled_rule(self):
         """The compiled kernel of the tangent space (:func:`projeq.constraints.compiled.tangent`),
-        None for a subclass that forms F by its own rule."""
+        None (after one warning) for a subclass that forms F by its own rule."""
         if type(self).F is not TangentSystem.F or type(self).particular is not TangentSystem.particular:
-            return None
+            return uncompiled(self, OWN_RULE)
         return compiled_tangent(self, ACTING)
 
     def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:

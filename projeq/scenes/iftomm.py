@@ -67,12 +67,18 @@ def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, spee
     tree = System(dict.fromkeys(cranks + couplers, rod), joints, gravity=(0.0, -g, 0.0))
     crank, coupler = (tuple(tree.q_slice[tree.index(name)].start for name in names) for names in (cranks, couplers))
 
-    def closure(q, t):  # tip of coupler i − (tip of crank i), i = 1 … n: x rows, then y rows (on the rows q[i])
-        x = [L * (np.cos(q[crank[i]]) + np.cos(q[crank[i]] + q[coupler[i]]) - 1.0 - np.cos(q[crank[i + 1]]))
-             for i in range(n)]  # pivots 1 apart
-        y = [L * (np.sin(q[crank[i]]) + np.sin(q[crank[i]] + q[coupler[i]]) - np.sin(q[crank[i + 1]]))
-             for i in range(n)]
-        return x + y
+    def closure(q, t):
+        """Tip of coupler i − (tip of crank i), i = 1 … n (pivots 1 apart): x rows, then y rows, on
+        the rows q[i]; each crank's cosine and sine once, into one list (compiled by numba as written)."""
+        rows = [q[0] * 0.0] * (2 * n)
+        cos, sin = np.cos(q[crank[0]]), np.sin(q[crank[0]])
+        for i in range(n):
+            coupler_angle = q[crank[i]] + q[coupler[i]]
+            cos_next, sin_next = np.cos(q[crank[i + 1]]), np.sin(q[crank[i + 1]])
+            rows[i] = L * (cos + np.cos(coupler_angle) - 1.0 - cos_next)
+            rows[n + i] = L * (sin + np.sin(coupler_angle) - sin_next)
+            cos, sin = cos_next, sin_next
+        return rows
 
     q0, s_dot0 = np.zeros(tree.n_q), np.zeros(tree.n_s)
     q0[list(crank)], q0[list(coupler)] = np.pi / 2, -np.pi / 2
@@ -149,20 +155,25 @@ def bricard(m: float = 1.0, L: float = 1.0, side: float = 0.1, g: float = 9.81, 
     def closure(q, t):
         """The chain's forward kinematics to rod5's far end in closed form, on the rows q[i] (a
         point, or a batch of points; compiled by numba as written): r += R ρ_i, then
-        R ← R R_axis(q_i), whose columns (i, j) after the axis k turn as (c R_i + s R_j, −s R_i + c R_j)."""
+        R ← R R_axis(q_i), whose columns (i, j) after the axis k turn as (c R_i + s R_j, −s R_i + c R_j);
+        R by rows in one flat list (R[3 a + b] = R_ab), r and the five rows in another."""
         zero = q[columns[0]] * 0.0
-        R = [[zero + 1.0, zero, zero], [zero, zero + 1.0, zero], [zero, zero, zero + 1.0]]  # rows of R
-        r = [zero, zero, zero]
-        for n in range(5):
+        R = [zero + 1.0, zero, zero, zero, zero + 1.0, zero, zero, zero, zero + 1.0]
+        r = [zero, zero, zero, zero, zero]  # r, then the rows R_10, R_20 of the last two
+        for n in range(6):
             for a in range(3):
-                r[a] = r[a] + R[a][0] * offsets[n][0] + R[a][1] * offsets[n][1] + R[a][2] * offsets[n][2]
+                r[a] = r[a] + R[3 * a] * offsets[n][0] + R[3 * a + 1] * offsets[n][1] + R[3 * a + 2] * offsets[n][2]
+            if n == 5:
+                break
             i, j = (axes[n] + 1) % 3, (axes[n] + 2) % 3
             c, s = np.cos(q[columns[n]]), np.sin(q[columns[n]])
             for a in range(3):
-                R_i, R_j = R[a][i], R[a][j]
-                R[a][i], R[a][j] = c * R_i + s * R_j, c * R_j - s * R_i
-        return [r[a] + R[a][0] * offsets[5][0] + R[a][1] * offsets[5][1] + R[a][2] * offsets[5][2] - end[a]
-                for a in range(3)] + [R[1][0], R[2][0]]
+                R_i, R_j = R[3 * a + i], R[3 * a + j]
+                R[3 * a + i], R[3 * a + j] = c * R_i + s * R_j, c * R_j - s * R_i
+        for a in range(3):
+            r[a] = r[a] - end[a]
+        r[3], r[4] = R[3], R[6]
+        return r
 
     return TangentSystem(tree, phi=closure, q0=np.zeros(tree.n_q), **options)
 
@@ -210,16 +221,22 @@ def andrews_squeezer(**options) -> TangentSystem:
               SpringDamper("gamma", (a["sd"], -a["sc"], 0.0), None, (a["xc"], a["yc"], 0.0), a["c0"], length=a["l0"])]
     tree = System(bodies, joints, forces=forces)
     column = {name: tree.q_slice[tree.index(name)].start for name in ANDREWS_ANGLES}
+    i_beta, i_theta, i_gamma, i_phi, i_delta, i_omega, i_epsilon = (column[name] for name in ANDREWS_ANGLES)
+    rr, d, ss, e, zt, u, zf = (a[key] for key in ("rr", "d", "ss", "e", "zt", "u", "zf"))
+    x_a, y_a, x_b, y_b = (a[key] for key in ("xa", "ya", "xb", "yb"))
 
-    def closure(q, t):  # point E from theta minus E from gamma, from phi and from omega (x, y rows)
-        beta, theta, gamma, phi, delta, omega, epsilon = (q[column[name]] for name in ANDREWS_ANGLES)
-        e_x = a["rr"] * np.cos(beta) - a["d"] * np.cos(beta + theta)
-        e_y = a["rr"] * np.sin(beta) - a["d"] * np.sin(beta + theta)
-        return [e_x - a["xb"] - a["ss"] * np.sin(gamma), e_y - a["yb"] + a["ss"] * np.cos(gamma),
-                e_x - a["xa"] - a["zt"] * np.cos(delta) - a["e"] * np.sin(phi + delta),
-                e_y - a["ya"] - a["zt"] * np.sin(delta) + a["e"] * np.cos(phi + delta),
-                e_x - a["xa"] - a["u"] * np.sin(epsilon) - a["zf"] * np.cos(omega + epsilon),
-                e_y - a["ya"] + a["u"] * np.cos(epsilon) - a["zf"] * np.sin(omega + epsilon)]
+    def closure(q, t):
+        """Point E from theta minus E from gamma, from phi and from omega (x, y rows), on the
+        rows q[i] and captured numbers (compiled by numba as written)."""
+        beta, theta, gamma, phi, delta = q[i_beta], q[i_theta], q[i_gamma], q[i_phi], q[i_delta]
+        omega, epsilon = q[i_omega], q[i_epsilon]
+        e_x = rr * np.cos(beta) - d * np.cos(beta + theta)
+        e_y = rr * np.sin(beta) - d * np.sin(beta + theta)
+        return [e_x - x_b - ss * np.sin(gamma), e_y - y_b + ss * np.cos(gamma),
+                e_x - x_a - zt * np.cos(delta) - e * np.sin(phi + delta),
+                e_y - y_a - zt * np.sin(delta) + e * np.cos(phi + delta),
+                e_x - x_a - u * np.sin(epsilon) - zf * np.cos(omega + epsilon),
+                e_y - y_a + u * np.cos(epsilon) - zf * np.sin(omega + epsilon)]
 
     q0 = np.zeros(tree.n_q)
     q0[[column[name] for name in ANDREWS_ANGLES]] = ANDREWS_Q0

@@ -19,7 +19,7 @@ from projeq.constraints.partitioned import ConstrainedSystem
 # the same stencils and the same M, b (tests/assembly/test_fast.py: ~1e-15 relative), summed in
 # another order: measured ≤ 2e-15 of max(1, |s̈_tree|∞) on these scenes
 RTOL = 1e-13
-COMPILED_SCENES = ("four_bar", "quick_return", "simple_pendulum", "n_four_bar", "bricard")
+COMPILED_SCENES = ("four_bar", "quick_return", "simple_pendulum", "n_four_bar", "bricard", "andrews_squeezer")
 
 
 def _states(model, count=3):
@@ -31,9 +31,43 @@ def _close(a, b) -> bool:
     return bool(np.abs(a - b).max(initial=0.0) <= RTOL * max(1.0, np.abs(b).max(initial=0.0)))
 
 
-@pytest.mark.parametrize("name", COMPILED_SCENES)
+def _loaded_four_bar(law=None):
+    """The four-bar of rigid rods (a, b, c = 0.3, 1.0, 0.8 m on a ground link of 1 m, q = (crank,
+    rocker, coupler relative to the crank); gravity −y) under every kind of compiled force law:
+    a spring-damper between coupler and rocker and one from the crank to the ground, a joint
+    spring on the coupler, a motor torque on the crank, a force at a point of the coupler (world
+    frame) and a torque on the rocker (body frame); ``law`` one more."""
+    a, b, c, d = 0.3, 1.0, 0.8, 1.0
+
+    def rod(m, L):
+        return pq.RigidBody(m, (L / 2, 0.0, 0.0), np.diag([1e-3, m * L * L / 12, m * L * L / 12]))
+
+    laws = [pq.SpringDamper("coupler", (0.5, 0.0, 0.0), "rocker", (0.4, 0.0, 0.0), 40.0, damping=2.0, length=0.3),
+            pq.SpringDamper("crank", (0.3, 0.0, 0.0), None, (0.2, 0.5, 0.0), 25.0, damping=0.5, length=0.1),
+            pq.JointSpring("coupler", 8.0, damping=0.3, q_ref=0.2), pq.JointForce("crank", [1.5]),
+            pq.Force("coupler", (0.5, -2.0, 0.3), point=(0.7, 0.0, 0.0)),
+            pq.Torque("rocker", (0.0, 0.1, -0.8), frame="body")] + ([law] if law else [])
+    tree = pq.System({"crank": rod(1.0, a), "rocker": rod(1.5, c), "coupler": rod(2.0, b)},
+                     {"crank": pq.Revolute(axis="z"), "rocker": pq.Revolute(axis="z", r_pn=(d, 0.0, 0.0)),
+                      "coupler": pq.Revolute(parent="crank", axis="z", r_pn=(a, 0.0, 0.0))},
+                     gravity=(0.0, -9.81, 0.0), forces=laws)
+
+    def closure(q, t):
+        return [a * np.cos(q[0]) + b * np.cos(q[0] + q[2]) - d - c * np.cos(q[1]),
+                a * np.sin(q[0]) + b * np.sin(q[0] + q[2]) - c * np.sin(q[1])]
+
+    theta2, theta3 = pq.scenes.mechanisms.four_bar_angles(0.5, a, b, c, d)
+    return ConstrainedSystem(tree, phi=closure, independent=[0], q0=(0.5, theta3, theta2 - 0.5), s_dot0=[3.0])
+
+
+MODELS = {name: pq.scenes.SCENES[name].build for name in COMPILED_SCENES} | {"loaded_four_bar": _loaded_four_bar}
+
+
+@pytest.mark.parametrize("name", MODELS)
 def test_the_compiled_call_gives_the_numpy_paths_accelerations_and_multipliers(name):
-    model = pq.scenes.SCENES[name].build()
+    """… on every scene the kernel takes, and on a loop under every kind of compiled force law
+    (whose loads the kernel adds by the fast evaluator's own loop, projeq.assembly.loads)."""
+    model = MODELS[name]()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert model.compiled_kernel() is not None
@@ -47,15 +81,21 @@ def test_the_compiled_call_gives_the_numpy_paths_accelerations_and_multipliers(n
         dense, lam_dense = model.accelerations_tree(q, s_dot, t, method="dense")
         assert _close(s_ddot_tree, dense) and _close(lam, lam_dense)
         assert np.array_equal(model.accelerations(q, s_dot, t), s_ddot_tree[model.independent])
+        assert np.array_equal(model.evaluator().accelerations(q, s_dot, t), s_ddot_tree[model.independent])
+        # a complex step through the evaluator takes the numpy path (the kernel is real): its imaginary part kept
+        step = model.evaluator().accelerations(q, s_dot + 1e-20j, t)
+        assert np.iscomplexobj(step) and _close(step.real, reference[model.independent])
         x_dot = model.evaluator().state_derivative(t, np.concatenate((q, s_dot)))  # simulate's right-hand side
         assert _close(x_dot, np.concatenate((model.q_dot(q, s_dot, t), reference[model.independent])))
 
 
-@pytest.mark.parametrize("name, rule, constant", [("four_bar", "partitioned", 1e8), ("n_four_bar", "tangent", 1e-6)])
+@pytest.mark.parametrize("name, rule, constant", [("four_bar", "partitioned", 1e8), ("n_four_bar", "tangent", 1e-6),
+                                                  ("loaded_four_bar", "partitioned", 1e8),
+                                                  ("andrews_squeezer", "tangent", 1e-6)])
 def test_the_kernel_interpreted_gives_the_compiled_numbers(name, rule, constant):
     """The kernel's source run as plain Python (Φ itself, the callees uncompiled) is the compiled
     algorithm step by step: the same s̈_tree, A_s, M and b to round-off."""
-    model = pq.scenes.SCENES[name].build()
+    model = MODELS[name]()
     interpreted = CompiledClosure(model.tree, model.n_c, model._phi, rule, (constant,), compiled=False)
     for q, s_dot, t in _states(model, 2):
         expected = model.compiled_kernel().accelerations(model, q, s_dot, t)
@@ -113,7 +153,8 @@ def test_a_phi_numba_cannot_compile_warns_once_naming_it_and_keeps_the_numpy_num
         model.evaluator()
     warned = [w for w in said if issubclass(w.category, UncompiledClosureWarning)]
     assert len(warned) == 1 and "rod_from_a_dict" in str(warned[0].message)
-    assert model.compiled_kernel() is None and "not in one compiled call: Φ does not compile" in ev.reason
+    assert model.compiled_kernel() is None
+    assert "not in one compiled call: numba cannot compile Φ (test_a_phi_numba_cannot" in ev.reason
     reference = model._projected_accelerations(model.q0, np.array([0.4]), 0.0, None)[0][model.independent]
     assert all(np.array_equal(value, reference) for value in s_ddot)
     # the same Φ written on scalars compiles, and gives the same motion
@@ -124,14 +165,66 @@ def test_a_phi_numba_cannot_compile_warns_once_naming_it_and_keeps_the_numpy_num
         assert _close(same.accelerations(same.q0, np.array([0.4])), reference)
 
 
-@pytest.mark.parametrize("name, why", [("whipple_bicycle", "Pfaffian"), ("andrews_squeezer", "force laws")])
-def test_models_outside_the_compiled_call_keep_the_numpy_path_saying_why(name, why):
-    model = pq.scenes.SCENES[name].build()
-    assert why in compiled.unsupported(model)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", UncompiledClosureWarning)  # not looked at: no warning about Φ
-        assert model.compiled_kernel() is None
-        assert f"not in one compiled call: {compiled.unsupported(model)}" in model.evaluator().reason
+def _driven_four_bar():
+    """The loaded four-bar with one more law, a force of a callable load (no compiled row)."""
+    return _loaded_four_bar(pq.Force("rocker", lambda t, q, s_dot: np.array([0.0, np.sin(t), 0.0])))
+
+
+def _planar_pendulum():
+    """A disc on a Planar joint (a joint that states its own relative motion), its centre held on
+    a circle."""
+    tree = pq.System({"bob": pq.RigidBody(1.0, (0.0, 0.0, 0.0), 0.1 * np.eye(3))}, {"bob": pq.Planar()},
+                     gravity=(0, -9.81, 0))
+    return ConstrainedSystem(tree, phi=lambda q, t: [q[0] ** 2 + q[1] ** 2 - 1.0], q0=[1.0, 0.0, 0.0],
+                             independent=[1, 2])
+
+
+def _shaken_pendulum():
+    """The pendulum of :func:`_pendulum` on a base shaken along y by a Prescribed joint (a joint
+    that states its own relative motion, with no coordinate of its own)."""
+    shake = pq.Prescribed(pq.Prismatic(axis="y"), lambda t: (0.1 * np.sin(t), 0.1 * np.cos(t), -0.1 * np.sin(t)))
+    tree = pq.System({"base": pq.Frame(), "x": pq.Frame(), "bob": pq.PointMass(1.0)},
+                     {"base": shake, "x": pq.Prismatic(parent="base", axis="x"),
+                      "bob": pq.Prismatic(parent="x", axis="z")}, gravity=(0, 0, -9.81))
+    return ConstrainedSystem(tree, phi=lambda q, t: [q[0] ** 2 + q[1] ** 2 - 1.0], q0=[0.6, -0.8], independent=[0])
+
+
+class _OwnRule(ConstrainedSystem):
+    """Coordinate partitioning restated by a subclass (its own F, here the inherited one)."""
+
+    def F(self, q, t=0.0, constraint_matrix=None):
+        return super().F(q, t, constraint_matrix)
+
+
+OUTSIDE = {
+    "Pfaffian": (pq.scenes.SCENES["whipple_bicycle"].build, "Pfaffian constraints"),
+    "callable load": (_driven_four_bar, "force law 6 (Force) has no compiled row"),
+    "joint with K ≠ E": (_planar_pendulum, "joints with q̇ ≠ ṡ (K ≠ E): 'bob' (Planar)"),
+    "joint stating its motion": (_shaken_pendulum, "joint 'base' (Prescribed) states its own relative motion"),
+    "rheonomic": (lambda: pq.scenes.four_bar(correction="baumgarte"), "Φ may depend on t"),
+    "own rule": (lambda: _OwnRule(pq.scenes.four_bar().tree, phi=pq.scenes.four_bar()._phi,
+                                  q0=pq.scenes.four_bar().q0, independent=[0]), "F by its own rule"),
+}
+
+
+@pytest.mark.parametrize("case", OUTSIDE)
+def test_models_outside_the_compiled_call_say_so_once_naming_the_piece_and_keep_the_numpy_path(case):
+    """No silent fall-back: the first look for the kernel (the evaluator simulate takes) warns once
+    per model, naming the piece that keeps it out; later evaluations do not warn again, and the
+    numbers are the numpy path's."""
+    build, why = OUTSIDE[case]
+    model = build()
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        ev = model.evaluator()
+        q, s_dot = model.q0, model.s_dot0
+        values = [ev.accelerations(q, s_dot, 0.0) for _ in range(2)]
+        assert model.compiled_kernel() is None and model.evaluator() is not None
+    warned = [str(w.message) for w in said if issubclass(w.category, UncompiledClosureWarning)]
+    assert len(warned) == 1 and why in warned[0] and "not one compiled call" in warned[0], warned
+    assert f"not in one compiled call: {why}" in ev.reason
+    reference = model._tree_accelerations(q, s_dot, 0.0, "dense")[0][model.independent]
+    assert all(_close(value, reference) for value in values)
 
 
 def test_a_degenerate_partition_met_by_the_compiled_call_raises_the_numpy_paths_error():
@@ -148,6 +241,15 @@ def test_a_degenerate_partition_met_by_the_compiled_call_raises_the_numpy_paths_
     assert kernel.accelerations(model, q, np.array([0.5]), 0.0) is None
     with pytest.raises(ValueError, match="independent: the dependent velocities"):
         model.accelerations_tree(q, np.array([0.5]), 0.0)
+
+
+def test_a_force_law_without_a_value_in_the_compiled_call_raises_the_numpy_paths_error():
+    """A spring-damper whose two points coincide (the crank's pivot and the ground's origin) has no
+    direction: the kernel flags it, and the numpy path names the law."""
+    model = _loaded_four_bar(pq.SpringDamper("crank", (0.0, 0.0, 0.0), None, (0.0, 0.0, 0.0), 1.0))
+    assert model.compiled_kernel().accelerations(model, model.q0, model.s_dot0, 0.0) is None
+    with pytest.raises(ValueError, match="the two points coincide"):
+        model.accelerations_tree(model.q0, model.s_dot0, 0.0)
 
 
 @pytest.mark.parametrize("shape", [(1, 2), (2, 3), (4, 5), (5, 5), (6, 7)])

@@ -17,10 +17,11 @@ import numpy as np
 import pytest
 
 import projeq as pq
+from projeq.assembly.kinematics import poses
 from projeq.constraints.augmented import AugmentedSystem
 from projeq.constraints.partitioned import ConstrainedSystem
 from projeq.scenes.iftomm import (
-    ANDREWS_REFERENCE, andrews_angles, andrews_balance, andrews_error, andrews_squeezer, bricard, n_four_bar,
+    ANDREWS, ANDREWS_REFERENCE, andrews_angles, andrews_balance, andrews_error, andrews_squeezer, bricard, n_four_bar,
     parallelogram_motion, pendulum_angle, point_b0, simple_pendulum,
 )
 
@@ -205,6 +206,26 @@ def test_andrews_squeezer_starts_with_the_published_accelerations():
         [14222.4439199541138705911625887, -10666.8329399655854029433719415, 0, 0, 0, 0, 0], rel=1e-10, abs=1e-8)
     assert -lam == pytest.approx([98.5668703962410896057654982170, -6.12268834425566265503114393122, 0, 0, 0, 0],
                                  rel=1e-10, abs=1e-10)
+
+
+def test_andrews_closure_is_point_e_of_the_trees_kinematics():
+    """Φ (stated on scalars, compiled by numba as written) is point E — (−d, 0) on theta,
+    (0, −ss) on gamma, (0, −e) on phi, (zf, 0) on omega (Hairer & Wanner 1996, §VII.7, Fig. 7.1) —
+    from theta minus E from each other body, by the tree's own forward kinematics (poses R, r), at
+    random q; numba's compiled Φ gives the same numbers."""
+    import numba
+
+    system = andrews_squeezer()
+    tree, a = system.tree, ANDREWS
+    points = {"theta": (-a["d"], 0.0, 0.0), "gamma": (0.0, -a["ss"], 0.0), "phi": (0.0, -a["e"], 0.0),
+              "omega": (a["zf"], 0.0, 0.0)}
+    compiled_phi = numba.njit(system._phi)
+    for q in np.random.default_rng(2).uniform(-np.pi, np.pi, (20, tree.n_q)):
+        pose = poses(tree, q, np.zeros(tree.n_s), 0.0)
+        E = {name: pose.r[tree.index(name)] + pose.R[tree.index(name)] @ point for name, point in points.items()}
+        expected = np.concatenate([(E["theta"] - E[name])[:2] for name in ("gamma", "phi", "omega")])
+        assert np.abs(system.phi(q) - expected).max() <= 1e-16  # m: round-off of lengths below 0.2 m
+        assert np.array_equal(np.array(compiled_phi(q, 0.0)), system.phi(q))
 
 
 @pytest.mark.slow

@@ -1,0 +1,67 @@
+"""A whole default ``simulate`` of constrained scenes (the scene's t_end and settings) with the
+constrained s̈ in one compiled call (:mod:`projeq.constraints.compiled`) against the same run on
+the numpy path it replaces (Φ's batched derivatives and the projection by numpy on the compiled
+tree's Gauss form), in one process, alternately: CPU seconds of each run (best of ``--repeat``),
+their ratio, the right-hand-side calls, and the largest difference of the two runs' q and ṡ
+(relative to the largest |q|, |ṡ|: the runs differ by round-off per call, amplified by the
+integrator's step selection).
+
+    python benchmarks/closure_runs.py                     # Andrews' squeezer (0.05 s)
+    python benchmarks/closure_runs.py four_bar bricard    # others
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+import projeq as pq
+from projeq import scenes
+
+
+def run(name: str, compiled: bool):
+    """(CPU s, Result) of the scene's default run, by the compiled call or the numpy path."""
+    scene = scenes.SCENES[name]
+    system = scene.build()
+    if not compiled:
+        system._compiled = None  # the numpy path, as for a Φ numba cannot compile
+    system.evaluator()
+    start = time.process_time()
+    result = pq.simulate(system, scene.t_end, **(scene.settings or {}))
+    return time.process_time() - start, result
+
+
+def row(name: str, repeat: int) -> dict:
+    run(name, True)  # compile and load the kernels once
+    seconds, results = {True: np.inf, False: np.inf}, {}
+    for _ in range(repeat):
+        for compiled in (True, False):
+            cpu, results[compiled] = run(name, compiled)
+            seconds[compiled] = min(seconds[compiled], cpu)
+    fast, slow = results[True], results[False]
+    same_grid = fast.t.shape == slow.t.shape and np.array_equal(fast.t, slow.t)
+    dq = np.abs(fast.q[-1] - slow.q[-1]).max() / np.abs(slow.q[-1]).max()
+    ds = np.abs(fast.s_dot[-1] - slow.s_dot[-1]).max() / max(np.abs(slow.s_dot[-1]).max(), 1e-300)
+    return {"scene": name, "t_end": scenes.SCENES[name].t_end, "compiled_s": seconds[True], "numpy_s": seconds[False],
+            "ratio": seconds[False] / seconds[True], "evaluations": (fast.nfev, slow.nfev),
+            "same_grid": same_grid, "q_end": dq, "s_dot_end": ds}
+
+
+def main(argv=None) -> list:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("scenes", nargs="*", default=["andrews_squeezer"], help="scene names")
+    parser.add_argument("--repeat", type=int, default=3, help="runs of each path, best CPU time (default 3)")
+    args = parser.parse_args(argv)
+    rows = [row(name, args.repeat) for name in args.scenes]
+    print(f"{'scene':18s} {'t_end':>6s} {'compiled s':>10s} {'numpy s':>8s} {'numpy/compiled':>14s} "
+          f"{'rhs calls (c, n)':>16s} {'Δq_end rel':>10s} {'Δṡ_end rel':>10s}")
+    for r in rows:
+        print(f"{r['scene']:18s} {r['t_end']:6.3g} {r['compiled_s']:10.3f} {r['numpy_s']:8.3f} {r['ratio']:14.1f} "
+              f"{str(r['evaluations']):>16s} {r['q_end']:10.1e} {r['s_dot_end']:10.1e}")
+    return rows
+
+
+if __name__ == "__main__":
+    main()
