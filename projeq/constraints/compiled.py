@@ -23,11 +23,19 @@ Newton–Euler, Featherstone, "Rigid Body Dynamics Algorithms", 2008, §5.3, §6
 evaluator's workspace. The numbers are those of the numpy path to round-off; the tangent kept
 along the branch is read from and written to the system as the numpy path keeps it.
 
-Where it applies (:func:`unsupported` says why not): holonomic constraints only, Φ independent
-of t (``correction="projection"``), q̇ = ṡ_tree (revolute and prismatic joints), a tree whose
+Pfaffian rows A(q) q̇ = 0 join Φ_q in A_s and γ gains their part (∂(A q̇)/∂q) q̇ = Im A(q + i h q̇) q̇ / h,
+A compiled and called as Φ is; the joints of kind GIVEN that are UserJoints from sympy (the
+Whipple bicycle's rear frame) state their relative motion A, r, w, ζ, F⁶ by compiled code of
+their own expressions (:meth:`~projeq.joints.UserJoint.compiled_values`, a second C callback)
+once ṡ_tree = F ṡ is known. Functions printed from sympy
+(:func:`projeq.symbolic.codegen.numeric_function`) are compiled once and cached on disk.
+
+Where it applies (:func:`unsupported` says why not): at least one holonomic constraint, Pfaffian
+rows with b = 0 and A independent of t, Φ independent of t (``correction="projection"``),
+q̇ = ṡ_tree (revolute and prismatic joints, UserJoints from sympy with K = E), a tree whose
 whole Gauss form the compiled kernels compute (no force laws, no joints that state their own
-relative motion, no coupled joints, no elastic bodies), and F by one of the two rules above (not
-a subclass's own, such as the augmented Lagrangian's). A Φ numba cannot compile, or whose
+relative motion in Python, no coupled joints, no elastic bodies), and F by one of the two rules above (not
+a subclass's own, such as the augmented Lagrangian's). A Φ (or A) numba cannot compile, or whose
 compiled values differ from its own at complex points near q0, keeps the numpy path after one
 :class:`UncompiledClosureWarning` naming it. Where the compiled call meets a degenerate partition
 (κ bound reached, or N_ind singular) or a singular FᵀMF it returns a flag and the numpy path
@@ -37,8 +45,12 @@ repeats the evaluation, which raises the error that names the cause.
 from __future__ import annotations
 
 import functools
+import hashlib
+import os
 import re
+import tempfile
 import warnings
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
@@ -98,18 +110,19 @@ def _python_joints(ev) -> list:
     return [n for n in ev._given if getattr(ev.system.joints[n], "compiled_values", lambda: None)() is None]
 
 
-def compiled_phi(phi, n: int, m, q0: NDArray, name: str = "phi"):
+def compiled_phi(phi, n: int, m, q0: NDArray, name: str = "phi", jitted=None):
     """``numba.njit(phi)`` if it compiles for q complex (n,), t float and gives Φ's own values
     (``m`` rows, or the shape ``m`` of a matrix such as the Pfaffian rows A), real and imaginary
     parts each to 1e-13 relative, at three complex points near q0; else None after one
-    :class:`UncompiledClosureWarning` naming ``phi`` (as the argument ``name``)."""
+    :class:`UncompiledClosureWarning` naming ``phi`` (as the argument ``name``); ``jitted``: its
+    compiled form if already built (:func:`_generated_module`), checked the same way."""
     import numba
 
     shape = (m,) if np.ndim(m) == 0 else tuple(m)
     rng = np.random.default_rng(11)
     X = q0[:, None] + 1e-2 * rng.standard_normal((n, 3)) + 1j * COMPLEX_STEP * rng.standard_normal((n, 3))
     try:
-        jitted = numba.njit(phi)
+        jitted = numba.njit(phi) if jitted is None else jitted
         got = np.stack([np.asarray(jitted(x.copy(), 0.0), dtype=complex) for x in X.T], axis=-1)
         want = np.stack([np.asarray(phi(x.copy(), 0.0), dtype=complex) for x in X.T], axis=-1)
     except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
@@ -154,13 +167,81 @@ _CALLBACKS: dict = {}  # _key(Φ) -> its C callback (numba.cfunc), or None where
 def closure_callback(phi, n: int, m, q0: NDArray, name: str = "phi"):
     """Φ (n coordinates, m rows; or the Pfaffian rows A, ``m`` their shape) compiled as a C
     callback ``into(x, t, value)`` (value ← Φ(x, t), x and value complex, a matrix row by row),
-    built once per Φ source and constants in a process; None (after one warning) if Φ does not
-    compile (:func:`compiled_phi`)."""
+    built once per Φ source and constants in a process — and, for a function printed by
+    :func:`projeq.symbolic.codegen.numeric_function`, compiled once and cached on disk
+    (:func:`_generated_module`); None (after one warning) if Φ does not compile (:func:`compiled_phi`)."""
     key = (_key(phi), m)
     if key not in _CALLBACKS:
-        jitted = compiled_phi(phi, n, m, q0, name)
-        _CALLBACKS[key] = None if jitted is None else _callback(jitted, n, m)
+        size = int(np.prod(m))
+        module = _generated_module(phi, _ROWS_INTO.format(n=n, size=size)) if hasattr(phi, "source") else None
+        jitted = compiled_phi(phi, n, m, q0, name, None if module is None else module.function)
+        _CALLBACKS[key] = None if jitted is None else module.into if module is not None else _callback(jitted, n, m)
     return _CALLBACKS[key]
+
+
+#: the C callbacks of printed functions (:func:`_generated_module`): Φ or A at complex x, and a joint's relative motion
+_ROWS_INTO = """
+@numba.cfunc(nb.void(nb.CPointer(nb.complex128), nb.float64, nb.CPointer(nb.complex128)), cache=True)
+def into(x_pointer, t, value_pointer):
+    x, value = numba.carray(x_pointer, ({n},)), numba.carray(value_pointer, ({size},))
+    found = function(x, t).ravel()
+    for i in range({size}):
+        value[i] = found[i]
+"""
+_JOINT_INTO = """
+@numba.cfunc(nb.void(nb.CPointer(nb.float64), nb.CPointer(nb.float64), nb.float64, nb.CPointer(nb.float64)), cache=True)
+def into(q_pointer, s_pointer, t, row_pointer):
+    q_n, s_n, row = numba.carray(q_pointer, ({n_q},)), numba.carray(s_pointer, ({n_s},)), numba.carray(row_pointer, ({width},))
+    found = function(q_n, s_n, t)
+    for i in range({width}):
+        row[i] = found[i]
+"""
+
+
+def _generated_module(f, into: str):
+    """A module of ``f``'s printed source (``f.source``, its constants — the values its closure holds
+    — as globals) compiled by ``numba.njit(cache=True)`` as ``function``, and the C callback ``into``
+    (``cache=True``): written once to a file named by its digest in numba's cache directory (or
+    ~/.cache/projeq) and imported, so that numba's disk cache, which needs a file, keeps both across
+    processes (a temporary directory where that is not writable: compiled anew each process)."""
+    import importlib.util
+    import sys
+
+    import numba
+
+    constants = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
+    source = "\n".join(["import numba", "import numpy", "from numba import types as nb", "",
+                        *(f"{name} = {float(value)!r}" for name, value in sorted(constants.items())), "",
+                        "@numba.njit(cache=True)", f.source.replace(f"def {f.__name__}(", "def function(", 1), into])
+    digest = hashlib.sha1((source + numba.__version__).encode()).hexdigest()[:20]
+    module_name = f"projeq_generated_{digest}"
+    if module_name not in sys.modules:
+        path = _write_once(module_name + ".py", source)
+        spec = importlib.util.spec_from_file_location(module_name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[module_name] = module  # numba's cache finds the module by its name
+        spec.loader.exec_module(module)
+    return sys.modules[module_name]
+
+
+def _write_once(filename: str, source: str) -> Path:
+    """The path of ``filename`` holding ``source`` in the cache directory (written atomically if absent)."""
+    import numba
+
+    for folder in (numba.config.CACHE_DIR or os.path.join(os.environ.get("XDG_CACHE_HOME") or
+                                                           os.path.expanduser("~/.cache"), "projeq"), None):
+        try:
+            folder = Path(folder or tempfile.mkdtemp(prefix="projeq-generated-")) / "generated"
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / filename
+            if not path.is_file() or path.read_text() != source:
+                part = folder / f"{filename}.{os.getpid()}.part"
+                part.write_text(source)
+                os.replace(part, path)
+            return path
+        except OSError:
+            continue
+    raise OSError(f"cannot write the generated module {filename} to a cache or a temporary directory")
 
 
 def _callback(jitted, n: int, m):
@@ -190,23 +271,11 @@ def _callback(jitted, n: int, m):
 def joint_callback(joint):
     """The relative motion of a UserJoint from sympy (:meth:`~projeq.joints.UserJoint.compiled_values`:
     A, r, w, ζ, F⁶ as one row) compiled as a C callback ``into(q_n, s_n, t, row)`` (real), built
-    once per expressions in a process."""
-    import numba
-    from numba import types as nb
-
+    once per expressions in a process and cached on disk (:func:`_generated_module`)."""
     values = joint.compiled_values()
     if values not in _CALLBACKS:
-        jitted, n_q, n_s = numba.njit(values), joint.n_q, joint.n_s
-        width = kernels.GIVEN_F + 6 * n_s
-
-        def into(q_pointer, s_pointer, t, row_pointer):
-            q_n, s_n = numba.carray(q_pointer, (n_q,)), numba.carray(s_pointer, (n_s,))
-            row, found = numba.carray(row_pointer, (width,)), jitted(q_n, s_n, t)
-            for i in range(width):
-                row[i] = found[i]
-
-        pointer = nb.CPointer(nb.float64)
-        _CALLBACKS[values] = numba.cfunc(nb.void(pointer, pointer, nb.float64, pointer))(into)
+        into = _JOINT_INTO.format(n_q=joint.n_q, n_s=joint.n_s, width=kernels.GIVEN_F + 6 * joint.n_s)
+        _CALLBACKS[values] = _generated_module(values, into).into
     return _CALLBACKS[values]
 
 

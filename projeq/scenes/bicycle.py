@@ -26,9 +26,12 @@ constraints: the front contact on the ground, Φ(q) = z_Q = 0 (holonomic: it fix
 pitch θ), and no slip at both contacts, A(q) q̇ = 0 (the horizontal velocity of each
 wheel's material contact point; the vertical one vanishes with Φ̇ and the coordinates).
 The minimal velocities are ṡ = (φ̇, θ̇_R, δ̇): roll rate, rear-wheel rate (forward speed
-v = −r_R θ̇_R) and steer rate. Φ and A are derived once with sympy from the geometry
-(exact, then lambdified); the dynamics are projeq's Projection Equation of the tree with
-the constraints inserted by coordinate partitioning (dense Gauss form).
+v = −r_R θ̇_R) and steer rate. Φ and A are stated once in sympy from the geometry and
+printed as scalar numpy code (:func:`projeq.symbolic.codegen.numeric_function`); the dynamics
+are projeq's Projection Equation of the tree with the constraints inserted by coordinate
+partitioning. Φ, A and the rear frame's relative motion compile with numba, so that s̈ is one
+compiled call (:mod:`projeq.constraints.compiled`: the tree's compiled Gauss form, Φ's and A's
+complex-step derivatives, the partition and the projection).
 
 Linearisation (:func:`whipple_eigenvalues`): about upright straight running at speed v,
 x, y, ψ, θ_R, θ_F are ignorable and dropped; the longitudinal states (θ, θ̇_R) decouple

@@ -39,8 +39,9 @@ def numeric_function(name: str, arguments, expressions, constants=()):
 
     ``arguments``: (name, symbols) pairs — a list of symbols are the entries ``name[i]`` of an
     array argument, a single symbol a scalar argument; ``constants``: symbols whose values
-    ``make`` takes (captured by the function, constants to numba). The generated source is
-    the function's ``source`` attribute."""
+    ``make`` takes (captured by the function, constants to numba). The function's ``source``
+    attribute is its own source (in the names of ``constants``, its ``constants`` attribute), to
+    be compiled where the constants are module globals (:func:`projeq.constraints.compiled.joint_callback`)."""
     rename = {}
     for argument, symbols in arguments:
         if isinstance(symbols, sp.Symbol):
@@ -61,11 +62,11 @@ def numeric_function(name: str, arguments, expressions, constants=()):
         body = ", ".join("[" + ", ".join(entries[r * matrix.cols:(r + 1) * matrix.cols]) + "]"
                          for r in range(matrix.rows))
     names = [str(c) for c in constants]
-    lines = [f"def make({', '.join(names)}):",
-             f"    def {name}({', '.join(a for a, _ in arguments)}):"]
-    lines += [f"        {s} = {printer.doprint(e)}" for s, e in temporaries]
-    lines += [f"        return numpy.array([{body}])", f"    {name}.source = source", f"    return {name}"]
+    signature = f"def {name}({', '.join(a for a, _ in arguments)}):"
+    body = [f"    {s} = {printer.doprint(e)}" for s, e in temporaries] + [f"    return numpy.array([{body}])"]
+    lines = [f"def make({', '.join(names)}):", "    " + signature, *("    " + line for line in body),
+             f"    {name}.source = source", f"    {name}.constants = {tuple(names)!r}", f"    return {name}"]
     source = "\n".join(lines) + "\n"
-    namespace = {"numpy": np, "source": source}
+    namespace = {"numpy": np, "source": "\n".join([signature, *body]) + "\n"}
     exec(compile(source, f"<projeq.symbolic.codegen {name}>", "exec"), namespace)  # noqa: S102 — our own printout
     return namespace["make"]
