@@ -173,7 +173,8 @@ def closure_callback(phi, n: int, m, q0: NDArray, name: str = "phi"):
     key = (_key(phi), m)
     if key not in _CALLBACKS:
         size = int(np.prod(m))
-        module = _generated_module(phi, _ROWS_INTO.format(n=n, size=size)) if hasattr(phi, "source") else None
+        printed = hasattr(phi, "source") and hasattr(phi, "constants")  # by projeq.symbolic.codegen
+        module = _generated_module(phi, _ROWS_INTO.format(n=n, size=size)) if printed else None
         jitted = compiled_phi(phi, n, m, q0, name, None if module is None else module.function)
         _CALLBACKS[key] = None if jitted is None else module.into if module is not None else _callback(jitted, n, m)
     return _CALLBACKS[key]
