@@ -154,3 +154,15 @@ def test_the_tangent_kernel_takes_the_pfaffian_rows_too(bike):
         found = model.accelerations_tree(q, s_dot, t)[0]
         model._tangent = None
         assert _close(found, model._projected_accelerations(q, s_dot, t, None)[0])
+
+
+def test_a_printed_function_is_compiled_from_a_module_file_numba_caches(bike):
+    """Φ printed by codegen compiles from a generated module file (numba's disk cache needs one), whose
+    compiled function gives Φ's own numbers, and whose C callback is the one the kernel calls."""
+    from pathlib import Path
+
+    module = compiled._generated_module(bike._phi, compiled._ROWS_INTO.format(n=bike.n_q, size=1))
+    assert Path(module.__file__).is_file() and Path(module.__file__).parent.name == "generated"
+    x = bike.q0 + 0.1 + 1e-30j
+    assert np.array_equal(module.function(x, 0.0).real, bike._phi(x, 0.0).real)
+    assert compiled.closure_callback(bike._phi, bike.n_q, 1, bike.q0) is module.into
