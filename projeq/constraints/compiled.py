@@ -173,8 +173,7 @@ def closure_callback(phi, n: int, m, q0: NDArray, name: str = "phi"):
     key = (_key(phi), m)
     if key not in _CALLBACKS:
         size = int(np.prod(m))
-        printed = hasattr(phi, "source") and hasattr(phi, "constants")  # by projeq.symbolic.codegen
-        module = _generated_module(phi, _ROWS_INTO.format(n=n, size=size)) if printed else None
+        module = _printed_module(phi, _ROWS_INTO.format(n=n, size=size))
         jitted = compiled_phi(phi, n, m, q0, name, None if module is None else module.function)
         _CALLBACKS[key] = None if jitted is None else module.into if module is not None else _callback(jitted, n, m)
     return _CALLBACKS[key]
@@ -199,6 +198,18 @@ def into(q_pointer, s_pointer, t, row_pointer):
 """
 
 
+def _printed_module(phi, into: str):
+    """:func:`_generated_module` of a function printed by :mod:`projeq.symbolic.codegen` (its
+    ``source`` and ``constants``), None for any other or where it does not compile (then
+    :func:`compiled_phi` compiles Φ in memory, or warns naming it)."""
+    if not (hasattr(phi, "source") and hasattr(phi, "constants")):
+        return None
+    try:
+        return _generated_module(phi, into)
+    except Exception:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+        return None
+
+
 def _generated_module(f, into: str):
     """A module of ``f``'s printed source (``f.source``, its constants — the values its closure holds
     — as globals) compiled by ``numba.njit(cache=True)`` as ``function``, and the C callback ``into``
@@ -221,7 +232,11 @@ def _generated_module(f, into: str):
         spec = importlib.util.spec_from_file_location(module_name, path)
         module = importlib.util.module_from_spec(spec)
         sys.modules[module_name] = module  # numba's cache finds the module by its name
-        spec.loader.exec_module(module)
+        try:
+            spec.loader.exec_module(module)
+        except Exception:
+            del sys.modules[module_name]
+            raise
     return sys.modules[module_name]
 
 
@@ -276,7 +291,13 @@ def joint_callback(joint):
     values = joint.compiled_values()
     if values not in _CALLBACKS:
         into = _JOINT_INTO.format(n_q=joint.n_q, n_s=joint.n_s, width=kernels.GIVEN_F + 6 * joint.n_s)
-        _CALLBACKS[values] = _generated_module(values, into).into
+        try:
+            _CALLBACKS[values] = _generated_module(values, into).into
+        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+            warnings.warn(f"joint: numba cannot compile the relative motion of {joint!r} ({type(exc).__name__}); "
+                          "the constrained s̈ takes the numpy path (about ten times slower)",
+                          UncompiledClosureWarning, stacklevel=4)
+            _CALLBACKS[values] = None
     return _CALLBACKS[values]
 
 
@@ -612,7 +633,8 @@ def _closure(system, rule: str, constant: float) -> "CompiledClosure | None":
     callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
     pfaffian = closure_callback(system._A, system.n_q, (system.m_p, system.n_q), system.q0, "A") if system.m_p \
         else None
-    if callback is None or (system.m_p and pfaffian is None):
+    joints = [joint_callback(system.tree.joints[n]) for n in system.tree.evaluator("fast")._given]
+    if callback is None or (system.m_p and pfaffian is None) or None in joints:
         return None
     return CompiledClosure(system.tree, system.n_c, callback, rule, (constant,), m_h=system.m_h, pfaffian=pfaffian)
 
