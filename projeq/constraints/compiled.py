@@ -26,12 +26,20 @@ law's terms stated once, in :mod:`projeq.forces`). The numbers are those of the 
 round-off; the tangent kept along the branch is read from and written to the system as the numpy
 path keeps it.
 
-Where it applies (:func:`unsupported` says why not): holonomic constraints only, Φ independent
-of t (``correction="projection"``), q̇ = ṡ_tree (revolute and prismatic joints), a tree whose
+Pfaffian rows A(q) q̇ = 0 join Φ_q in A_s and γ gains their part (∂(A q̇)/∂q) q̇ = Im A(q + i h q̇) q̇ / h,
+A compiled and called as Φ is; the joints of kind GIVEN that are UserJoints from sympy (the
+Whipple bicycle's rear frame) state their relative motion A, r, w, ζ, F⁶ by compiled code of
+their own expressions (:meth:`~projeq.joints.UserJoint.compiled_values`, a second C callback)
+once ṡ_tree = F ṡ is known. Functions printed from sympy
+(:func:`projeq.symbolic.codegen.numeric_function`) are compiled once and cached on disk.
+
+Where it applies (:func:`unsupported` says why not): at least one holonomic constraint, Pfaffian
+rows with b = 0 and A independent of t, Φ independent of t (``correction="projection"``),
+q̇ = ṡ_tree (revolute and prismatic joints, UserJoints from sympy with K = E), a tree whose
 whole Gauss form the compiled kernels compute (force laws with compiled rows only — not a
-callable load or a user's own ``add_to`` —, no joints that state their own relative motion, no
-coupled joints, no elastic bodies), and F by one of the two rules above (not a subclass's own,
-such as the augmented Lagrangian's). A Φ numba cannot compile, or whose
+callable load or a user's own ``add_to`` —, no joints that state their own relative motion in
+Python, no coupled joints, no elastic bodies), and F by one of the two rules above (not a
+subclass's own, such as the augmented Lagrangian's). A Φ (or A) numba cannot compile, or whose
 compiled values differ from its own at complex points near q0, keeps the numpy path after one
 :class:`UncompiledClosureWarning` naming it; so does a model outside the kernel, the warning naming
 the piece (:func:`unsupported`: a Pfaffian row, a joint, a force law, ...) — never silently. Where the compiled call meets a degenerate partition
@@ -43,8 +51,12 @@ a value, a spring-damper whose two points coincide).
 from __future__ import annotations
 
 import functools
+import hashlib
+import os
 import re
+import tempfile
 import warnings
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
@@ -72,10 +84,10 @@ def unsupported(system) -> str | None:
     partitioning) cannot be one compiled call (None if it can), module docstring."""
     tree = system.tree
     checks = (
-        (system.m_p > 0, "Pfaffian constraints A(q, t) q̇ = b(q, t)"),
+        (system.m_p > 0 and _rheonomic_rows(system), "Pfaffian constraints A(q, t) q̇ = b(q, t) with b ≠ 0 or A depending on t"),
         (system.m_h == 0, "no holonomic constraints"),
         (system.rheonomic, "Φ may depend on t (correction other than 'projection')"),
-        (not system._identity, _kinematics_piece(tree)),
+        (not (system._identity or _rates_are_speeds(tree)), _kinematics_piece(tree)),
         (not system.exact, "Φ does not take complex arguments (no complex step)"),
         (not system.compiled_tree(), "the tree's default evaluator is not the compiled one "
                                      f"({tree.evaluator('auto').reason})"),
@@ -88,7 +100,8 @@ def unsupported(system) -> str | None:
 
 def _kinematics_piece(tree) -> str:
     """The joints with q̇ ≠ ṡ (K ≠ E), named."""
-    names = [f"{tree.names[n]!r} ({type(tree.joints[n]).__name__})" for n in tree._general_kinematics]
+    names = [f"{tree.names[n]!r} ({type(tree.joints[n]).__name__})" for n in tree._general_kinematics
+             if not getattr(tree.joints[n], "rates_are_speeds", False)]
     return f"joints with q̇ ≠ ṡ (K ≠ E){': ' + ', '.join(names) if names else ''}"
 
 
@@ -96,9 +109,11 @@ def _tree_piece(tree) -> str | None:
     """The first piece of the tree whose terms the kernels do not compute in the closure kernel
     (named), else None."""
     ev = tree.evaluator("fast")
-    if ev._given:
-        n = ev._given[0]
-        return f"joint {tree.names[n]!r} ({type(tree.joints[n]).__name__}) states its own relative motion"
+    python = _python_joints(ev)
+    if python:
+        n = python[0]
+        return (f"joint {tree.names[n]!r} ({type(tree.joints[n]).__name__}) states its own relative motion in "
+                "Python (not a UserJoint from sympy)")
     if ev._expansion is not None:
         return "coupled joints (shared minimal velocities)"
     if ev._width > 6:
@@ -127,31 +142,51 @@ def uncompiled(system, why: str) -> None:
     )
 
 
-def compiled_phi(phi, n: int, m: int, q0: NDArray):
-    """``numba.njit(phi)`` if it compiles for q complex (n,), t float and gives Φ's own values,
-    real and imaginary parts each to 1e-13 relative, at three complex points near q0; else None
-    after one :class:`UncompiledClosureWarning` naming ``phi``."""
+def _rheonomic_rows(system) -> bool:
+    """Whether the Pfaffian rows A(q, t) q̇ = b(q, t) have a b or an A that depends on t (at q0)."""
+    A0 = np.asarray(system._A(system.q0, 0.0), dtype=float)
+    return system._b is not None or any(not np.array_equal(np.asarray(system._A(system.q0, t), dtype=float), A0)
+                                        for t in (0.37, 1.9))
+
+
+def _rates_are_speeds(tree) -> bool:
+    """Whether every joint with its own kinematics has q̇ = ṡ identically (UserJoint.rates_are_speeds)."""
+    return all(getattr(tree.joints[n], "rates_are_speeds", False) for n in tree._general_kinematics)
+
+
+def _python_joints(ev) -> list:
+    """The joints of kind GIVEN whose relative motion has no compiled form (UserJoint.compiled_values)."""
+    return [n for n in ev._given if getattr(ev.system.joints[n], "compiled_values", lambda: None)() is None]
+
+
+def compiled_phi(phi, n: int, m, q0: NDArray, name: str = "phi", jitted=None):
+    """``numba.njit(phi)`` if it compiles for q complex (n,), t float and gives Φ's own values
+    (``m`` rows, or the shape ``m`` of a matrix such as the Pfaffian rows A), real and imaginary
+    parts each to 1e-13 relative, at three complex points near q0; else None after one
+    :class:`UncompiledClosureWarning` naming ``phi`` (as the argument ``name``); ``jitted``: its
+    compiled form if already built (:func:`_generated_module`), checked the same way."""
     import numba
 
+    shape = (m,) if np.ndim(m) == 0 else tuple(m)
     rng = np.random.default_rng(11)
     X = q0[:, None] + 1e-2 * rng.standard_normal((n, 3)) + 1j * COMPLEX_STEP * rng.standard_normal((n, 3))
     try:
-        jitted = numba.njit(phi)
-        got = np.array([np.asarray(jitted(x.copy(), 0.0), dtype=complex) for x in X.T]).T
-        want = np.array([np.asarray(phi(x.copy(), 0.0), dtype=complex) for x in X.T]).T
+        jitted = numba.njit(phi) if jitted is None else jitted
+        got = np.stack([np.asarray(jitted(x.copy(), 0.0), dtype=complex) for x in X.T], axis=-1)
+        want = np.stack([np.asarray(phi(x.copy(), 0.0), dtype=complex) for x in X.T], axis=-1)
     except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
         lines = [line.strip() for line in re.sub(r"\x1b\[[0-9;]*m", "", str(exc)).splitlines() if line.strip()]
         why = f"{type(exc).__name__}: {' '.join(lines[:3])[:300]}"
     else:
         scale = max(1.0, np.abs(want.real).max(initial=0.0))
         rate = max(1.0, np.abs(want.imag / COMPLEX_STEP).max(initial=0.0))
-        if got.shape == want.shape == (m, 3) and np.all(np.abs(got.real - want.real) <= 1e-13 * scale) \
+        if got.shape == want.shape == (*shape, 3) and np.all(np.abs(got.real - want.real) <= 1e-13 * scale) \
                 and np.all(np.abs(got.imag - want.imag) / COMPLEX_STEP <= 1e-13 * rate):
             return jitted
         why = "its compiled values differ from its own at complex points near q0"
     warnings.warn(
-        f"phi: numba cannot compile {getattr(phi, '__qualname__', repr(phi))} ({why}); the constrained s̈ "
-        "takes the numpy path (about ten times slower): write Φ with numpy operations on scalars q[i] "
+        f"{name}: numba cannot compile {getattr(phi, '__qualname__', repr(phi))} ({why}); the constrained s̈ "
+        "takes the numpy path (about ten times slower): write it with numpy operations on scalars q[i] "
         "(no Python objects, dicts or calls of uncompiled functions)",
         UncompiledClosureWarning, stacklevel=4,
     )
@@ -178,35 +213,198 @@ def _frozen(value):
 _CALLBACKS: dict = {}  # _key(Φ) -> its C callback (numba.cfunc), or None where Φ did not compile
 
 
-def closure_callback(phi, n: int, m: int, q0: NDArray):
-    """Φ (n coordinates, m rows) compiled as a C callback ``into(x, t, value)`` (value ← Φ(x, t),
-    x and value complex), built once per Φ source and constants in a process; None (after one
-    warning) if Φ does not compile (:func:`compiled_phi`)."""
-    key = _key(phi)
+def closure_callback(phi, n: int, m, q0: NDArray, name: str = "phi"):
+    """Φ (n coordinates, m rows; or the Pfaffian rows A, ``m`` their shape) compiled as a C
+    callback ``into(x, t, value)`` (value ← Φ(x, t), x and value complex, a matrix row by row),
+    built once per Φ source and constants in a process — and, for a function printed by
+    :func:`projeq.symbolic.codegen.numeric_function`, compiled once and cached on disk
+    (:func:`_generated_module`); None (after one warning) if Φ does not compile (:func:`compiled_phi`)."""
+    key = (_key(phi), m)
     if key not in _CALLBACKS:
-        jitted = compiled_phi(phi, n, m, q0)
-        _CALLBACKS[key] = None if jitted is None else _callback(jitted, n, m)
+        size = int(np.prod(m))
+        module = _printed_module(phi, _ROWS_INTO.format(n=n, size=size))
+        jitted = compiled_phi(phi, n, m, q0, name, None if module is None else module.function)
+        _CALLBACKS[key] = None if jitted is None else module.into if module is not None else _callback(jitted, n, m)
     return _CALLBACKS[key]
 
 
-def _callback(jitted, n: int, m: int):
+#: the C callbacks of printed functions (:func:`_generated_module`): Φ or A at complex x, and a joint's relative motion
+_ROWS_INTO = """
+@numba.cfunc(nb.void(nb.CPointer(nb.complex128), nb.float64, nb.CPointer(nb.complex128)), cache=True)
+def into(x_pointer, t, value_pointer):
+    x, value = numba.carray(x_pointer, ({n},)), numba.carray(value_pointer, ({size},))
+    found = function(x, t).ravel()
+    for i in range({size}):
+        value[i] = found[i]
+"""
+_JOINT_INTO = """
+@numba.cfunc(nb.void(nb.CPointer(nb.float64), nb.CPointer(nb.float64), nb.float64, nb.CPointer(nb.float64)), cache=True)
+def into(q_pointer, s_pointer, t, row_pointer):
+    q_n, s_n, row = numba.carray(q_pointer, ({n_q},)), numba.carray(s_pointer, ({n_s},)), numba.carray(row_pointer, ({width},))
+    found = function(q_n, s_n, t)
+    for i in range({width}):
+        row[i] = found[i]
+"""
+
+
+def _printed_module(phi, into: str):
+    """:func:`_generated_module` of a function printed by :mod:`projeq.symbolic.codegen` (its
+    ``source`` and ``constants``), None for any other or where it does not compile (then
+    :func:`compiled_phi` compiles Φ in memory, or warns naming it)."""
+    if not (hasattr(phi, "source") and hasattr(phi, "constants")):
+        return None
+    try:
+        return _generated_module(phi, into)
+    except Exception:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+        return None
+
+
+def _generated_module(f, into: str):
+    """A module of ``f``'s printed source (``f.source``, its constants — the values its closure holds
+    — as globals) compiled by ``numba.njit(cache=True)`` as ``function``, and the C callback ``into``
+    (``cache=True``): written once to a file named by its digest in numba's cache directory (or
+    ~/.cache/projeq) and imported, so that numba's disk cache, which needs a file, keeps both across
+    processes (a temporary directory where that is not writable: compiled anew each process)."""
+    import importlib.util
+    import sys
+
+    import numba
+
+    constants = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
+    source = "\n".join(["import numba", "import numpy", "from numba import types as nb", "",
+                        *(f"{name} = {float(value)!r}" for name, value in sorted(constants.items())), "",
+                        "@numba.njit(cache=True)", f.source.replace(f"def {f.__name__}(", "def function(", 1), into])
+    digest = hashlib.sha1((source + numba.__version__).encode()).hexdigest()[:20]
+    module_name = f"projeq_generated_{digest}"
+    if module_name not in sys.modules:
+        path = _write_once(module_name + ".py", source)
+        spec = importlib.util.spec_from_file_location(module_name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[module_name] = module  # numba's cache finds the module by its name
+        try:
+            spec.loader.exec_module(module)
+        except Exception:
+            del sys.modules[module_name]
+            raise
+    return sys.modules[module_name]
+
+
+def _write_once(filename: str, source: str) -> Path:
+    """The path of ``filename`` holding ``source`` in the cache directory (written atomically if absent)."""
+    import numba
+
+    for folder in (numba.config.CACHE_DIR or os.path.join(os.environ.get("XDG_CACHE_HOME") or
+                                                           os.path.expanduser("~/.cache"), "projeq"), None):
+        try:
+            folder = Path(folder or tempfile.mkdtemp(prefix="projeq-generated-")) / "generated"
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / filename
+            if not path.is_file() or path.read_text() != source:
+                part = folder / f"{filename}.{os.getpid()}.part"
+                part.write_text(source)
+                os.replace(part, path)
+            return path
+        except OSError:
+            continue
+    raise OSError(f"cannot write the generated module {filename} to a cache or a temporary directory")
+
+
+def _callback(jitted, n: int, m):
     import numba
     from numba import types as nb
 
-    def into(x_pointer, t, value_pointer):
-        x, value = numba.carray(x_pointer, (n,)), numba.carray(value_pointer, (m,))
-        phi_value = jitted(x, t)
-        for r in range(m):
-            value[r] = phi_value[r]
+    if np.ndim(m) == 0:
+        def into(x_pointer, t, value_pointer):
+            x, value = numba.carray(x_pointer, (n,)), numba.carray(value_pointer, (m,))
+            phi_value = jitted(x, t)
+            for r in range(m):
+                value[r] = phi_value[r]
+    else:
+        rows, cols = m
+
+        def into(x_pointer, t, value_pointer):
+            x, value = numba.carray(x_pointer, (n,)), numba.carray(value_pointer, (rows, cols))
+            phi_value = jitted(x, t)
+            for r in range(rows):
+                for c in range(cols):
+                    value[r, c] = phi_value[r][c]  # an array or nested lists
 
     pointer = nb.CPointer(nb.complex128)
     return numba.cfunc(nb.void(pointer, nb.float64, pointer))(into)
 
 
+def joint_callback(joint):
+    """The relative motion of a UserJoint from sympy (:meth:`~projeq.joints.UserJoint.compiled_values`:
+    A, r, w, ζ, F⁶ as one row) compiled as a C callback ``into(q_n, s_n, t, row)`` (real), built
+    once per expressions in a process and cached on disk (:func:`_generated_module`)."""
+    values = joint.compiled_values()
+    if values not in _CALLBACKS:
+        into = _JOINT_INTO.format(n_q=joint.n_q, n_s=joint.n_s, width=kernels.GIVEN_F + 6 * joint.n_s)
+        try:
+            _CALLBACKS[values] = _generated_module(values, into).into
+        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+            warnings.warn(f"joint: numba cannot compile the relative motion of {joint!r} ({type(exc).__name__}); "
+                          "the constrained s̈ takes the numpy path (about ten times slower)",
+                          UncompiledClosureWarning, stacklevel=4)
+            _CALLBACKS[values] = None
+    return _CALLBACKS[values]
+
+
 def _phi_into(phi, x, t, value):
     """value ← Φ(x, t): in the compiled kernels ``phi`` is the address of Φ's C callback (an
-    intrinsic calls it, :func:`_intrinsic`); interpreted, ``phi`` is Φ itself."""
+    intrinsic calls it, :func:`_intrinsics`); interpreted, ``phi`` is Φ itself."""
     value[:] = np.asarray(phi(x, t))
+
+
+def _given_into(values, q_n, s_n, t, row):
+    """row ← the relative motion (A, r, w, ζ, F⁶) of a joint of kind GIVEN at (q_n, ṡ_n, t): in the
+    compiled kernels ``values`` is the address of its C callback (:func:`joint_callback`, called by
+    an intrinsic, :func:`_intrinsics`); interpreted, the joint's ``compiled_values`` function itself."""
+    found = values(q_n, s_n, t)
+    row[:found.shape[0]] = found
+
+
+def _given_motions(joints, q, s_dot_tree, t, given):
+    """given[n] ← the relative motions of the tree's joints of kind GIVEN at (q, ṡ_tree, t), the
+    numbers :class:`~projeq.assembly.fast.FastEvaluator` has them state before its kernels run
+    (``joints``: one row (n, first coordinate, n_q, first velocity, n_s, callback) each)."""
+    for g in range(joints.shape[0]):
+        n, q0, n_q, s0, n_s = joints[g, 0], joints[g, 1], joints[g, 2], joints[g, 3], joints[g, 4]
+        _given_into(joints[g, 5], q[q0:q0 + n_q], s_dot_tree[s0:s0 + n_s], t, given[n])
+
+
+def _constraint_rows(phi, pfaffian, q, t, m_h, A):
+    """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree): Φ_q by :func:`_jacobian` in the first ``m_h`` rows,
+    the Pfaffian rows A(q) (``pfaffian``, as Φ in :func:`_phi_into`) below them."""
+    _jacobian(phi, q, t, A[:m_h])
+    n, m_p = q.shape[0], A.shape[0] - m_h
+    if m_p > 0:
+        x, value = np.empty(n, np.complex128), np.empty((m_p, n), np.complex128)
+        for i in range(n):
+            x[i] = q[i]
+        _phi_into(pfaffian, x, t, value)
+        for r in range(m_p):
+            for j in range(n):
+                A[m_h + r, j] = value[r, j].real
+
+
+def _constraint_gamma(phi, pfaffian, q, q_dot, t, m_h, m):
+    """γ = [Φ″(q̇, q̇); (∂(A q̇)/∂q) q̇] at q̇ = ṡ_tree: Φ″ by :func:`_gamma`, the Pfaffian part as the
+    numpy path takes it, Im (A(q + i h q̇) q̇) / h (A independent of t, b = 0: :func:`unsupported`)."""
+    gamma = np.zeros(m)
+    gamma[:m_h] = _gamma(phi, q, q_dot, t, m_h)
+    n, m_p = q.shape[0], m - m_h
+    if m_p > 0:
+        x, value = np.empty(n, np.complex128), np.empty((m_p, n), np.complex128)
+        for i in range(n):
+            x[i] = q[i] + 1j * COMPLEX_STEP * q_dot[i]
+        _phi_into(pfaffian, x, t, value)
+        for r in range(m_p):
+            total = 0.0
+            for j in range(n):
+                total += value[r, j].imag * q_dot[j]
+            gamma[m_h + r] = total / COMPLEX_STEP
+    return gamma
 
 
 def _jacobian(phi, q, t, A):
@@ -301,14 +499,17 @@ def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
     return DONE
 
 
-def partitioned(phi, tree, q, s_dot, t, independent, dependent, bound, pivot, q_dot, s_ddot_tree, A, M, b):
+def partitioned(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot, q_dot,
+                s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (module
-    docstring) from Φ (``phi``: :func:`_phi_into`), the tree's packed arrays and workspace
-    (``tree``: those of :func:`projeq.assembly.kernels.chain_terms`), q, ṡ, t and the partition;
-    writes q̇ = ṡ_tree (K = E), s̈_tree, Φ_q (= A_s), M and b; returns DONE, SINGULAR (:func:`_projected`) or
-    DEGENERATE where ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
+    docstring) from Φ (``phi``: :func:`_phi_into`; ``m_h`` rows) and the Pfaffian rows A(q)
+    (``pfaffian``), the tree's packed arrays and workspace (``tree``: those of
+    :func:`projeq.assembly.kernels.chain_terms`) with its joints of kind GIVEN (``joints``:
+    :func:`_given_motions`), q, ṡ, t and the partition; writes q̇ = ṡ_tree (K = E), s̈_tree,
+    A_s = [Φ_q; A], M and b; returns DONE, SINGULAR (:func:`_projected`) or DEGENERATE where
+    ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
     n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
-    _jacobian(phi, q, t, A)
+    _constraint_rows(phi, pfaffian, q, t, m_h, A)
     A_dep = np.empty((m, m))
     for r in range(m):
         for c in range(m):
@@ -326,22 +527,24 @@ def partitioned(phi, tree, q, s_dot, t, independent, dependent, bound, pivot, q_
             F[dependent[r], c] = -total
     s_dot_tree = _matvec(F, s_dot)
     q_dot[:] = s_dot_tree
-    gamma = _gamma(phi, q, s_dot_tree, t, m)
+    gamma = _constraint_gamma(phi, pfaffian, q, s_dot_tree, t, m_h, m)
     f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
     minus_gamma = _matvec(inv, -gamma)
     for r in range(m):
         f_bar[dependent[r]] = minus_gamma[r]
+    _given_motions(joints, q, s_dot_tree, t, tree[4])
     return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
-def tangent(phi, tree, q, s_dot, t, independent, rank, separation, acting, kept, pivot, q_dot, s_ddot_tree, A, M, b):
+def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept, pivot, q_dot,
+            s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.tangent.TangentSystem`: F = N N_ind⁻¹ with
     N the null space of A_s = U Σ Vᵀ continued along the branch (``kept``: the tangent kept last,
     n × n_s, NaN where none; overwritten where the null space is separated, its rule), f̄ =
     x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) over the ``rank`` largest singular values above
     ``acting`` σ_max; otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular."""
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
-    _jacobian(phi, q, t, A)
+    _constraint_rows(phi, pfaffian, q, t, m_h, A)
     U, sigma, Vt = _svd(A)
     near = max(k, int(np.sum(sigma < separation * sigma[0])))
     if near == k or np.isnan(kept[0, 0]):
@@ -363,7 +566,7 @@ def tangent(phi, tree, q, s_dot, t, independent, rank, separation, acting, kept,
             F[independent[r], c] = 1.0 if r == c else 0.0
     s_dot_tree = _matvec(F, s_dot)
     q_dot[:] = s_dot_tree
-    gamma = _gamma(phi, q, s_dot_tree, t, m)
+    gamma = _constraint_gamma(phi, pfaffian, q, s_dot_tree, t, m_h, m)
     count = min(int(np.sum(sigma > acting * sigma[0])), rank)
     x0 = np.zeros(n)  # A_s⁺ (−γ) = V_k Σ_k⁻¹ U_kᵀ (−γ)
     for j in range(count):
@@ -377,6 +580,7 @@ def tangent(phi, tree, q, s_dot, t, independent, rank, separation, acting, kept,
     for c in range(k):
         x0_ind[c] = x0[independent[c]]
     f_bar = x0 - _matvec(F, x0_ind)
+    _given_motions(joints, q, s_dot_tree, t, tree[4])
     return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
@@ -460,45 +664,68 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _matvec, _matmul, _svd, _projected, _inverse)
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _given_motions, _matvec, _matmul, _svd, _projected,
+            _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
     """The :class:`CompiledClosure` of a ConstrainedSystem (partitioned) that :func:`unsupported`
     accepts (``bound``: the limit of ‖A_s‖_F ‖A_dep⁻¹‖_F above which the kernel flags the
-    partition), or None (after one warning) where numba cannot compile its Φ."""
+    partition), or None (after one warning) where numba cannot compile its Φ or A."""
     return _closure(system, "partitioned", bound)
 
 
 def compiled_tangent(system, acting: float) -> "CompiledClosure | None":
     """The :class:`CompiledClosure` of a TangentSystem that :func:`unsupported` accepts
     (``acting``: singular values below this fraction of the largest do not act in f̄), or None
-    (after one warning) where numba cannot compile its Φ."""
+    (after one warning) where numba cannot compile its Φ or A."""
     return _closure(system, "tangent", acting)
 
 
 def _closure(system, rule: str, constant: float) -> "CompiledClosure | None":
-    """The :class:`CompiledClosure` of ``system`` by the kernel ``rule``, or None where numba
-    cannot compile its Φ (:func:`closure_callback` warned, naming it; the system keeps the reason)."""
-    callback = closure_callback(system._phi, system.n_q, system.m_h, system.q0)
-    if callback is None:
-        system._uncompiled = f"numba cannot compile Φ ({getattr(system._phi, '__qualname__', repr(system._phi))})"
+    """The :class:`CompiledClosure` of ``system`` by the kernel ``rule`` with the C callbacks of Φ, of
+    the Pfaffian rows A (if any) and of the UserJoints' relative motions, or None where numba cannot
+    compile one of them (:func:`closure_callback`, :func:`joint_callback` warned, naming it; the
+    system keeps the reason)."""
+    tree = system.tree
+    given = tree.evaluator("fast")._given
+    phi = f"Φ ({getattr(system._phi, '__qualname__', repr(system._phi))})"
+    pieces = {phi: closure_callback(system._phi, system.n_q, system.m_h, system.q0)}
+    if system.m_p:
+        pieces["the Pfaffian rows A"] = closure_callback(system._A, system.n_q, (system.m_p, system.n_q), system.q0, "A")
+    pieces.update({f"the relative motion of joint {tree.names[n]!r}": joint_callback(tree.joints[n]) for n in given})
+    failed = [name for name, callback in pieces.items() if callback is None]
+    if failed:
+        system._uncompiled = f"numba cannot compile {', '.join(failed)}"
         return None
-    return CompiledClosure(system.tree, system.n_c, callback, rule, (constant,))
+    return CompiledClosure(tree, system.n_c, pieces[phi], rule, (constant,), m_h=system.m_h,
+                           pfaffian=pieces.get("the Pfaffian rows A"))
 
 
 class CompiledClosure:
     """s̈_tree, A_s, M and b of a constrained model by one call of a compiled kernel
-    (:func:`partitioned` or :func:`tangent`) with Φ's C callback, on the tree's fast evaluator's
-    workspace; ``accelerations`` returns None where the kernel flags a degenerate partition or a
+    (:func:`partitioned` or :func:`tangent`) with the C callbacks of Φ, of the Pfaffian rows A
+    (``pfaffian``, rows m_h … m − 1 of A_s) and of the relative motions of the tree's UserJoints
+    from sympy (:func:`joint_callback`), on the tree's fast evaluator's workspace;
+    ``accelerations`` returns None where the kernel flags a degenerate partition or a
     singular FᵀMF (the caller repeats the evaluation on the numpy path, which names the cause).
-    ``compiled=False`` runs the same kernel interpreted, with ``callback`` Φ itself (for testing)."""
+    ``compiled=False`` runs the same kernel interpreted, with ``callback`` Φ itself, ``pfaffian``
+    A itself and the joints' ``compiled_values`` functions (for testing)."""
 
-    def __init__(self, tree, m: int, callback, rule: str, constants: tuple, compiled: bool = True):
-        # the callback lives as long as this object, which passes its address
-        self.callback, self.rule, self.constants = callback, rule, constants
-        self.kernel, self.phi = (_compiled()[rule], callback.address) if compiled else (globals()[rule], callback)
+    def __init__(self, tree, m: int, callback, rule: str, constants: tuple, compiled: bool = True,
+                 m_h: int | None = None, pfaffian=None):
+        # the callbacks live as long as this object, which passes their addresses
         ev = self.fast = tree.evaluator("fast")
+        self.callback, self.rule, self.constants, self.m_h = callback, rule, constants, m if m_h is None else m_h
+        self._callbacks = [pfaffian] + [joint_callback(tree.joints[n]) if compiled else None for n in ev._given]
+        if compiled:
+            self.kernel, self.phi, self.pfaffian = _compiled()[rule], callback.address, \
+                0 if pfaffian is None else pfaffian.address
+        else:
+            self.kernel, self.phi, self.pfaffian = globals()[rule], callback, pfaffian
+        rows = [[n, q_n.start, joint.n_q, s_n.start, joint.n_s, back.address if compiled else joint.compiled_values()]
+                for (n, joint, q_n, s_n, _), back in zip(ev._given_plan, self._callbacks[1:])]
+        self.joints = np.array(rows, dtype=np.int64 if compiled else object).reshape(len(rows), 6)
         ws = self._workspace = ev._real
         self.tree = (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
                      ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist, ev._laws, ev._law_constants)
@@ -510,12 +737,14 @@ class CompiledClosure:
         M, b = self._workspace.M_all, self._workspace.b_all
         q, s_dot, t = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), float(t)
         if self.rule == "partitioned":
-            flag = self.kernel(self.phi, self.tree, q, s_dot, t, system.independent, system.dependent,
+            flag = self.kernel(self.phi, self.pfaffian, self.joints, self.tree, q, s_dot, t, self.m_h,
+                               system.independent, system.dependent,
                                self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b)
         else:
             kept = np.full((system.tree.n_s, system.n_s), np.nan) if system._tangent is None else \
                 np.array(system._tangent, dtype=float)
-            flag = self.kernel(self.phi, self.tree, q, s_dot, t, system.independent, system.tree.n_s - system.n_s,
+            flag = self.kernel(self.phi, self.pfaffian, self.joints, self.tree, q, s_dot, t, self.m_h,
+                               system.independent, system.tree.n_s - system.n_s,
                                system.separation, self.constants[0], kept, SINGULAR_PIVOT, self._q_dot,
                                self._s_ddot_tree, self._A, M, b)
             system._tangent = kept
@@ -547,30 +776,39 @@ class CompiledClosure:
 def _compiled() -> dict:
     """{"partitioned": …, "tangent": …}: the kernels compiled by numba (cached on disk) as
     :func:`projeq.assembly.kernels.jit` compiles another module's kernels, calling the compiled
-    kernels of :mod:`projeq.assembly.kernels`, the force laws' loop of :mod:`projeq.assembly.loads`
-    and Φ through its C callback's address by an intrinsic (:func:`_phi_into`)."""
+    kernels of :mod:`projeq.assembly.kernels`, the force laws' loop of :mod:`projeq.assembly.loads`,
+    and Φ, A and the UserJoints' relative motions through their C callbacks' addresses by the
+    intrinsics :func:`_phi_into` and :func:`_given_into`."""
     compiled = {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True)[0],
-                "add_loads": loads.kernel(True), "_phi_into": _intrinsic()}
+                "add_loads": loads.kernel(True), **_intrinsics()}
     return dict(zip(("partitioned", "tangent"), kernels.jit(partitioned, tangent, callees=_HELPERS, kernels=compiled)))
 
 
-def _intrinsic():
-    """The compiled :func:`_phi_into`: calls the C function at address ``phi`` with the data
-    pointers of x and value (numba's own layout of complex128, that of Φ's C callback)."""
+def _intrinsics() -> dict:
+    """The compiled :func:`_phi_into` and :func:`_given_into`: each calls the C function at the
+    address its first argument holds with the data pointers of its arrays (numba's own layout of
+    complex128 and float64, that of the C callbacks) and its scalars as they are."""
     import numba
     from llvmlite import ir
     from numba.extending import intrinsic
 
+    def caller(signature, args, context, builder):
+        address, values = args[0], []
+        for kind, value in zip(signature.args[1:], args[1:]):
+            is_array = isinstance(kind, numba.types.Array)
+            values.append(context.make_array(kind)(context, builder, value).data if is_array else value)
+        function = ir.FunctionType(ir.VoidType(), [v.type for v in values])
+        builder.call(builder.inttoptr(address, function.as_pointer()), values)
+        return context.get_dummy_value()
+
     @intrinsic
     def phi_into(typingctx, phi, x, t, value):
-        def codegen(context, builder, signature, args):
-            address, x_array, t_value, value_array = args
-            x_data = context.make_array(signature.args[1])(context, builder, x_array).data
-            value_data = context.make_array(signature.args[3])(context, builder, value_array).data
-            function = ir.FunctionType(ir.VoidType(), [x_data.type, t_value.type, value_data.type])
-            builder.call(builder.inttoptr(address, function.as_pointer()), [x_data, t_value, value_data])
-            return context.get_dummy_value()
+        return numba.types.void(phi, x, t, value), lambda context, builder, signature, args: caller(
+            signature, args, context, builder)
 
-        return numba.types.void(phi, x, t, value), codegen
+    @intrinsic
+    def given_into(typingctx, values, q_n, s_n, t, row):
+        return numba.types.void(values, q_n, s_n, t, row), lambda context, builder, signature, args: caller(
+            signature, args, context, builder)
 
-    return phi_into
+    return {"_phi_into": phi_into, "_given_into": given_into}

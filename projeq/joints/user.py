@@ -67,6 +67,22 @@ class UserJoint(Joint):
         rename = dict(zip(symbols["q"], q_n)) | dict(zip(symbols["s"], s_n)) | {symbols["t"]: t}
         return SymbolicRelative(*(symbols[key].xreplace(rename) for key in ("A", "r", "F", "f", "K", "k")))
 
+    def compiled_values(self):
+        """``values(q_n, ṡ_n, t)`` -> the array of :meth:`relative_values` (A, r, w, ζ, F⁶), the
+        same expressions printed as scalar numpy code that numba compiles
+        (:func:`projeq.joints.user_compiler.compiled_values`); None for a joint from callables."""
+        if self.symbols is None:
+            return None
+        from projeq.joints.user_compiler import compiled_values
+
+        return compiled_values(self.symbols)
+
+    @property
+    def rates_are_speeds(self) -> bool:
+        """Whether q̇ = ṡ identically (a joint from sympy with K = E and k = 0)."""
+        symbols = self.symbols
+        return symbols is not None and bool(symbols["K"].is_Identity) and bool(symbols["k"].is_zero_matrix)
+
     def q_dot(self, q_n, s_dot_n, t):
         """q̇_n = K ṡ_n + k; from sympy at real arrays: the same expressions compiled to scalar
         code (``math``) on Python floats, as :meth:`relative_values` (complex ones, of a complex

@@ -15,6 +15,7 @@ from projeq.analysis.differentiation import derivative_along
 from projeq.checks import check_rotation, finite_array
 from projeq.joints import Relative, pose_twist_mismatch
 from projeq.spatial import numeric
+from projeq.symbolic import codegen
 
 _SINGULAR_CONDITION = 1e10  # condition number of K(q0) treated as singular
 _POSE_TOLERANCE = 1e-5  # central differences of step 1e-7 in pose_twist_mismatch: error ~1e-9
@@ -74,9 +75,10 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
 
     zeta = d_dt(F) * s_vec + d_dt(f)
     rel = sp.lambdify([q, s, t], [A, r, F, F * s_vec + f, zeta], modules="numpy", cse=True)
+    symbols = {"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k, "zeta": zeta}
     # the same numbers as one flat list of scalars (Joint.relative_values): for real arguments
     at = ([0.0] * n_q if q0 is None else q0, [1.0] * n_s, 0.3)
-    scalar = _scalar_code([q, s, t], [*A, *r, *(F * s_vec + f), *zeta, *F.T], at)
+    scalar = _scalar_code([q, s, t], value_expressions(symbols), at)
     scalar_rates = _scalar_code([q, s, t], list(rates), at)  # q̇ = K ṡ + k, the same way
     K_fun = sp.lambdify([q, t], K, modules="numpy", cse=True)
     q_dot_fun = sp.lambdify([q, s, t], rates, modules="numpy", cse=True)
@@ -97,11 +99,33 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
         lambda q_n, time: numeric(K_fun(q_n, time)),
         lambda q_n, s_dot_n, time: numeric(q_dot_fun(q_n, s_dot_n, time)).ravel(),
         q0=q0, r_pn=r_pn, orientation=orientation, constraints=residual, n_c=n_c,
-        symbols={"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k}, values=scalar,
+        symbols=symbols, values=scalar,
         rates=scalar_rates,
     )
     _check_pose(joint)
     return joint
+
+
+def value_expressions(symbols: dict) -> list:
+    """The entries of :meth:`projeq.joints.base.Joint.relative_values` of a joint from sympy:
+    A row by row, r, w = F ṡ + f, ζ = Ḟ ṡ + ḟ, then F column by column."""
+    F, s = symbols["F"], sp.Matrix(symbols["s"])
+    return [*symbols["A"], *symbols["r"], *(F * s + symbols["f"]), *symbols["zeta"], *F.T]
+
+
+_COMPILED_VALUES: dict = {}  # the expressions of value_expressions -> their numeric_function
+
+
+def compiled_values(symbols: dict):
+    """``values(q_n, ṡ_n, t)`` -> the flat array of :func:`value_expressions`, printed as scalar
+    numpy code that numba compiles (:func:`projeq.symbolic.codegen.numeric_function`), built
+    once per expressions in a process."""
+    expressions = value_expressions(symbols)
+    key = tuple(expressions)
+    if key not in _COMPILED_VALUES:
+        arguments = [("q", list(symbols["q"])), ("s", list(symbols["s"])), ("t", symbols["t"])]
+        _COMPILED_VALUES[key] = codegen.numeric_function("relative_values", arguments, expressions)()
+    return _COMPILED_VALUES[key]
 
 
 def _scalar_code(args, expressions, at):

@@ -26,9 +26,12 @@ constraints: the front contact on the ground, Φ(q) = z_Q = 0 (holonomic: it fix
 pitch θ), and no slip at both contacts, A(q) q̇ = 0 (the horizontal velocity of each
 wheel's material contact point; the vertical one vanishes with Φ̇ and the coordinates).
 The minimal velocities are ṡ = (φ̇, θ̇_R, δ̇): roll rate, rear-wheel rate (forward speed
-v = −r_R θ̇_R) and steer rate. Φ and A are derived once with sympy from the geometry
-(exact, then lambdified); the dynamics are projeq's Projection Equation of the tree with
-the constraints inserted by coordinate partitioning (dense Gauss form).
+v = −r_R θ̇_R) and steer rate. Φ and A are stated once in sympy from the geometry and
+printed as scalar numpy code (:func:`projeq.symbolic.codegen.numeric_function`); the dynamics
+are projeq's Projection Equation of the tree with the constraints inserted by coordinate
+partitioning. Φ, A and the rear frame's relative motion compile with numba, so that s̈ is one
+compiled call (:mod:`projeq.constraints.compiled`: the tree's compiled Gauss form, Φ's and A's
+complex-step derivatives, the partition and the projection).
 
 Linearisation (:func:`whipple_eigenvalues`): about upright straight running at speed v,
 x, y, ψ, θ_R, θ_F are ignorable and dropped; the longitudinal states (θ, θ̇_R) decouple
@@ -52,9 +55,9 @@ from projeq.checks import finite_array
 from projeq.constraints.partitioned import ConstrainedSystem
 from projeq.joints import Revolute, UserJoint
 from projeq.analysis.linearize import linearize, sorted_eigenvalues
-from projeq.spatial import axis_spin, cross, rodrigues, rotation_x, rotation_y, rotation_z, skew
+from projeq.spatial import axis_spin, rodrigues, rotation_x, rotation_y, rotation_z
 from projeq.subsystems import RigidBody
-from projeq.symbolic import algebra
+from projeq.symbolic import algebra, codegen
 from projeq.system import System
 
 BENCHMARK = {  # MJPR Table 1 (SI units; x forward, z down, from the rear contact)
@@ -143,6 +146,50 @@ def _rear_frame_joint(r_R: float, q0: NDArray) -> UserJoint:
 
 
 # -- the contact constraints Φ(q) = 0 and A(q) q̇ = 0 ----------------------------------------
+@cache
+def _contact_expressions():
+    """(q, constants, Φ, A): the front-contact height and the no-slip rows in sympy (the
+    kinematics of :class:`Contacts`), in the coordinates q and the geometry's constants
+    r_R, r_F, the steer axis e_s = (s_x, 0, s_z) and the offsets d_fork = (f_x, 0, f_z) (frame
+    axes), d_front = (h_x, 0, h_z) (fork axes)."""
+    q = sp.symbols("x y psi phi theta theta_R delta theta_F")
+    constants = sp.symbols("r_R r_F s_x s_z f_x f_z h_x h_z")
+    r_R, r_F, s_x, s_z, f_x, f_z, h_x, h_z = constants
+    e_z = sp.Matrix([0, 0, 1])
+    lean = algebra.rotation_z(q[2]) * algebra.rotation_x(q[3])
+    frame = lean * algebra.rotation_y(q[4])
+    e_s = sp.Matrix([s_x, 0, s_z])
+    fork = algebra.mul(frame, algebra.rotation(e_s, q[6]))
+    d_fork, d_front = frame * sp.Matrix([f_x, 0, f_z]), fork * sp.Matrix([h_x, 0, h_z])
+    a = fork[:, 1]
+    n_z = sp.sqrt(1 - a[2] ** 2)
+    n = (e_z - a[2] * a) / n_z
+    phi = sp.Matrix([-r_R * lean[2, 2] + d_fork[2] + d_front[2] + r_F * n_z])
+    J_frame = sp.zeros(3, 8)
+    J_frame[:, 2], J_frame[:, 3], J_frame[:, 4] = e_z, lean[:, 0], lean[:, 1]
+    J_v = sp.zeros(3, 8)  # rear centre: (ẋ, ẏ, 0) − r_R ω_L × L e_z
+    J_v[0, 0] = J_v[1, 1] = 1
+    J_v[:, 2] = -r_R * algebra.cross(e_z, lean[:, 2])
+    J_v[:, 3] = -r_R * algebra.cross(lean[:, 0], lean[:, 2])
+    J_rear, J_fork = J_frame.copy(), J_frame.copy()
+    J_rear[:, 5], J_fork[:, 6] = lean[:, 1], frame * e_s
+    J_front = J_fork.copy()
+    J_front[:, 7] = fork[:, 1]
+    v_P = J_v - algebra.skew(r_R * lean[:, 2]) * J_rear
+    v_Q = J_v - algebra.skew(d_fork) * J_frame - algebra.skew(d_front) * J_fork - algebra.skew(r_F * n) * J_front
+    return q, constants, phi, sp.Matrix.vstack(v_P[:2, :], v_Q[:2, :])
+
+
+@cache
+def _contact_functions():
+    """Factories of Φ(q, t) and A(q, t) from :func:`_contact_expressions` (scalar numpy code
+    that numba compiles, :func:`projeq.symbolic.codegen.numeric_function`)."""
+    q, constants, phi, A = _contact_expressions()
+    arguments = [("q", list(q)), ("t", sp.Symbol("t"))]
+    return (codegen.numeric_function("phi", arguments, phi, constants),
+            codegen.numeric_function("A", arguments, A, constants))
+
+
 class Contacts:
     """Front-contact height Φ(q) and no-slip rows A(q) of the bicycle with parameters ``p``.
 
@@ -152,7 +199,14 @@ class Contacts:
     (L = R_z(ψ) R_x(φ), frame A = L R_y(θ)), the fork adds δ̇ A e_s, the wheels θ̇_R L e_y
     and θ̇_F a (a = the front axle). A wheel's material point at P has velocity
     v_c + ω × (P − c); the front contact is Q = c_F + r_F n with
-    n = (e_z − a_z a)/√(1 − a_z²), the wheel plane's most downward unit vector."""
+    n = (e_z − a_z a)/√(1 − a_z²), the wheel plane's most downward unit vector.
+
+    ``phi(q, t)`` (Φ = z_Q, zero on the ground; the rows q[i] may be arrays, a batch of
+    states) and ``A(q, t)`` (rows of A q̇ = 0: the horizontal velocities of the rear and the
+    front wheel's material contact points) are these expressions stated once in sympy
+    (:func:`_contact_expressions`) and printed as scalar code that numba compiles, so that the
+    constrained s̈ is one compiled call (:mod:`projeq.constraints.compiled`); ``_poses`` gives
+    the same poses in numpy."""
 
     def __init__(self, p: dict):
         self.r_R, self.r_F = p["r_R"], p["r_F"]
@@ -160,6 +214,9 @@ class Contacts:
         self.spin_s = axis_spin(self.e_s)
         self.d_fork = np.array([p["w"] + p["c"], 0.0, p["r_R"]])  # rear centre → fork origin, frame axes
         self.d_front = np.array([-p["c"], 0.0, -p["r_F"]])  # fork origin → front centre, fork axes
+        constants = (self.r_R, self.r_F, *self.e_s[[0, 2]], *self.d_fork[[0, 2]], *self.d_front[[0, 2]])
+        make_phi, make_A = _contact_functions()
+        self.phi, self.A = make_phi(*map(float, constants)), make_A(*map(float, constants))
 
     def _poses(self, q):
         lean = rotation_z(q[2]) @ rotation_x(q[3])
@@ -170,41 +227,6 @@ class Contacts:
         a = fork[:, 1]
         n = (_E[2] - a[2] * a) / np.sqrt(1.0 - a[2] ** 2)
         return lean, frame, fork, rear_centre, front_centre, n
-
-    def phi(self, q: NDArray, t: float = 0.0) -> NDArray:
-        """Φ(q) = z of the front contact Q (zero on the ground): with the frame's z-row
-        e_zᵀA = (−cos φ sin θ, sin φ, cos φ cos θ), the fork's e_zᵀA R_s(δ), a_z its middle
-        entry, and n_z = √(1 − a_z²). Written on the rows q[i], so a batch of states (q of shape
-        (8, B)) gives the B heights in one call, the row e_zᵀA R_s(δ) of Rodrigues' formula
-        (:func:`~projeq.spatial.rodrigues`) as e_zᵀA (E + sin δ ẽ + (1 − cos δ) ẽ²)."""
-        c_roll, s_roll = np.cos(q[3]), np.sin(q[3])
-        frame_z = np.array([-c_roll * np.sin(q[4]), s_roll, c_roll * np.cos(q[4])])
-        E, E2 = self.spin_s
-        fork_z = frame_z + np.sin(q[6]) * np.tensordot(E.T, frame_z, 1) + (1.0 - np.cos(q[6])) * np.tensordot(
-            E2.T, frame_z, 1)
-        height = -self.r_R * c_roll + np.tensordot(self.d_fork, frame_z, 1) + np.tensordot(self.d_front, fork_z, 1)
-        return np.array([height + self.r_F * np.sqrt(1.0 - fork_z[1] ** 2)])
-
-    def A(self, q: NDArray, t: float = 0.0) -> NDArray:
-        """Rows of A q̇ = 0: horizontal velocities of the rear and the front wheel's material
-        contact points."""
-        lean, frame, fork, rear_centre, front_centre, n = self._poses(q)
-        J_frame = np.zeros((3, 8), dtype=lean.dtype)  # complex for a complex step
-        J_frame[:, 2], J_frame[:, 3], J_frame[:, 4] = _E[2], lean[:, 0], lean[:, 1]
-        J_v = np.zeros((3, 8), dtype=lean.dtype)  # rear centre: (ẋ, ẏ, 0) − r_R ω_L × L e_z
-        J_v[:2, :2] = np.eye(2)
-        J_v[:, 2] = -self.r_R * cross(_E[2], lean[:, 2])
-        J_v[:, 3] = -self.r_R * cross(lean[:, 0], lean[:, 2])
-        J_rear = J_frame.copy()
-        J_rear[:, 5] = lean[:, 1]
-        J_fork = J_frame.copy()
-        J_fork[:, 6] = frame @ self.e_s
-        J_front = J_fork.copy()
-        J_front[:, 7] = fork[:, 1]
-        v_P = J_v - skew(self.r_R * lean[:, 2]) @ J_rear
-        v_Q = (J_v - skew(frame @ self.d_fork) @ J_frame - skew(fork @ self.d_front) @ J_fork
-               - skew(self.r_F * n) @ J_front)
-        return np.vstack((v_P[:2], v_Q[:2]))
 
 
 _E = np.eye(3)
@@ -230,7 +252,7 @@ def upright_pitch(roll: float, steer: float, params: dict | None = None) -> floa
     contacts = Contacts(bicycle_parameters(params))
 
     def height(pitch):
-        return contacts.phi(np.array([0.0, 0.0, 0.0, roll, pitch, 0.0, steer, 0.0]))[0]
+        return contacts.phi(np.array([0.0, 0.0, 0.0, roll, pitch, 0.0, steer, 0.0]), 0.0)[0]
 
     try:
         return float(scipy.optimize.brentq(height, -0.5, 0.5, xtol=1e-15))

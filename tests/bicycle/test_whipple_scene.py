@@ -41,9 +41,9 @@ def test_no_slip_rows_are_the_contact_points_velocities():
 
     h = 1e-6
     velocity = (material_points(h) - material_points(-h)) / (2 * h)
-    assert np.abs(contacts.A(q) @ q_dot - velocity[[0, 1, 3, 4]]).max() < 1e-8
+    assert np.abs(contacts.A(q, 0.0) @ q_dot - velocity[[0, 1, 3, 4]]).max() < 1e-8
     # the front contact's height: Φ(q) = z_Q, and on the ground in the upright configuration
-    assert contacts.phi(q)[0] == pytest.approx(front_centre[2] + contacts.r_F * n[2], abs=1e-15)
+    assert contacts.phi(q, 0.0)[0] == pytest.approx(front_centre[2] + contacts.r_F * n[2], abs=1e-15)
     assert abs(upright_pitch(0.0, 0.0)) < 1e-14  # MJPR's geometry: front wheel touches at θ = 0
 
 

@@ -189,6 +189,16 @@ def _shaken_pendulum():
     return ConstrainedSystem(tree, phi=lambda q, t: [q[0] ** 2 + q[1] ** 2 - 1.0], q0=[0.6, -0.8], independent=[0])
 
 
+def _driven_bead():
+    """A bead on a circle in the xz-plane, driven along y at a given speed: a Pfaffian row
+    A q̇ = b with b ≠ 0 (ẏ = 0.1 m/s)."""
+    tree = pq.System({"x": pq.Frame(), "y": pq.Frame(), "bob": pq.PointMass(1.0)},
+                     {"x": pq.Prismatic(axis="x"), "y": pq.Prismatic(parent="x", axis="y"),
+                      "bob": pq.Prismatic(parent="y", axis="z")}, gravity=(0, 0, -9.81))
+    return ConstrainedSystem(tree, phi=lambda q, t: [q[0] ** 2 + q[2] ** 2 - 1.0], A=lambda q, t: [[0.0, 1.0, 0.0]],
+                             b=lambda q, t: [0.1], q0=[0.6, 0.0, -0.8], independent=[0])
+
+
 class _OwnRule(ConstrainedSystem):
     """Coordinate partitioning restated by a subclass (its own F, here the inherited one)."""
 
@@ -197,7 +207,7 @@ class _OwnRule(ConstrainedSystem):
 
 
 OUTSIDE = {
-    "Pfaffian": (pq.scenes.SCENES["whipple_bicycle"].build, "Pfaffian constraints"),
+    "Pfaffian with b ≠ 0": (_driven_bead, "Pfaffian constraints A(q, t) q̇ = b(q, t) with b ≠ 0"),
     "callable load": (_driven_four_bar, "force law 6 (Force) has no compiled row"),
     "joint with K ≠ E": (_planar_pendulum, "joints with q̇ ≠ ṡ (K ≠ E): 'bob' (Planar)"),
     "joint stating its motion": (_shaken_pendulum, "joint 'base' (Prescribed) states its own relative motion"),
