@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import DOP853, RK23, RK45, DenseOutput, OdeSolver
 
-from projeq.analysis.differentiation import forward
+from projeq.analysis.differentiation import complex_step, exact_jacobian, forward, is_complex_safe
 from projeq.analysis.jacobians import differentiate
 
 PROJECTED = {"RK45-projected": RK45, "DOP853-projected": DOP853}
@@ -207,37 +207,87 @@ class _ProjectedDenseOutput(DenseOutput):
         return np.column_stack([self._project(ti, yi) for ti, yi in zip(np.atleast_1d(t), y.T)])
 
 
-def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32) -> float:
-    """ρ(∂f/∂x) at (t, x) by power iteration (:func:`fastest_mode`); costs ``iterations`` + 1
-    evaluations of f."""
-    return fastest_mode(fun, t, x, iterations)[0]
+def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None) -> float:
+    """ρ(∂f/∂x) at (t, x) (:func:`fastest_mode`, which says how and at what cost)."""
+    return fastest_mode(fun, t, x, iterations, jacobian)[0]
 
 
-def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32) -> tuple[float, bool]:
-    """(ρ, decays) of ∂f/∂x at (t, x) by power iteration on finite-difference products
-    Jv ≈ (f(x + εv) − f(x))/ε. ρ, the spectral radius: the geometric mean growth ‖J v_k‖ over an
-    even number of the last iterations (for an undamped mode, a pair ±iω, the growth alternates
-    between ω²|a|/|b| and |b|/|a| for a vector (a, b) of coordinate and rate: a pair's mean is ω).
-    ``decays``: the fastest mode is a real eigenvalue λ ≈ −ρ (a stiff damper, not an oscillation):
-    the last iterate v is then an eigenvector, ‖J v − λ v‖ ≤ 0.1 ρ with the Rayleigh quotient
-    λ = vᵀJv ≤ −0.5 ρ; the iterates of a complex pair rotate in its plane and fail the test
-    (Golub & Van Loan, "Matrix Computations", 4th ed. (2013), §7.3.1). Costs ``iterations`` + 1
-    evaluations of f."""
+DECAYING = 0.1  # a fastest eigenvalue λ with |Im λ| ≤ DECAYING ρ and Re λ < 0 decays without oscillating
+
+
+def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None) -> tuple[float, bool]:
+    """(ρ, decays) of J = ∂f/∂x at (t, x): ρ the spectral radius, ``decays`` whether the fastest
+    mode is a real eigenvalue λ ≈ −ρ (a stiff damper, not an oscillation: Re λ < 0 and
+    |Im λ| ≤ 0.1 ρ, a damping ratio ≥ 0.995).
+
+    Exact where the derivatives are (issue 16), the first of these that applies:
+
+    * ``jacobian(t, x)``, the model's exact ∂f/∂x in one call (a compiled evaluator's
+      ``state_jacobian``, :func:`projeq.analysis.jacobians.state_jacobian`), when given and not
+      None: its eigenvalues (``numpy.linalg.eigvals``, LAPACK's QR algorithm), ρ = max |λ|;
+    * for n_x ≤ ``iterations`` and a complex-safe f: the eigenvalues of J by the complex step
+      column by column (:func:`projeq.analysis.differentiation.exact_jacobian`, n_x complex
+      evaluations of f, fewer than the power iteration's);
+    * power iteration (Golub & Van Loan, "Matrix Computations", 4th ed. (2013), §7.3.1) on the
+      products J v = Im f(x + i h v)/h, the complex step along v (exact to round-off,
+      :func:`projeq.analysis.differentiation.complex_step`), for a complex-safe f;
+    * power iteration on forward-difference products (f(x + εv) − f(x))/ε, ε = √ε_m (1 + |x|),
+      only for an f that cannot take complex states (a user's callable that casts to float).
+
+    The power iteration: ρ is the geometric mean growth ‖J v_k‖ over an even number of the last
+    iterations (for an undamped mode, a pair ±iω, the growth alternates between ω²|a|/|b| and
+    |b|/|a| for a vector (a, b) of coordinate and rate: a pair's mean is ω), converged to a few
+    per cent (the two close pairs of the spinning beam: 3 %); the fastest mode decays when the
+    last iterate v is an eigenvector, ‖J v − λ v‖ ≤ 0.1 ρ with the Rayleigh quotient
+    λ = vᵀJv ≤ −0.5 ρ (the iterates of a complex pair rotate in its plane and fail the test).
+    It costs ``iterations`` + 1 evaluations of f (complex ones with the complex step).
+    """
     x = np.asarray(x, dtype=float)
+    J = None if jacobian is None else jacobian(t, x)
+    if J is None and len(x) <= iterations:
+        J = _complex_step_jacobian(fun, t, x)
+    if J is not None:
+        return _eigen_mode(np.linalg.eigvals(J))
+    if is_complex_safe(lambda z: fun(t, z), x):
+        return _power_iteration(lambda v: complex_step(lambda s: fun(t, x + s * v)), len(x), iterations)
     f0 = fun(t, x)
-    v = np.cos(np.arange(len(x)) + 1.0)  # a fixed start with components along every axis
+    eps = np.sqrt(np.finfo(float).eps) * (1.0 + np.linalg.norm(x))
+    return _power_iteration(lambda v: forward(lambda e: fun(t, x + e * v), eps, f0), len(x), iterations)
+
+
+def _complex_step_jacobian(fun, t: float, x: NDArray) -> NDArray | None:
+    """∂f/∂x at (t, x) by the complex step column by column, or None where f is not
+    complex-safe (it raises TypeError or ValueError on a complex state, or casts it to float)."""
+    try:
+        J = exact_jacobian(lambda z: fun(t, z), x)
+    except (TypeError, ValueError, np.exceptions.ComplexWarning):
+        return None
+    return J if np.all(np.isfinite(J)) else None
+
+
+def _eigen_mode(eigenvalues: NDArray) -> tuple[float, bool]:
+    """(ρ, decays) of the eigenvalues (:func:`fastest_mode`): every eigenvalue of the largest
+    modulus (to 1e-9 relative: a pair, or a tie) decays."""
+    moduli = np.abs(eigenvalues)
+    rho = float(moduli.max(initial=0.0))
+    fastest = eigenvalues[moduli >= (1 - 1e-9) * rho]
+    return rho, bool(rho > 0 and np.all((fastest.real < 0) & (np.abs(fastest.imag) <= DECAYING * rho)))
+
+
+def _power_iteration(product, n: int, iterations: int) -> tuple[float, bool]:
+    """(ρ, decays) by power iteration on the products J v (:func:`fastest_mode`)."""
+    v = np.cos(np.arange(n) + 1.0)  # a fixed start with components along every axis
     v /= np.linalg.norm(v)
     logs, w = [], v
     for _ in range(iterations):
-        eps = np.sqrt(np.finfo(float).eps) * (1.0 + np.linalg.norm(x))
         v = w / np.linalg.norm(w)
-        w = forward(lambda e: fun(t, x + e * v), eps, f0)
+        w = product(v)
         norm = np.linalg.norm(w)
         if not norm > 0:
             return 0.0, False
         logs.append(np.log(norm))
     rho, rayleigh = float(np.exp(np.mean(logs[-2 * (iterations // 4):]))), float(v @ w)
-    return rho, bool(rayleigh <= -0.5 * rho and np.linalg.norm(w - rayleigh * v) <= 0.1 * rho)
+    return rho, bool(rayleigh <= -0.5 * rho and np.linalg.norm(w - rayleigh * v) <= DECAYING * rho)
 
 
 def stability_limit(method: str) -> float:
