@@ -364,6 +364,24 @@ class DAEResult:
         self.__dict__.update(fields)
 
 
+def _dae_jacobian(fun, f, t: float, y: NDArray, f0: NDArray, exact: bool, counts: dict) -> NDArray:
+    """∂f/∂y at (t, y) for :func:`radau_dae`'s Newton iterations: by the complex step column by
+    column (exact to round-off, :func:`projeq.analysis.differentiation.exact_jacobian`) where
+    ``exact`` (``fun`` is complex-safe), else by forward differences with the steps
+    √ε_m max(1, |y_j|) through the counting ``f``; n evaluations of ``fun`` either way (counted)."""
+    n = y.size
+    if exact:
+        counts["nfev"] += n
+        return exact_jacobian(lambda z: np.asarray(fun(t, z)), y)
+    step = np.sqrt(np.finfo(float).eps) * np.maximum(1.0, np.abs(y))
+    J = np.empty((n, n))
+    for j in range(n):
+        yj = y.copy()
+        yj[j] += step[j]
+        J[:, j] = (f(t, yj) - f0) / step[j]
+    return J
+
+
 def _collocation(y0: NDArray, Z: NDArray, theta) -> NDArray:
     """y0 + P(θ), P the collocation polynomial with P(0) = 0, P(c_i) = Z_i (θ = (t − t0)/h, may exceed 1)."""
     theta = np.atleast_1d(theta)
@@ -389,7 +407,8 @@ def radau_dae(fun, t_span, y0, mass=None, index=None, rtol: float = 1e-6, atol: 
     integrated as they stand, without index reduction; the initial state must satisfy the constraints.
 
     Each step solves the 3n stage equations (I₃ ⊗ M) Z = h (A ⊗ I) F(Z) by simplified Newton
-    iterations with one dense LU of I₃ ⊗ M − h A ⊗ ∂f/∂y (∂f/∂y by forward differences, once per step),
+    iterations with one dense LU of I₃ ⊗ M − h A ⊗ ∂f/∂y (∂f/∂y once per step, :func:`_dae_jacobian`:
+    exact by the complex step where ``fun`` takes complex states, else by forward differences),
     started from the previous step's collocation polynomial; the step size follows the embedded error
     estimate (M/(γ₀h) − ∂f/∂y)⁻¹ (f(t₀, y₀) + M Σ e_i Z_i / h). ``t_eval`` values come from the
     collocation polynomial (stage order 3).
@@ -416,6 +435,7 @@ def radau_dae(fun, t_span, y0, mass=None, index=None, rtol: float = 1e-6, atol: 
         counts["nfev"] += 1
         return np.asarray(fun(t, x), dtype=float)
 
+    exact = is_complex_safe(lambda z: fun(t0, z), y)  # ∂f/∂y by the complex step (else forward differences)
     newton_tol = max(10 * np.finfo(float).eps / rtol, min(0.03, rtol**0.5))
     h = min(first_step or 1e-3 * (t_end - t0) * rtol ** 0.25, max_step, t_end - t0)
     t, f0 = t0, f(t0, y)
@@ -431,12 +451,7 @@ def radau_dae(fun, t_span, y0, mass=None, index=None, rtol: float = 1e-6, atol: 
             break
         h = min(h, max_step, t_end - t)
         counts["njev"] += 1
-        step = np.sqrt(np.finfo(float).eps) * np.maximum(1.0, np.abs(y))
-        J = np.empty((n, n))
-        for j in range(n):
-            yj = y.copy()
-            yj[j] += step[j]
-            J[:, j] = (f(t, yj) - f0) / step[j]
+        J = _dae_jacobian(fun, f, t, y, f0, exact, counts)
         while True:
             if h < 1e-14 * max(1.0, abs(t)):
                 message = f"step size underflow at t = {t}"
