@@ -106,7 +106,7 @@ class FastEvaluator:
         self._add_loads = loads.kernel(self.compiled) if len(self._laws) else None
         # ∂ẋ/∂x in one call where no Python runs between the kernels (no joint of kind GIVEN, no
         # force law without a compiled row, no coupling): then every joint has q̇ = ṡ (K = E)
-        self._jacobian = kernels.jacobian_kernel(self.compiled, rigid=rigid) \
+        self._jacobian = kernels.jacobian_kernel(loads, self.compiled, rigid=rigid) \
             if not (self._given or self._python_laws or system.coupled) else None
 
     def _pack(self, system) -> None:

@@ -711,18 +711,17 @@ def kernel(compiled: bool = True, rigid: bool = False):
     return compiled_kernels["chain_terms"], compiled_kernels["rigid_passes" if rigid else "passes"]
 
 
-def jacobian_kernel(compiled: bool = True, rigid: bool = False):
+def jacobian_kernel(loads, compiled: bool = True, rigid: bool = False):
     """:func:`tree_jacobian`, compiled by numba (as :func:`kernel`, with the same ``rigid``
-    passes) or with ``compiled=False`` interpreted; either calls the force laws' loop
-    :func:`projeq.assembly.loads.add_loads` (compiled, or interpreted), which imports this
-    module, so it is bound here, by name, as the compiled kernels are (:func:`_jit`)."""
-    from projeq.assembly import loads
-
+    passes) or with ``compiled=False`` interpreted, calling the force laws' loop ``add_loads`` of
+    ``loads`` (the module :mod:`projeq.assembly.loads`, compiled or interpreted alike; it imports
+    this module, so the caller hands it in) by name, as the compiled kernels call each other
+    (:func:`_jit`)."""
     if not compiled:
         namespace = {**globals(), "add_loads": loads.add_loads}
         return types.FunctionType(tree_jacobian.__code__, namespace, "tree_jacobian", tree_jacobian.__defaults__)
     kernel(True)  # the same refusal without numba
-    return _compiled_jacobians()["rigid_tree_jacobian" if rigid else "tree_jacobian"]
+    return _compiled_jacobians(loads)["rigid_tree_jacobian" if rigid else "tree_jacobian"]
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
@@ -740,18 +739,16 @@ def _compiled():
 
 
 @functools.cache
-def _compiled_jacobians():
+def _compiled_jacobians(loads):
     """{name: kernel}: :func:`tree_jacobian` with either passes (:func:`jacobian_kernel`), calling
-    the compiled chain_terms, passes and loads loop; compiled by :func:`jit`, whose name for it
-    carries a digest of the loads loop's sources (its file and the laws' statements): numba's
+    the compiled chain_terms, passes and loads loop; each cached on disk under its name and a
+    digest of the loads loop's sources (its module and the laws' statements it calls): numba's
     disk cache checks this file only, and a cached kernel holds the code of the kernels it calls."""
-    from projeq.assembly import loads
-
-    compiled = _compiled()
+    compiled, digest = _compiled(), _digest(loads, *loads.CALLEES)
     jacobians = {}
     for name, passes_ in (("tree_jacobian", compiled["passes"]), ("rigid_tree_jacobian", compiled["rigid_passes"])):
         callees = {"chain_terms": compiled["chain_terms"], "passes": passes_, "add_loads": loads.kernel(True)}
-        jacobians[name] = _jit(tree_jacobian, names=(f"{name}_{_digest(loads, *loads.CALLEES)}",), kernels=callees)[0]
+        jacobians[name] = _jit(tree_jacobian, names=(f"{name}_{digest}",), kernels=callees)[0]
     return jacobians
 
 
