@@ -229,13 +229,15 @@ def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None)
       n_x = 200, 97 vs 11 ms): its eigenvalues (``numpy.linalg.eigvals``, LAPACK's QR
       algorithm), ρ = max |λ|;
     * for n_x ≤ ``iterations`` and a complex-safe f: the eigenvalues of J by the complex step
-      column by column (:func:`projeq.analysis.differentiation.exact_jacobian`, n_x complex
-      evaluations of f, fewer than the power iteration's);
+      column by column (:func:`projeq.analysis.differentiation.exact_jacobian`, n_x + 1 complex
+      evaluations of f with the check, fewer than the power iteration's);
     * power iteration (Golub & Van Loan, "Matrix Computations", 4th ed. (2013), §7.3.1) on the
       products J v = Im f(x + i h v)/h, the complex step along v (exact to round-off,
       :func:`projeq.analysis.differentiation.complex_step`), for a complex-safe f;
     * power iteration on forward-difference products (f(x + εv) − f(x))/ε, ε = √ε_m (1 + |x|),
-      only for an f that cannot take complex states (a user's callable that casts to float).
+      only for an f that cannot take complex states (a user's callable that casts to float, a
+      compiled right-hand side for real states: simulate's fused ``state_derivative``, which
+      :func:`warn_if_stiff` differentiates).
 
     The power iteration: ρ is the geometric mean growth ‖J v_k‖ over an even number of the last
     iterations (for an undamped mode, a pair ±iω, the growth alternates between ω²|a|/|b| and
@@ -260,12 +262,12 @@ def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None)
 
 
 def _complex_step_jacobian(fun, t: float, x: NDArray) -> NDArray | None:
-    """∂f/∂x at (t, x) by the complex step column by column, or None where f is not
-    complex-safe (it raises TypeError or ValueError on a complex state, or casts it to float)."""
-    try:
-        J = exact_jacobian(lambda z: fun(t, z), x)
-    except (TypeError, ValueError, np.exceptions.ComplexWarning):
+    """∂f/∂x at (t, x) by the complex step column by column, or None where f is not complex-safe
+    (:func:`projeq.analysis.differentiation.is_complex_safe`: it raises on a complex state, casts
+    it to float, or returns real values, as a compiled right-hand side for real states does)."""
+    if not is_complex_safe(lambda z: fun(t, z), x):
         return None
+    J = exact_jacobian(lambda z: fun(t, z), x)
     return J if np.all(np.isfinite(J)) else None
 
 

@@ -62,6 +62,14 @@ def test_power_iteration_beyond_the_iterations_by_complex_step_and_by_difference
         assert found == pytest.approx(rho, rel=1e-3) and real is decays
 
 
+def test_a_right_hand_side_that_drops_the_imaginary_part_is_differenced():
+    """A right-hand side that returns real values for a complex state (as a compiled one for real
+    states does, silently) has no complex step: forward differences find ρ (1e-3), not 0."""
+    J = np.array([[0.0, 1.0], [-1e6, -1e4]])
+    found, decays = fastest_mode(lambda t, x: J @ np.real(x), 0.0, np.zeros(2))
+    assert found == pytest.approx(9898.979485566356, rel=1e-3) and decays
+
+
 def _spring_mass_chain(N: int, m: float, k: float, d: float = 0.0) -> pq.System:
     """N point masses m in a row on prismatic joints, each held to the previous one (the first
     to the ground) by a joint spring k (and damper d) on its relative coordinate."""
