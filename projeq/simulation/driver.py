@@ -394,7 +394,8 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
     """simulate's integrator when none is given, from the tolerance and the model's fastest
     mode measured at the initial state: ρ = the spectral radius of ∂ẋ/∂x (exact:
     :func:`projeq.simulation.integrators.fastest_mode`, the eigenvalues of the evaluator's
-    ``state_jacobian`` where it has one, else power iteration on complex-step products)
+    ``state_jacobian`` where it has one, else of the complex-step Jacobian for n_x ≤ 32, else
+    power iteration on complex-step products)
     gives the steps an explicit method needs for stability alone, n = ρ (t_end − t0) / |x_s|
     with |x_s| its stability interval (:func:`~projeq.simulation.integrators.stability_limit`:
     RK45 3.31, DOP853 6.39).
