@@ -212,6 +212,19 @@ def test_compiled_one_call_with_every_compiled_force_law(tree):
     complex step through the recursive evaluator (the laws' own add_to) to 1e-11 (as
     test_compiled_column_by_column_with_every_joint_and_force_law) and = Richardson's central
     differences to DIFFERENCES_TOL."""
+    _check_one_call_with_laws(tree)
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(tree=trees(max_n=6, planar=True, kinds=("revolute", "prismatic", "fixed"), forces="constant"))
+def test_compiled_one_call_with_every_compiled_force_law_on_planar_trees(tree):
+    """As above on planar bodies (a selection S: the kernel loads their spatial h_n, the
+    reference their selected coordinates, h_n += Sᵀ S w; no in-plane motion sees the
+    difference)."""
+    _check_one_call_with_laws(tree)
+
+
+def _check_one_call_with_laws(tree):
     system, x, t = with_every_law(tree), np.concatenate((tree.q, tree.s_dot)), tree.t
     assert all(law.compiled_terms() is not None for law in system.forces)
     one_call = system.evaluator().state_jacobian(t, x)
