@@ -251,24 +251,33 @@ def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None)
     x = np.asarray(x, dtype=float)
     J = None if jacobian is None or len(x) > 2 * iterations else jacobian(t, x)
     if J is None and len(x) <= iterations:
-        J = _complex_step_jacobian(fun, t, x)
-    if J is not None:
+        J = _by_complex_step(fun, t, x, lambda: exact_jacobian(lambda z: fun(t, z), x))
+    if J is not None and np.all(np.isfinite(J)):
         return _eigen_mode(np.linalg.eigvals(J))
-    if is_complex_safe(lambda z: fun(t, z), x):
-        return _power_iteration(lambda v: complex_step(lambda s: fun(t, x + s * v)), len(x), iterations)
+    found = _by_complex_step(fun, t, x, lambda: _power_iteration(
+        lambda v: complex_step(lambda s: fun(t, x + s * v)), len(x), iterations))
+    if found is not None:
+        return found
     f0 = fun(t, x)
     eps = np.sqrt(np.finfo(float).eps) * (1.0 + np.linalg.norm(x))
     return _power_iteration(lambda v: forward(lambda e: fun(t, x + e * v), eps, f0), len(x), iterations)
 
 
-def _complex_step_jacobian(fun, t: float, x: NDArray) -> NDArray | None:
-    """∂f/∂x at (t, x) by the complex step column by column, or None where f is not complex-safe
-    (:func:`projeq.analysis.differentiation.is_complex_safe`: it raises on a complex state, casts
-    it to float, or returns real values, as a compiled right-hand side for real states does)."""
+def _by_complex_step(fun, t: float, x: NDArray, run):
+    """``run()``, a computation on f at complex states, or None where f is not complex-safe: it
+    fails :func:`projeq.analysis.differentiation.is_complex_safe` at x (raises on a complex
+    state, casts it to float, or returns real values, as a compiled right-hand side for real
+    states does), or during the run raises TypeError or ValueError or casts a complex value to
+    float (simulate's right-hand side checks the distance to a coordinate singularity every 200
+    calls, on real states)."""
     if not is_complex_safe(lambda z: fun(t, z), x):
         return None
-    J = exact_jacobian(lambda z: fun(t, z), x)
-    return J if np.all(np.isfinite(J)) else None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", np.exceptions.ComplexWarning)
+        try:
+            return run()
+        except (TypeError, ValueError, np.exceptions.ComplexWarning):
+            return None
 
 
 def _eigen_mode(eigenvalues: NDArray) -> tuple[float, bool]:

@@ -9,6 +9,8 @@ oscillator (−d ± √(d² − 4mk))/2m. Each of fastest_mode's ways (the one-c
 complex step column by column, power iteration on complex-step products, power iteration on
 forward differences for a right-hand side that takes no complex state) against them."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -67,6 +69,24 @@ def test_a_right_hand_side_that_drops_the_imaginary_part_is_differenced():
     states does, silently) has no complex step: forward differences find ρ (1e-3), not 0."""
     J = np.array([[0.0, 1.0], [-1e6, -1e4]])
     found, decays = fastest_mode(lambda t, x: J @ np.real(x), 0.0, np.zeros(2))
+    assert found == pytest.approx(9898.979485566356, rel=1e-3) and decays
+
+
+def test_a_right_hand_side_that_casts_a_complex_state_now_and_then_is_differenced():
+    """A right-hand side that casts its state to float on some calls only (simulate's monitor of
+    coordinate singularities, every 200 calls): the complex step gives way to differences, ρ to
+    1e-3, without an error or a warning."""
+    J, calls = np.array([[0.0, 1.0], [-1e6, -1e4]]), [0]
+
+    def sometimes_real(t, x):
+        calls[0] += 1
+        if calls[0] % 3 == 0:
+            np.asarray(x, dtype=float)  # a check on real states
+        return J @ x
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        found, decays = fastest_mode(sometimes_real, 0.0, np.zeros(2))
     assert found == pytest.approx(9898.979485566356, rel=1e-3) and decays
 
 
