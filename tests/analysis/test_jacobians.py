@@ -273,6 +273,26 @@ def test_compiled_flexible_arm():
     assert _relative(J, _reference_jacobian(system, x, 0.0, system.evaluator("recursive"))) <= 1e-9
 
 
+def test_compiled_flexible_arm_with_force_laws():
+    """The flexible arm with a joint spring on its shoulder, a spring-damper from the ground to
+    its tip mass and a force on the beam (its reference frame): one compiled call = the complex
+    step column by column through the compiled evaluator exactly, = the complex step through the
+    recursive evaluator (the laws' own add_to) to 1e-9 of max(1, |J|) (measured 3.3e-10; the
+    conditioning of test_compiled_flexible_arm)."""
+    arm = pq.scenes.flexible_arm()
+    names = list(arm.names)
+    laws = [pq.JointSpring(names[0], 30.0, 1.0), pq.Force(names[1], (0.0, 1.0, 0.5), point=(0.1, 0.0, 0.0)),
+            pq.SpringDamper(None, (0.2, 0.1, 0.0), names[-1], (0.0, 0.0, 0.0), 100.0, 2.0, 0.3)]
+    system = pq.System(dict(zip(names, arm.subsystems)), dict(zip(names, arm.joints)), gravity=arm.gravity,
+                       q0=arm.q0, forces=laws)
+    rng = np.random.default_rng(1)
+    x = np.r_[np.asarray(system.q0) + 0.01 * rng.standard_normal(system.n_q), rng.standard_normal(system.n_s)]
+    J = system.evaluator().state_jacobian(0.2, x)
+    assert J is not None
+    assert np.array_equal(J, _reference_jacobian(system, x, 0.2, system.evaluator()))
+    assert _relative(J, _reference_jacobian(system, x, 0.2, system.evaluator("recursive"))) <= 1e-9
+
+
 @pytest.mark.parametrize("family", ["default", "clamped_free"])
 def test_compiled_hub_beam(family):
     """The spin-up beam (a RitzBeam on a prescribed hub): one call of
