@@ -57,8 +57,8 @@ def chain_with_laws(n: int) -> pq.System:
              pq.Torque(names[1], (0.3, 0.0, 0.1), frame="body"),
              pq.SpringDamper(None, (0.5, 0.3, 0.0), names[-1], (0.0, 0.0, -1.0), 400.0, 5.0, 1.0),
              pq.SpringDamper(names[1], (0.0, 0.0, -1.0), names[-2], (0.0, 0.0, -0.5), 200.0, 3.0, 1.5)]
-    return pq.System(dict(zip(names, chain.subsystems)), dict(zip(names, chain.joints)), gravity=chain.gravity,
-                     q0=chain.q0, forces=laws)
+    return pq.System(dict(zip(names, chain.subsystems)), dict(zip(names, chain.joints)),
+                     gravity=chain.gravity, q0=chain.q0, forces=laws)
 
 
 def state(system):
@@ -96,7 +96,7 @@ def best(f, repeat):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
-    parser.add_argument("--flyball", action="store_true", help="A05 over 10 s, one-call Jacobians vs per column")
+    parser.add_argument("--flyball", action="store_true", help="A05 over 10 s: one-call vs per-column Jacobians")
     parser.add_argument("--runs", type=int, default=2)
     args = parser.parse_args()
     if args.flyball:

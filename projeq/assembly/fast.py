@@ -279,9 +279,11 @@ class FastEvaluator:
         ws, n_q = self._workspace(complex), self.system.n_q
         J = np.zeros((len(x), len(x)))
         J[:n_q, n_q:] = np.eye(n_q)
+        x = np.asarray(x, dtype=float)
         failed = self._jacobian(self._index, self._geometry, self._inertia, self._gravity, self._laws,
-                                self._law_constants, np.asarray(x, dtype=float), n_q, COMPLEX_STEP, ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F,
-                                ws.M_n, ws.M_hat, ws.h_hat, ws.R, ws.r, ws.twist, self._pivot_min, J[n_q:])
+                                self._law_constants, x, n_q, COMPLEX_STEP, ws.given_values, self._elastic,
+                                self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat, ws.R, ws.r,
+                                ws.twist, self._pivot_min, J[n_q:])
         return J if failed < 0 else None
 
 

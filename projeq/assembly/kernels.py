@@ -504,8 +504,8 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
     return -1
 
 
-def tree_jacobian(index, geometry, inertia, gravity, laws, constants, x, n_q, step, given, elastic, port, T, zeta, F,
-                  M_n, M_hat, h_hat, R, r_O, twist, pivot_min, J):
+def tree_jacobian(index, geometry, inertia, gravity, laws, constants, x, n_q, step, given, elastic, port, T,
+                  zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, J):
     """∂s̈/∂x of the order-n kernel at the real state x = (q, ṡ) by the complex step, column
     k = Im s̈(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998): :func:`chain_terms`,
     the loads of the force laws' rows ``laws``, ``constants``
@@ -523,7 +523,8 @@ def tree_jacobian(index, geometry, inertia, gravity, laws, constants, x, n_q, st
         chain_terms(index, geometry, inertia, gravity, z[:n_q], z[n_q:], given, elastic, port, T, zeta, F, M_n,
                     h_hat, R, r_O, twist)
         if laws.shape[0]:
-            failed = add_loads(laws, constants, index, z[:n_q], z[n_q:], R, r_O, twist, F, T, h_hat)  # noqa: F821
+            failed = add_loads(laws, constants, index, z[:n_q], z[n_q:], R, r_O, twist, F, T,  # noqa: F821
+                               h_hat)
             if failed >= 0:
                 return n_x + failed
         failed = passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot)
@@ -719,7 +720,7 @@ def jacobian_kernel(loads, compiled: bool = True, rigid: bool = False):
     (:func:`_jit`)."""
     if not compiled:
         namespace = {**globals(), "add_loads": loads.add_loads}
-        return types.FunctionType(tree_jacobian.__code__, namespace, "tree_jacobian", tree_jacobian.__defaults__)
+        return types.FunctionType(tree_jacobian.__code__, namespace, "tree_jacobian")
     kernel(True)  # the same refusal without numba
     return _compiled_jacobians(loads)["rigid_tree_jacobian" if rigid else "tree_jacobian"]
 
@@ -746,7 +747,8 @@ def _compiled_jacobians(loads):
     disk cache checks this file only, and a cached kernel holds the code of the kernels it calls."""
     compiled, digest = _compiled(), _digest(loads, *loads.CALLEES)
     jacobians = {}
-    for name, passes_ in (("tree_jacobian", compiled["passes"]), ("rigid_tree_jacobian", compiled["rigid_passes"])):
+    for name, passes_ in (("tree_jacobian", compiled["passes"]),
+                          ("rigid_tree_jacobian", compiled["rigid_passes"])):
         callees = {"chain_terms": compiled["chain_terms"], "passes": passes_, "add_loads": loads.kernel(True)}
         jacobians[name] = _jit(tree_jacobian, names=(f"{name}_{digest}",), kernels=callees)[0]
     return jacobians

@@ -101,7 +101,8 @@ def _spring_mass_chain(N: int, m: float, k: float, d: float = 0.0) -> pq.System:
 
 def _rhs(system, evaluator):
     n_q = system.n_q
-    return lambda t, x: np.concatenate((system.q_dot(x[:n_q], x[n_q:], t), evaluator.accelerations(x[:n_q], x[n_q:], t)))
+    return lambda t, x: np.concatenate((system.q_dot(x[:n_q], x[n_q:], t),
+                                        evaluator.accelerations(x[:n_q], x[n_q:], t)))
 
 
 def test_the_spring_mass_chain_has_its_closed_form_fastest_frequency():
