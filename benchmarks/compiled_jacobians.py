@@ -11,9 +11,17 @@ beam's interpreted path), ``compiled`` (:func:`projeq.analysis.jacobians.state_j
 default), ``per column`` (the complex step column by column through the compiled evaluator's
 ``accelerations``, a Python call per column), ``forward diff.`` (n + 1 real compiled
 evaluations, for scale: not exact). CPU time, the best of ``--repeat`` batches of each, all in one
-run.
+run. "chain(10) + laws" is chain(10) with every force law kind that has a compiled row (a
+damped joint spring on each joint, a joint force, a body force and torque, spring-dampers to the
+ground and between links): with the flyball governor (two SpringDampers), one compiled call
+since the loads loop runs inside kernels.tree_jacobian.
 
-    python benchmarks/compiled_jacobians.py [--repeat 7]
+``--flyball``: IFToMM A05, the flyball governor over 10 s with simulate's default (Radau,
+jac="exact", rtol 1e-8), its Jacobians in one compiled call and, in the same process, column
+by column (the evaluator's one-call Jacobian switched off: what projeq did before the loads
+loop ran inside the Jacobian kernel), each the best CPU time of ``--runs`` alternating runs.
+
+    python benchmarks/compiled_jacobians.py [--repeat 7] [--flyball [--runs 2]]
 """
 
 from __future__ import annotations
@@ -33,10 +41,24 @@ from projeq.assembly.beam_fast import HubBeamEvaluator
 def models():
     return {
         "chain(10)": pq.scenes.chain(10),
+        "chain(10) + laws": chain_with_laws(10),
         "flexible arm": pq.scenes.flexible_arm(),
         "spin-up beam": pq.scenes.spin_up_beam(),
         "flyball governor": pq.scenes.flyball_governor(),
     }
+
+
+def chain_with_laws(n: int) -> pq.System:
+    """chain(n) with every force law kind that has a compiled row (module docstring)."""
+    chain = pq.scenes.chain(n)
+    names = list(chain.names)
+    laws = [pq.JointSpring(name, stiffness=50.0, damping=2.0, q_ref=0.1) for name in names]
+    laws += [pq.JointForce(names[0], [1.5]), pq.Force(names[-1], (0.0, 2.0, 1.0), point=(0.0, 0.0, -0.5)),
+             pq.Torque(names[1], (0.3, 0.0, 0.1), frame="body"),
+             pq.SpringDamper(None, (0.5, 0.3, 0.0), names[-1], (0.0, 0.0, -1.0), 400.0, 5.0, 1.0),
+             pq.SpringDamper(names[1], (0.0, 0.0, -1.0), names[-2], (0.0, 0.0, -0.5), 200.0, 3.0, 1.5)]
+    return pq.System(dict(zip(names, chain.subsystems)), dict(zip(names, chain.joints)),
+                     gravity=chain.gravity, q0=chain.q0, forces=laws)
 
 
 def state(system):
@@ -74,7 +96,11 @@ def best(f, repeat):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--flyball", action="store_true", help="A05 over 10 s: one-call vs per-column Jacobians")
+    parser.add_argument("--runs", type=int, default=2)
     args = parser.parse_args()
+    if args.flyball:
+        return flyball(args.runs)
     t = 0.3
     print(f"{'model':18} {'n_x':>4} {'ẋ µs':>7} {'ẋ(z) µs':>7} | {'interpreted':>17} | {'compiled':>17} | {'per column':>17} | "
           f"{'forward diff.':>17} | {'agree':>8}")
@@ -103,6 +129,41 @@ def main() -> None:
         agree = np.abs(J - J_reference).max() / np.abs(J_reference).max()
         print(f"{name:18} {len(x):4d} {unit * 1e6:7.1f} {complex_call * 1e6:7.1f} | " + " | ".join(cells)
               + f" | {agree:8.1e}")
+
+
+def flyball(runs: int) -> None:
+    """The flyball governor's default run (module docstring), one-call vs per-column Jacobians:
+    the CPU time of the whole run and of its Jacobians (simulate's ``_Run.jacobian``, timed)."""
+    from projeq.simulation import driver
+
+    system = pq.scenes.flyball_governor()
+    evaluator = system.evaluator()
+    one_call, jacobian = evaluator.state_jacobian, driver._Run.jacobian
+    spent = [0.0]
+
+    def timed(run, t, x):
+        start = time.process_time()
+        J = jacobian(run, t, x)
+        spent[0] += time.process_time() - start
+        return J
+
+    driver._Run.jacobian = timed
+    results = {}
+    for _ in range(runs):
+        for label, way in (("one call", one_call), ("per column", lambda t, x: None)):
+            evaluator.state_jacobian, spent[0] = way, 0.0
+            start = time.process_time()
+            r = pq.simulate(system, 10.0)
+            cpu = time.process_time() - start
+            if label not in results or cpu < results[label][0]:
+                results[label] = (cpu, spent[0], r)
+    evaluator.state_jacobian, driver._Run.jacobian = one_call, jacobian
+    print(f"{'Jacobians':12} {'method':>7} {'CPU s':>7} {'of which ∂ẋ/∂x':>15} {'nfev':>7} {'njev':>6}  final state")
+    for label, (cpu, in_jacobians, r) in results.items():
+        print(f"{label:12} {r.method:>7} {cpu:7.2f} {in_jacobians:15.2f} {r.nfev:7d} {r.njev:6d}  "
+              f"{np.r_[r.q[-1], r.s_dot[-1]]}")
+    (one, one_J, _), (column, column_J, _) = results["one call"], results["per column"]
+    print(f"per column / one call: run {column / one:.2f}, Jacobians {column_J / one_J:.2f}")
 
 
 def forward(f, x):

@@ -417,3 +417,15 @@ def with_couplings(tree: Tree, n_coupled: int = 3) -> pq.System:
         kind = pq.Revolute if rng.random() < 0.5 else pq.Prismatic
         joints[name] = kind(parent, unit_vector(rng), rng.uniform(-1, 1, 3), random_rotation(rng), coupling=follows)
     return pq.System(subsystems, joints, gravity=system.gravity, forces=system.forces)
+
+
+def with_every_law(tree) -> pq.System:
+    """``tree``'s System carrying one more law of every kind with constant loads (and a
+    force and a torque in the other frame than the first ones drawn), damped: every law has a
+    row in the fast evaluator's compiled loop (projeq/assembly/loads.py)."""
+    system, rng = tree.system, tree.rng
+    kinds = tree.kinds + [type(joint).__name__.lower() for joint in system.joints[len(tree.kinds):]]  # beams' joints
+    laws = [_force(kind, list(system.names), kinds, rng, tree.planar, damped=True, constant=True)
+            for kind in FORCE_KINDS + ("force", "torque", "spring_damper")]
+    return pq.System(dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints)),
+                     gravity=system.gravity, forces=list(system.forces) + [law for law in laws if law is not None])

@@ -14,17 +14,19 @@ The evaluation is the model's default one (:meth:`projeq.System.evaluator`): the
 kernels where they take the model (:mod:`projeq.assembly.kernels`, numba's complex128
 specialization of the same source), all n columns in one compiled call where no Python runs
 between the kernels (the evaluator's ``state_jacobian``: trees of revolute, prismatic and
-fixed joints with elastic bodies, the hub beam), else column by column through its
+fixed joints with elastic bodies and force laws that have compiled rows, the hub beam), else
+column by column through its
 ``accelerations``; the interpreted reference evaluators for the models the kernels do not take
 (their InterpretedWarning says so once) and for constrained systems.
 
 Why the complex step (docs/theory.md, "Exact derivatives", has the measured tables): it
 reuses the evaluation code unchanged (one source for s̈ and its derivatives) and costs n
-complex evaluations. Compiled, one ∂ẋ/∂x cost 18 (chain of 10, n = 20), 17 (flexible arm,
-n = 14) and 13 (spin-up beam, n = 16) real compiled evaluations of ẋ in one call, 11 for the
-flyball governor column by column (n = 8, force laws); forward differences on the compiled
-path (n + 1 evaluations, not exact) 62, 21, 27 and 11, the interpreted complex step 1517,
-1090, 249 and 64, in the same run (``python benchmarks/compiled_jacobians.py``).
+complex evaluations. Compiled, one ∂ẋ/∂x cost 12 (chain of 10, n = 20), 16 (the chain with
+every compiled force law), 14 (flexible arm, n = 14), 13 (spin-up beam, n = 16) and 7
+(flyball governor, n = 8, two spring-dampers) real compiled evaluations of ẋ in one call;
+column by column through ``accelerations`` 24, 43, 27, 39 and 15; forward differences on the
+compiled path (n + 1 evaluations, not exact) 21, 29, 21, 31 and 13; the interpreted complex
+step 789, 1413, 895, 496 and 420, in the same run (``python benchmarks/compiled_jacobians.py``).
 Interpreted, n complex evaluations cost 2.6 (four-bar) and 3.3 (Whipple bicycle, with its
 inner derivatives) real interpreted ones each. A symbolic alternative costs more before the
 first number: sympy's KanesMethod derivation of the Whipple bicycle

@@ -41,8 +41,8 @@ any other subsystem without rigid-body terms (beams in chains, a subsystem that 
 Complex arguments (the complex step of :mod:`projeq.analysis.jacobians`) run the same kernels,
 compiled by numba for complex128, on a complex workspace allocated on first use (force laws
 and joints of kind GIVEN state their numbers on it too); :meth:`FastEvaluator.state_jacobian`
-takes all columns of ∂ẋ/∂x in one compiled call (:func:`projeq.assembly.kernels.tree_jacobian`)
-where no Python runs between the kernels.
+takes all columns of ∂ẋ/∂x in one compiled call (:func:`projeq.assembly.kernels.tree_jacobian`,
+the compiled force laws' loop included) where no Python runs between the kernels.
 
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.chain(3)
@@ -105,9 +105,9 @@ class FastEvaluator:
         self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=rigid)
         self._add_loads = loads.kernel(self.compiled) if len(self._laws) else None
         # ∂ẋ/∂x in one call where no Python runs between the kernels (no joint of kind GIVEN, no
-        # force law, no coupling): then every joint has q̇ = ṡ (K = E)
-        self._jacobian = kernels.jacobian_kernel(self.compiled, rigid=rigid) \
-            if not (self._given or system.forces or system.coupled) else None
+        # force law without a compiled row, no coupling): then every joint has q̇ = ṡ (K = E)
+        self._jacobian = kernels.jacobian_kernel(loads, self.compiled, rigid=rigid) \
+            if not (self._given or self._python_laws or system.coupled) else None
 
     def _pack(self, system) -> None:
         """Flat arrays of the tree (built once) and the real workspace (a complex one on first use,
@@ -268,19 +268,22 @@ class FastEvaluator:
     def state_jacobian(self, t: float, x: NDArray) -> NDArray | None:
         """∂ẋ/∂x at the real state x = (q, ṡ) by the complex step through the kernels,
         :func:`projeq.assembly.kernels.tree_jacobian`: all n_x columns of ∂s̈/∂x in one call on
-        the complex workspace, ∂q̇/∂x = [0, E] (q̇ = ṡ); None where Python runs between the
-        kernels (joints of kind GIVEN, force laws, coupled joints: the caller takes the complex
-        step column by column through :meth:`accelerations`) or a pivot is singular (the caller's
-        evaluation then raises, naming it)."""
+        the complex workspace, the compiled force laws' loads included, ∂q̇/∂x = [0, E] (q̇ = ṡ);
+        None where Python runs between the kernels (joints of kind GIVEN, a force law without a
+        compiled row, coupled joints: the caller takes the complex step column by column through
+        :meth:`accelerations`) or an evaluation fails (a singular pivot, a spring-damper's
+        coincident points: the caller's evaluation then raises, naming it)."""
         if self._jacobian is None:
             return None
         self.n_calls += len(x)
         ws, n_q = self._workspace(complex), self.system.n_q
         J = np.zeros((len(x), len(x)))
         J[:n_q, n_q:] = np.eye(n_q)
-        failed = self._jacobian(self._index, self._geometry, self._inertia, self._gravity, np.asarray(x, dtype=float),
-                                n_q, COMPLEX_STEP, ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F,
-                                ws.M_n, ws.M_hat, ws.h_hat, ws.R, ws.r, ws.twist, self._pivot_min, J[n_q:])
+        x = np.asarray(x, dtype=float)
+        failed = self._jacobian(self._index, self._geometry, self._inertia, self._gravity, self._laws,
+                                self._law_constants, x, n_q, COMPLEX_STEP, ws.given_values, self._elastic,
+                                self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat, ws.R, ws.r,
+                                ws.twist, self._pivot_min, J[n_q:])
         return J if failed < 0 else None
 
 

@@ -504,14 +504,17 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
     return -1
 
 
-def tree_jacobian(index, geometry, inertia, gravity, x, n_q, step, given, elastic, port, T, zeta, F, M_n, M_hat,
-                  h_hat, R, r_O, twist, pivot_min, J):
+def tree_jacobian(index, geometry, inertia, gravity, laws, constants, x, n_q, step, given, elastic, port, T,
+                  zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, J):
     """∂s̈/∂x of the order-n kernel at the real state x = (q, ṡ) by the complex step, column
-    k = Im s̈(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998): :func:`chain_terms`
-    and :func:`passes` n_x times in one call on a complex workspace (T ... twist: complex128);
+    k = Im s̈(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998): :func:`chain_terms`,
+    the loads of the force laws' rows ``laws``, ``constants``
+    (:func:`projeq.assembly.loads.add_loads`, bound by :func:`jacobian_kernel`) and
+    :func:`passes` n_x times in one call on a complex workspace (T ... twist: complex128);
     written into J (n_s × n_x). For trees whose kinematics the kernel computes itself (no
-    joint of kind GIVEN) without force laws. Returns −1, or the :func:`passes` index of the
-    first singular pivot."""
+    joint of kind GIVEN) and whose laws all have compiled rows. Returns −1, or where an
+    evaluation failed: the :func:`passes` index of the first singular pivot, or n_x + the row
+    of a law that cannot be evaluated (a spring-damper whose points coincide)."""
     n_x = x.shape[0]
     z, s_ddot = np.empty(n_x, T.dtype), np.empty(J.shape[0], T.dtype)
     for k in range(n_x):
@@ -519,6 +522,11 @@ def tree_jacobian(index, geometry, inertia, gravity, x, n_q, step, given, elasti
         z[k] += 1j * step
         chain_terms(index, geometry, inertia, gravity, z[:n_q], z[n_q:], given, elastic, port, T, zeta, F, M_n,
                     h_hat, R, r_O, twist)
+        if laws.shape[0]:
+            failed = add_loads(laws, constants, index, z[:n_q], z[n_q:], R, r_O, twist, F, T,  # noqa: F821
+                               h_hat)
+            if failed >= 0:
+                return n_x + failed
         failed = passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot)
         if failed >= 0:
             return failed
@@ -704,13 +712,17 @@ def kernel(compiled: bool = True, rigid: bool = False):
     return compiled_kernels["chain_terms"], compiled_kernels["rigid_passes" if rigid else "passes"]
 
 
-def jacobian_kernel(compiled: bool = True, rigid: bool = False):
+def jacobian_kernel(loads, compiled: bool = True, rigid: bool = False):
     """:func:`tree_jacobian`, compiled by numba (as :func:`kernel`, with the same ``rigid``
-    passes) or with ``compiled=False`` the interpreted function."""
+    passes) or with ``compiled=False`` interpreted, calling the force laws' loop ``add_loads`` of
+    ``loads`` (the module :mod:`projeq.assembly.loads`, compiled or interpreted alike; it imports
+    this module, so the caller hands it in) by name, as the compiled kernels call each other
+    (:func:`_jit`)."""
     if not compiled:
-        return tree_jacobian
+        namespace = {**globals(), "add_loads": loads.add_loads}
+        return types.FunctionType(tree_jacobian.__code__, namespace, "tree_jacobian")
     kernel(True)  # the same refusal without numba
-    return _compiled()["rigid_tree_jacobian" if rigid else "tree_jacobian"]
+    return _compiled_jacobians(loads)["rigid_tree_jacobian" if rigid else "tree_jacobian"]
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
@@ -719,16 +731,27 @@ _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _r
 
 @functools.cache
 def _compiled():
-    """{name: kernel}: chain_terms, passes, the rigid trees' passes (:func:`kernel`) and the
-    Jacobians of both (:func:`jacobian_kernel`) compiled by numba, once per process (and cached on disk;
-    numba compiles each for the dtype it is called with, float64 or complex128, on first use)."""
+    """{name: kernel}: chain_terms, passes and the rigid trees' passes (:func:`kernel`) compiled by
+    numba, once per process (and cached on disk; numba compiles each for the dtype it is called
+    with, float64 or complex128, on first use)."""
     chain, general = _jit(chain_terms, passes)
     rigid = _jit(passes, names=("rigid_passes",), _rows=_six)[0]
-    compiled_kernels = {"chain_terms": chain, "passes": general, "rigid_passes": rigid}
-    for name, passes_ in (("tree_jacobian", general), ("rigid_tree_jacobian", rigid)):
-        callees = {"chain_terms": chain, "passes": passes_}
-        compiled_kernels[name] = _jit(tree_jacobian, names=(name,), kernels=callees)[0]
-    return compiled_kernels
+    return {"chain_terms": chain, "passes": general, "rigid_passes": rigid}
+
+
+@functools.cache
+def _compiled_jacobians(loads):
+    """{name: kernel}: :func:`tree_jacobian` with either passes (:func:`jacobian_kernel`), calling
+    the compiled chain_terms, passes and loads loop; each cached on disk under its name and a
+    digest of the loads loop's sources (its module and the laws' statements it calls): numba's
+    disk cache checks this file only, and a cached kernel holds the code of the kernels it calls."""
+    compiled, digest = _compiled(), _digest(loads, *loads.CALLEES)
+    jacobians = {}
+    for name, passes_ in (("tree_jacobian", compiled["passes"]),
+                          ("rigid_tree_jacobian", compiled["rigid_passes"])):
+        callees = {"chain_terms": compiled["chain_terms"], "passes": passes_, "add_loads": loads.kernel(True)}
+        jacobians[name] = _jit(tree_jacobian, names=(f"{name}_{digest}",), kernels=callees)[0]
+    return jacobians
 
 
 def gauss_form_kernel(compiled: bool = True):
@@ -774,14 +797,20 @@ def jit(*functions, callees=(), kernels=None):
     (:func:`_jit`): with their module's names, this module's callees, ``callees`` (the plain
     functions they call besides, compiled with them) and the compiled ``kernels`` they call by
     name. numba's disk cache checks the file of a compiled function only, so each is cached
-    under its name and a digest of this module's source, its callees' and its compiled
-    kernels' (their source and their names, which carry the digest of their own callees): an
-    edit to any, in another file than the function's, compiles it anew."""
-    sources = Path(__file__).read_text() + "".join(inspect.getsource(f) for f in callees) + "".join(
-        inspect.getsource(k.py_func) + k.py_func.__qualname__ for k in (kernels or {}).values() if hasattr(k, "py_func"))
-    digest = hashlib.sha1(sources.encode()).hexdigest()[:12]
+    under its name and a digest (:func:`_digest`) of this module's source, its callees' and its
+    compiled kernels' (their source and their names, which carry the digest of their own
+    callees): an edit to any, in another file than the function's, compiles it anew."""
+    compiled = [k.py_func for k in (kernels or {}).values() if hasattr(k, "py_func")]
+    digest = _digest(*callees, *compiled, names="".join(f.__qualname__ for f in compiled))
     return _jit(*functions, names=tuple(f"{f.__name__}_{digest}" for f in functions), callees=callees,
                 kernels=kernels)
+
+
+def _digest(*sources, names: str = "") -> str:
+    """12 hex digits of SHA-1 over this module's source, those of ``sources`` (functions or
+    modules) and ``names``."""
+    text = Path(__file__).read_text() + "".join(inspect.getsource(f) for f in sources) + names
+    return hashlib.sha1(text.encode()).hexdigest()[:12]
 
 
 def _jit(*functions, names=(), callees=(), kernels=None, **replaced):

@@ -96,6 +96,10 @@ def kernel(compiled: bool = True):
     return _compiled()[0]
 
 
+#: the statements the loop calls (compiled with it)
+CALLEES = (body_wrench, spring_end, spring_damper, spring_force, joint_wrench)
+
+
 @functools.cache
 def _compiled():
-    return kernels.jit(add_loads, callees=(body_wrench, spring_end, spring_damper, spring_force, joint_wrench))
+    return kernels.jit(add_loads, callees=CALLEES)

@@ -392,8 +392,10 @@ HIGH_ORDER_RTOL = 1e-7  # at rtol this tight or tighter the eighth order of DOP8
 def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_end: float,
                    rtol: float = 1e-8) -> str:
     """simulate's integrator when none is given, from the tolerance and the model's fastest
-    mode measured at the initial state: ρ = the spectral radius of ∂ẋ/∂x (power iteration,
-    :func:`projeq.simulation.integrators.fastest_mode`, 33 evaluations of ``evaluator``)
+    mode measured at the initial state: ρ = the spectral radius of ∂ẋ/∂x (exact:
+    :func:`projeq.simulation.integrators.fastest_mode`, the eigenvalues of the evaluator's
+    ``state_jacobian`` where it has one, else of the complex-step Jacobian for n_x ≤ 32, else
+    power iteration on complex-step products)
     gives the steps an explicit method needs for stability alone, n = ρ (t_end − t0) / |x_s|
     with |x_s| its stability interval (:func:`~projeq.simulation.integrators.stability_limit`:
     RK45 3.31, DOP853 6.39).
@@ -429,7 +431,8 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
         q, s_dot = x[: model.n_q], x[model.n_q :]
         return np.concatenate((model.q_dot(q, s_dot, t), evaluator.accelerations(q, s_dot, t)))
 
-    rho, decays = fastest_mode(rhs, t0, np.concatenate((q0, s_dot0)))
+    rho, decays = fastest_mode(rhs, t0, np.concatenate((q0, s_dot0)),
+                               jacobian=getattr(evaluator, "state_jacobian", None))
     rho_T = rho * (t_end - t0)
     explicit_steps = rho_T / stability_limit("RK45")
     if rho_T > STIFF_STEPS * stability_limit("DOP853") or (decays and explicit_steps > FAST_MODE_STEPS):

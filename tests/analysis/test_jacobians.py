@@ -18,7 +18,7 @@ from projeq.analysis.jacobians import state_derivative, state_jacobian, state_ja
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import HubBeamEvaluator
 from projeq.assembly.fast import FastEvaluator
-from strategies import random_state, trees, with_couplings
+from strategies import random_state, trees, with_couplings, with_every_law
 
 DIFFERENCES_TOL = 1e-7  # of max(1, |J|): the O(h⁴) differences' error at h = 1e-3 (module docstring)
 
@@ -201,6 +201,54 @@ def test_compiled_column_by_column_with_every_joint_and_force_law(tree):
         assert _relative(J, _reference_jacobian(system, x, t, FastEvaluator(system, compiled=False))) <= 1e-12
 
 
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(tree=trees(max_n=6, kinds=("revolute", "prismatic", "fixed"), forces="constant"))
+def test_compiled_one_call_with_every_compiled_force_law(tree):
+    """Trees the kernel computes alone carrying every force law kind with a compiled row (forces
+    and torques in world and body frames, joint forces, joint springs, spring-dampers to the
+    ground and between bodies, damped): one compiled call (kernels.tree_jacobian with the loads
+    loop) = the complex step column by column through the compiled evaluator to 1e-14 of
+    max(1, |J|) (the same arithmetic), = the same kernel source interpreted to 1e-13, = the
+    complex step through the recursive evaluator (the laws' own add_to) to 1e-11 (as
+    test_compiled_column_by_column_with_every_joint_and_force_law) and = Richardson's central
+    differences to DIFFERENCES_TOL."""
+    _check_one_call_with_laws(tree)
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(tree=trees(max_n=6, planar=True, kinds=("revolute", "prismatic", "fixed"), forces="constant"))
+def test_compiled_one_call_with_every_compiled_force_law_on_planar_trees(tree):
+    """As above on planar bodies (a selection S: the kernel loads their spatial h_n, the
+    reference their selected coordinates, h_n += Sᵀ S w; no in-plane motion sees the
+    difference)."""
+    _check_one_call_with_laws(tree)
+
+
+def _check_one_call_with_laws(tree):
+    system, x, t = with_every_law(tree), np.concatenate((tree.q, tree.s_dot)), tree.t
+    assert all(law.compiled_terms() is not None for law in system.forces)
+    one_call = system.evaluator().state_jacobian(t, x)
+    assert one_call is not None  # the compiled Jacobian, not a fall-back
+    assert _relative(one_call, _reference_jacobian(system, x, t, system.evaluator())) <= 1e-14
+    assert _relative(one_call, FastEvaluator(system, compiled=False).state_jacobian(t, x)) <= 1e-13
+    assert _relative(one_call, _reference_jacobian(system, x, t, system.evaluator("recursive"))) <= 1e-11
+    _check_against_differences(system, tree.q, tree.s_dot, t)
+
+
+def test_compiled_one_call_on_the_flyball_governor():
+    """IFToMM A05, the flyball governor (two stiff spring-dampers, SpringDamper rows): its
+    ∂ẋ/∂x in one compiled call = the complex step column by column through the compiled
+    evaluator to 1e-14 and = Richardson's central differences to DIFFERENCES_TOL."""
+    system = pq.scenes.flyball_governor()
+    rng = np.random.default_rng(5)
+    q, s_dot = np.asarray(system.q0) + 0.01 * rng.standard_normal(system.n_q), rng.standard_normal(system.n_s)
+    x = np.concatenate((q, s_dot))
+    one_call = system.evaluator().state_jacobian(0.3, x)
+    assert one_call is not None
+    assert _relative(one_call, _reference_jacobian(system, x, 0.3, system.evaluator())) <= 1e-14
+    _check_against_differences(system, q, s_dot, 0.3)
+
+
 def _bent_flexible_arm():
     """The state of test_beam_in_a_chain."""
     system = pq.scenes.flexible_arm()
@@ -223,6 +271,26 @@ def test_compiled_flexible_arm():
     assert np.array_equal(J, _reference_jacobian(system, x, 0.0, system.evaluator()))
     assert _relative(J, FastEvaluator(system, compiled=False).state_jacobian(0.0, x)) <= 1e-9
     assert _relative(J, _reference_jacobian(system, x, 0.0, system.evaluator("recursive"))) <= 1e-9
+
+
+def test_compiled_flexible_arm_with_force_laws():
+    """The flexible arm with a joint spring on its shoulder, a spring-damper from the ground to
+    its tip mass and a force on the beam (its reference frame): one compiled call = the complex
+    step column by column through the compiled evaluator exactly, = the complex step through the
+    recursive evaluator (the laws' own add_to) to 1e-9 of max(1, |J|) (measured 3.3e-10; the
+    conditioning of test_compiled_flexible_arm)."""
+    arm = pq.scenes.flexible_arm()
+    names = list(arm.names)
+    laws = [pq.JointSpring(names[0], 30.0, 1.0), pq.Force(names[1], (0.0, 1.0, 0.5), point=(0.1, 0.0, 0.0)),
+            pq.SpringDamper(None, (0.2, 0.1, 0.0), names[-1], (0.0, 0.0, 0.0), 100.0, 2.0, 0.3)]
+    system = pq.System(dict(zip(names, arm.subsystems)), dict(zip(names, arm.joints)), gravity=arm.gravity,
+                       q0=arm.q0, forces=laws)
+    rng = np.random.default_rng(1)
+    x = np.r_[np.asarray(system.q0) + 0.01 * rng.standard_normal(system.n_q), rng.standard_normal(system.n_s)]
+    J = system.evaluator().state_jacobian(0.2, x)
+    assert J is not None
+    assert np.array_equal(J, _reference_jacobian(system, x, 0.2, system.evaluator()))
+    assert _relative(J, _reference_jacobian(system, x, 0.2, system.evaluator("recursive"))) <= 1e-9
 
 
 @pytest.mark.parametrize("family", ["default", "clamped_free"])

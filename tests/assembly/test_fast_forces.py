@@ -15,7 +15,7 @@ import warnings
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from strategies import FORCE_KINDS, _force, random_state, trees
+from strategies import random_state, trees, with_every_law
 from test_fast_beams import trees_with_beams
 from test_recursive_vs_dense import _agree
 
@@ -24,17 +24,6 @@ from projeq.assembly import InterpretedWarning, kernels, loads
 from projeq.assembly.fast import FastEvaluator
 
 pytestmark = pytest.mark.skipif(not kernels.has_numba(), reason="numba is not installed")
-
-
-def _with_every_law(tree) -> pq.System:
-    """``tree``'s System carrying one more law of every kind with constant loads (and a
-    force and a torque in the other frame than the first ones drawn), damped."""
-    system, rng = tree.system, tree.rng
-    kinds = tree.kinds + [type(joint).__name__.lower() for joint in system.joints[len(tree.kinds):]]  # beams' joints
-    laws = [_force(kind, list(system.names), kinds, rng, tree.planar, damped=True, constant=True)
-            for kind in FORCE_KINDS + ("force", "torque", "spring_damper")]
-    return pq.System(dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints)),
-                     gravity=system.gravity, forces=list(system.forces) + [law for law in laws if law is not None])
 
 
 def _check(system, rng):
@@ -50,14 +39,14 @@ def _check(system, rng):
 def test_compiled_laws_equal_dense_and_recursive_on_spatial_trees(tree):
     """Spatial trees on every joint type with forces and torques (world and body frames), joint
     forces, joint springs and spring-dampers (to the ground and between bodies), all compiled."""
-    _check(_with_every_law(tree), tree.rng)
+    _check(with_every_law(tree), tree.rng)
 
 
 @given(trees(max_n=12, planar=True, forces="constant"))
 def test_compiled_laws_equal_dense_and_recursive_on_planar_trees(tree):
     """Planar bodies (a selection S: the reference loads them in their own coordinates,
     h_n += Sᵀ S w; the kernel adds the spatial w, whose difference no in-plane motion sees)."""
-    _check(_with_every_law(tree), tree.rng)
+    _check(with_every_law(tree), tree.rng)
 
 
 @settings(max_examples=max(10, settings().max_examples // 3), deadline=None)
@@ -66,7 +55,7 @@ def test_compiled_laws_on_trees_with_beams_equal_dense_and_recursive(tree):
     """RitzBeams in the tree (on its bodies and on the beams' stations): the loads act on the
     bodies' reference frames (the first six rows of h_n, S = [E; 0]); a joint force's pair
     reaches an elastic parent's q̇_e rows through T_np. Compiled, without a warning."""
-    system = _with_every_law(tree)
+    system = with_every_law(tree)
     with warnings.catch_warnings():
         warnings.simplefilter("error", InterpretedWarning)
         warnings.simplefilter("ignore", RuntimeWarning)  # an unstiffened beam spun fast: said once
@@ -80,7 +69,7 @@ def test_compiled_laws_on_trees_with_beams_equal_dense_and_recursive(tree):
 @given(trees(max_n=6, forces="constant"))
 def test_the_interpreted_loop_is_the_compiled_one(tree):
     """compiled=False runs the same loop source interpreted: the same s̈ as the compiled one."""
-    system = _with_every_law(tree)
+    system = with_every_law(tree)
     q, s_dot, t = random_state(system, tree.rng)
     compiled = FastEvaluator(system).accelerations(q, s_dot, t)
     interpreted = FastEvaluator(system, compiled=False).accelerations(q, s_dot, t)
