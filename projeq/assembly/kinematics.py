@@ -234,7 +234,7 @@ def gauss_terms(system, kin: Kinematics, q: NDArray, s_dot: NDArray, t: float) -
     for n in prep.singles:
         q_e = q[system.e_q_slice[n]]
         M[n], h[n] = system.subsystems[n].gauss_terms(kin.y_dot[n], kin.R[n], system.gravity, q_e)
-    if system.forces and any(np.iscomplexobj(x) for x in (*h, *kin.T_aug)):  # a complex step: forces add into h
+    if system.forces and any(np.iscomplexobj(x) for x in (q, s_dot, *h, *kin.T_aug)):  # a complex step: forces add into h
         h = [np.asarray(h_n, dtype=complex) for h_n in h]
     for force in system.forces:
         force.add_to(h, kin, t, q, s_dot)
