@@ -410,12 +410,17 @@ class ConstrainedSystem(Model):
 
     def rank(self, q: NDArray, t: float = 0.0) -> int:
         """The numerical rank of A_s at (q, t): its singular values above RANK_TOLERANCE ‖A_s‖₂."""
-        return numerical_rank(self.constraint_matrix(q, t)[0])
+        return self._rank_and_mobility(self.constraint_matrix(q, t)[0])[0]
 
     def mobility(self, q: NDArray, t: float = 0.0) -> int:
         """Degrees of freedom at (q, t): the tree's velocities minus :meth:`rank` (Grübler's count
         n_s,tree − n_c when no constraint is redundant)."""
-        return self.tree.n_s - self.rank(q, t)
+        return self._rank_and_mobility(self.constraint_matrix(q, t)[0])[1]
+
+    def _rank_and_mobility(self, A_s: NDArray) -> tuple[int, int]:
+        """(rank, n_s,tree − rank) of the constraint matrix A_s."""
+        rank = numerical_rank(A_s)
+        return rank, self.tree.n_s - rank
 
     def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:
         """(F, f) of ṡ_tree = F ṡ + f: F = [E; −A_dep⁻¹ A_ind], f = [0; A_dep⁻¹ b_s]
@@ -458,9 +463,9 @@ class ConstrainedSystem(Model):
             x[self.dependent] = np.linalg.solve(A_s[:, self.dependent], c)
         return x
 
-    def tree_velocities(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
-        """ṡ_tree = F ṡ + f."""
-        F, f = self.F(q, t)
+    def tree_velocities(self, q: NDArray, s_dot: NDArray, t: float = 0.0, constraint_matrix=None) -> NDArray:
+        """ṡ_tree = F ṡ + f (``constraint_matrix``: (A_s, b_s) at (q, t) if known)."""
+        F, f = self.F(q, t, constraint_matrix)
         return F @ s_dot + f
 
     # -- the Model protocol (projeq.system.Model) --------------------------------------------
@@ -478,7 +483,11 @@ class ConstrainedSystem(Model):
 
     def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
         """q̇ = K_tree (F ṡ + f) + k, minus β C_Φ⁺ Φ with Baumgarte's correction."""
-        q_dot = self.tree.q_dot(q, self.tree_velocities(q, s_dot, t), t)
+        return self._q_dot(q, self.tree_velocities(q, s_dot, t), t)
+
+    def _q_dot(self, q: NDArray, s_dot_tree: NDArray, t: float) -> NDArray:
+        """q̇ = K_tree ṡ_tree + k, minus β C_Φ⁺ Φ with Baumgarte's correction."""
+        q_dot = self.tree.q_dot(q, s_dot_tree, t)
         if self.correction == "baumgarte" and self.m_h:
             q_dot -= self.beta * minimum_norm_solution(self.phi_q(q, t), self.phi(q, t))
         return q_dot
@@ -525,6 +534,14 @@ class ConstrainedSystem(Model):
     def energy(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple[float, float]:
         """(kinetic, potential) of the tree at ṡ_tree = F ṡ + f."""
         return self.tree.energy(q, self.tree_velocities(q, s_dot, t), t)
+
+    def output_row(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple:
+        """:meth:`Model.output_row <projeq.system.Model.output_row>` from one constraint matrix
+        (A_s, b_s) at (q, t): ṡ_tree = F ṡ + f once for the energy and q̇, and the rank of A_s."""
+        A_s, b_s = self.constraint_matrix(q, t)
+        s_dot_tree = self.tree_velocities(q, s_dot, t, (A_s, b_s))
+        return (self.tree.energy(q, s_dot_tree, t), self.constraint_residual(q, self._q_dot(q, s_dot_tree, t), t),
+                self._rank_and_mobility(A_s))
 
     # -- dynamics ---------------------------------------------------------------------------
     def gamma(self, q: NDArray, s_dot_tree: NDArray, t: float = 0.0, C=None) -> NDArray:

@@ -558,7 +558,7 @@ def _assemble(run: _Run, wall_time: float, dense_output: bool) -> Result:
     n_q, n_s = system.n_q, system.n_s
     rows = [(p.model, ti) for p in pieces for ti in p.t]
     x = np.vstack([p.x for p in pieces] + [np.zeros((0, n_q + n_s))])
-    q, energies, residual = _row_values(run, rows, x)
+    q, energies, residual, ranks = _row_values(run, rows, x)
     t, s_dot = np.array([ti for _, ti in rows[:len(q)]]), x[:len(q), n_q:]
     partitions = tuple(
         (float(p.sol.ts[0]), p.model.partition) for i, p in enumerate(pieces)
@@ -576,31 +576,33 @@ def _assemble(run: _Run, wall_time: float, dense_output: bool) -> Result:
         partitions=partitions, coordinates=system.coordinates(),
         velocities=system.velocities() if len(partitions) < 2 else tuple((f"s_dot[{i}]", "") for i in range(n_s)),
         sol=_dense_solution(pieces, n_q) if dense_output and pieces else None, system=system,
-        **_rank_history(rows, q),
+        **_rank_history(rows, ranks),
     )
 
 
-def _rank_history(rows: list, q: NDArray) -> dict:
+def _rank_history(rows: list, ranks: list) -> dict:
     """Result's ``rank`` and ``mobility`` of a model with constraint equations: each output row's
-    in its own piece's model (its partition); nothing for other models."""
+    in its own piece's model (its partition, :meth:`projeq.system.Model.output_row`); nothing
+    for other models."""
     if not rows or not hasattr(rows[0][0], "mobility"):
         return {}
-    history = np.array([(model.rank(qi, t), model.mobility(qi, t)) for (model, t), qi in zip(rows, q)], dtype=int)
+    history = np.reshape(np.array(ranks, dtype=int), (len(ranks), 2))
     return {"rank": history[:, 0], "mobility": history[:, 1]}
 
 
-def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-    """Normalised q, (T, V) and constraint residuals (Φ, A q̇ − b) of each output row in its
-    own model, up to the first row where a user function raises (a constraint or residual
+def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, NDArray, list]:
+    """Normalised q, (T, V), constraint residuals (Φ, A q̇ − b) and (rank, mobility) of each
+    output row in its own model (:meth:`projeq.system.Model.output_row`), up to the first row
+    where a user function raises (a constraint or residual
     function that fails only late in the run, evaluated here for the first time at that
     row): the run is then a failure at that row's time (status, message naming the
     function, cause) and keeps the rows before it."""
     system, n_q = run.user_model, run.user_model.n_q
-    q, energies, residual = [], [], []
+    q, energies, residual, ranks = [], [], [], []
     for (model, t), xi in zip(rows, x):
         try:
             qi = model.normalized(xi[:n_q])
-            values = model.energy(qi, xi[n_q:], t), model.constraint_residual(qi, model.q_dot(qi, xi[n_q:], t), t)
+            values = model.output_row(qi, xi[n_q:], t)
         except Exception as exc:  # noqa: BLE001 - a user's function: reported by name with the time
             run.status, run.cause, run.reached = -1, exc, t
             run.message = _described(exc) + ("" if f"t = {t:.6g}" in str(exc) else f" (at the output time t = {t:.6g})")
@@ -608,8 +610,9 @@ def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, ND
         q.append(qi)
         energies.append(values[0])
         residual.append(values[1])
+        ranks.append(values[2])
     n = len(q)
-    return (np.reshape(q, (n, n_q)), np.reshape(energies, (n, 2)), np.reshape(residual, (n, system.n_c)))
+    return (np.reshape(q, (n, n_q)), np.reshape(energies, (n, 2)), np.reshape(residual, (n, system.n_c)), ranks)
 
 
 def _failure(run: _Run, result: Result) -> SimulationError:
