@@ -13,7 +13,7 @@ float), so the code evaluates the expressions as given.
 >>> make = numeric_function("height", [("q", q)], sp.Matrix([sp.Symbol("r") * sp.cos(q[0]) + q[1]]),
 ...                         constants=[sp.Symbol("r")])
 >>> height = make(2.0)
->>> height(np.array([0.0, 0.5]), 0.0).tolist()
+>>> height(np.array([0.0, 0.5])).tolist()
 [2.5]
 """
 
