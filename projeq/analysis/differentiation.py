@@ -34,6 +34,23 @@ JACOBIAN_STEP = 1e-4  # relative step of the coarser central difference in :func
 GRADIENT_STEP = 1e-6  # relative step of :func:`gradient`
 
 
+class DifferencesWarning(UserWarning):
+    """A derivative that would be exact by the complex step falls back to finite differences
+    because a user's callable cannot take complex arguments (issue 16: differences only on
+    request, a fall-back says so once, naming the callable)."""
+
+
+def warn_differences(piece: str, f, reason: str, stacklevel: int = 3) -> None:
+    """One :class:`DifferencesWarning`: the derivatives of ``piece`` (the parameter name) come
+    from differences because the callable ``f`` cannot take complex arguments (``reason``)."""
+    warnings.warn(
+        f"{piece}: {getattr(f, '__qualname__', repr(f))} cannot take complex arguments ({reason}); its "
+        "derivatives come from finite differences (round-off ~1e-10 relative), not exactly by the complex "
+        "step: write it with numpy operations (no float(), math.*, or dtype=float) for exact derivatives",
+        DifferencesWarning, stacklevel=stacklevel + 1,
+    )
+
+
 def central(f, h: float):
     """df/dε at 0 by the central difference (f(h) − f(−h)) / 2h: truncation O(h²),
     h²/6 |f‴|; round-off ε_m |f| / h (balanced at h ≈ ε_m^(1/3) ≈ 6e-6 relative)."""
