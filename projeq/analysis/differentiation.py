@@ -24,6 +24,8 @@ derivative is exact to round-off; it needs f to accept complex arguments (numpy 
 
 from __future__ import annotations
 
+import os
+import traceback
 import warnings
 
 import numpy as np
@@ -40,15 +42,32 @@ class DifferencesWarning(UserWarning):
     request, a fall-back says so once, naming the callable)."""
 
 
-def warn_differences(piece: str, f, reason: str, stacklevel: int = 3) -> None:
-    """One :class:`DifferencesWarning`: the derivatives of ``piece`` (the parameter name) come
-    from differences because the callable ``f`` cannot take complex arguments (``reason``)."""
+_WARNED: set = set()  # (piece, callable) pairs already warned about: one warning each per process
+
+
+def warn_differences(piece: str, culprit: str, reason: str, stacklevel: int = 3) -> None:
+    """One :class:`DifferencesWarning` per ``piece`` (the parameter or quantity) and ``culprit``
+    (the callable): its derivatives come from differences because the callable cannot take
+    complex arguments (``reason``)."""
+    if (piece, culprit) in _WARNED:
+        return
+    _WARNED.add((piece, culprit))
     warnings.warn(
-        f"{piece}: {getattr(f, '__qualname__', repr(f))} cannot take complex arguments ({reason}); its "
-        "derivatives come from finite differences (round-off ~1e-10 relative), not exactly by the complex "
-        "step: write it with numpy operations (no float(), math.*, or dtype=float) for exact derivatives",
+        f"{piece}: {culprit} cannot take complex arguments ({reason}); derivatives through it come from "
+        "finite differences (~1e-10 relative), not exactly by the complex step: write it with numpy "
+        "operations (no float(), math.*, dtype=float) for exact derivatives",
         DifferencesWarning, stacklevel=stacklevel + 1,
     )
+
+
+def raised_by(exc: BaseException) -> str:
+    """The innermost function outside projeq in the traceback of ``exc`` (the user's callable
+    that failed on a complex argument), else the innermost one, as "name (file:line)"."""
+    frames = list(traceback.walk_tb(exc.__traceback__))
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    outside = [frame for frame, _ in frames if not os.path.abspath(frame.f_code.co_filename).startswith(package)]
+    frame = (outside or [frame for frame, _ in frames])[-1]
+    return f"{frame.f_code.co_qualname} ({os.path.basename(frame.f_code.co_filename)}:{frame.f_code.co_firstlineno})"
 
 
 def central(f, h: float):
@@ -241,10 +260,20 @@ def second_derivative_along_differences(f, x: NDArray, u: NDArray, w: NDArray) -
 def is_complex_safe(f, x: NDArray) -> bool:
     """Whether f, evaluated at x + i 1e-30 (1, …, 1), returns complex values without an
     error or a cast that discards the imaginary part (then the complex step applies)."""
+    return complex_failure(f, x) is None
+
+
+def complex_failure(f, x: NDArray) -> tuple[str, str] | None:
+    """None if f is complex-safe at x (:func:`is_complex_safe`), else (the callable that failed,
+    :func:`raised_by`, or f's name; the reason)."""
     with warnings.catch_warnings():
         warnings.simplefilter("error", np.exceptions.ComplexWarning)
         try:
             value = np.asarray(f(np.asarray(x) + 1j * COMPLEX_STEP * np.ones(len(x))))
-        except (TypeError, ValueError, np.exceptions.ComplexWarning):
-            return False
-    return np.iscomplexobj(value) and bool(np.all(np.isfinite(value)))
+        except (TypeError, ValueError, np.exceptions.ComplexWarning) as exc:
+            return raised_by(exc), f"{type(exc).__name__}: {exc}"
+    if not np.iscomplexobj(value):
+        return getattr(f, "__qualname__", repr(f)), "it returns real values for a complex argument"
+    if not np.all(np.isfinite(value)):
+        return getattr(f, "__qualname__", repr(f)), "it returns non-finite values for a complex argument"
+    return None

@@ -15,7 +15,7 @@ import warnings
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.analysis.differentiation import complex_step, warn_differences
+from projeq.analysis.differentiation import complex_step, raised_by, warn_differences
 
 MODERATE_DEFLECTION = 0.1  # deflections and axial displacements up to 10 % of the length
 MODERATE_ROTATION = 0.2  # slopes up to 0.2 rad: their square 0.04 is small against 1
@@ -137,7 +137,7 @@ class BeamProbes:
         (Squire & Trapp, "Using complex variables to estimate derivatives of real functions",
         SIAM Review 40, 1998; exact to round-off; a function that returns a real constant has
         slope 0); a function that cannot take complex x (it casts to float) falls back, with one
-        warning per beam and axis, to the central difference over 2e-6 L inside [0, L]
+        warning per callable, to the central difference over 2e-6 L inside [0, L]
         (relative error ~1e-10, :class:`~projeq.analysis.differentiation.DifferencesWarning`)."""
         EI = self._EI[axis]
         if not callable(EI):
@@ -147,11 +147,8 @@ class BeamProbes:
             try:
                 return float(complex_step(lambda h: np.ravel(EI(np.array([x + h])))[0]))
             except (TypeError, ValueError, np.exceptions.ComplexWarning) as exc:
-                reason = f"{type(exc).__name__}: {exc}"
-        warned = self.__dict__.setdefault("_EI_slope_warned", set())  # once per beam and axis
-        if axis not in warned:
-            warned.add(axis)
-            warn_differences(f"EI_{axis}", EI, f"{reason}; shear_force's slope EI′(x)")
+                warn_differences(f"EI_{axis} (shear_force's slope EI′(x))", raised_by(exc),
+                                 f"{type(exc).__name__}: {exc}")
         h = 1e-6 * self.length
         ahead, behind = min(x + h, self.length), max(x - h, 0.0)
         return (self._EI_at(ahead, axis) - self._EI_at(behind, axis)) / (ahead - behind)
