@@ -263,17 +263,17 @@ def is_complex_safe(f, x: NDArray) -> bool:
     return complex_failure(f, x) is None
 
 
-def complex_failure(f, x: NDArray) -> tuple[str, str] | None:
-    """None if f is complex-safe at x (:func:`is_complex_safe`), else (the callable that failed,
-    :func:`raised_by`, or f's name; the reason)."""
+def complex_failure(f, x: NDArray) -> str | None:
+    """None if f is complex-safe at x (:func:`is_complex_safe`), else why not (the error and
+    the function that raised it, :func:`raised_by`)."""
     with warnings.catch_warnings():
         warnings.simplefilter("error", np.exceptions.ComplexWarning)
         try:
             value = np.asarray(f(np.asarray(x) + 1j * COMPLEX_STEP * np.ones(len(x))))
         except (TypeError, ValueError, np.exceptions.ComplexWarning) as exc:
-            return raised_by(exc), f"{type(exc).__name__}: {exc}"
+            return f"{type(exc).__name__}: {exc}, in {raised_by(exc)}"
     if not np.iscomplexobj(value):
-        return getattr(f, "__qualname__", repr(f)), "it returns real values for a complex argument"
+        return "it returns real values for a complex argument"
     if not np.all(np.isfinite(value)):
-        return getattr(f, "__qualname__", repr(f)), "it returns non-finite values for a complex argument"
+        return "it returns non-finite values for a complex argument"
     return None

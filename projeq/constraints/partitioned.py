@@ -209,7 +209,7 @@ class ConstrainedSystem(Model):
                     for name, f in given.items()}
         for name, failure in failures.items():
             if failure is not None:
-                warn_differences(name, getattr(given[name], "__qualname__", repr(given[name])), failure[1])
+                warn_differences(name, getattr(given[name], "__qualname__", repr(given[name])), failure)
         exact = not any(failures.values())
         self._d1 = derivative_along if exact else derivative_along_differences
         self._d2 = second_derivative_along if exact else second_derivative_along_differences
