@@ -24,6 +24,8 @@ derivative is exact to round-off; it needs f to accept complex arguments (numpy 
 
 from __future__ import annotations
 
+import os
+import traceback
 import warnings
 
 import numpy as np
@@ -32,6 +34,40 @@ from numpy.typing import NDArray
 COMPLEX_STEP = 1e-30  # Im f(ih)/h: truncation h²/6 |f‴| ≈ 1e-61, far below round-off
 JACOBIAN_STEP = 1e-4  # relative step of the coarser central difference in :func:`jacobian`
 GRADIENT_STEP = 1e-6  # relative step of :func:`gradient`
+
+
+class DifferencesWarning(UserWarning):
+    """A derivative that would be exact by the complex step falls back to finite differences
+    because a user's callable cannot take complex arguments (issue 16: differences only on
+    request, a fall-back says so once, naming the callable)."""
+
+
+_WARNED: set = set()  # (piece, callable) pairs already warned about: one warning each per process
+
+
+def warn_differences(piece: str, culprit: str, reason: str, stacklevel: int = 3) -> None:
+    """One :class:`DifferencesWarning` per ``piece`` (the parameter or quantity) and ``culprit``
+    (the callable): its derivatives come from differences because the callable cannot take
+    complex arguments (``reason``)."""
+    if (piece, culprit) in _WARNED:
+        return
+    _WARNED.add((piece, culprit))
+    warnings.warn(
+        f"{piece}: {culprit} cannot take complex arguments ({reason}); derivatives through it come from "
+        "finite differences (~1e-10 relative), not exactly by the complex step: write it with numpy "
+        "operations (no float(), math.*, dtype=float) for exact derivatives",
+        DifferencesWarning, stacklevel=stacklevel + 1,
+    )
+
+
+def raised_by(exc: BaseException) -> str:
+    """The innermost function outside projeq in the traceback of ``exc`` (the user's callable
+    that failed on a complex argument), else the innermost one, as "name (file:line)"."""
+    frames = list(traceback.walk_tb(exc.__traceback__))
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    outside = [frame for frame, _ in frames if not os.path.abspath(frame.f_code.co_filename).startswith(package)]
+    frame = (outside or [frame for frame, _ in frames])[-1]
+    return f"{frame.f_code.co_qualname} ({os.path.basename(frame.f_code.co_filename)}:{frame.f_code.co_firstlineno})"
 
 
 def central(f, h: float):
@@ -224,10 +260,20 @@ def second_derivative_along_differences(f, x: NDArray, u: NDArray, w: NDArray) -
 def is_complex_safe(f, x: NDArray) -> bool:
     """Whether f, evaluated at x + i 1e-30 (1, …, 1), returns complex values without an
     error or a cast that discards the imaginary part (then the complex step applies)."""
+    return complex_failure(f, x) is None
+
+
+def complex_failure(f, x: NDArray) -> str | None:
+    """None if f is complex-safe at x (:func:`is_complex_safe`), else why not (the error and
+    the function that raised it, :func:`raised_by`)."""
     with warnings.catch_warnings():
         warnings.simplefilter("error", np.exceptions.ComplexWarning)
         try:
             value = np.asarray(f(np.asarray(x) + 1j * COMPLEX_STEP * np.ones(len(x))))
-        except (TypeError, ValueError, np.exceptions.ComplexWarning):
-            return False
-    return np.iscomplexobj(value) and bool(np.all(np.isfinite(value)))
+        except (TypeError, ValueError, np.exceptions.ComplexWarning) as exc:
+            return f"{type(exc).__name__}: {exc}, in {raised_by(exc)}"
+    if not np.iscomplexobj(value):
+        return "it returns real values for a complex argument"
+    if not np.all(np.isfinite(value)):
+        return "it returns non-finite values for a complex argument"
+    return None

@@ -43,7 +43,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.analysis.differentiation import exact_jacobian, jacobian
+from projeq.analysis.differentiation import exact_jacobian, jacobian, raised_by, warn_differences
 
 DERIVATIVES = ("exact", "differences")
 
@@ -74,18 +74,21 @@ def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, i
     return np.concatenate((system.q_dot(q, s_dot, t), s_ddot))
 
 
-def differentiate(f, z0: NDArray, derivatives: str = "exact") -> tuple[NDArray, str]:
+def differentiate(f, z0: NDArray, derivatives: str = "exact", piece: str = "system",
+                  stacklevel: int = 4) -> tuple[NDArray, str]:
     """(∂f/∂z at z0, the method used): the complex step (:func:`exact_jacobian`) for
     ``"exact"``, falling back to Richardson's differences
-    (:func:`projeq.analysis.differentiation.jacobian`) where f cannot take complex arguments;
-    the differences alone for ``"differences"``."""
+    (:func:`projeq.analysis.differentiation.jacobian`) where f cannot take complex arguments,
+    with one :class:`~projeq.analysis.differentiation.DifferencesWarning` per callable that
+    failed (naming it and ``piece``, what is differentiated); the differences alone for
+    ``"differences"``."""
     if derivatives not in DERIVATIVES:
         raise ValueError(f"derivatives: expected one of {list(DERIVATIVES)}, got {derivatives!r}")
     if derivatives == "exact":
         try:
             return exact_jacobian(f, z0), "exact"
-        except (TypeError, np.exceptions.ComplexWarning):
-            pass  # a user callable that casts to float or calls a real-only function
+        except (TypeError, np.exceptions.ComplexWarning) as exc:  # a user callable casts to float
+            warn_differences(piece, raised_by(exc), f"{type(exc).__name__}: {exc}", stacklevel=stacklevel)
     return jacobian(f, z0), "differences"
 
 
@@ -95,6 +98,8 @@ def state_jacobian(system, x: NDArray, t: float, derivatives: str = "exact") -> 
     it has one (its ``state_jacobian``: the order-n kernel without Python between its calls, the
     hub beam), else column by column through its ``accelerations`` (compiled, complex128, where
     the kernels take the model) — as :func:`differentiate` says."""
+    if derivatives == "exact" and getattr(system, "exact", True) is False:
+        derivatives = "differences"  # its constraint callables take no complex arguments (warned when built)
     if derivatives == "exact":
         one_call = getattr(system.evaluator(None), "state_jacobian", None)
         J = None if one_call is None else one_call(t, np.asarray(x, dtype=float))

@@ -78,8 +78,9 @@ from projeq.assembly.linalg import solve_spd
 from projeq.constraints.batched import batched_closure
 from projeq.constraints.compiled import OWN_RULE, compiled_partition, uncompiled, unsupported
 from projeq.checks import positive, state_vector
-from projeq.analysis.differentiation import (derivative_along, derivative_along_differences, is_complex_safe,
-                                             second_derivative_along, second_derivative_along_differences)
+from projeq.analysis.differentiation import (complex_failure, derivative_along, derivative_along_differences,
+                                             second_derivative_along, second_derivative_along_differences,
+                                             warn_differences)
 from projeq.joints import Joint
 from projeq.spatial import numeric
 from projeq.system import Model
@@ -201,9 +202,15 @@ class ConstrainedSystem(Model):
 
     def _choose_derivatives(self, q0) -> bool:
         """The derivatives of Φ, A and b: by the complex step (exact to round-off) if the
-        callables take complex arguments, else by Richardson's stencils (``exact`` False)."""
-        given = [f for f in (self._phi, self._A, self._b) if f is not None]
-        exact = all(is_complex_safe(lambda x, f=f: f(x[:-1], x[-1].real), np.append(q0, 0.0)) for f in given)
+        callables take complex arguments, else by Richardson's stencils (``exact`` False), with
+        one :class:`~projeq.analysis.differentiation.DifferencesWarning` per callable that cannot."""
+        given = {name: f for name, f in (("phi", self._phi), ("A", self._A), ("b", self._b)) if f is not None}
+        failures = {name: complex_failure(lambda x, f=f: f(x[:-1], x[-1].real), np.append(q0, 0.0))
+                    for name, f in given.items()}
+        for name, failure in failures.items():
+            if failure is not None:
+                warn_differences(name, getattr(given[name], "__qualname__", repr(given[name])), failure)
+        exact = not any(failures.values())
         self._d1 = derivative_along if exact else derivative_along_differences
         self._d2 = second_derivative_along if exact else second_derivative_along_differences
         return exact

@@ -126,7 +126,7 @@ class TangentSystem(ConstrainedSystem):
     def velocity_constraints(self, q: NDArray, t: float = 0.0) -> tuple[NDArray, NDArray]:
         """(C, c) of ConstrainedSystem, kept for the latest (q, t): the integrator asks for q̇ and
         s̈ at the same state, and both need them."""
-        key = (np.asarray(q).tobytes(), np.asarray(q).dtype.str, float(t))  # a complex step is another point
+        key = (np.asarray(q).tobytes(), np.asarray(q).dtype.str, complex(t))  # a complex step is another point
         if self._latest[0] != key:
             self._latest = (key, super().velocity_constraints(q, t))
         return self._latest[1]
@@ -204,19 +204,18 @@ class TangentSystem(ConstrainedSystem):
         """An event for :func:`projeq.simulate` (``events=[system.singular_positions()]``, not
         terminal) that fires where ρ = σ_r / σ_max — the smallest of the r singular values of A_s
         that act at q0 (r its rank there), relative to the largest — has a minimum along the
-        motion: its rate dρ/dt (central difference along q̇, 1e-10 in q) rises through zero. At a
-        singular position ρ drops to zero with a kink, where the root is found. Pass the Result to
-        :meth:`rank_changes` for the rank and mobility at the positions found."""
+        motion: its rate dρ/dt (:func:`ratio_rate`, exact: Ȧ_s by the complex step along
+        (q̇, 1) through the constraint matrix) rises through zero. At a singular position ρ drops
+        to zero with a kink, where the root is found. Pass the Result to :meth:`rank_changes` for
+        the rank and mobility at the positions found."""
         acting = self.tree.n_s - self.n_s
 
-        def ratio(q, t):
-            sigma = np.linalg.svd(self.constraint_matrix(q, t)[0], compute_uv=False)
-            return sigma[acting - 1] / sigma[0]
+        def constraint_matrix(x):
+            return self.constraint_matrix(x[:-1], x[-1])[0]
 
         def singular_position(t, q, s_dot):
-            q_dot = self.q_dot(q, s_dot, t)
-            h = 1e-10 / max(np.abs(q_dot).max(), 1e-300)
-            return (ratio(q + h * q_dot, t + h) - ratio(q - h * q_dot, t - h)) / (2 * h)
+            x, v = np.append(q, t), np.append(self.q_dot(q, s_dot, t), 1.0)
+            return ratio_rate(self.constraint_matrix(q, t)[0], self._d1(constraint_matrix, x, v), acting)
 
         singular_position.terminal, singular_position.direction = False, 1
         return singular_position
@@ -256,6 +255,17 @@ class TangentSystem(ConstrainedSystem):
 
     def __repr__(self) -> str:
         return f"TangentSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian)"
+
+
+def ratio_rate(A: NDArray, A_dot: NDArray, r: int) -> float:
+    """dρ/dt of ρ = σ_r / σ_1, the r-th singular value of A(t) relative to the largest, from
+    Ȧ: σ̇_i = u_iᵀ Ȧ v_i for a simple singular value σ_i > 0 with singular vectors u_i, v_i
+    (Stewart & Sun, "Matrix Perturbation Theory", 1990, §IV.4; the first-order term of
+    σ_i(A + ε Ȧ)), so dρ/dt = (σ̇_r − ρ σ̇_1) / σ_1."""
+    U, sigma, Vt = np.linalg.svd(A)
+    pair = [0, r - 1]
+    rates = np.einsum("ij,ij->i", U[:, pair].T @ A_dot, Vt[pair])
+    return float((rates[1] - sigma[r - 1] / sigma[0] * rates[0]) / sigma[0])
 
 
 def _null_space_step(A_s: NDArray, N: NDArray, rank: int) -> NDArray:

@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
-from projeq.analysis.jacobians import state_jacobian
+from projeq.analysis.jacobians import state_derivative, state_jacobian
 from projeq.assembly import EVALUATORS
 from projeq.checks import callable_name, closest, count, finite_array, positive, state_vector
 from projeq.simulation.integrators import (
@@ -198,7 +198,8 @@ def simulate(
             else:
                 if not stiff_warned and run.steps >= 2 * checked:  # ρ at most log₂(steps) times per run
                     checked = run.steps
-                    stiff_warned = warn_if_stiff(run.rhs, run.steps, run.t_start, b, run.x_end, run.method, rtol)
+                    stiff_warned = warn_if_stiff(run.exact_rhs, run.steps, run.t_start, b, run.x_end, run.method,
+                                                 rtol, getattr(run.ev, "state_jacobian", None))
                 run.end_segment(b)
     result = _assemble(run, _time.perf_counter() - started, dense_output)
     if not run.out_of_range and len(result.t) and result.q.shape[1] == system.tree.n_q:
@@ -293,6 +294,12 @@ class _Run:
         if not np.isfinite(x_dot).all():
             raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
         return x_dot
+
+    def exact_rhs(self, t: float, x: NDArray) -> NDArray:
+        """ẋ of the current model for real or complex x (:func:`projeq.analysis.jacobians.state_derivative`,
+        complex-safe, unlike the fused compiled :meth:`rhs`): its complex step makes the stiffness
+        check's ρ exact (issue 16)."""
+        return state_derivative(self.model, x, t)
 
     def jacobian(self, t: float, x: NDArray) -> NDArray:
         """∂ẋ/∂x of the current model by the complex step (:func:`projeq.analysis.jacobians.state_jacobian`:

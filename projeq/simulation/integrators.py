@@ -236,8 +236,8 @@ def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None)
       :func:`projeq.analysis.differentiation.complex_step`), for a complex-safe f;
     * power iteration on forward-difference products (f(x + εv) − f(x))/ε, ε = √ε_m (1 + |x|),
       only for an f that cannot take complex states (a user's callable that casts to float, a
-      compiled right-hand side for real states: simulate's fused ``state_derivative``, which
-      :func:`warn_if_stiff` differentiates).
+      compiled right-hand side for real states such as simulate's fused ``state_derivative``;
+      simulate hands :func:`warn_if_stiff` the model's complex-safe ẋ instead).
 
     The power iteration: ρ is the geometric mean growth ‖J v_k‖ over an even number of the last
     iterations (for an undamped mode, a pair ±iω, the growth alternates between ω²|a|/|b| and
@@ -329,13 +329,15 @@ def _stability_interval(name: str) -> float:
     return -float(brentq(amplification, grid[first - 1], grid[first], xtol=1e-12))
 
 
-def warn_if_stiff(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rtol: float) -> bool:
+def warn_if_stiff(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rtol: float,
+                  jacobian=None) -> bool:
     """Warn (:class:`StiffnessWarning`) if an explicit ``method``'s ``n_steps`` steps from t0
     to t (all of a run's segments so far, whatever the segmenting) sit at its stability
     limit; ``x`` is the state at t. True if it warned.
 
     The criterion: mean step h with ρ h at least half the method's :func:`stability_limit`
-    (ρ = :func:`spectral_radius` at (t, x)), over at least 50 steps, at rtol ≤ 1e-5. At such
+    (ρ = :func:`spectral_radius` at (t, x), exact for a complex-safe ``fun`` or with the
+    model's one-call ``jacobian``), over at least 50 steps, at rtol ≤ 1e-5. At such
     tolerances a mode with ρ h that large would be integrated with a local error ≫ rtol, so
     the error control can only accept these steps because the fast mode is hardly excited:
     the step is set by stability, the definition of stiffness, and an implicit method could
@@ -346,7 +348,7 @@ def warn_if_stiff(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rt
     if method not in EXPLICIT or rtol > 1e-5 or n_steps < 50:
         return False
     h = (t - t0) / n_steps
-    rho = spectral_radius(fun, t, x)
+    rho = spectral_radius(fun, t, x, jacobian=jacobian)
     if rho * h < 0.5 * stability_limit(method):
         return False
     warnings.warn(

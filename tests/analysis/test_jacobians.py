@@ -8,13 +8,15 @@ truncation O(h⁴)) on hypothesis trees with every joint, force law and subsyste
 bounds it and still catches any lost term, which is O(1)); closed forms where the
 derivative is known exactly (the compound pendulum: to round-off)."""
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 
 import projeq as pq
-from projeq.analysis.differentiation import COMPLEX_STEP, exact_jacobian, jacobian
-from projeq.analysis.jacobians import state_derivative, state_jacobian, state_jacobians
+from projeq.analysis.differentiation import COMPLEX_STEP, DifferencesWarning, exact_jacobian, jacobian
+from projeq.analysis.jacobians import differentiate, state_derivative, state_jacobian, state_jacobians
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import HubBeamEvaluator
 from projeq.assembly.fast import FastEvaluator
@@ -67,6 +69,22 @@ def test_compound_pendulum_is_exact_to_round_off():
     assert (J.q_dot_q, J.q_dot_s_dot, J.s_ddot_s_dot) == (0.0, 1.0, 0.0)
 
 
+def test_differentiate_warns_once_per_callable_that_falls_back():
+    """math.sin casts a complex z to float (a ComplexWarning, as an error): differentiate falls back to Richardson's
+    differences, the derivative still cos z₀ to their accuracy, and says so once, naming the
+    callable and what is differentiated."""
+
+    def real_only(z):
+        return np.array([math.sin(z[0])])
+
+    with pytest.warns(DifferencesWarning, match=r"^the pendulum: .*real_only \(test_jacobians.py:\d+\).*ComplexWarning") \
+            as caught:
+        for z in (0.3, 0.7):
+            J, used = differentiate(real_only, np.array([z]), piece="the pendulum")
+            assert used == "differences" and J[0, 0] == pytest.approx(np.cos(z), rel=1e-10)
+    assert len([w for w in caught if w.category is DifferencesWarning]) == 1
+
+
 def test_differences_on_request():
     J = state_jacobians(pq.scenes.chain(2), [0.3, -0.2], [0.1, 0.4], derivatives="differences")
     assert J.derivatives == "differences"
@@ -82,11 +100,16 @@ def test_callables_without_complex_support_fall_back_to_differences():
                      {"x": pq.Prismatic(axis="x"), "bob": pq.Prismatic(parent="x", axis="z")},
                      gravity=(0, 0, -9.81))
     theta = 0.6
-    pendulum = pq.ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0],
-                                    q0=[np.sin(theta), -np.cos(theta)], independent=[0])
+
+    def circle(q, t):
+        return [np.hypot(q[0], q[1]) - 1.0]
+
+    with pytest.warns(DifferencesWarning, match=r"^phi: .*circle .*TypeError") as built:
+        pendulum = pq.ConstrainedSystem(tree, phi=circle, q0=[np.sin(theta), -np.cos(theta)], independent=[0])
     assert not pendulum.exact
-    J = state_jacobians(pendulum, pendulum.q0, [0.0])
+    J = state_jacobians(pendulum, pendulum.q0, [0.0])  # no second warning: the same callable
     assert J.derivatives == "differences"
+    assert len([w for w in built if w.category is DifferencesWarning]) == 1
     x_ddot = pendulum.accelerations(pendulum.q0, [0.0])[0]  # at rest: ẍ = l cos θ θ̈
     assert x_ddot == pytest.approx(-9.81 * np.sin(theta) * np.cos(theta), rel=1e-10)
 

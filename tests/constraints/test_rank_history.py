@@ -14,6 +14,8 @@ import pytest
 from scipy.optimize import brentq
 
 import projeq as pq
+from projeq.analysis.differentiation import richardson
+from projeq.constraints.tangent import ratio_rate
 from projeq.scenes.iftomm import bricard, n_four_bar, parallelogram_motion
 
 
@@ -73,3 +75,41 @@ def test_the_rank_history_is_saved_and_files_without_it_still_load(through_the_f
 def test_a_tree_without_constraint_equations_has_no_rank_history():
     r = pq.simulate(pq.scenes.chain(2), 0.1, n_points=3)
     assert r.rank.size == r.mobility.size == 0
+
+
+def test_ratio_rate_of_a_rotated_diagonal_matrix():
+    """A(t) = R(ωt) diag(3, 2 − t, 1 + t²) R(−2ωt)ᵀ (rotations about z and x keep the singular
+    values): ρ = σ₃/σ₁ = (1 + t²)/3 while 1 + t² < 2 − t, so dρ/dt = 2t/3 in closed form, and the
+    formula σ̇_i = u_iᵀ Ȧ v_i gives it to round-off whatever the rotations."""
+    omega, t = 0.7, 0.3
+
+    def R(angle, axis):
+        c, s = np.cos(angle), np.sin(angle)
+        i, j = [k for k in range(3) if k != axis]
+        out = np.eye(3, dtype=complex)
+        out[[i, i, j, j], [i, j, i, j]] = c, -s, s, c
+        return out
+
+    def A(t):
+        return R(omega * t, 2) @ np.diag([3.0, 2.0 - t, 1.0 + t * t]) @ R(-2 * omega * t, 0).T
+
+    A_dot = np.imag(A(t + 1e-30j)) / 1e-30  # the complex step: Ȧ exact
+    assert ratio_rate(A(t), A_dot, 3) == pytest.approx(2 * t / 3, rel=1e-14)
+
+
+def test_the_singular_position_event_is_the_exact_rate_of_the_ratio():
+    """The event of the double four-bar (A02, N = 2) on its way to the singular position: dρ/dt
+    (Ȧ_s by the complex step) against Richardson's difference of ρ(q + ε q̇, t + ε) (h = 1e-4,
+    truncation ~1e-13): to 1e-10."""
+    system = n_four_bar(2)
+    event, acting = system.singular_positions(), system.tree.n_s - system.n_s
+
+    def ratio(q, t):
+        sigma = np.linalg.svd(system.constraint_matrix(q, t)[0], compute_uv=False)
+        return sigma[acting - 1] / sigma[0]
+
+    r = pq.simulate(system, 0.7, n_points=8, rtol=1e-9, atol=1e-11)
+    for q, s_dot, t in zip(r.q[1:], r.s_dot[1:], r.t[1:]):
+        q_dot = system.q_dot(q, s_dot, t)
+        expected = richardson(lambda e: ratio(q + e * q_dot, t + e), 1e-4)
+        assert event(t, q, s_dot) == pytest.approx(expected, rel=1e-10)

@@ -4,12 +4,15 @@ properties as functions of x). Each reference is computed here without the Ritz
 discretisation: roots of the exact frequency determinant of the beam's differential
 equation."""
 
+import math
+
 import numpy as np
 import pytest
 from scipy.linalg import eigh
 from scipy.optimize import brentq
 from scipy.special import iv, jv
 
+from projeq.analysis.differentiation import DifferencesWarning
 from projeq.analysis.linearize import linearize
 from projeq.scenes.elastic import spinning_beam
 from projeq.subsystems import RitzBeam
@@ -132,7 +135,7 @@ def test_section_forces_of_a_tapered_cantilever_under_a_tip_load():
     test_beam_torsion_support's self-weight case). With EI = ĉ (L − x) the curvature
     w″ = M/EI = −P/ĉ is constant, w = −P x²/(2ĉ) lies in the span of the polynomial
     family, and K_e q = Φ_w(L) (−P) reproduces it: round-off (1e-9 of P, PL). The shear
-    probe needs the slope of EI(x) here (its central differences: measured 1e-10 of P)."""
+    probe needs the slope of EI(x) here (by the complex step)."""
     L, c_hat, P = 2.0, 5.0, 3.0
     beam = RitzBeam(L, 1.0, 1.0, EI_y=lambda x: c_hat * (L - x), n_v=0, n_w=3)
     Phi_tip, _ = beam.station_data(np.array([L]))
@@ -141,3 +144,38 @@ def test_section_forces_of_a_tapered_cantilever_under_a_tip_load():
         assert beam.bending_moment(q, x)[0, 1] == pytest.approx(-P * (L - x), abs=1e-9 * P * L)
         assert beam.shear_force(q, x)[0, 1] == pytest.approx(-P, abs=1e-9 * P)
     assert beam.deflection(q, L)[0, 2] == pytest.approx(-P * L**2 / (2 * c_hat), rel=1e-9)
+
+
+def test_shear_force_takes_the_exact_slope_of_EI():
+    """Q = −(EI′ w″ + EI w‴) with EI(x) = c e^{x/L}, EI′ = EI/L in closed form: the probe's
+    slope by the complex step matches to round-off (1e-13 of |Q|; the central difference it
+    replaced was off by ~1e-10). w″ and w‴ of the same q come from a beam with EI = 1
+    (M = w″, Q = −w‴), so the slope is the only thing compared."""
+    L, c = 2.0, 5.0
+    tapered = RitzBeam(L, 1.0, 1.0, EI_y=lambda x: c * np.exp(x / L), n_v=0, n_w=4)
+    unit = RitzBeam(L, 1.0, 1.0, n_v=0, n_w=4)
+    q = np.array([[0.3, -0.7, 0.2, 0.1]])
+    for x in (0.0, 0.7, 1.5, L):
+        EI = c * np.exp(x / L)
+        w2, w3 = unit.bending_moment(q, x)[0, 1], -unit.shear_force(q, x)[0, 1]
+        expected = -(EI / L * w2 + EI * w3)
+        assert tapered.shear_force(q, x)[0, 1] == pytest.approx(expected, rel=1e-13, abs=1e-13 * abs(EI * w3))
+
+
+def test_shear_force_of_a_real_only_EI_warns_once_and_differences():
+    """An EI(x) that casts to float cannot take the complex step: one DifferencesWarning naming
+    EI_y, then the central difference (~1e-10 relative) of the same closed form."""
+    L, c = 2.0, 5.0
+
+    def real_only(x):
+        return np.array([c * math.exp(float(xi) / L) for xi in x])
+
+    beam = RitzBeam(L, 1.0, 1.0, EI_y=real_only, n_v=0, n_w=4)
+    unit = RitzBeam(L, 1.0, 1.0, n_v=0, n_w=4)
+    q = np.array([[0.3, -0.7, 0.2, 0.1]])
+    with pytest.warns(DifferencesWarning, match=r"^EI_y .*real_only") as caught:
+        for x in (0.7, 1.5):
+            EI = c * np.exp(x / L)
+            expected = -(EI / L * unit.bending_moment(q, x)[0, 1] - EI * unit.shear_force(q, x)[0, 1])
+            assert beam.shear_force(q, x)[0, 1] == pytest.approx(expected, rel=1e-8)
+    assert len([w for w in caught if issubclass(w.category, DifferencesWarning)]) == 1

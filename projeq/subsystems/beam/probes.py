@@ -10,9 +10,12 @@ Ritz section forces converge more slowly than displacements (two and three deriv
 from __future__ import annotations
 
 import functools
+import warnings
 
 import numpy as np
 from numpy.typing import NDArray
+
+from projeq.analysis.differentiation import complex_step, raised_by, warn_differences
 
 MODERATE_DEFLECTION = 0.1  # deflections and axial displacements up to 10 % of the length
 MODERATE_ROTATION = 0.2  # slopes up to 0.2 rad: their square 0.04 is small against 1
@@ -105,14 +108,11 @@ class BeamProbes:
         return self._derivative(result, x, 2) * np.array([self._EI_at(x, "z"), self._EI_at(x, "y")])
 
     def shear_force(self, result, x: float) -> NDArray:
-        """Shear forces (Q_y, Q_z) = −((EI_z v″)′, (EI_y w″)′) at station x (N), one row per
-        time point: the force of the part beyond x on the part before x. For x-dependent
-        EI its slope comes from central differences (relative error ~1e-10)."""
+        """Shear forces (Q_y, Q_z) = −((EI_z v″)′, (EI_y w″)′) = −(EI′ Φ″ᵀq + EI Φ‴ᵀq) at
+        station x (N), one row per time point: the force of the part beyond x on the part
+        before x. The slope EI′(x) is exact (:meth:`_EI_slope`)."""
         EI = np.array([self._EI_at(x, "z"), self._EI_at(x, "y")])
-        h = 1e-6 * self.length
-        ahead, behind = min(x + h, self.length), max(x - h, 0.0)
-        EI_ahead, EI_behind = ([self._EI_at(at, axis) for axis in "zy"] for at in (ahead, behind))
-        EI_slope = (np.array(EI_ahead) - EI_behind) / (ahead - behind)
+        EI_slope = np.array([self._EI_slope(x, "z"), self._EI_slope(x, "y")])
         return -(EI_slope * self._derivative(result, x, 2) + EI * self._derivative(result, x, 3))
 
     def _derivative(self, result, x: float, order: int) -> NDArray:
@@ -130,7 +130,28 @@ class BeamProbes:
 
     def _EI_at(self, x: float, axis: str) -> float:
         EI = self._EI[axis]
-        return float(EI(np.array([x]))[0]) if callable(EI) else float(EI)
+        return float(np.ravel(EI(np.array([x])))[0]) if callable(EI) else float(EI)
+
+    def _EI_slope(self, x: float, axis: str) -> float:
+        """EI′(x): 0 for a constant EI; for EI a function of x its complex step Im EI(x + i h)/h
+        (Squire & Trapp, "Using complex variables to estimate derivatives of real functions",
+        SIAM Review 40, 1998; exact to round-off; a function that returns a real constant has
+        slope 0); a function that cannot take complex x (it casts to float) falls back, with one
+        warning per callable, to the central difference over 2e-6 L inside [0, L]
+        (relative error ~1e-10, :class:`~projeq.analysis.differentiation.DifferencesWarning`)."""
+        EI = self._EI[axis]
+        if not callable(EI):
+            return 0.0
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", np.exceptions.ComplexWarning)
+            try:
+                return float(complex_step(lambda h: np.ravel(EI(np.array([x + h])))[0]))
+            except (TypeError, ValueError, np.exceptions.ComplexWarning) as exc:
+                warn_differences(f"EI_{axis} (shear_force's slope EI′(x))", raised_by(exc),
+                                 f"{type(exc).__name__}: {exc}")
+        h = 1e-6 * self.length
+        ahead, behind = min(x + h, self.length), max(x - h, 0.0)
+        return (self._EI_at(ahead, axis) - self._EI_at(behind, axis)) / (ahead - behind)
 
     @staticmethod
     def _local(cols: slice) -> slice:
