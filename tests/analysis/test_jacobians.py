@@ -188,6 +188,15 @@ def _relative(J, reference):
     return np.abs(J - reference).max(initial=0.0) / max(1.0, np.abs(reference).max(initial=0.0))
 
 
+def _conditioning(system, q, t) -> float:
+    """max(1, κ₂(M)/10⁴): how much more than a well-conditioned tree two orders of the same
+    arithmetic may differ. s̈ solves M s̈ = b, whose forward error grows as κ(M) ε (Higham,
+    "Accuracy and Stability of Numerical Algorithms", 2nd ed. (2002), §7.1); random trees reach
+    κ ≈ 10⁵ (hypothesis found a planar–planar–revolute chain with κ = 7.8·10⁴ whose compiled and
+    interpreted Jacobians differ by 1.2e-12 = 0.07 κ ε)."""
+    return max(1.0, np.linalg.cond(system.mass_matrix(q, t)) / 1e4)
+
+
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(tree=trees(max_n=6, kinds=("revolute", "prismatic", "fixed"), forces=False))
 def test_compiled_one_call_equals_interpreted_complex_step(tree):
@@ -212,16 +221,17 @@ def test_compiled_column_by_column_with_every_joint_and_force_law(tree):
     through the compiled evaluator = the one through the reference evaluator to 1e-11 of
     max(1, |J|) (measured ≤ 3.1e-13, coupled ≤ 2.2e-12 over 200 trees: the two evaluators'
     round-off on ill-conditioned random trees) and = the same kernel source interpreted to 1e-12
-    (measured ≤ 3.8e-14, coupled ≤ 1.5e-13 over 150)."""
+    (measured ≤ 3.8e-14, coupled ≤ 1.5e-13 over 150), both bounds times :func:`_conditioning`
+    beyond κ(M) = 10⁴."""
     coupled = with_couplings(tree)
     for system, (q, s_dot, t) in ((tree.system, (tree.q, tree.s_dot, tree.t)),
                                   (coupled, random_state(coupled, tree.rng))):
         x = np.concatenate((q, s_dot))
         J, used = state_jacobian(system, x, t)
         assert used == "exact" and system.evaluator().name == "fast"
-        reference = system.evaluator("dense" if system.coupled else "recursive")
-        assert _relative(J, _reference_jacobian(system, x, t, reference)) <= 1e-11
-        assert _relative(J, _reference_jacobian(system, x, t, FastEvaluator(system, compiled=False))) <= 1e-12
+        reference, scale = system.evaluator("dense" if system.coupled else "recursive"), _conditioning(system, q, t)
+        assert _relative(J, _reference_jacobian(system, x, t, reference)) <= 1e-11 * scale
+        assert _relative(J, _reference_jacobian(system, x, t, FastEvaluator(system, compiled=False))) <= 1e-12 * scale
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
