@@ -229,14 +229,15 @@ class Prescribed(Joint):
 
     def angles(self, t: float) -> tuple[float, float, float]:
         """(θ, θ̇, θ̈) at t, checked: ValueError naming the motion and t when they are not three
-        finite numbers."""
+        finite numbers (complex at a complex t: the complex step through the motion)."""
         values = self.motion(t)
+        number = complex if isinstance(t, complex) else float
         try:
-            theta, theta_dot, theta_ddot = (float(v) for v in values)
+            theta, theta_dot, theta_ddot = (number(v) for v in values)
         except (TypeError, ValueError) as exc:
             raise ValueError(f"motion: {_label(self.motion)} must return three numbers (θ, θ̇, θ̈) at t = {t:.6g}, "
                              f"got {values!r}") from exc
-        if not (math.isfinite(theta) and math.isfinite(theta_dot) and math.isfinite(theta_ddot)):
+        if not (math.isfinite(abs(theta)) and math.isfinite(abs(theta_dot)) and math.isfinite(abs(theta_ddot))):
             raise ValueError(f"motion: {_label(self.motion)} returned (θ, θ̇, θ̈) = {(theta, theta_dot, theta_ddot)} "
                              f"at t = {t:.6g}; they must be finite")
         return theta, theta_dot, theta_ddot

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cmath
 import math
 
 import numpy as np
@@ -24,8 +25,9 @@ def spin_up_motion(omega_s: float, t_s: float):
     a, k = omega_s / t_s, 2.0 * np.pi / t_s
 
     def motion(t: float):
-        if t <= t_s:  # math's cos and sin: a scalar per right-hand side, 10× cheaper than numpy's
-            cos, sin = math.cos(k * t), math.sin(k * t)
+        if t.real <= t_s:  # math's cos and sin (cmath's for a complex step): a scalar, 10× cheaper than numpy's
+            trig = cmath if isinstance(t, complex) else math
+            cos, sin = trig.cos(k * t), trig.sin(k * t)
             return a * (0.5 * t * t + (cos - 1.0) / k**2), a * (t - sin / k), a * (1.0 - cos)
         return omega_s * (t - 0.5 * t_s), omega_s, 0.0
 

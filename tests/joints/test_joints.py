@@ -14,6 +14,8 @@ For a joint with coordinates q_n, minimal velocities ṡ_n and q̇_n = K ṡ_n +
 Every joint kind of ``tests/strategies.py`` is covered, one test case each.
 """
 
+import warnings
+
 import numpy as np
 import pytest
 import strategies as S
@@ -235,3 +237,23 @@ def test_chain_matrices_equal_those_of_the_absolute_poses(planar, data):
         assert np.abs(kin.y_dot[n] - chain).max() <= 1e-12 * max(1.0, np.abs(kin.y_dot[n]).max()), (
             system.names[n]
         )
+
+
+def test_a_prescribed_motion_takes_the_complex_step():
+    """Prescribed.angles at a complex t keeps the imaginary parts, so the complex step through a
+    complex-safe motion gives its rates exactly: Im θ(t + ih)/h = θ̇ and Im θ̇(t + ih)/h = θ̈ for
+    the spin-up's hub motion (closed form in scenes.elastic.spin_up_motion), during and after the
+    manoeuvre; the default scene's energy check then needs no differences (no DifferencesWarning)."""
+    from projeq.analysis.differentiation import DifferencesWarning
+    from projeq.scenes.elastic import spin_up_motion
+    from projeq.simulation.integrators import conserves_energy
+
+    joint = pq.Prescribed(pq.Revolute(axis="z"), spin_up_motion(4.0, 15.0))
+    for t in (3.0, 20.0):
+        stepped, exact = joint.angles(complex(t, 1e-30)), joint.angles(t)
+        assert np.imag(stepped[0]) / 1e-30 == pytest.approx(exact[1], rel=1e-14)
+        assert np.imag(stepped[1]) / 1e-30 == pytest.approx(exact[2], rel=1e-14, abs=1e-15)
+    system = pq.scenes.spin_up_beam()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DifferencesWarning)
+        assert not conserves_energy(system, system.q0, system.s_dot0)  # driven: dE/dt ≠ 0
