@@ -257,6 +257,20 @@ def second_derivative_along_differences(f, x: NDArray, u: NDArray, w: NDArray) -
     return nu * nw * richardson(lambda e: richardson(lambda g: f(x + e * u_hat + g * w_hat), h), h)
 
 
+def attempt_complex(run):
+    """(run(), None), or (None, the exception) where ``run`` — a computation at complex
+    arguments — raises TypeError or ValueError or casts a complex value to float (numpy's
+    ComplexWarning, raised as an error): the signs of a callable that cannot take complex
+    arguments, the one test of it that :func:`complex_failure` and the callers that fall back to
+    differences share."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", np.exceptions.ComplexWarning)
+        try:
+            return run(), None
+        except (TypeError, ValueError, np.exceptions.ComplexWarning) as exc:
+            return None, exc
+
+
 def is_complex_safe(f, x: NDArray) -> bool:
     """Whether f, evaluated at x + i 1e-30 (1, …, 1), returns complex values without an
     error or a cast that discards the imaginary part (then the complex step applies)."""
@@ -266,12 +280,9 @@ def is_complex_safe(f, x: NDArray) -> bool:
 def complex_failure(f, x: NDArray) -> str | None:
     """None if f is complex-safe at x (:func:`is_complex_safe`), else why not (the error and
     the function that raised it, :func:`raised_by`)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", np.exceptions.ComplexWarning)
-        try:
-            value = np.asarray(f(np.asarray(x) + 1j * COMPLEX_STEP * np.ones(len(x))))
-        except (TypeError, ValueError, np.exceptions.ComplexWarning) as exc:
-            return f"{type(exc).__name__}: {exc}, in {raised_by(exc)}"
+    value, exc = attempt_complex(lambda: np.asarray(f(np.asarray(x) + 1j * COMPLEX_STEP * np.ones(len(x)))))
+    if exc is not None:
+        return f"{type(exc).__name__}: {exc}, in {raised_by(exc)}"
     if not np.iscomplexobj(value):
         return "it returns real values for a complex argument"
     if not np.all(np.isfinite(value)):

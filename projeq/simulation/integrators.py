@@ -31,7 +31,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.integrate import DOP853, RK23, RK45, DenseOutput, OdeSolver
 
-from projeq.analysis.differentiation import complex_step, exact_jacobian, forward, is_complex_safe
+from projeq.analysis.differentiation import (attempt_complex, complex_step, exact_jacobian, forward,
+                                             is_complex_safe)
 from projeq.analysis.jacobians import differentiate
 
 PROJECTED = {"RK45-projected": RK45, "DOP853-projected": DOP853}
@@ -270,14 +271,7 @@ def _by_complex_step(fun, t: float, x: NDArray, run):
     states does), or during the run raises TypeError or ValueError or casts a complex value to
     float (simulate's right-hand side checks the distance to a coordinate singularity every 200
     calls, on real states)."""
-    if not is_complex_safe(lambda z: fun(t, z), x):
-        return None
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", np.exceptions.ComplexWarning)
-        try:
-            return run()
-        except (TypeError, ValueError, np.exceptions.ComplexWarning):
-            return None
+    return attempt_complex(run)[0] if is_complex_safe(lambda z: fun(t, z), x) else None
 
 
 def _eigen_mode(eigenvalues: NDArray) -> tuple[float, bool]:

@@ -10,12 +10,11 @@ Ritz section forces converge more slowly than displacements (two and three deriv
 from __future__ import annotations
 
 import functools
-import warnings
 
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.analysis.differentiation import complex_step, raised_by, warn_differences
+from projeq.analysis.differentiation import attempt_complex, complex_step, raised_by, warn_differences
 
 MODERATE_DEFLECTION = 0.1  # deflections and axial displacements up to 10 % of the length
 MODERATE_ROTATION = 0.2  # slopes up to 0.2 rad: their square 0.04 is small against 1
@@ -142,13 +141,10 @@ class BeamProbes:
         EI = self._EI[axis]
         if not callable(EI):
             return 0.0
-        with warnings.catch_warnings():
-            warnings.simplefilter("error", np.exceptions.ComplexWarning)
-            try:
-                return float(complex_step(lambda h: np.ravel(EI(np.array([x + h])))[0]))
-            except (TypeError, ValueError, np.exceptions.ComplexWarning) as exc:
-                warn_differences(f"EI_{axis} (shear_force's slope EI′(x))", raised_by(exc),
-                                 f"{type(exc).__name__}: {exc}")
+        slope, exc = attempt_complex(lambda: float(complex_step(lambda h: np.ravel(EI(np.array([x + h])))[0])))
+        if exc is None:
+            return slope
+        warn_differences(f"EI_{axis} (shear_force's slope EI′(x))", raised_by(exc), f"{type(exc).__name__}: {exc}")
         h = 1e-6 * self.length
         ahead, behind = min(x + h, self.length), max(x - h, 0.0)
         return (self._EI_at(ahead, axis) - self._EI_at(behind, axis)) / (ahead - behind)
