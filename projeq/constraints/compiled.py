@@ -42,8 +42,9 @@ Python, no coupled joints, no elastic bodies), and F by one of the two rules abo
 subclass's own, such as the augmented Lagrangian's). A Φ (or A) numba cannot compile, or whose
 compiled values differ from its own at complex points near q0, keeps the numpy path after one
 :class:`UncompiledClosureWarning` naming it; so does a model outside the kernel, the warning naming
-the piece (:func:`unsupported`: a Pfaffian row, a joint, a force law, ...) — never silently. Where the compiled call meets a degenerate partition
-(κ bound reached, or N_ind singular) or a singular FᵀMF it returns a flag and the numpy path
+the piece (:func:`unsupported`: a Pfaffian row, a joint, a force law, ...) — never silently.
+Where the compiled call meets a degenerate partition (κ bound reached, or N_ind singular) or a
+singular FᵀMF it returns a flag and the numpy path
 repeats the evaluation, which raises the error that names the cause (so does a force law without
 a value, a spring-damper whose two points coincide).
 """
@@ -84,10 +85,11 @@ def unsupported(system) -> str | None:
     partitioning) cannot be one compiled call (None if it can), module docstring."""
     tree = system.tree
     checks = (
-        (system.m_p > 0 and _rheonomic_rows(system), "Pfaffian constraints A(q, t) q̇ = b(q, t) with b ≠ 0 or A depending on t"),
+        (system.m_p > 0 and _rheonomic_rows(system),
+         "Pfaffian constraints A(q, t) q̇ = b(q, t) with b ≠ 0 or A depending on t"),
         (system.m_h == 0, "no holonomic constraints"),
         (system.rheonomic, "Φ may depend on t (correction other than 'projection')"),
-        (not (system._identity or _rates_are_speeds(tree)), _kinematics_piece(tree)),
+        (not system._identity and bool(_kinematics_joints(tree)), _kinematics_piece(tree)),
         (not system.exact, "Φ does not take complex arguments (no complex step)"),
         (not system.compiled_tree(), "the tree's default evaluator is not the compiled one "
                                      f"({tree.evaluator('auto').reason})"),
@@ -98,10 +100,15 @@ def unsupported(system) -> str | None:
     return _tree_piece(tree)
 
 
+def _kinematics_joints(tree) -> list:
+    """The joints with q̇ ≠ ṡ (K ≠ E): those with kinematics of their own but a UserJoint from
+    sympy whose rates are its speeds (UserJoint.rates_are_speeds)."""
+    return [n for n in tree._general_kinematics if not getattr(tree.joints[n], "rates_are_speeds", False)]
+
+
 def _kinematics_piece(tree) -> str:
     """The joints with q̇ ≠ ṡ (K ≠ E), named."""
-    names = [f"{tree.names[n]!r} ({type(tree.joints[n]).__name__})" for n in tree._general_kinematics
-             if not getattr(tree.joints[n], "rates_are_speeds", False)]
+    names = [f"{tree.names[n]!r} ({type(tree.joints[n]).__name__})" for n in _kinematics_joints(tree)]
     return f"joints with q̇ ≠ ṡ (K ≠ E){': ' + ', '.join(names) if names else ''}"
 
 
@@ -147,11 +154,6 @@ def _rheonomic_rows(system) -> bool:
     A0 = np.asarray(system._A(system.q0, 0.0), dtype=float)
     return system._b is not None or any(not np.array_equal(np.asarray(system._A(system.q0, t), dtype=float), A0)
                                         for t in (0.37, 1.9))
-
-
-def _rates_are_speeds(tree) -> bool:
-    """Whether every joint with its own kinematics has q̇ = ṡ identically (UserJoint.rates_are_speeds)."""
-    return all(getattr(tree.joints[n], "rates_are_speeds", False) for n in tree._general_kinematics)
 
 
 def _python_joints(ev) -> list:
