@@ -27,6 +27,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import inspect
+import sys
 import types
 from pathlib import Path
 
@@ -742,15 +743,14 @@ def _compiled():
 @functools.cache
 def _compiled_jacobians(loads):
     """{name: kernel}: :func:`tree_jacobian` with either passes (:func:`jacobian_kernel`), calling
-    the compiled chain_terms, passes and loads loop; each cached on disk under its name and a
-    digest of the loads loop's sources (its module and the laws' statements it calls): numba's
-    disk cache checks this file only, and a cached kernel holds the code of the kernels it calls."""
-    compiled, digest = _compiled(), _digest(loads, *loads.CALLEES)
+    the compiled chain_terms, passes and loads loop; cached on disk as :func:`jit` caches (under
+    a digest that sees the loads loop's edits: a cached kernel holds the code of those it calls)."""
+    compiled = _compiled()
     jacobians = {}
     for name, passes_ in (("tree_jacobian", compiled["passes"]),
                           ("rigid_tree_jacobian", compiled["rigid_passes"])):
         callees = {"chain_terms": compiled["chain_terms"], "passes": passes_, "add_loads": loads.kernel(True)}
-        jacobians[name] = _jit(tree_jacobian, names=(f"{name}_{digest}",), kernels=callees)[0]
+        jacobians[name] = jit(tree_jacobian, names=(name,), kernels=callees)[0]
     return jacobians
 
 
@@ -792,18 +792,20 @@ def _compiled_gauss_form():
     return _jit(gauss_form, projected_accelerations)
 
 
-def jit(*functions, callees=(), kernels=None):
-    """``functions`` of another module compiled by numba as this module's kernels are
-    (:func:`_jit`): with their module's names, this module's callees, ``callees`` (the plain
-    functions they call besides, compiled with them) and the compiled ``kernels`` they call by
-    name. numba's disk cache checks the file of a compiled function only, so each is cached
-    under its name and a digest (:func:`_digest`) of this module's source, its callees' and its
-    compiled kernels' (their source and their names, which carry the digest of their own
-    callees): an edit to any, in another file than the function's, compiles it anew."""
+def jit(*functions, callees=(), kernels=None, names=None):
+    """``functions`` compiled by numba as this module's kernels are (:func:`_jit`): with their
+    module's names, this module's callees, ``callees`` (the plain functions they call besides,
+    compiled with them) and the compiled ``kernels`` they call by name. numba's disk cache checks
+    the file of a compiled function only, so each is cached under its name (or that of
+    ``names``: one function compiled twice with other kernels) and a digest (:func:`_digest`) of
+    this module's source, its callees' and its compiled kernels' (the source of their modules —
+    their constants too — and their names, which carry the digest of their own callees): an
+    edit to any, in another file than the function's, compiles it anew."""
     compiled = [k.py_func for k in (kernels or {}).values() if hasattr(k, "py_func")]
-    digest = _digest(*callees, *compiled, names="".join(f.__qualname__ for f in compiled))
-    return _jit(*functions, names=tuple(f"{f.__name__}_{digest}" for f in functions), callees=callees,
-                kernels=kernels)
+    modules = dict.fromkeys(sys.modules[f.__module__] for f in compiled)
+    digest = _digest(*callees, *modules, names="".join(f.__qualname__ for f in compiled))
+    return _jit(*functions, names=tuple(f"{name}_{digest}" for name in names or [f.__name__ for f in functions]),
+                callees=callees, kernels=kernels)
 
 
 def _digest(*sources, names: str = "") -> str:
