@@ -40,9 +40,12 @@ any other subsystem without rigid-body terms (beams in chains, a subsystem that 
 
 Complex arguments (the complex step of :mod:`projeq.analysis.jacobians`) run the same kernels,
 compiled by numba for complex128, on a complex workspace allocated on first use (force laws
-and joints of kind GIVEN state their numbers on it too); :meth:`FastEvaluator.state_jacobian`
-takes all columns of ∂ẋ/∂x in one compiled call (:func:`projeq.assembly.kernels.tree_jacobian`,
-the compiled force laws' loop included) where no Python runs between the kernels.
+and joints of kind GIVEN state their numbers on it too); where no Python runs between the
+kernels, :meth:`FastEvaluator.state_derivative` gives ẋ = (ṡ, s̈) and
+:meth:`FastEvaluator.state_jacobian` all columns of ∂ẋ/∂x, each in one compiled call
+(:func:`projeq.assembly.kernels.tree_state_derivative`, :func:`~projeq.assembly.kernels.tree_jacobian`:
+the same evaluation, :func:`~projeq.assembly.kernels.tree_accelerations`, the compiled force
+laws' loop included).
 
 >>> import numpy as np, projeq as pq
 >>> system = pq.scenes.chain(3)
@@ -104,10 +107,10 @@ class FastEvaluator:
         rigid = bool(np.all(self._index[:, kernels.N_Y] == 6))
         self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=rigid)
         self._add_loads = loads.kernel(self.compiled) if len(self._laws) else None
-        # ∂ẋ/∂x in one call where no Python runs between the kernels (no joint of kind GIVEN, no
+        # ẋ and ∂ẋ/∂x in one call where no Python runs between the kernels (no joint of kind GIVEN, no
         # force law without a compiled row, no coupling): then every joint has q̇ = ṡ (K = E)
-        self._jacobian = kernels.jacobian_kernel(loads, self.compiled, rigid=rigid) \
-            if not (self._given or self._python_laws or system.coupled) else None
+        self._x_dot, self._jacobian = kernels.state_kernels(loads, self.compiled, rigid=rigid) \
+            if not (self._given or self._python_laws or system.coupled) else (None, None)
 
     def _pack(self, system) -> None:
         """Flat arrays of the tree (built once) and the real workspace (a complex one on first use,
@@ -264,6 +267,21 @@ class FastEvaluator:
                 "it moves no mass or inertia"
             )
         return s_ddot
+
+    def state_derivative(self, t: float, x: NDArray) -> NDArray | None:
+        """ẋ = (q̇, s̈) = (ṡ, s̈) at the real state x = (q, ṡ) in one call,
+        :func:`projeq.assembly.kernels.tree_state_derivative` (the compiled force laws' loads
+        included), for :func:`projeq.simulate`'s right-hand side; None where Python runs between
+        the kernels (as :meth:`state_jacobian`), for a complex x, or where x or ẋ is not finite or
+        an evaluation fails (the caller's checked evaluation then raises, naming it)."""
+        if self._x_dot is None or x.dtype.kind != "f":
+            return None
+        self.n_calls += 1
+        ws, x_dot = self._real, np.empty(len(x))
+        failed = self._x_dot(self._index, self._geometry, self._inertia, self._gravity, self._laws, self._law_constants,
+                             x, self.system.n_q, ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F,
+                             ws.M_n, ws.M_hat, ws.h_hat, ws.R, ws.r, ws.twist, self._pivot_min, x_dot)
+        return x_dot if failed < 0 else None
 
     def state_jacobian(self, t: float, x: NDArray) -> NDArray | None:
         """∂ẋ/∂x at the real state x = (q, ṡ) by the complex step through the kernels,

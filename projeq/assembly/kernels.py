@@ -505,30 +505,57 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
     return -1
 
 
+def tree_accelerations(index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port, T, zeta,
+                       F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, s_ddot):
+    """s̈ of the order-n kernel at the state x = (q, ṡ) (real, or complex for a complex step) into
+    s_ddot: :func:`chain_terms`, the loads of the force laws' rows ``laws``, ``constants``
+    (:func:`projeq.assembly.loads.add_loads`, bound by :func:`state_kernels`) and :func:`passes`
+    on a workspace of x's dtype (T ... twist). For trees whose kinematics the kernel computes
+    itself (no joint of kind GIVEN) and whose laws all have compiled rows. Returns −1, or where
+    the evaluation failed: the :func:`passes` index of the first singular pivot, or n_x + the row
+    of a law that cannot be evaluated (a spring-damper whose points coincide)."""
+    chain_terms(index, geometry, inertia, gravity, x[:n_q], x[n_q:], given, elastic, port, T, zeta, F, M_n, h_hat,
+                R, r_O, twist)
+    if laws.shape[0]:
+        failed = add_loads(laws, constants, index, x[:n_q], x[n_q:], R, r_O, twist, F, T, h_hat)  # noqa: F821
+        if failed >= 0:
+            return x.shape[0] + failed
+    return passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot)
+
+
+def tree_state_derivative(index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port, T,
+                          zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, x_dot):
+    """ẋ = (q̇, s̈) = (ṡ, s̈) at the real state x = (q, ṡ) into x_dot in one call
+    (:func:`tree_accelerations`; q̇ = ṡ: K = E for the trees it takes), the right-hand side of
+    :func:`projeq.simulate` without Python between the kernels. Returns −1, or where the
+    evaluation failed (:func:`tree_accelerations`' index) or x or ẋ is not finite: a
+    non-negative number (the caller's checked evaluation then raises, naming the cause)."""
+    failed = tree_accelerations(index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port,
+                                T, zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, x_dot[n_q:])
+    if failed >= 0:
+        return failed
+    for i in range(n_q):
+        x_dot[i] = x[n_q + i]
+    for i in range(x.shape[0]):
+        if not (np.isfinite(x[i]) and np.isfinite(x_dot[i])):
+            return x.shape[0] + laws.shape[0]
+    return -1
+
+
 def tree_jacobian(index, geometry, inertia, gravity, laws, constants, x, n_q, step, given, elastic, port, T,
                   zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, J):
     """∂s̈/∂x of the order-n kernel at the real state x = (q, ṡ) by the complex step, column
-    k = Im s̈(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998): :func:`chain_terms`,
-    the loads of the force laws' rows ``laws``, ``constants``
-    (:func:`projeq.assembly.loads.add_loads`, bound by :func:`jacobian_kernel`) and
-    :func:`passes` n_x times in one call on a complex workspace (T ... twist: complex128);
-    written into J (n_s × n_x). For trees whose kinematics the kernel computes itself (no
-    joint of kind GIVEN) and whose laws all have compiled rows. Returns −1, or where an
-    evaluation failed: the :func:`passes` index of the first singular pivot, or n_x + the row
-    of a law that cannot be evaluated (a spring-damper whose points coincide)."""
+    k = Im s̈(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998):
+    :func:`tree_accelerations` n_x times in one call on a complex workspace (T ... twist:
+    complex128); written into J (n_s × n_x). Returns −1, or the first failed evaluation's
+    index (:func:`tree_accelerations`)."""
     n_x = x.shape[0]
     z, s_ddot = np.empty(n_x, T.dtype), np.empty(J.shape[0], T.dtype)
     for k in range(n_x):
         z[:] = x
         z[k] += 1j * step
-        chain_terms(index, geometry, inertia, gravity, z[:n_q], z[n_q:], given, elastic, port, T, zeta, F, M_n,
-                    h_hat, R, r_O, twist)
-        if laws.shape[0]:
-            failed = add_loads(laws, constants, index, z[:n_q], z[n_q:], R, r_O, twist, F, T,  # noqa: F821
-                               h_hat)
-            if failed >= 0:
-                return n_x + failed
-        failed = passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot)
+        failed = tree_accelerations(index, geometry, inertia, gravity, laws, constants, z, n_q, given, elastic,
+                                    port, T, zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, s_ddot)
         if failed >= 0:
             return failed
         for i in range(J.shape[0]):
@@ -713,17 +740,19 @@ def kernel(compiled: bool = True, rigid: bool = False):
     return compiled_kernels["chain_terms"], compiled_kernels["rigid_passes" if rigid else "passes"]
 
 
-def jacobian_kernel(loads, compiled: bool = True, rigid: bool = False):
-    """:func:`tree_jacobian`, compiled by numba (as :func:`kernel`, with the same ``rigid``
-    passes) or with ``compiled=False`` interpreted, calling the force laws' loop ``add_loads`` of
-    ``loads`` (the module :mod:`projeq.assembly.loads`, compiled or interpreted alike; it imports
-    this module, so the caller hands it in) by name, as the compiled kernels call each other
-    (:func:`_jit`)."""
+def state_kernels(loads, compiled: bool = True, rigid: bool = False):
+    """(:func:`tree_state_derivative`, :func:`tree_jacobian`), compiled by numba (as :func:`kernel`,
+    with the same ``rigid`` passes) or with ``compiled=False`` interpreted, calling the force laws'
+    loop ``add_loads`` of ``loads`` (the module :mod:`projeq.assembly.loads`, compiled or
+    interpreted alike; it imports this module, so the caller hands it in) by name, as the
+    compiled kernels call each other (:func:`_jit`)."""
     if not compiled:
         namespace = {**globals(), "add_loads": loads.add_loads}
-        return types.FunctionType(tree_jacobian.__code__, namespace, "tree_jacobian")
+        namespace["tree_accelerations"] = types.FunctionType(tree_accelerations.__code__, namespace)
+        return tuple(types.FunctionType(f.__code__, namespace, f.__name__) for f in (tree_state_derivative,
+                                                                                       tree_jacobian))
     kernel(True)  # the same refusal without numba
-    return _compiled_jacobians(loads)["rigid_tree_jacobian" if rigid else "tree_jacobian"]
+    return _compiled_state_kernels(loads)["rigid" if rigid else "general"]
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
@@ -741,17 +770,19 @@ def _compiled():
 
 
 @functools.cache
-def _compiled_jacobians(loads):
-    """{name: kernel}: :func:`tree_jacobian` with either passes (:func:`jacobian_kernel`), calling
-    the compiled chain_terms, passes and loads loop; cached on disk as :func:`jit` caches (under
-    a digest that sees the loads loop's edits: a cached kernel holds the code of those it calls)."""
+def _compiled_state_kernels(loads):
+    """{"general" | "rigid": (tree_state_derivative, tree_jacobian)} with either passes
+    (:func:`state_kernels`), calling the compiled chain_terms, passes and loads loop; cached on
+    disk as :func:`jit` caches (under a digest that sees the loads loop's edits: a cached kernel
+    holds the code of those it calls)."""
     compiled = _compiled()
-    jacobians = {}
-    for name, passes_ in (("tree_jacobian", compiled["passes"]),
-                          ("rigid_tree_jacobian", compiled["rigid_passes"])):
+    found = {}
+    for variant, passes_ in (("general", compiled["passes"]), ("rigid", compiled["rigid_passes"])):
         callees = {"chain_terms": compiled["chain_terms"], "passes": passes_, "add_loads": loads.kernel(True)}
-        jacobians[name] = jit(tree_jacobian, names=(name,), kernels=callees)[0]
-    return jacobians
+        prefix = "" if variant == "general" else "rigid_"
+        found[variant] = jit(tree_state_derivative, tree_jacobian, callees=(tree_accelerations,), kernels=callees,
+                             names=(f"{prefix}tree_state_derivative", f"{prefix}tree_jacobian"))
+    return found
 
 
 def gauss_form_kernel(compiled: bool = True):
