@@ -34,7 +34,7 @@ from projeq.analysis.jacobians import state_derivative, state_jacobian
 from projeq.assembly import EVALUATORS
 from projeq.checks import callable_name, closest, count, finite_array, positive, state_vector
 from projeq.simulation.integrators import (
-    EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, warn_if_stiff,
+    EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, stiff_steps, warn_stiff,
 )
 from projeq.simulation.result import Result, SimulationError
 from projeq.constraints.nonholonomic import near_singularity
@@ -180,7 +180,7 @@ def simulate(
     """
     run = _Run(system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
                evaluator, n_segments, progress, jac, options, dense_output)
-    started, stiff_warned, checked = _time.perf_counter(), False, 0  # one StiffnessWarning per run at most
+    started, stiff, checked = _time.perf_counter(), None, 0  # one stiffness verdict per run at most
     with run.stopping():
         segments = deque(zip(run.bounds[:-1], run.bounds[1:]))  # a model event splits one
         while segments:
@@ -196,10 +196,14 @@ def simulate(
                 run.status, run.message = segment.status, segment.message
                 break
             else:
-                if not stiff_warned and run.steps >= 2 * checked:  # ρ at most log₂(steps) times per run
+                if stiff is None and run.steps >= 2 * checked:  # ρ at most log₂(steps) times per run
                     checked = run.steps
-                    stiff_warned = warn_if_stiff(run.exact_rhs, run.steps, run.t_start, b, run.x_end, run.method,
-                                                 rtol, getattr(run.ev, "state_jacobian", None))
+                    stiff = stiff_steps(run.exact_rhs, run.steps, run.t_start, b, run.x_end, run.method, rtol,
+                                        getattr(run.ev, "state_jacobian", None))
+                    if stiff is not None and run.chosen:
+                        run.go_implicit(b, stiff)
+                    elif stiff is not None:
+                        warn_stiff(run.method, stiff)
                 run.end_segment(b)
     result = _assemble(run, _time.perf_counter() - started, dense_output)
     if not run.out_of_range and len(result.t) and result.q.shape[1] == system.tree.n_q:
@@ -250,13 +254,14 @@ class _Run:
         self.fused = getattr(self.ev, "state_derivative", None)
         system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
         self.ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
-        if method is None:
+        self.chosen = method is None  # simulate's choice: it may go on with Radau (go_implicit)
+        if self.chosen:
             method = default_method(self.ev, system, q0, s_dot0, t_start, t_end, self.rtol)
             _check_options(method, options)
         self.method, self.progress, self.options = method, progress, options
         self.solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
-        self.jac = _jac_option(method, jac)
+        self.jac, self.switched, self.note = _jac_option(method, jac), "", ""  # go_implicit's record
         self.pieces, self.nfev, self.njev, self.cause, self.steps, self.calls = [], 0, 0, None, 0, 0
         self.dense_output, self.x_end = bool(dense_output), None  # x_end: the state at the end of the last segment
         self.out_of_range = False  # warned that a subsystem left the range of its model
@@ -369,6 +374,16 @@ class _Run:
         if self.method in PROJECTED:  # the same energy, now in the new partition's s_dot
             self.solver = projected_solver(self.method, self.model, x[:n_q], s_dot, t)
         return t
+
+    def go_implicit(self, t: float, evidence: str) -> None:
+        """The rest of a run whose explicit method simulate chose goes on with Radau and the
+        exact Jacobian, from t, where its steps were found to crawl at their stability limit
+        (``evidence``: :func:`~projeq.simulation.integrators.stiff_steps`): the choice a
+        :class:`~projeq.simulation.integrators.StiffnessWarning` would advise, recorded in
+        ``Result.method`` ("DOP853, Radau from t = …") and, with the evidence, ``Result.message``."""
+        self.switched = f"{self.method}, Radau from t = {t:.6g} s"
+        self.note = f"{self.method} crawled at its stability limit by t = {t:.6g} s ({evidence}): Radau went on. "
+        self.method = self.solver = "Radau"
 
     def end_segment(self, b: float) -> None:
         """The next segment starts at b, from the state there (not at the last output time)."""
@@ -578,8 +593,8 @@ def _assemble(run: _Run, wall_time: float, dense_output: bool) -> Result:
     return Result(
         t=t, q=q, s_dot=s_dot, kinetic=energies[:, 0], potential=energies[:, 1],
         constraint_residual=residual, nfev=int(run.nfev), njev=int(run.njev), wall_time=wall_time,
-        status=int(run.status), message=str(run.message), t_events=t_events, q_events=q_events,
-        s_dot_events=s_dot_events, names=system.names, method=getattr(run.method, "__name__", str(run.method)),
+        status=int(run.status), message=run.note + str(run.message), t_events=t_events, q_events=q_events,
+        s_dot_events=s_dot_events, names=system.names, method=run.switched or getattr(run.method, "__name__", str(run.method)),
         partitions=partitions, coordinates=system.coordinates(),
         velocities=system.velocities() if len(partitions) < 2 else tuple((f"s_dot[{i}]", "") for i in range(n_s)),
         sol=_dense_solution(pieces, n_q) if dense_output and pieces else None, system=system,
