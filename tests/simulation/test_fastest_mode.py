@@ -21,6 +21,7 @@ from projeq.analysis.jacobians import state_derivative, state_jacobian
 from projeq.simulation import driver
 from projeq.simulation.driver import default_method
 from projeq.simulation.integrators import fastest_mode, spectral_radius
+from tests.simulation.test_extremes import axially_stiff_beam
 
 
 @pytest.mark.parametrize("J, rho, decays", [
@@ -204,7 +205,8 @@ def test_a_default_run_whose_explicit_steps_crawl_goes_on_with_radau():
     for stability over the 10 s and default_method keeps DOP853 (bent by 1 cm it is 4× faster
     than Radau: benchmarks/default_integrator.py). At rest its steps outgrow the stability
     limit (ρh = 8.8 by t = 4 s): a forced DOP853 gets the StiffnessWarning, the default run
-    goes on with Radau instead, without one, and says so; bent by 1 cm, DOP853 to the end."""
+    goes on with Radau instead, without one, and says so; bent by 1 cm (over 2 s), DOP853 to
+    the end."""
     rest, bent = pq.scenes.spinning_beam(), spinning_beam_bent(0.01)
     x0 = np.zeros(rest.n_q + rest.n_s)
     rho, decays = fastest_mode(None, 0.0, x0, jacobian=rest.evaluator().state_jacobian)
@@ -215,7 +217,23 @@ def test_a_default_run_whose_explicit_steps_crawl_goes_on_with_radau():
     with warnings.catch_warnings():
         warnings.simplefilter("error", pq.StiffnessWarning)
         chosen = pq.simulate(rest, 10.0, n_points=2)
-        assert pq.simulate(bent, 10.0, n_points=2).method == "DOP853"
+        assert pq.simulate(bent, 2.0, n_points=2).method == "DOP853"
     assert chosen.method == "DOP853, Radau from t = 4 s" and chosen.njev > 0
     assert chosen.message.startswith("DOP853 crawled at its stability limit by t = 4 s (mean step 0.0714 s")
     np.testing.assert_array_equal(chosen.q[-1], 0.0)
+
+
+def test_the_default_run_goes_on_from_where_its_explicit_steps_crawled():
+    """The axially stiff beam of test_extremes (ρ = 1.7e3 1/s) over 0.5 s (within the beam's
+    moderate deflections): the default run's DOP853 steps crawl and Radau takes over from
+    t = 0.1 s, without a StiffnessWarning; its
+    final state is a run of Radau throughout's within 50 (rtol |x| + atol), the bound
+    test_extremes holds two methods' runs to (both keep their local errors at rtol)."""
+    system = axially_stiff_beam()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pq.StiffnessWarning)
+        chosen = pq.simulate(system, 0.5, n_points=2)
+        implicit = pq.simulate(system, 0.5, method="Radau", n_points=2)
+    assert chosen.method == "DOP853, Radau from t = 0.1 s"
+    for mine, theirs in ((chosen.q[-1], implicit.q[-1]), (chosen.s_dot[-1], implicit.s_dot[-1])):
+        assert np.all(np.abs(mine - theirs) < 50 * (1e-8 * np.abs(theirs) + 1e-10))
