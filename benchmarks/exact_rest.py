@@ -7,7 +7,7 @@ measured in one run:
    by the complex step); both against Richardson's difference of ρ (h = 1e-4) at the outputs of
    the first 0.7 s, the event times found, their distance to the parallelogram motion's
    horizontal cranks, the CPU per event call and of the whole run (the run without the event too).
-2. simulate's stiffness check (warn_if_stiff) on the four-bar and A02 at t = 1 s: ρ by the
+2. simulate's stiffness check (stiff_steps) on the four-bar and A02 at t = 1 s: ρ by the
    power iteration on forward differences of the fused real-only right-hand side it used
    against ρ now (the model's complex-safe ẋ) and the eigenvalues of the exact Jacobian.
 

@@ -14,9 +14,10 @@ Two concerns of the numerics at the extremes (issue 7, item 4):
   grows linearly, as for the base method.
 * **Stiffness.** An explicit method on a stiff model (a beam whose axial modes are 10³
   times faster than its bending modes) does not fail: it crawls at the step its stability
-  region allows. :func:`warn_if_stiff` recognises such a crawl over the steps of a run of
-  :func:`projeq.simulate` so far (whatever its segments) and warns (:class:`StiffnessWarning`) with the suggestion of an
-  implicit method.
+  region allows. :func:`stiff_steps` recognises such a crawl over the steps of a run of
+  :func:`projeq.simulate` so far (whatever its segments): a run whose method simulate chose
+  goes on with Radau, one whose explicit method the user chose gets a
+  :class:`StiffnessWarning` (:func:`warn_stiff`) with the suggestion of an implicit method.
 
 ``PROJECTED`` maps the method names :func:`projeq.simulate` accepts to their base method.
 """
@@ -238,7 +239,7 @@ def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None)
     * power iteration on forward-difference products (f(x + εv) − f(x))/ε, ε = √ε_m (1 + |x|),
       only for an f that cannot take complex states (a user's callable that casts to float, a
       compiled right-hand side for real states such as simulate's fused ``state_derivative``;
-      simulate hands :func:`warn_if_stiff` the model's complex-safe ẋ instead).
+      simulate hands :func:`stiff_steps` the model's complex-safe ẋ instead).
 
     The power iteration: ρ is the geometric mean growth ‖J v_k‖ over an even number of the last
     iterations (for an undamped mode, a pair ±iω, the growth alternates between ω²|a|/|b| and
@@ -323,11 +324,11 @@ def _stability_interval(name: str) -> float:
     return -float(brentq(amplification, grid[first - 1], grid[first], xtol=1e-12))
 
 
-def warn_if_stiff(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rtol: float,
-                  jacobian=None) -> bool:
-    """Warn (:class:`StiffnessWarning`) if an explicit ``method``'s ``n_steps`` steps from t0
-    to t (all of a run's segments so far, whatever the segmenting) sit at its stability
-    limit; ``x`` is the state at t. True if it warned.
+def stiff_steps(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rtol: float,
+                jacobian=None) -> str | None:
+    """Whether an explicit ``method``'s ``n_steps`` steps from t0 to t (all of a run's segments
+    so far, whatever the segmenting) sit at its stability limit: the evidence (mean step, ρ,
+    ρh) as text, or None; ``x`` is the state at t.
 
     The criterion: mean step h with ρ h at least half the method's :func:`stability_limit`
     (ρ = :func:`spectral_radius` at (t, x), exact for a complex-safe ``fun`` or with the
@@ -340,19 +341,24 @@ def warn_if_stiff(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rt
     benchmarks/default_integrator.py.)
     """
     if method not in EXPLICIT or rtol > 1e-5 or n_steps < 50:
-        return False
+        return None
     h = (t - t0) / n_steps
     rho = spectral_radius(fun, t, x, jacobian=jacobian)
     if rho * h < 0.5 * stability_limit(method):
-        return False
+        return None
+    return f"mean step {h:.3g} s, fastest mode {rho:.3g} 1/s, ρh = {rho * h:.2g}"
+
+
+def warn_stiff(method, evidence: str) -> None:
+    """The :class:`StiffnessWarning` of a run whose explicit ``method`` the user chose and whose
+    steps crawl at its stability limit (``evidence``: :func:`stiff_steps`'), for the caller of
+    :func:`projeq.simulate`."""
     warnings.warn(
-        f"method: {method!r} is explicit and crawls at its stability limit (mean step {h:.3g} s, "
-        f"fastest mode {rho:.3g} 1/s, ρh = {rho * h:.2g}): the model is stiff (a very stiff beam, or a "
-        "pose near a coordinate singularity); try method='Radau' or 'BDF'",
+        f"method: {method!r} is explicit and crawls at its stability limit ({evidence}): the model "
+        "is stiff (a very stiff beam, or a pose near a coordinate singularity); try method='Radau' or 'BDF'",
         StiffnessWarning,
         stacklevel=3,
     )
-    return True
 
 
 # -- Radau IIA for differential-algebraic equations ----------------------------------------

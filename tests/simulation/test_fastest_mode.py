@@ -21,6 +21,7 @@ from projeq.analysis.jacobians import state_derivative, state_jacobian
 from projeq.simulation import driver
 from projeq.simulation.driver import default_method
 from projeq.simulation.integrators import fastest_mode, spectral_radius
+from tests.simulation.test_extremes import axially_stiff_beam
 
 
 @pytest.mark.parametrize("J, rho, decays", [
@@ -163,18 +164,18 @@ def test_default_method_picks_radau_for_the_overdamped_spring_and_dop853_for_the
 
 
 def test_simulates_stiffness_check_is_exact_on_a_closed_loop(monkeypatch):
-    """simulate's stiffness check (warn_if_stiff) on the four-bar, a closed loop whose fused
+    """simulate's stiffness check (stiff_steps) on the four-bar, a closed loop whose fused
     compiled right-hand side takes real states only: it is handed the model's complex-safe
     ẋ, so its ρ is the largest |λ| of the exact (complex-step) Jacobian at the segment's end,
     to round-off, and agrees with Richardson's differences (1e-8; the forward-difference power
     iteration on the fused right-hand side it replaced gave ρ 8.2 % low at t = 1)."""
-    seen, original = [], driver.warn_if_stiff
+    seen, original = [], driver.stiff_steps
 
     def spy(fun, n_steps, t0, t, x, method, rtol, one_call=None):
         seen.append((fun, t, np.array(x), one_call))
         return original(fun, n_steps, t0, t, x, method, rtol, one_call)
 
-    monkeypatch.setattr(driver, "warn_if_stiff", spy)
+    monkeypatch.setattr(driver, "stiff_steps", spy)
     system = pq.scenes.four_bar()
     pq.simulate(system, 1.0, method="RK45", rtol=1e-6, n_segments=2)
     assert seen
@@ -185,3 +186,54 @@ def test_simulates_stiffness_check_is_exact_on_a_closed_loop(monkeypatch):
         differences = np.abs(np.linalg.eigvals(richardson_jacobian(lambda z: state_derivative(system, z, t), x))).max()
         assert rho == pytest.approx(exact, rel=1e-12)
         assert rho == pytest.approx(differences, rel=1e-8)
+
+
+def spinning_beam_bent(tip: float) -> pq.System:
+    """The spinning beam scene (at rest: q = 0 is its solution) bent by its first v function to
+    ``tip`` m at the tip."""
+    beam = pq.scenes.spinning_beam()
+    q0 = np.zeros(beam.n_q)
+    q0[0] = tip
+    return pq.System(dict(zip(beam.names, beam.subsystems)), dict(zip(beam.names, beam.joints)), q0=q0)
+
+
+def test_a_default_run_whose_explicit_steps_crawl_goes_on_with_radau():
+    """The spinning beam scene (EI = ρA = L = 1, Ω = 2 rad/s, four clamped–free functions per
+    plane): ρ at rest is its fourth bending frequency β₄² √(EI/(ρA L⁴)) raised by the spin Ω
+    in the co-rotating frame (the eigenvalues ±i(ω_k ± Ω) of a round beam spinning about its
+    axis; β₄L = 10.99554 of cos βL cosh βL = −1), so DOP853 needs ρT/6.39 = 192 < 100,000 steps
+    for stability over the 10 s and default_method keeps DOP853 (bent by 1 cm it is 4× faster
+    than Radau: benchmarks/default_integrator.py). At rest its steps outgrow the stability
+    limit (ρh = 8.8 by t = 4 s): a forced DOP853 gets the StiffnessWarning, the default run
+    goes on with Radau instead, without one, and says so; bent by 1 cm (over 2 s), DOP853 to
+    the end."""
+    rest, bent = pq.scenes.spinning_beam(), spinning_beam_bent(0.01)
+    x0 = np.zeros(rest.n_q + rest.n_s)
+    rho, decays = fastest_mode(None, 0.0, x0, jacobian=rest.evaluator().state_jacobian)
+    assert rho == pytest.approx(10.995540734875467**2 + 2.0, rel=1e-9) and not decays
+    assert default_method(rest.evaluator(), rest, rest.q0, rest.s_dot0, 0.0, 10.0) == "DOP853"
+    with pytest.warns(pq.StiffnessWarning, match="ρh = 8.8"):
+        assert pq.simulate(rest, 10.0, method="DOP853", n_points=2).method == "DOP853"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pq.StiffnessWarning)
+        chosen = pq.simulate(rest, 10.0, n_points=2)
+        assert pq.simulate(bent, 2.0, n_points=2).method == "DOP853"
+    assert chosen.method == "DOP853, Radau from t = 4 s" and chosen.njev > 0
+    assert chosen.message.startswith("DOP853 crawled at its stability limit by t = 4 s (mean step 0.0714 s")
+    np.testing.assert_array_equal(chosen.q[-1], 0.0)
+
+
+def test_the_default_run_goes_on_from_where_its_explicit_steps_crawled():
+    """The axially stiff beam of test_extremes (ρ = 1.7e3 1/s) over 0.5 s (within the beam's
+    moderate deflections): the default run's DOP853 steps crawl and Radau takes over from
+    t = 0.1 s, without a StiffnessWarning; its
+    final state is a run of Radau throughout's within 50 (rtol |x| + atol), the bound
+    test_extremes holds two methods' runs to (both keep their local errors at rtol)."""
+    system = axially_stiff_beam()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pq.StiffnessWarning)
+        chosen = pq.simulate(system, 0.5, n_points=2)
+        implicit = pq.simulate(system, 0.5, method="Radau", n_points=2)
+    assert chosen.method == "DOP853, Radau from t = 0.1 s"
+    for mine, theirs in ((chosen.q[-1], implicit.q[-1]), (chosen.s_dot[-1], implicit.s_dot[-1])):
+        assert np.all(np.abs(mine - theirs) < 50 * (1e-8 * np.abs(theirs) + 1e-10))
