@@ -483,10 +483,13 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
 
 
 def _may_be_singular(tree) -> bool:
-    """Whether a joint of ``tree`` has minimal velocities of its own, whose K(q) and F(q)
-    :func:`~projeq.constraints.nonholonomic.near_singularity` checks (a forward pass: 0.5 ms
-    on the spin-up beam, whose prescribed hub has none)."""
-    return any(joint.n_s and not joint.coupling for joint in tree.joints)
+    """Whether a joint of ``tree`` has minimal velocities of its own whose K(q) or F(q) can lose
+    rank, which :func:`~projeq.constraints.nonholonomic.near_singularity` checks (a forward
+    pass and condition numbers: 0.5 ms on the spin-up beam, whose prescribed hub has none; ~2 ms
+    on chain(5)): not a revolute or prismatic joint, whose K = E and F = its unit axis have
+    condition number 1 at every q."""
+    return any(joint.n_s and not joint.coupling and joint.compiled_kind not in ("revolute", "prismatic")
+               for joint in tree.joints)
 
 
 def _counted(solver, run: _Run) -> type:
