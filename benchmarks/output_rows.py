@@ -1,5 +1,5 @@
 """The whole default ``simulate`` of a scene (its t_end and settings) in this tree against another
-checkout (before/after a change of the output rows), in fresh processes, alternately: CPU
+checkout (before/after a change: of the output rows, of the right-hand side), in fresh processes, alternately: CPU
 seconds of each (median of ``--repeat`` processes, the numba kernels loaded from the disk cache
 by a warm-up run first), their ratio, and whether the two Results' arrays are bit-identical
 (t, q, s_dot, kinetic, potential, constraint_residual, rank, mobility).
