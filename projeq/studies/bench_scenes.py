@@ -2,7 +2,8 @@
 ``scenes.chain(k)`` with k = the scene's number of minimal velocities (issue 15: "every
 scene at most 3× the cost of chain(k)").
 
-For each scene (default parameters, its q0 and ṡ0, t = 0): which evaluator the default
+For each scene (default parameters, t = 0, at ``STATES`` states near its q0 taken in turn:
+:func:`moving_states`): which evaluator the default
 (``method=None``, :mod:`projeq.assembly.auto`) picks — "fast" (compiled), "hub_beam",
 or an interpreted reference ("recursive", "dense"; a ConstrainedSystem projects its tree's
 Gauss form, compiled or dense: "partitioned(fast)", "partitioned(dense)") — and the CPU time of one s̈ call next to the
@@ -15,6 +16,7 @@ compiled chain of the same k, both timed alternately in one run
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import subprocess
@@ -44,17 +46,34 @@ def default_evaluator(system) -> tuple[str, str]:
     return ev.name, ev.reason
 
 
+STATES = 8  # the states each s̈ is timed at, in turn (moving_states)
+
+
+def moving_states(system, count: int, rng) -> list:
+    """``count`` states (q, ṡ) near the model's initial one, as a run visits them: q0 moved by
+    1e-2 along random directions and put back onto the model's manifold (``normalized``: unit
+    quaternions, a closed loop's Φ = 0), ṡ uniform in [−1, 1]. Each call of a timing meets
+    another state, so no evaluator serves it from what it kept of the last (a closed loop's
+    decomposition, its partition), and no scene is timed at rest only."""
+    q0 = np.asarray(system.q0, dtype=float)
+    return [(system.normalized(q0 + 1e-2 * rng.standard_normal(q0.size)), rng.uniform(-1, 1, system.n_s))
+            for _ in range(count)]
+
+
 def scene_row(name: str, budget: float) -> dict:
-    """One scene: evaluator, k = n_s, µs per s̈ call, the chain(k)'s, and their ratio."""
+    """One scene: evaluator, k = n_s, µs per s̈ call, the chain(k)'s, and their ratio, each
+    over :data:`STATES` states taken in turn (:func:`moving_states`)."""
     system = scenes.SCENES[name].build()
     evaluator, reason = default_evaluator(system)
     k = system.n_s
-    scene_ev, chain_ev = system.evaluator(), scenes.chain(k).evaluator("fast")
-    q0, s_dot0 = system.q0, system.s_dot0
-    chain_q, chain_s = np.random.default_rng(k).uniform(-1, 1, (2, k))
+    chain = scenes.chain(k)
+    scene_ev, chain_ev = system.evaluator(), chain.evaluator("fast")
+    rng = np.random.default_rng(k)
+    scene_states = itertools.cycle(moving_states(system, STATES, rng))
+    chain_states = itertools.cycle(moving_states(chain, STATES, rng))
     seconds = time_per_call({
-        "scene": lambda _q, _s: scene_ev.accelerations(q0, s_dot0, 0.0),
-        "chain": lambda _q, _s: chain_ev.accelerations(chain_q, chain_s, 0.0),
+        "scene": lambda _q, _s: scene_ev.accelerations(*next(scene_states), 0.0),
+        "chain": lambda _q, _s: chain_ev.accelerations(*next(chain_states), 0.0),
     }, None, None, budget)
     return {"scene": name, "evaluator": evaluator, "k": k, "scene_us": seconds["scene"] * 1e6,
             "chain_us": seconds["chain"] * 1e6, "ratio": seconds["scene"] / seconds["chain"], "reason": reason}
