@@ -19,6 +19,7 @@ import numpy as np
 
 import projeq as pq
 from projeq import scenes
+from projeq.studies.table import Table
 
 
 def run(name: str, compiled: bool):
@@ -55,11 +56,13 @@ def main(argv=None) -> list:
     parser.add_argument("--repeat", type=int, default=3, help="runs of each path, best CPU time (default 3)")
     args = parser.parse_args(argv)
     rows = [row(name, args.repeat) for name in args.scenes]
-    print(f"{'scene':18s} {'t_end':>6s} {'compiled s':>10s} {'numpy s':>8s} {'numpy/compiled':>14s} "
-          f"{'rhs calls (c, n)':>16s} {'Δq_end rel':>10s} {'Δṡ_end rel':>10s}")
-    for r in rows:
-        print(f"{r['scene']:18s} {r['t_end']:6.3g} {r['compiled_s']:10.3f} {r['numpy_s']:8.3f} {r['ratio']:14.1f} "
-              f"{str(r['evaluations']):>16s} {r['q_end']:10.1e} {r['s_dot_end']:10.1e}")
+    print(Table(("scene", "t_end", "compiled", "numpy", "numpy/compiled", "rhs calls (c, n)", "Δq_end rel",
+                 "Δṡ_end rel"),
+                [(r["scene"], r["t_end"], r["compiled_s"], r["numpy_s"], r["ratio"], str(r["evaluations"]), r["q_end"],
+                  r["s_dot_end"]) for r in rows],
+                units={"t_end": "s", "compiled": "s", "numpy": "s"},
+                formats={"compiled": ".3f", "numpy": ".3f", "numpy/compiled": ".1f", "Δq_end rel": ".1e",
+                         "Δṡ_end rel": ".1e"}).to_text())
     return rows
 
 

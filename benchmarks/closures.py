@@ -1,7 +1,8 @@
 """The constrained scenes' s̈ in one compiled call against the numpy path it replaces, both next
 to the compiled ``scenes.chain(k)`` (k = the scene's minimal velocities), timed alternately in one
 run (:func:`projeq.studies.timing.time_per_call`: ratios, not absolute times, hold on a loaded
-machine). "numpy path": Φ's batched complex-step derivatives, the partition (or the null space)
+machine), each at eight states near q0 in turn (:func:`projeq.studies.bench_scenes.moving_states`,
+as ``projeq bench``). "numpy path": Φ's batched complex-step derivatives, the partition (or the null space)
 and the projection by numpy on the compiled tree's Gauss form (the default before
 :mod:`projeq.constraints.compiled`); "default": what ``system.evaluator()`` does now.
 
@@ -12,11 +13,14 @@ and the projection by numpy on the compiled tree's Gauss form (the default befor
 from __future__ import annotations
 
 import argparse
+import itertools
 import warnings
 
 import numpy as np
 
 from projeq import scenes
+from projeq.studies.bench_scenes import STATES, moving_states
+from projeq.studies.table import Table
 from projeq.studies.timing import time_per_call
 
 CONSTRAINED = ("whipple_bicycle", "quick_return", "four_bar", "simple_pendulum", "n_four_bar", "bricard",
@@ -29,15 +33,16 @@ def row(name: str, budget: float) -> dict:
         warnings.simplefilter("ignore")  # a Φ that does not compile says so once; the row shows it
         system = scenes.SCENES[name].build()
         ev = system.evaluator()
-    q, s_dot = system.q0, system.s_dot0
-    chain = scenes.chain(system.n_s).evaluator("fast")
-    chain_q, chain_s = np.random.default_rng(system.n_s).uniform(-1, 1, (2, system.n_s))
+    k, rng = system.n_s, np.random.default_rng(system.n_s)
+    chain = scenes.chain(k)
+    chain_ev = chain.evaluator("fast")
+    states, chain_states = (itertools.cycle(moving_states(m, STATES, rng)) for m in (system, chain))
     seconds = time_per_call({
-        "default": lambda _q, _s: ev.accelerations(q, s_dot, 0.0),
-        "numpy": lambda _q, _s: system._projected_accelerations(q, s_dot, 0.0, None),
-        "chain": lambda _q, _s: chain.accelerations(chain_q, chain_s, 0.0),
+        "default": lambda _q, _s: ev.accelerations(*next(states), 0.0),
+        "numpy": lambda _q, _s: system._projected_accelerations(*next(states), 0.0, None),
+        "chain": lambda _q, _s: chain_ev.accelerations(*next(chain_states), 0.0),
     }, None, None, budget)
-    return {"scene": name, "k": system.n_s, **{f"{key}_us": value * 1e6 for key, value in seconds.items()},
+    return {"scene": name, "k": k, **{f"{key}_us": value * 1e6 for key, value in seconds.items()},
             "compiled": system.compiled_kernel() is not None}
 
 
@@ -47,12 +52,12 @@ def main(argv=None) -> list:
     parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per scene (default 0.5)")
     args = parser.parse_args(argv)
     rows = [row(name, args.budget) for name in args.scenes]
-    print(f"{'scene':18s} {'k':>2s} {'chain µs':>9s} {'numpy µs':>9s} {'default µs':>10s} "
-          f"{'numpy/chain':>11s} {'default/chain':>13s}  one compiled call")
-    for r in rows:
-        print(f"{r['scene']:18s} {r['k']:2d} {r['chain_us']:9.1f} {r['numpy_us']:9.1f} {r['default_us']:10.1f} "
-              f"{r['numpy_us'] / r['chain_us']:11.1f} {r['default_us'] / r['chain_us']:13.2f}  "
-              f"{'yes' if r['compiled'] else 'no'}")
+    print(Table(("scene", "k", "chain_us", "numpy_us", "default_us", "numpy/chain", "default/chain", "one compiled call"),
+                [(r["scene"], r["k"], r["chain_us"], r["numpy_us"], r["default_us"], r["numpy_us"] / r["chain_us"],
+                  r["default_us"] / r["chain_us"], "yes" if r["compiled"] else "no") for r in rows],
+                units={"chain_us": "µs", "numpy_us": "µs", "default_us": "µs"},
+                formats={"chain_us": ".1f", "numpy_us": ".1f", "default_us": ".1f", "numpy/chain": ".1f",
+                         "default/chain": ".2f"}).to_text())
     return rows
 
 
