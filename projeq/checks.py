@@ -111,3 +111,22 @@ def drop_inherited_twins(cls, base, numeric: tuple, twins: tuple) -> None:
             if twin not in vars(cls):  # the inherited twin states another plug-in's terms
                 setattr(cls, twin, vars(base)[twin])
 
+
+def depends_on_t(f, q0: NDArray) -> bool:
+    """Whether the constraint function f(q, t) (Φ, or the Pfaffian rows A) changes with t, at q0
+    or at three points around it (q0 moved by 0.1 (1 + |q0|) along seeded random directions): a
+    dependence that vanishes at q0 alone, Φ = Φ₀(q) + t (q₁ − q0₁), is seen too. Values compared
+    at t = 0.37 and 1.9 against t = 0 to 1e-14 (relative and absolute); a point where f is not
+    defined (an exception, or values not finite) is skipped."""
+    rng = np.random.default_rng(0)
+    q0 = np.asarray(q0, dtype=float)
+    for q in [q0] + [q0 + 0.1 * (1.0 + np.abs(q0)) * rng.standard_normal(q0.size) for _ in range(3)]:
+        try:
+            with np.errstate(all="ignore"):
+                values = [np.asarray(f(q, t), dtype=float) for t in (0.0, 0.37, 1.9)]
+        except (ArithmeticError, ValueError):
+            continue
+        if all(np.all(np.isfinite(v)) for v in values) and any(
+                not np.allclose(v, values[0], rtol=1e-14, atol=1e-14) for v in values[1:]):
+            return True
+    return False

@@ -66,6 +66,7 @@ from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import kernels, loads
 from projeq.assembly.kernels import cholesky, cholesky_solve
 from projeq.assembly.linalg import SINGULAR_PIVOT
+from projeq.checks import depends_on_t
 from projeq.constraints.batched import NODES, WEIGHTS
 
 #: flags of the kernels (:func:`partitioned`, :func:`tangent`): done; partition bound reached (or
@@ -150,10 +151,9 @@ def uncompiled(system, why: str) -> None:
 
 
 def _rheonomic_rows(system) -> bool:
-    """Whether the Pfaffian rows A(q, t) q̇ = b(q, t) have a b or an A that depends on t (at q0)."""
-    A0 = np.asarray(system._A(system.q0, 0.0), dtype=float)
-    return system._b is not None or any(not np.array_equal(np.asarray(system._A(system.q0, t), dtype=float), A0)
-                                        for t in (0.37, 1.9))
+    """Whether the Pfaffian rows A(q, t) q̇ = b(q, t) have a b or an A that depends on t
+    (:func:`~projeq.checks.depends_on_t`: at q0 and around it)."""
+    return system._b is not None or depends_on_t(system._A, system.q0)
 
 
 def _python_joints(ev) -> list:

@@ -24,7 +24,7 @@ sixth-order stencil on normalised directions, ≈ 1e-14 relative whatever the sp
 motions, 6e-3 relative at 1/1000 of the four-bar's rates). A Φ written with numpy operations on the
 rows q[i] is evaluated at all points of a stencil in one call (:mod:`projeq.constraints.batched`,
 the same stencils; checked once at q0, else point by point after a warning naming Φ); under
-``correction="projection"`` Φ is independent of t (checked at q0), so ∂Φ/∂t and the rheonomic parts of
+``correction="projection"`` Φ is independent of t (checked at q0 and around it), so ∂Φ/∂t and the rheonomic parts of
 Φ″ are not evaluated, and where every tree joint has q̇ = ṡ_tree (K = E) neither are K, k nor K̇.
 Position drift of the loop closures Φ = 0 is corrected either by a
 Gauss–Newton projection of q onto Φ = 0 wherever :func:`projeq.simulate` normalises q
@@ -77,7 +77,7 @@ from numpy.typing import NDArray
 from projeq.assembly.linalg import solve_spd
 from projeq.constraints.batched import batched_closure
 from projeq.constraints.compiled import OWN_RULE, compiled_partition, uncompiled, unsupported
-from projeq.checks import positive, state_vector
+from projeq.checks import depends_on_t, positive, state_vector
 from projeq.analysis.differentiation import (complex_failure, derivative_along, derivative_along_differences,
                                              second_derivative_along, second_derivative_along_differences,
                                              warn_differences)
@@ -176,8 +176,7 @@ class ConstrainedSystem(Model):
         self.exact = self._choose_derivatives(q0)
         self._closure = batched_closure(phi, self.n_q, np.append(q0, 0.0), self.m_h) if self.exact and self.m_h \
             else None  # Φ's derivatives from one call at a batch of points (projeq.constraints.batched)
-        if correction == "projection" and self.m_h and any(  # simulate normalises q without the time
-                not np.allclose(self.phi(q0, t), self.phi(q0, 0.0), rtol=0, atol=1e-14) for t in (0.37, 1.9)):
+        if correction == "projection" and self.m_h and depends_on_t(self.phi, q0):  # q is normalised without t
             raise ValueError("correction: 'projection' needs Φ independent of t (q is normalised without the "
                              "time); use correction='baumgarte' for rheonomic constraints")
         self.rheonomic = correction != "projection"  # else Φ(q) alone: ∂Φ/∂t and its derivatives are 0
@@ -838,3 +837,4 @@ def _full_rank_nearby(matrix, q0: NDArray, rank: int, tol: float) -> bool:
     rng = np.random.default_rng(1)
     return all(np.linalg.matrix_rank(matrix(q0 + 1e-3 * rng.standard_normal(len(q0))), tol) == rank
                for _ in range(2))
+

@@ -127,6 +127,13 @@ def test_time_dependent_loop_with_projection(tree):
         ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0 - 0.1 * np.sin(t)])
 
 
+def test_time_dependence_that_vanishes_at_q0_is_seen(tree):
+    """Φ = |q| − 1 + 0.1 t (x − 0.6) does not change with t at q0 = (0.6, −0.8) alone: the check
+    looks around q0 too (projection would take ∂Φ/∂t = 0, a wrong γ wherever x ≠ 0.6)."""
+    with pytest.raises(ValueError, match="correction: 'projection' needs Φ independent of t"):
+        ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0 + 0.1 * t * (q[0] - 0.6)])
+
+
 def test_reactions_of_a_tree(tree):
     r = pq.simulate(tree, 0.1, n_points=3)
     with pytest.raises(ValueError, match="system: reactions need a ConstrainedSystem"):

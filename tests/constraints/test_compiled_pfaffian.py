@@ -120,6 +120,7 @@ def test_a_user_joints_compiled_values_are_its_relative_values():
 @pytest.mark.parametrize("constraints, why", [
     ({"A": lambda q, t: np.array([[0.0, 1.0, 0.0]]), "b": lambda q, t: [0.5]}, "b ≠ 0"),
     ({"A": lambda q, t: np.array([[t, 1.0, 0.0]])}, "A depending on t"),
+    ({"A": lambda q, t: np.array([[t * q[1], 1.0, 0.0]])}, "A depending on t"),  # not at q0 = 0: around it
 ])
 def test_rheonomic_pfaffian_rows_keep_the_numpy_path_saying_why(constraints, why):
     model = pq.System({"x": pq.PointMass(1.0), "y": pq.PointMass(1.0), "z": pq.PointMass(1.0)},
