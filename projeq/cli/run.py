@@ -281,7 +281,7 @@ def _summary(name, system, result, record: dict, out: Path, files) -> None:
         print("no time step completed")
         return
     print(f"t = {result.t[-1]:.6g} s, {result.nfev} evaluations, {record['cpu_time']:.3g} s CPU, "
-          f"{result.wall_time:.3g} s wall ({result.method})")
+          f"{record['wall_time']:.3g} s wall ({result.method})")  # both of the whole simulate call
     for label, values, named in (("final q", result.q, result.coordinates),
                                  ("final s_dot", result.s_dot, result.velocities)):
         print(_named_values(label, values, named))
