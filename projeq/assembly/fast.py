@@ -277,10 +277,9 @@ class FastEvaluator:
         if self._x_dot is None or x.dtype.kind != "f":
             return None
         self.n_calls += 1
-        ws, x_dot = self._real, np.empty(len(x))
-        failed = self._x_dot(self._index, self._geometry, self._inertia, self._gravity, self._laws, self._law_constants,
-                             x, self.system.n_q, ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F,
-                             ws.M_n, ws.M_hat, ws.h_hat, ws.R, ws.r, ws.twist, self._pivot_min, x_dot)
+        x_dot = np.empty(len(x))
+        tree, workspace = self._one_call_arguments(self._real)
+        failed = self._x_dot(*tree, x, self.system.n_q, *workspace, x_dot)
         return x_dot if failed < 0 else None
 
     def state_jacobian(self, t: float, x: NDArray) -> NDArray | None:
@@ -294,15 +293,20 @@ class FastEvaluator:
         if self._jacobian is None:
             return None
         self.n_calls += len(x)
-        ws, n_q = self._workspace(complex), self.system.n_q
+        n_q = self.system.n_q
         J = np.zeros((len(x), len(x)))
         J[:n_q, n_q:] = np.eye(n_q)
-        x = np.asarray(x, dtype=float)
-        failed = self._jacobian(self._index, self._geometry, self._inertia, self._gravity, self._laws,
-                                self._law_constants, x, n_q, COMPLEX_STEP, ws.given_values, self._elastic,
-                                self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat, ws.R, ws.r,
-                                ws.twist, self._pivot_min, J[n_q:])
+        tree, workspace = self._one_call_arguments(self._workspace(complex))
+        failed = self._jacobian(*tree, np.asarray(x, dtype=float), n_q, COMPLEX_STEP, *workspace, J[n_q:])
         return J if failed < 0 else None
+
+    def _one_call_arguments(self, ws: _Workspace) -> tuple[tuple, tuple]:
+        """The arguments of the one-call kernels (:func:`~projeq.assembly.kernels.tree_state_derivative`,
+        :func:`~projeq.assembly.kernels.tree_jacobian`) before the state and after it: the tree and
+        its compiled laws; the workspace ``ws`` and the pivot bound."""
+        return ((self._index, self._geometry, self._inertia, self._gravity, self._laws, self._law_constants),
+                (ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat,
+                 ws.R, ws.r, ws.twist, self._pivot_min))
 
 
 class _Workspace:

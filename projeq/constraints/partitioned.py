@@ -837,4 +837,3 @@ def _full_rank_nearby(matrix, q0: NDArray, rank: int, tol: float) -> bool:
     rng = np.random.default_rng(1)
     return all(np.linalg.matrix_rank(matrix(q0 + 1e-3 * rng.standard_normal(len(q0))), tol) == rank
                for _ in range(2))
-
