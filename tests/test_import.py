@@ -15,6 +15,19 @@ def test_import_projeq_loads_no_heavy_module():
     assert out == "", f"import projeq loads {out}"
 
 
+def test_import_projeq_scenes_loads_no_solver_of_scipy():
+    """The scenes' references (the pendulum's elliptic functions, the parallelogram's solve_ivp,
+    the flyball's Brent roots) import scipy's solvers where they are called: ``import
+    projeq.scenes`` (and the parser of ``projeq run``) costs numpy and scipy.linalg, not
+    scipy.integrate's import of scipy.special, scipy.optimize and scipy.sparse (0.70 s instead
+    of 1.31 s CPU, benchmarks/results/2026-11-28)."""
+    code = ("import sys, types, projeq.scenes\n"
+            "loaded = [m for m in %r if type(sys.modules.get(m)) is types.ModuleType]\n"
+            "print(','.join(loaded))" % (tuple(m for m in HEAVY if m != "scipy.linalg") + ("scipy.special", "scipy.sparse"),))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    assert out == "", f"import projeq.scenes loads {out}"
+
+
 def test_a_lazily_imported_sympy_works_for_the_user():
     code = ("import projeq, sympy\n"
             "from sympy.physics.mechanics import dynamicsymbols\n"

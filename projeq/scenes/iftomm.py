@@ -14,9 +14,6 @@ coordinate (:func:`parallelogram_motion`).
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
-from scipy.special import ellipj, ellipk
 
 from projeq.checks import count, non_negative, positive
 from projeq.constraints.tangent import TangentSystem
@@ -42,6 +39,8 @@ def pendulum_angle(t, L: float = 1.0, g: float = 9.81, theta0: float = np.pi / 2
     """The angle from the downward vertical of a simple pendulum released from rest at θ0:
     sin(θ/2) = k sn(K(k) − ω t, k), k = sin(θ0/2), ω = √(g/L) (Jacobi's elliptic functions;
     e.g. Lawden, "Elliptic Functions and Applications", 1989, §5.2)."""
+    from scipy.special import ellipj, ellipk  # the references load scipy's solvers where used: import projeq.scenes stays light
+
     k = np.sin(theta0 / 2)
     sn = ellipj(ellipk(k * k) - np.sqrt(g / L) * np.asarray(t, dtype=float), k * k)[0]
     return 2 * np.arcsin(k * sn)
@@ -112,6 +111,8 @@ def parallelogram_motion(t, n: int = 2, m: float = 1.0, L: float = 1.0, g: float
     at the same angle θ, the couplers translating —, the motion through the singular positions
     that keeps its velocity (the benchmark's). Lagrange's equation in θ alone:
     T = ½ ((n + 1)/3 + n) m L² θ̇², V = ((n + 1)/2 + n) m g L sin θ, integrated to ``rtol``."""
+    from scipy.integrate import solve_ivp
+
     inertia, weight = ((n + 1) / 3 + n) * m * L * L, ((n + 1) / 2 + n) * m * g * L
     t = np.asarray(t, dtype=float)
     sol = solve_ivp(lambda _, x: [x[1], -weight * np.cos(x[0]) / inertia], (0.0, t.max()),
@@ -345,6 +346,8 @@ def flyball_steady_state(K: float = FLYBALL["K"], angular_momentum: float | None
     against the centrifugal one. V and I_zz in closed form (:func:`_flyball_geometry`), their
     derivatives by the complex step (exact to round-off), the roots by Brent's method, s(α) inside
     α's. Returns α, s, ω and ℓ (the springs' length) there."""
+    from scipy.optimize import brentq
+
     K = positive("K", K)
     L_z = (_flyball_geometry(FLYBALL["alpha0"], FLYBALL["s0"], K)[0] * FLYBALL["omega0"]
            if angular_momentum is None else positive("angular_momentum", angular_momentum))
