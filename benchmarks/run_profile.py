@@ -46,6 +46,18 @@ clock = lambda: (time.process_time(), time.perf_counter())
 start = clock()  # CPU since the process started: Python's own start
 spent = {}
 
+import gc
+collector = [0.0, 0.0, 0, 0]  # the cyclic garbage collector: CPU s, wall s, collections, full collections
+
+def on_collection(phase, info, mark=[]):
+    if phase == "start":
+        mark[:] = clock()
+        return
+    collector[:2] = [c + b - a for c, a, b in zip(collector, mark, clock())]
+    collector[2] += 1
+    collector[3] += info["generation"] == 2
+
+gc.callbacks.append(on_collection)
 stack = []  # the timed calls in progress: [label, time of the timed calls inside it]
 
 def timed(function, label):
@@ -73,6 +85,8 @@ def patch(owner, name, label):
 
 import projeq.cli.commands as commands
 projeq_import = [b - a for a, b in zip(start, clock())]
+if hasattr(commands, "THRESHOLDS"):  # what command() sets first, before the imports below (the parser's)
+    gc.set_threshold(*commands.THRESHOLDS)
 patch(commands, "parser", "parser: CLI, scenes, their imports")
 import projeq.assembly.kernels as kernels
 
@@ -110,7 +124,7 @@ code = commands.command() if hasattr(commands, "command") else commands.main(sys
 end = clock()
 print(json.dumps({"code": code, "python_start": start, "end": end, "projeq_import": projeq_import,
                   "preimport": preimport, "main": [end[0] - before_main[0], end[1] - before_main[1]],
-                  "phases": spent}))
+                  "phases": spent, "collector": collector}))
 """
 
 
@@ -153,6 +167,8 @@ def phases(scene: list, out: str, env: dict | None = None) -> dict:
     rows["rest of main (record, summary, checks)"] = [record["main"][0] - sum(v[0] for v in spent.values())
                                                       - parser[0], nan]
     rows["Python's exit (atexit, teardown)"] = [cpu - record["end"][0], nan]
+    rows["cyclic garbage collector (in the rows above)"] = record["collector"][:2]
+    rows["  its collections (full collections)"] = record["collector"][2:]
     rows["process (all)"] = [cpu, wall]
     return rows
 
@@ -301,6 +317,9 @@ def main() -> None:
     for name in runs[0]:
         cpu = statistics.median(r[name][0] for r in runs)
         wall = statistics.median(r[name][1] for r in runs)
+        if name.endswith("(full collections)"):
+            print(f"  {name:<45} {cpu:6.0f} ({wall:.0f})")
+            continue
         print(f"  {name:<45} {cpu:6.3f}" + ("" if wall != wall else f" ({wall:.3f})"))
     print("\nimport self-time by package (-X importtime, s; the instrumentation inflates it):")
     for package, seconds in list(packages.items())[:20]:
