@@ -60,7 +60,7 @@ evaluator.accelerations(system.q0, system.s_dot0, 0.0)
 marks.append(clock())
 evaluator.accelerations(system.q0, system.s_dot0, 0.0)
 marks.append(clock())
-dispatchers = kernels._compiled() + kernels._compiled_gauss_form()
+dispatchers = [*kernels._compiled().values(), *kernels._compiled_gauss_form()]
 kernels_ = {d.__name__: {"loaded": len(d.signatures), "in_cache_index": len(d._cache._cache_file._load_index()),
                          "cache_misses": sum(d.stats.cache_misses.values())} for d in dispatchers}
 phases = ["import projeq, build chain(5)", "import numba", "numba's target initialisation",

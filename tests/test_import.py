@@ -38,7 +38,7 @@ def test_a_lazily_imported_sympy_works_for_the_user():
 
 
 def test_projeq_run_imports_no_sympy_matplotlib_or_meshio(tmp_path):
-    """``projeq run`` (issue 15: about a second with no arguments) loads only what it runs: not
+    """``projeq run`` (issue 15: as fast as it can with no arguments) loads only what it runs: not
     sympy (the symbolic scenes register lazily), matplotlib (plots only with --plots), meshio
     (the VTU files are written directly) nor the benchmark and study modules."""
     code = ("import sys, types\nfrom projeq.cli import main\n"
