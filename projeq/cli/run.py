@@ -10,7 +10,7 @@ CPU time, status, files), ``<scene>.npz`` (the Result with the same record,
 :meth:`projeq.Result.load`), ``<scene>.csv`` (named columns with units), a ParaView series
 ``paraview/<scene>.pvd`` and, with ``--plots``, PNG plots ``<scene>_history.png`` ... (a scene
 given as ``FILE.py:FUNCTION`` is called ``FILE-FUNCTION``). The plots are asked for, not
-written by default: matplotlib's import and drawing cost more CPU time (about 1.2 s) than the
+written by default: matplotlib's import and drawing cost more CPU time (about 1.7 s) than the
 rest of the default run's writing, in a run of about 2.7 s CPU in all (1.8 s of it Python's
 start, the imports of numpy, scipy and projeq and numba's start; ``benchmarks/run_profile.py``
 splits it). A failed or interrupted run (Ctrl-C or SIGTERM) writes its results up to where it
@@ -50,7 +50,7 @@ def run_arguments(parser) -> None:
                         help=f"scene name (default {DEFAULT_SCENE}) or FILE.py:FUNCTION, a function returning a System")
     simulation_options(parser)
     parser.add_argument("--plots", action="store_true",
-                        help="also write PNG plots (time history, drift, path, beam tips; matplotlib, about 1 s more)")
+                        help="also write PNG plots (time history, drift, path, beam tips; matplotlib, about 1.7 s CPU more)")
     parser.set_defaults(execute=run_scene)
 
 
