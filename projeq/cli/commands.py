@@ -85,8 +85,8 @@ def main(argv=None) -> int:
 
 
 #: the cyclic collector's thresholds in the command's process: a young generation of 10,000
-#: objects instead of Python 3.11's 700. The imports of scipy and numba leave some 10⁶ long-lived
-#: objects, and with 700 the collector walked all of them in 3 full collections during ``projeq
+#: objects instead of Python 3.11's 700. The imports of scipy and numba leave some 130,000 long-lived
+#: tracked objects, and with 700 the collector walked all of them in 3 full collections during ``projeq
 #: run`` (0.21–0.23 s CPU in 307 collections, 0.10–0.13 s of it the full ones); with 10,000 it makes
 #: 21 collections, none full (0.08–0.13 s; ``benchmarks/run_profile.py``'s row "cyclic garbage
 #: collector"). Garbage in cycles then waits for at most 10,000 allocations.
