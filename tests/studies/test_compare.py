@@ -219,20 +219,24 @@ def test_disc_constraint_inserted_too_early(disc_table):
     assert "before the derivation" in row["why"]
 
 
-def test_spinning_beam_reports_the_difference():
+@pytest.fixture(scope="module")
+def beam_table():
+    """The spinning beam's three rows, each derived once and simulated over 1 s of
+    ``spin_up_motion(3, 2)`` (the symbolic check and the torsion-free row's motion share them)."""
+    return compare("spinning_beam", t_end=1.0, repeats=1)
+
+
+def test_spinning_beam_reports_the_difference(beam_table):
     """Hamilton's B(18) ≠ the Projection Equation's B(23), as printed in the paper (the v
     equation's ρI α̈ w″ with opposite signs, the w equations alike): the difference
     B(23) − B(18) = (−2 ρI α̈ w″, 0), because of the non-orthogonal Cardan axes (§4.1)."""
-    from projeq.symbolic import spinning_beam as sb
-
-    table = compare("spinning_beam", simulate=False, repeats=1)
-    hamilton = _row(table, "hamilton (field equations, Ritz)")
+    hamilton = _row(beam_table, "hamilton (field equations, Ritz)")
     assert hamilton["identical"] == "no" and hamilton["check"].startswith("symbolic")
     gap = [sp.expand(p - h) for p, h in zip(printed.expected_B23(), printed.expected_B18())]
     assert gap[1] == 0 and gap[0] != 0
     assert all(sp.expand(d - e) == 0 for d, e in zip(hamilton["difference"], gap))
     assert "non-orthogonal" in hamilton["why"]
-    assert "much less effort" in table.claims[0]
+    assert "much less effort" in beam_table.claims[0]
 
 
 def test_format_and_csv(car_table, tmp_path):
@@ -291,14 +295,12 @@ def test_table_is_a_plain_object():
     assert "a" in table.format() and table.rows[0]["n_ops"] == 3
 
 
-def test_spinning_beam_shows_the_torsion_free_beam():
+def test_spinning_beam_shows_the_torsion_free_beam(beam_table):
     """The third row: the beam without torsional strain (the model a converged chain of rigid
     slices and projeq's RitzBeam agree with, tests/subsystems/test_beam_slice_chain.py) differs
     from B(23) under spin-up: over 1 s of `spin_up_motion(3, 2)` the motions part by ~3e-4 m, far
     above the integration tolerance (rtol 1e-9)."""
-    table = compare("spinning_beam", ["projection (field equations, Ritz)", "torsion_free (Ritz, = RitzBeam)"],
-                    t_end=1.0, repeats=1)
-    row = _row(table, "torsion_free (Ritz, = RitzBeam)")
+    row = _row(beam_table, "torsion_free (Ritz, = RitzBeam)")
     assert row["identical"] == "no" and "geometric twist" in row["why"] and "B(23)'s by max |Δa|" in row["note"]
     assert row["derivation"].startswith("Lagrange (2nd kind)")
     gap = float(row["note"].rsplit("= ", 1)[1].split()[0])
