@@ -29,6 +29,7 @@ from projeq.studies.compare_barhorst import BARHORST_STUDIES, BARHORST_T_END
 from projeq.studies.effort import (DERIVATION_REPEATS, EFFORT, as_symbols, cse_ops, derivation_repeats,
                                    derivation_timed, timed)
 from projeq.studies.table import Table
+from projeq.symbolic.algebra import trig_normal
 
 COLUMNS = ("formulation", "derivation_s", "n_ops", "identical", "check", "difference", "why", "integration_s",
            "energy_drift", "constraint_drift", "derivation", "note")
@@ -132,9 +133,9 @@ def _compare_equations(reference, other, evaluators, system) -> dict:
     """identical ("yes"/"no"), check (how) and difference (reference − other per equation, or None).
 
     Symbolic when both are Gauss forms in the same symbols: the residuals' difference in the
-    normal form of :func:`_trig_normal` (zero there is a proof). Otherwise at random states."""
+    normal form of :func:`~projeq.symbolic.algebra.trig_normal` (zero there is a proof). Otherwise at random states."""
     if reference is not None and other is not None and (reference.q, reference.s) == (other.q, other.s):
-        difference = tuple(_trig_normal(d, reference.q) for d in _residuals(reference) - _residuals(other))
+        difference = tuple(trig_normal(d, reference.q) for d in _residuals(reference) - _residuals(other))
         return {"identical": "yes" if all(d == 0 for d in difference) else "no", "difference": difference,
                 "check": "symbolic: residuals subtracted, sin² + cos² = 1 normal form"}
     rng = np.random.default_rng(0)
@@ -146,21 +147,6 @@ def _compare_equations(reference, other, evaluators, system) -> dict:
     # 1e-9: round-off of two independently compiled evaluators, far below any modelling difference
     return {"identical": "yes" if max(errors) < 1e-9 else "no", "difference": None,
             "check": f"numeric, 5 random states, max rel err {max(errors):.1e}"}
-
-
-def _trig_normal(expression, q) -> sp.Expr:
-    """A normal form of ``expression`` that is 0 exactly when it vanishes identically in q:
-    trigonometric sums expanded, the numerator written as a polynomial in sᵢ = sin qᵢ,
-    cᵢ = cos qᵢ and reduced modulo sᵢ² + cᵢ² − 1 (these form a Gröbner basis — their leading
-    terms sᵢ² are coprime —, so the remainder is unique), then factored."""
-    sines = {x: sp.Dummy(f"sin_{x}") for x in q}
-    cosines = {x: sp.Dummy(f"cos_{x}") for x in q}
-    polynomial = sp.expand_trig(sp.sympify(expression)).xreplace({sp.sin(x): sines[x] for x in q})
-    numerator, denominator = sp.fraction(sp.together(polynomial.xreplace({sp.cos(x): cosines[x] for x in q})))
-    generators = [g for x in q for g in (sines[x], cosines[x])]
-    _, remainder = sp.reduced(sp.expand(numerator), [sines[x] ** 2 + cosines[x] ** 2 - 1 for x in q], *generators)
-    back = {sines[x]: sp.sin(x) for x in q} | {cosines[x]: sp.cos(x) for x in q}
-    return sp.factor(remainder.xreplace(back)) / denominator.xreplace(back)
 
 
 def _simulate_row(system, evaluator, t_end: float) -> tuple[dict, np.ndarray]:

@@ -1,9 +1,10 @@
 """Spatial algebra in sympy: the symbolic twin of :mod:`projeq.spatial`.
 
 Spin matrices, cross products, rotations (Rodrigues about an axis, about the coordinate
-axes, from a unit quaternion), motion cross products and the conversion of numbers to exact
-sympy values, written once for every symbolic derivation (``gauss_form``, the symbolic
-joints and loads, user joints, the scenes derived with sympy). The same conventions as
+axes, from a unit quaternion), motion cross products, the conversion of numbers to exact
+sympy values and a normal form of trigonometric polynomials (:func:`trig_normal`), written
+once for every symbolic derivation (``gauss_form``, the symbolic joints and loads, user
+joints, the scenes derived with sympy, the comparisons' symbolic checks). The same conventions as
 the numeric module: ``skew(a) b = a × b``; a rotation maps rotated-frame coordinates into
 the original frame (its columns are the rotated axes).
 
@@ -21,7 +22,7 @@ import numpy as np
 import sympy as sp
 
 __all__ = ["exact", "mul", "cross", "skew", "cross_motion", "rotation", "rotation_x", "rotation_y", "rotation_z",
-           "quaternion_matrix", "quaternion_rate_matrix"]
+           "quaternion_matrix", "quaternion_rate_matrix", "trig_normal"]
 
 
 def exact(value) -> sp.Matrix | sp.Expr:
@@ -102,3 +103,18 @@ def quaternion_rate_matrix(quat) -> sp.Matrix:
     """The 4×3 matrix Γ with q̇ = Γ ω for ω in body coordinates (q̇ = ½ q ⊗ (0, ω))."""
     w, x, y, z = quat
     return sp.Matrix([[-x, -y, -z], [w, -z, y], [z, w, -x], [-y, x, w]]) / 2
+
+
+def trig_normal(expression, q) -> sp.Expr:
+    """A normal form of ``expression`` that is 0 exactly when it vanishes identically in q:
+    trigonometric sums expanded, the numerator written as a polynomial in sᵢ = sin qᵢ,
+    cᵢ = cos qᵢ and reduced modulo sᵢ² + cᵢ² − 1 (these form a Gröbner basis — their leading
+    terms sᵢ² are coprime —, so the remainder is unique), then factored."""
+    sines = {x: sp.Dummy(f"sin_{x}") for x in q}
+    cosines = {x: sp.Dummy(f"cos_{x}") for x in q}
+    polynomial = sp.expand_trig(sp.sympify(expression)).xreplace({sp.sin(x): sines[x] for x in q})
+    numerator, denominator = sp.fraction(sp.together(polynomial.xreplace({sp.cos(x): cosines[x] for x in q})))
+    generators = [g for x in q for g in (sines[x], cosines[x])]
+    _, remainder = sp.reduced(sp.expand(numerator), [sines[x] ** 2 + cosines[x] ** 2 - 1 for x in q], *generators)
+    back = {sines[x]: sp.sin(x) for x in q} | {cosines[x]: sp.cos(x) for x in q}
+    return sp.factor(remainder.xreplace(back)) / denominator.xreplace(back)

@@ -27,7 +27,16 @@ def run():
     return system, pq.simulate(system, T_END, t_eval=np.linspace(0, T_END, 31), rtol=RTOL, atol=ATOL)
 
 
-def test_rocker_partition_repivots_before_the_rocker_extreme(run):
+@pytest.fixture(scope="module")
+def reference(run):
+    """The closed-loop Lagrange reference (test_loops'), integrated once for the module: its values
+    at the run's output times and its dense output (solve_ivp's steps do not depend on t_eval)."""
+    _, r = run
+    return solve_ivp(_four_bar_reference(**PARAMS), (0, T_END), [THETA1, OMEGA1], t_eval=r.t, rtol=RTOL, atol=ATOL,
+                     dense_output=True)
+
+
+def test_rocker_partition_repivots_before_the_rocker_extreme(run, reference):
     """The rocker's extreme (outer dead centre) is where crank and coupler are collinear,
     |rocker tip| = a + b: cos θ1* = (d² + (a + b)² − c²) / (2 d (a + b)) (law of cosines).
     The run starts with ṡ = q̇3, switches once, shortly before the crank reaches θ1* (the
@@ -39,21 +48,18 @@ def test_rocker_partition_repivots_before_the_rocker_extreme(run):
     t_switch = r.partitions[1][0]
     a, b, c, d = (PARAMS[k] for k in "abcd")
     theta_star = np.arccos((d * d + (a + b) ** 2 - c * c) / (2 * d * (a + b)))
-    ref = solve_ivp(_four_bar_reference(**PARAMS), (0, T_END), [THETA1, OMEGA1], rtol=RTOL, atol=ATOL,
-                    dense_output=True)
-    t_star = brentq(lambda t: ref.sol(t)[0] - theta_star, 0, T_END)
+    t_star = brentq(lambda t: reference.sol(t)[0] - theta_star, 0, T_END)
     # κ grows like 1/|dq3/dq1| towards t*: the limit (108 here) is met ~11 ms before it
     assert t_star - 0.02 < t_switch < t_star, (t_switch, t_star)
 
 
-def test_repivoted_run_agrees_with_the_explicitly_solved_loop(run):
+def test_repivoted_run_agrees_with_the_explicitly_solved_loop(run, reference):
     """Across the switch the motion is that of the four-bar in the minimal coordinate θ1
     with its loop solved in closed form and Lagrange's equation (test_loops'
     reference, an independent formulation); the energy is conserved and the loop stays closed."""
     system, r = run
-    ref = solve_ivp(_four_bar_reference(**PARAMS), (0, T_END), [THETA1, OMEGA1], t_eval=r.t, rtol=RTOL, atol=ATOL)
     # both integrated to rtol 1e-9: 10 rtol·|θ1| (achieved 2.5e-10 rad)
-    assert np.abs(r.q[:, 0] - ref.y[0]).max() < 10 * RTOL * np.abs(ref.y[0]).max()
+    assert np.abs(r.q[:, 0] - reference.y[0]).max() < 10 * RTOL * np.abs(reference.y[0]).max()
     # energies computed in each row's own partition: local errors of size rtol (achieved 3e-10)
     assert r.energy_drift < 100 * RTOL
     # the projection at the outputs stops at POSITION_TOLERANCE · max(1, |q|)

@@ -13,6 +13,8 @@ method on the eigenvalues) to 1e-12 relative. Central differences gave ~1e-6 (th
 test_rolling_disk.py bound, 1e-5).
 """
 
+from functools import cache
+
 import numpy as np
 import pytest
 from scipy.optimize import brentq
@@ -24,7 +26,10 @@ G, M, R = 9.81, 0.030, 0.015  # Barhorst's disk in SI
 I, J = M * R * R / 4, M * R * R / 2  # uniform thin disk: diameter and polar moments
 
 
+@cache
 def disc():
+    """The disc, built once for the module (a build costs ~0.3 s, a linearisation ~5 ms; the
+    tests ask for λ² 16 times): a System is frozen, linearize changes nothing in it."""
     return pq.scenes.knife_edge_disc(m=M, r=R, I=I, J=J, g=G, q0=np.zeros(5))
 
 

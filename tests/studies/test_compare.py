@@ -28,12 +28,13 @@ def _row(table, name):
 
 @pytest.fixture(scope="module")
 def car_run():
-    """The car's full table (t_end 0.2 s, 2 derivations per row) and how often sympy's cache was cleared."""
+    """The car's full table (t_end 0.2 s, one derivation per row: that each of several repeats starts
+    cold is test_derivation_time_is_the_median_of_the_repeats') and how often sympy's cache was cleared."""
     clears = []
     with pytest.MonkeyPatch.context() as patch:
         clear = sympy.core.cache.clear_cache
         patch.setattr(sympy.core.cache, "clear_cache", lambda: clears.append(1) or clear())
-        table = compare("car", t_end=0.2, repeats=2)
+        table = compare("car", t_end=0.2, repeats=1)
     return table, len(clears)
 
 
@@ -96,16 +97,20 @@ def test_every_derivation_is_measured_the_same_way(car_run):
     derived = [r for r in table.rows if r.get("derivation_s") is not None]
     assert [r["formulation"] for r in table.rows if r not in derived] == ["projection (numeric, dense)",
                                                                           "projection (numeric, recursive)"]
-    assert clears == 2 * len(derived)
+    assert clears == len(derived)
     assert all(isinstance(r["n_ops"], int) and r["derivation_s"] > 0 for r in derived)
-    assert "median of 2 runs" in table.effort and "sympy.cse" in table.effort
+    assert "median of 1 runs" in table.effort and "sympy.cse" in table.effort
 
 
 def test_derivation_time_is_the_median_of_the_repeats(monkeypatch):
-    durations = iter([0.5, 0.1, 0.3])
-    monkeypatch.setattr(effort, "timed", lambda derive: (derive(), next(durations)))
+    """The median of the ``repeats`` timed runs, each after sympy's cache is cleared."""
+    durations, clears = iter([0.5, 0.1, 0.3]), []
+    clear = sympy.core.cache.clear_cache
+    monkeypatch.setattr(sympy.core.cache, "clear_cache", lambda: clears.append(1) or clear())
+    monkeypatch.setattr(effort, "timed", lambda derive: (clears.append("timed") or derive(), next(durations)))
     table = compare("car", ["projection (symbolic)"], simulate=False, repeats=3)
     assert table.rows[0]["derivation_s"] == 0.3
+    assert clears == [1, "timed"] * 3
 
 
 def test_cold_start_empties_projeqs_memoised_derivations():
@@ -219,20 +224,24 @@ def test_disc_constraint_inserted_too_early(disc_table):
     assert "before the derivation" in row["why"]
 
 
-def test_spinning_beam_reports_the_difference():
+@pytest.fixture(scope="module")
+def beam_table():
+    """The spinning beam's three rows, each derived once and simulated over 1 s of
+    ``spin_up_motion(3, 2)`` (the symbolic check and the torsion-free row's motion share them)."""
+    return compare("spinning_beam", t_end=1.0, repeats=1)
+
+
+def test_spinning_beam_reports_the_difference(beam_table):
     """Hamilton's B(18) ≠ the Projection Equation's B(23), as printed in the paper (the v
     equation's ρI α̈ w″ with opposite signs, the w equations alike): the difference
     B(23) − B(18) = (−2 ρI α̈ w″, 0), because of the non-orthogonal Cardan axes (§4.1)."""
-    from projeq.symbolic import spinning_beam as sb
-
-    table = compare("spinning_beam", simulate=False, repeats=1)
-    hamilton = _row(table, "hamilton (field equations, Ritz)")
+    hamilton = _row(beam_table, "hamilton (field equations, Ritz)")
     assert hamilton["identical"] == "no" and hamilton["check"].startswith("symbolic")
     gap = [sp.expand(p - h) for p, h in zip(printed.expected_B23(), printed.expected_B18())]
     assert gap[1] == 0 and gap[0] != 0
     assert all(sp.expand(d - e) == 0 for d, e in zip(hamilton["difference"], gap))
     assert "non-orthogonal" in hamilton["why"]
-    assert "much less effort" in table.claims[0]
+    assert "much less effort" in beam_table.claims[0]
 
 
 def test_format_and_csv(car_table, tmp_path):
@@ -291,14 +300,12 @@ def test_table_is_a_plain_object():
     assert "a" in table.format() and table.rows[0]["n_ops"] == 3
 
 
-def test_spinning_beam_shows_the_torsion_free_beam():
+def test_spinning_beam_shows_the_torsion_free_beam(beam_table):
     """The third row: the beam without torsional strain (the model a converged chain of rigid
     slices and projeq's RitzBeam agree with, tests/subsystems/test_beam_slice_chain.py) differs
     from B(23) under spin-up: over 1 s of `spin_up_motion(3, 2)` the motions part by ~3e-4 m, far
     above the integration tolerance (rtol 1e-9)."""
-    table = compare("spinning_beam", ["projection (field equations, Ritz)", "torsion_free (Ritz, = RitzBeam)"],
-                    t_end=1.0, repeats=1)
-    row = _row(table, "torsion_free (Ritz, = RitzBeam)")
+    row = _row(beam_table, "torsion_free (Ritz, = RitzBeam)")
     assert row["identical"] == "no" and "geometric twist" in row["why"] and "B(23)'s by max |Δa|" in row["note"]
     assert row["derivation"].startswith("Lagrange (2nd kind)")
     gap = float(row["note"].rsplit("= ", 1)[1].split()[0])
