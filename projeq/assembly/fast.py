@@ -176,8 +176,6 @@ class FastEvaluator:
         values = ws.given_values
         for n, joint, q_n, s_n, width in self._given_plan:
             values[n, :width] = joint.relative_values(q_all[q_n], s_all[s_n], t)
-            if ws.F is not ws.given_F:
-                ws.F[n, :6, :6] = ws.given_F[n]
 
     def _add_forces(self, ws: _Workspace, q: NDArray, s_dot: NDArray, t: float) -> None:
         """The own ``add_to`` of the laws without a compiled row (a callable load, a user's
@@ -225,9 +223,8 @@ class FastEvaluator:
     def _state(self, q, s_dot) -> tuple[NDArray, NDArray, _Workspace]:
         """q and ṡ as arrays of one dtype, float or complex (a complex step), and its workspace."""
         q, s_dot = np.asarray(q), np.asarray(s_dot)
-        if q.dtype.kind == "c" or s_dot.dtype.kind == "c":
-            return q.astype(complex, copy=False), s_dot.astype(complex, copy=False), self._workspace(complex)
-        return q.astype(float, copy=False), s_dot.astype(float, copy=False), self._real
+        dtype = complex if q.dtype.kind == "c" or s_dot.dtype.kind == "c" else float
+        return kernel_array(q, dtype), kernel_array(s_dot, dtype), self._real if dtype is float else self._workspace(dtype)
 
     def _assembled(self, ws: _Workspace) -> tuple[NDArray, NDArray]:
         """M and b of the terms in the workspace: :func:`projeq.assembly.kernels.gauss_form` in
@@ -279,7 +276,7 @@ class FastEvaluator:
         self.n_calls += 1
         x_dot = np.empty(len(x))
         tree, workspace = self._one_call_arguments(self._real)
-        failed = self._x_dot(*tree, x, self.system.n_q, *workspace, x_dot)
+        failed = self._x_dot(*tree, kernel_array(x), self.system.n_q, *workspace, x_dot)
         return x_dot if failed < 0 else None
 
     def state_jacobian(self, t: float, x: NDArray) -> NDArray | None:
@@ -297,7 +294,7 @@ class FastEvaluator:
         J = np.zeros((len(x), len(x)))
         J[:n_q, n_q:] = np.eye(n_q)
         tree, workspace = self._one_call_arguments(self._workspace(complex))
-        failed = self._jacobian(*tree, np.asarray(x, dtype=float), n_q, COMPLEX_STEP, *workspace, J[n_q:])
+        failed = self._jacobian(*tree, kernel_array(x), n_q, COMPLEX_STEP, *workspace, J[n_q:])
         return J if failed < 0 else None
 
     def _one_call_arguments(self, ws: _Workspace) -> tuple[tuple, tuple]:
@@ -309,14 +306,23 @@ class FastEvaluator:
                  ws.R, ws.r, ws.twist, self._pivot_min))
 
 
+def kernel_array(a, dtype=float) -> NDArray:
+    """``a`` as the one kind of array the compiled kernels are specialised for: of ``dtype``,
+    C-contiguous and writeable (a read-only or strided view, such as a row of a frozen Result
+    or a column of a solution, is copied: numba would compile the kernels again for its layout,
+    10–30 s cold)."""
+    a = np.asarray(a, dtype=dtype)
+    return a if a.flags.c_contiguous and a.flags.writeable else np.array(a, dtype=dtype, order="C")
+
+
 class _Workspace:
     """The arrays one evaluation of :class:`FastEvaluator` overwrites, of one dtype (float, or
     complex for the complex step): T_np, ζ_n, F_n, M_n, M̂_n, ĥ_n, the poses and twists, one
     row per joint of kind GIVEN for its ``relative_values`` (A, r, w, ζ, F⁶ by columns: the
-    entries kernels.GIVEN_A ... GIVEN_F, F⁶ through the view ``given_F``, given_F[n, :, j] =
-    column j, which is F itself unless elastic bodies make F wider (n_y rows, their q̇_e
-    columns): then F takes the given columns), the Gauss form's M and b, and the force laws'
-    kinematics and loads."""
+    entries kernels.GIVEN_A ... GIVEN_F, which the chain terms' kernel copies into F), the Gauss
+    form's M and b, and the force laws' kinematics and loads. Every array is C-contiguous: numba
+    compiles one specialisation of a kernel per layout of its arguments (a transposed view
+    would give F the layouts 'F' for one body and 'A' for more, each another cold compilation)."""
 
     def __init__(self, ev: FastEvaluator, dtype):
         N, width, depth = len(ev._rigid_M), ev._width, ev._depth
@@ -324,9 +330,8 @@ class _Workspace:
         self.M = np.zeros((ev.system.n_s,) * 2, dtype)
         self.M_n = np.zeros((N, width, width), dtype)
         self.M_n[:, :6, :6] = ev._rigid_M
-        values = self.given_values = np.zeros((N, kernels.GIVEN_F + 36), dtype)
-        self.given_F = values[:, kernels.GIVEN_F:].reshape(N, 6, 6).transpose(0, 2, 1)
-        self.F = self.given_F if (width, depth) == (6, 6) else np.zeros((N, width, depth), dtype)
+        self.given_values = np.zeros((N, kernels.GIVEN_F + 36), dtype)
+        self.F = np.zeros((N, width, depth), dtype)
         self.T, self.zeta = np.zeros((N, width, width), dtype), np.zeros((N, width), dtype)
         self.M_hat, self.h_hat = np.zeros((N, width, width), dtype), np.zeros((N + 1, width), dtype)
         self.R, self.r, self.twist = np.zeros((N + 1, 3, 3), dtype), np.zeros((N + 1, 3), dtype), np.zeros((N + 1, 6), dtype)

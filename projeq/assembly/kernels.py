@@ -142,6 +142,8 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
                     A_rel[a, b] = given[n, GIVEN_A + 3 * a + b]
             for a in range(6):
                 w[a] = given[n, GIVEN_W + a]
+                for c in range(6):  # F⁶ column by column
+                    F[n, a, c] = given[n, GIVEN_F + 6 * c + a]
         else:
             x = q[q_index[n]] if k != FIXED else 0.0
             _relative_rotation(k, e, x, A_rel)

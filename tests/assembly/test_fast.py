@@ -470,3 +470,38 @@ def test_hub_beam_compiled_equals_interpreted(build):
 def test_hub_beam_evaluator_refuses_other_systems():
     with pytest.raises(ValueError, match="system: the system has 2 subsystems"):
         HubBeamEvaluator(pq.scenes.chain(2))
+
+
+def _layouts(types) -> set:
+    """(layout, mutable) of every array among numba ``types`` (tuples opened)."""
+    found = set()
+    for t in types:
+        if hasattr(t, "layout"):
+            found.add((t.layout, t.mutable))
+        elif hasattr(t, "types"):
+            found |= _layouts(t.types)
+    return found
+
+
+def test_kernels_are_specialised_once_per_dtype():
+    """numba compiles a dispatcher once per tuple of argument types, an array's layout and
+    mutability included (numba documentation, "Compiling Python code with @jit": lazy
+    compilation, one specialisation per input type), 10–30 s each on a clean checkout: one
+    body (a transposed view would be F-contiguous), several bodies, a beam in a chain (F wider
+    than 6), a joint stating its own motion, read-only and strided states must all reach the
+    chain-terms kernel with C-contiguous arrays, writeable except the model's constants."""
+    chain_terms = kernels.kernel(True)[0]
+    for name in ("simple_pendulum", "chain", "elastic_arm", "car"):
+        system = pq.scenes.SCENES[name].build()
+        ev = system.evaluator("fast")
+        q, s_dot = np.asarray(system.q0, dtype=float), np.asarray(system.s_dot0, dtype=float) + 0.1
+        frozen = q.copy()
+        frozen.flags.writeable = False
+        strided = np.repeat(s_dot, 2)[::2]
+        for state in ((q, s_dot), (frozen, strided), (q + 0j, s_dot)):
+            ev.accelerations(*state, 0.0)
+    layouts = _layouts(a for signature in chain_terms.signatures for a in signature)
+    assert {layout for layout, _ in layouts} == {"C"}, layouts
+    states = {(signature[4].layout, signature[4].mutable, signature[5].mutable) for signature in chain_terms.signatures}
+    assert states == {("C", True, True)}, states
+    assert len(chain_terms.signatures) <= 2, chain_terms.signatures
