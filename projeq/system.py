@@ -586,21 +586,39 @@ class System(Model):
         """M(q) = Σ J_nᵀ M_n J_n (docs/theory.md §5)."""
         return self.gauss_form(q, np.zeros(self.n_s), t)[0]
 
-    def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:
-        """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and gravity plus springs; complex for
-        complex (q, ṡ) (unchecked then: a complex step, as for the exact energy gradient of
-        :mod:`projeq.simulation.integrators`)."""
+    def energy(self, q, s_dot, t: float = 0.0, method: str | None = None) -> tuple[float, float]:
+        """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and :meth:`potential_energy` (gravity, strain,
+        springs), by ``method``: "fast" (on the compiled kinematics,
+        :meth:`projeq.assembly.fast.FastEvaluator.energy`), "recursive" (on the reference
+        kinematics, :func:`projeq.assembly.kinematics.poses`, and each subsystem's own
+        ``kinetic_energy``) or None: "fast" where the system's default evaluator is the compiled
+        one. Complex for complex (q, ṡ, t), by the reference (unchecked then: a complex step, as
+        for the exact energy gradient of :mod:`projeq.simulation.integrators`)."""
         from projeq.assembly.kinematics import poses
 
+        if method not in (None, "fast", "recursive"):
+            raise ValueError(f"method: unknown energy evaluation {method!r}; use 'fast', 'recursive' or None")
         complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot) or np.iscomplexobj(t)
-        q, s_dot = (np.asarray(q), np.asarray(s_dot)) if complex_step else self.check_state(q, s_dot, t)
-        kin = poses(self, q, s_dot, t if complex_step else float(t))
+        if complex_step:
+            q, s_dot = np.asarray(q), np.asarray(s_dot)
+            kin = poses(self, q, s_dot, t)
+        else:
+            q, s_dot = self.check_state(q, s_dot, t)
+            if method == "fast" or (method is None and self.evaluator(None).name == "fast"):
+                return self.evaluator("fast").energy(q, s_dot, float(t))
+            kin = poses(self, q, s_dot, float(t))
         q_e = [q[sl] for sl in self.e_q_slice]
         kinetic = sum(sub.kinetic_energy(kin.y_dot[n], q_e[n]) for n, sub in enumerate(self.subsystems))
-        potential = sum(
-            sub.potential_energy(kin.R[n], kin.r[n], self.gravity, q_e[n]) for n, sub in enumerate(self.subsystems)
-        ) + sum(f.potential(kin, q) for f in self.forces)
+        potential = self.potential_energy(kin, q)
         return (complex(kinetic), complex(potential)) if complex_step else (float(kinetic), float(potential))
+
+    def potential_energy(self, kin, q: NDArray):
+        """V at the poses ``kin`` (R_n, r_n, twists, ẏ_n; the ground's last) and q: each
+        subsystem's ``potential_energy`` (gravity, strain) and each force law's ``potential``."""
+        return sum(
+            sub.potential_energy(kin.R[n], kin.r[n], self.gravity, q[self.e_q_slice[n]])
+            for n, sub in enumerate(self.subsystems)
+        ) + sum(f.potential(kin, q) for f in self.forces)
 
     def _check_planar(self) -> None:
         """A subsystem with a selection S must not be driven out of its plane by its joint
