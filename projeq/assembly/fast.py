@@ -197,7 +197,8 @@ class FastEvaluator:
 
     def _kinematics(self, ws: _Workspace, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
         """The poses, twists, T_np, ζ_n, F_n, M_n and the gravity part of h_n of every body into the
-        workspace ``ws`` (:func:`projeq.assembly.kernels.chain_terms`); (q_all, ṡ_all), every joint's own."""
+        workspace ``ws`` (:func:`projeq.assembly.kernels.chain_terms`); returns (q_all, ṡ_all), every
+        joint's own coordinates and velocities."""
         q_all, s_all = (q, s_dot) if self._expansion is None else (self._expansion[0] @ q, self._expansion[1] @ s_dot)
         if self._given:
             self._relative_motions(ws, q_all, s_all, t)
@@ -233,7 +234,8 @@ class FastEvaluator:
         for n, e_s in self._internal:
             y_dot[n, 6 : 6 + e_s.stop - e_s.start] = s_dot[e_s]
         kinetic = 0.5 * np.einsum("ni,nij,nj->", y_dot, ws.M_n, y_dot)
-        return float(kinetic), float(self.system.potential_energy(_SelectedKinematics(self.system, ws, s_dot), q))
+        potential = self.system.potential_energy(_SelectedKinematics(self.system, ws, s_dot), q)
+        return float(kinetic), float(potential)
 
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
         """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels (by
@@ -437,8 +439,9 @@ class _SelectedKinematics(Kinematics):
     """The :class:`~projeq.assembly.kinematics.Kinematics` of the reference evaluators for a
     tree with selections S (ẏ_n = S_n twist, and F_n = S_n F⁶, T̃_np = S̃_n T̃⁶ S̃_pᵀ by
     :func:`projeq.assembly.kinematics.selected_chain_terms`) over the kernel's spatial
-    ``kinematics``; ẏ_n and the chain terms are computed when a force law first reads them
-    (a force or torque on a body reads only its pose)."""
+    ``kinematics`` (the workspace itself for :meth:`FastEvaluator.energy`'s potentials); ẏ_n
+    and the chain terms are computed when a force law first reads them (a force or torque on a
+    body, a potential, reads only its pose)."""
 
     def __init__(self, system, kinematics: Kinematics, s_dot: NDArray):
         self.R, self.r, self.twist = kinematics.R, kinematics.r, kinematics.twist

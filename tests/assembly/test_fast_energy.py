@@ -23,7 +23,8 @@ FEW = settings(max_examples=max(5, settings().max_examples // 5), deadline=None,
 
 def _agree(system, q, s_dot, t):
     """The compiled energies equal the reference ones to round-off of the terms' size."""
-    fast, reference = system.energy(q, s_dot, t, method="fast"), system.energy(q, s_dot, t, method="recursive")
+    fast = system.energy(q, s_dot, t, method="fast")
+    reference = system.energy(q, s_dot, t, method="recursive")
     scale = 1.0 + sum(abs(e) for e in reference)
     np.testing.assert_allclose(fast, reference, rtol=0, atol=1e-13 * scale)
     assert system.energy(q, s_dot, t) == fast  # the default is the compiled one
@@ -41,7 +42,8 @@ def test_energy_on_spatial_trees_with_every_joint_and_law(tree):
 @FEW
 @given(trees(max_n=10, planar=True))
 def test_energy_on_planar_trees(tree):
-    """Planar bodies: the kernel's spatial twist and M⁶ against the selected ẏ = S twist and S M⁶ Sᵀ."""
+    """Planar bodies: the kernel's spatial twist and M⁶ against the selected ẏ = S twist and
+    S M⁶ Sᵀ."""
     _agree(tree.system, tree.q, tree.s_dot, tree.t)
 
 
@@ -93,7 +95,8 @@ def _beam_on_a_spring(gravity):
         {"beam": beam, "tip": pq.PointMass(0.5)},
         {"beam": pq.Revolute(None, (0.0, 0.3, 1.0)), "tip": pq.Fixed("beam", (1.2, 0.0, 0.0))},
         gravity=gravity,
-        forces=[pq.JointSpring("beam", 3.0, q_ref=0.2), pq.SpringDamper(None, (0.5, 0.5, 0.0), "tip", (0.0, 0.0, 0.0), 7.0)],
+        forces=[pq.JointSpring("beam", 3.0, q_ref=0.2),
+                pq.SpringDamper(None, (0.5, 0.5, 0.0), "tip", (0.0, 0.0, 0.0), 7.0)],
     )
 
 
