@@ -105,3 +105,9 @@ def test_compiled_energy_is_conserved_with_a_beam():
     q = np.array([0.4, 0.05, -0.03, 0.02])
     power, scale = _power(system, q, np.array([1.0, -2.0, 3.0, 1.5]))
     assert abs(power) < 1e-7 * scale
+
+
+def test_an_unknown_energy_method_is_refused_by_name():
+    system = pq.scenes.chain(2)
+    with pytest.raises(ValueError, match="method: unknown energy evaluation 'dense'"):
+        system.energy(system.q0, system.s_dot0, 0.0, method="dense")
