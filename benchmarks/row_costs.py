@@ -56,6 +56,7 @@ def parts(model, X, T) -> dict:
     """µs per row of each part at the rows' states X (q, ṡ) and times T."""
     n, N = model.n_q, len(X)
     constrained = hasattr(model, "project")
+
     def normalise(i):
         return model.normalized(X[i][:n], T[i]) if constrained else model.normalized(X[i][:n])
 
