@@ -2,7 +2,8 @@
 checkout (before/after a change: of the output rows, of the right-hand side), in fresh processes, alternately: CPU
 seconds of each (median of ``--repeat`` processes, the numba kernels loaded from the disk cache
 by a warm-up run first), their ratio, and whether the two Results' arrays are bit-identical
-(t, q, s_dot, kinetic, potential, constraint_residual, rank, mobility).
+(t, q, s_dot, kinetic, potential, constraint_residual, rank, mobility), else the largest
+difference of each array that is not, relative to its largest entry.
 
     git -C /work/main archive HEAD | tar -x -C /tmp/out_old
     PYTHONPATH=. python benchmarks/output_rows.py /tmp/out_old [--repeat 3] [SCENE[:t_end] ...]
@@ -48,10 +49,18 @@ def run(tree: Path, name: str, t_end: float, out: str) -> dict:
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def identical(a: str, b: str) -> bool:
-    """Whether the two saved Results hold the same arrays, bit for bit."""
+def differences(a: str, b: str) -> str:
+    """"identical" if the two saved Results hold the same arrays, bit for bit, else the arrays
+    that differ with the largest difference relative to the array's largest entry."""
     with np.load(a) as x, np.load(b) as y:
-        return all(x[k].shape == y[k].shape and np.array_equal(x[k], y[k]) for k in x.files)
+        differ = []
+        for k in x.files:
+            if x[k].shape != y[k].shape:
+                differ.append(f"{k}: shape {x[k].shape} vs {y[k].shape}")
+            elif not np.array_equal(x[k], y[k]):
+                scale = max(np.abs(x[k]).max(), np.finfo(float).tiny)
+                differ.append(f"{k} {np.abs(x[k] - y[k]).max() / scale:.1e}")
+        return "identical" if not differ else "; ".join(differ)
 
 
 def main() -> None:
@@ -64,7 +73,7 @@ def main() -> None:
 
     here = Path(__file__).resolve().parent.parent
     print(f"{'scene':18s} {'t_end':>6s} {'rows':>5s} {'nfev':>6s} {'before s':>9s} {'after s':>8s} "
-          f"{'before/after':>12s} {'identical':>9s}")
+          f"{'before/after':>12s} arrays (identical, or max |difference| / max |entry|)")
     with tempfile.TemporaryDirectory() as tmp:
         for spec in args.scenes:
             name, _, t = spec.partition(":")
@@ -74,10 +83,10 @@ def main() -> None:
                 for label, tree in (("before", args.other.resolve()), ("after", here)):
                     r = run(tree, name, t_end, f"{tmp}/{label}.npz")
                     cpu[label].append(r["cpu"])
-            same = identical(f"{tmp}/before.npz", f"{tmp}/after.npz")
+            same = differences(f"{tmp}/before.npz", f"{tmp}/after.npz")
             b, a = statistics.median(cpu["before"]), statistics.median(cpu["after"])
             print(f"{name:18s} {t_end:6.3g} {r['rows']:5d} {r['nfev']:6d} {b:9.3f} {a:8.3f} {b / a:12.2f} "
-                  f"{str(same):>9s}", flush=True)
+                  f"{same}", flush=True)
 
 
 if __name__ == "__main__":

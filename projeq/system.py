@@ -211,11 +211,11 @@ class Model(ABC):
     def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:
         """(kinetic, potential) energy at (q, ṡ, t)."""
 
+    @abstractmethod
     def output_row(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple:
         """What :func:`projeq.simulate` records at an output row (q normalised): the energies
         (:meth:`energy`), the constraint residuals at q̇ (:meth:`constraint_residual`) and, for a
         model with constraint equations, (rank, mobility) of its constraint matrix (else None)."""
-        return self.energy(q, s_dot, t), self.constraint_residual(q, self.q_dot(q, s_dot, t), t), None
 
     # -- events ---------------------------------------------------------------------------
     def events(self) -> tuple:
@@ -586,21 +586,46 @@ class System(Model):
         """M(q) = Σ J_nᵀ M_n J_n (docs/theory.md §5)."""
         return self.gauss_form(q, np.zeros(self.n_s), t)[0]
 
-    def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:
-        """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and gravity plus springs; complex for
-        complex (q, ṡ) (unchecked then: a complex step, as for the exact energy gradient of
-        :mod:`projeq.simulation.integrators`)."""
+    def energy(self, q, s_dot, t: float = 0.0, method: str | None = None) -> tuple[float, float]:
+        """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and :meth:`potential_energy` (gravity, strain,
+        springs), by ``method``: "fast" (on the compiled kinematics,
+        :meth:`projeq.assembly.fast.FastEvaluator.energy`), "recursive" (on the reference
+        kinematics, :func:`projeq.assembly.kinematics.poses`, and each subsystem's own
+        ``kinetic_energy``) or None: "fast" where the system's default evaluator is the compiled
+        one. Complex for complex (q, ṡ, t), by the reference (unchecked then: a complex step, as
+        for the exact energy gradient of :mod:`projeq.simulation.integrators`)."""
+        if method not in (None, "fast", "recursive"):
+            raise ValueError(f"method: unknown energy evaluation {method!r}; use 'fast', 'recursive' or None")
+        complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot) or np.iscomplexobj(t)
+        if complex_step:
+            return self._energy(np.asarray(q), np.asarray(s_dot), t, "recursive")
+        q, s_dot = self.check_state(q, s_dot, t)
+        return self._energy(q, s_dot, float(t), method)
+
+    def _energy(self, q: NDArray, s_dot: NDArray, t, method: str | None = None) -> tuple:
+        """:meth:`energy` at a checked (q, ṡ, t), or by the reference at a complex one."""
         from projeq.assembly.kinematics import poses
 
+        if method == "fast" or (method is None and self.evaluator(None).name == "fast"):
+            return self.evaluator("fast").energy(q, s_dot, t)
         complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot) or np.iscomplexobj(t)
-        q, s_dot = (np.asarray(q), np.asarray(s_dot)) if complex_step else self.check_state(q, s_dot, t)
-        kin = poses(self, q, s_dot, t if complex_step else float(t))
+        kin = poses(self, q, s_dot, t)
         q_e = [q[sl] for sl in self.e_q_slice]
         kinetic = sum(sub.kinetic_energy(kin.y_dot[n], q_e[n]) for n, sub in enumerate(self.subsystems))
-        potential = sum(
-            sub.potential_energy(kin.R[n], kin.r[n], self.gravity, q_e[n]) for n, sub in enumerate(self.subsystems)
-        ) + sum(f.potential(kin, q) for f in self.forces)
+        potential = self.potential_energy(kin, q)
         return (complex(kinetic), complex(potential)) if complex_step else (float(kinetic), float(potential))
+
+    def output_row(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple:
+        """:meth:`Model.output_row`, the energy unchecked (the row's state is the integrator's)."""
+        return self._energy(q, s_dot, float(t)), self.constraint_residual(q, self.q_dot(q, s_dot, t), t), None
+
+    def potential_energy(self, kin, q: NDArray):
+        """V at the poses ``kin`` (R_n, r_n, twists, ẏ_n; the ground's last) and q: each
+        subsystem's ``potential_energy`` (gravity, strain) and each force law's ``potential``."""
+        return sum(
+            sub.potential_energy(kin.R[n], kin.r[n], self.gravity, q[self.e_q_slice[n]])
+            for n, sub in enumerate(self.subsystems)
+        ) + sum(f.potential(kin, q) for f in self.forces)
 
     def _check_planar(self) -> None:
         """A subsystem with a selection S must not be driven out of its plane by its joint

@@ -150,6 +150,7 @@ class FastEvaluator:
             for n in self._given
         ]
         self._n_cols = n_cols
+        self._internal = [(n, system.e_s_slice[n]) for n, b in enumerate(bodies) if b.n_e]  # ṡ_e of ẏ_n
         terms = [law.compiled_terms() for law in system.forces]
         self._laws, self._law_constants = loads.table([row for row in terms if row is not None])
         self._python_laws = [law for law, row in zip(system.forces, terms) if row is None]  # their own add_to
@@ -192,8 +193,10 @@ class FastEvaluator:
         for n, S_T in self._selected:
             ws.h_hat[n] += S_T @ h[n]
 
-    def _terms(self, ws: _Workspace, q: NDArray, s_dot: NDArray, t: float) -> None:
-        """T_np, ζ_n, F_n, h_n (forces included) of every body into the workspace ``ws``."""
+    def _kinematics(self, ws: _Workspace, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
+        """The poses, twists, T_np, ζ_n, F_n, M_n and the gravity part of h_n of every body into the
+        workspace ``ws`` (:func:`projeq.assembly.kernels.chain_terms`); returns (q_all, ṡ_all), every
+        joint's own coordinates and velocities."""
         q_all, s_all = (q, s_dot) if self._expansion is None else (self._expansion[0] @ q, self._expansion[1] @ s_dot)
         if self._given:
             self._relative_motions(ws, q_all, s_all, t)
@@ -201,6 +204,11 @@ class FastEvaluator:
             self._index, self._geometry, self._inertia, self._gravity, q_all, s_all, ws.given_values,
             self._elastic, self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist,
         )
+        return q_all, s_all
+
+    def _terms(self, ws: _Workspace, q: NDArray, s_dot: NDArray, t: float) -> None:
+        """T_np, ζ_n, F_n, h_n (forces included) of every body into the workspace ``ws``."""
+        q_all, s_all = self._kinematics(ws, q, s_dot, t)
         if self._add_loads is not None:
             failed = self._add_loads(self._laws, self._law_constants, self._index, q_all, s_all, ws.R, ws.r,
                                      ws.twist, ws.F, ws.T, ws.h_hat)
@@ -209,6 +217,23 @@ class FastEvaluator:
                 raise ValueError(f"forces: law {failed} of the compiled ones cannot be evaluated at t = {t:.6g}")
         if ws.kin is not None:
             self._add_forces(ws, q, s_dot, t)
+
+    def energy(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[float, float]:
+        """(kinetic, potential) at the real (q, ṡ, t) on the compiled kinematics (:meth:`_kinematics`):
+        T = ½ Σ ẏ_nᵀ M_n ẏ_n with the kernel's M_n (those its passes use, an elastic body's at its
+        q_e) and ẏ_n = (twist_n, ṡ_e) (the spatial twist: a planar body's is in its plane); V, the
+        subsystems' and force laws' potentials at the kernel's poses
+        (:meth:`projeq.System.potential_energy`)."""
+        q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
+        ws = self._real
+        self._kinematics(ws, q, s_dot, t)
+        y_dot = ws.y_dot
+        y_dot[:, :6] = ws.twist[:-1]
+        for n, e_s in self._internal:
+            y_dot[n, 6 : 6 + e_s.stop - e_s.start] = s_dot[e_s]
+        kinetic = 0.5 * np.einsum("ni,nij,nj->", y_dot, ws.M_n, y_dot)
+        potential = self.system.potential_energy(_SelectedKinematics(self.system, ws, s_dot), q)
+        return float(kinetic), float(potential)
 
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
         """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels (by
@@ -333,6 +358,7 @@ class _Workspace:
         self.given_values = np.zeros((N, kernels.GIVEN_F + 36), dtype)
         self.F = np.zeros((N, width, depth), dtype)
         self.T, self.zeta = np.zeros((N, width, width), dtype), np.zeros((N, width), dtype)
+        self.y_dot = np.zeros((N, width), dtype)
         self.M_hat, self.h_hat = np.zeros((N, width, width), dtype), np.zeros((N + 1, width), dtype)
         self.R, self.r, self.twist = np.zeros((N + 1, 3, 3), dtype), np.zeros((N + 1, 3), dtype), np.zeros((N + 1, 6), dtype)
         self.kin = _WorkspaceKinematics(ev._n_cols, self.R, self.r, self.twist, self.F, self.T, self.zeta) \
@@ -418,8 +444,9 @@ class _SelectedKinematics(Kinematics):
     """The :class:`~projeq.assembly.kinematics.Kinematics` of the reference evaluators for a
     tree with selections S (ẏ_n = S_n twist, and F_n = S_n F⁶, T̃_np = S̃_n T̃⁶ S̃_pᵀ by
     :func:`projeq.assembly.kinematics.selected_chain_terms`) over the kernel's spatial
-    ``kinematics``; ẏ_n and the chain terms are computed when a force law first reads them
-    (a force or torque on a body reads only its pose)."""
+    ``kinematics`` (the workspace itself for :meth:`FastEvaluator.energy`'s potentials); ẏ_n
+    and the chain terms are computed when a force law first reads them (a force or torque on a
+    body, a potential, reads only its pose)."""
 
     def __init__(self, system, kinematics: Kinematics, s_dot: NDArray):
         self.R, self.r, self.twist = kinematics.R, kinematics.r, kinematics.twist

@@ -546,8 +546,8 @@ class ConstrainedSystem(Model):
         (A_s, b_s) at (q, t): ṡ_tree = F ṡ + f once for the energy and q̇, and the rank of A_s."""
         A_s, b_s = self.constraint_matrix(q, t)
         s_dot_tree = self.tree_velocities(q, s_dot, t, (A_s, b_s))
-        return (self.tree.energy(q, s_dot_tree, t), self.constraint_residual(q, self._q_dot(q, s_dot_tree, t), t),
-                self._rank_and_mobility(A_s))
+        residual = self.constraint_residual(q, self._q_dot(q, s_dot_tree, t), t)
+        return self.tree._energy(q, s_dot_tree, float(t)), residual, self._rank_and_mobility(A_s)
 
     # -- dynamics ---------------------------------------------------------------------------
     def gamma(self, q: NDArray, s_dot_tree: NDArray, t: float = 0.0, C=None) -> NDArray:
