@@ -211,11 +211,11 @@ class Model(ABC):
     def energy(self, q, s_dot, t: float = 0.0) -> tuple[float, float]:
         """(kinetic, potential) energy at (q, ṡ, t)."""
 
-    @abstractmethod
     def output_row(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple:
         """What :func:`projeq.simulate` records at an output row (q normalised): the energies
         (:meth:`energy`), the constraint residuals at q̇ (:meth:`constraint_residual`) and, for a
         model with constraint equations, (rank, mobility) of its constraint matrix (else None)."""
+        return self.energy(q, s_dot, t), self.constraint_residual(q, self.q_dot(q, s_dot, t), t), None
 
     # -- events ---------------------------------------------------------------------------
     def events(self) -> tuple:

@@ -224,8 +224,7 @@ class FastEvaluator:
         q_e) and ẏ_n = (twist_n, ṡ_e) (the spatial twist: a planar body's is in its plane); V, the
         subsystems' and force laws' potentials at the kernel's poses
         (:meth:`projeq.System.potential_energy`)."""
-        q, s_dot = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float)
-        ws = self._real
+        q, s_dot, ws = kernel_array(q), kernel_array(s_dot), self._real
         self._kinematics(ws, q, s_dot, t)
         y_dot = ws.y_dot
         y_dot[:, :6] = ws.twist[:-1]
