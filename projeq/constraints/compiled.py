@@ -588,54 +588,154 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
 
 def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     """(U, σ, Vᵀ) of A (m × n) with all n singular values, descending (those beyond m zero to
-    round-off), V n × n and U m × n (column j = A v_j / σ_j, zero where σ_j = 0): one-sided
-    Jacobi rotations of the columns of A until they are orthogonal to round-off (Demmel &
-    Veselić, "Jacobi's method is more accurate than QR", SIAM J. Matrix Anal. Appl. 13, 1992,
-    Algorithm 4.1) — for the few rows and columns of a loop's A_s, without LAPACK's calls and
-    workspace."""
+    round-off), V n × n and U m × n (column j = A v_j / σ_j, zero where σ_j = 0), for the few rows
+    and columns of a loop's A_s, without LAPACK's calls and workspace: the QR decomposition with
+    column pivoting of Aᵀ (:func:`_transposed_qr`, A[order] Q = [L 0]) as the preconditioner of
+    Drmač & Veselić ("New fast and accurate Jacobi SVD algorithm I", SIAM J. Matrix Anal. Appl. 29,
+    2008, §3: the one-sided Jacobi method on Rᵀ = L converges in fewer sweeps than on A), then
+    one-sided Jacobi rotations of the columns of L (:func:`_jacobi` of [L; E]): L W = Ũ Σ, so that
+    V = Q diag(W, E) and U[order] = Ũ."""
     m, n = A.shape
-    W, V = A.copy(), np.eye(n)
-    floor = (1e-15 * np.sqrt(np.sum(A * A))) ** 2  # a column below this is A v = 0 to round-off: in the null space
+    X, Q, order = _transposed_qr(A)  # X = [L; E]
+    p = X.shape[1]
+    _jacobi(X, m)  # X = [Ũ Σ; W]
+    norms = np.zeros(p)
+    for j in range(p):
+        norms[j] = _column_square(X, m, j)
+    ranked = np.argsort(-norms)
+    sigma, U, Vt = np.zeros(n), np.zeros((m, n)), np.zeros((n, n))
+    for c in range(p):
+        j = ranked[c]
+        for i in range(n):
+            total = 0.0
+            for l in range(p):
+                total += Q[i, l] * X[m + l, j]
+            Vt[c, i] = total
+        if norms[j] > 0.0:
+            sigma[c] = np.sqrt(norms[j])
+            for i in range(m):
+                U[order[i], c] = X[i, j] / sigma[c]
+    for c in range(p, n):  # the columns of Q beyond the rows of A: in its null space
+        for i in range(n):
+            Vt[c, i] = Q[i, c]
+    return U, sigma, Vt
+
+
+def _transposed_qr(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """([L; E], Q, order): Householder QR with column pivoting of Aᵀ (m × n A), Aᵀ[:, order] = Q R
+    (Golub & Van Loan, "Matrix Computations", 4th ed., 2013, Algorithm 5.4.1; Q n × n orthogonal,
+    the product H_0 ⋯ H_{p−1} of p = min(m, n) reflectors accumulated backwards, §5.1.6), so that
+    A[order] Q = Rᵀ = [L 0] with L = R[:p]ᵀ, m × p lower trapezoidal, above the p × p identity."""
+    m, n = A.shape
+    p = min(m, n)
+    B, order = A.T.copy(), np.arange(m)
+    reflectors, scales = np.zeros((n, p)), np.zeros(p)  # H_c = E − scales[c] v_c v_cᵀ, v_c zero above row c
+    for c in range(p):
+        size, chosen = -1.0, c  # the column of largest norm below row c first
+        for j in range(c, m):
+            column = 0.0
+            for i in range(c, n):
+                column += B[i, j] * B[i, j]
+            if column > size:
+                size, chosen = column, j
+        for i in range(n):
+            B[i, c], B[i, chosen] = B[i, chosen], B[i, c]
+        order[c], order[chosen] = order[chosen], order[c]
+        if size == 0.0:  # the rest is zero: H_c = E
+            continue
+        head = -np.sqrt(size) if B[c, c] >= 0.0 else np.sqrt(size)  # R[c, c], of the sign that avoids cancellation
+        for i in range(c, n):
+            reflectors[i, c] = B[i, c]
+        reflectors[c, c] -= head
+        scales[c] = 2.0 / (size - B[c, c] * B[c, c] + reflectors[c, c] * reflectors[c, c])  # 2 / v_cᵀ v_c
+        _reflect(reflectors, scales[c], c, B, c + 1, m)
+        B[c, c] = head
+    Q = np.eye(n)
+    for c in range(p - 1, -1, -1):  # Q = H_0 (H_1 (⋯ H_{p−1})): H_c touches rows and columns c… only
+        _reflect(reflectors, scales[c], c, Q, c, n)
+    X = np.zeros((m + p, p))  # [L; E]
+    for c in range(p):
+        for i in range(c, m):
+            X[i, c] = B[c, i]
+        X[m + c, c] = 1.0
+    return X, Q, order
+
+
+def _reflect(reflectors: NDArray, scale: float, c: int, X: NDArray, first: int, last: int) -> None:
+    """Columns first … last − 1 of X ← H_c X, H_c = E − scale v vᵀ, v = reflectors[:, c] (zero above row c)."""
+    if scale == 0.0:
+        return
+    for j in range(first, last):
+        dot = 0.0
+        for i in range(c, X.shape[0]):
+            dot += reflectors[i, c] * X[i, j]
+        dot *= scale
+        for i in range(c, X.shape[0]):
+            X[i, j] -= dot * reflectors[i, c]
+
+
+#: an updated squared column norm that has dropped below this fraction of its value before the
+#: rotation is computed anew (its update lost digits to cancellation)
+DRIFT = 0.1
+
+
+def _jacobi(X: NDArray, m: int) -> None:
+    """Rotate the columns of X = [W; V] (W its first ``m`` rows, V the others alike) until those of
+    W are orthogonal to round-off (one-sided Jacobi, Demmel & Veselić, "Jacobi's method is more
+    accurate than QR", SIAM J. Matrix Anal. Appl. 13, 1992, Algorithm 4.1): a pair (a, r) whose
+    cosine |γ| / √(α β) (α, β the squared norms of the columns of W, γ their dot product) is above
+    1e-15 is rotated by the angle that makes it zero. The squared norms are taken at each sweep's
+    start and updated by each rotation, α' = α − t γ, β' = β + t γ with t = tan of the angle (de
+    Rijk, "A one-sided Jacobi algorithm for computing the singular value decomposition on a vector
+    computer", SIAM J. Sci. Stat. Comput. 10, 1989), computed anew where one drops below DRIFT of
+    its value; the last sweep rotates none, so that every pair's cosine is tested on norms taken
+    afresh. A column below 1e-15 of ‖W‖_F is W v = 0 to round-off (in the null space): not rotated."""
+    p = X.shape[1]
+    squares, floor = np.zeros(p), 0.0
+    for j in range(p):
+        floor += 1e-30 * _column_square(X, m, j)
     for _ in range(100):  # sweeps; quadratic convergence takes a handful
+        for j in range(p):
+            squares[j] = 0.0
+            for i in range(m):
+                squares[j] += X[i, j] * X[i, j]
         rotated = False
-        for p in range(n - 1):
-            for r in range(p + 1, n):
-                alpha, beta, gamma = 0.0, 0.0, 0.0
+        for a in range(p - 1):
+            for r in range(a + 1, p):
+                alpha, beta = squares[a], squares[r]
+                if alpha <= floor or beta <= floor:
+                    continue
+                gamma = 0.0
                 for i in range(m):
-                    alpha += W[i, p] * W[i, p]
-                    beta += W[i, r] * W[i, r]
-                    gamma += W[i, p] * W[i, r]
-                if alpha <= floor or beta <= floor or abs(gamma) <= 1e-15 * np.sqrt(alpha) * np.sqrt(beta):
+                    gamma += X[i, a] * X[i, r]
+                if abs(gamma) <= 1e-15 * np.sqrt(alpha * beta):
                     continue  # orthogonal to round-off
                 rotated = True
                 if abs(beta - alpha) > 1e100 * abs(gamma):  # a tiny angle: tan = 1/(2ζ) to round-off
                     tan = gamma / (beta - alpha)
                 else:
                     zeta = (beta - alpha) / (2.0 * gamma)
-                    tan = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.hypot(1.0, zeta))
+                    tan = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
                 cos = 1.0 / np.sqrt(1.0 + tan * tan)
                 sin = cos * tan
-                for X in (W, V):
-                    for i in range(X.shape[0]):
-                        x_p, x_r = X[i, p], X[i, r]
-                        X[i, p], X[i, r] = cos * x_p - sin * x_r, sin * x_p + cos * x_r
+                for i in range(X.shape[0]):
+                    x_a, x_r = X[i, a], X[i, r]
+                    X[i, a], X[i, r] = cos * x_a - sin * x_r, sin * x_a + cos * x_r
+                squares[a], squares[r] = alpha - tan * gamma, beta + tan * gamma
+                if squares[a] < DRIFT * alpha:
+                    squares[a] = _column_square(X, m, a)
+                if squares[r] < DRIFT * beta:
+                    squares[r] = _column_square(X, m, r)
         if not rotated:
             break
-    norms = np.zeros(n)
-    for j in range(n):
-        for i in range(m):
-            norms[j] += W[i, j] * W[i, j]
-    order = np.argsort(-norms)
-    sigma, U, Vt = np.zeros(n), np.zeros((m, n)), np.zeros((n, n))
-    for c in range(n):
-        j = order[c]
-        sigma[c] = np.sqrt(norms[j])
-        for i in range(n):
-            Vt[c, i] = V[i, j]
-        if sigma[c] > 0.0:
-            for i in range(m):
-                U[i, c] = W[i, j] / sigma[c]
-    return U, sigma, Vt
+
+
+def _column_square(X: NDArray, m: int, j: int) -> float:
+    """|X[:m, j]|²."""
+    total = 0.0
+    for i in range(m):
+        total += X[i, j] * X[i, j]
+    return total
 
 
 # interpreted; _compiled holds the compiled ones
@@ -666,8 +766,8 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _given_motions, _matvec, _matmul, _svd, _projected,
-            _inverse)
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _given_motions, _matvec, _matmul, _svd,
+            _transposed_qr, _reflect, _jacobi, _column_square, _projected, _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
@@ -781,9 +881,15 @@ def _compiled() -> dict:
     kernels of :mod:`projeq.assembly.kernels`, the force laws' loop of :mod:`projeq.assembly.loads`,
     and Φ, A and the UserJoints' relative motions through their C callbacks' addresses by the
     intrinsics :func:`_phi_into` and :func:`_given_into`."""
-    compiled = {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True)[0],
-                "add_loads": loads.kernel(True), **_intrinsics()}
-    return dict(zip(("partitioned", "tangent"), kernels.jit(partitioned, tangent, callees=_HELPERS, kernels=compiled)))
+    return dict(zip(("partitioned", "tangent"), kernels.jit(partitioned, tangent, callees=_HELPERS,
+                                                             kernels=_compiled_callees())))
+
+
+def _compiled_callees() -> dict:
+    """The compiled functions the kernels call by name: the tree's kernels, the force laws' loop and
+    the intrinsics that call the C callbacks."""
+    return {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True)[0],
+            "add_loads": loads.kernel(True), **_intrinsics()}
 
 
 def _intrinsics() -> dict:
