@@ -57,6 +57,7 @@ import os
 import re
 import tempfile
 import warnings
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -832,6 +833,7 @@ class CompiledClosure:
         self.tree = (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
                      ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist, ev._laws, ev._law_constants)
         self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
+        self._kept = (None, None)  # (the system, the tangent it keeps) of the last call (_kept_tangent)
 
     def _call(self, system, q: NDArray, s_dot: NDArray, t: float) -> bool:
         """One kernel call for ``system`` (its partition; for a TangentSystem its kept tangent,
@@ -843,14 +845,23 @@ class CompiledClosure:
                                system.independent, system.dependent,
                                self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b)
         else:
-            kept = np.full((system.tree.n_s, system.n_s), np.nan) if system._tangent is None else \
-                np.array(system._tangent, dtype=float)
             flag = self.kernel(self.phi, self.pfaffian, self.joints, self.tree, q, s_dot, t, self.m_h,
                                system.independent, system.tree.n_s - system.n_s,
-                               system.separation, self.constants[0], kept, SINGULAR_PIVOT, self._q_dot,
-                               self._s_ddot_tree, self._A, M, b)
-            system._tangent = kept
+                               system.separation, self.constants[0], self._kept_tangent(system), SINGULAR_PIVOT,
+                               self._q_dot, self._s_ddot_tree, self._A, M, b)
         return flag == DONE
+
+    def _kept_tangent(self, system) -> NDArray:
+        """The tangent ``system`` keeps (TangentSystem._tangent) as the array the kernel reads and
+        overwrites: the one the last call wrote, where it is still the system's (no copy per call);
+        else a copy of the one the numpy path (or the system this one was copied from) kept, NaN
+        where none, which the system then keeps."""
+        owner, kept = self._kept
+        if kept is None or system._tangent is not kept or owner() is not system:
+            kept = np.full((system.tree.n_s, system.n_s), np.nan) if system._tangent is None else \
+                np.array(system._tangent, dtype=float)
+            system._tangent, self._kept = kept, (weakref.ref(system), kept)
+        return kept
 
     def accelerations(self, system, q: NDArray, s_dot: NDArray, t: float):
         """(s̈_tree, A_s, M, b) of ``system`` at (q, ṡ, t), or None (flagged)."""
