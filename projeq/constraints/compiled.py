@@ -498,7 +498,11 @@ def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
         cholesky_solve(M_min, k, s_ddot)
     else:
         return SINGULAR
-    s_ddot_tree[:] = _matvec(F, s_ddot) + f_bar
+    for i in range(n):  # F s̈ + f̄
+        total = 0.0
+        for c in range(k):
+            total += F[i, c] * s_ddot[c]
+        s_ddot_tree[i] = total + f_bar[i]
     return DONE
 
 
@@ -549,7 +553,10 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
     _constraint_rows(phi, pfaffian, q, t, m_h, A)
     U, sigma, Vt = _svd(A)
-    near = max(k, int(np.sum(sigma < separation * sigma[0])))
+    near = 0  # the singular values below separation σ_max, at least k
+    for value in sigma:
+        near += value < separation * sigma[0]
+    near = max(k, near)
     if near == k or np.isnan(kept[0, 0]):
         N = Vt[n - k:].T.copy()
         kept[:, :] = N
@@ -561,8 +568,10 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
         for c in range(k):
             N_ind[r, c] = N[independent[r], c]
     inv = _inverse(N_ind)
-    if not np.all(np.isfinite(inv)):
-        return DEGENERATE
+    for r in range(k):
+        for c in range(k):
+            if not np.isfinite(inv[r, c]):
+                return DEGENERATE
     F = _matmul(N, inv)  # F = N N_ind⁻¹, F[independent] = E
     for r in range(k):
         for c in range(k):
@@ -570,7 +579,10 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
     s_dot_tree = _matvec(F, s_dot)
     q_dot[:] = s_dot_tree
     gamma = _constraint_gamma(phi, pfaffian, q, s_dot_tree, t, m_h, m)
-    count = min(int(np.sum(sigma > acting * sigma[0])), rank)
+    count = 0  # the singular values above acting σ_max, at most rank
+    for value in sigma:
+        count += value > acting * sigma[0]
+    count = min(count, rank)
     x0 = np.zeros(n)  # A_s⁺ (−γ) = V_k Σ_k⁻¹ U_kᵀ (−γ)
     for j in range(count):
         weight = 0.0
@@ -582,7 +594,12 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
     x0_ind = np.empty(k)
     for c in range(k):
         x0_ind[c] = x0[independent[c]]
-    f_bar = x0 - _matvec(F, x0_ind)
+    f_bar = x0  # x₀ − F x₀[independent], in place
+    for i in range(n):
+        total = 0.0
+        for c in range(k):
+            total += F[i, c] * x0_ind[c]
+        f_bar[i] = x0[i] - total
     _given_motions(joints, q, s_dot_tree, t, tree[4])
     return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
 
