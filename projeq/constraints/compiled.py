@@ -611,15 +611,15 @@ def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     column pivoting of Aᵀ (:func:`_transposed_qr`, A[order] Q = [L 0]) as the preconditioner of
     Drmač & Veselić ("New fast and accurate Jacobi SVD algorithm I", SIAM J. Matrix Anal. Appl. 29,
     2008, §3: the one-sided Jacobi method on Rᵀ = L converges in fewer sweeps than on A), then
-    one-sided Jacobi rotations of the columns of L (:func:`_jacobi` of [L; E]): L W = Ũ Σ, so that
+    one-sided Jacobi rotations of the columns of L (:func:`_jacobi` of [L; E]ᵀ): L W = Ũ Σ, so that
     V = Q diag(W, E) and U[order] = Ũ."""
     m, n = A.shape
-    X, Q, order = _transposed_qr(A)  # X = [L; E]
-    p = X.shape[1]
-    _jacobi(X, m)  # X = [Ũ Σ; W]
+    X, Q, order = _transposed_qr(A)  # X = [L; E]ᵀ
+    p = X.shape[0]
+    _jacobi(X, m)  # X = [Ũ Σ; W]ᵀ
     norms = np.zeros(p)
     for j in range(p):
-        norms[j] = _column_square(X, m, j)
+        norms[j] = _row_square(X, m, j)
     ranked = np.argsort(-norms)
     sigma, U, Vt = np.zeros(n), np.zeros((m, n)), np.zeros((n, n))
     for c in range(p):
@@ -627,12 +627,12 @@ def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
         for i in range(n):
             total = 0.0
             for l in range(p):
-                total += Q[i, l] * X[m + l, j]
+                total += Q[i, l] * X[j, m + l]
             Vt[c, i] = total
         if norms[j] > 0.0:
             sigma[c] = np.sqrt(norms[j])
             for i in range(m):
-                U[order[i], c] = X[i, j] / sigma[c]
+                U[order[i], c] = X[j, i] / sigma[c]
     for c in range(p, n):  # the columns of Q beyond the rows of A: in its null space
         for i in range(n):
             Vt[c, i] = Q[i, c]
@@ -640,7 +640,7 @@ def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
 
 
 def _transposed_qr(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-    """([L; E], Q, order): Householder QR with column pivoting of Aᵀ (m × n A), Aᵀ[:, order] = Q R
+    """([L; E]ᵀ, Q, order): Householder QR with column pivoting of Aᵀ (m × n A), Aᵀ[:, order] = Q R
     (Golub & Van Loan, "Matrix Computations", 4th ed., 2013, Algorithm 5.4.1; Q n × n orthogonal,
     the product H_0 ⋯ H_{p−1} of p = min(m, n) reflectors accumulated backwards, §5.1.6), so that
     A[order] Q = Rᵀ = [L 0] with L = R[:p]ᵀ, m × p lower trapezoidal, above the p × p identity."""
@@ -671,11 +671,11 @@ def _transposed_qr(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     Q = np.eye(n)
     for c in range(p - 1, -1, -1):  # Q = H_0 (H_1 (⋯ H_{p−1})): H_c touches rows and columns c… only
         _reflect(reflectors, scales[c], c, Q, c, n)
-    X = np.zeros((m + p, p))  # [L; E]
+    X = np.zeros((p, m + p))  # [L; E]ᵀ = [R[:p] E]
     for c in range(p):
         for i in range(c, m):
-            X[i, c] = B[c, i]
-        X[m + c, c] = 1.0
+            X[c, i] = B[c, i]
+        X[c, m + c] = 1.0
     return X, Q, order
 
 
@@ -698,8 +698,9 @@ DRIFT = 0.1
 
 
 def _jacobi(X: NDArray, m: int) -> None:
-    """Rotate the columns of X = [W; V] (W its first ``m`` rows, V the others alike) until those of
-    W are orthogonal to round-off (one-sided Jacobi, Demmel & Veselić, "Jacobi's method is more
+    """Rotate the rows of X = [W; V]ᵀ (the columns of W their first ``m`` entries, those of V the
+    others, rotated alike; rows, so that the loops run over contiguous entries) until the columns
+    of W are orthogonal to round-off (one-sided Jacobi, Demmel & Veselić, "Jacobi's method is more
     accurate than QR", SIAM J. Matrix Anal. Appl. 13, 1992, Algorithm 4.1): a pair (a, r) whose
     cosine |γ| / √(α β) (α, β the squared norms of the columns of W, γ their dot product) is above
     1e-15 is rotated by the angle that makes it zero. The squared norms are taken at each sweep's
@@ -708,15 +709,15 @@ def _jacobi(X: NDArray, m: int) -> None:
     computer", SIAM J. Sci. Stat. Comput. 10, 1989), computed anew where one drops below DRIFT of
     its value; the last sweep rotates none, so that every pair's cosine is tested on norms taken
     afresh. A column below 1e-15 of ‖W‖_F is W v = 0 to round-off (in the null space): not rotated."""
-    p = X.shape[1]
+    p = X.shape[0]
     squares, floor = np.zeros(p), 0.0
     for j in range(p):
-        floor += 1e-30 * _column_square(X, m, j)
+        floor += 1e-30 * _row_square(X, m, j)
     for _ in range(100):  # sweeps; quadratic convergence takes a handful
         for j in range(p):
             squares[j] = 0.0
             for i in range(m):
-                squares[j] += X[i, j] * X[i, j]
+                squares[j] += X[j, i] * X[j, i]
         rotated = False
         for a in range(p - 1):
             for r in range(a + 1, p):
@@ -725,7 +726,7 @@ def _jacobi(X: NDArray, m: int) -> None:
                     continue
                 gamma = 0.0
                 for i in range(m):
-                    gamma += X[i, a] * X[i, r]
+                    gamma += X[a, i] * X[r, i]
                 if abs(gamma) <= 1e-15 * np.sqrt(alpha * beta):
                     continue  # orthogonal to round-off
                 rotated = True
@@ -736,23 +737,23 @@ def _jacobi(X: NDArray, m: int) -> None:
                     tan = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
                 cos = 1.0 / np.sqrt(1.0 + tan * tan)
                 sin = cos * tan
-                for i in range(X.shape[0]):
-                    x_a, x_r = X[i, a], X[i, r]
-                    X[i, a], X[i, r] = cos * x_a - sin * x_r, sin * x_a + cos * x_r
+                for i in range(X.shape[1]):
+                    x_a, x_r = X[a, i], X[r, i]
+                    X[a, i], X[r, i] = cos * x_a - sin * x_r, sin * x_a + cos * x_r
                 squares[a], squares[r] = alpha - tan * gamma, beta + tan * gamma
                 if squares[a] < DRIFT * alpha:
-                    squares[a] = _column_square(X, m, a)
+                    squares[a] = _row_square(X, m, a)
                 if squares[r] < DRIFT * beta:
-                    squares[r] = _column_square(X, m, r)
+                    squares[r] = _row_square(X, m, r)
         if not rotated:
             break
 
 
-def _column_square(X: NDArray, m: int, j: int) -> float:
-    """|X[:m, j]|²."""
+def _row_square(X: NDArray, m: int, j: int) -> float:
+    """|X[j, :m]|²."""
     total = 0.0
     for i in range(m):
-        total += X[i, j] * X[i, j]
+        total += X[j, i] * X[j, i]
     return total
 
 
@@ -785,7 +786,7 @@ def _inverse(A: NDArray) -> NDArray:
 
 
 _HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _given_motions, _matvec, _matmul, _svd,
-            _transposed_qr, _reflect, _jacobi, _column_square, _projected, _inverse)
+            _transposed_qr, _reflect, _jacobi, _row_square, _projected, _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
