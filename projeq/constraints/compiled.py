@@ -614,7 +614,7 @@ def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     one-sided Jacobi rotations of the columns of L (:func:`_jacobi` of [L; E]ᵀ): L W = Ũ Σ, so that
     V = Q diag(W, E) and U[order] = Ũ."""
     m, n = A.shape
-    X, Q, order = _transposed_qr(A)  # X = [L; E]ᵀ
+    X, Qt, order = _transposed_qr(A)  # X = [L; E]ᵀ
     p = X.shape[0]
     _jacobi(X, m)  # X = [Ũ Σ; W]ᵀ
     norms = np.zeros(p)
@@ -624,72 +624,72 @@ def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     sigma, U, Vt = np.zeros(n), np.zeros((m, n)), np.zeros((n, n))
     for c in range(p):
         j = ranked[c]
-        for i in range(n):
-            total = 0.0
-            for l in range(p):
-                total += Q[i, l] * X[j, m + l]
-            Vt[c, i] = total
+        for l in range(p):  # v_c = Q₁ w_j: Vt[c] = Σ_l W[l, j] Qᵀ[l]
+            for i in range(n):
+                Vt[c, i] += X[j, m + l] * Qt[l, i]
         if norms[j] > 0.0:
             sigma[c] = np.sqrt(norms[j])
             for i in range(m):
                 U[order[i], c] = X[j, i] / sigma[c]
     for c in range(p, n):  # the columns of Q beyond the rows of A: in its null space
         for i in range(n):
-            Vt[c, i] = Q[i, c]
+            Vt[c, i] = Qt[c, i]
     return U, sigma, Vt
 
 
 def _transposed_qr(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-    """([L; E]ᵀ, Q, order): Householder QR with column pivoting of Aᵀ (m × n A), Aᵀ[:, order] = Q R
+    """([L; E]ᵀ, Qᵀ, order): Householder QR with column pivoting of Aᵀ (m × n A), Aᵀ[:, order] = Q R
     (Golub & Van Loan, "Matrix Computations", 4th ed., 2013, Algorithm 5.4.1; Q n × n orthogonal,
     the product H_0 ⋯ H_{p−1} of p = min(m, n) reflectors accumulated backwards, §5.1.6), so that
-    A[order] Q = Rᵀ = [L 0] with L = R[:p]ᵀ, m × p lower trapezoidal, above the p × p identity."""
+    A[order] Q = Rᵀ = [L 0] with L = R[:p]ᵀ, m × p lower trapezoidal, above the p × p identity.
+    The columns of Aᵀ are the rows of A: the reflectors act on rows (:func:`_reflect`)."""
     m, n = A.shape
     p = min(m, n)
-    B, order = A.T.copy(), np.arange(m)
-    reflectors, scales = np.zeros((n, p)), np.zeros(p)  # H_c = E − scales[c] v_c v_cᵀ, v_c zero above row c
+    C, order = A.copy(), np.arange(m)  # C = Aᵀᵀ: row j is column j of Aᵀ, reflected in place
+    reflectors, scales = np.zeros((p, n)), np.zeros(p)  # H_c = E − scales[c] v_c v_cᵀ, v_c zero before entry c
     for c in range(p):
         size, chosen = -1.0, c  # the column of largest norm below row c first
         for j in range(c, m):
             column = 0.0
             for i in range(c, n):
-                column += B[i, j] * B[i, j]
+                column += C[j, i] * C[j, i]
             if column > size:
                 size, chosen = column, j
         for i in range(n):
-            B[i, c], B[i, chosen] = B[i, chosen], B[i, c]
+            C[c, i], C[chosen, i] = C[chosen, i], C[c, i]
         order[c], order[chosen] = order[chosen], order[c]
         if size == 0.0:  # the rest is zero: H_c = E
             continue
-        head = -np.sqrt(size) if B[c, c] >= 0.0 else np.sqrt(size)  # R[c, c], of the sign that avoids cancellation
+        head = -np.sqrt(size) if C[c, c] >= 0.0 else np.sqrt(size)  # R[c, c], of the sign that avoids cancellation
         for i in range(c, n):
-            reflectors[i, c] = B[i, c]
+            reflectors[c, i] = C[c, i]
         reflectors[c, c] -= head
-        scales[c] = 2.0 / (size - B[c, c] * B[c, c] + reflectors[c, c] * reflectors[c, c])  # 2 / v_cᵀ v_c
-        _reflect(reflectors, scales[c], c, B, c + 1, m)
-        B[c, c] = head
-    Q = np.eye(n)
+        scales[c] = 2.0 / (size - C[c, c] * C[c, c] + reflectors[c, c] * reflectors[c, c])  # 2 / v_cᵀ v_c
+        _reflect(reflectors, scales[c], c, C, c + 1, m)
+        C[c, c] = head
+    Qt = np.eye(n)
     for c in range(p - 1, -1, -1):  # Q = H_0 (H_1 (⋯ H_{p−1})): H_c touches rows and columns c… only
-        _reflect(reflectors, scales[c], c, Q, c, n)
+        _reflect(reflectors, scales[c], c, Qt, c, n)
     X = np.zeros((p, m + p))  # [L; E]ᵀ = [R[:p] E]
     for c in range(p):
         for i in range(c, m):
-            X[c, i] = B[c, i]
+            X[c, i] = C[i, c]
         X[c, m + c] = 1.0
-    return X, Q, order
+    return X, Qt, order
 
 
 def _reflect(reflectors: NDArray, scale: float, c: int, X: NDArray, first: int, last: int) -> None:
-    """Columns first … last − 1 of X ← H_c X, H_c = E − scale v vᵀ, v = reflectors[:, c] (zero above row c)."""
+    """Rows first … last − 1 of X ← X H_c (each the transpose of H_c times a column), H_c = E − scale v vᵀ,
+    v = reflectors[c] (zero before entry c)."""
     if scale == 0.0:
         return
     for j in range(first, last):
         dot = 0.0
-        for i in range(c, X.shape[0]):
-            dot += reflectors[i, c] * X[i, j]
+        for i in range(c, X.shape[1]):
+            dot += reflectors[c, i] * X[j, i]
         dot *= scale
-        for i in range(c, X.shape[0]):
-            X[i, j] -= dot * reflectors[i, c]
+        for i in range(c, X.shape[1]):
+            X[j, i] -= dot * reflectors[c, i]
 
 
 #: an updated squared column norm that has dropped below this fraction of its value before the
