@@ -57,6 +57,7 @@ import os
 import re
 import tempfile
 import warnings
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -497,7 +498,11 @@ def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
         cholesky_solve(M_min, k, s_ddot)
     else:
         return SINGULAR
-    s_ddot_tree[:] = _matvec(F, s_ddot) + f_bar
+    for i in range(n):  # F s̈ + f̄
+        total = 0.0
+        for c in range(k):
+            total += F[i, c] * s_ddot[c]
+        s_ddot_tree[i] = total + f_bar[i]
     return DONE
 
 
@@ -548,7 +553,10 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
     _constraint_rows(phi, pfaffian, q, t, m_h, A)
     U, sigma, Vt = _svd(A)
-    near = max(k, int(np.sum(sigma < separation * sigma[0])))
+    near = 0  # the singular values below separation σ_max, at least k
+    for value in sigma:
+        near += value < separation * sigma[0]
+    near = max(k, near)
     if near == k or np.isnan(kept[0, 0]):
         N = Vt[n - k:].T.copy()
         kept[:, :] = N
@@ -560,8 +568,10 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
         for c in range(k):
             N_ind[r, c] = N[independent[r], c]
     inv = _inverse(N_ind)
-    if not np.all(np.isfinite(inv)):
-        return DEGENERATE
+    for r in range(k):
+        for c in range(k):
+            if not np.isfinite(inv[r, c]):
+                return DEGENERATE
     F = _matmul(N, inv)  # F = N N_ind⁻¹, F[independent] = E
     for r in range(k):
         for c in range(k):
@@ -569,7 +579,10 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
     s_dot_tree = _matvec(F, s_dot)
     q_dot[:] = s_dot_tree
     gamma = _constraint_gamma(phi, pfaffian, q, s_dot_tree, t, m_h, m)
-    count = min(int(np.sum(sigma > acting * sigma[0])), rank)
+    count = 0  # the singular values above acting σ_max, at most rank
+    for value in sigma:
+        count += value > acting * sigma[0]
+    count = min(count, rank)
     x0 = np.zeros(n)  # A_s⁺ (−γ) = V_k Σ_k⁻¹ U_kᵀ (−γ)
     for j in range(count):
         weight = 0.0
@@ -581,61 +594,167 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
     x0_ind = np.empty(k)
     for c in range(k):
         x0_ind[c] = x0[independent[c]]
-    f_bar = x0 - _matvec(F, x0_ind)
+    f_bar = x0  # x₀ − F x₀[independent], in place
+    for i in range(n):
+        total = 0.0
+        for c in range(k):
+            total += F[i, c] * x0_ind[c]
+        f_bar[i] = x0[i] - total
     _given_motions(joints, q, s_dot_tree, t, tree[4])
     return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
 def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     """(U, σ, Vᵀ) of A (m × n) with all n singular values, descending (those beyond m zero to
-    round-off), V n × n and U m × n (column j = A v_j / σ_j, zero where σ_j = 0): one-sided
-    Jacobi rotations of the columns of A until they are orthogonal to round-off (Demmel &
-    Veselić, "Jacobi's method is more accurate than QR", SIAM J. Matrix Anal. Appl. 13, 1992,
-    Algorithm 4.1) — for the few rows and columns of a loop's A_s, without LAPACK's calls and
-    workspace."""
+    round-off), V n × n and U m × n (column j = A v_j / σ_j, zero where σ_j = 0), for the few rows
+    and columns of a loop's A_s, without LAPACK's calls and workspace: the QR decomposition with
+    column pivoting of Aᵀ (:func:`_transposed_qr`, A[order] Q = [L 0]) as the preconditioner of
+    Drmač & Veselić ("New fast and accurate Jacobi SVD algorithm I", SIAM J. Matrix Anal. Appl. 29,
+    2008, §3: the one-sided Jacobi method on Rᵀ = L converges in fewer sweeps than on A), then
+    one-sided Jacobi rotations of the columns of L (:func:`_jacobi` of [L; E]ᵀ): L W = Ũ Σ, so that
+    V = Q diag(W, E) and U[order] = Ũ."""
     m, n = A.shape
-    W, V = A.copy(), np.eye(n)
-    floor = (1e-15 * np.sqrt(np.sum(A * A))) ** 2  # a column below this is A v = 0 to round-off: in the null space
+    X, Qt, order = _transposed_qr(A)  # X = [L; E]ᵀ
+    p = X.shape[0]
+    _jacobi(X, m)  # X = [Ũ Σ; W]ᵀ
+    norms = np.zeros(p)
+    for j in range(p):
+        norms[j] = _row_square(X, m, j)
+    ranked = np.argsort(-norms)
+    sigma, U, Vt = np.zeros(n), np.zeros((m, n)), np.zeros((n, n))
+    for c in range(p):
+        j = ranked[c]
+        for l in range(p):  # v_c = Q₁ w_j: Vt[c] = Σ_l W[l, j] Qᵀ[l]
+            for i in range(n):
+                Vt[c, i] += X[j, m + l] * Qt[l, i]
+        if norms[j] > 0.0:
+            sigma[c] = np.sqrt(norms[j])
+            for i in range(m):
+                U[order[i], c] = X[j, i] / sigma[c]
+    for c in range(p, n):  # the columns of Q beyond the rows of A: in its null space
+        for i in range(n):
+            Vt[c, i] = Qt[c, i]
+    return U, sigma, Vt
+
+
+def _transposed_qr(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """([L; E]ᵀ, Qᵀ, order): Householder QR with column pivoting of Aᵀ (m × n A), Aᵀ[:, order] = Q R
+    (Golub & Van Loan, "Matrix Computations", 4th ed., 2013, Algorithm 5.4.1; Q n × n orthogonal,
+    the product H_0 ⋯ H_{p−1} of p = min(m, n) reflectors accumulated backwards, §5.1.6), so that
+    A[order] Q = Rᵀ = [L 0] with L = R[:p]ᵀ, m × p lower trapezoidal, above the p × p identity.
+    The columns of Aᵀ are the rows of A: the reflectors act on rows (:func:`_reflect`)."""
+    m, n = A.shape
+    p = min(m, n)
+    C, order = A.copy(), np.arange(m)  # C = Aᵀᵀ: row j is column j of Aᵀ, reflected in place
+    reflectors, scales = np.zeros((p, n)), np.zeros(p)  # H_c = E − scales[c] v_c v_cᵀ, v_c zero before entry c
+    for c in range(p):
+        size, chosen = -1.0, c  # the column of largest norm below row c first
+        for j in range(c, m):
+            column = 0.0
+            for i in range(c, n):
+                column += C[j, i] * C[j, i]
+            if column > size:
+                size, chosen = column, j
+        for i in range(n):
+            C[c, i], C[chosen, i] = C[chosen, i], C[c, i]
+        order[c], order[chosen] = order[chosen], order[c]
+        if size == 0.0:  # the rest is zero: H_c = E
+            continue
+        head = -np.sqrt(size) if C[c, c] >= 0.0 else np.sqrt(size)  # R[c, c], of the sign that avoids cancellation
+        for i in range(c, n):
+            reflectors[c, i] = C[c, i]
+        reflectors[c, c] -= head
+        scales[c] = 2.0 / (size - C[c, c] * C[c, c] + reflectors[c, c] * reflectors[c, c])  # 2 / v_cᵀ v_c
+        _reflect(reflectors, scales[c], c, C, c + 1, m)
+        C[c, c] = head
+    Qt = np.eye(n)
+    for c in range(p - 1, -1, -1):  # Q = H_0 (H_1 (⋯ H_{p−1})): H_c touches rows and columns c… only
+        _reflect(reflectors, scales[c], c, Qt, c, n)
+    X = np.zeros((p, m + p))  # [L; E]ᵀ = [R[:p] E]
+    for c in range(p):
+        for i in range(c, m):
+            X[c, i] = C[i, c]
+        X[c, m + c] = 1.0
+    return X, Qt, order
+
+
+def _reflect(reflectors: NDArray, scale: float, c: int, X: NDArray, first: int, last: int) -> None:
+    """Rows first … last − 1 of X ← X H_c (each the transpose of H_c times a column), H_c = E − scale v vᵀ,
+    v = reflectors[c] (zero before entry c)."""
+    if scale == 0.0:
+        return
+    for j in range(first, last):
+        dot = 0.0
+        for i in range(c, X.shape[1]):
+            dot += reflectors[c, i] * X[j, i]
+        dot *= scale
+        for i in range(c, X.shape[1]):
+            X[j, i] -= dot * reflectors[c, i]
+
+
+#: an updated squared column norm that has dropped below this fraction of its value before the
+#: rotation is computed anew (its update lost digits to cancellation)
+DRIFT = 0.1
+
+
+def _jacobi(X: NDArray, m: int) -> None:
+    """Rotate the rows of X = [W; V]ᵀ (the columns of W their first ``m`` entries, those of V the
+    others, rotated alike; rows, so that the loops run over contiguous entries) until the columns
+    of W are orthogonal to round-off (one-sided Jacobi, Demmel & Veselić, "Jacobi's method is more
+    accurate than QR", SIAM J. Matrix Anal. Appl. 13, 1992, Algorithm 4.1): a pair (a, r) whose
+    cosine |γ| / √(α β) (α, β the squared norms of the columns of W, γ their dot product) is above
+    1e-15 is rotated by the angle that makes it zero. The squared norms are taken at each sweep's
+    start and updated by each rotation, α' = α − t γ, β' = β + t γ with t = tan of the angle (de
+    Rijk, "A one-sided Jacobi algorithm for computing the singular value decomposition on a vector
+    computer", SIAM J. Sci. Stat. Comput. 10, 1989), computed anew where one drops below DRIFT of
+    its value; the last sweep rotates none, so that every pair's cosine is tested on norms taken
+    afresh. A column below 1e-15 of ‖W‖_F is W v = 0 to round-off (in the null space): not rotated."""
+    p = X.shape[0]
+    squares, floor = np.zeros(p), 0.0
+    for j in range(p):
+        floor += 1e-30 * _row_square(X, m, j)
     for _ in range(100):  # sweeps; quadratic convergence takes a handful
+        for j in range(p):
+            squares[j] = 0.0
+            for i in range(m):
+                squares[j] += X[j, i] * X[j, i]
         rotated = False
-        for p in range(n - 1):
-            for r in range(p + 1, n):
-                alpha, beta, gamma = 0.0, 0.0, 0.0
+        for a in range(p - 1):
+            for r in range(a + 1, p):
+                alpha, beta = squares[a], squares[r]
+                if alpha <= floor or beta <= floor:
+                    continue
+                gamma = 0.0
                 for i in range(m):
-                    alpha += W[i, p] * W[i, p]
-                    beta += W[i, r] * W[i, r]
-                    gamma += W[i, p] * W[i, r]
-                if alpha <= floor or beta <= floor or abs(gamma) <= 1e-15 * np.sqrt(alpha) * np.sqrt(beta):
+                    gamma += X[a, i] * X[r, i]
+                if abs(gamma) <= 1e-15 * np.sqrt(alpha * beta):
                     continue  # orthogonal to round-off
                 rotated = True
                 if abs(beta - alpha) > 1e100 * abs(gamma):  # a tiny angle: tan = 1/(2ζ) to round-off
                     tan = gamma / (beta - alpha)
                 else:
                     zeta = (beta - alpha) / (2.0 * gamma)
-                    tan = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.hypot(1.0, zeta))
+                    tan = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
                 cos = 1.0 / np.sqrt(1.0 + tan * tan)
                 sin = cos * tan
-                for X in (W, V):
-                    for i in range(X.shape[0]):
-                        x_p, x_r = X[i, p], X[i, r]
-                        X[i, p], X[i, r] = cos * x_p - sin * x_r, sin * x_p + cos * x_r
+                for i in range(X.shape[1]):
+                    x_a, x_r = X[a, i], X[r, i]
+                    X[a, i], X[r, i] = cos * x_a - sin * x_r, sin * x_a + cos * x_r
+                squares[a], squares[r] = alpha - tan * gamma, beta + tan * gamma
+                if squares[a] < DRIFT * alpha:
+                    squares[a] = _row_square(X, m, a)
+                if squares[r] < DRIFT * beta:
+                    squares[r] = _row_square(X, m, r)
         if not rotated:
             break
-    norms = np.zeros(n)
-    for j in range(n):
-        for i in range(m):
-            norms[j] += W[i, j] * W[i, j]
-    order = np.argsort(-norms)
-    sigma, U, Vt = np.zeros(n), np.zeros((m, n)), np.zeros((n, n))
-    for c in range(n):
-        j = order[c]
-        sigma[c] = np.sqrt(norms[j])
-        for i in range(n):
-            Vt[c, i] = V[i, j]
-        if sigma[c] > 0.0:
-            for i in range(m):
-                U[i, c] = W[i, j] / sigma[c]
-    return U, sigma, Vt
+
+
+def _row_square(X: NDArray, m: int, j: int) -> float:
+    """|X[j, :m]|²."""
+    total = 0.0
+    for i in range(m):
+        total += X[j, i] * X[j, i]
+    return total
 
 
 # interpreted; _compiled holds the compiled ones
@@ -666,8 +785,8 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _given_motions, _matvec, _matmul, _svd, _projected,
-            _inverse)
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _given_motions, _matvec, _matmul, _svd,
+            _transposed_qr, _reflect, _jacobi, _row_square, _projected, _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
@@ -732,6 +851,7 @@ class CompiledClosure:
         self.tree = (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
                      ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist, ev._laws, ev._law_constants)
         self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
+        self._kept = (None, None)  # (the system, the tangent it keeps) of the last call (_kept_tangent)
 
     def _call(self, system, q: NDArray, s_dot: NDArray, t: float) -> bool:
         """One kernel call for ``system`` (its partition; for a TangentSystem its kept tangent,
@@ -743,14 +863,23 @@ class CompiledClosure:
                                system.independent, system.dependent,
                                self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b)
         else:
-            kept = np.full((system.tree.n_s, system.n_s), np.nan) if system._tangent is None else \
-                np.array(system._tangent, dtype=float)
             flag = self.kernel(self.phi, self.pfaffian, self.joints, self.tree, q, s_dot, t, self.m_h,
                                system.independent, system.tree.n_s - system.n_s,
-                               system.separation, self.constants[0], kept, SINGULAR_PIVOT, self._q_dot,
-                               self._s_ddot_tree, self._A, M, b)
-            system._tangent = kept
+                               system.separation, self.constants[0], self._kept_tangent(system), SINGULAR_PIVOT,
+                               self._q_dot, self._s_ddot_tree, self._A, M, b)
         return flag == DONE
+
+    def _kept_tangent(self, system) -> NDArray:
+        """The tangent ``system`` keeps (TangentSystem._tangent) as the array the kernel reads and
+        overwrites: the one the last call wrote, where it is still the system's (no copy per call);
+        else a copy of the one the numpy path (or the system this one was copied from) kept, NaN
+        where none, which the system then keeps."""
+        owner, kept = self._kept
+        if kept is None or system._tangent is not kept or owner() is not system:
+            kept = np.full((system.tree.n_s, system.n_s), np.nan) if system._tangent is None else \
+                np.array(system._tangent, dtype=float)
+            system._tangent, self._kept = kept, (weakref.ref(system), kept)
+        return kept
 
     def accelerations(self, system, q: NDArray, s_dot: NDArray, t: float):
         """(s̈_tree, A_s, M, b) of ``system`` at (q, ṡ, t), or None (flagged)."""
@@ -781,9 +910,15 @@ def _compiled() -> dict:
     kernels of :mod:`projeq.assembly.kernels`, the force laws' loop of :mod:`projeq.assembly.loads`,
     and Φ, A and the UserJoints' relative motions through their C callbacks' addresses by the
     intrinsics :func:`_phi_into` and :func:`_given_into`."""
-    compiled = {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True)[0],
-                "add_loads": loads.kernel(True), **_intrinsics()}
-    return dict(zip(("partitioned", "tangent"), kernels.jit(partitioned, tangent, callees=_HELPERS, kernels=compiled)))
+    return dict(zip(("partitioned", "tangent"), kernels.jit(partitioned, tangent, callees=_HELPERS,
+                                                             kernels=_compiled_callees())))
+
+
+def _compiled_callees() -> dict:
+    """The compiled functions the kernels call by name: the tree's kernels, the force laws' loop and
+    the intrinsics that call the C callbacks."""
+    return {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True)[0],
+            "add_loads": loads.kernel(True), **_intrinsics()}
 
 
 def _intrinsics() -> dict:

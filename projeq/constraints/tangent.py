@@ -279,5 +279,7 @@ def _null_space_step(A_s: NDArray, N: NDArray, rank: int) -> NDArray:
 
 
 def _pivoted_independent(N: NDArray, n_s: int) -> NDArray:
-    """The n_s tree velocities whose rows of the null space N pivoted QR of Nᵀ takes first (sorted)."""
-    return np.sort(scipy.linalg.qr(N.T, pivoting=True)[2][:n_s])
+    """The n_s tree velocities whose rows of the null space N pivoted QR of Nᵀ takes first (sorted;
+    indices of numpy's own integer type: LAPACK's pivots are 32-bit, and indexing by them costs a
+    conversion at every s̈)."""
+    return np.sort(scipy.linalg.qr(N.T, pivoting=True)[2][:n_s]).astype(np.intp)

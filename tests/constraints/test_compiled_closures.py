@@ -280,3 +280,54 @@ def test_the_kernels_jacobi_svd_equals_lapacks(shape):
     assert np.abs(Vt @ Vt.T - np.eye(n)).max() <= 1e-14
     rank = int(np.sum(expected > 1e-12 * expected[0]))
     assert np.abs(A @ Vt[rank:].T).max(initial=0.0) <= 1e-14 * expected[0]
+
+
+def _with_singular_values(rng, m: int, n: int, sigma) -> np.ndarray:
+    """U diag(σ) Vᵀ, m × n, with random orthogonal U, V (QR of Gaussian matrices)."""
+    U = np.linalg.qr(rng.standard_normal((m, m)))[0]
+    V = np.linalg.qr(rng.standard_normal((n, n)))[0]
+    S = np.zeros((m, n))
+    S[np.arange(len(sigma)), np.arange(len(sigma))] = sigma
+    return U @ S @ V.T
+
+
+def _svd_cases():
+    """(name, A): m ≤ 8, n ≤ 9 — full rank, rank-deficient (some σ exactly 0 in exact arithmetic),
+    repeated singular values, zero rows, more rows than columns, rank 0."""
+    rng = np.random.default_rng(2026)
+    for m, n in ((1, 1), (1, 4), (3, 5), (6, 7), (8, 9), (5, 5), (7, 3), (8, 8)):
+        p = min(m, n)
+        yield f"{m}x{n} full rank", _with_singular_values(rng, m, n, rng.uniform(0.1, 1.0, p))
+        if p > 1:
+            yield f"{m}x{n} rank {p - 1}", _with_singular_values(rng, m, n, [*rng.uniform(0.1, 1.0, p - 1), 0.0])
+            yield f"{m}x{n} repeated", _with_singular_values(rng, m, n, [0.7] * (p // 2) + [0.3] * (p - p // 2))
+            A = _with_singular_values(rng, m, n, rng.uniform(0.1, 1.0, p))
+            A[rng.choice(m, size=max(1, m // 3), replace=False)] = 0.0
+            yield f"{m}x{n} zero rows", A
+        yield f"{m}x{n} rank 0", np.zeros((m, n))
+
+
+def test_the_kernels_svd_gives_lapacks_singular_values_null_space_and_pseudo_inverse():
+    """The kernel's SVD (QR-preconditioned one-sided Jacobi, Drmač & Veselić 2008; norms updated
+    by the rotations, de Rijk 1989) against numpy's LAPACK SVD on matrices of the sizes of a loop's
+    A_s: the same singular values, the same null space (its orthogonal projector: the basis of a
+    null space of dimension > 1 is not unique) and the same pseudo-inverse V Σ⁺ Uᵀ over the
+    nonzero singular values (unique, also where singular values repeat), each to 1e-13 of its
+    size; U Σ Vᵀ = A and V orthogonal."""
+    for name, A in _svd_cases():
+        m, n = A.shape
+        U, sigma, Vt = compiled._svd(A)
+        expected = np.linalg.svd(A, compute_uv=False)
+        scale = max(expected.max(initial=0.0), 1e-300)
+        rank = int(np.sum(expected > 1e-10 * scale))
+        assert np.abs(sigma[:len(expected)] - expected).max() <= 1e-13 * scale, name
+        assert np.abs(sigma[len(expected):]).max(initial=0.0) <= 1e-13 * scale, name
+        assert np.all(np.diff(sigma) <= 0.0), name
+        assert np.abs((U * sigma) @ Vt - A).max() <= 1e-13 * scale, name
+        assert np.abs(Vt @ Vt.T - np.eye(n)).max() <= 1e-13, name
+        null = Vt[rank:].T @ Vt[rank:]
+        expected_null = np.eye(n) - np.linalg.pinv(A, rcond=1e-10) @ A
+        assert np.abs(null - expected_null).max() <= 1e-13, name
+        pseudo_inverse = (Vt[:rank].T / sigma[:rank]) @ U[:, :rank].T
+        expected_inverse = np.linalg.pinv(A, rcond=1e-10)
+        assert np.abs(pseudo_inverse - expected_inverse).max() <= 1e-13 * max(1.0, np.abs(expected_inverse).max()), name
