@@ -184,7 +184,7 @@ class HubBeamEvaluator:
         self._hub(t)
         self.n_calls += len(x)
         J = np.empty((len(x), len(x)))
-        status = self._jacobian(*self._head, np.asarray(x, dtype=float), COMPLEX_STEP, *self._tail[np.dtype(complex)], J)
+        status = self._jacobian(*self._head, kernels.kernel_array(x), COMPLEX_STEP, *self._tail[np.dtype(complex)], J)
         return J if status < 0 else None
 
     def _hub(self, t: float) -> None:

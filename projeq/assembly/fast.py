@@ -224,7 +224,7 @@ class FastEvaluator:
         q_e) and ẏ_n = (twist_n, ṡ_e) (the spatial twist: a planar body's is in its plane); V, the
         subsystems' and force laws' potentials at the kernel's poses
         (:meth:`projeq.System.potential_energy`)."""
-        q, s_dot, ws = kernel_array(q), kernel_array(s_dot), self._real
+        q, s_dot, ws = kernels.kernel_array(q), kernels.kernel_array(s_dot), self._real
         self._kinematics(ws, q, s_dot, t)
         y_dot = ws.y_dot
         y_dot[:, :6] = ws.twist[:-1]
@@ -248,7 +248,8 @@ class FastEvaluator:
         """q and ṡ as arrays of one dtype, float or complex (a complex step), and its workspace."""
         q, s_dot = np.asarray(q), np.asarray(s_dot)
         dtype = complex if q.dtype.kind == "c" or s_dot.dtype.kind == "c" else float
-        return kernel_array(q, dtype), kernel_array(s_dot, dtype), self._real if dtype is float else self._workspace(dtype)
+        ws = self._real if dtype is float else self._workspace(dtype)
+        return kernels.kernel_array(q, dtype), kernels.kernel_array(s_dot, dtype), ws
 
     def _assembled(self, ws: _Workspace) -> tuple[NDArray, NDArray]:
         """M and b of the terms in the workspace: :func:`projeq.assembly.kernels.gauss_form` in
@@ -300,7 +301,7 @@ class FastEvaluator:
         self.n_calls += 1
         x_dot = np.empty(len(x))
         tree, workspace = self._one_call_arguments(self._real)
-        failed = self._x_dot(*tree, kernel_array(x), self.system.n_q, *workspace, x_dot)
+        failed = self._x_dot(*tree, kernels.kernel_array(x), self.system.n_q, *workspace, x_dot)
         return x_dot if failed < 0 else None
 
     def state_jacobian(self, t: float, x: NDArray) -> NDArray | None:
@@ -318,7 +319,7 @@ class FastEvaluator:
         J = np.zeros((len(x), len(x)))
         J[:n_q, n_q:] = np.eye(n_q)
         tree, workspace = self._one_call_arguments(self._workspace(complex))
-        failed = self._jacobian(*tree, kernel_array(x), n_q, COMPLEX_STEP, *workspace, J[n_q:])
+        failed = self._jacobian(*tree, kernels.kernel_array(x), n_q, COMPLEX_STEP, *workspace, J[n_q:])
         return J if failed < 0 else None
 
     def _one_call_arguments(self, ws: _Workspace) -> tuple[tuple, tuple]:
@@ -328,15 +329,6 @@ class FastEvaluator:
         return ((self._index, self._geometry, self._inertia, self._gravity, self._laws, self._law_constants),
                 (ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat,
                  ws.R, ws.r, ws.twist, self._pivot_min))
-
-
-def kernel_array(a, dtype=float) -> NDArray:
-    """``a`` as the one kind of array the compiled kernels are specialised for: of ``dtype``,
-    C-contiguous and writeable (a read-only or strided view, such as a row of a frozen Result
-    or a column of a solution, is copied: numba would compile the kernels again for its layout,
-    10–30 s cold)."""
-    a = np.asarray(a, dtype=dtype)
-    return a if a.flags.c_contiguous and a.flags.writeable else np.array(a, dtype=dtype, order="C")
 
 
 class _Workspace:

@@ -51,6 +51,15 @@ CENTRE, INERTIA, MASS = 0, 1, 4
 GIVEN_A, GIVEN_R, GIVEN_W, GIVEN_ZETA, GIVEN_F = 0, 9, 12, 18, 24
 
 
+def kernel_array(a, dtype=float) -> np.ndarray:
+    """``a`` as the one kind of array the compiled kernels are specialised for: of ``dtype``,
+    C-contiguous and writeable (a read-only or strided view, such as a row of a frozen Result
+    or a column of a solution, is copied: numba would compile the kernels again for its layout,
+    10–30 s cold)."""
+    a = np.asarray(a, dtype=dtype)
+    return a if a.flags.c_contiguous and a.flags.writeable else np.array(a, dtype=dtype, order="C")
+
+
 def _numba():
     try:
         import numba

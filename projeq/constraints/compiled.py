@@ -857,7 +857,7 @@ class CompiledClosure:
         """One kernel call for ``system`` (its partition; for a TangentSystem its kept tangent,
         which the call updates as the numpy path does) into the workspace; whether it is done."""
         M, b = self._workspace.M_all, self._workspace.b_all
-        q, s_dot, t = np.asarray(q, dtype=float), np.asarray(s_dot, dtype=float), float(t)
+        q, s_dot, t = kernels.kernel_array(q), kernels.kernel_array(s_dot), float(t)
         if self.rule == "partitioned":
             flag = self.kernel(self.phi, self.pfaffian, self.joints, self.tree, q, s_dot, t, self.m_h,
                                system.independent, system.dependent,

@@ -822,8 +822,9 @@ def numerical_rank(A: NDArray) -> int:
 
 def _pivoted_dependent(A_s: NDArray, n_c: int) -> NDArray:
     """The n_c columns of A_s that column-pivoted QR takes first (sorted): the dependent
-    velocities with the best-conditioned block A_dep."""
-    return np.sort(scipy.linalg.qr(A_s, pivoting=True)[2][:n_c])
+    velocities with the best-conditioned block A_dep (numpy's index type: LAPACK's pivots are
+    int32, for which the compiled closure kernel would be compiled again)."""
+    return np.sort(scipy.linalg.qr(A_s, pivoting=True)[2][:n_c]).astype(np.intp)
 
 
 def _pfaffian_residual(system: ConstrainedSystem, q_t, q_dot) -> NDArray:
