@@ -26,7 +26,7 @@ from projeq.assembly import kernels
 from projeq.assembly.linalg import SINGULAR_PIVOT
 from projeq.constraints import compiled
 from projeq.constraints.compiled import (
-    _constraint_gamma, _constraint_rows, _inverse, _matmul, _matvec, _projected, _svd,
+    _constraint_gamma, _constraint_rows, _particular, _projected, _scaled, _svd,
 )
 from projeq.studies.bench_scenes import STATES, moving_states
 from projeq.studies.timing import time_per_call
@@ -51,12 +51,7 @@ def scaled_loop(Vts, independent, repeats):
     for _ in range(repeats):
         for j in range(Vts.shape[0]):
             Vt = Vts[j]
-            N = Vt[Vt.shape[0] - k:].T.copy()
-            N_ind = np.empty((k, k))
-            for r in range(k):
-                for c in range(k):
-                    N_ind[r, c] = N[independent[r], c]
-            _matmul(N, _inverse(N_ind))
+            _scaled(Vt[Vt.shape[0] - k:].T.copy(), independent)
 
 
 def gamma_loop(phi, pfaffian, Q, Q_dot, t, m_h, m, repeats):
@@ -66,20 +61,8 @@ def gamma_loop(phi, pfaffian, Q, Q_dot, t, m_h, m, repeats):
 
 
 def particular_loop(U, sigma, Vt, gamma, F, independent, count, repeats):
-    n, m, k = Vt.shape[0], U.shape[0], independent.shape[0]
     for _ in range(repeats):
-        x0 = np.zeros(n)
-        for j in range(count):
-            weight = 0.0
-            for r in range(m):
-                weight -= U[r, j] * gamma[r]
-            weight /= sigma[j]
-            for i in range(n):
-                x0[i] += Vt[j, i] * weight
-        x0_ind = np.empty(k)
-        for c in range(k):
-            x0_ind[c] = x0[independent[c]]
-        x0 - _matvec(F, x0_ind)
+        _particular(U, sigma, Vt, gamma, count, F, independent)
 
 
 def projected_loop(tree, Q, Q_dot, t, F, f_bar, pivot, M, b, s_ddot_tree, repeats):

@@ -563,6 +563,24 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
     else:
         V_near = Vt[n - near:]  # the near-null space (rows)
         N = np.linalg.qr(_matmul(V_near.T, _matmul(V_near, kept)))[0]
+    F = _scaled(N, independent)
+    if F.shape[0] == 0:
+        return DEGENERATE
+    s_dot_tree = _matvec(F, s_dot)
+    q_dot[:] = s_dot_tree
+    gamma = _constraint_gamma(phi, pfaffian, q, s_dot_tree, t, m_h, m)
+    count = 0  # the singular values above acting σ_max, at most rank
+    for value in sigma:
+        count += value > acting * sigma[0]
+    f_bar = _particular(U, sigma, Vt, gamma, min(count, rank), F, independent)
+    _given_motions(joints, q, s_dot_tree, t, tree[4])
+    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+
+
+def _scaled(N: NDArray, independent: NDArray) -> NDArray:
+    """F = N N_ind⁻¹ (F[independent] = E exactly) of the null-space basis N (n × k), N_ind its
+    rows ``independent``; an empty F (0 × k) where N_ind is singular."""
+    k = independent.shape[0]
     N_ind = np.empty((k, k))
     for r in range(k):
         for c in range(k):
@@ -571,19 +589,20 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
     for r in range(k):
         for c in range(k):
             if not np.isfinite(inv[r, c]):
-                return DEGENERATE
-    F = _matmul(N, inv)  # F = N N_ind⁻¹, F[independent] = E
+                return np.empty((0, k))
+    F = _matmul(N, inv)
     for r in range(k):
         for c in range(k):
             F[independent[r], c] = 1.0 if r == c else 0.0
-    s_dot_tree = _matvec(F, s_dot)
-    q_dot[:] = s_dot_tree
-    gamma = _constraint_gamma(phi, pfaffian, q, s_dot_tree, t, m_h, m)
-    count = 0  # the singular values above acting σ_max, at most rank
-    for value in sigma:
-        count += value > acting * sigma[0]
-    count = min(count, rank)
-    x0 = np.zeros(n)  # A_s⁺ (−γ) = V_k Σ_k⁻¹ U_kᵀ (−γ)
+    return F
+
+
+def _particular(U: NDArray, sigma: NDArray, Vt: NDArray, gamma: NDArray, count: int, F: NDArray,
+                independent: NDArray) -> NDArray:
+    """f̄ = x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) = V_k Σ_k⁻¹ U_kᵀ (−γ) over the ``count``
+    largest singular values of A_s = U Σ Vᵀ."""
+    n, m, k = Vt.shape[0], U.shape[0], independent.shape[0]
+    x0 = np.zeros(n)
     for j in range(count):
         weight = 0.0
         for r in range(m):
@@ -594,14 +613,13 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
     x0_ind = np.empty(k)
     for c in range(k):
         x0_ind[c] = x0[independent[c]]
-    f_bar = x0  # x₀ − F x₀[independent], in place
+    f_bar = x0  # in place
     for i in range(n):
         total = 0.0
         for c in range(k):
             total += F[i, c] * x0_ind[c]
         f_bar[i] = x0[i] - total
-    _given_motions(joints, q, s_dot_tree, t, tree[4])
-    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+    return f_bar
 
 
 def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
@@ -786,7 +804,7 @@ def _inverse(A: NDArray) -> NDArray:
 
 
 _HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _given_motions, _matvec, _matmul, _svd,
-            _transposed_qr, _reflect, _jacobi, _row_square, _projected, _inverse)
+            _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _projected, _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
