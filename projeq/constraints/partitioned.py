@@ -300,7 +300,7 @@ class ConstrainedSystem(Model):
         n_s = self.tree.n_s
         A_s = self.constraint_matrix(q0)[0]
         if independent is None:
-            dependent = _pivoted_dependent(A_s, self.n_c)
+            dependent = pivoted_columns(A_s, self.n_c)
         else:
             why = f"n_s = {n_s} minus {self.n_c} constraints"
             chosen = independent_indices(independent, n_s - self.n_c, n_s, why)
@@ -346,7 +346,7 @@ class ConstrainedSystem(Model):
             raise self._degenerate(q, t, self.condition(q, t), self.limit)
         if self._near_dependent(q, t):  # re-pivoting here would carry on along another branch, silently
             raise self._singular_position(q, t)
-        dependent = _pivoted_dependent(self.constraint_matrix(q, t)[0], self.n_c)
+        dependent = pivoted_columns(self.constraint_matrix(q, t)[0], self.n_c)
         new = self._in_partition(np.setdiff1d(np.arange(self.tree.n_s), dependent), q, t)
         new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
         return new, new.s_dot0.copy()
@@ -820,11 +820,12 @@ def numerical_rank(A: NDArray) -> int:
     return int(np.count_nonzero(sigma > RANK_TOLERANCE * sigma[0]))
 
 
-def _pivoted_dependent(A_s: NDArray, n_c: int) -> NDArray:
-    """The n_c columns of A_s that column-pivoted QR takes first (sorted): the dependent
-    velocities with the best-conditioned block A_dep (numpy's index type: LAPACK's pivots are
-    int32, for which the compiled closure kernel would be compiled again)."""
-    return np.sort(scipy.linalg.qr(A_s, pivoting=True)[2][:n_c]).astype(np.intp)
+def pivoted_columns(A: NDArray, k: int) -> NDArray:
+    """The k columns of A that column-pivoted QR takes first, sorted: those with the
+    best-conditioned block (a ConstrainedSystem's dependent velocities, columns of A_s; a
+    TangentSystem's independent ones, columns of Nᵀ). In numpy's index type: LAPACK's pivots are
+    int32, which cost a conversion at every indexing and a second compilation of the closure kernel."""
+    return np.sort(scipy.linalg.qr(A, pivoting=True)[2][:k]).astype(np.intp)
 
 
 def _pfaffian_residual(system: ConstrainedSystem, q_t, q_dot) -> NDArray:

@@ -52,12 +52,12 @@ from __future__ import annotations
 from numbers import Real
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 
 from projeq.constraints.compiled import OWN_RULE, compiled_tangent, uncompiled
 from projeq.constraints.partitioned import (
     RANK_TOLERANCE, REPIVOT_CONDITION, ConstrainedSystem, independent_indices, minimum_norm_solution, numerical_rank,
+    pivoted_columns,
 )
 
 
@@ -115,7 +115,7 @@ class TangentSystem(ConstrainedSystem):
         A_s = self.constraint_matrix(q0)[0]
         self.n_s = self.tree.n_s - numerical_rank(A_s)
         if independent is None:
-            chosen = _pivoted_independent(self._null_space(A_s), self.n_s)
+            chosen = pivoted_columns(self._null_space(A_s).T, self.n_s)
         else:
             chosen = independent_indices(independent, self.n_s, self.tree.n_s, "the mobility at q0")
         self.independent, self.dependent = chosen, np.setdiff1d(np.arange(self.tree.n_s), chosen)
@@ -187,7 +187,7 @@ class TangentSystem(ConstrainedSystem):
         """Re-chosen independent velocities where N_ind degenerates (pivoted QR of N at q)."""
         if not self.repivot:
             self.check_configuration(q, t)
-        chosen = _pivoted_independent(self._null_space(self.constraint_matrix(q, t)[0]), self.n_s)
+        chosen = pivoted_columns(self._null_space(self.constraint_matrix(q, t)[0]).T, self.n_s)
         new = self._in_partition(chosen, q, t)
         new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
         return new, new.s_dot0.copy()
@@ -276,10 +276,3 @@ def _null_space_step(A_s: NDArray, N: NDArray, rank: int) -> NDArray:
     normalisation N₀ᵀ dN = 0. F = N N_ind⁻¹ is then analytic in the step, and the complex step
     through it gives ∂F exactly (the SVD's own rotations conjugate; issue 16)."""
     return N - minimum_norm_solution(np.real(A_s), A_s @ N, ACTING, rank)
-
-
-def _pivoted_independent(N: NDArray, n_s: int) -> NDArray:
-    """The n_s tree velocities whose rows of the null space N pivoted QR of Nᵀ takes first (sorted;
-    indices of numpy's own integer type: LAPACK's pivots are 32-bit, and indexing by them costs a
-    conversion at every s̈)."""
-    return np.sort(scipy.linalg.qr(N.T, pivoting=True)[2][:n_s]).astype(np.intp)

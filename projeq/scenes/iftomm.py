@@ -39,7 +39,7 @@ def pendulum_angle(t, L: float = 1.0, g: float = 9.81, theta0: float = np.pi / 2
     """The angle from the downward vertical of a simple pendulum released from rest at θ0:
     sin(θ/2) = k sn(K(k) − ω t, k), k = sin(θ0/2), ω = √(g/L) (Jacobi's elliptic functions;
     e.g. Lawden, "Elliptic Functions and Applications", 1989, §5.2)."""
-    from scipy.special import ellipj, ellipk  # the references load scipy's solvers where used: import projeq.scenes stays light
+    from scipy.special import ellipj, ellipk  # here, not at the top: import projeq.scenes stays light
 
     k = np.sin(theta0 / 2)
     sn = ellipj(ellipk(k * k) - np.sqrt(g / L) * np.asarray(t, dtype=float), k * k)[0]
