@@ -375,16 +375,17 @@ def unsupported(system) -> str | None:
                         f"({', '.join(python)}: a callable load or a user's law)")
         elif body.rigid_inertia is None:
             return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of rigid bodies, "
-                    "rigid_inertia, spatial or selected by S, and of RitzBeams without rotary inertia)")
+                    "rigid_inertia, spatial or selected by S, and of RitzBeams)")
         if system.plan.port[n] and not hasattr(system.plan.stations[n], "field"):
             return f"joint {name!r} sits on a port of {type(system.subsystems[system.parent[n]]).__name__} without a field"
     return None
 
 
 def _elastic_fields(system) -> tuple:
-    """(slot, e_index, n_e, m_k, r₀, Ψ, Q, K_e, damping) of :func:`projeq.assembly.kernels.chain_terms`:
-    the station fields of the elastic bodies (:meth:`projeq.RitzBeam.slice_field`), padded to
-    the most stations and internal coordinates (zero masses and columns)."""
+    """(slot, e_index, n_e, m_k, r₀, Ψ, Q, K_e, damping, I, Φ_θ, T) of
+    :func:`projeq.assembly.kernels.chain_terms`: the station fields of the elastic bodies
+    (:meth:`projeq.RitzBeam.slice_field`, :meth:`projeq.RitzBeam.rotation_field`), padded to
+    the most stations and internal coordinates (zero masses, rotary inertias and columns)."""
     N, beams = len(system.subsystems), [n for n, b in enumerate(system.subsystems) if b.n_e]
     slot = np.full(N, -1, dtype=np.int64)
     e_index = np.array([[system.e_q_slice[n].start, system.e_s_slice[n].start] if system.subsystems[n].n_e else [0, 0]
@@ -395,28 +396,30 @@ def _elastic_fields(system) -> tuple:
     B = len(beams)
     m, r0, Psi, Q = np.zeros((B, K)), np.zeros((B, K, 3)), np.zeros((B, K, 3, E)), np.zeros((B, K, E, E))
     K_e, damping = np.zeros((B, E, E)), np.zeros(B)
+    I, Phi_theta, T = np.zeros((B, K, 3)), np.zeros((B, K, 3, E)), np.zeros((B, K, E, E))
     for i, n in enumerate(beams):
         beam = system.subsystems[n]
         slot[n], k, e = i, len(beam.mass_weights), beam.n_e
         m[i, :k] = beam.mass_weights
         r0[i, :k], Psi[i, :k, :, :e], Q[i, :k, :e, :e] = beam.slice_field()
+        I[i, :k], Phi_theta[i, :k, :, :e], T[i, :k, :e, :e] = beam.rotation_field()
         K_e[i, :e, :e], damping[i] = beam.K_e, beam.damping
-    return slot, e_index, n_e, m, r0, Psi, Q, K_e, damping
+    return slot, e_index, n_e, m, r0, Psi, Q, K_e, damping, I, Phi_theta, T
 
 
 def _port_fields(system) -> tuple:
-    """(slot, r₀, Ψ, Q, slopes, c) of :func:`projeq.assembly.kernels.chain_terms`: the fields of
+    """(slot, r₀, Ψ, Q, angles, c) of :func:`projeq.assembly.kernels.chain_terms`: the fields of
     the stations that joints sit at (:class:`projeq.subsystems.beam.beam.BeamPort`), padded."""
     N, stations = len(system.joints), system.plan.stations
     slot = np.full(N, -1, dtype=np.int64)
     E = max([system.subsystems[system.parent[n]].n_e for n in stations], default=1)
     P = len(stations)
-    r0, Psi, Q, slopes, c = np.zeros((P, 3)), np.zeros((P, 3, E)), np.zeros((P, E, E)), np.zeros((P, 2, E)), np.zeros((P, 3))
+    r0, Psi, Q, angles, c = np.zeros((P, 3)), np.zeros((P, 3, E)), np.zeros((P, E, E)), np.zeros((P, 3, E)), np.zeros((P, 3))
     for i, (n, port) in enumerate(stations.items()):
         slot[n], e = i, port.field[1].shape[1]
-        r0[i], Psi[i, :, :e], Q[i, :e, :e], slopes[i, :, :e] = port.field
+        r0[i], Psi[i, :, :e], Q[i, :e, :e], angles[i, :, :e] = port.field
         c[i] = port.offset
-    return slot, r0, Psi, Q, slopes, c
+    return slot, r0, Psi, Q, angles, c
 
 
 def _expansion(system) -> tuple[NDArray, NDArray]:

@@ -87,9 +87,10 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
     per joint and body, columns named by the constants of this module (:data:`KIND` ...).
 
     Elastic subsystems (docs/theory.md §10): ``elastic`` = (slot, e_index, n_e, m_k, r₀, Ψ, Q,
-    K_e, damping) — slot[n] ≥ 0 picks the station field of body n (:func:`elastic_body`),
+    K_e, damping, I, Φ_θ, T) — slot[n] ≥ 0 picks the station fields of body n (:func:`elastic_body`,
+    :func:`rotary_body`),
     whose ẏ_n = (twist, q̇_e) has n_y = 6 + n_e rows and F_n the extra columns [0; E];
-    ``port`` = (slot, r₀, Ψ, Q, slopes, c) — slot[n] ≥ 0: joint n sits at a station of its
+    ``port`` = (slot, r₀, Ψ, Q, angles, c) — slot[n] ≥ 0: joint n sits at a station of its
     elastic parent p, whose frame (:func:`port_motion`) is the base of the joint, and
     T̃_np = T̃⁶_np P̃ with P̃ = [[T⁶_port, F_port, ζ̂_port], [0, 0, 1]] (the reference's
     :func:`projeq.assembly.kinematics.forward`).
@@ -100,8 +101,8 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
     n_cols = index[:, N_COLS]
     axis, offset, orientation = geometry[:, AXIS], geometry[:, OFFSET], geometry[:, ORIENTATION:]
     m, r_c, I_c = inertia[:, MASS, 0], inertia[:, CENTRE], inertia[:, INERTIA:MASS]
-    body, e_index, n_e, el_m, el_r0, el_Psi, el_Q, el_K, el_damping = elastic
-    port_slot, port_r0, port_Psi, port_Q, port_slopes, port_c = port
+    body, e_index, n_e, el_m, el_r0, el_Psi, el_Q, el_K, el_damping, el_I, el_Phi_theta, el_T = elastic
+    port_slot, port_r0, port_Psi, port_Q, port_angles, port_c = port
     twist[N] = 0.0
     R[N] = 0.0
     r_O[N] = 0.0
@@ -121,7 +122,7 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
         j = port_slot[n]
         if j >= 0:  # the base is the frame at a station of the elastic parent p
             k_p, i0, s0 = n_e[p], e_index[p, 0], e_index[p, 1]
-            port_motion(port_r0[j], port_Psi[j, :, :k_p], port_Q[j, :k_p, :k_p], port_slopes[j, :, :k_p], port_c[j],
+            port_motion(port_r0[j], port_Psi[j, :, :k_p], port_Q[j, :k_p, :k_p], port_angles[j, :, :k_p], port_c[j],
                         q[i0 : i0 + k_p], s_dot[s0 : s0 + k_p], A_port, r_port, F_port[:, :k_p], zeta_port)
             for a in range(6):
                 w_port[a] = 0.0
@@ -206,6 +207,8 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
                 F[n, 6 + a, n_j + a] = 1.0
             elastic_body(el_m[i], el_r0[i], el_Psi[i, :, :, :k_n], el_Q[i, :, :k_n, :k_n], el_K[i, :k_n, :k_n],
                          el_damping[i], q[i0 : i0 + k_n], s_dot[s0 : s0 + k_n], twist[n], g_body[n], M[n], h[n])
+            rotary_body(el_I[i], el_Phi_theta[i, :, :, :k_n], el_T[i, :, :k_n, :k_n], q[i0 : i0 + k_n],
+                        s_dot[s0 : s0 + k_n], twist[n], M[n], h[n])
         else:
             _rigid_h(m[n], r_c[n], I_c[n], twist[n], g_body[n], h[n, :6], work)
 
@@ -266,7 +269,72 @@ def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
             h[6 + i] -= K_e[i, l] * (q_e[l] + damping * q_e_dot[l])
 
 
-def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, pivot_min, M, h, x_dot):
+def rotary_body(I, Phi_theta, T, q_e, q_e_dot, twist, M, h):
+    """Adds the slices' rotary inertia (a Rayleigh beam) to M_n and h_n of :func:`elastic_body`,
+    from the field of :meth:`projeq.RitzBeam.rotation_field`: at station k, I_k = diag(I[k]),
+    θ = Φ_θ,k q_e + (q_eᵀ T_k q_e) e_x, ∂θ/∂q_e = Φ_θ,k + e_x ((T_k + T_kᵀ) q_e)ᵀ,
+    J_ω = [0, E − θ̃, (E − ½θ̃) ∂θ/∂q_e], ω_c = J_ω ẏ, θ̇ = ∂θ/∂q_e q̇_e, τ̈ = 2 q̇_eᵀ T_k q̇_e and
+    c = ω̃ θ̇ + τ̈ e_x − ½ θ × τ̈ e_x: M_n += Σ_k J_ωᵀ I_k J_ω, h_n −= Σ_k J_ωᵀ (I_k c + ω̃_c I_k ω_c)
+    (docs/theory.md §10). Compiled twin of :meth:`projeq.RitzBeam._slice_rotation` and the
+    rotary rows of its ``gauss_terms``. Stations with I_k = 0 (padding, or a beam without
+    rotary inertia) are skipped."""
+    k_e = q_e.shape[0]
+    n_y = 6 + k_e
+    J, f = np.zeros((3, n_y), M.dtype), np.empty(3, M.dtype)
+    w0, w1, w2 = twist[3], twist[4], twist[5]
+    for k in range(I.shape[0]):
+        I0, I1, I2 = I[k, 0], I[k, 1], I[k, 2]
+        if I0 == 0.0 and I1 == 0.0 and I2 == 0.0:
+            continue
+        tau, acceleration = 0.0, 0.0
+        for i in range(k_e):
+            T_q, q_T, T_qd = 0.0, 0.0, 0.0
+            for l in range(k_e):
+                T_q += T[k, i, l] * q_e[l]
+                q_T += T[k, l, i] * q_e[l]
+                T_qd += T[k, i, l] * q_e_dot[l]
+            tau += T_q * q_e[i]
+            acceleration += 2.0 * T_qd * q_e_dot[i]
+            J[0, 6 + i] = Phi_theta[k, 0, i] + T_q + q_T  # ∂θ/∂q_e, turned below
+            J[1, 6 + i] = Phi_theta[k, 1, i]
+            J[2, 6 + i] = Phi_theta[k, 2, i]
+        t0, t1, t2, d0, d1, d2 = tau, 0.0, 0.0, 0.0, 0.0, 0.0
+        for i in range(k_e):
+            t0 += Phi_theta[k, 0, i] * q_e[i]
+            t1 += Phi_theta[k, 1, i] * q_e[i]
+            t2 += Phi_theta[k, 2, i] * q_e[i]
+            d0 += J[0, 6 + i] * q_e_dot[i]
+            d1 += J[1, 6 + i] * q_e_dot[i]
+            d2 += J[2, 6 + i] * q_e_dot[i]
+        for i in range(k_e):  # (E − ½θ̃) ∂θ/∂q_e
+            a0, a1, a2 = J[0, 6 + i], J[1, 6 + i], J[2, 6 + i]
+            J[0, 6 + i] = a0 - 0.5 * (t1 * a2 - t2 * a1)
+            J[1, 6 + i] = a1 - 0.5 * (t2 * a0 - t0 * a2)
+            J[2, 6 + i] = a2 - 0.5 * (t0 * a1 - t1 * a0)
+        J[0, 3], J[0, 4], J[0, 5] = 1.0, t2, -t1  # E − θ̃
+        J[1, 3], J[1, 4], J[1, 5] = -t2, 1.0, t0
+        J[2, 3], J[2, 4], J[2, 5] = t1, -t0, 1.0
+        o0 = J[0, 3] * w0 + J[0, 4] * w1 + J[0, 5] * w2
+        o1 = J[1, 3] * w0 + J[1, 4] * w1 + J[1, 5] * w2
+        o2 = J[2, 3] * w0 + J[2, 4] * w1 + J[2, 5] * w2
+        for i in range(k_e):
+            o0 += J[0, 6 + i] * q_e_dot[i]
+            o1 += J[1, 6 + i] * q_e_dot[i]
+            o2 += J[2, 6 + i] * q_e_dot[i]
+        c0 = w1 * d2 - w2 * d1 + acceleration
+        c1 = w2 * d0 - w0 * d2 - 0.5 * acceleration * t2
+        c2 = w0 * d1 - w1 * d0 + 0.5 * acceleration * t1
+        f[0] = I0 * c0 + o1 * I2 * o2 - o2 * I1 * o1  # I c + ω̃_c I ω_c
+        f[1] = I1 * c1 + o2 * I0 * o0 - o0 * I2 * o2
+        f[2] = I2 * c2 + o0 * I1 * o1 - o1 * I0 * o0
+        for a in range(3, n_y):
+            h[a] -= J[0, a] * f[0] + J[1, a] * f[1] + J[2, a] * f[2]
+            for b in range(3, n_y):
+                M[a, b] += J[0, a] * I0 * J[0, b] + J[1, a] * I1 * J[1, b] + J[2, a] * I2 * J[2, b]
+
+
+def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, I, Phi_theta, T, x,
+             pivot_min, M, h, x_dot):
     """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) of one elastic body on a hub whose motion is given, its
     reference frame moving with ẏ = (w, q̇_e) and ÿ = (ζ, q̈_e) — B(14) projected on q̇_e
     (:mod:`projeq.assembly.beam_fast`); M_n and h_n by :func:`elastic_body`, M_ee by
@@ -299,6 +367,7 @@ def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e
         for a in range(3):
             g[b] += (orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]) * gravity[a]
     elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, w, g, M, h)
+    rotary_body(I, Phi_theta, T, q_e, q_e_dot, w, M, h)
     for i in range(k_e):
         q_e_ddot[i] = h[6 + i] - _dot6(M[6 + i], zeta)
     M_ee = M[6:, 6:]
@@ -311,8 +380,8 @@ def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e
     return -1
 
 
-def hub_beam_jacobian(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, step, pivot_min,
-                      M, h, J):
+def hub_beam_jacobian(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, I, Phi_theta, T, x,
+                      step, pivot_min, M, h, J):
     """∂ẋ/∂x of :func:`hub_beam` at the real state x by the complex step, column k =
     Im ẋ(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998), all n_x columns in
     one call on a complex workspace (``M``, ``h``: complex128); written into J. Returns
@@ -322,8 +391,8 @@ def hub_beam_jacobian(kind, axis, angles, given, orientation, gravity, m, r0, Ps
     for k in range(n_x):
         z[:] = x
         z[k] += 1j * step
-        status = hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, z,
-                          pivot_min, M, h, z_dot)
+        status = hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, I, Phi_theta, T,
+                          z, pivot_min, M, h, z_dot)
         if status >= 0:
             return status
         for i in range(n_x):
@@ -331,21 +400,25 @@ def hub_beam_jacobian(kind, axis, angles, given, orientation, gravity, m, r0, Ps
     return -1
 
 
-def port_motion(r0, Psi, Q, slopes, offset, q_e, q_e_dot, A, r, F, zeta):
-    """The frame at a station of an elastic body relative to its reference frame: A = R_z(a) R_y(b)
-    with a = v′ and b = −w′ (slopes · q_e), r = r₀ + Ψ q_e − ½ (q_eᵀ Q q_e) e_x + A c,
-    F = [[Aᵀ Φ_r − c̃ Φ_ω], [Φ_ω]] with Φ_ω = (−sin b ∂a, ∂b, cos b ∂a), and ζ = Ḟ q̇_e:
-    [−Ω × Aᵀ ṙ − (q̇_eᵀ Q q̇_e) Aᵀ e_x − c × α; α] with Ω = Φ_ω q̇_e, α = (−cos b, 0, −sin b) ȧ ḃ
-    (Ȧ = A Ω̃). Compiled twin of :meth:`projeq.subsystems.beam.beam.BeamPort.relative` for a
-    beam without torsion (whose Ḟ q̇_e is a complex step)."""
+def port_motion(r0, Psi, Q, angles, offset, q_e, q_e_dot, A, r, F, zeta):
+    """The frame at a station of an elastic body relative to its reference frame:
+    A = R_z(a) R_y(b) R_x(β) with a = v′, b = −w′ and the torsion β (``angles`` · q_e),
+    r = r₀ + Ψ q_e − ½ (q_eᵀ Q q_e) e_x + A c, F = [[Aᵀ Φ_r − c̃ Φ_ω], [Φ_ω]] with
+    Φ_ω = R_xᵀ (−sin b ∂a, ∂b, cos b ∂a) + e_x ∂β, and ζ = Ḟ q̇_e:
+    [−Ω × Aᵀ ṙ − (q̇_eᵀ Q q̇_e) Aᵀ e_x − c × α; α] with Ω = Φ_ω q̇_e and
+    α = R_xᵀ (−cos b, 0, −sin b) ȧ ḃ − β̇ e_x × R_xᵀ (−sin b ȧ, ḃ, cos b ȧ) (Ȧ = A Ω̃,
+    Ṙ_xᵀ = −β̇ ẽ_x R_xᵀ). Compiled twin of :meth:`projeq.subsystems.beam.beam.BeamPort.relative`
+    (whose Ḟ q̇_e is a complex step)."""
     k_e = q_e.shape[0]
-    a_, b_, a_dot, b_dot, quadratic, rate = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    a_, b_, beta, a_dot, b_dot, beta_dot, quadratic, rate = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     Phi_r, r_dot = np.empty((3, k_e), A.dtype), np.zeros(3, A.dtype)
     for i in range(k_e):
-        a_ += slopes[0, i] * q_e[i]
-        b_ += slopes[1, i] * q_e[i]
-        a_dot += slopes[0, i] * q_e_dot[i]
-        b_dot += slopes[1, i] * q_e_dot[i]
+        a_ += angles[0, i] * q_e[i]
+        b_ += angles[1, i] * q_e[i]
+        beta += angles[2, i] * q_e[i]
+        a_dot += angles[0, i] * q_e_dot[i]
+        b_dot += angles[1, i] * q_e_dot[i]
+        beta_dot += angles[2, i] * q_e_dot[i]
         Qq, Qqd = 0.0, 0.0
         for l in range(k_e):
             Qq += Q[i, l] * q_e[l]
@@ -354,10 +427,13 @@ def port_motion(r0, Psi, Q, slopes, offset, q_e, q_e_dot, A, r, F, zeta):
         rate += Qqd * q_e_dot[i]
         for a in range(3):
             Phi_r[a, i] = Psi[a, i] - (Qq if a == 0 else 0.0)
-    ca, sa, cb, sb = np.cos(a_), np.sin(a_), np.cos(b_), np.sin(b_)
-    A[0, 0], A[0, 1], A[0, 2] = ca * cb, -sa, ca * sb
+    ca, sa, cb, sb, cx, sx = np.cos(a_), np.sin(a_), np.cos(b_), np.sin(b_), np.cos(beta), np.sin(beta)
+    A[0, 0], A[0, 1], A[0, 2] = ca * cb, -sa, ca * sb  # R_z R_y, then turned by R_x below
     A[1, 0], A[1, 1], A[1, 2] = sa * cb, ca, sa * sb
     A[2, 0], A[2, 1], A[2, 2] = -sb, 0.0, cb
+    for a in range(3):
+        y_, z_ = A[a, 1], A[a, 2]
+        A[a, 1], A[a, 2] = cx * y_ + sx * z_, cx * z_ - sx * y_
     for a in range(3):
         r[a] = r0[a] + A[a, 0] * offset[0] + A[a, 1] * offset[1] + A[a, 2] * offset[2]
         for i in range(k_e):
@@ -365,20 +441,25 @@ def port_motion(r0, Psi, Q, slopes, offset, q_e, q_e_dot, A, r, F, zeta):
             r_dot[a] += Phi_r[a, i] * q_e_dot[i]
     r[0] -= 0.5 * quadratic
     Phi_w, c_w, v_rel, Omega = np.empty(3, A.dtype), np.empty(3, A.dtype), np.empty(3, A.dtype), np.empty(3, A.dtype)
-    for i in range(k_e):
-        Phi_w[0], Phi_w[1], Phi_w[2] = -sb * slopes[0, i], slopes[1, i], cb * slopes[0, i]
+    for i in range(k_e):  # Φ_ω = R_xᵀ (−sin b ∂a, ∂b, cos b ∂a) + e_x ∂β
+        w1, w2 = angles[1, i], cb * angles[0, i]
+        Phi_w[0], Phi_w[1], Phi_w[2] = -sb * angles[0, i] + angles[2, i], cx * w1 + sx * w2, cx * w2 - sx * w1
         c_w[:] = 0.0
         _add_cross(offset, Phi_w, c_w)
         for a in range(3):
             F[a, i] = A[0, a] * Phi_r[0, i] + A[1, a] * Phi_r[1, i] + A[2, a] * Phi_r[2, i] - c_w[a]
             F[3 + a, i] = Phi_w[a]
     alpha = zeta[3:]
-    Omega[0], Omega[1], Omega[2] = -sb * a_dot, b_dot, cb * a_dot
+    w1, w2 = b_dot, cb * a_dot  # R_xᵀ (−sin b ȧ, ḃ, cos b ȧ): Ω without β̇
+    turned1, turned2 = cx * w1 + sx * w2, cx * w2 - sx * w1
+    Omega[0], Omega[1], Omega[2] = -sb * a_dot + beta_dot, turned1, turned2
     for a in range(3):
         v_rel[a] = A[0, a] * r_dot[0] + A[1, a] * r_dot[1] + A[2, a] * r_dot[2]
         zeta[a] = -rate * A[0, a]
     _add_cross(v_rel, Omega, zeta[:3])  # − Ω × Aᵀ ṙ
-    alpha[0], alpha[1], alpha[2] = -cb * a_dot * b_dot, 0.0, -sb * a_dot * b_dot
+    alpha[0] = -cb * a_dot * b_dot  # R_xᵀ (−cos b, 0, −sin b) ȧ ḃ − β̇ e_x × R_xᵀ(…)
+    alpha[1] = -sx * sb * a_dot * b_dot + beta_dot * turned2
+    alpha[2] = -cx * sb * a_dot * b_dot - beta_dot * turned1
     _add_cross(alpha, offset, zeta[:3])  # − c × α
 
 
@@ -767,7 +848,7 @@ def state_kernels(loads, compiled: bool = True, rigid: bool = False):
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
-            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, elastic_body, port_motion)
+            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, elastic_body, rotary_body, port_motion)
 
 
 @functools.cache
