@@ -1,8 +1,10 @@
 """RitzBeams anywhere in a tree on the compiled path (projeq/assembly/kernels.py, the elastic block
 and the stations' frames): s̈ equals the dense Gauss form (docs/theory.md §5, an independent
 O(N³) formulation) within the bound of tests/assembly/test_recursive_vs_dense.py, on random
-trees with beams on revolute, prismatic, fixed and prescribed joints (any joint in the rigid part), both integration strategies, children on the beams'
-stations (beams on beams too), and the kernel's twins equal the beam's own statements."""
+trees with beams on revolute, prismatic, fixed and prescribed joints (beams with rotary inertia,
+sometimes torsion, on free, spherical and planar joints too; any joint in the rigid part), both
+integration strategies, children on the beams' stations (beams on beams too), and the kernel's
+twins equal the beam's own statements."""
 
 import warnings
 
