@@ -405,12 +405,13 @@ def with_couplings(tree: Tree, n_coupled: int = 3) -> pq.System:
     """``tree``'s System with up to ``n_coupled`` more bodies on revolute or prismatic joints
     (random axes and frames) that are *coupled*: each follows Σ ratio · coordinate of one or
     two of the tree's own revolute or prismatic joints (gears, ropes: shared minimal
-    velocities, docs/theory.md §4); the tree itself unchanged if it has no such joint."""
+    velocities, docs/theory.md §4), each on a rigid body of the tree (a beam's stations are
+    no place for a random offset); the tree itself unchanged if it has no such joint."""
     system, rng = tree.system, tree.rng
     leaders = [name for name, kind in zip(system.names, tree.kinds) if kind in ("revolute", "prismatic")]
     subsystems, joints = dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints))
     for i in range(n_coupled if leaders else 0):
-        name, parent = f"c{i}", str(rng.choice(list(subsystems)))
+        name, parent = f"c{i}", str(rng.choice([n for n, body in subsystems.items() if not body.n_e]))
         m = random_mass(rng)
         subsystems[name] = pq.RigidBody(m, rng.uniform(-0.5, 0.5, 3), random_inertia(rng, m))
         follows = {str(leader): float(rng.uniform(-2, 2)) for leader in rng.choice(leaders, min(2, len(leaders)))}

@@ -657,7 +657,8 @@ def tree_jacobian(index, geometry, inertia, gravity, laws, constants, x, n_q, st
 
 def gauss_form(index, T, zeta, F, M_n, h, M, b):
     """M = Σ J_nᵀ M_n J_n and b = Σ J_nᵀ (M_n ζ̄_n − h_n) of the Gauss form M s̈ + b = 0
-    (docs/theory.md §5) from the kernel's T_np, ζ_n, F_n, M_n and h_n, without the dense J_n.
+    (docs/theory.md §5) from the kernel's T_np, ζ_n, F_n, M_n and h_n, without the dense J_n,
+    for bodies with ``n_y[n]`` describing velocities (6, or 6 + n_e for an elastic body).
 
     b: the Newton–Euler recursion at s̈ = 0 — ζ̄_n = T_np ζ̄_p + ζ_n root → leaves,
     f_n = M_n ζ̄_n − h_n gathered leaves → root (f_p += T_npᵀ f_n), b_n = F_nᵀ f_n. M: the
@@ -666,41 +667,46 @@ def gauss_form(index, T, zeta, F, M_n, h, M, b):
     by U ← T_jpᵀ U (Featherstone (2008), *Rigid Body Dynamics Algorithms*, §5.3 and
     §6.2, Tables 5.1 and 6.2). Order N d (d: the tree's depth). Writes M (n × n) and b (n).
     """
-    N = index.shape[0]
-    n_cols, parent, s_index = index[:, N_COLS], index[:, PARENT], index[:, S_INDEX]
+    N, width = index.shape[0], M_n.shape[1]
+    n_cols, n_y, parent, s_index = index[:, N_COLS], index[:, N_Y], index[:, PARENT], index[:, S_INDEX]
+    rows = _rows
     dtype = M.dtype  # of the workspace: float, or complex under the complex step
-    zeta_bar, f, M_c = np.zeros((N, 6), dtype), np.zeros((N, 6), dtype), M_n.copy()
-    U, V, MT = np.zeros((6, 6), dtype), np.zeros((6, 6), dtype), np.empty((6, 6), dtype)
+    zeta_bar, f, M_c = np.zeros((N, width), dtype), np.zeros((N, width), dtype), M_n.copy()
+    U, V, MT = np.zeros((width, width), dtype), np.zeros((width, width), dtype), np.empty((width, width), dtype)
     for n in range(N):  # root → leaves: ζ̄_n, f_n
-        p = parent[n]
-        for a in range(6):
-            zeta_bar[n, a] = zeta[n, a] + (_dot6(T[n, a], zeta_bar[p]) if p >= 0 else 0.0)
-        for a in range(6):
-            f[n, a] = _dot6(M_n[n, a], zeta_bar[n]) - h[n, a]
+        p, m = parent[n], rows(n_y, n)
+        for a in range(m):
+            zeta_bar[n, a] = zeta[n, a] + (_dot(T[n, a], zeta_bar[p], rows(n_y, p)) if p >= 0 else 0.0)
+        for a in range(m):
+            f[n, a] = _dot(M_n[n, a], zeta_bar[n], m) - h[n, a]
     for n in range(N - 1, -1, -1):  # leaves → root: b_n, M^c_p += T_npᵀ M^c_n T_np, f_p += T_npᵀ f_n
+        p, m = parent[n], rows(n_y, n)
         for j in range(n_cols[n]):
-            b[s_index[n] + j] = _dot6(F[n, :, j], f[n])
-        if parent[n] >= 0:
-            _add_congruence(T[n], M_c[n], f[n], MT, M_c[parent[n]], f[parent[n]])
+            b[s_index[n] + j] = _dot(F[n, :, j], f[n], m)
+        if p >= 0 and m == 6 and rows(n_y, p) == 6:
+            _add_congruence(T[n], M_c[n], f[n], MT, M_c[p], f[p])
+        elif p >= 0:
+            _add_congruence_general(T[n], M_c[n], f[n], MT, m, rows(n_y, p), M_c[p], f[p])
     M[:, :] = 0.0
     for n in range(N):
-        k = n_cols[n]
+        k, m = n_cols[n], rows(n_y, n)
         if k == 0:
             continue
-        for a in range(6):
+        for a in range(m):
             for j in range(k):
-                U[a, j] = _dot6(M_c[n, a], F[n, :, j])
+                U[a, j] = _dot(M_c[n, a], F[n, :, j], m)
         i = n
         while i >= 0:  # M_in = F_iᵀ U, then U ← T_ipᵀ U
+            m_i, p = rows(n_y, i), parent[i]
             for r in range(n_cols[i]):
                 for j in range(k):
-                    M[s_index[i] + r, s_index[n] + j] = M[s_index[n] + j, s_index[i] + r] = _dot6(F[i, :, r], U[:, j])
-            if parent[i] >= 0:
-                for a in range(6):
+                    M[s_index[i] + r, s_index[n] + j] = M[s_index[n] + j, s_index[i] + r] = _dot(F[i, :, r], U[:, j], m_i)
+            if p >= 0:
+                for a in range(rows(n_y, p)):
                     for j in range(k):
-                        V[a, j] = _dot6(T[i, :, a], U[:, j])
+                        V[a, j] = _dot(T[i, :, a], U[:, j], m_i)
                 U[:, :k] = V[:, :k]
-            i = parent[i]
+            i = p
 
 
 def projected_accelerations(M_all, b_all, P, pivot_min, M, s_ddot):
@@ -877,13 +883,14 @@ def _compiled_state_kernels(loads):
     return found
 
 
-def gauss_form_kernel(compiled: bool = True):
+def gauss_form_kernel(compiled: bool = True, rigid: bool = False):
     """(:func:`gauss_form`, :func:`projected_accelerations`), compiled by numba (as
-    :func:`kernel`; ValueError without it) or with ``compiled=False`` the interpreted functions."""
+    :func:`kernel`, with the same ``rigid`` variant: n_y = 6 a constant; ValueError without
+    numba) or with ``compiled=False`` the interpreted functions."""
     if not compiled:
         return gauss_form, projected_accelerations
     kernel(True)  # the same refusal without numba
-    return _compiled_gauss_form()
+    return _compiled_gauss_form(rigid)
 
 
 def hub_beam_kernel(compiled: bool = True):
@@ -911,7 +918,9 @@ def _compiled_hub_beam():
 
 
 @functools.cache
-def _compiled_gauss_form():
+def _compiled_gauss_form(rigid: bool):
+    if rigid:
+        return _jit(gauss_form, names=("rigid_gauss_form",), _rows=_six)[0], _compiled_gauss_form(False)[1]
     return _jit(gauss_form, projected_accelerations)
 
 

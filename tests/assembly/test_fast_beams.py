@@ -6,13 +6,14 @@ sometimes torsion, on free, spherical and planar joints too; any joint in the ri
 integration strategies, children on the beams' stations (beams on beams too), and the kernel's
 twins equal the beam's own statements."""
 
+import types
 import warnings
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from strategies import Tree, random_inertia, random_mass, random_rotation, random_state, spatial_joint, trees
+from strategies import Tree, random_inertia, random_mass, random_rotation, random_state, spatial_joint, trees, with_couplings
 from test_recursive_vs_dense import _agree
 
 import projeq as pq
@@ -101,6 +102,36 @@ def test_beams_in_trees_are_compiled_and_equal_dense(tree):
         warnings.simplefilter("ignore", RuntimeWarning)  # an unstiffened beam spun fast: said once
         assert tree.system.evaluator().name == "fast"
         _agree(tree, "auto", "dense")
+
+
+@settings(max_examples=max(5, settings().max_examples // 6), deadline=None)
+@given(trees_with_beams())
+def test_beams_beside_coupled_joints_are_compiled_and_equal_dense(tree):
+    """Trees with beams and up to three bodies on coupled joints (strategies.with_couplings):
+    compiled by default; the kernel's Gauss form (kernels.gauss_form with each body's n_y,
+    in every joint's own velocities and the beams' q̇_e after them, projected by P) equals
+    the dense J_nᵀ M_n J_n sums to round-off relative to their largest entries, and its s̈
+    the dense one (bound of _agree). The coupled bodies on the rigid tree's bodies come before
+    the beams, so that the kernel's ṡ_all (a coupled joint's own velocity in it) and the
+    System's ṡ place the beams' q̇_e differently."""
+    coupled = with_couplings(tree)
+    rigid_tree = {f"b{i}" for i in range(tree.n)}
+    early = [n for n, j in zip(coupled.names, coupled.joints) if n not in rigid_tree and j.coupling and j.parent in rigid_tree]
+    order = sorted(coupled.names, key=lambda n: 0 if n in rigid_tree else 1 if n in early else 2)
+    bodies, joints = dict(zip(coupled.names, coupled.subsystems)), dict(zip(coupled.names, coupled.joints))
+    system = pq.System({n: bodies[n] for n in order}, {n: joints[n] for n in order}, gravity=coupled.gravity)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InterpretedWarning)
+        warnings.simplefilter("ignore", RuntimeWarning)  # an unstiffened beam spun fast: said once
+        assert system.evaluator().name == "fast"
+        q, s_dot = system.normalized(tree.rng.uniform(-1, 1, system.n_q)), tree.rng.uniform(-1, 1, system.n_s)
+        for n in range(len(system.names)):
+            q[system.e_q_slice[n]] *= 0.05  # moderate deflections
+        M, b = system.gauss_form(q, s_dot, tree.t)
+        M_fast, b_fast = system.evaluator("fast").gauss_form(q, s_dot, tree.t)
+        assert np.abs(M_fast - M).max() <= 1e-12 * max(1.0, np.abs(M).max())
+        assert np.abs(b_fast - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
+        _agree(types.SimpleNamespace(system=system, q=q, s_dot=s_dot, t=tree.t), "auto", "dense")
 
 
 @settings(max_examples=max(5, settings().max_examples // 10), deadline=None)
