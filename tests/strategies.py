@@ -251,9 +251,10 @@ def planar_joint(kind: str, parent, rng) -> pq.Joint:
 
 
 # -- forces --------------------------------------------------------------------------------
-def _force(kind, names, kinds, rng, planar: bool, damped: bool, constant: bool = False):
+def _force(kind, names, kinds, rng, planar: bool, damped: bool, constant: bool = False, dofs=None):
     """A random force law of ``kind`` (None when the tree has no joint it can act on); loads
-    given as callables half of the time unless ``constant``."""
+    given as callables half of the time unless ``constant``; ``dofs``: each joint's number of
+    minimal velocities (default: by its kind)."""
     body = names[rng.integers(len(names))]
     point = rng.uniform(-0.5, 0.5, 3)
     if planar:
@@ -288,7 +289,7 @@ def _force(kind, names, kinds, rng, planar: bool, damped: bool, constant: bool =
         if not candidates:
             return None
         joint = candidates[rng.integers(len(candidates))]
-        n_s = {"planar": 3, "free": 6, "spherical": 3, "car": 2, "car_sympy": 2}.get(
+        n_s = dofs[names.index(joint)] if dofs else {"planar": 3, "free": 6, "spherical": 3, "car": 2, "car_sympy": 2}.get(
             kinds[names.index(joint)], 1
         )
         tau = rng.uniform(-3, 3, n_s)
@@ -426,7 +427,8 @@ def with_every_law(tree) -> pq.System:
     row in the fast evaluator's compiled loop (projeq/assembly/loads.py)."""
     system, rng = tree.system, tree.rng
     kinds = tree.kinds + [type(joint).__name__.lower() for joint in system.joints[len(tree.kinds):]]  # beams' joints
-    laws = [_force(kind, list(system.names), kinds, rng, tree.planar, damped=True, constant=True)
+    dofs = [joint.n_s for joint in system.joints]
+    laws = [_force(kind, list(system.names), kinds, rng, tree.planar, damped=True, constant=True, dofs=dofs)
             for kind in FORCE_KINDS + ("force", "torque", "spring_damper")]
     return pq.System(dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints)),
                      gravity=system.gravity, forces=list(system.forces) + [law for law in laws if law is not None])
