@@ -2,11 +2,17 @@
 
 From sympy: F, A, r, K (and the rheonomic f, k) are checked for unknown symbols,
 Ḟ ṡ + ḟ is derived by differentiating along q̇ = K ṡ + k, and everything is lambdified
-once with common subexpressions. From callables: Ḟ ṡ + ḟ by complex-step
+once with common subexpressions — once per statement (symbols, expressions with the parameters'
+values, constraints) in a process (:func:`derive`, the last :data:`DERIVED_SIZE` kept), so a
+scene built again (a sweep, a loop, the tests) takes its joint's functions ready; each joint keeps
+its own parent, q0, placement and copy of the expressions. From callables: Ḟ ṡ + ḟ by complex-step
 differentiation, exact to round-off. Either way the pose is checked against F and K.
 """
 
 from __future__ import annotations
+
+from functools import cached_property, lru_cache
+from typing import NamedTuple
 
 import numpy as np
 import sympy as sp
@@ -49,8 +55,44 @@ def _check_symbols(name: str, expr: sp.Matrix, allowed: set, q, t, s=()) -> None
 
 def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0, r_pn, orientation,
                        constraints=None, q_dot=None):
-    """A :class:`UserJoint` from sympy expressions (see ``UserJoint.from_sympy``)."""
-    q, s = list(q), list(s)
+    """A :class:`UserJoint` from sympy expressions (see ``UserJoint.from_sympy``): the statement
+    checked and its parameters put in, its derivation and compiled functions from :func:`derive`
+    (built once per statement in a process), the joint's own placement and q0, the pose checked."""
+    statement = _statement(q, s, A, r, F, K, f, k, t, parameters, constraints, q_dot)
+    derived = derive(statement)
+    q0 = None if q0 is None else finite_array("q0", q0, (len(statement.q),))
+    at = ([0.0] * len(statement.q) if q0 is None else q0, [1.0] * len(statement.s), 0.3)
+    joint = cls(
+        parent, len(statement.q), len(statement.s), derived.relative, derived.K, derived.q_dot,
+        q0=q0, r_pn=r_pn, orientation=orientation, constraints=derived.residual, n_c=derived.n_c,
+        symbols=derived.symbols(), values=_evaluates(derived.values, at), rates=_evaluates(derived.rates, at),
+        compiled=derived.compiled_values,
+    )
+    _check_pose(joint)
+    return joint
+
+
+class Statement(NamedTuple):
+    """What determines a joint from sympy, hashable (the key of :func:`derive`): the symbols of
+    q, ṡ and t, the expressions A, r, F, K, f, k with the parameters' values put in, and the
+    original velocity constraints (with their values put in) in the rates ``q_dot``, or None."""
+
+    q: tuple
+    s: tuple
+    t: sp.Symbol
+    A: sp.ImmutableMatrix
+    r: sp.ImmutableMatrix
+    F: sp.ImmutableMatrix
+    K: sp.ImmutableMatrix
+    f: sp.ImmutableMatrix
+    k: sp.ImmutableMatrix
+    constraints: sp.ImmutableMatrix | None
+    q_dot: tuple | None
+
+
+def _statement(q, s, A, r, F, K, f, k, t, parameters, constraints, q_dot) -> Statement:
+    """The user's expressions checked (shapes, symbols) with the parameters' values put in."""
+    q, s = tuple(q), tuple(s)
     t = t if t is not None else sp.Symbol("t")
     n_q, n_s = len(q), len(s)
     exprs = {
@@ -65,8 +107,30 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
     allowed = set(q) | {t} | set(values)
     for name, expr in exprs.items():
         _check_symbols(name, expr, allowed, q, t, s)
-    A, r, F, K, f, k = (e.xreplace(values) for e in exprs.values())
+    C = None
+    if constraints is not None:
+        if q_dot is None or len(q_dot) != n_q:
+            raise ValueError("q_dot: give one symbol for each coordinate's rate to state constraints")
+        q_dot = tuple(q_dot)
+        C = sp.Matrix(list(constraints))
+        _check_symbols("constraints", C, allowed | set(q_dot), q, t)
+        C = sp.ImmutableMatrix(C.xreplace(values))
+    return Statement(q, s, t, *(sp.ImmutableMatrix(e.xreplace(values)) for e in exprs.values()), C,
+                     q_dot if constraints is not None else None)
 
+
+#: statements whose derivation :func:`derive` keeps (least recently used first out): the scenes
+#: of a session, and a parameter sweep's last points (each parameter value is its own statement)
+DERIVED_SIZE = 64
+
+
+@lru_cache(maxsize=DERIVED_SIZE)
+def derive(statement: Statement) -> Derived:
+    """Ḟ ṡ + ḟ = (∂F/∂q q̇ + ∂F/∂t) ṡ + ∂f/∂q q̇ + ∂f/∂t along q̇ = K ṡ + k, and every function of
+    the joint lambdified once with common subexpressions: the same statement (equal symbols and
+    expressions, equal parameter values) is derived once per process (``derive.cache_info()``)."""
+    q, s, t = list(statement.q), list(statement.s), statement.t
+    A, r, F, K, f, k = (sp.Matrix(e) for e in statement[3:9])
     s_vec = sp.Matrix(s)
     rates = K * s_vec + k  # q̇
 
@@ -74,12 +138,8 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
         return sum((M.diff(qi) * rates[i] for i, qi in enumerate(q)), M.diff(t))
 
     zeta = d_dt(F) * s_vec + d_dt(f)
-    rel = sp.lambdify([q, s, t], [A, r, F, F * s_vec + f, zeta], modules="numpy", cse=True)
     symbols = {"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k, "zeta": zeta}
-    # the same numbers as one flat list of scalars (Joint.relative_values): for real arguments
-    at = ([0.0] * n_q if q0 is None else q0, [1.0] * n_s, 0.3)
-    scalar = _scalar_code([q, s, t], value_expressions(symbols), at)
-    scalar_rates = _scalar_code([q, s, t], list(rates), at)  # q̇ = K ṡ + k, the same way
+    rel = sp.lambdify([q, s, t], [A, r, F, F * s_vec + f, zeta], modules="numpy", cse=True)
     K_fun = sp.lambdify([q, t], K, modules="numpy", cse=True)
     q_dot_fun = sp.lambdify([q, s, t], rates, modules="numpy", cse=True)
 
@@ -93,17 +153,41 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
             numeric(z_).ravel(),
         )
 
-    residual, n_c = _compile_constraints(constraints, q, q_dot, t, values)
-    joint = cls(
-        parent, n_q, n_s, relative,
+    residual, n_c = _compile_constraints(statement.constraints, q, statement.q_dot, t)
+    return Derived(
+        symbols, relative,
         lambda q_n, time: numeric(K_fun(q_n, time)),
         lambda q_n, s_dot_n, time: numeric(q_dot_fun(q_n, s_dot_n, time)).ravel(),
-        q0=q0, r_pn=r_pn, orientation=orientation, constraints=residual, n_c=n_c,
-        symbols=symbols, values=scalar,
-        rates=scalar_rates,
+        # the same numbers as flat lists of scalars (Joint.relative_values, q̇): for real arguments
+        sp.lambdify([q, s, t], value_expressions(symbols), modules="math", cse=True),
+        sp.lambdify([q, s, t], list(rates), modules="math", cse=True),
+        residual, n_c,
     )
-    _check_pose(joint)
-    return joint
+
+
+class Derived:
+    """The derivation of one :class:`Statement` (:func:`derive`): functions of (q, ṡ, t) shared
+    by every joint from it, none with state of its own — ``relative``, ``K``, ``q_dot``, the
+    scalar ``values`` and ``rates`` (``math``), the constraints' ``residual`` (or None) and their
+    number ``n_c`` — and the expressions, copied for each joint (:meth:`symbols`)."""
+
+    def __init__(self, symbols, relative, K, q_dot, values, rates, residual, n_c):
+        self._symbols = symbols
+        self.relative, self.K, self.q_dot, self.values, self.rates = relative, K, q_dot, values, rates
+        self.residual, self.n_c = residual, n_c
+
+    def symbols(self) -> dict:
+        """The expressions {"q", "s", "t", "A", "r", "F", "K", "f", "k", "zeta"}, a joint's own
+        copy (sympy matrices are mutable)."""
+        return {key: value.copy() for key, value in self._symbols.items() if key != "t"} | {"t": self._symbols["t"]}
+
+    @cached_property
+    def _compiled(self):
+        return compiled_values(self._symbols)
+
+    def compiled_values(self):
+        """:func:`compiled_values` of the expressions, built on first use, once per statement."""
+        return self._compiled
 
 
 def value_expressions(symbols: dict) -> list:
@@ -113,25 +197,16 @@ def value_expressions(symbols: dict) -> list:
     return [*symbols["A"], *symbols["r"], *(F * s + symbols["f"]), *symbols["zeta"], *F.T]
 
 
-_COMPILED_VALUES: dict = {}  # the expressions of value_expressions -> their numeric_function
-
-
 def compiled_values(symbols: dict):
     """``values(q_n, ṡ_n, t)`` -> the flat array of :func:`value_expressions`, printed as scalar
-    numpy code that numba compiles (:func:`projeq.symbolic.codegen.numeric_function`), built
-    once per expressions in a process."""
-    expressions = value_expressions(symbols)
-    key = tuple(expressions)
-    if key not in _COMPILED_VALUES:
-        arguments = [("q", list(symbols["q"])), ("s", list(symbols["s"])), ("t", symbols["t"])]
-        _COMPILED_VALUES[key] = codegen.numeric_function("relative_values", arguments, expressions)()
-    return _COMPILED_VALUES[key]
+    numpy code that numba compiles (:func:`projeq.symbolic.codegen.numeric_function`)."""
+    arguments = [("q", list(symbols["q"])), ("s", list(symbols["s"])), ("t", symbols["t"])]
+    return codegen.numeric_function("relative_values", arguments, value_expressions(symbols))()
 
 
-def _scalar_code(args, expressions, at):
-    """The expressions lambdified to scalar code (``math``) for Python floats, or None where
-    it cannot evaluate them (a function ``math`` does not have): then the numpy form serves."""
-    values = sp.lambdify(args, expressions, modules="math", cse=True)
+def _evaluates(values, at):
+    """The scalar code ``values`` (``math``) if it evaluates at ``at`` (q0, ṡ, t), else None (a
+    function ``math`` does not have, or a domain error there): then the numpy form serves."""
     try:
         values(*(list(map(float, a)) if np.ndim(a) else a for a in at))
     except (NameError, TypeError, ValueError, ZeroDivisionError):
@@ -139,15 +214,12 @@ def _scalar_code(args, expressions, at):
     return values
 
 
-def _compile_constraints(constraints, q, q_dot, t, values):
-    """Residual function of the original velocity constraints (expressions in q, q̇, t)."""
-    if constraints is None:
+def _compile_constraints(C, q, q_dot, t):
+    """Residual function of the original velocity constraints C (expressions in q, q̇, t; None:
+    no constraints) and their number."""
+    if C is None:
         return None, 0
-    if q_dot is None or len(q_dot) != len(q):
-        raise ValueError("q_dot: give one symbol for each coordinate's rate to state constraints")
-    C = sp.Matrix(list(constraints))
-    _check_symbols("constraints", C, set(q) | set(q_dot) | {t} | set(values), q, t)
-    fun = sp.lambdify([q, list(q_dot), t], list(C.xreplace(values)), modules="numpy", cse=True)
+    fun = sp.lambdify([q, list(q_dot), t], list(C), modules="numpy", cse=True)
     return (lambda q_n, q_dot_n, time: np.asarray(fun(q_n, q_dot_n, time), dtype=float)), len(C)
 
 
