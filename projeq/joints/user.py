@@ -71,8 +71,9 @@ class UserJoint(Joint):
     def compiled_values(self):
         """``values(q_n, ṡ_n, t)`` -> the array of :meth:`relative_values` (A, r, w, ζ, F⁶), the
         same expressions printed as scalar numpy code that numba compiles
-        (:func:`projeq.joints.user_compiler.compiled_values`), built once per statement in a
-        process (:func:`projeq.joints.user_compiler.derive`); None for a joint from callables."""
+        (:func:`projeq.joints.user_compiler.printed_values`), printed once per statement and
+        made once per parameter values in a process (:func:`projeq.joints.user_compiler.derive`);
+        None for a joint from callables."""
         return None if self._compiled is None else self._compiled()
 
     @property
@@ -140,11 +141,12 @@ class UserJoint(Joint):
 
         ``A`` (3×3) and ``r`` (3) give the pose, ``F`` (6×n_s) and ``f`` (6) the relative
         twist F ṡ + f in child coordinates, ``K`` (n_q×n_s) and ``k`` (n_q) give q̇.
-        Ḟ ṡ + ḟ = (∂F/∂q q̇ + ∂F/∂t) ṡ + ∂f/∂q q̇ + ∂f/∂t is derived and compiled once per
-        process for the same statement (symbols, expressions, parameter values, constraints:
-        :func:`projeq.joints.user_compiler.derive`, which keeps the last
-        :data:`~projeq.joints.user_compiler.DERIVED_SIZE`); ``parent``, ``q0``, ``r_pn`` and
-        ``orientation`` are each joint's own. ``constraints`` lists the original velocity constraints (expressions in q, the
+        Ḟ ṡ + ḟ = (∂F/∂q q̇ + ∂F/∂t) ṡ + ∂f/∂q q̇ + ∂f/∂t is derived and lambdified once per
+        process for the same statement (symbols, expressions, constraints, the parameters'
+        symbols: :func:`projeq.joints.user_compiler.derive`, which keeps the last
+        :data:`~projeq.joints.user_compiler.DERIVED_SIZE`), the parameters' values passed at
+        run time; their values, ``parent``, ``q0``, ``r_pn`` and ``orientation`` are each joint's
+        own. ``constraints`` lists the original velocity constraints (expressions in q, the
         symbols ``q_dot`` for q̇, and t) whose residuals every Result reports.
         """
         from projeq.joints.user_compiler import compile_user_joint

@@ -1,9 +1,9 @@
-"""A joint from sympy is derived and compiled once per statement in a process
+"""A joint from sympy is derived once per statement in a process
 (``projeq.joints.user_compiler.derive``): a repeated ``UserJoint.from_sympy`` with the same
-symbols, expressions, parameter values and constraints reuses the derivation, and gives the
-accelerations of a fresh derivation; a statement that differs in a parameter value, an expression
-or a constraint is derived anew; joints from one derivation keep their own parent, q0, placement
-and expressions.
+symbols, expressions and constraints reuses the derivation, with the same parameters' values or
+others (passed at run time), and gives the accelerations of a fresh derivation; a statement that
+differs in an expression or a constraint is derived anew; joints from one derivation keep their
+own parameters' values, parent, q0, placement and expressions.
 
 The reference is always a fresh derivation of the same statement (the cache cleared), and the
 particle's s̈ the one of Barhorst's particle with ẏ + a zᵖ ẋ = 0 (Barhorst, "Systematic closed form
@@ -51,37 +51,39 @@ def close(u, v) -> bool:
 
 
 def test_a_repeated_scene_build_reuses_the_derivation_and_gives_the_fresh_accelerations():
-    """Barhorst's rolling disk of radius 1.5 cm and 2 cm, each built twice (interleaved): two
-    derivations, two reuses (the cache's statistics), the compiled function of one statement
-    shared, and the reused joints' s̈ at a moving state are the fresh derivations' to round-off."""
+    """Barhorst's rolling disk of radius 1.5 cm and 2 cm, each built twice (interleaved): one
+    derivation, three reuses (the cache's statistics), one compiled function per radius, and the
+    reused joints' s̈ at a moving state are the fresh derivations' to round-off."""
     q, s_dot = np.array([0.1, 0.2, 0.3, 0.01, -0.02]), np.array([1.0, 15.0, -0.5])
     derive.cache_clear()
     first = [pq.scenes.rolling_disk(R=R) for R in (0.015, 0.02)]
     again = [pq.scenes.rolling_disk(R=R) for R in (0.015, 0.02)]
     info = derive.cache_info()
-    assert (info.misses, info.hits) == (2, 2)
+    assert (info.misses, info.hits) == (1, 3)
     assert again[1].joints[0].compiled_values() is first[1].joints[0].compiled_values()
-    for R, system in zip((0.015, 0.02), again):
-        reference = fresh(lambda: pq.scenes.rolling_disk(R=R))
+    assert again[0].joints[0].compiled_values() is not again[1].joints[0].compiled_values()
+    references = fresh(lambda: [pq.scenes.rolling_disk(R=R) for R in (0.015, 0.02)])
+    for system, reference in zip(again, references):
         expected = reference.accelerations(q, s_dot, method="recursive")
         assert close(system.accelerations(q, s_dot, method="recursive"), expected)
+    assert not close(*(system.accelerations(q, s_dot, method="recursive") for system in again))
 
 
-@pytest.mark.parametrize("first, variant", [
-    pytest.param({}, {"a_value": 2.0}, id="parameter"),
-    pytest.param({}, {"power": 2}, id="expression"),
-    pytest.param({"scale": 1}, {"scale": 2}, id="constraint"),
+@pytest.mark.parametrize("first, variant, derivations", [
+    pytest.param({}, {"a_value": 2.0}, 1, id="parameter"),
+    pytest.param({}, {"power": 2}, 2, id="expression"),
+    pytest.param({"scale": 1}, {"scale": 2}, 2, id="constraint"),
 ])
-def test_a_different_statement_is_derived_anew(first, variant):
-    """After the particle with a = p = 1, one that differs from it only in the parameter a, only
-    in the power p (the expressions F and K) or only in the stated constraint is a miss of the
-    cache, and its s̈ and constraint residual are those of its own fresh derivation (which differ
-    from the first particle's)."""
+def test_a_different_statement_is_derived_anew_other_parameter_values_are_its_own(first, variant, derivations):
+    """After the particle with a = p = 1, one that differs from it only in the power p (the
+    expressions F and K) or only in the stated constraint is derived anew, one that differs only in
+    the parameter's value a reuses the derivation; either way its s̈ and constraint residual are
+    those of its own fresh derivation (which differ from the first particle's)."""
     q_dot = np.array([0.5, 0.9, -0.3])  # violates the constraint: the residual shows its statement
     derive.cache_clear()
     base = particle_joint(**first)
     other = particle_joint(**variant)
-    assert derive.cache_info().misses == 2
+    assert derive.cache_info().misses == derivations
     reference = fresh(lambda: particle_joint(**variant))
     s_ddot, residual = particle_s_ddot(other), other.constraint_residual(STATE[0], q_dot, 0.0)
     assert close(s_ddot, particle_s_ddot(reference))
@@ -92,10 +94,10 @@ def test_a_different_statement_is_derived_anew(first, variant):
 
 
 def test_joints_from_one_derivation_keep_their_own_placement_and_expressions():
-    """Two particles from one derivation (a = 1) — the second on the first, placed and turned,
-    another q0 — and a third with a = 2 on the first: each keeps its parent, q0, r_pn and
-    orientation, changing one's expressions leaves the other and the next build alone, and the
-    system's s̈ is the one of the same joints each derived afresh."""
+    """Three particles from one derivation: the first (a = 1), the second on the first, placed and
+    turned, another q0, and a third with a = 2 on the first: each keeps its parent, q0, r_pn,
+    orientation and parameter, changing one's expressions leaves the other and the next build
+    alone, and the system's s̈ is the one of the same joints each derived afresh."""
     turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     placements = {"one": {"q0": (0.1, 0.2, 0.3)},
                   "two": {"parent": "one", "q0": (-0.4, 0.0, 0.5), "r_pn": (0.3, 0.0, 0.2), "orientation": turn},
@@ -109,7 +111,7 @@ def test_joints_from_one_derivation_keep_their_own_placement_and_expressions():
 
     derive.cache_clear()
     shared = {name: particle_joint(**placement) for name, placement in placements.items()}
-    assert (derive.cache_info().misses, derive.cache_info().hits) == (2, 1)
+    assert (derive.cache_info().misses, derive.cache_info().hits) == (1, 2)
     one, two = shared["one"], shared["two"]
     assert one.compiled_values() is two.compiled_values()
     assert (one.parent, two.parent) == (None, "one")
@@ -119,5 +121,6 @@ def test_joints_from_one_derivation_keep_their_own_placement_and_expressions():
     F = one.symbols["F"].copy()
     two.symbols["F"][1, 0] = 7
     assert one.symbols["F"] == F and particle_joint().symbols["F"] == F
+    assert shared["three"].symbols["F"] == F.xreplace({z: 2 * z})
     separately = {name: fresh(lambda: particle_joint(**placement)) for name, placement in placements.items()}
     assert close(s_ddot(shared), s_ddot(separately))
