@@ -109,6 +109,9 @@ def _statement(q, s, A, r, F, K, f, k, t, parameters, constraints, q_dot) -> tup
         "k": _matrix("k", sp.zeros(n_q, 1) if k is None else k, (n_q, 1)),
     }
     values = {sym: float(finite_array(f"parameters[{sym}]", val, ())) for sym, val in parameters.items()}
+    variables = sorted(map(str, set(values) & (set(q) | set(s) | {t})))
+    if variables:
+        raise ValueError(f"parameters: {variables} are coordinates, minimal velocities or time, not constants")
     allowed = set(q) | {t} | set(values)
     for name, expr in exprs.items():
         _check_symbols(name, expr, allowed, q, t, s)
