@@ -34,12 +34,13 @@ class UserJoint(Joint):
     """
 
     def __init__(self, parent, n_q, n_s, relative, K, q_dot, q0=None, r_pn=(0, 0, 0), orientation=None,
-                 constraints=None, n_c=0, symbols: dict | None = None, values=None, rates=None):
+                 constraints=None, n_c=0, symbols: dict | None = None, values=None, rates=None, compiled=None):
         super().__init__(parent, r_pn, orientation)
         self.n_q, self.n_s, self.n_c = n_q, n_s, n_c
         self._relative, self._K, self._q_dot = relative, K, q_dot
         self._values = values  # (q_n, ṡ_n, t) as lists -> relative_values, or None: relative packed
         self._rates = rates  # (q_n, ṡ_n, t) as lists -> q̇_n as a list, or None: q_dot alone
+        self._compiled = compiled  # () -> compiled_values(), or None: none
         self._constraints = constraints
         self._q0 = np.zeros(n_q) if q0 is None else finite_array("q0", q0, (n_q,))
         self.symbols = symbols
@@ -70,12 +71,10 @@ class UserJoint(Joint):
     def compiled_values(self):
         """``values(q_n, ṡ_n, t)`` -> the array of :meth:`relative_values` (A, r, w, ζ, F⁶), the
         same expressions printed as scalar numpy code that numba compiles
-        (:func:`projeq.joints.user_compiler.compiled_values`); None for a joint from callables."""
-        if self.symbols is None:
-            return None
-        from projeq.joints.user_compiler import compiled_values
-
-        return compiled_values(self.symbols)
+        (:func:`projeq.joints.user_compiler.printed_values`), printed once per statement and
+        made once per parameter values in a process (:func:`projeq.joints.user_compiler.derive`);
+        None for a joint from callables."""
+        return None if self._compiled is None else self._compiled()
 
     @property
     def rates_are_speeds(self) -> bool:
@@ -142,8 +141,12 @@ class UserJoint(Joint):
 
         ``A`` (3×3) and ``r`` (3) give the pose, ``F`` (6×n_s) and ``f`` (6) the relative
         twist F ṡ + f in child coordinates, ``K`` (n_q×n_s) and ``k`` (n_q) give q̇.
-        Ḟ ṡ + ḟ = (∂F/∂q q̇ + ∂F/∂t) ṡ + ∂f/∂q q̇ + ∂f/∂t is derived and compiled once.
-        ``constraints`` lists the original velocity constraints (expressions in q, the
+        Ḟ ṡ + ḟ = (∂F/∂q q̇ + ∂F/∂t) ṡ + ∂f/∂q q̇ + ∂f/∂t is derived and lambdified once per
+        process for the same statement (symbols, expressions, constraints, the parameters'
+        symbols: :func:`projeq.joints.user_compiler.derive`, which keeps the last
+        :data:`~projeq.joints.user_compiler.DERIVED_SIZE`), the parameters' values passed at
+        run time; their values, ``parent``, ``q0``, ``r_pn`` and ``orientation`` are each joint's
+        own. ``constraints`` lists the original velocity constraints (expressions in q, the
         symbols ``q_dot`` for q̇, and t) whose residuals every Result reports.
         """
         from projeq.joints.user_compiler import compile_user_joint

@@ -2,11 +2,18 @@
 
 From sympy: F, A, r, K (and the rheonomic f, k) are checked for unknown symbols,
 Ḟ ṡ + ḟ is derived by differentiating along q̇ = K ṡ + k, and everything is lambdified
-once with common subexpressions. From callables: Ḟ ṡ + ḟ by complex-step
+once with common subexpressions and the parameters as an argument — once per statement (symbols,
+expressions, constraints) in a process (:func:`derive`, the last :data:`DERIVED_SIZE` kept), so a
+scene built again (a sweep, a loop, the tests), with the same parameters' values or others, takes
+its joint's functions ready; each joint keeps its own parameters' values, parent, q0, placement
+and expressions. From callables: Ḟ ṡ + ḟ by complex-step
 differentiation, exact to round-off. Either way the pose is checked against F and K.
 """
 
 from __future__ import annotations
+
+from functools import cached_property, lru_cache, partial
+from typing import NamedTuple
 
 import numpy as np
 import sympy as sp
@@ -49,8 +56,48 @@ def _check_symbols(name: str, expr: sp.Matrix, allowed: set, q, t, s=()) -> None
 
 def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0, r_pn, orientation,
                        constraints=None, q_dot=None):
-    """A :class:`UserJoint` from sympy expressions (see ``UserJoint.from_sympy``)."""
-    q, s = list(q), list(s)
+    """A :class:`UserJoint` from sympy expressions (see ``UserJoint.from_sympy``): the statement
+    checked, its derivation and functions from :func:`derive` (built once per statement in a
+    process), the parameters' values, placement and q0 the joint's own, the pose checked."""
+    statement, p = _statement(q, s, A, r, F, K, f, k, t, parameters, constraints, q_dot)
+    derived = derive(statement)
+    q0 = None if q0 is None else finite_array("q0", q0, (len(statement.q),))
+    at = ([0.0] * len(statement.q) if q0 is None else q0, [1.0] * len(statement.s), 0.3)
+    joint = cls(
+        parent, len(statement.q), len(statement.s), partial(derived.relative, p), partial(derived.K, p),
+        partial(derived.q_dot, p), q0=q0, r_pn=r_pn, orientation=orientation,
+        constraints=None if derived.residual is None else partial(derived.residual, p), n_c=derived.n_c,
+        symbols=derived.symbols(p), values=_evaluates(partial(derived.values, p), at),
+        rates=_evaluates(partial(derived.rates, p), at), compiled=partial(_compiled_values, derived, p),
+    )
+    _check_pose(joint)
+    return joint
+
+
+class Statement(NamedTuple):
+    """What determines the derivation of a joint from sympy, hashable (the key of :func:`derive`):
+    the symbols of q, ṡ and t, the expressions A, r, F, K, f, k, the original velocity constraints
+    in the rates ``q_dot`` (or None), and the ``parameters``' symbols, whose values each joint
+    passes to the derived functions as their first argument."""
+
+    q: tuple
+    s: tuple
+    t: sp.Symbol
+    A: sp.ImmutableMatrix
+    r: sp.ImmutableMatrix
+    F: sp.ImmutableMatrix
+    K: sp.ImmutableMatrix
+    f: sp.ImmutableMatrix
+    k: sp.ImmutableMatrix
+    constraints: sp.ImmutableMatrix | None
+    q_dot: tuple | None
+    parameters: tuple
+
+
+def _statement(q, s, A, r, F, K, f, k, t, parameters, constraints, q_dot) -> tuple[Statement, tuple]:
+    """The user's expressions checked (shapes, symbols), and the parameters' values in the order of
+    the statement's ``parameters`` (sympy's canonical order of their symbols)."""
+    q, s = tuple(q), tuple(s)
     t = t if t is not None else sp.Symbol("t")
     n_q, n_s = len(q), len(s)
     exprs = {
@@ -62,11 +109,38 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
         "k": _matrix("k", sp.zeros(n_q, 1) if k is None else k, (n_q, 1)),
     }
     values = {sym: float(finite_array(f"parameters[{sym}]", val, ())) for sym, val in parameters.items()}
+    variables = sorted(map(str, set(values) & (set(q) | set(s) | {t})))
+    if variables:
+        raise ValueError(f"parameters: {variables} are coordinates, minimal velocities or time, not constants")
     allowed = set(q) | {t} | set(values)
     for name, expr in exprs.items():
         _check_symbols(name, expr, allowed, q, t, s)
-    A, r, F, K, f, k = (e.xreplace(values) for e in exprs.values())
+    C = None
+    if constraints is not None:
+        if q_dot is None or len(q_dot) != n_q:
+            raise ValueError("q_dot: give one symbol for each coordinate's rate to state constraints")
+        q_dot = tuple(q_dot)
+        C = sp.ImmutableMatrix(list(constraints))
+        _check_symbols("constraints", C, allowed | set(q_dot), q, t)
+    symbols = tuple(sorted(values, key=sp.default_sort_key))
+    statement = Statement(q, s, t, *map(sp.ImmutableMatrix, exprs.values()), C,
+                          q_dot if constraints is not None else None, symbols)
+    return statement, tuple(values[symbol] for symbol in symbols)
 
+
+#: statements whose derivation :func:`derive` keeps (least recently used first out), and
+#: parameter values whose compiled function :func:`_compiled_values` keeps
+DERIVED_SIZE = 64
+
+
+@lru_cache(maxsize=DERIVED_SIZE)
+def derive(statement: Statement) -> Derived:
+    """Ḟ ṡ + ḟ = (∂F/∂q q̇ + ∂F/∂t) ṡ + ∂f/∂q q̇ + ∂f/∂t along q̇ = K ṡ + k, and every function of
+    the joint lambdified once with common subexpressions, the parameters p their first argument:
+    the same statement (equal symbols, expressions and constraints) is derived once per process
+    whatever its parameters' values (``derive.cache_info()``)."""
+    p, q, s, t = list(statement.parameters), list(statement.q), list(statement.s), statement.t
+    A, r, F, K, f, k = (sp.Matrix(e) for e in statement[3:9])
     s_vec = sp.Matrix(s)
     rates = K * s_vec + k  # q̇
 
@@ -74,17 +148,13 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
         return sum((M.diff(qi) * rates[i] for i, qi in enumerate(q)), M.diff(t))
 
     zeta = d_dt(F) * s_vec + d_dt(f)
-    rel = sp.lambdify([q, s, t], [A, r, F, F * s_vec + f, zeta], modules="numpy", cse=True)
     symbols = {"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k, "zeta": zeta}
-    # the same numbers as one flat list of scalars (Joint.relative_values): for real arguments
-    at = ([0.0] * n_q if q0 is None else q0, [1.0] * n_s, 0.3)
-    scalar = _scalar_code([q, s, t], value_expressions(symbols), at)
-    scalar_rates = _scalar_code([q, s, t], list(rates), at)  # q̇ = K ṡ + k, the same way
-    K_fun = sp.lambdify([q, t], K, modules="numpy", cse=True)
-    q_dot_fun = sp.lambdify([q, s, t], rates, modules="numpy", cse=True)
+    rel = sp.lambdify([p, q, s, t], [A, r, F, F * s_vec + f, zeta], modules="numpy", cse=True)
+    K_fun = sp.lambdify([p, q, t], K, modules="numpy", cse=True)
+    q_dot_fun = sp.lambdify([p, q, s, t], rates, modules="numpy", cse=True)
 
-    def relative(q_n, s_dot_n, time):
-        A_, r_, F_, w_, z_ = rel(q_n, s_dot_n, time)
+    def relative(p_n, q_n, s_dot_n, time):
+        A_, r_, F_, w_, z_ = rel(p_n, q_n, s_dot_n, time)
         return Relative(
             numeric(A_),
             numeric(r_).ravel(),
@@ -93,17 +163,49 @@ def compile_user_joint(cls, q, s, A, r, F, K, *, f, k, t, parameters, parent, q0
             numeric(z_).ravel(),
         )
 
-    residual, n_c = _compile_constraints(constraints, q, q_dot, t, values)
-    joint = cls(
-        parent, n_q, n_s, relative,
-        lambda q_n, time: numeric(K_fun(q_n, time)),
-        lambda q_n, s_dot_n, time: numeric(q_dot_fun(q_n, s_dot_n, time)).ravel(),
-        q0=q0, r_pn=r_pn, orientation=orientation, constraints=residual, n_c=n_c,
-        symbols=symbols, values=scalar,
-        rates=scalar_rates,
+    residual, n_c = _compile_constraints(statement.constraints, p, q, statement.q_dot, t)
+    return Derived(
+        p, symbols, relative,
+        lambda p_n, q_n, time: numeric(K_fun(p_n, q_n, time)),
+        lambda p_n, q_n, s_dot_n, time: numeric(q_dot_fun(p_n, q_n, s_dot_n, time)).ravel(),
+        # the same numbers as flat lists of scalars (Joint.relative_values, q̇): for real arguments
+        sp.lambdify([p, q, s, t], value_expressions(symbols), modules="math", cse=True),
+        sp.lambdify([p, q, s, t], list(rates), modules="math", cse=True),
+        residual, n_c,
     )
-    _check_pose(joint)
-    return joint
+
+
+class Derived:
+    """The derivation of one :class:`Statement` (:func:`derive`): functions of (p, q, ṡ, t), the
+    parameters' values p first, shared by every joint from it, none with state of its own —
+    ``relative``, ``K``, ``q_dot``, the scalar ``values`` and ``rates`` (``math``), the
+    constraints' ``residual`` (or None) and their number ``n_c`` — and the expressions, each
+    joint's own with its parameters' values put in (:meth:`symbols`)."""
+
+    def __init__(self, parameters, symbols, relative, K, q_dot, values, rates, residual, n_c):
+        self.parameters, self._symbols = parameters, symbols
+        self.relative, self.K, self.q_dot, self.values, self.rates = relative, K, q_dot, values, rates
+        self.residual, self.n_c = residual, n_c
+
+    def symbols(self, p) -> dict:
+        """The expressions {"q", "s", "t", "A", "r", "F", "K", "f", "k", "zeta"} with the
+        parameters' values ``p`` put in: a joint's own (sympy matrices are mutable)."""
+        numbers = dict(zip(self.parameters, p))
+        return {key: (value.xreplace(numbers) if isinstance(value, sp.MatrixBase) else value.copy())
+                for key, value in self._symbols.items() if key != "t"} | {"t": self._symbols["t"]}
+
+    @cached_property
+    def make_values(self):
+        """``make(*p)`` -> the compiled-form ``values`` at the parameters' values p
+        (:func:`printed_values`, printed once per statement)."""
+        return printed_values(self._symbols, self.parameters)
+
+
+@lru_cache(maxsize=DERIVED_SIZE)
+def _compiled_values(derived: Derived, p: tuple):
+    """The compiled-form ``values`` of ``derived`` at the parameters' values ``p``, one function per
+    (statement, values) in a process, so that its numba callback is built once."""
+    return derived.make_values(*p)
 
 
 def value_expressions(symbols: dict) -> list:
@@ -113,25 +215,20 @@ def value_expressions(symbols: dict) -> list:
     return [*symbols["A"], *symbols["r"], *(F * s + symbols["f"]), *symbols["zeta"], *F.T]
 
 
-_COMPILED_VALUES: dict = {}  # the expressions of value_expressions -> their numeric_function
+def printed_values(symbols: dict, parameters=()):
+    """``make(*p)`` -> ``values(q_n, ṡ_n, t)``, the flat array of :func:`value_expressions` at
+    the ``parameters``' values p, printed as scalar numpy code that numba compiles, the values
+    its constants (:func:`projeq.symbolic.codegen.numeric_function`; the parameters renamed
+    p0, p1, … there, names numba can read)."""
+    arguments = [("q", list(symbols["q"])), ("s", list(symbols["s"])), ("t", symbols["t"])]
+    names = [sp.Symbol(f"p{i}") for i in range(len(parameters))]
+    expressions = [e.xreplace(dict(zip(parameters, names))) for e in value_expressions(symbols)]
+    return codegen.numeric_function("relative_values", arguments, expressions, names)
 
 
-def compiled_values(symbols: dict):
-    """``values(q_n, ṡ_n, t)`` -> the flat array of :func:`value_expressions`, printed as scalar
-    numpy code that numba compiles (:func:`projeq.symbolic.codegen.numeric_function`), built
-    once per expressions in a process."""
-    expressions = value_expressions(symbols)
-    key = tuple(expressions)
-    if key not in _COMPILED_VALUES:
-        arguments = [("q", list(symbols["q"])), ("s", list(symbols["s"])), ("t", symbols["t"])]
-        _COMPILED_VALUES[key] = codegen.numeric_function("relative_values", arguments, expressions)()
-    return _COMPILED_VALUES[key]
-
-
-def _scalar_code(args, expressions, at):
-    """The expressions lambdified to scalar code (``math``) for Python floats, or None where
-    it cannot evaluate them (a function ``math`` does not have): then the numpy form serves."""
-    values = sp.lambdify(args, expressions, modules="math", cse=True)
+def _evaluates(values, at):
+    """The scalar code ``values`` (``math``) if it evaluates at ``at`` (q0, ṡ, t), else None (a
+    function ``math`` does not have, or a domain error there): then the numpy form serves."""
     try:
         values(*(list(map(float, a)) if np.ndim(a) else a for a in at))
     except (NameError, TypeError, ValueError, ZeroDivisionError):
@@ -139,16 +236,13 @@ def _scalar_code(args, expressions, at):
     return values
 
 
-def _compile_constraints(constraints, q, q_dot, t, values):
-    """Residual function of the original velocity constraints (expressions in q, q̇, t)."""
-    if constraints is None:
+def _compile_constraints(C, p, q, q_dot, t):
+    """Residual function (p, q, q̇, t) of the original velocity constraints C (expressions in the
+    parameters p, q, q̇, t; None: no constraints) and their number."""
+    if C is None:
         return None, 0
-    if q_dot is None or len(q_dot) != len(q):
-        raise ValueError("q_dot: give one symbol for each coordinate's rate to state constraints")
-    C = sp.Matrix(list(constraints))
-    _check_symbols("constraints", C, set(q) | set(q_dot) | {t} | set(values), q, t)
-    fun = sp.lambdify([q, list(q_dot), t], list(C.xreplace(values)), modules="numpy", cse=True)
-    return (lambda q_n, q_dot_n, time: np.asarray(fun(q_n, q_dot_n, time), dtype=float)), len(C)
+    fun = sp.lambdify([p, q, list(q_dot), t], list(C), modules="numpy", cse=True)
+    return (lambda p_n, q_n, q_dot_n, time: np.asarray(fun(p_n, q_n, q_dot_n, time), dtype=float)), len(C)
 
 
 def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, orientation,

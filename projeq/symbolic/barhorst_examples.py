@@ -22,7 +22,7 @@ import numpy as np
 import sympy as sp
 from sympy.physics.mechanics import dynamicsymbols
 
-from .algebra import rotation_x, rotation_y, rotation_z
+from .algebra import rotation_x, rotation_y, rotation_z, trig_normal
 from .lagrange import MultiplierSystem, multiplier_system
 from .projection import Body, t
 
@@ -34,8 +34,9 @@ class PoseBody:
     """A body by its mass centre r(q) and orientation R(q) (body → N; None: a point mass), mass ``m``,
     central inertia ``I_c`` in the body frame, a non-potential force ``f`` in N at the mass centre and
     torque ``M`` in the body frame (expressions in q, q̇); gravity is the example's. ``omega``: the
-    angular velocity in the body frame in q, q̇ (default: from ω̃ = RᵀṘ, simplified — slow for
-    three Euler angles, so the examples give Barhorst's own expressions)."""
+    angular velocity in the body frame in q, q̇ (default: from ω̃ = RᵀṘ, each entry in the
+    sin² + cos² = 1 normal form of :func:`~projeq.symbolic.algebra.trig_normal`, the expressions
+    trigsimp gives in a fraction of its time; the examples give Barhorst's own expressions)."""
 
     m: object
     r: sp.Matrix
@@ -70,7 +71,7 @@ class Example:
         if body.omega is not None:
             return r_dot, sp.Matrix(body.omega)
         R_dot = sum((body.R.diff(qi) * qd for qi, qd in zip(self.q, self.q_dot)), sp.zeros(3, 3))
-        W = (body.R.T * R_dot).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
+        W = (body.R.T * R_dot).applyfunc(lambda e: trig_normal(e, self.q))
         return r_dot, sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
 
     @property

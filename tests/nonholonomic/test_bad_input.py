@@ -1,7 +1,8 @@
 """Bad input for non-holonomic systems (the issue's "Bad input" list).
 
 - a user-defined joint whose F has the wrong shape, or depends on symbols that are not
-  coordinates, time or declared parameters (named in the message), or on the speeds;
+  coordinates, time or declared parameters (named in the message), or on the speeds; a
+  parameter that is a coordinate;
 - K(q) singular at the start: Barhorst's Euler angles at tilt q2 = π/2
   (Barhorst §3.2, eq. 96, "the singularity near q2 = π/2"); the knife-edge disc's
   F at ϕ = π/2 (Orsino (2020) slide 31: the 1/cos²ϕ of the Hamiltonian);
@@ -37,6 +38,8 @@ def test_F_with_unknown_symbols_names_them():
     with pytest.raises(ValueError, match=r"^F: depends on \['k'\], which are not coordinates \['x', 'y'\]"):
         particle_joint(sp.Matrix([1, k * y**2, 0, 0, 0, 0]))
     particle_joint(sp.Matrix([1, k * y**2, 0, 0, 0, 0]), K=sp.Matrix([[1], [k * y**2]]), parameters={k: 1.0})
+    with pytest.raises(ValueError, match=r"^parameters: \['y'\] are coordinates, minimal velocities or time"):
+        particle_joint(sp.Matrix([1, y**2, 0, 0, 0, 0]), parameters={y: 1.0})
     with pytest.raises(ValueError, match=r"^F: depends on the minimal velocities \['u'\]"):
         particle_joint(sp.Matrix([1, u * y, 0, 0, 0, 0]))
     with pytest.raises(ValueError, match=r"^constraints: depends on \['k'\]"):

@@ -3,12 +3,15 @@ canonical equations of motion", §2–3): general
 speeds u = Y q̇ + Z (eqs. 8–11, 93), the energy-conservation condition (eq. 38/55) on his three examples, and
 Hamilton's canonical equations with multipliers integrated as a DAE."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import sympy as sp
 
 from projeq.symbolic import energy_rate, lagrangian_canonical, projective_canonical, t
 from projeq.symbolic import barhorst_examples as bx
+from projeq.symbolic.algebra import rotation_x, rotation_z
 
 
 def _energy_in_u(example, form):
@@ -115,3 +118,19 @@ def test_hamilton_dae_particle_follows_the_integral_curve():
     assert np.abs(energy - 20).max() < 1e-8
     with pytest.raises(ValueError, match="phi: expected 1 position constraints"):
         ms.hamilton_dae(phi=[ms.q[0], ms.q[1]])
+
+
+def test_angular_velocity_from_the_orientation_is_barhorsts():
+    """A body given by its orientation R alone gets ω from ω̃ = RᵀṘ: for the disk's C = R_z(q1) R_x(q2)
+    R_y(q3) that is Barhorst's u1..u3 of eq. (93), entry by entry; for R_z(q1) R_x(q2) the very
+    expressions sympy's trigsimp gives (its time for three Euler angles is 5 s, a test's too much)."""
+    example = bx.rolling_disk()
+    disk = replace(example.bodies[0], omega=None)
+    from_R = replace(example, bodies=(disk, *example.bodies[1:])).bodies_in(example.q_dot, sp.eye(5))[0].omega
+    assert (from_R - bx.disk_speeds(example.q, example.q_dot)[:3, :]).applyfunc(sp.expand) == sp.zeros(3, 1)
+    q1, q2 = example.q[:2]
+    tilt = replace(disk, R=rotation_z(q1) * rotation_x(q2))
+    R_dot = tilt.R.diff(q1) * example.q_dot[0] + tilt.R.diff(q2) * example.q_dot[1]
+    W = (tilt.R.T * R_dot).applyfunc(lambda e: sp.trigsimp(sp.expand(e)))
+    omega = replace(example, bodies=(tilt,)).bodies_in(example.q_dot, sp.eye(5))[0].omega
+    assert omega == sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
