@@ -266,38 +266,52 @@ def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
             h[6 + i] -= K_e[i, l] * (q_e[l] + damping * q_e_dot[l])
 
 
-def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, pivot_min, M, h, x_dot):
-    """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) of one elastic body on a hub whose motion is given, its
-    reference frame moving with ẏ = (w, q̇_e) and ÿ = (ζ, q̈_e) — B(14) projected on q̇_e
-    (:mod:`projeq.assembly.beam_fast`); M_n and h_n by :func:`elastic_body`, M_ee by
-    Cholesky in place. The hub: a Revolute or Prismatic ``kind`` about ``axis`` at
-    ``angles`` = (θ, θ̇, θ̈) (A_Jn by :func:`_relative_rotation`, w = F⁶ θ̇, ζ = F⁶ θ̈: a
-    Prescribed joint), FIXED (angles zero), or GIVEN: A, r, w, ζ of the joint's own
-    ``relative_values`` in ``given``. R = A_pJ A_Jn (the ground at rest), g_n = Rᵀ g.
-    The state x = (q_e, q̇_e), written: ẋ = (q̇_e, q̈_e) (q̇ = ṡ for elastic coordinates).
-    Returns −1; 0 when a pivot of M_ee is not above ``pivot_min``; 1 when x or ẋ is not
-    finite (ẋ written as far as it got)."""
-    dtype = M.dtype  # of the workspace: float, or complex under the complex step
-    k_e, A, w, zeta, g = x.shape[0] // 2, np.empty((3, 3), dtype), np.zeros(6, dtype), np.zeros(6, dtype), np.zeros(3, dtype)
-    for i in range(2 * k_e):
-        if not np.isfinite(x[i]):
-            return 1
-    q_e, q_e_dot, q_e_ddot = x[:k_e], x[k_e:], x_dot[k_e:]
-    x_dot[:k_e] = q_e_dot
+def hub_motion(kind, axis, angles, given, orientation, gravity, A, r, w, zeta, g):
+    """The relative motion of a hub whose motion is given, on the ground at rest: A = A_Jn,
+    r = r_Jn, w = F⁶ θ̇ (ẏ's twist), ζ = F⁶ θ̈, and g_n = (A_pJ A_Jn)ᵀ g. A Revolute or
+    Prismatic ``kind`` about ``axis`` at ``angles`` = (θ, θ̇, θ̈) (A_Jn by
+    :func:`_relative_rotation`, r_Jn = e θ for a prismatic hub: a Prescribed joint), FIXED
+    (angles zero), or GIVEN: A, r, w, ζ of the joint's own ``relative_values`` in ``given``."""
+    r[:] = 0.0
+    w[:] = 0.0
+    zeta[:] = 0.0
+    g[:] = 0.0
     if kind == GIVEN:
         for a in range(3):
+            r[a] = given[GIVEN_R + a]
             for b in range(3):
-                A[a, b] = given[3 * a + b]
-        w[:] = given[12:18]
-        zeta[:] = given[18:24]
+                A[a, b] = given[GIVEN_A + 3 * a + b]
+        w[:] = given[GIVEN_W : GIVEN_W + 6]
+        zeta[:] = given[GIVEN_ZETA : GIVEN_ZETA + 6]
     else:
         _relative_rotation(kind, axis, angles[0], A)
         first = 3 if kind == REVOLUTE else 0  # F⁶ = [0; e] or [e; 0]
         for a in range(3 if kind != FIXED else 0):
             w[first + a], zeta[first + a] = axis[a] * angles[1], axis[a] * angles[2]
+            if kind == PRISMATIC:
+                r[a] = axis[a] * angles[0]
     for b in range(3):  # g_n = (A_pJ A_Jn)ᵀ g
         for a in range(3):
             g[b] += (orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]) * gravity[a]
+
+
+def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, pivot_min, M, h, x_dot):
+    """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) of one elastic body on a hub whose motion is given, its
+    reference frame moving with ẏ = (w, q̇_e) and ÿ = (ζ, q̈_e) — B(14) projected on q̇_e
+    (:mod:`projeq.assembly.beam_fast`); the hub's motion by :func:`hub_motion`, M_n and h_n by
+    :func:`elastic_body`, M_ee by Cholesky in place. R = A_pJ A_Jn (the ground at rest), g_n = Rᵀ g.
+    The state x = (q_e, q̇_e), written: ẋ = (q̇_e, q̈_e) (q̇ = ṡ for elastic coordinates).
+    Returns −1; 0 when a pivot of M_ee is not above ``pivot_min``; 1 when x or ẋ is not
+    finite (ẋ written as far as it got)."""
+    dtype = M.dtype  # of the workspace: float, or complex under the complex step
+    k_e, A, r = x.shape[0] // 2, np.empty((3, 3), dtype), np.empty(3, dtype)
+    w, zeta, g = np.empty(6, dtype), np.empty(6, dtype), np.empty(3, dtype)
+    for i in range(2 * k_e):
+        if not np.isfinite(x[i]):
+            return 1
+    q_e, q_e_dot, q_e_ddot = x[:k_e], x[k_e:], x_dot[k_e:]
+    x_dot[:k_e] = q_e_dot
+    hub_motion(kind, axis, angles, given, orientation, gravity, A, r, w, zeta, g)
     elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, w, g, M, h)
     for i in range(k_e):
         q_e_ddot[i] = h[6 + i] - _dot6(M[6 + i], zeta)
@@ -309,6 +323,26 @@ def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e
         if not np.isfinite(q_e_ddot[i]):
             return 1
     return -1
+
+
+def hub_beam_kinetic_energy(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, M, h,
+                            A, r):
+    """T = ½ ẏᵀ M_n ẏ of one elastic body on a hub whose motion is given (:func:`hub_beam`'s
+    body): ẏ = (w, q̇_e) with the hub's twist w (:func:`hub_motion`) and M_n of
+    :func:`elastic_body` at q_e, the state x = (q_e, q̇_e); the hub's A_Jn and r_Jn written
+    into ``A`` and ``r`` (the pose at which the caller states the potential energy)."""
+    dtype = M.dtype
+    k_e, w, zeta, g = x.shape[0] // 2, np.empty(6, dtype), np.empty(6, dtype), np.empty(3, dtype)
+    hub_motion(kind, axis, angles, given, orientation, gravity, A, r, w, zeta, g)
+    elastic_body(m, r0, Psi, Q, K_e, damping, x[:k_e], x[k_e:], w, g, M, h)
+    y_dot = np.empty(6 + k_e, dtype)
+    y_dot[:6] = w
+    y_dot[6:] = x[k_e:]
+    T = 0.0
+    for a in range(6 + k_e):
+        for b in range(6 + k_e):
+            T += y_dot[a] * M[a, b] * y_dot[b]
+    return 0.5 * T
 
 
 def hub_beam_jacobian(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, step, pivot_min,
@@ -767,7 +801,8 @@ def state_kernels(loads, compiled: bool = True, rigid: bool = False):
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
-            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, elastic_body, port_motion)
+            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, elastic_body, port_motion,
+            hub_motion)
 
 
 @functools.cache
@@ -821,6 +856,20 @@ def hub_beam_jacobian_kernel(compiled: bool = True):
         return hub_beam_jacobian
     kernel(True)  # the same refusal without numba
     return _compiled_hub_beam()[1]
+
+
+def hub_beam_energy_kernel(compiled: bool = True):
+    """:func:`hub_beam_kinetic_energy`, compiled by numba (as :func:`kernel`) or with
+    ``compiled=False`` the interpreted function."""
+    if not compiled:
+        return hub_beam_kinetic_energy
+    kernel(True)  # the same refusal without numba
+    return _compiled_hub_beam_energy()
+
+
+@functools.cache
+def _compiled_hub_beam_energy():
+    return _jit(hub_beam_kinetic_energy)[0]
 
 
 @functools.cache
