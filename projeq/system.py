@@ -607,14 +607,14 @@ class System(Model):
 
     def _energy(self, q: NDArray, s_dot: NDArray, t, method: str | None = None) -> tuple:
         """:meth:`energy` at a checked (q, ṡ, t), or by the reference at a complex one."""
+        if method is None:  # the default evaluator's own where it is a compiled one
+            picked = self.evaluator(None).evaluator
+            if getattr(picked, "compiled", False):
+                return picked.energy(q, s_dot, t)
+        elif method != "recursive":
+            return self.evaluator(method).energy(q, s_dot, t)
         from projeq.assembly.kinematics import poses
 
-        if method is None:
-            default = self.evaluator(None)
-            method = default.name if default.name == "fast" or (default.name == "hub_beam" and
-                                                                  default.evaluator.compiled) else None
-        if method in ("fast", "hub_beam"):
-            return self.evaluator(method).energy(q, s_dot, t)
         complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot) or np.iscomplexobj(t)
         kin = poses(self, q, s_dot, t)
         q_e = [q[sl] for sl in self.e_q_slice]

@@ -145,7 +145,8 @@ class HubBeamEvaluator:
         self._head = (self._kind, self._axis, self._angles, self._given, self._orientation, self._gravity, *self._field)
         self._tail = {np.dtype(dtype): (self._pivot_min, np.zeros((n_y, n_y), dtype), np.zeros(n_y, dtype))
                       for dtype in (float, complex)}
-        self._energy_kernel, self._pose = None, (np.zeros((3, 3)), np.zeros(3))  # the kernel on first use; A_Jn, r_Jn
+        # the energy's kernel on first use, the joint's offset r_pJ and the pose it writes
+        self._energy_kernel, self._offset, self._pose = None, np.array(joint.r_pn, dtype=float), _HubPose()
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) at (q, ṡ, t) = (q_e, q̇_e, t)."""
@@ -192,9 +193,10 @@ class HubBeamEvaluator:
         """(kinetic, potential) at the real (q, ṡ, t) = (q_e, q̇_e, t) in one compiled call,
         :func:`projeq.assembly.kernels.hub_beam_kinetic_energy`: T = ½ ẏᵀ M_n ẏ with
         ẏ = (w, q̇_e) and the kernel's M_n (the one :meth:`accelerations` solves with); V, the
-        beam's own potential energy at the hub's pose R = A_pJ A_Jn, r = r_pJ + A_pJ r_Jn
-        (:meth:`projeq.System.potential_energy`). ValueError on the interpreted path (the
-        reference energy of ``System.energy(method="recursive")`` is the one for it)."""
+        beam's own potential energy at the pose the kernel writes, R = A_pJ A_Jn,
+        r = r_pJ + A_pJ r_Jn (:meth:`projeq.System.potential_energy`). ValueError on the
+        interpreted path (the reference energy of ``System.energy(method="recursive")`` is the
+        one for it)."""
         if not self.compiled:
             raise ValueError(f"method: the 'hub_beam' energy is compiled only; this system's path is interpreted: "
                              f"{self.interpreted_reason}")
@@ -202,9 +204,9 @@ class HubBeamEvaluator:
             self._energy_kernel = kernels.hub_beam_energy_kernel(True)
         x = kernels.kernel_array(np.concatenate((q, s_dot)))
         self._hub(t)
-        A, r = self._pose
-        kinetic = self._energy_kernel(*self._head, x, *self._tail[np.dtype(float)][1:], A, r)
-        pose = _HubPose(self._orientation @ A, self.joint.r_pn + self._orientation @ r)
+        pose = self._pose
+        kinetic = self._energy_kernel(*self._head, x, *self._tail[np.dtype(float)][1:], self._offset, pose.R[0],
+                                      pose.r[0])
         return float(kinetic), float(self.system.potential_energy(pose, x[: len(q)]))
 
     def _hub(self, t: float) -> None:
@@ -231,8 +233,9 @@ class HubBeamEvaluator:
 
 
 class _HubPose:
-    """The pose of the beam's reference frame (the only subsystem, the ground last) as the
-    :meth:`projeq.System.potential_energy` reads it: R_n, r_n."""
+    """The pose of the beam's reference frame as :meth:`projeq.System.potential_energy` reads
+    it, R_n and r_n (the beam's, which :meth:`HubBeamEvaluator.energy`'s kernel overwrites,
+    then the ground's)."""
 
-    def __init__(self, R: NDArray, r: NDArray):
-        self.R, self.r = (R, np.eye(3)), (r, np.zeros(3))
+    def __init__(self):
+        self.R, self.r = (np.zeros((3, 3)), np.eye(3)), (np.zeros(3), np.zeros(3))

@@ -326,14 +326,20 @@ def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e
 
 
 def hub_beam_kinetic_energy(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, M, h,
-                            A, r):
+                            offset, R, r):
     """T = ½ ẏᵀ M_n ẏ of one elastic body on a hub whose motion is given (:func:`hub_beam`'s
     body): ẏ = (w, q̇_e) with the hub's twist w (:func:`hub_motion`) and M_n of
-    :func:`elastic_body` at q_e, the state x = (q_e, q̇_e); the hub's A_Jn and r_Jn written
-    into ``A`` and ``r`` (the pose at which the caller states the potential energy)."""
+    :func:`elastic_body` at q_e, the state x = (q_e, q̇_e); the pose of the body's frame, at
+    which the caller states the potential energy, written into ``R`` = A_pJ A_Jn and
+    ``r`` = r_pJ + A_pJ r_Jn (the joint's ``offset`` r_pJ; the ground at rest)."""
     dtype = M.dtype
-    k_e, w, zeta, g = x.shape[0] // 2, np.empty(6, dtype), np.empty(6, dtype), np.empty(3, dtype)
-    hub_motion(kind, axis, angles, given, orientation, gravity, A, r, w, zeta, g)
+    k_e, A, r_Jn = x.shape[0] // 2, np.empty((3, 3), dtype), np.empty(3, dtype)
+    w, zeta, g = np.empty(6, dtype), np.empty(6, dtype), np.empty(3, dtype)
+    hub_motion(kind, axis, angles, given, orientation, gravity, A, r_Jn, w, zeta, g)
+    for a in range(3):
+        r[a] = offset[a] + orientation[a, 0] * r_Jn[0] + orientation[a, 1] * r_Jn[1] + orientation[a, 2] * r_Jn[2]
+        for b in range(3):
+            R[a, b] = orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]
     elastic_body(m, r0, Psi, Q, K_e, damping, x[:k_e], x[k_e:], w, g, M, h)
     y_dot = np.empty(6 + k_e, dtype)
     y_dot[:6] = w

@@ -432,9 +432,13 @@ class RitzBeam(BeamProbes, Subsystem):
         return 0.5 * (y_dot @ M @ y_dot)
 
     def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray, q_e: NDArray) -> float:
-        """Gravity −∫ g·r_slice dm plus the strain energy ½ q_eᵀ K_e q_e."""
+        """Gravity −∫ g·r_slice dm (at the slices' positions only under gravity) plus the strain
+        energy ½ q_eᵀ K_e q_e."""
+        strain = 0.5 * q_e @ self.K_e @ q_e
+        if not np.any(gravity):
+            return strain
         r_x, _ = self.slices(q_e)
-        return -self.mass_weights @ (r_x @ R.T + r) @ gravity + 0.5 * q_e @ self.K_e @ q_e
+        return -self.mass_weights @ (r_x @ R.T + r) @ gravity + strain
 
     def port(self, point: NDArray, q_e: NDArray, q_e_dot: NDArray) -> Relative:
         """Kinematics of a frame attached at ``point`` of the undeformed beam (station
