@@ -295,75 +295,57 @@ def hub_motion(kind, axis, angles, given, orientation, gravity, A, r, w, zeta, g
             g[b] += (orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]) * gravity[a]
 
 
-def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, pivot_min, M, h, x_dot):
+def hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, x, pivot_min, M, h,
+             L, frame, x_dot):
     """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) of one elastic body on a hub whose motion is given, its
     reference frame moving with ẏ = (w, q̇_e) and ÿ = (ζ, q̈_e) — B(14) projected on q̇_e
     (:mod:`projeq.assembly.beam_fast`); the hub's motion by :func:`hub_motion`, M_n and h_n by
-    :func:`elastic_body`, M_ee by Cholesky in place. R = A_pJ A_Jn (the ground at rest), g_n = Rᵀ g.
+    :func:`elastic_body` (left in ``M`` and ``h``), M_ee = L Lᵀ by Cholesky into ``L``. The
+    frame's pose and twist (the ground at rest) into ``frame`` (6 × 3): R = A_pJ A_Jn (rows
+    0–2), r = r_pJ + A_pJ r_Jn with the joint's ``offset`` r_pJ (row 3), w (rows 4–5); g_n = Rᵀ g.
     The state x = (q_e, q̇_e), written: ẋ = (q̇_e, q̈_e) (q̇ = ṡ for elastic coordinates).
     Returns −1; 0 when a pivot of M_ee is not above ``pivot_min``; 1 when x or ẋ is not
-    finite (ẋ written as far as it got)."""
+    finite (ẋ written as far as it got; nothing else when x is not)."""
     dtype = M.dtype  # of the workspace: float, or complex under the complex step
-    k_e, A, r = x.shape[0] // 2, np.empty((3, 3), dtype), np.empty(3, dtype)
+    k_e, A, r_Jn = x.shape[0] // 2, np.empty((3, 3), dtype), np.empty(3, dtype)
     w, zeta, g = np.empty(6, dtype), np.empty(6, dtype), np.empty(3, dtype)
     for i in range(2 * k_e):
         if not np.isfinite(x[i]):
             return 1
     q_e, q_e_dot, q_e_ddot = x[:k_e], x[k_e:], x_dot[k_e:]
     x_dot[:k_e] = q_e_dot
-    hub_motion(kind, axis, angles, given, orientation, gravity, A, r, w, zeta, g)
+    hub_motion(kind, axis, angles, given, orientation, gravity, A, r_Jn, w, zeta, g)
+    for a in range(3):
+        frame[3, a] = offset[a] + orientation[a, 0] * r_Jn[0] + orientation[a, 1] * r_Jn[1] + orientation[a, 2] * r_Jn[2]
+        frame[4, a], frame[5, a] = w[a], w[3 + a]
+        for b in range(3):
+            frame[a, b] = orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]
     elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, w, g, M, h)
     for i in range(k_e):
         q_e_ddot[i] = h[6 + i] - _dot6(M[6 + i], zeta)
-    M_ee = M[6:, 6:]
-    if not cholesky(M_ee, k_e, pivot_min):
+    L[:, :] = M[6:, 6:]
+    if not cholesky(L, k_e, pivot_min):
         return 0
-    cholesky_solve(M_ee, k_e, q_e_ddot)
+    cholesky_solve(L, k_e, q_e_ddot)
     for i in range(k_e):
         if not np.isfinite(q_e_ddot[i]):
             return 1
     return -1
 
 
-def hub_beam_kinetic_energy(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, M, h,
-                            offset, R, r):
-    """T = ½ ẏᵀ M_n ẏ of one elastic body on a hub whose motion is given (:func:`hub_beam`'s
-    body): ẏ = (w, q̇_e) with the hub's twist w (:func:`hub_motion`) and M_n of
-    :func:`elastic_body` at q_e, the state x = (q_e, q̇_e); the pose of the body's frame, at
-    which the caller states the potential energy, written into ``R`` = A_pJ A_Jn and
-    ``r`` = r_pJ + A_pJ r_Jn (the joint's ``offset`` r_pJ; the ground at rest)."""
-    dtype = M.dtype
-    k_e, A, r_Jn = x.shape[0] // 2, np.empty((3, 3), dtype), np.empty(3, dtype)
-    w, zeta, g = np.empty(6, dtype), np.empty(6, dtype), np.empty(3, dtype)
-    hub_motion(kind, axis, angles, given, orientation, gravity, A, r_Jn, w, zeta, g)
-    for a in range(3):
-        r[a] = offset[a] + orientation[a, 0] * r_Jn[0] + orientation[a, 1] * r_Jn[1] + orientation[a, 2] * r_Jn[2]
-        for b in range(3):
-            R[a, b] = orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]
-    elastic_body(m, r0, Psi, Q, K_e, damping, x[:k_e], x[k_e:], w, g, M, h)
-    y_dot = np.empty(6 + k_e, dtype)
-    y_dot[:6] = w
-    y_dot[6:] = x[k_e:]
-    T = 0.0
-    for a in range(6 + k_e):
-        for b in range(6 + k_e):
-            T += y_dot[a] * M[a, b] * y_dot[b]
-    return 0.5 * T
-
-
-def hub_beam_jacobian(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, x, step, pivot_min,
-                      M, h, J):
+def hub_beam_jacobian(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, x, step,
+                      pivot_min, M, h, L, frame, J):
     """∂ẋ/∂x of :func:`hub_beam` at the real state x by the complex step, column k =
     Im ẋ(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998), all n_x columns in
-    one call on a complex workspace (``M``, ``h``: complex128); written into J. Returns
+    one call on a complex workspace (``M``, ``h``, ``L``, ``frame``: complex128); written into J. Returns
     :func:`hub_beam`'s status (−1: every column written)."""
     n_x = x.shape[0]
     z, z_dot = np.empty(n_x, M.dtype), np.empty(n_x, M.dtype)
     for k in range(n_x):
         z[:] = x
         z[k] += 1j * step
-        status = hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, z,
-                          pivot_min, M, h, z_dot)
+        status = hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, z,
+                          pivot_min, M, h, L, frame, z_dot)
         if status >= 0:
             return status
         for i in range(n_x):
@@ -862,20 +844,6 @@ def hub_beam_jacobian_kernel(compiled: bool = True):
         return hub_beam_jacobian
     kernel(True)  # the same refusal without numba
     return _compiled_hub_beam()[1]
-
-
-def hub_beam_energy_kernel(compiled: bool = True):
-    """:func:`hub_beam_kinetic_energy`, compiled by numba (as :func:`kernel`) or with
-    ``compiled=False`` the interpreted function."""
-    if not compiled:
-        return hub_beam_kinetic_energy
-    kernel(True)  # the same refusal without numba
-    return _compiled_hub_beam_energy()
-
-
-@functools.cache
-def _compiled_hub_beam_energy():
-    return _jit(hub_beam_kinetic_energy)[0]
 
 
 @functools.cache
