@@ -196,7 +196,8 @@ class HubBeamEvaluator:
         compiled call (:meth:`_compiled`, :func:`projeq.assembly.kernels.hub_beam`): T = ½ ẏᵀ M_n ẏ
         with the kernel's M_n (the one it solves with) and ẏ = (w, q̇_e), the hub's twist w it
         writes; V, the beam's own potential energy at the pose it writes, R = A_pJ A_Jn,
-        r = r_pJ + A_pJ r_Jn (:meth:`projeq.System.potential_energy`). ValueError on the
+        r = r_pJ + A_pJ r_Jn (:meth:`projeq.System.potential_energy`); the beam's
+        ``check_spin`` at w's ω (the rows of :func:`projeq.simulate` say so). ValueError on the
         interpreted path (the reference energy of ``System.energy(method="recursive")`` is the
         one for it)."""
         if not self.compiled:
@@ -206,6 +207,7 @@ class HubBeamEvaluator:
         if self._evaluate(x, t)[1] == 1 and not np.all(np.isfinite(x)):
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no energy")
         M, frame = self._tail[x.dtype][1], self._tail[x.dtype][4]
+        self.beam.check_spin(frame[5])  # said once where the spin makes an unstiffened beam unstable
         y_dot = np.concatenate((frame[4:].ravel(), x[len(q):]))
         return float(0.5 * (y_dot @ M @ y_dot)), float(self.system.potential_energy(self._pose, x[: len(q)]))
 

@@ -335,10 +335,11 @@ class RitzBeam(BeamProbes, Subsystem):
             Q[:, e(self.w_cols), e(self.w_cols)] = H["w"]
         return r0, Psi, Q
 
-    def slices(self, q_e: NDArray, x: NDArray | None = None, data=None):
+    def slices(self, q_e: NDArray, field: tuple | None = None):
         """r(x) and Φ_r(x, q_e) = ∂r/∂q_e = Ψ − e_x (Q q_e)ᵀ at the quadrature stations (or
-        at ``x`` with its ``station_data``): :meth:`slice_field` evaluated at q_e."""
-        r0, Psi, Q = self.slice_field(x, data) if x is not None else self._field
+        at those of ``field``, another :meth:`slice_field`, formed once by the caller):
+        the slice field evaluated at q_e."""
+        r0, Psi, Q = self._field if field is None else field
         Qq = Q @ q_e  # complex for the complex-step derivative of ports
         r = r0 + Psi @ q_e
         r[:, 0] -= 0.5 * (Qq @ q_e)  # u₂
@@ -359,7 +360,7 @@ class RitzBeam(BeamProbes, Subsystem):
         """(M_n, h_n) of B(25): the translation by the beam's integration strategy, the
         rotary inertia of the slices and the restoring forces (module docstring)."""
         omega, q_e_dot = y_dot[3:6], y_dot[6:]
-        self._check_spin(omega)
+        self.check_spin(omega)
         M, h = self.integrals.terms(y_dot, R, gravity, q_e)
         if self.rotary is not None:
             Jw, omega_c, c_w = self._slice_rotation(omega, q_e, q_e_dot, y_dot)
@@ -376,11 +377,11 @@ class RitzBeam(BeamProbes, Subsystem):
         if self.rotary is not None:
             M, h = self.gauss_terms(y_dot, R, gravity, q_e)
             return M[6:], h[6:]
-        self._check_spin(y_dot[3:6])
+        self.check_spin(y_dot[3:6])
         M_e, h_e = self.integrals.elastic_rows(y_dot, R, gravity, q_e)
         return M_e, h_e - self._restoring_force(q_e, y_dot[6:])
 
-    def _check_spin(self, omega: NDArray) -> None:
+    def check_spin(self, omega: NDArray) -> None:
         """Without stiffening a spin about an axis across the beam faster than its first
         bending frequency makes the model unstable (ω_lag² = ω₁² − Ω² < 0): allowed, but
         said by a RuntimeWarning whose text is fixed per beam, so that Python's warning
@@ -469,8 +470,8 @@ class RitzBeam(BeamProbes, Subsystem):
     def _port_terms(self, q_e, port):
         """(A, r, F) of ``port`` (a :class:`BeamPort`) from its field; complex-safe, for the
         complex-step Ḟ."""
-        (x, (Phi, H)), offset, slopes = port.data, port.offset, port.field[3]
-        r_x, Phi_r = self.slices(q_e, x, (Phi, H))
+        Phi, offset, slopes = port.data[1][0], port.offset, port.field[3]
+        r_x, Phi_r = self.slices(q_e, tuple(constants[None] for constants in port.field[:3]))  # at the one station
         a, b = slopes @ q_e  # v′, −w′
         beta = Phi["beta"][0][:, 0] @ q_e[self._local(self.beta_cols)]
         R_x = rotation_x(beta)
