@@ -323,7 +323,9 @@ def hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi
     elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, w, g, M, h)
     for i in range(k_e):
         q_e_ddot[i] = h[6 + i] - _dot6(M[6 + i], zeta)
-    L[:, :] = M[6:, 6:]
+    for i in range(k_e):
+        for j in range(i + 1):  # the lower triangle, which the factorization reads
+            L[i, j] = M[6 + i, 6 + j]
     if not cholesky(L, k_e, pivot_min):
         return 0
     cholesky_solve(L, k_e, q_e_ddot)
