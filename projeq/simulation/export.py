@@ -48,6 +48,19 @@ def written_atomically(path):
         raise
 
 
+def _write(path: Path, text: str) -> None:
+    """``text`` (UTF-8) into the file ``path`` through :func:`written_atomically`, by the system
+    calls alone (no file object: a series writes hundreds of small files)."""
+    with written_atomically(path) as temporary:
+        descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        try:
+            data = memoryview(text.encode())
+            while data:
+                data = data[os.write(descriptor, data):]
+        finally:
+            os.close(descriptor)
+
+
 VTK_LINE = 3  # the VTK cell type of a two-point line
 
 
@@ -222,18 +235,12 @@ def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21
         if len(links):
             meshes[1] = (f"{name}_mechanism_{k:04d}.vtu", templates[1].text(joints))
         for part, (file, text) in meshes.items():
-            with written_atomically(directory / file) as temporary:
-                temporary.write_text(text)
+            _write(directory / file, text)
             entries.append(f'    <DataSet timestep="{t:.12g}" part="{part}" file="{escape(file)}"/>')
     tree = system.tree
-    with written_atomically(directory / f"{name}_bodies.csv") as temporary:
-        temporary.write_text("body,name,joint\n" + "".join(
-            f"{n},{label},{type(joint).__name__}\n" for n, (label, joint) in enumerate(zip(tree.names, tree.joints))))
+    _write(directory / f"{name}_bodies.csv", "body,name,joint\n" + "".join(
+        f"{n},{label},{type(joint).__name__}\n" for n, (label, joint) in enumerate(zip(tree.names, tree.joints))))
     pvd = directory / f"{name}.pvd"
-    with written_atomically(pvd) as temporary:  # last: it names only files already complete
-        temporary.write_text(
-            '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
-            + "\n".join(entries)
-            + "\n  </Collection>\n</VTKFile>\n"
-        )
+    _write(pvd, '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+           + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")  # last: it names only files already complete
     return pvd
