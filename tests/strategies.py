@@ -251,9 +251,10 @@ def planar_joint(kind: str, parent, rng) -> pq.Joint:
 
 
 # -- forces --------------------------------------------------------------------------------
-def _force(kind, names, kinds, rng, planar: bool, damped: bool, constant: bool = False):
+def _force(kind, names, kinds, rng, planar: bool, damped: bool, constant: bool = False, dofs=None):
     """A random force law of ``kind`` (None when the tree has no joint it can act on); loads
-    given as callables half of the time unless ``constant``."""
+    given as callables half of the time unless ``constant``; ``dofs``: each joint's number of
+    minimal velocities (default: by its kind)."""
     body = names[rng.integers(len(names))]
     point = rng.uniform(-0.5, 0.5, 3)
     if planar:
@@ -288,7 +289,7 @@ def _force(kind, names, kinds, rng, planar: bool, damped: bool, constant: bool =
         if not candidates:
             return None
         joint = candidates[rng.integers(len(candidates))]
-        n_s = {"planar": 3, "free": 6, "spherical": 3, "car": 2, "car_sympy": 2}.get(
+        n_s = dofs[names.index(joint)] if dofs else {"planar": 3, "free": 6, "spherical": 3, "car": 2, "car_sympy": 2}.get(
             kinds[names.index(joint)], 1
         )
         tau = rng.uniform(-3, 3, n_s)
@@ -405,12 +406,13 @@ def with_couplings(tree: Tree, n_coupled: int = 3) -> pq.System:
     """``tree``'s System with up to ``n_coupled`` more bodies on revolute or prismatic joints
     (random axes and frames) that are *coupled*: each follows Σ ratio · coordinate of one or
     two of the tree's own revolute or prismatic joints (gears, ropes: shared minimal
-    velocities, docs/theory.md §4); the tree itself unchanged if it has no such joint."""
+    velocities, docs/theory.md §4), each on a rigid body of the tree (a beam's stations are
+    no place for a random offset); the tree itself unchanged if it has no such joint."""
     system, rng = tree.system, tree.rng
     leaders = [name for name, kind in zip(system.names, tree.kinds) if kind in ("revolute", "prismatic")]
     subsystems, joints = dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints))
     for i in range(n_coupled if leaders else 0):
-        name, parent = f"c{i}", str(rng.choice(list(subsystems)))
+        name, parent = f"c{i}", str(rng.choice([n for n, body in subsystems.items() if not body.n_e]))
         m = random_mass(rng)
         subsystems[name] = pq.RigidBody(m, rng.uniform(-0.5, 0.5, 3), random_inertia(rng, m))
         follows = {str(leader): float(rng.uniform(-2, 2)) for leader in rng.choice(leaders, min(2, len(leaders)))}
@@ -425,7 +427,8 @@ def with_every_law(tree) -> pq.System:
     row in the fast evaluator's compiled loop (projeq/assembly/loads.py)."""
     system, rng = tree.system, tree.rng
     kinds = tree.kinds + [type(joint).__name__.lower() for joint in system.joints[len(tree.kinds):]]  # beams' joints
-    laws = [_force(kind, list(system.names), kinds, rng, tree.planar, damped=True, constant=True)
+    dofs = [joint.n_s for joint in system.joints]
+    laws = [_force(kind, list(system.names), kinds, rng, tree.planar, damped=True, constant=True, dofs=dofs)
             for kind in FORCE_KINDS + ("force", "torque", "spring_damper")]
     return pq.System(dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints)),
                      gravity=system.gravity, forces=list(system.forces) + [law for law in laws if law is not None])

@@ -1,11 +1,11 @@
 """``method="auto"``, the default evaluator: the best evaluator available for a System, picked once.
 
 In this order: ``"hub_beam"`` (:mod:`projeq.assembly.beam_fast`, compiled) for one RitzBeam on a
-prescribed or fixed hub (interpreted, with one :class:`InterpretedWarning`, for a beam with
-rotary inertia or a user's subsystem there); ``"fast"`` (the compiled order-n kernel, :mod:`projeq.assembly.fast`)
+prescribed or fixed hub (interpreted, with one :class:`InterpretedWarning`, for a user's
+subsystem there); ``"fast"`` (the compiled order-n kernel, :mod:`projeq.assembly.fast`)
 when the kernel knows every subsystem (rigid bodies, spatial or planar, on any joint, coupled
-ones included, under any force law; RitzBeams without rotary inertia anywhere in a tree
-under gravity and the force laws the kernel compiles); else the
+ones included, under any force law; RitzBeams, rotary inertia and torsion included, anywhere
+in a tree under gravity and the force laws the kernel compiles); else the
 reference evaluators, ``"dense"`` when joints share minimal velocities (coupled) and
 ``"recursive"`` otherwise, with one :class:`InterpretedWarning` per System naming the piece
 the kernel does not know — the fall-back is never silent. Each evaluator evaluates its
@@ -28,8 +28,8 @@ once (``projeq bench`` reports the first-call latency), later processes load it.
 'recursive'
 >>> [str(w.message) for w in said]  # doctest: +NORMALIZE_WHITESPACE
 ["system: evaluated by the interpreted 'recursive' evaluator, not the compiled one: subsystem 'rod' is a
-Own (the kernel knows the terms of rigid bodies, rigid_inertia, spatial or selected by S, and of RitzBeams
-without rotary inertia)"]
+Own (the kernel knows the terms of rigid bodies, rigid_inertia, spatial or selected by S, and of
+RitzBeams)"]
 """
 
 from __future__ import annotations

@@ -16,13 +16,14 @@ positive definite for the independent Ritz functions a RitzBeam accepts, so a pl
 solve suffices. Equal to the general evaluators to round-off
 (tests/assembly/test_fast.py).
 
-Compiled by default: a RitzBeam without rotary inertia (the slice field the compiled
-kernel knows, :func:`projeq.assembly.kernels.elastic_body`, the same statement of the
-beam's terms as the order-n kernel's elastic block) on a Prescribed Revolute or Prismatic,
-a Fixed joint or any joint without coordinates (read by its ``relative_values``) is one
-call of :func:`projeq.assembly.kernels.hub_beam` per s̈. Any other subsystem with internal
-coordinates and the beam's layout ẏ = (twist, q̇_e) (a beam with rotary inertia or
-torsion, a user's subsystem) takes the interpreted path through its ``elastic_terms``
+Compiled by default: a RitzBeam, rotary inertia and torsion included (its slice and rotation
+fields, which the compiled kernel evaluates, :func:`projeq.assembly.kernels.elastic_body` and
+:func:`~projeq.assembly.kernels.rotary_body`, the same statement of the beam's terms as the
+order-n kernel's elastic block) on a Prescribed Revolute or Prismatic, a Fixed joint or any
+joint without coordinates (read by its ``relative_values``) is one call of
+:func:`projeq.assembly.kernels.hub_beam` per s̈. Any other subsystem with internal
+coordinates and the beam's layout ẏ = (twist, q̇_e) (a user's subsystem, a RitzBeam that
+restates its terms) takes the interpreted path through its ``elastic_terms``
 (:class:`projeq.Subsystem`: by default the last n_e rows of its own ``gauss_terms``).
 Complex arguments (the complex-step derivatives of :mod:`projeq.analysis.jacobians`) take
 the same kernel, compiled for complex128 (a second specialization of the same source).
@@ -67,17 +68,17 @@ def hub_beam_unsupported(system) -> str | None:
 
 
 def elastic_unsupported(body) -> str | None:
-    """Why the kernel's elastic block (:func:`projeq.assembly.kernels.elastic_body`) cannot take
-    ``body`` (None if it can): it takes bodies with ẏ = (twist, q̇_e) whose terms are the slice
-    sums of their ``slice_field`` with linear restoring forces (a RitzBeam without rotary inertia)."""
-    if not hasattr(body, "slice_field") or body.S is None or not np.array_equal(body.S, np.eye(6 + body.n_e, 6)):
-        return "(the kernel knows elastic bodies by the slice field of a RitzBeam)"
+    """Why the kernel's elastic block (:func:`projeq.assembly.kernels.elastic_body` and
+    :func:`~projeq.assembly.kernels.rotary_body`) cannot take ``body`` (None if it can): it takes
+    bodies with ẏ = (twist, q̇_e) whose terms are the slice sums of their ``slice_field`` and
+    ``rotation_field`` (translation and rotary inertia) with linear restoring forces (a RitzBeam)."""
+    if not hasattr(body, "slice_field") or not hasattr(body, "rotation_field") or body.S is None \
+            or not np.array_equal(body.S, np.eye(6 + body.n_e, 6)):
+        return "(the kernel knows elastic bodies by the slice and rotation fields of a RitzBeam)"
     owner = next(c for c in type(body).__mro__ if "slice_field" in vars(c))
     if type(body).gauss_terms is not owner.gauss_terms:
         return ("that restates gauss_terms (the kernel knows the terms of the slice field, not the ones "
                 "it adds)")
-    if body.rotary is not None:
-        return "with rotary inertia or torsion (the kernel's elastic block has the slices' translation only)"
     return None
 
 
@@ -126,7 +127,8 @@ class HubBeamEvaluator:
 
     def _pack(self, system) -> None:
         """The kernel's constants: the hub's kind, axis and frame, the beam's slice field
-        (:meth:`projeq.RitzBeam.slice_field`), K_e and damping; and its workspace."""
+        (:meth:`projeq.RitzBeam.slice_field`), K_e, damping and rotation field
+        (:meth:`projeq.RitzBeam.rotation_field`); and its workspace."""
         beam, joint = self.beam, self.joint
         inner = joint.joint if isinstance(joint, Prescribed) else joint
         kind = kernels.KINDS.get(getattr(inner, "compiled_kind", None), kernels.GIVEN)
@@ -136,7 +138,8 @@ class HubBeamEvaluator:
         self._angles, self._given = np.zeros(3), np.zeros(24)
         self._orientation, self._gravity = np.array(joint.orientation, dtype=float), np.array(system.gravity, float)
         self._field = (np.array(beam.mass_weights, dtype=float), *(np.ascontiguousarray(a) for a in beam.slice_field()),
-                       np.array(beam.K_e, dtype=float), float(beam.damping))
+                       np.array(beam.K_e, dtype=float), float(beam.damping),
+                       *(np.ascontiguousarray(a) for a in beam.rotation_field()))
         n_y = 6 + beam.n_e
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
         self._kernel, self._jacobian = kernels.hub_beam_kernel(True), kernels.hub_beam_jacobian_kernel(True)

@@ -33,8 +33,11 @@ statement their ``add_to`` calls (:mod:`projeq.assembly.loads`); any other (a ca
 load, a user's own law) by its own ``add_to``, reading poses, twists, F_n and T̃_np from
 the kernel's workspace (in the selected coordinates of the bodies that have a selection
 S, whose loads are then carried back by Sᵀ). One :class:`~projeq.RitzBeam` on a prescribed or fixed hub
-has its own fast evaluator, ``method="hub_beam"`` (:mod:`projeq.assembly.beam_fast`);
-any other subsystem without rigid-body terms (beams in chains, a subsystem that overrides
+has its own fast evaluator, ``method="hub_beam"`` (:mod:`projeq.assembly.beam_fast`); RitzBeams
+anywhere in a tree (rotary inertia and torsion included, joints on their stations, beside
+coupled joints too) are the kernel's elastic block, from the beams' slice and rotation fields
+(:func:`projeq.assembly.kernels.elastic_body`, :func:`~projeq.assembly.kernels.rotary_body`);
+any other subsystem without rigid-body terms (a user's subsystem, one that overrides
 ``gauss_terms``) is refused with the piece named: it is evaluated by the reference ones
 (recursive, or dense for coupled joints).
 
@@ -102,10 +105,10 @@ class FastEvaluator:
         self.system = system
         self.n_calls = 0
         self.compiled = bool(compiled)
-        self._gauss_form, self._projected_accelerations = kernels.gauss_form_kernel(self.compiled)
         self._pack(system)
         rigid = bool(np.all(self._index[:, kernels.N_Y] == 6))
         self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=rigid)
+        self._gauss_form, self._projected_accelerations = kernels.gauss_form_kernel(self.compiled, rigid=rigid)
         self._add_loads = loads.kernel(self.compiled) if len(self._laws) else None
         # ẋ and ∂ẋ/∂x in one call where no Python runs between the kernels (no joint of kind GIVEN, no
         # force law without a compiled row, no coupling): then every joint has q̇ = ṡ (K = E)
@@ -139,7 +142,7 @@ class FastEvaluator:
         rigid = [b.rigid_inertia or (0.0, np.zeros(3), np.zeros((3, 3))) for b in bodies]
         self._inertia = np.array([[r_c, *I_c, (m, 0.0, 0.0)] for m, r_c, I_c in rigid],
                                  dtype=float).reshape(N, 5, 3)  # the rows kernels.CENTRE, INERTIA, MASS
-        self._elastic, self._ports = _elastic_fields(system), _port_fields(system)
+        self._elastic, self._ports = _elastic_fields(system, self._index), _port_fields(system)
         self._width, self._depth = 6 + max(b.n_e for b in bodies), max(6, max(n_cols))
         self._rigid_M = [rigid_mass_matrix(*inertia) for inertia in rigid]
         self._gravity = np.asarray(system.gravity, dtype=float)
@@ -235,10 +238,7 @@ class FastEvaluator:
         return float(kinetic), float(potential)
 
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
-        """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels (by
-        the dense evaluator for a tree with elastic bodies, which the Gauss-form kernel does not take)."""
-        if self._width > 6:
-            return self.system.evaluator("dense").gauss_form(q, s_dot, t)
+        """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels."""
         self.n_calls += 1
         q, s_dot, ws = self._state(q, s_dot)
         self._terms(ws, q, s_dot, t)
@@ -366,69 +366,73 @@ def unsupported(system) -> str | None:
             reason = elastic_unsupported(body)
             if reason:
                 return f"subsystem {name!r} is a {type(body).__name__} {reason}"
-            if system.coupled:
-                return (f"subsystem {name!r} is elastic in a system with coupled joints (the kernel's elastic "
-                        "block takes trees, not shared velocities)")
             python = [type(law).__name__ for law in system.forces if law.compiled_terms() is None]
             if python:
                 return (f"subsystem {name!r} is elastic in a system with force laws the kernel cannot compile "
                         f"({', '.join(python)}: a callable load or a user's law)")
         elif body.rigid_inertia is None:
             return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of rigid bodies, "
-                    "rigid_inertia, spatial or selected by S, and of RitzBeams without rotary inertia)")
+                    "rigid_inertia, spatial or selected by S, and of RitzBeams)")
         if system.plan.port[n] and not hasattr(system.plan.stations[n], "field"):
             return f"joint {name!r} sits on a port of {type(system.subsystems[system.parent[n]]).__name__} without a field"
     return None
 
 
-def _elastic_fields(system) -> tuple:
-    """(slot, e_index, n_e, m_k, r₀, Ψ, Q, K_e, damping) of :func:`projeq.assembly.kernels.chain_terms`:
-    the station fields of the elastic bodies (:meth:`projeq.RitzBeam.slice_field`), padded to
-    the most stations and internal coordinates (zero masses and columns)."""
+def _elastic_fields(system, index) -> tuple:
+    """(slot, e_index, n_e, m_k, r₀, Ψ, Q, K_e, damping, I, Φ_θ, T) of
+    :func:`projeq.assembly.kernels.chain_terms`: the station fields of the elastic bodies
+    (:meth:`projeq.RitzBeam.slice_field`, :meth:`projeq.RitzBeam.rotation_field`), padded to
+    the most stations and internal coordinates (zero masses, rotary inertias and columns);
+    e_index: where a body's internal coordinates and velocities start in the kernel's q_all
+    and ṡ_all (after its joint's own, in the layout of ``index``, :meth:`FastEvaluator._pack`)."""
     N, beams = len(system.subsystems), [n for n, b in enumerate(system.subsystems) if b.n_e]
     slot = np.full(N, -1, dtype=np.int64)
-    e_index = np.array([[system.e_q_slice[n].start, system.e_s_slice[n].start] if system.subsystems[n].n_e else [0, 0]
-                        for n in range(N)], dtype=np.int64).reshape(N, 2)
+    own = np.array([[joint.n_q, joint.n_s] for joint in system.joints], dtype=np.int64).reshape(N, 2)
+    e_index = index[:, [kernels.Q_INDEX, kernels.S_INDEX]] + own
     n_e = np.array([b.n_e for b in system.subsystems], dtype=np.int64)
     K = max([len(system.subsystems[n].mass_weights) for n in beams], default=1)
     E = max([system.subsystems[n].n_e for n in beams], default=1)
     B = len(beams)
     m, r0, Psi, Q = np.zeros((B, K)), np.zeros((B, K, 3)), np.zeros((B, K, 3, E)), np.zeros((B, K, E, E))
     K_e, damping = np.zeros((B, E, E)), np.zeros(B)
+    I, Phi_theta, T = np.zeros((B, K, 3)), np.zeros((B, K, 3, E)), np.zeros((B, K, E, E))
     for i, n in enumerate(beams):
         beam = system.subsystems[n]
         slot[n], k, e = i, len(beam.mass_weights), beam.n_e
         m[i, :k] = beam.mass_weights
         r0[i, :k], Psi[i, :k, :, :e], Q[i, :k, :e, :e] = beam.slice_field()
+        I[i, :k], Phi_theta[i, :k, :, :e], T[i, :k, :e, :e] = beam.rotation_field()
         K_e[i, :e, :e], damping[i] = beam.K_e, beam.damping
-    return slot, e_index, n_e, m, r0, Psi, Q, K_e, damping
+    return slot, e_index, n_e, m, r0, Psi, Q, K_e, damping, I, Phi_theta, T
 
 
 def _port_fields(system) -> tuple:
-    """(slot, r₀, Ψ, Q, slopes, c) of :func:`projeq.assembly.kernels.chain_terms`: the fields of
+    """(slot, r₀, Ψ, Q, angles, c) of :func:`projeq.assembly.kernels.chain_terms`: the fields of
     the stations that joints sit at (:class:`projeq.subsystems.beam.beam.BeamPort`), padded."""
     N, stations = len(system.joints), system.plan.stations
     slot = np.full(N, -1, dtype=np.int64)
     E = max([system.subsystems[system.parent[n]].n_e for n in stations], default=1)
     P = len(stations)
-    r0, Psi, Q, slopes, c = np.zeros((P, 3)), np.zeros((P, 3, E)), np.zeros((P, E, E)), np.zeros((P, 2, E)), np.zeros((P, 3))
+    r0, Psi, Q, angles, c = np.zeros((P, 3)), np.zeros((P, 3, E)), np.zeros((P, E, E)), np.zeros((P, 3, E)), np.zeros((P, 3))
     for i, (n, port) in enumerate(stations.items()):
         slot[n], e = i, port.field[1].shape[1]
-        r0[i], Psi[i, :, :e], Q[i, :e, :e], slopes[i, :, :e] = port.field
+        r0[i], Psi[i, :, :e], Q[i, :e, :e], angles[i, :, :e] = port.field
         c[i] = port.offset
-    return slot, r0, Psi, Q, slopes, c
+    return slot, r0, Psi, Q, angles, c
 
 
 def _expansion(system) -> tuple[NDArray, NDArray]:
     """(P_q, P): q_all = P_q q and ṡ_all = P ṡ, every joint's own coordinates and velocities
-    (a coupled joint's computed from those it follows), read off the System's joint getters
-    (linear maps) at the unit vectors."""
-    def matrix(getters, n):
-        return np.column_stack([np.concatenate([get(e) for get in getters]) for e in np.eye(n)])
+    (a coupled joint's computed from those it follows) followed by its body's internal ones
+    (the layout of :meth:`FastEvaluator._pack`), read off the System's joint getters (linear
+    maps) at the unit vectors."""
+    def matrix(getter, internal, n):
+        return np.column_stack([np.concatenate([np.concatenate((getter(k)(e), e[internal[k]])) for k in range(N)])
+                                for e in np.eye(n)])
 
     N = len(system.joints)
-    return (matrix([system.joint_q_getter(n) for n in range(N)], system.n_q),
-            matrix([system.joint_s_dot_getter(n) for n in range(N)], system.n_s))
+    return (matrix(system.joint_q_getter, system.e_q_slice, system.n_q),
+            matrix(system.joint_s_dot_getter, system.e_s_slice, system.n_s))
 
 
 class _SelectedKinematics(Kinematics):

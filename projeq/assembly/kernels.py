@@ -87,9 +87,10 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
     per joint and body, columns named by the constants of this module (:data:`KIND` ...).
 
     Elastic subsystems (docs/theory.md §10): ``elastic`` = (slot, e_index, n_e, m_k, r₀, Ψ, Q,
-    K_e, damping) — slot[n] ≥ 0 picks the station field of body n (:func:`elastic_body`),
+    K_e, damping, I, Φ_θ, T) — slot[n] ≥ 0 picks the station fields of body n (:func:`elastic_body`,
+    :func:`rotary_body`),
     whose ẏ_n = (twist, q̇_e) has n_y = 6 + n_e rows and F_n the extra columns [0; E];
-    ``port`` = (slot, r₀, Ψ, Q, slopes, c) — slot[n] ≥ 0: joint n sits at a station of its
+    ``port`` = (slot, r₀, Ψ, Q, angles, c) — slot[n] ≥ 0: joint n sits at a station of its
     elastic parent p, whose frame (:func:`port_motion`) is the base of the joint, and
     T̃_np = T̃⁶_np P̃ with P̃ = [[T⁶_port, F_port, ζ̂_port], [0, 0, 1]] (the reference's
     :func:`projeq.assembly.kinematics.forward`).
@@ -100,8 +101,8 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
     n_cols = index[:, N_COLS]
     axis, offset, orientation = geometry[:, AXIS], geometry[:, OFFSET], geometry[:, ORIENTATION:]
     m, r_c, I_c = inertia[:, MASS, 0], inertia[:, CENTRE], inertia[:, INERTIA:MASS]
-    body, e_index, n_e, el_m, el_r0, el_Psi, el_Q, el_K, el_damping = elastic
-    port_slot, port_r0, port_Psi, port_Q, port_slopes, port_c = port
+    body, e_index, n_e, el_m, el_r0, el_Psi, el_Q, el_K, el_damping, el_I, el_Phi_theta, el_T = elastic
+    port_slot, port_r0, port_Psi, port_Q, port_angles, port_c = port
     twist[N] = 0.0
     R[N] = 0.0
     r_O[N] = 0.0
@@ -121,7 +122,7 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
         j = port_slot[n]
         if j >= 0:  # the base is the frame at a station of the elastic parent p
             k_p, i0, s0 = n_e[p], e_index[p, 0], e_index[p, 1]
-            port_motion(port_r0[j], port_Psi[j, :, :k_p], port_Q[j, :k_p, :k_p], port_slopes[j, :, :k_p], port_c[j],
+            port_motion(port_r0[j], port_Psi[j, :, :k_p], port_Q[j, :k_p, :k_p], port_angles[j, :, :k_p], port_c[j],
                         q[i0 : i0 + k_p], s_dot[s0 : s0 + k_p], A_port, r_port, F_port[:, :k_p], zeta_port)
             for a in range(6):
                 w_port[a] = 0.0
@@ -206,6 +207,8 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
                 F[n, 6 + a, n_j + a] = 1.0
             elastic_body(el_m[i], el_r0[i], el_Psi[i, :, :, :k_n], el_Q[i, :, :k_n, :k_n], el_K[i, :k_n, :k_n],
                          el_damping[i], q[i0 : i0 + k_n], s_dot[s0 : s0 + k_n], twist[n], g_body[n], M[n], h[n])
+            rotary_body(el_I[i], el_Phi_theta[i, :, :, :k_n], el_T[i, :, :k_n, :k_n], q[i0 : i0 + k_n],
+                        s_dot[s0 : s0 + k_n], twist[n], M[n], h[n])
         else:
             _rigid_h(m[n], r_c[n], I_c[n], twist[n], g_body[n], h[n, :6], work)
 
@@ -266,6 +269,70 @@ def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
             h[6 + i] -= K_e[i, l] * (q_e[l] + damping * q_e_dot[l])
 
 
+def rotary_body(I, Phi_theta, T, q_e, q_e_dot, twist, M, h):
+    """Adds the slices' rotary inertia (a Rayleigh beam) to M_n and h_n of :func:`elastic_body`,
+    from the field of :meth:`projeq.RitzBeam.rotation_field`: at station k, I_k = diag(I[k]),
+    θ = Φ_θ,k q_e + (q_eᵀ T_k q_e) e_x, ∂θ/∂q_e = Φ_θ,k + e_x ((T_k + T_kᵀ) q_e)ᵀ,
+    J_ω = [0, E − θ̃, (E − ½θ̃) ∂θ/∂q_e], ω_c = J_ω ẏ, θ̇ = ∂θ/∂q_e q̇_e, τ̈ = 2 q̇_eᵀ T_k q̇_e and
+    c = ω̃ θ̇ + τ̈ e_x − ½ θ × τ̈ e_x: M_n += Σ_k J_ωᵀ I_k J_ω, h_n −= Σ_k J_ωᵀ (I_k c + ω̃_c I_k ω_c)
+    (docs/theory.md §10). Compiled twin of :meth:`projeq.RitzBeam._slice_rotation` and the
+    rotary rows of its ``gauss_terms``. Stations with I_k = 0 (padding, or a beam without
+    rotary inertia) are skipped."""
+    k_e = q_e.shape[0]
+    n_y = 6 + k_e
+    J, f = np.zeros((3, n_y), M.dtype), np.empty(3, M.dtype)
+    w0, w1, w2 = twist[3], twist[4], twist[5]
+    for k in range(I.shape[0]):
+        I0, I1, I2 = I[k, 0], I[k, 1], I[k, 2]
+        if I0 == 0.0 and I1 == 0.0 and I2 == 0.0:
+            continue
+        tau, acceleration = 0.0, 0.0
+        for i in range(k_e):
+            T_q, q_T, T_qd = 0.0, 0.0, 0.0
+            for l in range(k_e):
+                T_q += T[k, i, l] * q_e[l]
+                q_T += T[k, l, i] * q_e[l]
+                T_qd += T[k, i, l] * q_e_dot[l]
+            tau += T_q * q_e[i]
+            acceleration += 2.0 * T_qd * q_e_dot[i]
+            J[0, 6 + i] = Phi_theta[k, 0, i] + T_q + q_T  # ∂θ/∂q_e, turned below
+            J[1, 6 + i] = Phi_theta[k, 1, i]
+            J[2, 6 + i] = Phi_theta[k, 2, i]
+        t0, t1, t2, d0, d1, d2 = tau, 0.0, 0.0, 0.0, 0.0, 0.0
+        for i in range(k_e):
+            t0 += Phi_theta[k, 0, i] * q_e[i]
+            t1 += Phi_theta[k, 1, i] * q_e[i]
+            t2 += Phi_theta[k, 2, i] * q_e[i]
+            d0 += J[0, 6 + i] * q_e_dot[i]
+            d1 += J[1, 6 + i] * q_e_dot[i]
+            d2 += J[2, 6 + i] * q_e_dot[i]
+        for i in range(k_e):  # (E − ½θ̃) ∂θ/∂q_e
+            a0, a1, a2 = J[0, 6 + i], J[1, 6 + i], J[2, 6 + i]
+            J[0, 6 + i] = a0 - 0.5 * (t1 * a2 - t2 * a1)
+            J[1, 6 + i] = a1 - 0.5 * (t2 * a0 - t0 * a2)
+            J[2, 6 + i] = a2 - 0.5 * (t0 * a1 - t1 * a0)
+        J[0, 3], J[0, 4], J[0, 5] = 1.0, t2, -t1  # E − θ̃
+        J[1, 3], J[1, 4], J[1, 5] = -t2, 1.0, t0
+        J[2, 3], J[2, 4], J[2, 5] = t1, -t0, 1.0
+        o0 = J[0, 3] * w0 + J[0, 4] * w1 + J[0, 5] * w2
+        o1 = J[1, 3] * w0 + J[1, 4] * w1 + J[1, 5] * w2
+        o2 = J[2, 3] * w0 + J[2, 4] * w1 + J[2, 5] * w2
+        for i in range(k_e):
+            o0 += J[0, 6 + i] * q_e_dot[i]
+            o1 += J[1, 6 + i] * q_e_dot[i]
+            o2 += J[2, 6 + i] * q_e_dot[i]
+        c0 = w1 * d2 - w2 * d1 + acceleration
+        c1 = w2 * d0 - w0 * d2 - 0.5 * acceleration * t2
+        c2 = w0 * d1 - w1 * d0 + 0.5 * acceleration * t1
+        f[0] = I0 * c0 + o1 * I2 * o2 - o2 * I1 * o1  # I c + ω̃_c I ω_c
+        f[1] = I1 * c1 + o2 * I0 * o0 - o0 * I2 * o2
+        f[2] = I2 * c2 + o0 * I1 * o1 - o1 * I0 * o0
+        for a in range(3, n_y):
+            h[a] -= J[0, a] * f[0] + J[1, a] * f[1] + J[2, a] * f[2]
+            for b in range(3, n_y):
+                M[a, b] += J[0, a] * I0 * J[0, b] + J[1, a] * I1 * J[1, b] + J[2, a] * I2 * J[2, b]
+
+
 def hub_motion(kind, axis, angles, given, orientation, gravity, A, r, w, zeta, g):
     """The relative motion of a hub whose motion is given, on the ground at rest: A = A_Jn,
     r = r_Jn, w = F⁶ θ̇ (ẏ's twist), ζ = F⁶ θ̈, and g_n = (A_pJ A_Jn)ᵀ g. A Revolute or
@@ -295,17 +362,18 @@ def hub_motion(kind, axis, angles, given, orientation, gravity, A, r, w, zeta, g
             g[b] += (orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]) * gravity[a]
 
 
-def hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, x, pivot_min, M, h,
-             L, frame, x_dot):
+def hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, I, Phi_theta, T, x,
+             pivot_min, M, h, L, frame, x_dot):
     """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) of one elastic body on a hub whose motion is given, its
     reference frame moving with ẏ = (w, q̇_e) and ÿ = (ζ, q̈_e) — B(14) projected on q̇_e
     (:mod:`projeq.assembly.beam_fast`); the hub's motion by :func:`hub_motion`, M_n and h_n by
-    :func:`elastic_body` (left in ``M`` and ``h``), M_ee = L Lᵀ by Cholesky into ``L``. The
-    frame's pose and twist (the ground at rest) into ``frame`` (6 × 3): R = A_pJ A_Jn (rows
-    0–2), r = r_pJ + A_pJ r_Jn with the joint's ``offset`` r_pJ (row 3), w (rows 4–5); g_n = Rᵀ g.
-    The state x = (q_e, q̇_e), written: ẋ = (q̇_e, q̈_e) (q̇ = ṡ for elastic coordinates).
-    Returns −1; 0 when a pivot of M_ee is not above ``pivot_min``; 1 when x or ẋ is not
-    finite (ẋ written as far as it got; nothing else when x is not)."""
+    :func:`elastic_body` and :func:`rotary_body` (left in ``M`` and ``h``), M_ee = L Lᵀ by
+    Cholesky into ``L``. The frame's pose and twist (the ground at rest) into ``frame``
+    (6 × 3): R = A_pJ A_Jn (rows 0–2), r = r_pJ + A_pJ r_Jn with the joint's ``offset`` r_pJ
+    (row 3), w (rows 4–5); g_n = Rᵀ g. The state x = (q_e, q̇_e), written: ẋ = (q̇_e, q̈_e)
+    (q̇ = ṡ for elastic coordinates). Returns −1; 0 when a pivot of M_ee is not above
+    ``pivot_min``; 1 when x or ẋ is not finite (ẋ written as far as it got; nothing else
+    when x is not)."""
     dtype = M.dtype  # of the workspace: float, or complex under the complex step
     k_e, A, r_Jn = x.shape[0] // 2, np.empty((3, 3), dtype), np.empty(3, dtype)
     w, zeta, g = np.empty(6, dtype), np.empty(6, dtype), np.empty(3, dtype)
@@ -321,6 +389,7 @@ def hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi
         for b in range(3):
             frame[a, b] = orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]
     elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, w, g, M, h)
+    rotary_body(I, Phi_theta, T, q_e, q_e_dot, w, M, h)
     for i in range(k_e):
         q_e_ddot[i] = h[6 + i] - _dot6(M[6 + i], zeta)
     for i in range(k_e):
@@ -335,19 +404,19 @@ def hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi
     return -1
 
 
-def hub_beam_jacobian(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, x, step,
-                      pivot_min, M, h, L, frame, J):
+def hub_beam_jacobian(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, I, Phi_theta,
+                      T, x, step, pivot_min, M, h, L, frame, J):
     """∂ẋ/∂x of :func:`hub_beam` at the real state x by the complex step, column k =
     Im ẋ(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998), all n_x columns in
-    one call on a complex workspace (``M``, ``h``, ``L``, ``frame``: complex128); written into J. Returns
-    :func:`hub_beam`'s status (−1: every column written)."""
+    one call on a complex workspace (``M``, ``h``, ``L``, ``frame``: complex128); written into J.
+    Returns :func:`hub_beam`'s status (−1: every column written)."""
     n_x = x.shape[0]
     z, z_dot = np.empty(n_x, M.dtype), np.empty(n_x, M.dtype)
     for k in range(n_x):
         z[:] = x
         z[k] += 1j * step
-        status = hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, z,
-                          pivot_min, M, h, L, frame, z_dot)
+        status = hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, I,
+                          Phi_theta, T, z, pivot_min, M, h, L, frame, z_dot)
         if status >= 0:
             return status
         for i in range(n_x):
@@ -355,21 +424,25 @@ def hub_beam_jacobian(kind, axis, angles, given, orientation, offset, gravity, m
     return -1
 
 
-def port_motion(r0, Psi, Q, slopes, offset, q_e, q_e_dot, A, r, F, zeta):
-    """The frame at a station of an elastic body relative to its reference frame: A = R_z(a) R_y(b)
-    with a = v′ and b = −w′ (slopes · q_e), r = r₀ + Ψ q_e − ½ (q_eᵀ Q q_e) e_x + A c,
-    F = [[Aᵀ Φ_r − c̃ Φ_ω], [Φ_ω]] with Φ_ω = (−sin b ∂a, ∂b, cos b ∂a), and ζ = Ḟ q̇_e:
-    [−Ω × Aᵀ ṙ − (q̇_eᵀ Q q̇_e) Aᵀ e_x − c × α; α] with Ω = Φ_ω q̇_e, α = (−cos b, 0, −sin b) ȧ ḃ
-    (Ȧ = A Ω̃). Compiled twin of :meth:`projeq.subsystems.beam.beam.BeamPort.relative` for a
-    beam without torsion (whose Ḟ q̇_e is a complex step)."""
+def port_motion(r0, Psi, Q, angles, offset, q_e, q_e_dot, A, r, F, zeta):
+    """The frame at a station of an elastic body relative to its reference frame:
+    A = R_z(a) R_y(b) R_x(β) with a = v′, b = −w′ and the torsion β (``angles`` · q_e),
+    r = r₀ + Ψ q_e − ½ (q_eᵀ Q q_e) e_x + A c, F = [[Aᵀ Φ_r − c̃ Φ_ω], [Φ_ω]] with
+    Φ_ω = R_xᵀ (−sin b ∂a, ∂b, cos b ∂a) + e_x ∂β, and ζ = Ḟ q̇_e:
+    [−Ω × Aᵀ ṙ − (q̇_eᵀ Q q̇_e) Aᵀ e_x − c × α; α] with Ω = Φ_ω q̇_e and
+    α = R_xᵀ (−cos b, 0, −sin b) ȧ ḃ − β̇ e_x × R_xᵀ (−sin b ȧ, ḃ, cos b ȧ) (Ȧ = A Ω̃,
+    Ṙ_xᵀ = −β̇ ẽ_x R_xᵀ). Compiled twin of :meth:`projeq.subsystems.beam.beam.BeamPort.relative`
+    (whose Ḟ q̇_e is a complex step)."""
     k_e = q_e.shape[0]
-    a_, b_, a_dot, b_dot, quadratic, rate = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    a_, b_, beta, a_dot, b_dot, beta_dot, quadratic, rate = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     Phi_r, r_dot = np.empty((3, k_e), A.dtype), np.zeros(3, A.dtype)
     for i in range(k_e):
-        a_ += slopes[0, i] * q_e[i]
-        b_ += slopes[1, i] * q_e[i]
-        a_dot += slopes[0, i] * q_e_dot[i]
-        b_dot += slopes[1, i] * q_e_dot[i]
+        a_ += angles[0, i] * q_e[i]
+        b_ += angles[1, i] * q_e[i]
+        beta += angles[2, i] * q_e[i]
+        a_dot += angles[0, i] * q_e_dot[i]
+        b_dot += angles[1, i] * q_e_dot[i]
+        beta_dot += angles[2, i] * q_e_dot[i]
         Qq, Qqd = 0.0, 0.0
         for l in range(k_e):
             Qq += Q[i, l] * q_e[l]
@@ -378,10 +451,13 @@ def port_motion(r0, Psi, Q, slopes, offset, q_e, q_e_dot, A, r, F, zeta):
         rate += Qqd * q_e_dot[i]
         for a in range(3):
             Phi_r[a, i] = Psi[a, i] - (Qq if a == 0 else 0.0)
-    ca, sa, cb, sb = np.cos(a_), np.sin(a_), np.cos(b_), np.sin(b_)
-    A[0, 0], A[0, 1], A[0, 2] = ca * cb, -sa, ca * sb
+    ca, sa, cb, sb, cx, sx = np.cos(a_), np.sin(a_), np.cos(b_), np.sin(b_), np.cos(beta), np.sin(beta)
+    A[0, 0], A[0, 1], A[0, 2] = ca * cb, -sa, ca * sb  # R_z R_y, then turned by R_x below
     A[1, 0], A[1, 1], A[1, 2] = sa * cb, ca, sa * sb
     A[2, 0], A[2, 1], A[2, 2] = -sb, 0.0, cb
+    for a in range(3):
+        y_, z_ = A[a, 1], A[a, 2]
+        A[a, 1], A[a, 2] = cx * y_ + sx * z_, cx * z_ - sx * y_
     for a in range(3):
         r[a] = r0[a] + A[a, 0] * offset[0] + A[a, 1] * offset[1] + A[a, 2] * offset[2]
         for i in range(k_e):
@@ -389,20 +465,25 @@ def port_motion(r0, Psi, Q, slopes, offset, q_e, q_e_dot, A, r, F, zeta):
             r_dot[a] += Phi_r[a, i] * q_e_dot[i]
     r[0] -= 0.5 * quadratic
     Phi_w, c_w, v_rel, Omega = np.empty(3, A.dtype), np.empty(3, A.dtype), np.empty(3, A.dtype), np.empty(3, A.dtype)
-    for i in range(k_e):
-        Phi_w[0], Phi_w[1], Phi_w[2] = -sb * slopes[0, i], slopes[1, i], cb * slopes[0, i]
+    for i in range(k_e):  # Φ_ω = R_xᵀ (−sin b ∂a, ∂b, cos b ∂a) + e_x ∂β
+        w1, w2 = angles[1, i], cb * angles[0, i]
+        Phi_w[0], Phi_w[1], Phi_w[2] = -sb * angles[0, i] + angles[2, i], cx * w1 + sx * w2, cx * w2 - sx * w1
         c_w[:] = 0.0
         _add_cross(offset, Phi_w, c_w)
         for a in range(3):
             F[a, i] = A[0, a] * Phi_r[0, i] + A[1, a] * Phi_r[1, i] + A[2, a] * Phi_r[2, i] - c_w[a]
             F[3 + a, i] = Phi_w[a]
     alpha = zeta[3:]
-    Omega[0], Omega[1], Omega[2] = -sb * a_dot, b_dot, cb * a_dot
+    w1, w2 = b_dot, cb * a_dot  # R_xᵀ (−sin b ȧ, ḃ, cos b ȧ): Ω without β̇
+    turned1, turned2 = cx * w1 + sx * w2, cx * w2 - sx * w1
+    Omega[0], Omega[1], Omega[2] = -sb * a_dot + beta_dot, turned1, turned2
     for a in range(3):
         v_rel[a] = A[0, a] * r_dot[0] + A[1, a] * r_dot[1] + A[2, a] * r_dot[2]
         zeta[a] = -rate * A[0, a]
     _add_cross(v_rel, Omega, zeta[:3])  # − Ω × Aᵀ ṙ
-    alpha[0], alpha[1], alpha[2] = -cb * a_dot * b_dot, 0.0, -sb * a_dot * b_dot
+    alpha[0] = -cb * a_dot * b_dot  # R_xᵀ (−cos b, 0, −sin b) ȧ ḃ − β̇ e_x × R_xᵀ(…)
+    alpha[1] = -sx * sb * a_dot * b_dot + beta_dot * turned2
+    alpha[2] = -cx * sb * a_dot * b_dot - beta_dot * turned1
     _add_cross(alpha, offset, zeta[:3])  # − c × α
 
 
@@ -600,7 +681,8 @@ def tree_jacobian(index, geometry, inertia, gravity, laws, constants, x, n_q, st
 
 def gauss_form(index, T, zeta, F, M_n, h, M, b):
     """M = Σ J_nᵀ M_n J_n and b = Σ J_nᵀ (M_n ζ̄_n − h_n) of the Gauss form M s̈ + b = 0
-    (docs/theory.md §5) from the kernel's T_np, ζ_n, F_n, M_n and h_n, without the dense J_n.
+    (docs/theory.md §5) from the kernel's T_np, ζ_n, F_n, M_n and h_n, without the dense J_n,
+    for bodies with ``n_y[n]`` describing velocities (6, or 6 + n_e for an elastic body).
 
     b: the Newton–Euler recursion at s̈ = 0 — ζ̄_n = T_np ζ̄_p + ζ_n root → leaves,
     f_n = M_n ζ̄_n − h_n gathered leaves → root (f_p += T_npᵀ f_n), b_n = F_nᵀ f_n. M: the
@@ -609,41 +691,46 @@ def gauss_form(index, T, zeta, F, M_n, h, M, b):
     by U ← T_jpᵀ U (Featherstone (2008), *Rigid Body Dynamics Algorithms*, §5.3 and
     §6.2, Tables 5.1 and 6.2). Order N d (d: the tree's depth). Writes M (n × n) and b (n).
     """
-    N = index.shape[0]
-    n_cols, parent, s_index = index[:, N_COLS], index[:, PARENT], index[:, S_INDEX]
+    N, width = index.shape[0], M_n.shape[1]
+    n_cols, n_y, parent, s_index = index[:, N_COLS], index[:, N_Y], index[:, PARENT], index[:, S_INDEX]
+    rows = _rows
     dtype = M.dtype  # of the workspace: float, or complex under the complex step
-    zeta_bar, f, M_c = np.zeros((N, 6), dtype), np.zeros((N, 6), dtype), M_n.copy()
-    U, V, MT = np.zeros((6, 6), dtype), np.zeros((6, 6), dtype), np.empty((6, 6), dtype)
+    zeta_bar, f, M_c = np.zeros((N, width), dtype), np.zeros((N, width), dtype), M_n.copy()
+    U, V, MT = np.zeros((width, width), dtype), np.zeros((width, width), dtype), np.empty((width, width), dtype)
     for n in range(N):  # root → leaves: ζ̄_n, f_n
-        p = parent[n]
-        for a in range(6):
-            zeta_bar[n, a] = zeta[n, a] + (_dot6(T[n, a], zeta_bar[p]) if p >= 0 else 0.0)
-        for a in range(6):
-            f[n, a] = _dot6(M_n[n, a], zeta_bar[n]) - h[n, a]
+        p, m = parent[n], rows(n_y, n)
+        for a in range(m):
+            zeta_bar[n, a] = zeta[n, a] + (_dot(T[n, a], zeta_bar[p], rows(n_y, p)) if p >= 0 else 0.0)
+        for a in range(m):
+            f[n, a] = _dot(M_n[n, a], zeta_bar[n], m) - h[n, a]
     for n in range(N - 1, -1, -1):  # leaves → root: b_n, M^c_p += T_npᵀ M^c_n T_np, f_p += T_npᵀ f_n
+        p, m = parent[n], rows(n_y, n)
         for j in range(n_cols[n]):
-            b[s_index[n] + j] = _dot6(F[n, :, j], f[n])
-        if parent[n] >= 0:
-            _add_congruence(T[n], M_c[n], f[n], MT, M_c[parent[n]], f[parent[n]])
+            b[s_index[n] + j] = _dot(F[n, :, j], f[n], m)
+        if p >= 0 and m == 6 and rows(n_y, p) == 6:
+            _add_congruence(T[n], M_c[n], f[n], MT, M_c[p], f[p])
+        elif p >= 0:
+            _add_congruence_general(T[n], M_c[n], f[n], MT, m, rows(n_y, p), M_c[p], f[p])
     M[:, :] = 0.0
     for n in range(N):
-        k = n_cols[n]
+        k, m = n_cols[n], rows(n_y, n)
         if k == 0:
             continue
-        for a in range(6):
+        for a in range(m):
             for j in range(k):
-                U[a, j] = _dot6(M_c[n, a], F[n, :, j])
+                U[a, j] = _dot(M_c[n, a], F[n, :, j], m)
         i = n
         while i >= 0:  # M_in = F_iᵀ U, then U ← T_ipᵀ U
+            m_i, p = rows(n_y, i), parent[i]
             for r in range(n_cols[i]):
                 for j in range(k):
-                    M[s_index[i] + r, s_index[n] + j] = M[s_index[n] + j, s_index[i] + r] = _dot6(F[i, :, r], U[:, j])
-            if parent[i] >= 0:
-                for a in range(6):
+                    M[s_index[i] + r, s_index[n] + j] = M[s_index[n] + j, s_index[i] + r] = _dot(F[i, :, r], U[:, j], m_i)
+            if p >= 0:
+                for a in range(rows(n_y, p)):
                     for j in range(k):
-                        V[a, j] = _dot6(T[i, :, a], U[:, j])
+                        V[a, j] = _dot(T[i, :, a], U[:, j], m_i)
                 U[:, :k] = V[:, :k]
-            i = parent[i]
+            i = p
 
 
 def projected_accelerations(M_all, b_all, P, pivot_min, M, s_ddot):
@@ -791,7 +878,7 @@ def state_kernels(loads, compiled: bool = True, rigid: bool = False):
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
-            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, elastic_body, port_motion,
+            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, elastic_body, rotary_body, port_motion,
             hub_motion)
 
 
@@ -821,13 +908,14 @@ def _compiled_state_kernels(loads):
     return found
 
 
-def gauss_form_kernel(compiled: bool = True):
+def gauss_form_kernel(compiled: bool = True, rigid: bool = False):
     """(:func:`gauss_form`, :func:`projected_accelerations`), compiled by numba (as
-    :func:`kernel`; ValueError without it) or with ``compiled=False`` the interpreted functions."""
+    :func:`kernel`, with the same ``rigid`` variant: n_y = 6 a constant; ValueError without
+    numba) or with ``compiled=False`` the interpreted functions."""
     if not compiled:
         return gauss_form, projected_accelerations
     kernel(True)  # the same refusal without numba
-    return _compiled_gauss_form()
+    return _compiled_gauss_form(rigid)
 
 
 def hub_beam_kernel(compiled: bool = True):
@@ -855,7 +943,9 @@ def _compiled_hub_beam():
 
 
 @functools.cache
-def _compiled_gauss_form():
+def _compiled_gauss_form(rigid: bool):
+    if rigid:
+        return _jit(gauss_form, names=("rigid_gauss_form",), _rows=_six)[0], _compiled_gauss_form(False)[1]
     return _jit(gauss_form, projected_accelerations)
 
 

@@ -935,7 +935,7 @@ def _compiled() -> dict:
 def _compiled_callees() -> dict:
     """The compiled functions the kernels call by name: the tree's kernels, the force laws' loop and
     the intrinsics that call the C callbacks."""
-    return {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True)[0],
+    return {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True, rigid=True)[0],
             "add_loads": loads.kernel(True), **_intrinsics()}
 
 

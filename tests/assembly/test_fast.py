@@ -242,14 +242,6 @@ def test_the_kernel_takes_massless_frames():
                                system.accelerations(system.q0, system.s_dot0, method="recursive"), rtol=1e-13, atol=1e-14)
 
 
-def _arm_with_rotary_inertia():
-    """A link carrying a RitzBeam with rotary inertia (beyond the kernel's elastic block)."""
-    beam = pq.RitzBeam(1.0, 2.0, 50.0, rho_I=(1e-3, 1e-3), n_v=2, n_w=2)
-    link = pq.RigidBody(1.0, (0.25, 0, 0), np.diag([1e-3, 0.02, 0.02]))
-    return pq.System({"link": link, "beam": beam},
-                     {"link": pq.Revolute(axis="z"), "beam": pq.Revolute(parent="link", axis="z", r_pn=(0.5, 0, 0))})
-
-
 class _OwnTerms(pq.RigidBody):
     """A rigid body that restates its Gauss-form terms (the same ones): the kernel cannot know
     what an overridden ``gauss_terms`` computes, so it has no ``rigid_inertia``."""
@@ -273,9 +265,8 @@ def _own_terms_on_a_rope():
         (lambda: pq.System({"rod": _OwnTerms(1.0, (0, 0, -0.5), np.eye(3) * 0.1)}, {"rod": pq.Revolute(axis="y")},
                            gravity=(0, 0, -9.81)), "_OwnTerms"),
         (_own_terms_on_a_rope, "_OwnTerms"),
-        (_arm_with_rotary_inertia, "rotary inertia"),
     ],
-    ids=["overridden gauss_terms", "overridden gauss_terms, coupled joints", "beam with rotary inertia"],
+    ids=["overridden gauss_terms", "overridden gauss_terms, coupled joints"],
 )
 def test_unsupported_systems_are_refused_and_auto_picks_the_general_path(build, reason):
     """Unknown pieces: method="fast" raises naming the piece; the default evaluator
@@ -410,18 +401,13 @@ def _clamped_beam():
 def test_hub_beam_path_equals_recursive(build):
     """One RitzBeam on a prescribed or fixed hub goes through its own evaluator
     (method="hub_beam", projeq/assembly/beam_fast.py: M_ee q̈ = h_e − M_eR ζ, no chain, no
-    passes), which "auto" picks, and "fast" (the order-n kernel) refuses a beam with rotary
-    inertia (beyond its elastic block) and otherwise takes too; each equals the
-    recursive evaluator (docs/theory.md §6) to round-off (1e-10 of max(1, |s̈|∞)) at deformed,
-    moving states and several times."""
+    passes), which "auto" picks, and "fast" (the order-n kernel's elastic block, rotary
+    inertia and torsion included) takes too; each equals the recursive evaluator
+    (docs/theory.md §6) to round-off (1e-10 of max(1, |s̈|∞)) at deformed, moving states and
+    several times."""
     system = build()
     assert system.evaluator("auto").name == "hub_beam"
-    methods = ["hub_beam"]
-    if system.subsystems[0].rotary is None:  # the order-n kernel's elastic block takes it too
-        methods.append("fast")
-    else:
-        with pytest.raises(ValueError, match="the fast kernel cannot evaluate it: .*method='hub_beam' is the fast one"):
-            system.evaluator("fast")
+    methods = ["hub_beam", "fast"]
     rng = np.random.default_rng(4)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # the unstiffened beam may spin too fast: said once
@@ -442,19 +428,12 @@ def test_hub_beam_path_equals_recursive(build):
 )
 def test_hub_beam_compiled_equals_interpreted(build):
     """The compiled hub path (projeq/assembly/kernels.py hub_beam: the elastic block's slice
-    sums, M_ee by Cholesky) equals the interpreted one (the beam's elastic_terms by its
-    integration strategy, numpy's solve) to round-off, and its ẋ in one call
-    (``state_derivative``, what simulate calls) is (ṡ, s̈) of ``accelerations``; a beam with
-    rotary inertia is interpreted, and "auto" says so once, naming the piece."""
+    sums and rotary terms, M_ee by Cholesky) equals the interpreted one (the beam's
+    elastic_terms by its integration strategy, numpy's solve) to round-off, rotary inertia and
+    torsion included, and its ẋ in one call (``state_derivative``, what simulate calls) is
+    (ṡ, s̈) of ``accelerations``."""
     system = build()
     compiled, interpreted = HubBeamEvaluator(system), HubBeamEvaluator(system, compiled=False)
-    if system.subsystems[0].rotary is not None:
-        assert not compiled.compiled and "rotary inertia" in compiled.interpreted_reason
-        with warnings.catch_warnings(record=True) as said:
-            warnings.simplefilter("always")
-            AutoEvaluator(system)
-        assert [type(w.message) for w in said] == [InterpretedWarning] and "rotary inertia" in str(said[0].message)
-        return
     assert compiled.compiled and not interpreted.compiled
     rng = np.random.default_rng(11)
     for t in (0.3, 2.0, 17.0):

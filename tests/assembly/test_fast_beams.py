@@ -1,16 +1,19 @@
 """RitzBeams anywhere in a tree on the compiled path (projeq/assembly/kernels.py, the elastic block
 and the stations' frames): s̈ equals the dense Gauss form (docs/theory.md §5, an independent
 O(N³) formulation) within the bound of tests/assembly/test_recursive_vs_dense.py, on random
-trees with beams on revolute, prismatic, fixed and prescribed joints (any joint in the rigid part), both integration strategies, children on the beams'
-stations (beams on beams too), and the kernel's twins equal the beam's own statements."""
+trees with beams on revolute, prismatic, fixed and prescribed joints (beams with rotary inertia,
+sometimes torsion, on free, spherical and planar joints too; any joint in the rigid part), both
+integration strategies, children on the beams' stations (beams on beams too), and the kernel's
+twins equal the beam's own statements."""
 
+import types
 import warnings
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from strategies import Tree, random_inertia, random_mass, random_rotation, random_state, spatial_joint, trees
+from strategies import Tree, random_inertia, random_mass, random_rotation, random_state, spatial_joint, trees, with_couplings
 from test_recursive_vs_dense import _agree
 
 import projeq as pq
@@ -18,20 +21,29 @@ from projeq.assembly import InterpretedWarning, kernels
 from projeq.assembly.fast import FastEvaluator
 
 # a beam without rotary inertia has none about its axis x: a joint that may turn it about x
-# alone (free, spherical, planar yz) gives a singular D_n, so the beams sit on these
+# alone (free, spherical, planar yz) gives a singular D_n, so such beams sit on these; a beam
+# with rotary inertia (ρI_p about x) sits on any of ROTARY_BEAM_JOINTS
 BEAM_JOINTS = ("revolute", "prismatic", "fixed", "prescribed")
+ROTARY_BEAM_JOINTS = BEAM_JOINTS + ("free", "spherical", "planar")
 
 
-def _beam(rng) -> pq.RitzBeam:
+def _beam(rng, rotary: bool | None = None) -> pq.RitzBeam:
     """A beam with random bending (and sometimes axial) functions, family, stiffening,
-    damping and integration strategy (no rotary inertia: the kernel's elastic block)."""
+    damping and integration strategy; with rotary inertia (``rotary``; default: at random),
+    then sometimes with torsion (the kernel's rotary block, kernels.rotary_body)."""
     n_v, n_w, n_u = (int(n) for n in rng.integers(0, 4, 3))
     n_v = max(n_v, 1)
+    rotary = bool(rng.random() < 0.5) if rotary is None else rotary
+    options = {}
+    if rotary:
+        options = dict(rho_I=tuple(rng.uniform(1e-4, 1e-2, 2)), rho_I_p=float(rng.uniform(1e-4, 1e-2)))
+        if rng.random() < 0.5:
+            options.update(n_beta=int(rng.integers(1, 3)), GI_t=float(rng.uniform(1.0, 20.0)))
     return pq.RitzBeam(
         float(rng.uniform(0.3, 2.0)), float(rng.uniform(0.5, 5.0)), float(rng.uniform(5.0, 100.0)),
         EI_y=float(rng.uniform(5.0, 100.0)), EA=float(rng.uniform(1e3, 1e4)), n_v=n_v, n_w=n_w, n_u=n_u % 2,
         family=("polynomial", "clamped_free")[rng.integers(2)], stiffening=bool(rng.random() < 0.8),
-        damping=float(rng.choice([0.0, 0.01])), precomputed_integrals=bool(rng.random() < 0.5),
+        damping=float(rng.choice([0.0, 0.01])), precomputed_integrals=bool(rng.random() < 0.5), **options,
     )
 
 
@@ -62,7 +74,8 @@ def trees_with_beams(draw):
         name, beam = f"beam{i}", _beam(rng)
         parent = None if rng.random() < 0.2 else system.names[rng.integers(len(system.names))]
         subsystems[name] = beam
-        joints[name] = spatial_joint(BEAM_JOINTS[rng.integers(len(BEAM_JOINTS))], parent, rng)
+        kinds = BEAM_JOINTS if beam.rotary is None else ROTARY_BEAM_JOINTS
+        joints[name] = spatial_joint(kinds[rng.integers(len(kinds))], parent, rng)
         beams.append((name, beam))
     for name, beam in list(beams):
         for j in range(int(rng.integers(0, 3))):
@@ -91,6 +104,36 @@ def test_beams_in_trees_are_compiled_and_equal_dense(tree):
         _agree(tree, "auto", "dense")
 
 
+@settings(max_examples=max(5, settings().max_examples // 6), deadline=None)
+@given(trees_with_beams())
+def test_beams_beside_coupled_joints_are_compiled_and_equal_dense(tree):
+    """Trees with beams and up to three bodies on coupled joints (strategies.with_couplings):
+    compiled by default; the kernel's Gauss form (kernels.gauss_form with each body's n_y,
+    in every joint's own velocities and the beams' q̇_e after them, projected by P) equals
+    the dense J_nᵀ M_n J_n sums to round-off relative to their largest entries, and its s̈
+    the dense one (bound of _agree). The coupled bodies on the rigid tree's bodies come before
+    the beams, so that the kernel's ṡ_all (a coupled joint's own velocity in it) and the
+    System's ṡ place the beams' q̇_e differently."""
+    coupled = with_couplings(tree)
+    rigid_tree = {f"b{i}" for i in range(tree.n)}
+    early = [n for n, j in zip(coupled.names, coupled.joints) if n not in rigid_tree and j.coupling and j.parent in rigid_tree]
+    order = sorted(coupled.names, key=lambda n: 0 if n in rigid_tree else 1 if n in early else 2)
+    bodies, joints = dict(zip(coupled.names, coupled.subsystems)), dict(zip(coupled.names, coupled.joints))
+    system = pq.System({n: bodies[n] for n in order}, {n: joints[n] for n in order}, gravity=coupled.gravity)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InterpretedWarning)
+        warnings.simplefilter("ignore", RuntimeWarning)  # an unstiffened beam spun fast: said once
+        assert system.evaluator().name == "fast"
+        q, s_dot = system.normalized(tree.rng.uniform(-1, 1, system.n_q)), tree.rng.uniform(-1, 1, system.n_s)
+        for n in range(len(system.names)):
+            q[system.e_q_slice[n]] *= 0.05  # moderate deflections
+        M, b = system.gauss_form(q, s_dot, tree.t)
+        M_fast, b_fast = system.evaluator("fast").gauss_form(q, s_dot, tree.t)
+        assert np.abs(M_fast - M).max() <= 1e-12 * max(1.0, np.abs(M).max())
+        assert np.abs(b_fast - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
+        _agree(types.SimpleNamespace(system=system, q=q, s_dot=s_dot, t=tree.t), "auto", "dense")
+
+
 @settings(max_examples=max(5, settings().max_examples // 10), deadline=None)
 @given(trees_with_beams())
 def test_interpreted_kernel_with_beams_equals_recursive(tree):
@@ -103,17 +146,19 @@ def test_interpreted_kernel_with_beams_equals_recursive(tree):
 
 @pytest.mark.parametrize("seed", range(10))
 def test_the_elastic_twins_equal_the_beams_own_terms(seed):
-    """kernels.elastic_body = the beam's gauss_terms (Quadrature and PrecomputedIntegrals,
-    restoring and damping forces included) and kernels.port_motion = BeamPort.relative
-    (whose Ḟ q̇_e is a complex step), at random deformed, moving states."""
+    """kernels.elastic_body and kernels.rotary_body = the beam's gauss_terms (Quadrature and
+    PrecomputedIntegrals, restoring and damping forces, rotary inertia and torsion included:
+    odd seeds) and kernels.port_motion = BeamPort.relative (whose Ḟ q̇_e is a complex step),
+    at random deformed, moving states."""
     rng = np.random.default_rng(seed)
-    beam = _beam(rng)
+    beam = _beam(rng, rotary=seed % 2 == 1)
     q_e, q_e_dot = 0.05 * rng.standard_normal(beam.n_e), rng.standard_normal(beam.n_e)
     twist, R, g = rng.standard_normal(6), random_rotation(rng), rng.uniform(-10, 10, 3)
     y_dot = np.concatenate((twist, q_e_dot))
     M_ref, h_ref = beam.gauss_terms(y_dot, R, g, q_e)
     M, h = np.empty((beam.n_y, beam.n_y)), np.empty(beam.n_y)
     kernels.elastic_body(beam.mass_weights, *beam.slice_field(), beam.K_e, beam.damping, q_e, q_e_dot, twist, R.T @ g, M, h)
+    kernels.rotary_body(*beam.rotation_field(), q_e, q_e_dot, twist, M, h)
     assert np.abs(M - M_ref).max() <= 1e-12 * np.abs(M_ref).max()
     assert np.abs(h - h_ref).max() <= 1e-12 * np.abs(h_ref).max()
     port = beam.port_at(np.array([rng.uniform(0, beam.length), *rng.uniform(-0.1, 0.1, 2)]))

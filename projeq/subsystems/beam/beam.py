@@ -241,26 +241,37 @@ class RitzBeam(BeamProbes, Subsystem):
 
     def _rotary(self, rho_I, rho_I_p) -> None:
         """Rotary inertia per station diag(ρI_p, ρI_y, ρI_z) (ρI_p = ρ(I_y + I_z) unless
-        given) and J_ω(x) = [0, E, Φ_θ], Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (docs/theory.md §10)."""
-        if rho_I is None and rho_I_p is None:
-            self.rotary = None
-            return
-        I_y, I_z = 0.0, 0.0
-        if rho_I is not None:
-            rho_I = finite_array("rho_I", rho_I)
-            if rho_I.size not in (1, 2):
-                raise ValueError(f"rho_I: expected ρI or (ρI_y, ρI_z), got {rho_I.size} values")
-            rho_I = np.broadcast_to(rho_I.ravel(), (2,))
-            I_y, I_z = (positive(f"rho_I[{i}]", v) for i, v in enumerate(rho_I))
-        I_p = I_y + I_z if rho_I_p is None else positive("rho_I_p", rho_I_p)
-        self.rotary = self.weights[:, None] * np.array([I_p, I_y, I_z])[None, :]
-        J = np.zeros((len(self.x), 3, self.n_y))
-        J[:, :, 3:6] = np.eye(3)
-        J[:, 0, self.beta_cols] = self.Phi["beta"][0].T  # twist about x: β
-        J[:, 1, self.w_cols] = -self.Phi["w"][1].T  # rotation about y: −w′
-        J[:, 2, self.v_cols] = self.Phi["v"][1].T  # rotation about z: +v′
-        self.J_omega = J
-        self.twist_matrix = self._geometric_twist(self.x)
+        given) and the slices' rotation field (:meth:`rotation_field`)."""
+        self.rotary = None
+        if rho_I is not None or rho_I_p is not None:
+            I_y, I_z = 0.0, 0.0
+            if rho_I is not None:
+                rho_I = finite_array("rho_I", rho_I)
+                if rho_I.size not in (1, 2):
+                    raise ValueError(f"rho_I: expected ρI or (ρI_y, ρI_z), got {rho_I.size} values")
+                rho_I = np.broadcast_to(rho_I.ravel(), (2,))
+                I_y, I_z = (positive(f"rho_I[{i}]", v) for i, v in enumerate(rho_I))
+            I_p = I_y + I_z if rho_I_p is None else positive("rho_I_p", rho_I_p)
+            self.rotary = self.weights[:, None] * np.array([I_p, I_y, I_z])[None, :]
+        Phi_theta = np.zeros((len(self.x), 3, self.n_e))
+        e = self._local
+        Phi_theta[:, 0, e(self.beta_cols)] = self.Phi["beta"][0].T  # twist about x: β
+        Phi_theta[:, 1, e(self.w_cols)] = -self.Phi["w"][1].T  # rotation about y: −w′
+        Phi_theta[:, 2, e(self.v_cols)] = self.Phi["v"][1].T  # rotation about z: +v′
+        T = np.zeros((len(self.x), self.n_e, self.n_e))
+        if self.rotary is not None:
+            T[:, e(self.v_cols), e(self.w_cols)] = self._geometric_twist(self.x)
+        self._rotation = (np.zeros((len(self.x), 3)) if self.rotary is None else self.rotary, Phi_theta, T)
+
+    def rotation_field(self) -> tuple[NDArray, NDArray, NDArray]:
+        """The slices' rotation at the quadrature stations as constants (I, Φ_θ, T): the rotary
+        inertia I_k = Δx_k (ρI_p, ρI_y, ρI_z) (zero without rotary inertia) and the rotation
+        vector θ(q_e) = Φ_θ q_e + (q_eᵀ T q_e) e_x of each slice relative to R, with
+        Φ_θ = (Φ_β, −Φ_w′, Φ_v′) (torsion, then the bending slopes, docs/theory.md §10) and T
+        the geometric twist τ = q_vᵀ T(x) q_w (:meth:`_geometric_twist`) in q_e's positions.
+        :meth:`_slice_rotation` evaluates it, and so does the compiled kernel
+        (:func:`projeq.assembly.kernels.rotary_body`)."""
+        return self._rotation
 
     def _geometric_twist(self, x: NDArray) -> NDArray:
         """T(x) = ½ ∫₀ˣ (Φ_v′Φ_w″ᵀ − Φ_v″Φ_w′ᵀ) dξ at stations x: the slices of a beam without
@@ -303,8 +314,8 @@ class RitzBeam(BeamProbes, Subsystem):
         Psi = self.slices(np.zeros(self.n_e))[1]
         M = np.einsum("k,kai,kaj->ij", self.mass_weights, Psi, Psi)
         if self.rotary is not None:
-            Phi_theta = self.J_omega[:, :, 6:]
-            M += np.einsum("ka,kai,kaj->ij", self.rotary, Phi_theta, Phi_theta)
+            I, Phi_theta, _ = self._rotation
+            M += np.einsum("ka,kai,kaj->ij", I, Phi_theta, Phi_theta)
         return M
 
     def coordinates(self) -> tuple:
@@ -400,28 +411,27 @@ class RitzBeam(BeamProbes, Subsystem):
 
     def _slice_rotation(self, omega, q_e, q_e_dot, y_dot):
         """Angular velocity of the slices in their own (slightly turned) frames to second
-        order, ω_c = (E − θ̃) ω + (E − ½θ̃) θ̇ with the rotation vector θ = (β + τ, −w′, v′) of
-        the slice relative to R, τ = q_vᵀ T q_w the geometric twist of a beam without
-        torsional strain (:meth:`_geometric_twist`): its Jacobian J_ω(x, q_e) (q̇_e columns
-        (E − ½θ̃) ∂θ/∂q_e), ω_c, and J̇_ω ẏ = ω̃ θ̇ + (E − ½θ̃) e_x 2 q̇_vᵀT q̇_w (the rotary
-        terms of the Rayleigh beam; with Euler's ω̃_c I ω_c the power is exactly
-        d/dt ½ ω_cᵀ I ω_c). The second-order parts carry the ρI_p α̈ coupling of a beam spun
-        about its axis (docs/theory.md, "The spinning beam's rotary inertia")."""
-        J = self.J_omega.astype(np.result_type(self.J_omega, q_e, q_e_dot))  # complex in a complex step
-        e = self._local
-        q_v, q_w = q_e[e(self.v_cols)], q_e[e(self.w_cols)]
-        qd_v, qd_w = q_e_dot[e(self.v_cols)], q_e_dot[e(self.w_cols)]
-        T_q_w = self.twist_matrix @ q_w
-        J[:, 0, self.v_cols] += T_q_w  # ∂τ/∂q_v
-        J[:, 0, self.w_cols] += q_v @ self.twist_matrix  # ∂τ/∂q_w
-        theta = self.J_omega[:, :, 6:] @ q_e
-        theta[:, 0] += T_q_w @ q_v  # τ
-        Phi_theta = J[:, :, 6:]  # ∂θ/∂q_e
+        order, ω_c = (E − θ̃) ω + (E − ½θ̃) θ̇ with the rotation vector θ = Φ_θ q_e + τ e_x of the
+        slice relative to R (:meth:`rotation_field`; τ = q_eᵀ T q_e the geometric twist of a
+        beam without torsional strain, :meth:`_geometric_twist`): its Jacobian
+        J_ω(x, q_e) = [0, E − θ̃, (E − ½θ̃) ∂θ/∂q_e] with ∂θ/∂q_e = Φ_θ + e_x ((T + Tᵀ) q_e)ᵀ,
+        ω_c, and J̇_ω ẏ = ω̃ θ̇ + (E − ½θ̃) e_x 2 q̇_eᵀ T q̇_e (the rotary terms of the Rayleigh
+        beam; with Euler's ω̃_c I ω_c the power is exactly d/dt ½ ω_cᵀ I ω_c). The second-order
+        parts carry the ρI_p α̈ coupling of a beam spun about its axis (docs/theory.md, "The
+        spinning beam's rotary inertia")."""
+        _, Phi_theta, T = self._rotation
+        dtype = np.result_type(Phi_theta, q_e, q_e_dot)  # complex in a complex step
+        T_q, q_T = T @ q_e, q_e @ T
+        theta = (Phi_theta @ q_e).astype(dtype)
+        theta[:, 0] += T_q @ q_e  # τ
+        d_theta = Phi_theta.astype(dtype)  # ∂θ/∂q_e
+        d_theta[:, 0, :] += T_q + q_T
         theta_skew = skew_stack(theta)
-        theta_dot = Phi_theta @ q_e_dot
-        twist_acceleration = 2.0 * ((self.twist_matrix @ qd_w) @ qd_v)
-        J[:, :, 6:] = Phi_theta - 0.5 * theta_skew @ Phi_theta
-        J[:, :, 3:6] -= theta_skew
+        theta_dot = d_theta @ q_e_dot
+        twist_acceleration = 2.0 * ((T @ q_e_dot) @ q_e_dot)
+        J = np.zeros((len(theta), 3, self.n_y), dtype)
+        J[:, :, 3:6] = np.eye(3) - theta_skew
+        J[:, :, 6:] = d_theta - 0.5 * theta_skew @ d_theta
         c_w = cross(omega, theta_dot)
         c_w[:, 0] += twist_acceleration
         c_w -= 0.5 * np.cross(theta, twist_acceleration[:, None] * np.array([1.0, 0.0, 0.0]))
@@ -461,23 +471,23 @@ class RitzBeam(BeamProbes, Subsystem):
         station = np.array([x])
         data = (station, self.station_data(station))
         e = self._local
-        slopes = np.zeros((2, self.n_e))  # ∂v′/∂q_e and ∂(−w′)/∂q_e at the station
-        slopes[0, e(self.v_cols)] = data[1][0]["v"][1][:, 0]
-        slopes[1, e(self.w_cols)] = -data[1][0]["w"][1][:, 0]
+        angles = np.zeros((3, self.n_e))  # ∂v′/∂q_e, ∂(−w′)/∂q_e and ∂β/∂q_e at the station
+        angles[0, e(self.v_cols)] = data[1][0]["v"][1][:, 0]
+        angles[1, e(self.w_cols)] = -data[1][0]["w"][1][:, 0]
+        angles[2, e(self.beta_cols)] = data[1][0]["beta"][0][:, 0]
         r0, Psi, Q = self.slice_field(*data)
-        return BeamPort(self, data, np.array([0.0, point[1], point[2]]), (r0[0], Psi[0], Q[0], slopes))
+        return BeamPort(self, data, np.array([0.0, point[1], point[2]]), (r0[0], Psi[0], Q[0], angles))
 
     def _port_terms(self, q_e, port):
         """(A, r, F) of ``port`` (a :class:`BeamPort`) from its field; complex-safe, for the
         complex-step Ḟ."""
-        Phi, offset, slopes = port.data[1][0], port.offset, port.field[3]
+        offset, angles = port.offset, port.field[3]
         r_x, Phi_r = self.slices(q_e, tuple(constants[None] for constants in port.field[:3]))  # at the one station
-        a, b = slopes @ q_e  # v′, −w′
-        beta = Phi["beta"][0][:, 0] @ q_e[self._local(self.beta_cols)]
+        a, b, beta = angles @ q_e  # v′, −w′, β
         R_x = rotation_x(beta)
         A = rotation_z(a) @ rotation_y(b) @ R_x
-        Phi_omega = R_x.T @ np.array([-np.sin(b) * slopes[0], slopes[1], np.cos(b) * slopes[0]])
-        Phi_omega[0, self._local(self.beta_cols)] += Phi["beta"][0][:, 0]
+        Phi_omega = R_x.T @ np.array([-np.sin(b) * angles[0], angles[1], np.cos(b) * angles[0]])
+        Phi_omega[0] += angles[2]
         F = np.vstack((A.T @ Phi_r[0] - skew(offset) @ Phi_omega, Phi_omega))
         return A, r_x[0] + A @ offset, F
 
@@ -494,7 +504,7 @@ class BeamPort:
     beam: RitzBeam
     data: tuple  # (x as a 1-array, station_data(x))
     offset: NDArray  # c = (0, y, z)
-    field: tuple  # (r₀, Ψ, Q) of RitzBeam.slice_field at x, and the slopes ∂(v′, −w′)/∂q_e
+    field: tuple  # (r₀, Ψ, Q) of RitzBeam.slice_field at x, and the angles' rows ∂(v′, −w′, β)/∂q_e
 
     def relative(self, q_e: NDArray, q_e_dot: NDArray) -> Relative:
         """Pose, F q̇_e and Ḟ q̇_e relative to the beam's frame (:meth:`RitzBeam.port`);
