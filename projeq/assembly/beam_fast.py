@@ -196,7 +196,7 @@ class HubBeamEvaluator:
 
     def energy(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[float, float]:
         """(kinetic, potential) at the real (q, ṡ, t) = (q_e, q̇_e, t) on the terms of one
-        compiled call (:meth:`_compiled`, :func:`projeq.assembly.kernels.hub_beam`): T = ½ ẏᵀ M_n ẏ
+        compiled call (:meth:`_evaluate`, :func:`projeq.assembly.kernels.hub_beam`): T = ½ ẏᵀ M_n ẏ
         with the kernel's M_n (the one it solves with) and ẏ = (w, q̇_e), the hub's twist w it
         writes; V, the beam's own potential energy at the pose it writes, R = A_pJ A_Jn,
         r = r_pJ + A_pJ r_Jn (:meth:`projeq.System.potential_energy`); the beam's
