@@ -589,13 +589,16 @@ class System(Model):
     def energy(self, q, s_dot, t: float = 0.0, method: str | None = None) -> tuple[float, float]:
         """(kinetic, potential): Σ ½ ẏ_nᵀ M_n ẏ_n and :meth:`potential_energy` (gravity, strain,
         springs), by ``method``: "fast" (on the compiled kinematics,
-        :meth:`projeq.assembly.fast.FastEvaluator.energy`), "recursive" (on the reference
-        kinematics, :func:`projeq.assembly.kinematics.poses`, and each subsystem's own
-        ``kinetic_energy``) or None: "fast" where the system's default evaluator is the compiled
-        one. Complex for complex (q, ṡ, t), by the reference (unchecked then: a complex step, as
-        for the exact energy gradient of :mod:`projeq.simulation.integrators`)."""
-        if method not in (None, "fast", "recursive"):
-            raise ValueError(f"method: unknown energy evaluation {method!r}; use 'fast', 'recursive' or None")
+        :meth:`projeq.assembly.fast.FastEvaluator.energy`), "hub_beam" (a beam on a prescribed
+        hub, compiled: :meth:`projeq.assembly.beam_fast.HubBeamEvaluator.energy`), "recursive"
+        (on the reference kinematics, :func:`projeq.assembly.kinematics.poses`, and each
+        subsystem's own ``kinetic_energy``) or None: that of the system's default evaluator
+        where it is a compiled one, else "recursive". Complex for complex (q, ṡ, t), by the
+        reference (unchecked then: a complex step, as for the exact energy gradient of
+        :mod:`projeq.simulation.integrators`)."""
+        if method not in (None, "fast", "hub_beam", "recursive"):
+            raise ValueError(f"method: unknown energy evaluation {method!r}; use 'fast', 'hub_beam', 'recursive' "
+                             "or None")
         complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot) or np.iscomplexobj(t)
         if complex_step:
             return self._energy(np.asarray(q), np.asarray(s_dot), t, "recursive")
@@ -604,10 +607,14 @@ class System(Model):
 
     def _energy(self, q: NDArray, s_dot: NDArray, t, method: str | None = None) -> tuple:
         """:meth:`energy` at a checked (q, ṡ, t), or by the reference at a complex one."""
+        if method is None:  # the default evaluator's own where it is a compiled one
+            picked = self.evaluator(None).evaluator
+            if getattr(picked, "compiled", False):
+                return picked.energy(q, s_dot, t)
+        elif method != "recursive":
+            return self.evaluator(method).energy(q, s_dot, t)
         from projeq.assembly.kinematics import poses
 
-        if method == "fast" or (method is None and self.evaluator(None).name == "fast"):
-            return self.evaluator("fast").energy(q, s_dot, t)
         complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot) or np.iscomplexobj(t)
         kin = poses(self, q, s_dot, t)
         q_e = [q[sl] for sl in self.e_q_slice]

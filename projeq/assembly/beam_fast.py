@@ -144,10 +144,14 @@ class HubBeamEvaluator:
         self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
         self._kernel, self._jacobian = kernels.hub_beam_kernel(True), kernels.hub_beam_jacobian_kernel(True)
         # the kernel's arguments before and after the state, packed once (the hub's rows are overwritten in
-        # place); after it the workspace M_n, h_n, one per dtype (complex for the complex step)
-        self._head = (self._kind, self._axis, self._angles, self._given, self._orientation, self._gravity, *self._field)
-        self._tail = {np.dtype(dtype): (self._pivot_min, np.zeros((n_y, n_y), dtype), np.zeros(n_y, dtype))
+        # place); after it the workspace M_n, h_n, M_ee's Cholesky factor and the frame's pose and twist, one
+        # per dtype (complex for the complex step)
+        self._head = (self._kind, self._axis, self._angles, self._given, self._orientation,
+                      np.array(joint.r_pn, dtype=float), self._gravity, *self._field)
+        self._tail = {np.dtype(dtype): (self._pivot_min, np.zeros((n_y, n_y), dtype), np.zeros(n_y, dtype),
+                                        np.zeros((beam.n_e, beam.n_e), dtype), np.zeros((6, 3), dtype))
                       for dtype in (float, complex)}
+        self._pose = _HubPose(self._tail[np.dtype(float)][4])
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) at (q, ṡ, t) = (q_e, q̇_e, t)."""
@@ -190,6 +194,26 @@ class HubBeamEvaluator:
         status = self._jacobian(*self._head, kernels.kernel_array(x), COMPLEX_STEP, *self._tail[np.dtype(complex)], J)
         return J if status < 0 else None
 
+    def energy(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[float, float]:
+        """(kinetic, potential) at the real (q, ṡ, t) = (q_e, q̇_e, t) on the terms of one
+        compiled call (:meth:`_evaluate`, :func:`projeq.assembly.kernels.hub_beam`): T = ½ ẏᵀ M_n ẏ
+        with the kernel's M_n (the one it solves with) and ẏ = (w, q̇_e), the hub's twist w it
+        writes; V, the beam's own potential energy at the pose it writes, R = A_pJ A_Jn,
+        r = r_pJ + A_pJ r_Jn (:meth:`projeq.System.potential_energy`); the beam's
+        ``check_spin`` at w's ω (the rows of :func:`projeq.simulate` say so). ValueError on the
+        interpreted path (the reference energy of ``System.energy(method="recursive")`` is the
+        one for it)."""
+        if not self.compiled:
+            raise ValueError(f"method: the 'hub_beam' energy is compiled only; this system's path is interpreted: "
+                             f"{self.interpreted_reason}")
+        x = kernels.kernel_array(np.concatenate((q, s_dot)))
+        if self._evaluate(x, t)[1] == 1 and not np.all(np.isfinite(x)):
+            raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no energy")
+        M, frame = self._tail[x.dtype][1], self._tail[x.dtype][4]
+        self.beam.check_spin(frame[5])  # said once where the spin makes an unstiffened beam unstable
+        y_dot = np.concatenate((frame[4:].ravel(), x[len(q):]))
+        return float(0.5 * (y_dot @ M @ y_dot)), float(self.system.potential_energy(self._pose, x[: len(q)]))
+
     def _hub(self, t: float) -> None:
         """The hub's (θ, θ̇, θ̈) of a Prescribed joint (its checked ``angles``) or the numbers of
         its ``relative_values`` at t into the kernel's rows."""
@@ -200,14 +224,27 @@ class HubBeamEvaluator:
             angles[0], angles[1], angles[2] = self.joint.angles(t)
 
     def _compiled(self, x: NDArray, t: float) -> tuple[NDArray, int]:
-        """(ẋ, status) of :func:`projeq.assembly.kernels.hub_beam` at (x, t): the hub's motion
-        (:meth:`_hub`), then one compiled call; SingularMassError where it finds M_ee singular
-        (status 0)."""
+        """(ẋ, status) of :func:`projeq.assembly.kernels.hub_beam` at (x, t) (:meth:`_evaluate`),
+        counted; SingularMassError where it finds M_ee singular (status 0)."""
         self.n_calls += 1
-        self._hub(t)
-        x_dot = np.empty(x.shape[0], x.dtype)
-        status = self._kernel(*self._head, x, *self._tail[x.dtype], x_dot)
+        x_dot, status = self._evaluate(x, t)
         if status == 0:
             raise SingularMassError(f"M_ee of subsystem {self.system.names[0]!r} is singular or indefinite at "
                                     f"t = {t:.6g}: the state has left the range the model describes")
         return x_dot, status
+
+    def _evaluate(self, x: NDArray, t: float) -> tuple[NDArray, int]:
+        """(ẋ, status) of one call of :func:`projeq.assembly.kernels.hub_beam` at (x, t), the hub's
+        motion first (:meth:`_hub`); its terms stay in the workspace of x's dtype."""
+        self._hub(t)
+        x_dot = np.empty(x.shape[0], x.dtype)
+        return x_dot, self._kernel(*self._head, x, *self._tail[x.dtype], x_dot)
+
+
+class _HubPose:
+    """The pose of the beam's reference frame as :meth:`projeq.System.potential_energy` reads
+    it, R_n and r_n: the beam's, rows of the kernel's ``frame`` (:func:`projeq.assembly.kernels.hub_beam`),
+    then the ground's."""
+
+    def __init__(self, frame: NDArray):
+        self.R, self.r = (frame[:3], np.eye(3)), (frame[3], np.zeros(3))

@@ -333,66 +333,90 @@ def rotary_body(I, Phi_theta, T, q_e, q_e_dot, twist, M, h):
                 M[a, b] += J[0, a] * I0 * J[0, b] + J[1, a] * I1 * J[1, b] + J[2, a] * I2 * J[2, b]
 
 
-def hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, I, Phi_theta, T, x,
-             pivot_min, M, h, x_dot):
-    """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) of one elastic body on a hub whose motion is given, its
-    reference frame moving with ẏ = (w, q̇_e) and ÿ = (ζ, q̈_e) — B(14) projected on q̇_e
-    (:mod:`projeq.assembly.beam_fast`); M_n and h_n by :func:`elastic_body`, M_ee by
-    Cholesky in place. The hub: a Revolute or Prismatic ``kind`` about ``axis`` at
-    ``angles`` = (θ, θ̇, θ̈) (A_Jn by :func:`_relative_rotation`, w = F⁶ θ̇, ζ = F⁶ θ̈: a
-    Prescribed joint), FIXED (angles zero), or GIVEN: A, r, w, ζ of the joint's own
-    ``relative_values`` in ``given``. R = A_pJ A_Jn (the ground at rest), g_n = Rᵀ g.
-    The state x = (q_e, q̇_e), written: ẋ = (q̇_e, q̈_e) (q̇ = ṡ for elastic coordinates).
-    Returns −1; 0 when a pivot of M_ee is not above ``pivot_min``; 1 when x or ẋ is not
-    finite (ẋ written as far as it got)."""
-    dtype = M.dtype  # of the workspace: float, or complex under the complex step
-    k_e, A, w, zeta, g = x.shape[0] // 2, np.empty((3, 3), dtype), np.zeros(6, dtype), np.zeros(6, dtype), np.zeros(3, dtype)
-    for i in range(2 * k_e):
-        if not np.isfinite(x[i]):
-            return 1
-    q_e, q_e_dot, q_e_ddot = x[:k_e], x[k_e:], x_dot[k_e:]
-    x_dot[:k_e] = q_e_dot
+def hub_motion(kind, axis, angles, given, orientation, gravity, A, r, w, zeta, g):
+    """The relative motion of a hub whose motion is given, on the ground at rest: A = A_Jn,
+    r = r_Jn, w = F⁶ θ̇ (ẏ's twist), ζ = F⁶ θ̈, and g_n = (A_pJ A_Jn)ᵀ g. A Revolute or
+    Prismatic ``kind`` about ``axis`` at ``angles`` = (θ, θ̇, θ̈) (A_Jn by
+    :func:`_relative_rotation`, r_Jn = e θ for a prismatic hub: a Prescribed joint), FIXED
+    (angles zero), or GIVEN: A, r, w, ζ of the joint's own ``relative_values`` in ``given``."""
+    r[:] = 0.0
+    w[:] = 0.0
+    zeta[:] = 0.0
+    g[:] = 0.0
     if kind == GIVEN:
         for a in range(3):
+            r[a] = given[GIVEN_R + a]
             for b in range(3):
-                A[a, b] = given[3 * a + b]
-        w[:] = given[12:18]
-        zeta[:] = given[18:24]
+                A[a, b] = given[GIVEN_A + 3 * a + b]
+        w[:] = given[GIVEN_W : GIVEN_W + 6]
+        zeta[:] = given[GIVEN_ZETA : GIVEN_ZETA + 6]
     else:
         _relative_rotation(kind, axis, angles[0], A)
         first = 3 if kind == REVOLUTE else 0  # F⁶ = [0; e] or [e; 0]
         for a in range(3 if kind != FIXED else 0):
             w[first + a], zeta[first + a] = axis[a] * angles[1], axis[a] * angles[2]
+            if kind == PRISMATIC:
+                r[a] = axis[a] * angles[0]
     for b in range(3):  # g_n = (A_pJ A_Jn)ᵀ g
         for a in range(3):
             g[b] += (orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]) * gravity[a]
+
+
+def hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, I, Phi_theta, T, x,
+             pivot_min, M, h, L, frame, x_dot):
+    """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) of one elastic body on a hub whose motion is given, its
+    reference frame moving with ẏ = (w, q̇_e) and ÿ = (ζ, q̈_e) — B(14) projected on q̇_e
+    (:mod:`projeq.assembly.beam_fast`); the hub's motion by :func:`hub_motion`, M_n and h_n by
+    :func:`elastic_body` and :func:`rotary_body` (left in ``M`` and ``h``), M_ee = L Lᵀ by
+    Cholesky into ``L``. The frame's pose and twist (the ground at rest) into ``frame``
+    (6 × 3): R = A_pJ A_Jn (rows 0–2), r = r_pJ + A_pJ r_Jn with the joint's ``offset`` r_pJ
+    (row 3), w (rows 4–5); g_n = Rᵀ g. The state x = (q_e, q̇_e), written: ẋ = (q̇_e, q̈_e)
+    (q̇ = ṡ for elastic coordinates). Returns −1; 0 when a pivot of M_ee is not above
+    ``pivot_min``; 1 when x or ẋ is not finite (ẋ written as far as it got; nothing else
+    when x is not)."""
+    dtype = M.dtype  # of the workspace: float, or complex under the complex step
+    k_e, A, r_Jn = x.shape[0] // 2, np.empty((3, 3), dtype), np.empty(3, dtype)
+    w, zeta, g = np.empty(6, dtype), np.empty(6, dtype), np.empty(3, dtype)
+    for i in range(2 * k_e):
+        if not np.isfinite(x[i]):
+            return 1
+    q_e, q_e_dot, q_e_ddot = x[:k_e], x[k_e:], x_dot[k_e:]
+    x_dot[:k_e] = q_e_dot
+    hub_motion(kind, axis, angles, given, orientation, gravity, A, r_Jn, w, zeta, g)
+    for a in range(3):
+        frame[3, a] = offset[a] + orientation[a, 0] * r_Jn[0] + orientation[a, 1] * r_Jn[1] + orientation[a, 2] * r_Jn[2]
+        frame[4, a], frame[5, a] = w[a], w[3 + a]
+        for b in range(3):
+            frame[a, b] = orientation[a, 0] * A[0, b] + orientation[a, 1] * A[1, b] + orientation[a, 2] * A[2, b]
     elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, w, g, M, h)
     rotary_body(I, Phi_theta, T, q_e, q_e_dot, w, M, h)
     for i in range(k_e):
         q_e_ddot[i] = h[6 + i] - _dot6(M[6 + i], zeta)
-    M_ee = M[6:, 6:]
-    if not cholesky(M_ee, k_e, pivot_min):
+    for i in range(k_e):
+        for j in range(i + 1):  # the lower triangle, which the factorization reads
+            L[i, j] = M[6 + i, 6 + j]
+    if not cholesky(L, k_e, pivot_min):
         return 0
-    cholesky_solve(M_ee, k_e, q_e_ddot)
+    cholesky_solve(L, k_e, q_e_ddot)
     for i in range(k_e):
         if not np.isfinite(q_e_ddot[i]):
             return 1
     return -1
 
 
-def hub_beam_jacobian(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, I, Phi_theta, T, x,
-                      step, pivot_min, M, h, J):
+def hub_beam_jacobian(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, I, Phi_theta,
+                      T, x, step, pivot_min, M, h, L, frame, J):
     """∂ẋ/∂x of :func:`hub_beam` at the real state x by the complex step, column k =
     Im ẋ(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998), all n_x columns in
-    one call on a complex workspace (``M``, ``h``: complex128); written into J. Returns
-    :func:`hub_beam`'s status (−1: every column written)."""
+    one call on a complex workspace (``M``, ``h``, ``L``, ``frame``: complex128); written into J.
+    Returns :func:`hub_beam`'s status (−1: every column written)."""
     n_x = x.shape[0]
     z, z_dot = np.empty(n_x, M.dtype), np.empty(n_x, M.dtype)
     for k in range(n_x):
         z[:] = x
         z[k] += 1j * step
-        status = hub_beam(kind, axis, angles, given, orientation, gravity, m, r0, Psi, Q, K_e, damping, I, Phi_theta, T,
-                          z, pivot_min, M, h, z_dot)
+        status = hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi, Q, K_e, damping, I,
+                          Phi_theta, T, z, pivot_min, M, h, L, frame, z_dot)
         if status >= 0:
             return status
         for i in range(n_x):
@@ -854,7 +878,8 @@ def state_kernels(loads, compiled: bool = True, rigid: bool = False):
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
-            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, elastic_body, rotary_body, port_motion)
+            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, elastic_body, rotary_body, port_motion,
+            hub_motion)
 
 
 @functools.cache

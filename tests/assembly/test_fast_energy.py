@@ -6,14 +6,23 @@ planar, coupled, rheonomic), every force law and RitzBeams; and the conservation
 the motion of conservative trees (dE/dt = ∇E · ẋ = 0), which fails if any term of T or V is
 left out (gravity, a spring's or a beam's strain energy)."""
 
+import functools
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
-from strategies import random_state, trees, with_couplings, with_every_law
+from hypothesis import strategies as st
+from strategies import random_rotation, random_state, trees, with_couplings, with_every_law
 from test_fast_beams import trees_with_beams
 
 import projeq as pq
 from projeq.assembly import kernels
+from projeq.assembly.beam_fast import HubBeamEvaluator
+from projeq.assembly.kinematics import poses
+from projeq.constraints.reactions import joint_reactions
+from projeq.joints.base import Relative
+from projeq.spatial import rotation
 
 pytestmark = pytest.mark.skipif(not kernels.has_numba(), reason="numba is not installed")
 
@@ -117,3 +126,98 @@ def test_an_unknown_energy_method_is_refused_by_name():
     system = pq.scenes.chain(2)
     with pytest.raises(ValueError, match="method: unknown energy evaluation 'dense'"):
         system.energy(system.q0, system.s_dot0, 0.0, method="dense")
+
+
+# -- one beam on a hub whose motion is given (HubBeamEvaluator.energy) ----------------------------
+class _ScrewHub(pq.Joint):
+    """A hub without coordinates that turns by θ(t) = a t² about its axis e and advances p θ
+    along it (rheonomic; no compiled kind: the hub kernel reads its ``relative_values``, kind
+    GIVEN): A = rot(e, θ), r = p θ e, w = θ̇ (p e, e), ζ = θ̈ (p e, e)."""
+
+    def __init__(self, axis, pitch, rate, **placement):
+        super().__init__(None, **placement)
+        self.axis, self.pitch, self.rate = np.asarray(axis, float) / np.linalg.norm(axis), pitch, rate
+
+    def relative(self, q_n, s_dot_n, t):
+        theta, theta_dot, theta_ddot = self.rate * t**2, 2 * self.rate * t, 2 * self.rate
+        e, p = self.axis, self.pitch
+        twist = np.concatenate((p * e, e))
+        return Relative(rotation(e, theta), p * theta * e, np.zeros((6, 0)), theta_dot * twist, theta_ddot * twist)
+
+
+def _hub_beam(hub: str, rate: float, rng, damping=0.02) -> pq.System:
+    """A RitzBeam (bending both ways, axial, stiffening, damping) under tilted gravity on a hub
+    ``hub`` placed at a random offset and orientation: turning at the spin-up θ = rate t² /
+    (1 + t) (rheonomic), advancing along its axis, a screw motion (kind GIVEN) or fixed."""
+    beam = pq.RitzBeam(1.3, 1.6, 20.0, EI_y=30.0, EA=700.0, n_v=2, n_w=2, n_u=1, family="clamped_free",
+                       damping=damping)
+    placement = {"r_pn": rng.uniform(-0.5, 0.5, 3), "orientation": random_rotation(rng)}
+    axis = rng.standard_normal(3)
+    motion = lambda t: (rate * t**2 / (1 + t), rate * (t**2 + 2 * t) / (1 + t) ** 2, 2 * rate / (1 + t) ** 3)  # noqa: E731
+    joint = {"revolute": lambda: pq.Prescribed(pq.Revolute(axis=axis / np.linalg.norm(axis), **placement), motion),
+             "prismatic": lambda: pq.Prescribed(pq.Prismatic(axis=axis / np.linalg.norm(axis), **placement), motion),
+             "screw": lambda: _ScrewHub(axis, 0.3, rate, **placement),
+             "fixed": lambda: pq.Fixed(**placement)}[hub]()
+    return pq.System({"beam": beam}, {"beam": joint}, gravity=rng.uniform(-10, 10, 3))
+
+
+HUB_SCENES = {
+    "spin-up, gravity": lambda rate, rng: pq.scenes.spin_up_beam(omega_s=rate, t_s=5.0, n_shapes=2, n_axial=1,
+                                                                 gravity=9.81),
+    "spin-up precomputed, unstiffened": lambda rate, rng: pq.scenes.spin_up_beam(
+        omega_s=rate, t_s=5.0, n_shapes=2, stiffening=False, precomputed_integrals=True),
+    "spinning": lambda rate, rng: pq.scenes.spinning_beam(omega=rate, n_shapes=3),
+    "spinning, rotary inertia": lambda rate, rng: pq.scenes.spinning_beam(omega=rate, rho_I=1e-2, n_shapes=2),
+    **{f"{hub} hub": functools.partial(lambda hub, rate, rng: _hub_beam(hub, rate, rng), hub)
+       for hub in ("revolute", "prismatic", "screw", "fixed")},
+}
+
+
+@FEW
+@given(st.sampled_from(sorted(HUB_SCENES)), st.floats(0.2, 8.0), st.floats(0.0, 12.0), st.integers(0, 2**32 - 1))
+def test_hub_beam_energy_equals_the_reference(scene, rate, t, seed):
+    """T and V of the hub kernel (T = ½ ẏᵀ M_n ẏ with the kernel's M_n and the hub's twist; V,
+    the beam's own at the kernel's pose) equal each subsystem's own kinetic and potential
+    energy on the reference kinematics at random states, spin rates and times, on every hub
+    kind the kernel knows (revolute, prismatic, fixed) and one it reads (GIVEN); the default
+    energy of these systems is the hub kernel's."""
+    rng = np.random.default_rng(seed)
+    system = HUB_SCENES[scene](rate, rng)
+    assert system.evaluator(None).name == "hub_beam" and system.evaluator("hub_beam").compiled
+    q, s_dot = 0.05 * rng.standard_normal(system.n_q), rng.standard_normal(system.n_s)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # the unstiffened beam may spin too fast: said once
+        fast = system.energy(q, s_dot, t, method="hub_beam")
+        reference = system.energy(q, s_dot, t, method="recursive")
+        assert system.energy(q, s_dot, t) == fast  # the default is the compiled one
+    np.testing.assert_allclose(fast, reference, rtol=1e-13, atol=1e-13 * (1.0 + sum(abs(e) for e in reference)))
+
+
+@pytest.mark.parametrize("hub", ["revolute", "prismatic", "screw"])
+def test_hub_beam_energy_balance_under_a_driven_hub(hub):
+    """dE/dt = W · ẏ: the rate of the compiled E = T + V along the motion of an undamped beam
+    (time included: the hub moves as given) is the power of the wrench W the hub transmits
+    (:func:`projeq.constraints.reactions.joint_reactions`, B(14) on the reference kinematics)."""
+    rng = np.random.default_rng(5)
+    system = _hub_beam(hub, 2.0, rng, damping=0.0)
+    q, s_dot, t = 0.05 * rng.standard_normal(system.n_q), rng.standard_normal(system.n_s), 1.3
+    s_ddot = system.accelerations(q, s_dot, t)
+
+    def rate(h):  # central differences of E along (q̇, s̈, 1)
+        E = [sum(system.energy(q + step * s_dot, s_dot + step * s_ddot, t + step)) for step in (h, -h)]
+        return (E[0] - E[1]) / (2 * h)
+
+    E_dot = (4 * rate(5e-5) - rate(1e-4)) / 3  # Richardson: error O(h⁴)
+    power = joint_reactions(system, q, s_dot, t)["beam"] @ poses(system, q, s_dot, t).y_dot[0]
+    scale = sum(abs(e) for e in system.energy(q, s_dot, t))
+    assert abs(power) > 1e-2 * scale  # the hub does work here
+    assert abs(E_dot - power) < 1e-8 * scale
+
+
+def test_hub_beam_energy_is_compiled_only():
+    """The interpreted hub path (``compiled=False``) has no energy of its own: it is refused,
+    naming why (its systems' default energy is then the reference one)."""
+    system = pq.scenes.spinning_beam(n_shapes=2)
+    interpreted = HubBeamEvaluator(system, compiled=False)
+    with pytest.raises(ValueError, match="method: the 'hub_beam' energy is compiled only.*compiled=False"):
+        interpreted.energy(np.full(system.n_q, 0.01), np.ones(system.n_s), 0.5)

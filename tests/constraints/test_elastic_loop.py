@@ -21,7 +21,7 @@ A, B, C, D = 0.3, 1.0, 0.8, 1.0  # crank, coupler (the beam), rocker, ground
 def _tip(beam, q_e):
     """The coupler's tip in its reference frame (the beam's slice at x = L, bent)."""
     station = np.array([beam.length])
-    return beam.slices(q_e, station, beam.station_data(station))[0][0]
+    return beam.slices(q_e, beam.slice_field(station, beam.station_data(station)))[0][0]
 
 
 @pytest.fixture(scope="module")

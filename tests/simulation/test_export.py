@@ -8,6 +8,7 @@ import pytest
 
 import projeq as pq
 from projeq.simulation.export import write_vtu_series
+from projeq.spatial import rotation_z
 from projeq.scenes.elastic import elastic_arm
 
 
@@ -74,3 +75,34 @@ def test_a_saved_run_is_exported_from_its_run_record(tmp_path):
     pq.Result.save(result, tmp_path / "bare.npz")
     with pytest.raises(ValueError, match="no run record"):
         write_vtu_series(pq.Result.load(tmp_path / "bare.npz"), tmp_path / "bare")
+
+
+def test_the_spin_up_beams_frames_are_its_centre_line_turned_by_the_hub(tmp_path):
+    """The default run's scene (a beam on a prescribed hub): each frame's points are the
+    centre line (x + u, v, w)(q_e) at the stations (RitzBeam.displacement) turned by the hub
+    angle θ(t) about z; ``displacement`` is the points less the first frame's, and
+    ``velocity`` the rate of the points along (q̇_e, 1) by central differences (an independent
+    statement of R J ẏ); the beam's line cells join neighbouring stations, and a beam alone
+    has no mechanism part."""
+    system = pq.scenes.spin_up_beam(n_shapes=2)
+    result = pq.simulate(system, 6.0, n_points=4)
+    pvd = write_vtu_series(result, tmp_path, name="beam", stations=5)
+    parts = [(d.attrib["part"], d.attrib["file"]) for d in ET.parse(pvd).getroot().iter("DataSet")]
+    assert [part for part, _ in parts] == ["0"] * 4
+    beam, hub = system.subsystem("beam"), system.joints[0]
+    x = np.linspace(0.0, beam.length, 5)
+
+    def centre_line(q_e, t):
+        return (beam.displacement(q_e, x) + np.outer(x, (1.0, 0.0, 0.0))) @ rotation_z(hub.angles(t)[0]).T
+
+    first, h = None, 1e-6
+    for (_, file), t, q_e, q_e_dot in zip(parts, result.t, result.q, result.s_dot):
+        mesh = meshio.read(tmp_path / file)
+        points = centre_line(q_e, t)
+        first = points if first is None else first
+        velocity = (centre_line(q_e + h * q_e_dot, t + h) - centre_line(q_e - h * q_e_dot, t - h)) / (2 * h)
+        np.testing.assert_allclose(mesh.points, points, rtol=0, atol=1e-12 * beam.length)
+        np.testing.assert_allclose(mesh.point_data["displacement"], points - first, rtol=0, atol=1e-12 * beam.length)
+        np.testing.assert_allclose(mesh.point_data["velocity"], velocity, rtol=0,
+                                   atol=1e-6 * (1.0 + np.abs(velocity).max()))
+        assert mesh.cells_dict["line"].tolist() == [[i, i + 1] for i in range(4)]

@@ -346,10 +346,11 @@ class RitzBeam(BeamProbes, Subsystem):
             Q[:, e(self.w_cols), e(self.w_cols)] = H["w"]
         return r0, Psi, Q
 
-    def slices(self, q_e: NDArray, x: NDArray | None = None, data=None):
+    def slices(self, q_e: NDArray, field: tuple | None = None):
         """r(x) and Φ_r(x, q_e) = ∂r/∂q_e = Ψ − e_x (Q q_e)ᵀ at the quadrature stations (or
-        at ``x`` with its ``station_data``): :meth:`slice_field` evaluated at q_e."""
-        r0, Psi, Q = self.slice_field(x, data) if x is not None else self._field
+        at those of ``field``, another :meth:`slice_field`, formed once by the caller):
+        the slice field evaluated at q_e."""
+        r0, Psi, Q = self._field if field is None else field
         Qq = Q @ q_e  # complex for the complex-step derivative of ports
         r = r0 + Psi @ q_e
         r[:, 0] -= 0.5 * (Qq @ q_e)  # u₂
@@ -370,7 +371,7 @@ class RitzBeam(BeamProbes, Subsystem):
         """(M_n, h_n) of B(25): the translation by the beam's integration strategy, the
         rotary inertia of the slices and the restoring forces (module docstring)."""
         omega, q_e_dot = y_dot[3:6], y_dot[6:]
-        self._check_spin(omega)
+        self.check_spin(omega)
         M, h = self.integrals.terms(y_dot, R, gravity, q_e)
         if self.rotary is not None:
             Jw, omega_c, c_w = self._slice_rotation(omega, q_e, q_e_dot, y_dot)
@@ -387,11 +388,11 @@ class RitzBeam(BeamProbes, Subsystem):
         if self.rotary is not None:
             M, h = self.gauss_terms(y_dot, R, gravity, q_e)
             return M[6:], h[6:]
-        self._check_spin(y_dot[3:6])
+        self.check_spin(y_dot[3:6])
         M_e, h_e = self.integrals.elastic_rows(y_dot, R, gravity, q_e)
         return M_e, h_e - self._restoring_force(q_e, y_dot[6:])
 
-    def _check_spin(self, omega: NDArray) -> None:
+    def check_spin(self, omega: NDArray) -> None:
         """Without stiffening a spin about an axis across the beam faster than its first
         bending frequency makes the model unstable (ω_lag² = ω₁² − Ω² < 0): allowed, but
         said by a RuntimeWarning whose text is fixed per beam, so that Python's warning
@@ -442,9 +443,13 @@ class RitzBeam(BeamProbes, Subsystem):
         return 0.5 * (y_dot @ M @ y_dot)
 
     def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray, q_e: NDArray) -> float:
-        """Gravity −∫ g·r_slice dm plus the strain energy ½ q_eᵀ K_e q_e."""
+        """Gravity −∫ g·r_slice dm (at the slices' positions only under gravity) plus the strain
+        energy ½ q_eᵀ K_e q_e."""
+        strain = 0.5 * q_e @ self.K_e @ q_e
+        if not np.any(gravity):
+            return strain
         r_x, _ = self.slices(q_e)
-        return -self.mass_weights @ (r_x @ R.T + r) @ gravity + 0.5 * q_e @ self.K_e @ q_e
+        return -self.mass_weights @ (r_x @ R.T + r) @ gravity + strain
 
     def port(self, point: NDArray, q_e: NDArray, q_e_dot: NDArray) -> Relative:
         """Kinematics of a frame attached at ``point`` of the undeformed beam (station
@@ -476,8 +481,8 @@ class RitzBeam(BeamProbes, Subsystem):
     def _port_terms(self, q_e, port):
         """(A, r, F) of ``port`` (a :class:`BeamPort`) from its field; complex-safe, for the
         complex-step Ḟ."""
-        (x, data), offset, angles = port.data, port.offset, port.field[3]
-        r_x, Phi_r = self.slices(q_e, x, data)
+        offset, angles = port.offset, port.field[3]
+        r_x, Phi_r = self.slices(q_e, tuple(constants[None] for constants in port.field[:3]))  # at the one station
         a, b, beta = angles @ q_e  # v′, −w′, β
         R_x = rotation_x(beta)
         A = rotation_z(a) @ rotation_y(b) @ R_x

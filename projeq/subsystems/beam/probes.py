@@ -28,9 +28,9 @@ class BeamProbes:
         """(u + u₂, v, w) at stations x in the beam's reference frame: for one q_e a
         (len(x), 3) array, for a trajectory of q_e (rows) a (n_t, len(x), 3) array."""
         x = self._stations(x)
-        data = self.station_data(x)
+        field = self.slice_field(x, self.station_data(x))
         q_e = np.asarray(q_e, dtype=float)
-        rows = [self.slices(q, x, data)[0] - np.outer(x, (1.0, 0.0, 0.0)) for q in np.atleast_2d(q_e)]
+        rows = [self.slices(q, field)[0] - np.outer(x, (1.0, 0.0, 0.0)) for q in np.atleast_2d(q_e)]
         return np.array(rows) if q_e.ndim == 2 else rows[0]
 
     def out_of_range(self, q_e) -> str | None:
@@ -62,16 +62,15 @@ class BeamProbes:
     def centre_line(self, q_e: NDArray, y_dot: NDArray, stations: int = 21) -> tuple[NDArray, NDArray]:
         """Positions r(x) and velocities J(x) ẏ of ``stations`` equally spaced points of the
         centre line, in the beam's reference frame (for drawing and export)."""
-        x, data = self._centre_line_stations(int(stations))
-        r, Phi_r = self.slices(q_e, x, data)
+        r, Phi_r = self.slices(q_e, self._centre_line_field(int(stations)))
         return r, self.jacobian(r, Phi_r) @ y_dot
 
     @functools.lru_cache(maxsize=4)  # noqa: B019 -- a handful of beams per run; drawing a series asks the same stations per frame
-    def _centre_line_stations(self, stations: int) -> tuple:
-        """The equally spaced stations of :meth:`centre_line` and their ``station_data``
-        (computed once per count: 40 % of writing a ParaView series of the spin-up beam before)."""
+    def _centre_line_field(self, stations: int) -> tuple:
+        """The slice field (``slice_field``) at the equally spaced stations of :meth:`centre_line`
+        (formed once per count: most of the centre line's cost in a ParaView series otherwise)."""
         x = np.linspace(0.0, self.length, stations)
-        return x, self.station_data(x)
+        return self.slice_field(x, self.station_data(x))
 
     def _coordinates(self, result) -> NDArray:
         """This beam's q_e along a trajectory (rows), found in ``result.system``; a plain
