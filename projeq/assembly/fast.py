@@ -226,13 +226,16 @@ class FastEvaluator:
         T = ½ Σ ẏ_nᵀ M_n ẏ_n with the kernel's M_n (those its passes use, an elastic body's at its
         q_e) and ẏ_n = (twist_n, ṡ_e) (the spatial twist: a planar body's is in its plane); V, the
         subsystems' and force laws' potentials at the kernel's poses
-        (:meth:`projeq.System.potential_energy`)."""
+        (:meth:`projeq.System.potential_energy`). Each beam's ``check_spin`` at its ω, as the
+        reference's terms do (the rows of :func:`projeq.simulate` say where a spin makes an
+        unstiffened beam unstable)."""
         q, s_dot, ws = kernels.kernel_array(q), kernels.kernel_array(s_dot), self._real
         self._kinematics(ws, q, s_dot, t)
         y_dot = ws.y_dot
         y_dot[:, :6] = ws.twist[:-1]
         for n, e_s in self._internal:
             y_dot[n, 6 : 6 + e_s.stop - e_s.start] = s_dot[e_s]
+            self.system.subsystems[n].check_spin(ws.twist[n, 3:6])
         kinetic = 0.5 * np.einsum("ni,nij,nj->", y_dot, ws.M_n, y_dot)
         potential = self.system.potential_energy(_SelectedKinematics(self.system, ws, s_dot), q)
         return float(kinetic), float(potential)

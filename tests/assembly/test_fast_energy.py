@@ -221,3 +221,18 @@ def test_hub_beam_energy_is_compiled_only():
     interpreted = HubBeamEvaluator(system, compiled=False)
     with pytest.raises(ValueError, match="method: the 'hub_beam' energy is compiled only.*compiled=False"):
         interpreted.energy(np.full(system.n_q, 0.01), np.ones(system.n_s), 0.5)
+
+
+@pytest.mark.parametrize("spin", [0.5, 3.0])
+def test_compiled_energy_says_where_an_unstiffened_beam_spins_too_fast(spin):
+    """A beam without stiffening in a tree, turned about an axis across it faster than its first
+    bending frequency, is unstable (ω_lag² = ω₁² − Ω² < 0): the compiled energy (what simulate's
+    rows call) says so by the beam's RuntimeWarning, as the reference terms do; slower, nothing."""
+    beam = pq.RitzBeam(1.0, 2.0, 1.0, n_v=2, n_w=0, stiffening=False, family="clamped_free")
+    system = pq.System({"hub": pq.RigidBody(1.0, (0.0, 0.0, 0.0), 0.1 * np.eye(3)), "beam": beam},
+                       {"hub": pq.Revolute(axis="z"), "beam": pq.Fixed("hub")})
+    s_dot = np.array([spin * beam.first_frequency, 0.0, 0.0])
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        system.energy(system.q0, s_dot, 0.0, method="fast")
+    assert [w.category for w in said] == ([RuntimeWarning] if spin > 1 else [])
