@@ -238,17 +238,12 @@ def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
                 Qqd += Q[k, i, l] * q_e_dot[l]
             quadratic += Qq[i] * q_e[i]
             rate += Qqd * q_e_dot[i]
-        r0_, r1, r2, d0, d1, d2 = r0[k, 0] - 0.5 * quadratic, r0[k, 1], r0[k, 2], 0.0, 0.0, 0.0
         for i in range(k_e):
             J[0, 6 + i] = Psi[k, 0, i] - Qq[i]
             J[1, 6 + i] = Psi[k, 1, i]
             J[2, 6 + i] = Psi[k, 2, i]
-            r0_ += Psi[k, 0, i] * q_e[i]
-            r1 += Psi[k, 1, i] * q_e[i]
-            r2 += Psi[k, 2, i] * q_e[i]
-            d0 += J[0, 6 + i] * q_e_dot[i]
-            d1 += J[1, 6 + i] * q_e_dot[i]
-            d2 += J[2, 6 + i] * q_e_dot[i]
+        p0, p1, p2, d0, d1, d2 = _image(Psi[k], J, q_e, q_e_dot)  # Ψ q_e and ṙ = Φ_r q̇_e
+        r0_, r1, r2 = r0[k, 0] - 0.5 * quadratic + p0, r0[k, 1] + p1, r0[k, 2] + p2
         J[0, 4], J[0, 5], J[1, 3], J[1, 5], J[2, 3], J[2, 4] = r2, -r1, -r2, r0_, r1, -r0_  # −r̃
         # c = ω̃ ṙ + ω̃ (v + ω̃ r + ṙ) − g = ω̃ u − g with u = v + ω̃ r + 2 ṙ
         u0 = twist[0] + w1 * r2 - w2 * r1 + 2.0 * d0
@@ -267,6 +262,20 @@ def elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, twist, g, M, h):
     for i in range(k_e):
         for l in range(k_e):
             h[6 + i] -= K_e[i, l] * (q_e[l] + damping * q_e_dot[l])
+
+
+def _image(P, J, q_e, q_e_dot):
+    """(P q_e, J[:, 6:] q̇_e) as six scalars: a station's field (3 × n_e) at q_e and the rate
+    that the elastic columns of its Jacobian J (3 × n_y) give."""
+    p0, p1, p2, d0, d1, d2 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    for i in range(q_e.shape[0]):
+        p0 += P[0, i] * q_e[i]
+        p1 += P[1, i] * q_e[i]
+        p2 += P[2, i] * q_e[i]
+        d0 += J[0, 6 + i] * q_e_dot[i]
+        d1 += J[1, 6 + i] * q_e_dot[i]
+        d2 += J[2, 6 + i] * q_e_dot[i]
+    return p0, p1, p2, d0, d1, d2
 
 
 def rotary_body(I, Phi_theta, T, q_e, q_e_dot, twist, M, h):
@@ -298,14 +307,8 @@ def rotary_body(I, Phi_theta, T, q_e, q_e_dot, twist, M, h):
             J[0, 6 + i] = Phi_theta[k, 0, i] + T_q + q_T  # ∂θ/∂q_e, turned below
             J[1, 6 + i] = Phi_theta[k, 1, i]
             J[2, 6 + i] = Phi_theta[k, 2, i]
-        t0, t1, t2, d0, d1, d2 = tau, 0.0, 0.0, 0.0, 0.0, 0.0
-        for i in range(k_e):
-            t0 += Phi_theta[k, 0, i] * q_e[i]
-            t1 += Phi_theta[k, 1, i] * q_e[i]
-            t2 += Phi_theta[k, 2, i] * q_e[i]
-            d0 += J[0, 6 + i] * q_e_dot[i]
-            d1 += J[1, 6 + i] * q_e_dot[i]
-            d2 += J[2, 6 + i] * q_e_dot[i]
+        t0, t1, t2, d0, d1, d2 = _image(Phi_theta[k], J, q_e, q_e_dot)  # θ − τ e_x and θ̇
+        t0 += tau
         for i in range(k_e):  # (E − ½θ̃) ∂θ/∂q_e
             a0, a1, a2 = J[0, 6 + i], J[1, 6 + i], J[2, 6 + i]
             J[0, 6 + i] = a0 - 0.5 * (t1 * a2 - t2 * a1)
@@ -878,8 +881,8 @@ def state_kernels(loads, compiled: bool = True, rigid: bool = False):
 
 
 _CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
-            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, elastic_body, rotary_body, port_motion,
-            hub_motion)
+            _add_congruence, _add_congruence_general, cholesky, cholesky_solve, _image, elastic_body, rotary_body,
+            port_motion, hub_motion)
 
 
 @functools.cache
