@@ -251,10 +251,10 @@ def planar_joint(kind: str, parent, rng) -> pq.Joint:
 
 
 # -- forces --------------------------------------------------------------------------------
-def _force(kind, names, kinds, rng, planar: bool, damped: bool, constant: bool = False, dofs=None):
-    """A random force law of ``kind`` (None when the tree has no joint it can act on); loads
-    given as callables half of the time unless ``constant``; ``dofs``: each joint's number of
-    minimal velocities (default: by its kind)."""
+def _force(kind, names, kinds, dofs, rng, planar: bool, damped: bool, constant: bool = False):
+    """A random force law of ``kind`` (None when the tree has no joint it can act on) on the
+    joints ``names`` of ``kinds`` with ``dofs`` minimal velocities each; loads given as callables
+    half of the time unless ``constant``."""
     body = names[rng.integers(len(names))]
     point = rng.uniform(-0.5, 0.5, 3)
     if planar:
@@ -289,10 +289,7 @@ def _force(kind, names, kinds, rng, planar: bool, damped: bool, constant: bool =
         if not candidates:
             return None
         joint = candidates[rng.integers(len(candidates))]
-        n_s = dofs[names.index(joint)] if dofs else {"planar": 3, "free": 6, "spherical": 3, "car": 2, "car_sympy": 2}.get(
-            kinds[names.index(joint)], 1
-        )
-        tau = rng.uniform(-3, 3, n_s)
+        tau = rng.uniform(-3, 3, dofs[names.index(joint)])
         if constant or rng.random() < 0.5:
             return pq.JointForce(joint, tau)
         return pq.JointForce(joint, lambda t, q, s_dot: tau * np.sin(2 * t))
@@ -392,7 +389,8 @@ def trees(
         else:
             subsystems[name] = pq.RigidBody(m, r_c, random_inertia(rng, m))
             joints[name] = spatial_joint(joint_kinds[i], parent, rng)
-    laws = [_force(k, names, joint_kinds, rng, planar, damped=forces in (True, "constant"),
+    dofs = [joints[name].n_s for name in names]
+    laws = [_force(k, names, joint_kinds, dofs, rng, planar, damped=forces in (True, "constant"),
                    constant=forces == "constant") for k in force_kinds]
     gravity = rng.uniform(-10, 10, 3)
     if planar:
@@ -428,7 +426,7 @@ def with_every_law(tree) -> pq.System:
     system, rng = tree.system, tree.rng
     kinds = tree.kinds + [type(joint).__name__.lower() for joint in system.joints[len(tree.kinds):]]  # beams' joints
     dofs = [joint.n_s for joint in system.joints]
-    laws = [_force(kind, list(system.names), kinds, rng, tree.planar, damped=True, constant=True, dofs=dofs)
+    laws = [_force(kind, list(system.names), kinds, dofs, rng, tree.planar, damped=True, constant=True)
             for kind in FORCE_KINDS + ("force", "torque", "spring_damper")]
     return pq.System(dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints)),
                      gravity=system.gravity, forces=list(system.forces) + [law for law in laws if law is not None])
