@@ -56,6 +56,7 @@ import hashlib
 import os
 import re
 import tempfile
+import types
 import warnings
 import weakref
 from pathlib import Path
@@ -65,10 +66,11 @@ from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import kernels, loads
-from projeq.assembly.kernels import cholesky, cholesky_solve
+from projeq.assembly.kernels import N_COLS, N_Y, PARENT, S_INDEX, _add_cross, _dot, cholesky, cholesky_solve
 from projeq.assembly.linalg import SINGULAR_PIVOT
 from projeq.checks import depends_on_t
 from projeq.constraints.batched import NODES, WEIGHTS
+from projeq.constraints.cut_joints import point_rows
 
 #: flags of the kernels (:func:`partitioned`, :func:`tangent`): done; partition bound reached (or
 #: A_dep, N_ind singular); FᵀMF not positive definite; a force law without a value (a spring-damper
@@ -376,11 +378,19 @@ def _given_motions(joints, q, s_dot_tree, t, given):
         _given_into(joints[g, 5], q[q0:q0 + n_q], s_dot_tree[s0:s0 + n_s], t, given[n])
 
 
-def _constraint_rows(phi, pfaffian, q, t, m_h, A):
-    """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree): Φ_q by :func:`_jacobian` in the first ``m_h`` rows,
-    the Pfaffian rows A(q) (``pfaffian``, as Φ in :func:`_phi_into`) below them."""
-    _jacobian(phi, q, t, A[:m_h])
+def _constraint_rows(phi, pins, points, pfaffian, joints, tree, q, t, m_h, A):
+    """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree): the first ``m_h`` rows Φ_q by :func:`_jacobian`, or for cut
+    joints (``pins``, ``points``: :func:`pin_table`) by :func:`_pin_jacobian` from the tree's chain
+    terms at q (its joints of kind GIVEN stated at rest: positions and F⁶ need no velocities); the
+    Pfaffian rows A(q) (``pfaffian``, as Φ in :func:`_phi_into`) below them."""
     n, m_p = q.shape[0], A.shape[0] - m_h
+    if pins.shape[0]:
+        rest = np.zeros(n)
+        _given_motions(joints, q, rest, t, tree[4])
+        _chain_terms(tree, q, rest)
+        _pin_jacobian(pins, points, tree[0], tree[7], tree[9], tree[12], A[:m_h])
+    else:
+        _jacobian(phi, q, t, A[:m_h])
     if m_p > 0:
         x, value = np.empty(n, np.complex128), np.empty((m_p, n), np.complex128)
         for i in range(n):
@@ -391,11 +401,16 @@ def _constraint_rows(phi, pfaffian, q, t, m_h, A):
                 A[m_h + r, j] = value[r, j].real
 
 
-def _constraint_gamma(phi, pfaffian, q, q_dot, t, m_h, m):
-    """γ = [Φ″(q̇, q̇); (∂(A q̇)/∂q) q̇] at q̇ = ṡ_tree: Φ″ by :func:`_gamma`, the Pfaffian part as the
-    numpy path takes it, Im (A(q + i h q̇) q̇) / h (A independent of t, b = 0: :func:`unsupported`)."""
+def _constraint_gamma(phi, pins, points, pfaffian, tree, q, q_dot, t, m_h, m):
+    """γ = [Φ″(q̇, q̇); (∂(A q̇)/∂q) q̇] at q̇ = ṡ_tree: Φ″ by :func:`_gamma`, or for cut joints by
+    :func:`_pin_gamma` from the tree's chain terms at (q, ṡ_tree) (computed before); the Pfaffian
+    part as the numpy path takes it, Im (A(q + i h q̇) q̇) / h (A independent of t, b = 0:
+    :func:`unsupported`)."""
     gamma = np.zeros(m)
-    gamma[:m_h] = _gamma(phi, q, q_dot, t, m_h)
+    if pins.shape[0]:
+        _pin_gamma(pins, points, tree[0], tree[7], tree[8], tree[12], tree[14], gamma[:m_h])
+    else:
+        gamma[:m_h] = _gamma(phi, q, q_dot, t, m_h)
     n, m_p = q.shape[0], m - m_h
     if m_p > 0:
         x, value = np.empty(n, np.complex128), np.empty((m_p, n), np.complex128)
@@ -408,6 +423,74 @@ def _constraint_gamma(phi, pfaffian, q, q_dot, t, m_h, m):
                 total += value[r, j].imag * q_dot[j]
             gamma[m_h + r] = total / COMPLEX_STEP
     return gamma
+
+
+def _pin_jacobian(pins, points, index, T, F, R, A):
+    """A[r] ← the row ∂Φ_r/∂ṡ_tree of cut-joint row r (one inertial ``axis`` of P_a − P_b, the
+    points ρ_a, ρ_b of bodies a, b in body axes; b = −1: an inertial point), from the point's
+    velocity R_n (v_n + ω_n × ρ) with the body's twist (v_n, ω_n) = J_n ṡ_tree: the Jacobians
+    J_n = ∂ẏ_n/∂ṡ_tree by the chain, J_n = T_np J_p + F_n (in the columns of joint n's ṡ_n)."""
+    N, width, n_s = index.shape[0], T.shape[1], A.shape[1]
+    n_y, parent, s_index, n_cols = index[:, N_Y], index[:, PARENT], index[:, S_INDEX], index[:, N_COLS]
+    J = np.zeros((N, width, n_s))
+    for n in range(N):  # root → leaves
+        p, m = parent[n], n_y[n]
+        if p >= 0:
+            for a in range(m):
+                for j in range(n_s):
+                    total = 0.0
+                    for c in range(n_y[p]):
+                        total += T[n, a, c] * J[p, c, j]
+                    J[n, a, j] = total
+        for c in range(n_cols[n]):
+            for a in range(m):
+                J[n, a, s_index[n] + c] += F[n, a, c]
+    A[:, :] = 0.0
+    v = np.empty(3)
+    for r in range(pins.shape[0]):
+        axis = pins[r, 2]
+        for side in range(2):
+            n = pins[r, side]
+            if n < 0:
+                continue
+            sign = 1.0 if side == 0 else -1.0
+            rho = points[r, side]
+            for j in range(n_s):  # v + ω × ρ of the unit velocity ṡ_tree = e_j
+                v[0] = J[n, 0, j] + J[n, 4, j] * rho[2] - J[n, 5, j] * rho[1]
+                v[1] = J[n, 1, j] + J[n, 5, j] * rho[0] - J[n, 3, j] * rho[2]
+                v[2] = J[n, 2, j] + J[n, 3, j] * rho[1] - J[n, 4, j] * rho[0]
+                A[r, j] += sign * (R[n, axis, 0] * v[0] + R[n, axis, 1] * v[1] + R[n, axis, 2] * v[2])
+
+
+def _pin_gamma(pins, points, index, T, zeta, R, twist, gamma):
+    """γ_r = (Φ̈_r at s̈_tree = 0) of cut-joint row r: the point's acceleration
+    R_n (v̇ + ω̇ × ρ + ω × (v + ω × ρ)) with the twist (v, ω) and its rate (v̇, ω̇) = ζ̄_n at s̈ = 0,
+    ζ̄_n = T_np ζ̄_p + ζ_n (the components' derivatives in body axes, docs/theory.md §4)."""
+    N, width = index.shape[0], T.shape[1]
+    n_y, parent = index[:, N_Y], index[:, PARENT]
+    zeta_bar = np.zeros((N, width))
+    for n in range(N):  # root → leaves
+        p = parent[n]
+        for a in range(n_y[n]):
+            zeta_bar[n, a] = zeta[n, a] + (_dot(T[n, a], zeta_bar[p], n_y[p]) if p >= 0 else 0.0)
+    u, acc = np.empty(3), np.empty(3)
+    for r in range(pins.shape[0]):
+        axis = pins[r, 2]
+        gamma[r] = 0.0
+        for side in range(2):
+            n = pins[r, side]
+            if n < 0:
+                continue
+            sign = 1.0 if side == 0 else -1.0
+            rho, w = points[r, side], twist[n, 3:6]
+            for a in range(3):  # u = v + ω × ρ
+                u[a] = twist[n, a]
+            _add_cross(w, rho, u)
+            for a in range(3):  # v̇ + ω̇ × ρ + ω × u
+                acc[a] = zeta_bar[n, a]
+            _add_cross(zeta_bar[n, 3:6], rho, acc)
+            _add_cross(w, u, acc)
+            gamma[r] += sign * (R[n, axis, 0] * acc[0] + R[n, axis, 1] * acc[1] + R[n, axis, 2] * acc[2])
 
 
 def _jacobian(phi, q, t, A):
@@ -462,17 +545,27 @@ def _matmul(A, B):
     return out
 
 
-def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
-    """The tree's M, b at (q, ṡ_tree) by the compiled kernels, the loads of its force laws added to
-    h_n by their compiled rows (:func:`projeq.assembly.loads.add_loads`, the loop of the fast
-    evaluator), then s̈ from Fᵀ(M (F s̈ + f̄) + b) = 0 and s̈_tree ← F s̈ + f̄; DONE, UNLOADED where a
-    law cannot be evaluated, or SINGULAR where a squared pivot of FᵀMF is not above ``pivot`` times
-    its largest diagonal entry."""
+def _chain_terms(tree, q, s_dot_tree):
+    """The tree's chain terms, poses, twists and h_n at (q, ṡ_tree) into its workspace (the
+    relative motions of its joints of kind GIVEN stated before)."""
     index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist, laws, constants = tree
     chain_terms(index, geometry, inertia, gravity, q, s_dot_tree, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O,
                 twist)
-    if laws.shape[0] and add_loads(laws, constants, index, q, s_dot_tree, R, r_O, twist, F_n, T, h) >= 0:
-        return UNLOADED
+
+
+def _loaded(tree, q, s_dot_tree):
+    """The loads of the tree's force laws added to h_n by their compiled rows
+    (:func:`projeq.assembly.loads.add_loads`, the loop of the fast evaluator) after
+    :func:`_chain_terms`; False where a law cannot be evaluated."""
+    index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist, laws, constants = tree
+    return not (laws.shape[0] and add_loads(laws, constants, index, q, s_dot_tree, R, r_O, twist, F_n, T, h) >= 0)
+
+
+def _projected(tree, F, f_bar, pivot, M, b, s_ddot_tree):
+    """The tree's M, b by the compiled kernels from its chain terms (:func:`_chain_terms`,
+    :func:`_loaded`), then s̈ from Fᵀ(M (F s̈ + f̄) + b) = 0 and s̈_tree ← F s̈ + f̄; DONE, or SINGULAR
+    where a squared pivot of FᵀMF is not above ``pivot`` times its largest diagonal entry."""
+    index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist, laws, constants = tree
     gauss_form(index, T, zeta, F_n, M_n, h, M, b)
     n, k = F.shape
     MF, g = np.zeros((n, k)), b.copy()  # M F and M f̄ + b
@@ -506,8 +599,8 @@ def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
     return DONE
 
 
-def partitioned(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot, q_dot,
-                s_ddot_tree, A, M, b):
+def partitioned(phi, pins, points, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
+                q_dot, s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (module
     docstring) from Φ (``phi``: :func:`_phi_into`; ``m_h`` rows) and the Pfaffian rows A(q)
     (``pfaffian``), the tree's packed arrays and workspace (``tree``: those of
@@ -516,7 +609,7 @@ def partitioned(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, depe
     A_s = [Φ_q; A], M and b; returns DONE, SINGULAR (:func:`_projected`) or DEGENERATE where
     ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
     n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
-    _constraint_rows(phi, pfaffian, q, t, m_h, A)
+    _constraint_rows(phi, pins, points, pfaffian, joints, tree, q, t, m_h, A)
     A_dep = np.empty((m, m))
     for r in range(m):
         for c in range(m):
@@ -534,24 +627,27 @@ def partitioned(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, depe
             F[dependent[r], c] = -total
     s_dot_tree = _matvec(F, s_dot)
     q_dot[:] = s_dot_tree
-    gamma = _constraint_gamma(phi, pfaffian, q, s_dot_tree, t, m_h, m)
+    _given_motions(joints, q, s_dot_tree, t, tree[4])
+    _chain_terms(tree, q, s_dot_tree)
+    if not _loaded(tree, q, s_dot_tree):
+        return UNLOADED
+    gamma = _constraint_gamma(phi, pins, points, pfaffian, tree, q, s_dot_tree, t, m_h, m)
     f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
     minus_gamma = _matvec(inv, -gamma)
     for r in range(m):
         f_bar[dependent[r]] = minus_gamma[r]
-    _given_motions(joints, q, s_dot_tree, t, tree[4])
-    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+    return _projected(tree, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
-def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept, pivot, q_dot,
-            s_ddot_tree, A, M, b):
+def tangent(phi, pins, points, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept,
+            pivot, q_dot, s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.tangent.TangentSystem`: F = N N_ind⁻¹ with
     N the null space of A_s = U Σ Vᵀ continued along the branch (``kept``: the tangent kept last,
     n × n_s, NaN where none; overwritten where the null space is separated, its rule), f̄ =
     x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) over the ``rank`` largest singular values above
     ``acting`` σ_max; otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular."""
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
-    _constraint_rows(phi, pfaffian, q, t, m_h, A)
+    _constraint_rows(phi, pins, points, pfaffian, joints, tree, q, t, m_h, A)
     U, sigma, Vt = _svd(A)
     near = 0  # the singular values below separation σ_max, at least k
     for value in sigma:
@@ -568,13 +664,16 @@ def tangent(phi, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, se
         return DEGENERATE
     s_dot_tree = _matvec(F, s_dot)
     q_dot[:] = s_dot_tree
-    gamma = _constraint_gamma(phi, pfaffian, q, s_dot_tree, t, m_h, m)
+    _given_motions(joints, q, s_dot_tree, t, tree[4])
+    _chain_terms(tree, q, s_dot_tree)
+    if not _loaded(tree, q, s_dot_tree):
+        return UNLOADED
+    gamma = _constraint_gamma(phi, pins, points, pfaffian, tree, q, s_dot_tree, t, m_h, m)
     count = 0  # the singular values above acting σ_max, at most rank
     for value in sigma:
         count += value > acting * sigma[0]
     f_bar = _particular(U, sigma, Vt, gamma, min(count, rank), F, independent)
-    _given_motions(joints, q, s_dot_tree, t, tree[4])
-    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+    return _projected(tree, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
 def _scaled(N: NDArray, independent: NDArray) -> NDArray:
@@ -803,8 +902,9 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _given_motions, _matvec, _matmul, _svd,
-            _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _projected, _inverse)
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pin_jacobian, _pin_gamma, _given_motions,
+            _matvec, _matmul, _svd, _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms,
+            _loaded, _projected, _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
@@ -829,7 +929,8 @@ def _closure(system, rule: str, constant: float) -> "CompiledClosure | None":
     tree = system.tree
     given = tree.evaluator("fast")._given
     phi = f"Φ ({getattr(system._phi, '__qualname__', repr(system._phi))})"
-    pieces = {phi: closure_callback(system._phi, system.n_q, system.m_h, system.q0)}
+    pins = pin_table(system._phi, system.m_h)
+    pieces = {phi: _NO_CALLBACK if pins[0].shape[0] else closure_callback(system._phi, system.n_q, system.m_h, system.q0)}
     if system.m_p:
         pieces["the Pfaffian rows A"] = closure_callback(system._A, system.n_q, (system.m_p, system.n_q), system.q0, "A")
     pieces.update({f"the relative motion of joint {tree.names[n]!r}": joint_callback(tree.joints[n]) for n in given})
@@ -838,7 +939,23 @@ def _closure(system, rule: str, constant: float) -> "CompiledClosure | None":
         system._uncompiled = f"numba cannot compile {', '.join(failed)}"
         return None
     return CompiledClosure(tree, system.n_c, pieces[phi], rule, (constant,), m_h=system.m_h,
-                           pfaffian=pieces.get("the Pfaffian rows A"))
+                           pfaffian=pieces.get("the Pfaffian rows A"), pins=pins)
+
+
+#: the Φ "callback" of a closure made of cut joints: the kernels evaluate them themselves
+#: (:func:`_pin_jacobian`, :func:`_pin_gamma`) and never call it
+_NO_CALLBACK = types.SimpleNamespace(address=0)
+
+
+def pin_table(phi, m_h: int) -> tuple[NDArray, NDArray]:
+    """The rows of Φ that are cut joints (:meth:`~projeq.constraints.cut_joints.PinClosure.point_rows`)
+    as the kernels read them: (pins, points) with pins[r] = (a, b, inertial axis) and points[r] =
+    (ρ_a, ρ_b); empty where Φ is a user's function (its rows by the complex step)."""
+    rows = point_rows(phi) or []
+    pins = np.array([row[:3] for row in rows], dtype=np.int64).reshape(len(rows), 3)
+    points = np.array([row[3:] for row in rows], dtype=float).reshape(len(rows), 2, 3)
+    assert not rows or len(rows) == m_h
+    return pins, points
 
 
 class CompiledClosure:
@@ -852,10 +969,11 @@ class CompiledClosure:
     A itself and the joints' ``compiled_values`` functions (for testing)."""
 
     def __init__(self, tree, m: int, callback, rule: str, constants: tuple, compiled: bool = True,
-                 m_h: int | None = None, pfaffian=None):
+                 m_h: int | None = None, pfaffian=None, pins=None):
         # the callbacks live as long as this object, which passes their addresses
         ev = self.fast = tree.evaluator("fast")
         self.callback, self.rule, self.constants, self.m_h = callback, rule, constants, m if m_h is None else m_h
+        self.pins, self.points = pin_table(None, 0) if pins is None else pins
         self._callbacks = [pfaffian] + [joint_callback(tree.joints[n]) if compiled else None for n in ev._given]
         if compiled:
             self.kernel, self.phi, self.pfaffian = _compiled()[rule], callback.address, \
@@ -877,12 +995,12 @@ class CompiledClosure:
         M, b = self._workspace.M_all, self._workspace.b_all
         q, s_dot, t = kernels.kernel_array(q), kernels.kernel_array(s_dot), float(t)
         if self.rule == "partitioned":
-            flag = self.kernel(self.phi, self.pfaffian, self.joints, self.tree, q, s_dot, t, self.m_h,
-                               system.independent, system.dependent,
+            flag = self.kernel(self.phi, self.pins, self.points, self.pfaffian, self.joints, self.tree, q, s_dot, t,
+                               self.m_h, system.independent, system.dependent,
                                self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b)
         else:
-            flag = self.kernel(self.phi, self.pfaffian, self.joints, self.tree, q, s_dot, t, self.m_h,
-                               system.independent, system.tree.n_s - system.n_s,
+            flag = self.kernel(self.phi, self.pins, self.points, self.pfaffian, self.joints, self.tree, q, s_dot, t,
+                               self.m_h, system.independent, system.tree.n_s - system.n_s,
                                system.separation, self.constants[0], self._kept_tangent(system), SINGULAR_PIVOT,
                                self._q_dot, self._s_ddot_tree, self._A, M, b)
         return flag == DONE

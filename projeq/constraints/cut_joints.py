@@ -65,9 +65,19 @@ class PinClosure:
         return rho if n is None else kin.r[n] + kin.R[n] @ rho
 
     def __call__(self, q, t: float = 0.0) -> NDArray:
-        """Φ = (P_a − P_b)[axes] in inertial coordinates."""
-        kin = poses(self.tree, np.asarray(q, dtype=float), np.zeros(self.tree.n_s), float(t))
+        """Φ = (P_a − P_b)[axes] in inertial coordinates; complex q gives complex Φ (the
+        complex step's exact derivatives, Martins, Sturdza & Alonso 2003)."""
+        return self.difference(_poses(self.tree, q, t))
+
+    def difference(self, kin) -> NDArray:
+        """(P_a − P_b)[axes] at the tree's poses ``kin``."""
         return (self._point(kin, self.a, self.rho_a) - self._point(kin, self.b, self.rho_b))[self.rows]
+
+    def point_rows(self) -> list:
+        """One (a, b, axis, ρ_a, ρ_b) per row of Φ (b = −1: the inertial point ρ_b), the
+        statement the compiled closure kernel evaluates (projeq.constraints.compiled)."""
+        b = -1 if self.b is None else self.b
+        return [(self.a, b, axis, self.rho_a, self.rho_b) for axis in self.rows]
 
     def wrenches(self, kin, lam: NDArray) -> dict:
         """{n: w_n}: the joint's force λ (inertial, rows of ``axes``) on a at P_a and −λ on b
@@ -82,3 +92,44 @@ class PinClosure:
         w = np.concatenate((f_body, cross(rho, f_body)))  # force and moment about O_n, body axes
         S = self.tree.S[n]
         return w if S is None else S @ w
+
+
+class CutJoints:
+    """Φ(q, t) of several cut joints of one tree: the :class:`PinClosure` rows stacked in the
+    order given (what :class:`~projeq.constraints.partitioned.ConstrainedSystem` makes of
+    ``phi=[pin_1, pin_2, …]``)."""
+
+    def __init__(self, pins):
+        pins = list(pins)
+        if not pins or not all(isinstance(pin, PinClosure) for pin in pins):
+            raise ValueError(f"phi: expected a callable or a list of PinClosure, got {pins!r}")
+        if any(pin.tree is not pins[0].tree for pin in pins):
+            raise ValueError("phi: the cut joints belong to different trees")
+        self.pins, self.tree = pins, pins[0].tree
+
+    def __call__(self, q, t: float = 0.0) -> NDArray:
+        """Φ = the pins' (P_a − P_b)[axes], stacked; complex q gives complex Φ."""
+        kin = _poses(self.tree, q, t)
+        return np.concatenate([pin.difference(kin) for pin in self.pins])
+
+    def point_rows(self) -> list:
+        """The pins' :meth:`PinClosure.point_rows`, stacked."""
+        return [row for pin in self.pins for row in pin.point_rows()]
+
+
+def cut_joints(phi):
+    """``phi`` as ConstrainedSystem keeps it: a list or tuple of :class:`PinClosure` as one
+    :class:`CutJoints`, anything else as it is."""
+    return CutJoints(phi) if isinstance(phi, (list, tuple)) else phi
+
+
+def _poses(tree, q, t):
+    """The tree's poses at q and t (real or complex: the complex step), at rest."""
+    q = np.asarray(q)
+    return poses(tree, q.astype(np.result_type(q, float)), np.zeros(tree.n_s), t)
+
+
+def point_rows(phi) -> list | None:
+    """The (a, b, axis, ρ_a, ρ_b) rows of ``phi`` if it is made of cut joints (:class:`PinClosure`,
+    :class:`CutJoints`), else None."""
+    return phi.point_rows() if isinstance(phi, (PinClosure, CutJoints)) else None

@@ -77,6 +77,7 @@ from numpy.typing import NDArray
 from projeq.assembly.linalg import solve_spd
 from projeq.constraints.batched import batched_closure
 from projeq.constraints.compiled import OWN_RULE, compiled_partition, uncompiled, unsupported
+from projeq.constraints.cut_joints import cut_joints, point_rows
 from projeq.checks import depends_on_t, positive, state_vector
 from projeq.analysis.differentiation import (complex_failure, derivative_along, derivative_along_differences,
                                              second_derivative_along, second_derivative_along_differences,
@@ -109,8 +110,9 @@ class ConstrainedSystem(Model):
     ----------
     system : System
         The tree (cut the loops open: each closing joint becomes a constraint).
-    phi : callable ``phi(q, t) -> (m_h,)``, optional
-        Holonomic constraints Φ(q, t) = 0 (loop closures).
+    phi : callable ``phi(q, t) -> (m_h,)``, or a list of PinClosure, optional
+        Holonomic constraints Φ(q, t) = 0 (loop closures); a list of cut joints
+        (:class:`~projeq.constraints.cut_joints.PinClosure`) stacks their closures.
     A, b : callables ``A(q, t) -> (m_p, n_q)``, ``b(q, t) -> (m_p,)``, optional
         Pfaffian constraints A q̇ = b (b defaults to 0).
     independent : sequence of int, optional
@@ -155,6 +157,7 @@ class ConstrainedSystem(Model):
                  repivot: bool | None = None):
         if phi is None and A is None:
             raise ValueError("phi: give holonomic constraints phi(q, t) and/or Pfaffian ones A(q, t)")
+        phi = cut_joints(phi)
         for name, f in (("phi", phi), ("A", A), ("b", b)):
             if f is not None and not callable(f):
                 raise ValueError(f"{name}: expected a callable {name}(q, t), got {f!r}")
@@ -174,8 +177,10 @@ class ConstrainedSystem(Model):
             self._constraint_rows("b", b, (q0, 0.0), 1, self.m_p)
         self.n_c = self.n_lambda = self.m_h + self.m_p
         self.exact = self._choose_derivatives(q0)
-        self._closure = batched_closure(phi, self.n_q, np.append(q0, 0.0), self.m_h) if self.exact and self.m_h \
-            else None  # Φ's derivatives from one call at a batch of points (projeq.constraints.batched)
+        # Φ's derivatives from one call at a batch of points (projeq.constraints.batched); the cut
+        # joints' points are the compiled kernel's own (projeq.constraints.compiled), pointwise here
+        self._closure = batched_closure(phi, self.n_q, np.append(q0, 0.0), self.m_h) \
+            if self.exact and self.m_h and point_rows(phi) is None else None
         if correction == "projection" and self.m_h and depends_on_t(self.phi, q0):  # q is normalised without t
             raise ValueError("correction: 'projection' needs Φ independent of t (q is normalised without the "
                              "time); use correction='baumgarte' for rheonomic constraints")
