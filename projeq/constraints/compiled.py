@@ -66,7 +66,8 @@ from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import kernels, loads
-from projeq.assembly.kernels import N_COLS, N_Y, PARENT, S_INDEX, _add_cross, _dot, cholesky, cholesky_solve
+from projeq.assembly.kernels import (N_COLS, N_Y, PARENT, S_INDEX, _add_cross, _add_motion_cross, _chain_matrix, _dot,
+                                     _dot6, cholesky, cholesky_solve, port_motion)
 from projeq.assembly.linalg import SINGULAR_PIVOT
 from projeq.checks import depends_on_t
 from projeq.constraints.batched import NODES, WEIGHTS
@@ -127,9 +128,6 @@ def _tree_piece(tree) -> str | None:
                 "Python (not a UserJoint from sympy)")
     if ev._expansion is not None:
         return "coupled joints (shared minimal velocities)"
-    if ev._width > 6:
-        name = next(name for name, body in zip(tree.names, tree.subsystems) if body.n_e)
-        return f"subsystem {name!r} is elastic"
     for i, law in enumerate(tree.forces):
         if law.compiled_terms() is None:
             return (f"force law {i} ({type(law).__name__}) has no compiled row (a callable load, or a law "
@@ -378,7 +376,7 @@ def _given_motions(joints, q, s_dot_tree, t, given):
         _given_into(joints[g, 5], q[q0:q0 + n_q], s_dot_tree[s0:s0 + n_s], t, given[n])
 
 
-def _constraint_rows(phi, pins, points, pfaffian, joints, tree, q, t, m_h, A):
+def _constraint_rows(phi, pins, points, ports, pfaffian, joints, tree, q, t, m_h, A):
     """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree): the first ``m_h`` rows Φ_q by :func:`_jacobian`, or for cut
     joints (``pins``, ``points``: :func:`pin_table`) by :func:`_pin_jacobian` from the tree's chain
     terms at q (its joints of kind GIVEN stated at rest: positions and F⁶ need no velocities); the
@@ -388,7 +386,7 @@ def _constraint_rows(phi, pins, points, pfaffian, joints, tree, q, t, m_h, A):
         rest = np.zeros(n)
         _given_motions(joints, q, rest, t, tree[4])
         _chain_terms(tree, q, rest)
-        _pin_jacobian(pins, points, tree[0], tree[7], tree[9], tree[12], A[:m_h])
+        _pin_jacobian(pins, points, ports, tree, q, A[:m_h])
     else:
         _jacobian(phi, q, t, A[:m_h])
     if m_p > 0:
@@ -401,14 +399,14 @@ def _constraint_rows(phi, pins, points, pfaffian, joints, tree, q, t, m_h, A):
                 A[m_h + r, j] = value[r, j].real
 
 
-def _constraint_gamma(phi, pins, points, pfaffian, tree, q, q_dot, t, m_h, m):
+def _constraint_gamma(phi, pins, points, ports, pfaffian, tree, q, q_dot, t, m_h, m):
     """γ = [Φ″(q̇, q̇); (∂(A q̇)/∂q) q̇] at q̇ = ṡ_tree: Φ″ by :func:`_gamma`, or for cut joints by
     :func:`_pin_gamma` from the tree's chain terms at (q, ṡ_tree) (computed before); the Pfaffian
     part as the numpy path takes it, Im (A(q + i h q̇) q̇) / h (A independent of t, b = 0:
     :func:`unsupported`)."""
     gamma = np.zeros(m)
     if pins.shape[0]:
-        _pin_gamma(pins, points, tree[0], tree[7], tree[8], tree[12], tree[14], gamma[:m_h])
+        _pin_gamma(pins, points, ports, tree, q, q_dot, gamma[:m_h])
     else:
         gamma[:m_h] = _gamma(phi, q, q_dot, t, m_h)
     n, m_p = q.shape[0], m - m_h
@@ -425,12 +423,82 @@ def _constraint_gamma(phi, pins, points, pfaffian, tree, q, q_dot, t, m_h, m):
     return gamma
 
 
-def _pin_jacobian(pins, points, index, T, F, R, A):
-    """A[r] ← the row ∂Φ_r/∂ṡ_tree of cut-joint row r (one inertial ``axis`` of P_a − P_b, the
-    points ρ_a, ρ_b of bodies a, b in body axes; b = −1: an inertial point), from the point's
-    velocity R_n (v_n + ω_n × ρ) with the body's twist (v_n, ω_n) = J_n ṡ_tree: the Jacobians
+def _pin_frame(pins, points, ports, elastic, r, side, q, s_dot, A_port, r_port, F_port, zeta_port):
+    """The frame P of the point on side ``side`` (0: a, 1: b) of cut-joint row r relative to its
+    body n, which it returns (−1: the ground): for a rigid body the point ρ (A = E, r = ρ, F = 0,
+    ζ = 0); for the station of an elastic body (``pins[r, 3 + side]``: its row of ``ports`` =
+    (r₀, Ψ, Q, angles, c)) the station's frame by :func:`projeq.assembly.kernels.port_motion`
+    — its pose, the columns F (k = n_e) of its twist F q̇_e and ζ = Ḟ q̇_e."""
+    n, slot = pins[r, side], pins[r, 3 + side]
+    if n < 0:
+        return n
+    if slot >= 0:
+        n_e, e_index = elastic[2], elastic[1]
+        k, i0, s0 = n_e[n], e_index[n, 0], e_index[n, 1]
+        port_r0, port_Psi, port_Q, port_angles, port_c = ports
+        port_motion(port_r0[slot], port_Psi[slot, :, :k], port_Q[slot, :k, :k], port_angles[slot, :, :k],
+                    port_c[slot], q[i0:i0 + k], s_dot[s0:s0 + k], A_port, r_port, F_port[:, :k], zeta_port)
+        return n
+    A_port[:, :] = 0.0
+    for a in range(3):
+        A_port[a, a] = 1.0
+        r_port[a] = points[r, side, a]
+    F_port[:, :] = 0.0
+    zeta_port[:] = 0.0
+    return n
+
+
+def _port_chain(A_port, r_port, T6):
+    """T6 ← T⁶ = [[A_Pᵀ, −A_Pᵀ r̃_P], [0, A_Pᵀ]] of a frame P at r_P, turned by A_P."""
+    A_np = np.empty((3, 3))
+    for a in range(3):
+        for b in range(3):
+            A_np[a, b] = A_port[b, a]
+    _chain_matrix(A_np, r_port, T6)
+
+
+def cut_joint_rows(pins, points, ports, joints, tree, q, q_dot, t, values, A, gamma):
+    """Φ, Φ_q = A_s (K = E) and γ = Φ″(q̇, q̇) of cut joints alone (the rows a ConstrainedSystem asks
+    for outside its accelerations: projections, conditions, residuals), from the tree's chain terms
+    at q at rest and (for γ, where q̇ ≠ 0) at (q, q̇)."""
+    rest = np.zeros(q.shape[0])
+    _given_motions(joints, q, rest, t, tree[4])
+    _chain_terms(tree, q, rest)
+    _pin_values(pins, points, ports, tree, q, values)
+    _pin_jacobian(pins, points, ports, tree, q, A)
+    gamma[:] = 0.0
+    if np.any(q_dot != 0.0):
+        _given_motions(joints, q, q_dot, t, tree[4])
+        _chain_terms(tree, q, q_dot)
+        _pin_gamma(pins, points, ports, tree, q, q_dot, gamma)
+
+
+def _pin_values(pins, points, ports, tree, q, values):
+    """values[r] ← Φ_r = (P_a − P_b)[axis] of cut-joint row r: P = r_n + R_n r_P with r_P the point's
+    frame (:func:`_pin_frame`), or ρ_b itself for the ground."""
+    elastic, R, r_O, k_max = tree[5], tree[12], tree[13], ports[1].shape[2]
+    A_port, r_port, F_port, zeta_port = np.empty((3, 3)), np.empty(3), np.empty((6, k_max)), np.empty(6)
+    rest = np.zeros(q.shape[0])
+    for r in range(pins.shape[0]):
+        axis, values[r] = pins[r, 2], 0.0
+        for side in range(2):
+            sign = 1.0 if side == 0 else -1.0
+            n = _pin_frame(pins, points, ports, elastic, r, side, q, rest, A_port, r_port, F_port, zeta_port)
+            if n < 0:
+                values[r] += sign * points[r, side, axis]
+            else:
+                values[r] += sign * (r_O[n, axis] + R[n, axis, 0] * r_port[0] + R[n, axis, 1] * r_port[1]
+                                     + R[n, axis, 2] * r_port[2])
+
+
+def _pin_jacobian(pins, points, ports, tree, q, A):
+    """A[r] ← the row ∂Φ_r/∂ṡ_tree of cut-joint row r (one inertial ``axis`` of P_a − P_b; the
+    points' frames by :func:`_pin_frame`), from the point's velocity R_n A_P v_P with the twist of
+    its frame P, (v_P, ω_P) = T⁶_P (v_n, ω_n) + F_P q̇_e (the chain step of a joint's base frame,
+    T⁶ = [[A_Pᵀ, −A_Pᵀ r̃_P], [0, A_Pᵀ]]), and the bodies' twists ẏ_n = J_n ṡ_tree: the Jacobians
     J_n = ∂ẏ_n/∂ṡ_tree by the chain, J_n = T_np J_p + F_n (in the columns of joint n's ṡ_n)."""
-    N, width, n_s = index.shape[0], T.shape[1], A.shape[1]
+    index, elastic, T, F, R = tree[0], tree[5], tree[7], tree[9], tree[12]
+    N, width, n_s, k_max = index.shape[0], T.shape[1], A.shape[1], ports[1].shape[2]
     n_y, parent, s_index, n_cols = index[:, N_Y], index[:, PARENT], index[:, S_INDEX], index[:, N_COLS]
     J = np.zeros((N, width, n_s))
     for n in range(N):  # root → leaves
@@ -445,52 +513,67 @@ def _pin_jacobian(pins, points, index, T, F, R, A):
         for c in range(n_cols[n]):
             for a in range(m):
                 J[n, a, s_index[n] + c] += F[n, a, c]
+    A_port, r_port, F_port, zeta_port = np.empty((3, 3)), np.empty(3), np.empty((6, k_max)), np.empty(6)
+    T6, v, rest = np.empty((6, 6)), np.empty(3), np.zeros(q.shape[0])
     A[:, :] = 0.0
-    v = np.empty(3)
     for r in range(pins.shape[0]):
         axis = pins[r, 2]
         for side in range(2):
-            n = pins[r, side]
+            n = _pin_frame(pins, points, ports, elastic, r, side, q, rest, A_port, r_port, F_port, zeta_port)
             if n < 0:
                 continue
-            sign = 1.0 if side == 0 else -1.0
-            rho = points[r, side]
-            for j in range(n_s):  # v + ω × ρ of the unit velocity ṡ_tree = e_j
-                v[0] = J[n, 0, j] + J[n, 4, j] * rho[2] - J[n, 5, j] * rho[1]
-                v[1] = J[n, 1, j] + J[n, 5, j] * rho[0] - J[n, 3, j] * rho[2]
-                v[2] = J[n, 2, j] + J[n, 3, j] * rho[1] - J[n, 4, j] * rho[0]
-                A[r, j] += sign * (R[n, axis, 0] * v[0] + R[n, axis, 1] * v[1] + R[n, axis, 2] * v[2])
+            _port_chain(A_port, r_port, T6)
+            sign, k = 1.0 if side == 0 else -1.0, n_y[n] - 6
+            for j in range(n_s):
+                for a in range(3):  # v_P of the unit velocity ṡ_tree = e_j
+                    v[a] = _dot6(T6[a], J[n, :6, j])
+                    for i in range(k):
+                        v[a] += F_port[a, i] * J[n, 6 + i, j]
+                for a in range(3):
+                    A[r, j] += sign * (R[n, axis, 0] * A_port[0, a] + R[n, axis, 1] * A_port[1, a]
+                                       + R[n, axis, 2] * A_port[2, a]) * v[a]
 
 
-def _pin_gamma(pins, points, index, T, zeta, R, twist, gamma):
-    """γ_r = (Φ̈_r at s̈_tree = 0) of cut-joint row r: the point's acceleration
-    R_n (v̇ + ω̇ × ρ + ω × (v + ω × ρ)) with the twist (v, ω) and its rate (v̇, ω̇) = ζ̄_n at s̈ = 0,
-    ζ̄_n = T_np ζ̄_p + ζ_n (the components' derivatives in body axes, docs/theory.md §4)."""
-    N, width = index.shape[0], T.shape[1]
+def _pin_gamma(pins, points, ports, tree, q, s_dot_tree, gamma):
+    """γ_r = (Φ̈_r at s̈_tree = 0) of cut-joint row r: the point's acceleration R_n A_P (v̇_P + ω_P × v_P)
+    with its frame's twist (v_P, ω_P) = u + w, u = T⁶_P ẏ_n, w = F_P q̇_e, and its rate at s̈ = 0,
+    ζ̄_P = T⁶_P ζ̄_n + F_P q̈_e + u × w + ζ_P (the chain's step, docs/theory.md §4), ζ̄_n = T_np ζ̄_p + ζ_n
+    the bodies' at s̈ = 0 (the components' derivatives in body axes)."""
+    index, elastic, T, zeta, R, twist = tree[0], tree[5], tree[7], tree[8], tree[12], tree[14]
+    N, width, k_max = index.shape[0], T.shape[1], ports[1].shape[2]
     n_y, parent = index[:, N_Y], index[:, PARENT]
     zeta_bar = np.zeros((N, width))
     for n in range(N):  # root → leaves
         p = parent[n]
         for a in range(n_y[n]):
             zeta_bar[n, a] = zeta[n, a] + (_dot(T[n, a], zeta_bar[p], n_y[p]) if p >= 0 else 0.0)
-    u, acc = np.empty(3), np.empty(3)
+    A_port, r_port, F_port, zeta_port = np.empty((3, 3)), np.empty(3), np.empty((6, k_max)), np.empty(6)
+    T6, u, w, rate, acc = np.empty((6, 6)), np.empty(6), np.empty(6), np.empty(6), np.empty(3)
     for r in range(pins.shape[0]):
         axis = pins[r, 2]
         gamma[r] = 0.0
         for side in range(2):
-            n = pins[r, side]
+            n = _pin_frame(pins, points, ports, elastic, r, side, q, s_dot_tree, A_port, r_port, F_port, zeta_port)
             if n < 0:
                 continue
-            sign = 1.0 if side == 0 else -1.0
-            rho, w = points[r, side], twist[n, 3:6]
-            for a in range(3):  # u = v + ω × ρ
-                u[a] = twist[n, a]
-            _add_cross(w, rho, u)
-            for a in range(3):  # v̇ + ω̇ × ρ + ω × u
-                acc[a] = zeta_bar[n, a]
-            _add_cross(zeta_bar[n, 3:6], rho, acc)
-            _add_cross(w, u, acc)
-            gamma[r] += sign * (R[n, axis, 0] * acc[0] + R[n, axis, 1] * acc[1] + R[n, axis, 2] * acc[2])
+            _port_chain(A_port, r_port, T6)
+            sign, k, s0 = 1.0 if side == 0 else -1.0, n_y[n] - 6, elastic[1][n, 1]
+            for a in range(6):
+                u[a] = _dot6(T6[a], twist[n])
+                rate[a] = _dot6(T6[a], zeta_bar[n, :6]) + zeta_port[a]
+                w[a] = 0.0
+                for i in range(k):
+                    w[a] += F_port[a, i] * s_dot_tree[s0 + i]
+                    rate[a] += F_port[a, i] * zeta_bar[n, 6 + i]
+            _add_motion_cross(u, w, rate)
+            for a in range(6):
+                u[a] += w[a]  # the frame's twist
+            for a in range(3):  # v̇_P + ω_P × v_P
+                acc[a] = rate[a]
+            _add_cross(u[3:], u[:3], acc)
+            for a in range(3):
+                gamma[r] += sign * (R[n, axis, 0] * A_port[0, a] + R[n, axis, 1] * A_port[1, a]
+                                    + R[n, axis, 2] * A_port[2, a]) * acc[a]
 
 
 def _jacobian(phi, q, t, A):
@@ -599,7 +682,7 @@ def _projected(tree, F, f_bar, pivot, M, b, s_ddot_tree):
     return DONE
 
 
-def partitioned(phi, pins, points, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
+def partitioned(phi, pins, points, ports, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
                 q_dot, s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (module
     docstring) from Φ (``phi``: :func:`_phi_into`; ``m_h`` rows) and the Pfaffian rows A(q)
@@ -609,7 +692,7 @@ def partitioned(phi, pins, points, pfaffian, joints, tree, q, s_dot, t, m_h, ind
     A_s = [Φ_q; A], M and b; returns DONE, SINGULAR (:func:`_projected`) or DEGENERATE where
     ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
     n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
-    _constraint_rows(phi, pins, points, pfaffian, joints, tree, q, t, m_h, A)
+    _constraint_rows(phi, pins, points, ports, pfaffian, joints, tree, q, t, m_h, A)
     A_dep = np.empty((m, m))
     for r in range(m):
         for c in range(m):
@@ -631,7 +714,7 @@ def partitioned(phi, pins, points, pfaffian, joints, tree, q, s_dot, t, m_h, ind
     _chain_terms(tree, q, s_dot_tree)
     if not _loaded(tree, q, s_dot_tree):
         return UNLOADED
-    gamma = _constraint_gamma(phi, pins, points, pfaffian, tree, q, s_dot_tree, t, m_h, m)
+    gamma = _constraint_gamma(phi, pins, points, ports, pfaffian, tree, q, s_dot_tree, t, m_h, m)
     f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
     minus_gamma = _matvec(inv, -gamma)
     for r in range(m):
@@ -639,7 +722,7 @@ def partitioned(phi, pins, points, pfaffian, joints, tree, q, s_dot, t, m_h, ind
     return _projected(tree, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
-def tangent(phi, pins, points, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept,
+def tangent(phi, pins, points, ports, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept,
             pivot, q_dot, s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.tangent.TangentSystem`: F = N N_ind⁻¹ with
     N the null space of A_s = U Σ Vᵀ continued along the branch (``kept``: the tangent kept last,
@@ -647,7 +730,7 @@ def tangent(phi, pins, points, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) over the ``rank`` largest singular values above
     ``acting`` σ_max; otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular."""
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
-    _constraint_rows(phi, pins, points, pfaffian, joints, tree, q, t, m_h, A)
+    _constraint_rows(phi, pins, points, ports, pfaffian, joints, tree, q, t, m_h, A)
     U, sigma, Vt = _svd(A)
     near = 0  # the singular values below separation σ_max, at least k
     for value in sigma:
@@ -668,7 +751,7 @@ def tangent(phi, pins, points, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     _chain_terms(tree, q, s_dot_tree)
     if not _loaded(tree, q, s_dot_tree):
         return UNLOADED
-    gamma = _constraint_gamma(phi, pins, points, pfaffian, tree, q, s_dot_tree, t, m_h, m)
+    gamma = _constraint_gamma(phi, pins, points, ports, pfaffian, tree, q, s_dot_tree, t, m_h, m)
     count = 0  # the singular values above acting σ_max, at most rank
     for value in sigma:
         count += value > acting * sigma[0]
@@ -902,7 +985,8 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pin_jacobian, _pin_gamma, _given_motions,
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pin_frame, _port_chain, _pin_values, _pin_jacobian,
+            _pin_gamma, _given_motions,
             _matvec, _matmul, _svd, _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms,
             _loaded, _projected, _inverse)
 
@@ -947,15 +1031,28 @@ def _closure(system, rule: str, constant: float) -> "CompiledClosure | None":
 _NO_CALLBACK = types.SimpleNamespace(address=0)
 
 
-def pin_table(phi, m_h: int) -> tuple[NDArray, NDArray]:
+def pin_table(phi, m_h: int) -> tuple:
     """The rows of Φ that are cut joints (:meth:`~projeq.constraints.cut_joints.PinClosure.point_rows`)
-    as the kernels read them: (pins, points) with pins[r] = (a, b, inertial axis) and points[r] =
-    (ρ_a, ρ_b); empty where Φ is a user's function (its rows by the complex step)."""
+    as the kernels read them: (pins, points, ports) with pins[r] = (a, b, inertial axis, slot_a,
+    slot_b), points[r] = (ρ_a, ρ_b) and ports = (r₀, Ψ, Q, angles, c), one row per slot: the fields
+    of a point's station on a RitzBeam (:class:`~projeq.subsystems.beam.beam.BeamPort`; slot −1: a
+    rigid body's point); empty where Φ is a user's function (its rows by the complex step)."""
     rows = point_rows(phi) or []
-    pins = np.array([row[:3] for row in rows], dtype=np.int64).reshape(len(rows), 3)
-    points = np.array([row[3:] for row in rows], dtype=float).reshape(len(rows), 2, 3)
     assert not rows or len(rows) == m_h
-    return pins, points
+    stations = list({id(port): port for row in rows for port in row[5:] if port is not None}.values())
+    slot = {id(port): i for i, port in enumerate(stations)}
+    slots = [[slot.get(id(port), -1) for port in row[5:]] for row in rows]
+    pins = np.array([[*row[:3], *slot] for row, slot in zip(rows, slots)], dtype=np.int64).reshape(len(rows), 5)
+    points = np.array([row[3:5] for row in rows], dtype=float).reshape(len(rows), 2, 3)
+    k = max([port.beam.n_e for port in stations], default=1)
+    ports = (np.zeros((len(stations), 3)), np.zeros((len(stations), 3, k)), np.zeros((len(stations), k, k)),
+             np.zeros((len(stations), 3, k)), np.zeros((len(stations), 3)))
+    for i, port in enumerate(stations):
+        n_e = port.beam.n_e
+        r0, Psi, Q, angles = port.field
+        ports[0][i], ports[1][i, :, :n_e], ports[2][i, :n_e, :n_e], ports[3][i, :, :n_e] = r0, Psi, Q, angles
+        ports[4][i] = port.offset
+    return pins, points, ports
 
 
 class CompiledClosure:
@@ -973,10 +1070,10 @@ class CompiledClosure:
         # the callbacks live as long as this object, which passes their addresses
         ev = self.fast = tree.evaluator("fast")
         self.callback, self.rule, self.constants, self.m_h = callback, rule, constants, m if m_h is None else m_h
-        self.pins, self.points = pin_table(None, 0) if pins is None else pins
+        self.pins, self.points, self.ports = pin_table(None, 0) if pins is None else pins
         self._callbacks = [pfaffian] + [joint_callback(tree.joints[n]) if compiled else None for n in ev._given]
         if compiled:
-            self.kernel, self.phi, self.pfaffian = _compiled()[rule], callback.address, \
+            self.kernel, self.phi, self.pfaffian = _compiled(ev._width > 6)[rule], callback.address, \
                 0 if pfaffian is None else pfaffian.address
         else:
             self.kernel, self.phi, self.pfaffian = globals()[rule], callback, pfaffian
@@ -988,6 +1085,7 @@ class CompiledClosure:
                      ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist, ev._laws, ev._law_constants)
         self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
         self._kept = (None, None)  # (the system, the tangent it keeps) of the last call (_kept_tangent)
+        self.rows = _compiled(ev._width > 6)["cut_joint_rows"] if compiled else cut_joint_rows
 
     def _call(self, system, q: NDArray, s_dot: NDArray, t: float) -> bool:
         """One kernel call for ``system`` (its partition; for a TangentSystem its kept tangent,
@@ -995,15 +1093,19 @@ class CompiledClosure:
         M, b = self._workspace.M_all, self._workspace.b_all
         q, s_dot, t = kernels.kernel_array(q), kernels.kernel_array(s_dot), float(t)
         if self.rule == "partitioned":
-            flag = self.kernel(self.phi, self.pins, self.points, self.pfaffian, self.joints, self.tree, q, s_dot, t,
+            flag = self.kernel(self.phi, self.pins, self.points, self.ports, self.pfaffian, self.joints, self.tree, q, s_dot, t,
                                self.m_h, system.independent, system.dependent,
                                self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b)
         else:
-            flag = self.kernel(self.phi, self.pins, self.points, self.pfaffian, self.joints, self.tree, q, s_dot, t,
+            flag = self.kernel(self.phi, self.pins, self.points, self.ports, self.pfaffian, self.joints, self.tree, q, s_dot, t,
                                self.m_h, system.independent, system.tree.n_s - system.n_s,
                                system.separation, self.constants[0], self._kept_tangent(system), SINGULAR_PIVOT,
                                self._q_dot, self._s_ddot_tree, self._A, M, b)
         return flag == DONE
+
+    def cut_joints(self) -> "CutJointRows | None":
+        """Φ, Φ_q and Φ″ of the cut joints this kernel evaluates itself (None: Φ is a user's function)."""
+        return CutJointRows(self) if self.pins.shape[0] else None
 
     def _kept_tangent(self, system) -> NDArray:
         """The tangent ``system`` keeps (TangentSystem._tangent) as the array the kernel reads and
@@ -1039,24 +1141,61 @@ class CompiledClosure:
         return x_dot if np.isfinite(x_dot).all() else None
 
 
+class CutJointRows:
+    """Φ, Φ_x and Φ″(v, v) of a ConstrainedSystem whose Φ is made of cut joints (real arguments, Φ
+    independent of t, K = E), by its compiled kernel's own statement of them (:func:`cut_joint_rows`):
+    what the numpy path's projections, conditions and residuals ask for, in place of its complex
+    steps through the poses (one Python pass over the tree per point). The interface of
+    :class:`~projeq.constraints.batched.BatchedClosure`, and Φ itself."""
+
+    def __init__(self, kernel: CompiledClosure):
+        self.kernel = kernel
+        m_h, n = kernel.m_h, kernel._A.shape[1]
+        self._values, self._A, self._gamma = np.zeros(m_h), np.zeros((m_h, n)), np.zeros(m_h)
+
+    def _call(self, q: NDArray, q_dot: NDArray, t: float) -> None:
+        k = self.kernel
+        k.rows(k.pins, k.points, k.ports, k.joints, k.tree, kernels.kernel_array(q), kernels.kernel_array(q_dot),
+               float(t), self._values, self._A, self._gamma)
+
+    def values(self, q: NDArray, t: float) -> NDArray:
+        """Φ(q)."""
+        self._call(q, np.zeros(len(q)), t)
+        return self._values.copy()
+
+    def jacobian(self, x: NDArray, columns: int) -> NDArray:
+        """Φ_q at x = (q, t) (``columns`` = n_q: Φ independent of t)."""
+        self._call(x[:-1], np.zeros(len(x) - 1), x[-1])
+        return self._A.copy()
+
+    def second(self, x: NDArray, q_dot: NDArray, rheonomic: bool) -> NDArray:
+        """Φ″(q̇, q̇) at x = (q, t) (``rheonomic`` False: Φ independent of t)."""
+        self._call(x[:-1], q_dot, x[-1])
+        return self._gamma.copy()
+
+
 @functools.cache
-def _compiled() -> dict:
-    """{"partitioned": …, "tangent": …}: the kernels compiled by numba (cached on disk) as
+def _compiled(elastic: bool = False) -> dict:
+    """{"partitioned": …, "tangent": …, "cut_joint_rows": …}: the kernels compiled by numba (cached on disk) as
     :func:`projeq.assembly.kernels.jit` compiles another module's kernels, calling the compiled
-    kernels of :mod:`projeq.assembly.kernels`, the force laws' loop of :mod:`projeq.assembly.loads`,
-    and Φ, A and the UserJoints' relative motions through their C callbacks' addresses by the
-    intrinsics :func:`_phi_into` and :func:`_given_into`."""
-    return dict(zip(("partitioned", "tangent"), kernels.jit(partitioned, tangent, callees=_HELPERS,
-                                                             kernels=_compiled_callees())))
+    kernels of :mod:`projeq.assembly.kernels` (the Gauss form's rigid variant, n_y = 6 a constant,
+    or for trees with ``elastic`` bodies the one that reads each body's n_y), the force laws' loop
+    of :mod:`projeq.assembly.loads`, and Φ, A and the UserJoints' relative motions through their C
+    callbacks' addresses by the intrinsics :func:`_phi_into` and :func:`_given_into`."""
+    rules = ("partitioned", "tangent", "cut_joint_rows")
+    names = tuple(f"elastic_{rule}" for rule in rules) if elastic else None
+    return dict(zip(rules, kernels.jit(partitioned, tangent, cut_joint_rows, callees=_HELPERS,
+                                       kernels=_compiled_callees(elastic), names=names)))
 
 
-def _compiled_callees() -> dict:
+def _compiled_callees(elastic: bool) -> dict:
     """The compiled functions the kernels call by name: the tree's kernels, the force laws' loop and
     the intrinsics that call the C callbacks."""
-    return {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True, rigid=True)[0],
+    return {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True, rigid=not elastic)[0],
             "add_loads": loads.kernel(True), **_intrinsics()}
 
 
+@functools.cache
 def _intrinsics() -> dict:
     """The compiled :func:`_phi_into` and :func:`_given_into`: each calls the C function at the
     address its first argument holds with the data pointers of its arrays (numba's own layout of

@@ -52,44 +52,66 @@ class PinClosure:
         self.a, self.b = tree.index(a), None if b is None else tree.index(b)
         if self.a == self.b:
             raise ValueError(f"b: the cut joint must join two subsystems, got a = b = {a!r}")
-        for name, n in (("a", self.a), ("b", self.b)):
-            if n is not None and tree.e_s_slice[n].stop > tree.e_s_slice[n].start:
-                raise ValueError(f"{name}: a cut joint needs a rigid subsystem, {tree.names[n]!r} deforms")
         self.rho_a, self.rho_b = finite_array("rho_a", rho_a, (3,)), finite_array("rho_b", rho_b, (3,))
+        self.ports = {n: _port(tree, name, n, rho) for name, n, rho in (("a", self.a, self.rho_a),
+                                                                     ("b", self.b, self.rho_b)) if _deforms(tree, n)}
         if not axes or len(set(axes)) != len(axes) or set(axes) - set(_AXES):
             raise ValueError(f"axes: expected distinct letters of 'xyz' (the inertial directions held), got {axes!r}")
         self.rows = [_AXES.index(axis) for axis in axes]
         self.names = (tree.names[self.a], None if b is None else tree.names[self.b])
 
-    def _point(self, kin, n, rho) -> NDArray:
-        return rho if n is None else kin.r[n] + kin.R[n] @ rho
+    def _point(self, kin, n, rho, q) -> NDArray:
+        """P = r_n + R_n ρ (rigid n), r_n + R_n r_port(q_e) (the frame at the station ρ of a
+        deforming n), or ρ itself (the ground)."""
+        if n is None:
+            return rho
+        local = self.ports[n].position(q[self.tree.e_q_slice[n]]) if n in self.ports else rho
+        return kin.r[n] + kin.R[n] @ local
 
     def __call__(self, q, t: float = 0.0) -> NDArray:
         """Φ = (P_a − P_b)[axes] in inertial coordinates; complex q gives complex Φ (the
         complex step's exact derivatives, Martins, Sturdza & Alonso 2003)."""
-        return self.difference(_poses(self.tree, q, t))
+        q = _complex_safe(q)
+        return self.difference(_poses(self.tree, q, t), q)
 
-    def difference(self, kin) -> NDArray:
-        """(P_a − P_b)[axes] at the tree's poses ``kin``."""
-        return (self._point(kin, self.a, self.rho_a) - self._point(kin, self.b, self.rho_b))[self.rows]
+    def difference(self, kin, q) -> NDArray:
+        """(P_a − P_b)[axes] at the tree's poses ``kin`` and coordinates q."""
+        return (self._point(kin, self.a, self.rho_a, q) - self._point(kin, self.b, self.rho_b, q))[self.rows]
 
     def point_rows(self) -> list:
-        """One (a, b, axis, ρ_a, ρ_b) per row of Φ (b = −1: the inertial point ρ_b), the
-        statement the compiled closure kernel evaluates (projeq.constraints.compiled)."""
+        """One (a, b, axis, ρ_a, ρ_b, port_a, port_b) per row of Φ (b = −1: the inertial point
+        ρ_b; port: the frame at the station of a deforming subsystem, else None), the statement
+        the compiled closure kernel evaluates (projeq.constraints.compiled)."""
         b = -1 if self.b is None else self.b
-        return [(self.a, b, axis, self.rho_a, self.rho_b) for axis in self.rows]
+        ports = (self.ports.get(self.a), self.ports.get(self.b))
+        return [(self.a, b, axis, self.rho_a, self.rho_b, *ports) for axis in self.rows]
 
-    def wrenches(self, kin, lam: NDArray) -> dict:
+    def wrenches(self, kin, lam: NDArray, q=None) -> dict:
         """{n: w_n}: the joint's force λ (inertial, rows of ``axes``) on a at P_a and −λ on b
-        at P_b as wrenches in the subsystems' ẏ coordinates (``kin``: the tree's kinematics)."""
+        at P_b as wrenches in the subsystems' ẏ coordinates (``kin``: the tree's kinematics at
+        q, which a point on a deforming subsystem needs)."""
         f = np.zeros(3)
         f[self.rows] = lam
         loads = {self.a: (f, self.rho_a)} | ({} if self.b is None else {self.b: (-f, self.rho_b)})
-        return {n: self._wrench(kin, n, force, rho) for n, (force, rho) in loads.items()}
+        return {n: self._wrench(kin, n, force, rho, q) for n, (force, rho) in loads.items()}
 
-    def _wrench(self, kin, n, force, rho) -> NDArray:
+    def _wrench(self, kin, n, force, rho, q) -> NDArray:
+        """w_n with w_nᵀ ẏ_n the power of ``force`` at the point: [f; ρ × f] about O_n in body
+        axes; at the station of a deforming subsystem [f; r × f; (A F_v)ᵀ f] with the station's
+        origin r, orientation A and velocity rows F_v (ṙ = A F_v q̇_e, its ``relative``)."""
         f_body = kin.R[n].T @ force
-        w = np.concatenate((f_body, cross(rho, f_body)))  # force and moment about O_n, body axes
+        if n not in self.ports:
+            return self._selected(n, np.concatenate((f_body, cross(rho, f_body))))  # force, moment about O_n
+        if q is None:
+            raise ValueError(f"q: the wrench of a cut joint on the deforming {self.tree.names[n]!r} needs q")
+        q_e = np.asarray(q, dtype=float)[self.tree.e_q_slice[n]]
+        port = self.ports[n].relative(q_e, np.zeros_like(q_e))
+        w = self._selected(n, np.concatenate((f_body, cross(port.r, f_body))))
+        w[-len(q_e):] += (port.A @ port.F[:3]).T @ f_body  # ẏ_n's last n_e rows are q̇_e
+        return w
+
+    def _selected(self, n, w: NDArray) -> NDArray:
+        """S_n w of a wrench w about O_n in body axes."""
         S = self.tree.S[n]
         return w if S is None else S @ w
 
@@ -109,8 +131,9 @@ class CutJoints:
 
     def __call__(self, q, t: float = 0.0) -> NDArray:
         """Φ = the pins' (P_a − P_b)[axes], stacked; complex q gives complex Φ."""
+        q = _complex_safe(q)
         kin = _poses(self.tree, q, t)
-        return np.concatenate([pin.difference(kin) for pin in self.pins])
+        return np.concatenate([pin.difference(kin, q) for pin in self.pins])
 
     def point_rows(self) -> list:
         """The pins' :meth:`PinClosure.point_rows`, stacked."""
@@ -123,10 +146,31 @@ def cut_joints(phi):
     return CutJoints(phi) if isinstance(phi, (list, tuple)) else phi
 
 
+def _complex_safe(q) -> NDArray:
+    """q as an array of floats, or of complex numbers under the complex step."""
+    q = np.asarray(q)
+    return q.astype(np.result_type(q, float))
+
+
 def _poses(tree, q, t):
     """The tree's poses at q and t (real or complex: the complex step), at rest."""
-    q = np.asarray(q)
-    return poses(tree, q.astype(np.result_type(q, float)), np.zeros(tree.n_s), t)
+    return poses(tree, q, np.zeros(tree.n_s), t)
+
+
+def _deforms(tree, n) -> bool:
+    return n is not None and tree.e_s_slice[n].stop > tree.e_s_slice[n].start
+
+
+def _port(tree, name: str, n: int, rho):
+    """The frame at the station ``rho`` of the deforming subsystem n (its ``port_at``)."""
+    body = tree.subsystems[n]
+    if not body.has_ports:
+        raise ValueError(f"{name}: {tree.names[n]!r} deforms and has no ports (stations where a cut joint can "
+                         "hold a point); a cut joint needs a rigid subsystem or one with ports, such as a RitzBeam")
+    try:
+        return body.port_at(rho)
+    except ValueError as error:
+        raise ValueError(f"rho_{name}: {str(error).split(': ', 1)[-1]}") from None
 
 
 def point_rows(phi) -> list | None:

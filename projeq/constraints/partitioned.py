@@ -188,6 +188,7 @@ class ConstrainedSystem(Model):
         self._choose_velocities(q0, independent, repivot)
         self.q0 = self._initial_q(q0, project_q0)
         self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
+        self._cut_rows = False if point_rows(phi) is not None else None  # looked for once built (_cut_joint_rows)
 
     # -- the constraint functions -----------------------------------------------------------
     def _constraint_rows(self, name, f, args, ndim, n_cols=None) -> int:
@@ -221,7 +222,29 @@ class ConstrainedSystem(Model):
 
     def phi(self, q: NDArray, t: float = 0.0) -> NDArray:
         """Φ(q, t), the holonomic constraints (empty without any)."""
-        return numeric(self._phi(q, t)) if self.m_h else np.zeros(0)
+        if not self.m_h:
+            return np.zeros(0)
+        rows = self._cut_joint_rows()
+        if rows is not None and not np.iscomplexobj(q):
+            return rows.values(q, t)
+        return numeric(self._phi(q, t))
+
+    _cut_rows = None  # CutJointRows; None: Φ is not made of cut joints (or their kernel does not apply); False: not looked for
+
+    def _cut_joint_rows(self):
+        """The compiled kernel's own Φ, Φ_q and Φ″ of cut joints
+        (:class:`~projeq.constraints.compiled.CutJointRows`), where Φ is made of them and the kernel
+        applies (looked for once the system is built), else None."""
+        if self._cut_rows is False:
+            kernel = self.compiled_kernel()
+            self._cut_rows = None if kernel is None else kernel.cut_joints()
+        return self._cut_rows
+
+    def _batched(self):
+        """What gives Φ's derivatives at a batch of points (real arguments): the compiled cut joints'
+        rows, the batched closure, or None (pointwise)."""
+        rows = self._cut_joint_rows()
+        return self._closure if rows is None else rows
 
     def _pfaffian(self, q, t) -> tuple[NDArray, NDArray]:
         if not self.m_p:
@@ -244,8 +267,9 @@ class ConstrainedSystem(Model):
         if not self.m_h:
             return np.zeros((0, self.n_q)), np.zeros(0)
         n = self.n_q + self.rheonomic  # the columns along q, and along t if Φ depends on it
-        if self._closure is not None and not np.iscomplexobj(x):
-            Phi_x = self._closure.jacobian(x, n)
+        batched = self._batched()
+        if batched is not None and not np.iscomplexobj(x):
+            Phi_x = batched.jacobian(x, n)
         else:
             Phi_x = np.array([self._d1(self._phi_x, x, e) for e in np.eye(self.n_q + 1)[:n]]).T.reshape(self.m_h, n)
         return Phi_x[:, :self.n_q], (Phi_x[:, -1] if self.rheonomic else np.zeros(self.m_h, dtype=Phi_x.dtype))
@@ -587,8 +611,9 @@ class ConstrainedSystem(Model):
         """Φ″(v, v) = Φ″(v_q, v_q) + 2 Φ″(v_q, v_t) + Φ″(v_t, v_t) at x = (q, t), v_q = (q̇, 0),
         v_t = (0, 1) (:meth:`gamma`; the rheonomic parts only where Φ depends on t), by one call
         at a batch of points where Φ takes them."""
-        if self._closure is not None and not (np.iscomplexobj(x) or np.iscomplexobj(q_dot)):
-            return self._closure.second(x, q_dot, self.rheonomic)
+        batched = self._batched()
+        if batched is not None and not (np.iscomplexobj(x) or np.iscomplexobj(q_dot)):
+            return batched.second(x, q_dot, self.rheonomic)
         v_q, v_t = np.append(q_dot, 0.0), np.eye(len(x))[-1]
         value = self._d2(self._phi_x, x, v_q, v_q)
         if self.rheonomic:

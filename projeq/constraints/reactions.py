@@ -85,7 +85,7 @@ def joint_reactions(system, q, s_dot, t: float = 0.0, cuts=None) -> dict:
     kin = forward(tree, q, s_dot_tree, float(t))
     applied, cut_wrenches, row = {}, {}, 0
     for name, closure in cuts.items():
-        loads = closure.wrenches(kin, lam[row: row + len(closure.rows)])
+        loads = closure.wrenches(kin, lam[row: row + len(closure.rows)], q)
         row += len(closure.rows)
         cut_wrenches[name] = loads[closure.a]
         for n, w in loads.items():

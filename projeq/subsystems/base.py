@@ -147,6 +147,10 @@ class Port:
         """:meth:`Subsystem.port` at this point."""
         return self.subsystem.port(self.point, q_e, q_e_dot)
 
+    def position(self, q_e: NDArray) -> NDArray:
+        """The frame's origin in the reference frame at q_e (real or complex)."""
+        return self.relative(q_e, np.zeros_like(q_e)).r
+
 
 def conform(name: str, sub) -> None:
     """Check that ``sub`` (added under ``name``) is a subsystem; called where a System is built.

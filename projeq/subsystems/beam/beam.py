@@ -513,6 +513,10 @@ class BeamPort:
         F_dot = derivative_along(lambda q: self.beam._port_terms(q, self)[2], q_e, q_e_dot)
         return Relative(A, r, F, F @ q_e_dot, F_dot @ q_e_dot)
 
+    def position(self, q_e: NDArray) -> NDArray:
+        """The frame's origin r(x) + A c in the beam's frame at q_e (real or complex)."""
+        return self.beam._port_terms(q_e, self)[1]
+
 
 def first_bending_frequency(K_b: NDArray, M_b: NDArray) -> float:
     """Lowest bending frequency (rad/s) of a beam at rest on its support: ω₁ = √λ₁ with λ₁
