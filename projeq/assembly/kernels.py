@@ -15,8 +15,8 @@ D_n = F_nᵀ M̂_n F_n by Cholesky); subsystems: rigid bodies (M_n = M6, h_n of 
 
 Compiled twins. numba compiles scalar loops, not the array functions of
 :mod:`projeq.spatial`, so four formulas have a second, scalar form here and only here:
-:func:`_relative_rotation` (Rodrigues, :func:`projeq.spatial.rodrigues`), :func:`_chain_matrix`
-(:func:`projeq.spatial.chain_matrix`), :func:`_add_cross` (:func:`projeq.spatial.cross`, added
+:func:`_relative_rotation` (Rodrigues, :func:`projeq.spatial.rodrigues`), :func:`chain_matrix_into`
+(:func:`projeq.spatial.chain_matrix`), :func:`add_cross` (:func:`projeq.spatial.cross`, added
 into an output: the per-body loops allocate no temporaries) and
 :func:`_rigid_h` (:func:`projeq.subsystems.rigid.rigid_h`); tests/assembly/test_fast.py
 checks each against its twin.
@@ -131,10 +131,10 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
             for a in range(3):
                 for b in range(3):
                     A_np[a, b] = A_port[b, a]
-            _chain_matrix(A_np, r_port, T_port)
+            chain_matrix_into(A_np, r_port, T_port)
             for a in range(6):
-                u[a] = _dot6(T_port[a], twist[p])
-            _add_motion_cross(u, w_port, zeta_port)
+                u[a] = dot6(T_port[a], twist[p])
+            add_motion_cross(u, w_port, zeta_port)
             for a in range(6):
                 port_twist[a] = u[a] + w_port[a]
             for a in range(3):
@@ -176,7 +176,7 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
             for b in range(3):
                 R[n, a, b] = R_b[a, 0] * A_np[b, 0] + R_b[a, 1] * A_np[b, 1] + R_b[a, 2] * A_np[b, 2]
         v_p[:] = twist_b[:3]  # the parent's twist at the origin of n: v_p + ω_p × r_pn, ω_p
-        _add_cross(twist_b[3:], r, v_p)
+        add_cross(twist_b[3:], r, v_p)
         w_p = twist_b[3:]
         for a in range(3):  # u = T_np ẏ_p, g_n = A_np g_p
             u[a] = A_np[a, 0] * v_p[0] + A_np[a, 1] * v_p[1] + A_np[a, 2] * v_p[2]
@@ -185,20 +185,20 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
         for a in range(6):
             twist[n, a] = u[a] + w[a]
         zeta6[:] = 0.0
-        _add_motion_cross(u, w, zeta6)
+        add_motion_cross(u, w, zeta6)
         if k == GIVEN:
             for a in range(6):
                 zeta6[a] += given[n, GIVEN_ZETA + a]
         if j >= 0:  # T_np = T⁶ [T⁶_port, F_port], ζ_n = T⁶ ζ̂_port + ζ⁶
-            _chain_matrix(A_np, r, T6)
+            chain_matrix_into(A_np, r, T6)
             for a in range(6):
-                zeta[n, a] = zeta6[a] + _dot6(T6[a], zeta_port)
+                zeta[n, a] = zeta6[a] + dot6(T6[a], zeta_port)
                 for b in range(6):
-                    T[n, a, b] = _dot6(T6[a], T_port[:, b])
+                    T[n, a, b] = dot6(T6[a], T_port[:, b])
                 for b in range(n_e[p]):
-                    T[n, a, 6 + b] = _dot6(T6[a], F_port[:, b])
+                    T[n, a, 6 + b] = dot6(T6[a], F_port[:, b])
         else:
-            _chain_matrix(A_np, r, T[n])
+            chain_matrix_into(A_np, r, T[n])
             zeta[n, :6] = zeta6
         i = body[n]
         if i >= 0:
@@ -394,7 +394,7 @@ def hub_beam(kind, axis, angles, given, orientation, offset, gravity, m, r0, Psi
     elastic_body(m, r0, Psi, Q, K_e, damping, q_e, q_e_dot, w, g, M, h)
     rotary_body(I, Phi_theta, T, q_e, q_e_dot, w, M, h)
     for i in range(k_e):
-        q_e_ddot[i] = h[6 + i] - _dot6(M[6 + i], zeta)
+        q_e_ddot[i] = h[6 + i] - dot6(M[6 + i], zeta)
     for i in range(k_e):
         for j in range(i + 1):  # the lower triangle, which the factorization reads
             L[i, j] = M[6 + i, 6 + j]
@@ -472,7 +472,7 @@ def port_motion(r0, Psi, Q, angles, offset, q_e, q_e_dot, A, r, F, zeta):
         w1, w2 = angles[1, i], cb * angles[0, i]
         Phi_w[0], Phi_w[1], Phi_w[2] = -sb * angles[0, i] + angles[2, i], cx * w1 + sx * w2, cx * w2 - sx * w1
         c_w[:] = 0.0
-        _add_cross(offset, Phi_w, c_w)
+        add_cross(offset, Phi_w, c_w)
         for a in range(3):
             F[a, i] = A[0, a] * Phi_r[0, i] + A[1, a] * Phi_r[1, i] + A[2, a] * Phi_r[2, i] - c_w[a]
             F[3 + a, i] = Phi_w[a]
@@ -483,11 +483,11 @@ def port_motion(r0, Psi, Q, angles, offset, q_e, q_e_dot, A, r, F, zeta):
     for a in range(3):
         v_rel[a] = A[0, a] * r_dot[0] + A[1, a] * r_dot[1] + A[2, a] * r_dot[2]
         zeta[a] = -rate * A[0, a]
-    _add_cross(v_rel, Omega, zeta[:3])  # − Ω × Aᵀ ṙ
+    add_cross(v_rel, Omega, zeta[:3])  # − Ω × Aᵀ ṙ
     alpha[0] = -cb * a_dot * b_dot  # R_xᵀ (−cos b, 0, −sin b) ȧ ḃ − β̇ e_x × R_xᵀ(…)
     alpha[1] = -sx * sb * a_dot * b_dot + beta_dot * turned2
     alpha[2] = -cx * sb * a_dot * b_dot - beta_dot * turned1
-    _add_cross(alpha, offset, zeta[:3])  # − c × α
+    add_cross(alpha, offset, zeta[:3])  # − c × α
 
 
 def _relative_rotation(kind, e, x, A):
@@ -505,7 +505,7 @@ def _relative_rotation(kind, e, x, A):
     A[2, 1] += s * e[0]
 
 
-def _chain_matrix(A_np, r, T):
+def chain_matrix_into(A_np, r, T):
     """T = [[A_np, −A_np r̃], [0, A_np]] written into T[:6, :6] (the columns of −A_np r̃ are
     A_np (e_j × r)); compiled twin of :func:`projeq.spatial.chain_matrix`."""
     T[:6, :6] = 0.0
@@ -517,7 +517,7 @@ def _chain_matrix(A_np, r, T):
         T[a, 5] = A_np[a, 1] * r[0] - A_np[a, 0] * r[1]
 
 
-def _add_cross(a, b, out):
+def add_cross(a, b, out):
     """out += a × b of two 3-vectors, without a temporary (the form the per-body loops use:
     numba allocates every array a function returns)."""
     out[0] += a[1] * b[2] - a[2] * b[1]
@@ -525,12 +525,12 @@ def _add_cross(a, b, out):
     out[2] += a[0] * b[1] - a[1] * b[0]
 
 
-def _add_motion_cross(u, w, zeta):
+def add_motion_cross(u, w, zeta):
     """ζ += u × w, the motion cross product of two twists (v, ω):
     (ω_u × v_w + v_u × ω_w, ω_u × ω_w)."""
-    _add_cross(u[3:], w[:3], zeta[:3])
-    _add_cross(u[:3], w[3:], zeta[:3])
-    _add_cross(u[3:], w[3:], zeta[3:])
+    add_cross(u[3:], w[:3], zeta[:3])
+    add_cross(u[:3], w[3:], zeta[:3])
+    add_cross(u[3:], w[3:], zeta[3:])
 
 
 def _rigid_h(m, r_c, I_c, twist, g_body, out, work):
@@ -540,16 +540,16 @@ def _rigid_h(m, r_c, I_c, twist, g_body, out, work):
     omega, v_c, L_c = twist[3:], work[0], work[1]
     force, moment = out[:3], out[3:]
     v_c[:] = twist[:3]
-    _add_cross(omega, r_c, v_c)
+    add_cross(omega, r_c, v_c)
     for a in range(3):
         L_c[a] = I_c[a, 0] * omega[0] + I_c[a, 1] * omega[1] + I_c[a, 2] * omega[2]
         force[a] = 0.0
         moment[a] = 0.0
-    _add_cross(v_c, omega, force)  # −ω̃ v_c, then m (g − ω̃ v_c) = m g − ω̃ p
+    add_cross(v_c, omega, force)  # −ω̃ v_c, then m (g − ω̃ v_c) = m g − ω̃ p
     for a in range(3):
         force[a] = m * (g_body[a] + force[a])
-    _add_cross(r_c, force, moment)
-    _add_cross(L_c, omega, moment)  # − ω̃ I_c ω
+    add_cross(r_c, force, moment)
+    add_cross(L_c, omega, moment)  # − ω̃ I_c ω
 
 
 def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
@@ -574,16 +574,16 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
     for n in range(N - 1, -1, -1):  # backward: leaves → root
         M, k, m = M_hat[n], n_cols[n], rows(n_y, n)
         for a in range(m):
-            c[a] = h_hat[n, a] - _dot(M[a], zeta[n], m)
+            c[a] = h_hat[n, a] - dot_first(M[a], zeta[n], m)
         if k > 0:
             for a in range(m):
                 for j in range(k):
-                    U[n, a, j] = _dot(M[a], F[n, :, j], m)
+                    U[n, a, j] = dot_first(M[a], F[n, :, j], m)
             for i in range(k):
                 for j in range(k):
-                    L[n, i, j] = _dot(F[n, :, i], U[n, :, j], m)  # D_n, factored in place
-                f_h[n, i] = _dot(F[n, :, i], h_hat[n], m)
-                g[i] = _dot(F[n, :, i], c, m)
+                    L[n, i, j] = dot_first(F[n, :, i], U[n, :, j], m)  # D_n, factored in place
+                f_h[n, i] = dot_first(F[n, :, i], h_hat[n], m)
+                g[i] = dot_first(F[n, :, i], c, m)
             if not cholesky(L[n], k, pivot_min):
                 return n
             cholesky_solve(L[n], k, g)  # D_n⁻¹ F_nᵀ c
@@ -612,10 +612,10 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
         p, k, m = parent[n], n_cols[n], rows(n_y, n)
         a = y_ddot[n]
         for i in range(m):
-            a[i] = zeta[n, i] + (_dot(T[n, i], y_ddot[p], rows(n_y, p)) if p >= 0 else 0.0)
+            a[i] = zeta[n, i] + (dot_first(T[n, i], y_ddot[p], rows(n_y, p)) if p >= 0 else 0.0)
         if k > 0:
             for j in range(k):
-                g[j] = f_h[n, j] - _dot(U[n, :, j], a, m)
+                g[j] = f_h[n, j] - dot_first(U[n, :, j], a, m)
             cholesky_solve(L[n], k, g)
             for j in range(k):
                 s_ddot[s_index[n] + j] = g[j]
@@ -703,13 +703,13 @@ def gauss_form(index, T, zeta, F, M_n, h, M, b):
     for n in range(N):  # root → leaves: ζ̄_n, f_n
         p, m = parent[n], rows(n_y, n)
         for a in range(m):
-            zeta_bar[n, a] = zeta[n, a] + (_dot(T[n, a], zeta_bar[p], rows(n_y, p)) if p >= 0 else 0.0)
+            zeta_bar[n, a] = zeta[n, a] + (dot_first(T[n, a], zeta_bar[p], rows(n_y, p)) if p >= 0 else 0.0)
         for a in range(m):
-            f[n, a] = _dot(M_n[n, a], zeta_bar[n], m) - h[n, a]
+            f[n, a] = dot_first(M_n[n, a], zeta_bar[n], m) - h[n, a]
     for n in range(N - 1, -1, -1):  # leaves → root: b_n, M^c_p += T_npᵀ M^c_n T_np, f_p += T_npᵀ f_n
         p, m = parent[n], rows(n_y, n)
         for j in range(n_cols[n]):
-            b[s_index[n] + j] = _dot(F[n, :, j], f[n], m)
+            b[s_index[n] + j] = dot_first(F[n, :, j], f[n], m)
         if p >= 0 and m == 6 and rows(n_y, p) == 6:
             _add_congruence(T[n], M_c[n], f[n], MT, M_c[p], f[p])
         elif p >= 0:
@@ -721,17 +721,17 @@ def gauss_form(index, T, zeta, F, M_n, h, M, b):
             continue
         for a in range(m):
             for j in range(k):
-                U[a, j] = _dot(M_c[n, a], F[n, :, j], m)
+                U[a, j] = dot_first(M_c[n, a], F[n, :, j], m)
         i = n
         while i >= 0:  # M_in = F_iᵀ U, then U ← T_ipᵀ U
             m_i, p = rows(n_y, i), parent[i]
             for r in range(n_cols[i]):
                 for j in range(k):
-                    M[s_index[i] + r, s_index[n] + j] = M[s_index[n] + j, s_index[i] + r] = _dot(F[i, :, r], U[:, j], m_i)
+                    M[s_index[i] + r, s_index[n] + j] = M[s_index[n] + j, s_index[i] + r] = dot_first(F[i, :, r], U[:, j], m_i)
             if p >= 0:
                 for a in range(rows(n_y, p)):
                     for j in range(k):
-                        V[a, j] = _dot(T[i, :, a], U[:, j], m_i)
+                        V[a, j] = dot_first(T[i, :, a], U[:, j], m_i)
                 U[:, :k] = V[:, :k]
             i = p
 
@@ -785,7 +785,7 @@ def cholesky_solve(L, k, b):
         b[i] = total / L[i, i]
 
 
-def _dot6(a, b):
+def dot6(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
 
 
@@ -800,10 +800,10 @@ def _six(n_y, n):
     return 6
 
 
-def _dot(a, b, m):
+def dot_first(a, b, m):
     """Σ a_i b_i over the first m entries (m = 6 unrolled)."""
     if m == 6:
-        return _dot6(a, b)
+        return dot6(a, b)
     total = 0.0
     for i in range(m):
         total += a[i] * b[i]
@@ -880,7 +880,7 @@ def state_kernels(loads, compiled: bool = True, rigid: bool = False):
     return _compiled_state_kernels(loads)["rigid" if rigid else "general"]
 
 
-_CALLEES = (_relative_rotation, _chain_matrix, _add_cross, _add_motion_cross, _rigid_h, _dot6, _dot, _rows,
+_CALLEES = (_relative_rotation, chain_matrix_into, add_cross, add_motion_cross, _rigid_h, dot6, dot_first, _rows,
             _add_congruence, _add_congruence_general, cholesky, cholesky_solve, _image, elastic_body, rotary_body,
             port_motion, hub_motion)
 

@@ -26,6 +26,14 @@ law's terms stated once, in :mod:`projeq.forces`). The numbers are those of the 
 round-off; the tangent kept along the branch is read from and written to the system as the numpy
 path keeps it.
 
+Cut joints (Φ made of :class:`~projeq.constraints.cut_joints.PinClosure`, points of rigid bodies or
+the frames at a RitzBeam's stations) are the kernels' own: A_s = ∂Φ/∂ṡ_tree row by row from the point's
+velocity R_n A_P (T⁶_P ẏ_n + F_P q̇_e)[:3] with the bodies' Jacobians J_n = T_np J_p + F_n, and
+γ = Φ̈ at s̈ = 0 from the point's acceleration with ζ̄_n = T_np ζ̄_p + ζ_n (the chain's own terms,
+docs/theory.md §4; a station's frame by :func:`projeq.assembly.kernels.port_motion`) — exact, no
+complex step, at any speed; :class:`CutJointRows` gives the same Φ, Φ_q and Φ″ to the numpy
+path's projections, conditions and residuals.
+
 Pfaffian rows A(q) q̇ = 0 join Φ_q in A_s and γ gains their part (∂(A q̇)/∂q) q̇ = Im A(q + i h q̇) q̇ / h,
 A compiled and called as Φ is; the joints of kind GIVEN that are UserJoints from sympy (the
 Whipple bicycle's rear frame) state their relative motion A, r, w, ζ, F⁶ by compiled code of
@@ -38,7 +46,8 @@ rows with b = 0 and A independent of t, Φ independent of t (``correction="proje
 q̇ = ṡ_tree (revolute and prismatic joints, UserJoints from sympy with K = E), a tree whose
 whole Gauss form the compiled kernels compute (force laws with compiled rows only — not a
 callable load or a user's own ``add_to`` —, no joints that state their own relative motion in
-Python, no coupled joints, no elastic bodies), and F by one of the two rules above (not a
+Python, no coupled joints; elastic bodies take the Gauss form's variant that reads each body's
+n_y), and F by one of the two rules above (not a
 subclass's own, such as the augmented Lagrangian's). A Φ (or A) numba cannot compile, or whose
 compiled values differ from its own at complex points near q0, keeps the numpy path after one
 :class:`UncompiledClosureWarning` naming it; so does a model outside the kernel, the warning naming
@@ -66,8 +75,8 @@ from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import kernels, loads
-from projeq.assembly.kernels import (N_COLS, N_Y, PARENT, S_INDEX, _add_cross, _add_motion_cross, _chain_matrix, _dot,
-                                     _dot6, cholesky, cholesky_solve, port_motion)
+from projeq.assembly.kernels import (N_COLS, N_Y, PARENT, S_INDEX, add_cross, add_motion_cross, chain_matrix_into,
+                                     cholesky, cholesky_solve, dot6, dot_first, port_motion)
 from projeq.assembly.linalg import SINGULAR_PIVOT
 from projeq.checks import depends_on_t
 from projeq.constraints.batched import NODES, WEIGHTS
@@ -454,7 +463,7 @@ def _port_chain(A_port, r_port, T6):
     for a in range(3):
         for b in range(3):
             A_np[a, b] = A_port[b, a]
-    _chain_matrix(A_np, r_port, T6)
+    chain_matrix_into(A_np, r_port, T6)
 
 
 def cut_joint_rows(pins, points, ports, joints, tree, q, q_dot, t, values, A, gamma):
@@ -526,7 +535,7 @@ def _pin_jacobian(pins, points, ports, tree, q, A):
             sign, k = 1.0 if side == 0 else -1.0, n_y[n] - 6
             for j in range(n_s):
                 for a in range(3):  # v_P of the unit velocity ṡ_tree = e_j
-                    v[a] = _dot6(T6[a], J[n, :6, j])
+                    v[a] = dot6(T6[a], J[n, :6, j])
                     for i in range(k):
                         v[a] += F_port[a, i] * J[n, 6 + i, j]
                 for a in range(3):
@@ -546,7 +555,7 @@ def _pin_gamma(pins, points, ports, tree, q, s_dot_tree, gamma):
     for n in range(N):  # root → leaves
         p = parent[n]
         for a in range(n_y[n]):
-            zeta_bar[n, a] = zeta[n, a] + (_dot(T[n, a], zeta_bar[p], n_y[p]) if p >= 0 else 0.0)
+            zeta_bar[n, a] = zeta[n, a] + (dot_first(T[n, a], zeta_bar[p], n_y[p]) if p >= 0 else 0.0)
     A_port, r_port, F_port, zeta_port = np.empty((3, 3)), np.empty(3), np.empty((6, k_max)), np.empty(6)
     T6, u, w, rate, acc = np.empty((6, 6)), np.empty(6), np.empty(6), np.empty(6), np.empty(3)
     for r in range(pins.shape[0]):
@@ -559,18 +568,18 @@ def _pin_gamma(pins, points, ports, tree, q, s_dot_tree, gamma):
             _port_chain(A_port, r_port, T6)
             sign, k, s0 = 1.0 if side == 0 else -1.0, n_y[n] - 6, elastic[1][n, 1]
             for a in range(6):
-                u[a] = _dot6(T6[a], twist[n])
-                rate[a] = _dot6(T6[a], zeta_bar[n, :6]) + zeta_port[a]
+                u[a] = dot6(T6[a], twist[n])
+                rate[a] = dot6(T6[a], zeta_bar[n, :6]) + zeta_port[a]
                 w[a] = 0.0
                 for i in range(k):
                     w[a] += F_port[a, i] * s_dot_tree[s0 + i]
                     rate[a] += F_port[a, i] * zeta_bar[n, 6 + i]
-            _add_motion_cross(u, w, rate)
+            add_motion_cross(u, w, rate)
             for a in range(6):
                 u[a] += w[a]  # the frame's twist
             for a in range(3):  # v̇_P + ω_P × v_P
                 acc[a] = rate[a]
-            _add_cross(u[3:], u[:3], acc)
+            add_cross(u[3:], u[:3], acc)
             for a in range(3):
                 gamma[r] += sign * (R[n, axis, 0] * A_port[0, a] + R[n, axis, 1] * A_port[1, a]
                                     + R[n, axis, 2] * A_port[2, a]) * acc[a]

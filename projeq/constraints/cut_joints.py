@@ -6,13 +6,22 @@ closure, given to :class:`~projeq.constraints.partitioned.ConstrainedSystem` as 
 
     Φ(q) = (r_a + R_a ρ_a − r_b − R_b ρ_b)[axes]
 
-(r_n, R_n: origin O_n and orientation of frame n; ρ: the point in body axes). With the
+(r_n, R_n: origin O_n and orientation of frame n; ρ: the point in body axes; on a deforming
+subsystem with ports, such as a RitzBeam, R_n ρ is replaced by R_n r_P(q_e), the origin of the frame
+at the station ρ — x along the beam, (0, y, z) the cross-section offset —, which bends and turns
+with the beam, docs/theory.md §10). With the
 constraint inserted before the projection, M s̈_tree + b = A_sᵀ λ = (J_a − J_b)ᵀ λ, where
 J is the Jacobian of the point's inertial velocity by ṡ_tree: the multipliers λ are the
 joint's force on a at P_a (and −λ on b at P_b), in inertial axes, one per row of ``axes``.
 In the coordinates ẏ_n of a rigid subsystem (velocity of O_n and angular velocity, body
 axes, selected by S_n) a force f at ρ is the wrench w_n = S_n (R_nᵀ f; ρ × R_nᵀ f), so that
-w_nᵀ ẏ_n is its power.
+w_nᵀ ẏ_n is its power; at a station of a beam it gains the generalised forces (A F_v)ᵀ R_nᵀ f on
+the amplitudes q_e (ṙ_P = A F_v q̇_e, the station's ``relative``).
+
+Φ takes complex q (the complex step gives the numpy path exact derivatives), and the compiled
+closure kernels evaluate cut joints themselves (:mod:`projeq.constraints.compiled`): A_s and γ
+from the chain's own terms, without differences. Several cut joints are ``phi=[pin_1, pin_2]``
+(:class:`CutJoints`).
 """
 
 from __future__ import annotations

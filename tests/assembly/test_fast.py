@@ -175,11 +175,11 @@ def test_the_kernel_twins_equal_their_array_forms(seed):
     kernels._relative_rotation(kernels.REVOLUTE, e, x, A)
     assert np.abs(A - rotation(e, x)).max() <= TWIN_RTOL
     T = np.empty((6, 6))
-    kernels._chain_matrix(A, r, T)
+    kernels.chain_matrix_into(A, r, T)
     assert np.abs(T - chain_matrix(A, r)).max() <= TWIN_RTOL * np.abs(T).max()
     a, b = rng.uniform(-3, 3, (2, 3))
     out = np.array([0.5, -1.0, 2.0])
-    kernels._add_cross(a, b, out)
+    kernels.add_cross(a, b, out)
     assert np.abs(out - ([0.5, -1.0, 2.0] + cross(a, b))).max() <= TWIN_RTOL * 10
     m, r_c, L = 10 ** rng.uniform(-2, 2), rng.uniform(-1, 1, 3), rng.standard_normal((3, 3))
     I_c, twist, g = m * L @ L.T, rng.uniform(-3, 3, 6), rng.uniform(-10, 10, 3)
