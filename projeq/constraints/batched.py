@@ -74,6 +74,8 @@ class BatchedClosure:
     """Φ_x and Φ″(v, v) of ``phi(q, t)`` (n coordinates) by the complex step on batches of points
     (module docstring); real arguments only."""
 
+    complex_safe = False  # real arguments only
+
     def __init__(self, phi, n: int, m: int):
         self.phi, self.n, self.m = phi, n, m
         self._unit = np.eye(n + 1)

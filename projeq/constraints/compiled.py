@@ -459,7 +459,7 @@ def _pin_frame(pins, points, ports, elastic, r, side, q, s_dot, A_port, r_port, 
 
 def _port_chain(A_port, r_port, T6):
     """T6 ← T⁶ = [[A_Pᵀ, −A_Pᵀ r̃_P], [0, A_Pᵀ]] of a frame P at r_P, turned by A_P."""
-    A_np = np.empty((3, 3))
+    A_np = np.empty((3, 3), A_port.dtype)
     for a in range(3):
         for b in range(3):
             A_np[a, b] = A_port[b, a]
@@ -470,7 +470,7 @@ def cut_joint_rows(pins, points, ports, joints, tree, q, q_dot, t, values, A, ga
     """Φ, Φ_q = A_s (K = E) and γ = Φ″(q̇, q̇) of cut joints alone (the rows a ConstrainedSystem asks
     for outside its accelerations: projections, conditions, residuals), from the tree's chain terms
     at q at rest and (for γ, where q̇ ≠ 0) at (q, q̇)."""
-    rest = np.zeros(q.shape[0])
+    rest = np.zeros(q.shape[0], q.dtype)
     _given_motions(joints, q, rest, t, tree[4])
     _chain_terms(tree, q, rest)
     _pin_values(pins, points, ports, tree, q, values)
@@ -485,9 +485,9 @@ def cut_joint_rows(pins, points, ports, joints, tree, q, q_dot, t, values, A, ga
 def _pin_values(pins, points, ports, tree, q, values):
     """values[r] ← Φ_r = (P_a − P_b)[axis] of cut-joint row r: P = r_n + R_n r_P with r_P the point's
     frame (:func:`_pin_frame`), or ρ_b itself for the ground."""
-    elastic, R, r_O, k_max = tree[5], tree[12], tree[13], ports[1].shape[2]
-    A_port, r_port, F_port, zeta_port = np.empty((3, 3)), np.empty(3), np.empty((6, k_max)), np.empty(6)
-    rest = np.zeros(q.shape[0])
+    elastic, R, r_O, k_max, dtype = tree[5], tree[12], tree[13], ports[1].shape[2], q.dtype
+    A_port, r_port = np.empty((3, 3), dtype), np.empty(3, dtype)
+    F_port, zeta_port, rest = np.empty((6, k_max), dtype), np.empty(6, dtype), np.zeros(q.shape[0], dtype)
     for r in range(pins.shape[0]):
         axis, values[r] = pins[r, 2], 0.0
         for side in range(2):
@@ -507,23 +507,23 @@ def _pin_jacobian(pins, points, ports, tree, q, A):
     T⁶ = [[A_Pᵀ, −A_Pᵀ r̃_P], [0, A_Pᵀ]]), and the bodies' twists ẏ_n = J_n ṡ_tree: the Jacobians
     J_n = ∂ẏ_n/∂ṡ_tree by the chain, J_n = T_np J_p + F_n (in the columns of joint n's ṡ_n)."""
     index, elastic, T, F, R = tree[0], tree[5], tree[7], tree[9], tree[12]
-    N, width, n_s, k_max = index.shape[0], T.shape[1], A.shape[1], ports[1].shape[2]
+    N, width, n_s, k_max, dtype = index.shape[0], T.shape[1], A.shape[1], ports[1].shape[2], T.dtype
     n_y, parent, s_index, n_cols = index[:, N_Y], index[:, PARENT], index[:, S_INDEX], index[:, N_COLS]
-    J = np.zeros((N, width, n_s))
+    J = np.zeros((N, width, n_s), dtype)
     for n in range(N):  # root → leaves
         p, m = parent[n], n_y[n]
         if p >= 0:
             for a in range(m):
                 for j in range(n_s):
-                    total = 0.0
+                    J[n, a, j] = 0.0
                     for c in range(n_y[p]):
-                        total += T[n, a, c] * J[p, c, j]
-                    J[n, a, j] = total
+                        J[n, a, j] += T[n, a, c] * J[p, c, j]
         for c in range(n_cols[n]):
             for a in range(m):
                 J[n, a, s_index[n] + c] += F[n, a, c]
-    A_port, r_port, F_port, zeta_port = np.empty((3, 3)), np.empty(3), np.empty((6, k_max)), np.empty(6)
-    T6, v, rest = np.empty((6, 6)), np.empty(3), np.zeros(q.shape[0])
+    A_port, r_port, F_port, zeta_port = np.empty((3, 3), dtype), np.empty(3, dtype), np.empty((6, k_max), dtype), \
+        np.empty(6, dtype)
+    T6, v, rest = np.empty((6, 6), dtype), np.empty(3, dtype), np.zeros(q.shape[0], dtype)
     A[:, :] = 0.0
     for r in range(pins.shape[0]):
         axis = pins[r, 2]
@@ -549,15 +549,17 @@ def _pin_gamma(pins, points, ports, tree, q, s_dot_tree, gamma):
     ζ̄_P = T⁶_P ζ̄_n + F_P q̈_e + u × w + ζ_P (the chain's step, docs/theory.md §4), ζ̄_n = T_np ζ̄_p + ζ_n
     the bodies' at s̈ = 0 (the components' derivatives in body axes)."""
     index, elastic, T, zeta, R, twist = tree[0], tree[5], tree[7], tree[8], tree[12], tree[14]
-    N, width, k_max = index.shape[0], T.shape[1], ports[1].shape[2]
+    N, width, k_max, dtype = index.shape[0], T.shape[1], ports[1].shape[2], T.dtype
     n_y, parent = index[:, N_Y], index[:, PARENT]
-    zeta_bar = np.zeros((N, width))
+    zeta_bar = np.zeros((N, width), dtype)
     for n in range(N):  # root → leaves
         p = parent[n]
         for a in range(n_y[n]):
             zeta_bar[n, a] = zeta[n, a] + (dot_first(T[n, a], zeta_bar[p], n_y[p]) if p >= 0 else 0.0)
-    A_port, r_port, F_port, zeta_port = np.empty((3, 3)), np.empty(3), np.empty((6, k_max)), np.empty(6)
-    T6, u, w, rate, acc = np.empty((6, 6)), np.empty(6), np.empty(6), np.empty(6), np.empty(3)
+    A_port, r_port, F_port, zeta_port = np.empty((3, 3), dtype), np.empty(3, dtype), np.empty((6, k_max), dtype), \
+        np.empty(6, dtype)
+    T6, u, w, rate, acc = np.empty((6, 6), dtype), np.empty(6, dtype), np.empty(6, dtype), np.empty(6, dtype), \
+        np.empty(3, dtype)
     for r in range(pins.shape[0]):
         axis = pins[r, 2]
         gamma[r] = 0.0
@@ -1089,9 +1091,8 @@ class CompiledClosure:
         rows = [[n, q_n.start, joint.n_q, s_n.start, joint.n_s, back.address if compiled else joint.compiled_values()]
                 for (n, joint, q_n, s_n, _), back in zip(ev._given_plan, self._callbacks[1:])]
         self.joints = np.array(rows, dtype=np.int64 if compiled else object).reshape(len(rows), 6)
-        ws = self._workspace = ev._real
-        self.tree = (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
-                     ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist, ev._laws, ev._law_constants)
+        self._workspace = ev._real
+        self.tree = self.tree_arrays(float)
         self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
         self._kept = (None, None)  # (the system, the tangent it keeps) of the last call (_kept_tangent)
         self.rows = _compiled(ev._width > 6)["cut_joint_rows"] if compiled else cut_joint_rows
@@ -1111,6 +1112,15 @@ class CompiledClosure:
                                system.separation, self.constants[0], self._kept_tangent(system), SINGULAR_PIVOT,
                                self._q_dot, self._s_ddot_tree, self._A, M, b)
         return flag == DONE
+
+    def tree_arrays(self, dtype) -> tuple:
+        """The tree's packed arrays and its fast evaluator's workspace of ``dtype`` (float; complex for
+        the complex step), as the kernels read them (``tree``: those of
+        :func:`projeq.assembly.kernels.chain_terms`, the force laws' rows last)."""
+        ev = self.fast
+        ws = ev._real if dtype is float else ev._workspace(dtype)
+        return (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
+                ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist, ev._laws, ev._law_constants)
 
     def cut_joints(self) -> "CutJointRows | None":
         """Φ, Φ_q and Φ″ of the cut joints this kernel evaluates itself (None: Φ is a user's function)."""
@@ -1151,36 +1161,43 @@ class CompiledClosure:
 
 
 class CutJointRows:
-    """Φ, Φ_x and Φ″(v, v) of a ConstrainedSystem whose Φ is made of cut joints (real arguments, Φ
-    independent of t, K = E), by its compiled kernel's own statement of them (:func:`cut_joint_rows`):
-    what the numpy path's projections, conditions and residuals ask for, in place of its complex
-    steps through the poses (one Python pass over the tree per point). The interface of
-    :class:`~projeq.constraints.batched.BatchedClosure`, and Φ itself."""
+    """Φ, Φ_x and Φ″(v, v) of a ConstrainedSystem whose Φ is made of cut joints (Φ independent of t,
+    K = E), by its compiled kernel's own statement of them (:func:`cut_joint_rows`): what the numpy
+    path's projections, conditions and residuals ask for, in place of its complex steps through the
+    poses (one Python pass over the tree per point). The interface of
+    :class:`~projeq.constraints.batched.BatchedClosure`, and Φ itself. ``complex_safe``: complex
+    arguments too (an outer complex step, the exact Jacobians and the stiffness estimate of
+    :mod:`projeq.analysis.jacobians`): the kernel is an analytic function of q and q̇, so at
+    q = a + i b it gives f(a) + i f′(a) b exactly; not with joints of kind GIVEN, whose relative
+    motions are real C callbacks."""
 
     def __init__(self, kernel: CompiledClosure):
         self.kernel = kernel
-        m_h, n = kernel.m_h, kernel._A.shape[1]
-        self._values, self._A, self._gamma = np.zeros(m_h), np.zeros((m_h, n)), np.zeros(m_h)
+        self.complex_safe = kernel.joints.shape[0] == 0
+        self._trees = {}
 
-    def _call(self, q: NDArray, q_dot: NDArray, t: float) -> None:
-        k = self.kernel
-        k.rows(k.pins, k.points, k.ports, k.joints, k.tree, kernels.kernel_array(q), kernels.kernel_array(q_dot),
-               float(t), self._values, self._A, self._gamma)
+    def _call(self, q: NDArray, q_dot: NDArray, t: float) -> tuple[NDArray, NDArray, NDArray]:
+        """(Φ, A_s, γ) at (q, q̇, t), new arrays of the arguments' dtype."""
+        k, dtype = self.kernel, np.result_type(q, q_dot, float)
+        if dtype not in self._trees:
+            self._trees[dtype] = k.tree_arrays(dtype)
+        m_h, n = k.m_h, k._A.shape[1]
+        values, A, gamma = np.zeros(m_h, dtype), np.zeros((m_h, n), dtype), np.zeros(m_h, dtype)
+        k.rows(k.pins, k.points, k.ports, k.joints, self._trees[dtype], np.ascontiguousarray(q, dtype),
+               np.ascontiguousarray(q_dot, dtype), float(np.real(t)), values, A, gamma)
+        return values, A, gamma
 
     def values(self, q: NDArray, t: float) -> NDArray:
         """Φ(q)."""
-        self._call(q, np.zeros(len(q)), t)
-        return self._values.copy()
+        return self._call(q, np.zeros(len(q)), t)[0]
 
     def jacobian(self, x: NDArray, columns: int) -> NDArray:
         """Φ_q at x = (q, t) (``columns`` = n_q: Φ independent of t)."""
-        self._call(x[:-1], np.zeros(len(x) - 1), x[-1])
-        return self._A.copy()
+        return self._call(x[:-1], np.zeros(len(x) - 1), x[-1])[1]
 
     def second(self, x: NDArray, q_dot: NDArray, rheonomic: bool) -> NDArray:
         """Φ″(q̇, q̇) at x = (q, t) (``rheonomic`` False: Φ independent of t)."""
-        self._call(x[:-1], q_dot, x[-1])
-        return self._gamma.copy()
+        return self._call(x[:-1], q_dot, x[-1])[2]
 
 
 @functools.cache

@@ -225,7 +225,7 @@ class ConstrainedSystem(Model):
         if not self.m_h:
             return np.zeros(0)
         rows = self._cut_joint_rows()
-        if rows is not None and not np.iscomplexobj(q):
+        if rows is not None and (rows.complex_safe or not np.iscomplexobj(q)):
             return rows.values(q, t)
         return numeric(self._phi(q, t))
 
@@ -268,7 +268,7 @@ class ConstrainedSystem(Model):
             return np.zeros((0, self.n_q)), np.zeros(0)
         n = self.n_q + self.rheonomic  # the columns along q, and along t if Φ depends on it
         batched = self._batched()
-        if batched is not None and not np.iscomplexobj(x):
+        if batched is not None and (batched.complex_safe or not np.iscomplexobj(x)):
             Phi_x = batched.jacobian(x, n)
         else:
             Phi_x = np.array([self._d1(self._phi_x, x, e) for e in np.eye(self.n_q + 1)[:n]]).T.reshape(self.m_h, n)
@@ -612,7 +612,7 @@ class ConstrainedSystem(Model):
         v_t = (0, 1) (:meth:`gamma`; the rheonomic parts only where Φ depends on t), by one call
         at a batch of points where Φ takes them."""
         batched = self._batched()
-        if batched is not None and not (np.iscomplexobj(x) or np.iscomplexobj(q_dot)):
+        if batched is not None and (batched.complex_safe or not (np.iscomplexobj(x) or np.iscomplexobj(q_dot))):
             return batched.second(x, q_dot, self.rheonomic)
         v_q, v_t = np.append(q_dot, 0.0), np.eye(len(x))[-1]
         value = self._d2(self._phi_x, x, v_q, v_q)
