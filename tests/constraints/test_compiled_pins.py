@@ -67,9 +67,9 @@ def four_bar(g=G, forces=(), kind=ConstrainedSystem, axes="xy", **options):
     return kind(tree, phi=pin, q0=_four_bar_q0(), **options)
 
 
-def pendulum():
-    """tests/constraints/test_cut_joints.py's pendulum: a uniform rod on x and y sliders, its end
-    pinned to the ground (b = None) by a cut revolute joint."""
+def pendulum(rho=0.0):
+    """tests/constraints/test_cut_joints.py's pendulum: a uniform rod (PlanarBody) on x and y
+    sliders, its point (ρ, 0, 0) pinned to the ground (b = None) by a cut revolute joint."""
     m, length = 1.3, 0.9
     tree = pq.System(
         {"x": pq.Frame(), "y": pq.Frame(), "rod": pq.PlanarBody(m, (length / 2, 0, 0), m * length**2 / 12)},
@@ -77,8 +77,8 @@ def pendulum():
          "rod": pq.Revolute(parent="y", axis="z")},
         gravity=(0, -G, 0),
     )
-    pin = PinClosure(tree, "rod", (0, 0, 0), None, (0, 0, 0), axes="xy")
-    return ConstrainedSystem(tree, phi=pin, q0=[0.0, 0.0, -np.pi / 2])
+    pin = PinClosure(tree, "rod", (rho, 0, 0), None, (0, 0, 0), axes="xy")
+    return ConstrainedSystem(tree, phi=pin, q0=[0.0, rho, -np.pi / 2])  # the rod hanging, P = 0
 
 
 def two_loops(forces=()):
@@ -143,6 +143,7 @@ def _springs(damping=0.7):
 MODELS = {
     "spatial four-bar": lambda: four_bar(independent=[0]),
     "pendulum pinned to the ground": pendulum,
+    "pendulum pinned off the rod's origin": lambda: pendulum(rho=0.2),
     "two loops, phi=[pin_1, pin_2]": two_loops,
     "spatial loop, spherical cut joint": spatial_loop,
     "tangent four-bar": lambda: four_bar(kind=TangentSystem),
