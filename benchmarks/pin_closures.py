@@ -16,6 +16,10 @@ output rows and with 2 (``run_2_rows``: the integration alone, nearly — each o
 steps through the tree's poses in Python, for the hand-written Φ one batched call).
 
     PYTHONPATH=. python benchmarks/pin_closures.py [--budget 3] [--runs 3]
+
+Measured 2026-11-28 (2 shared cores, load 1.3): s̈ 28.9 µs compiled, 3076 µs numpy path (106×),
+29.6 µs hand-written Φ (1.02×); simulate 2 s: 2.84 s CPU compiled, 7.50 s numpy path (2.64×),
+0.51 s hand-written Φ (0.18×); with 2 output rows 0.67, 5.54 and 0.21 s; 1372 s̈ evaluations each.
 """
 
 from __future__ import annotations
