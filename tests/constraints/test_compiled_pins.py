@@ -5,8 +5,9 @@ the dense Gauss form, docs/theory.md §7); the four-bar's loop closure different
 KKT system [M A_sᵀ; A_s 0] solved by numpy; the work–energy theorem (the cut joints' forces do no
 work, so a conservative mechanism keeps dE/dt = 0); and the refusal of a ``phi`` list that is not
 made of one tree's cut joints. The models: planar four-bars (partitioned and tangent, with force
-laws), a rod pinned to the ground, two loops on one crank, and a spatial loop on skew axes whose
-terms the planar ones cannot see (ω̇ at s̈ = 0, ζ̄ carried down a chain, z components)."""
+laws, on a sympy UserJoint), a rod pinned to the ground, two loops on one crank, and a spatial loop
+on skew axes whose terms the planar ones cannot see (ω̇ at s̈ = 0, ζ̄ carried down a chain, z
+components)."""
 
 import warnings
 from contextlib import contextmanager
@@ -104,6 +105,23 @@ def two_loops(forces=()):
     return ConstrainedSystem(tree, phi=pins, q0=q0, independent=[tree.index("crank")])
 
 
+def cam_four_bar():
+    """The four-bar with its coupler on a UserJoint from sympy (a joint of kind GIVEN in the kernels:
+    its relative motion by a compiled callback): a revolute about z whose pivot slides along the
+    crank with the angle, r = (0.05 sin θ, 0, 0), so that F(q) = [R_zᵀ r′; e_z] varies (Ḟ ≠ 0)."""
+    th, w = sp.symbols("theta omega")
+    Rz = sp.Matrix([[sp.cos(th), -sp.sin(th), 0], [sp.sin(th), sp.cos(th), 0], [0, 0, 1]])
+    r = sp.Matrix([0.05 * sp.sin(th), 0, 0])
+    v = Rz.T * r.diff(th)  # the pivot's velocity per θ̇, child axes
+    joint = pq.UserJoint.from_sympy([th], [w], Rz, r, sp.Matrix([*v, 0, 0, 1]), sp.eye(1), parent="crank",
+                                    r_pn=(A, 0, 0))
+    tree = pq.System({"crank": _rod(1.0, A), "coupler": _rod(2.0, B), "rocker": _rod(1.5, C)},
+                     {"crank": pq.Revolute(axis="z"), "coupler": joint, "rocker": pq.Revolute(axis="z", r_pn=(D, 0, 0))},
+                     gravity=(0, -G, 0))
+    pin = PinClosure(tree, "coupler", (B, 0, 0), "rocker", (C, 0, 0), axes="xy")
+    return ConstrainedSystem(tree, phi=pin, q0=_four_bar_q0(), independent=[0], project_q0=True)
+
+
 def _body(m, centre, inertia):
     return pq.RigidBody(m, centre, np.array(inertia, dtype=float))
 
@@ -151,6 +169,7 @@ MODELS = {
     "tangent four-bar": lambda: four_bar(kind=TangentSystem),
     "tangent four-bar, redundant z row": lambda: four_bar(kind=TangentSystem, axes="xyz"),
     "four-bar with springs and gravity": lambda: four_bar(forces=_springs(), independent=[0]),
+    "four-bar on a sympy UserJoint (kind GIVEN, F(q))": cam_four_bar,
 }
 
 
