@@ -108,7 +108,8 @@ def two_loops(forces=()):
 def cam_four_bar():
     """The four-bar with its coupler on a UserJoint from sympy (a joint of kind GIVEN in the kernels:
     its relative motion by a compiled callback): a revolute about z whose pivot slides along the
-    crank with the angle, r = (0.05 sin θ, 0, 0), so that F(q) = [R_zᵀ r′; e_z] varies (Ḟ ≠ 0)."""
+    crank with the angle, r = (0.05 sin θ, 0, 0), so that F(q) = [R_zᵀ r′; e_z] varies (Ḟ ≠ 0): the
+    only model that sees A_s taken with a GIVEN joint's F left from the previous call."""
     th, w = sp.symbols("theta omega")
     Rz = sp.Matrix([[sp.cos(th), -sp.sin(th), 0], [sp.sin(th), sp.cos(th), 0], [0, 0, 1]])
     r = sp.Matrix([0.05 * sp.sin(th), 0, 0])
