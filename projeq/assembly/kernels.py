@@ -700,10 +700,9 @@ def gauss_form(index, T, zeta, F, M_n, h, M, b):
     dtype = M.dtype  # of the workspace: float, or complex under the complex step
     zeta_bar, f, M_c = np.zeros((N, width), dtype), np.zeros((N, width), dtype), M_n.copy()
     U, V, MT = np.zeros((width, width), dtype), np.zeros((width, width), dtype), np.empty((width, width), dtype)
-    for n in range(N):  # root → leaves: ζ̄_n, f_n
-        p, m = parent[n], rows(n_y, n)
-        for a in range(m):
-            zeta_bar[n, a] = zeta[n, a] + (dot_first(T[n, a], zeta_bar[p], rows(n_y, p)) if p >= 0 else 0.0)
+    bias_rates(index, T, zeta, zeta_bar)
+    for n in range(N):  # f_n
+        m = rows(n_y, n)
         for a in range(m):
             f[n, a] = dot_first(M_n[n, a], zeta_bar[n], m) - h[n, a]
     for n in range(N - 1, -1, -1):  # leaves → root: b_n, M^c_p += T_npᵀ M^c_n T_np, f_p += T_npᵀ f_n
@@ -734,6 +733,15 @@ def gauss_form(index, T, zeta, F, M_n, h, M, b):
                         V[a, j] = dot_first(T[i, :, a], U[:, j], m_i)
                 U[:, :k] = V[:, :k]
             i = p
+
+
+def bias_rates(index, T, zeta, zeta_bar):
+    """zeta_bar ← ζ̄_n = T_np ζ̄_p + ζ_n root → leaves: the bodies' ÿ_n at s̈ = 0 (docs/theory.md §4)."""
+    n_y, parent = index[:, N_Y], index[:, PARENT]
+    for n in range(index.shape[0]):
+        p = parent[n]
+        for a in range(_rows(n_y, n)):
+            zeta_bar[n, a] = zeta[n, a] + (dot_first(T[n, a], zeta_bar[p], _rows(n_y, p)) if p >= 0 else 0.0)
 
 
 def projected_accelerations(M_all, b_all, P, pivot_min, M, s_ddot):
@@ -880,7 +888,7 @@ def state_kernels(loads, compiled: bool = True, rigid: bool = False):
     return _compiled_state_kernels(loads)["rigid" if rigid else "general"]
 
 
-_CALLEES = (_relative_rotation, chain_matrix_into, add_cross, add_motion_cross, _rigid_h, dot6, dot_first, _rows,
+_CALLEES = (_relative_rotation, chain_matrix_into, add_cross, add_motion_cross, _rigid_h, dot6, dot_first, _rows, bias_rates,
             _add_congruence, _add_congruence_general, cholesky, cholesky_solve, _image, elastic_body, rotary_body,
             port_motion, hub_motion)
 

@@ -75,8 +75,8 @@ from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import kernels, loads
-from projeq.assembly.kernels import (N_COLS, N_Y, PARENT, S_INDEX, add_cross, add_motion_cross, chain_matrix_into,
-                                     cholesky, cholesky_solve, dot6, dot_first, port_motion)
+from projeq.assembly.kernels import (N_COLS, N_Y, PARENT, S_INDEX, add_cross, add_motion_cross, bias_rates,
+                                     chain_matrix_into, cholesky, cholesky_solve, dot6, port_motion)
 from projeq.assembly.linalg import SINGULAR_PIVOT
 from projeq.checks import depends_on_t
 from projeq.constraints.batched import NODES, WEIGHTS
@@ -507,23 +507,12 @@ def _pin_jacobian(pins, points, ports, tree, q, A):
     T⁶ = [[A_Pᵀ, −A_Pᵀ r̃_P], [0, A_Pᵀ]]), and the bodies' twists ẏ_n = J_n ṡ_tree: the Jacobians
     J_n = ∂ẏ_n/∂ṡ_tree by the chain, J_n = T_np J_p + F_n (in the columns of joint n's ṡ_n)."""
     index, elastic, T, F, R = tree[0], tree[5], tree[7], tree[9], tree[12]
-    N, width, n_s, k_max, dtype = index.shape[0], T.shape[1], A.shape[1], ports[1].shape[2], T.dtype
-    n_y, parent, s_index, n_cols = index[:, N_Y], index[:, PARENT], index[:, S_INDEX], index[:, N_COLS]
-    J = np.zeros((N, width, n_s), dtype)
-    for n in range(N):  # root → leaves
-        p, m = parent[n], n_y[n]
-        if p >= 0:
-            for a in range(m):
-                for j in range(n_s):
-                    J[n, a, j] = 0.0
-                    for c in range(n_y[p]):
-                        J[n, a, j] += T[n, a, c] * J[p, c, j]
-        for c in range(n_cols[n]):
-            for a in range(m):
-                J[n, a, s_index[n] + c] += F[n, a, c]
+    n_s, k_max, dtype, n_y = A.shape[1], ports[1].shape[2], T.dtype, index[:, N_Y]
+    J = np.zeros((index.shape[0], T.shape[1], n_s), dtype)
+    _body_jacobians(index, T, F, J)
     A_port, r_port, F_port, zeta_port = np.empty((3, 3), dtype), np.empty(3, dtype), np.empty((6, k_max), dtype), \
         np.empty(6, dtype)
-    T6, v, rest = np.empty((6, 6), dtype), np.empty(3, dtype), np.zeros(q.shape[0], dtype)
+    T6, v, e, rest = np.empty((6, 6), dtype), np.empty(3, dtype), np.empty(3, dtype), np.zeros(q.shape[0], dtype)
     A[:, :] = 0.0
     for r in range(pins.shape[0]):
         axis = pins[r, 2]
@@ -533,14 +522,35 @@ def _pin_jacobian(pins, points, ports, tree, q, A):
                 continue
             _port_chain(A_port, r_port, T6)
             sign, k = 1.0 if side == 0 else -1.0, n_y[n] - 6
+            _inertial_axis(R, n, axis, A_port, e)
             for j in range(n_s):
                 for a in range(3):  # v_P of the unit velocity ṡ_tree = e_j
                     v[a] = dot6(T6[a], J[n, :6, j])
                     for i in range(k):
                         v[a] += F_port[a, i] * J[n, 6 + i, j]
-                for a in range(3):
-                    A[r, j] += sign * (R[n, axis, 0] * A_port[0, a] + R[n, axis, 1] * A_port[1, a]
-                                       + R[n, axis, 2] * A_port[2, a]) * v[a]
+                A[r, j] += sign * (e[0] * v[0] + e[1] * v[1] + e[2] * v[2])
+
+
+def _body_jacobians(index, T, F, J):
+    """J[n] ← J_n = ∂ẏ_n/∂ṡ_tree root → leaves: J_n = T_np J_p + F_n in the columns of joint n's ṡ_n."""
+    n_y, parent, s_index, n_cols = index[:, N_Y], index[:, PARENT], index[:, S_INDEX], index[:, N_COLS]
+    for n in range(index.shape[0]):
+        p, m = parent[n], n_y[n]
+        if p >= 0:
+            for a in range(m):
+                for j in range(J.shape[2]):
+                    J[n, a, j] = 0.0
+                    for c in range(n_y[p]):
+                        J[n, a, j] += T[n, a, c] * J[p, c, j]
+        for c in range(n_cols[n]):
+            for a in range(m):
+                J[n, a, s_index[n] + c] += F[n, a, c]
+
+
+def _inertial_axis(R, n, axis, A_port, e):
+    """e ← (R_n A_P)ᵀ e_axis: the inertial direction ``axis`` in the axes of the point's frame P."""
+    for a in range(3):
+        e[a] = R[n, axis, 0] * A_port[0, a] + R[n, axis, 1] * A_port[1, a] + R[n, axis, 2] * A_port[2, a]
 
 
 def _pin_gamma(pins, points, ports, tree, q, s_dot_tree, gamma):
@@ -549,17 +559,13 @@ def _pin_gamma(pins, points, ports, tree, q, s_dot_tree, gamma):
     ζ̄_P = T⁶_P ζ̄_n + F_P q̈_e + u × w + ζ_P (the chain's step, docs/theory.md §4), ζ̄_n = T_np ζ̄_p + ζ_n
     the bodies' at s̈ = 0 (the components' derivatives in body axes)."""
     index, elastic, T, zeta, R, twist = tree[0], tree[5], tree[7], tree[8], tree[12], tree[14]
-    N, width, k_max, dtype = index.shape[0], T.shape[1], ports[1].shape[2], T.dtype
-    n_y, parent = index[:, N_Y], index[:, PARENT]
-    zeta_bar = np.zeros((N, width), dtype)
-    for n in range(N):  # root → leaves
-        p = parent[n]
-        for a in range(n_y[n]):
-            zeta_bar[n, a] = zeta[n, a] + (dot_first(T[n, a], zeta_bar[p], n_y[p]) if p >= 0 else 0.0)
+    k_max, dtype, n_y = ports[1].shape[2], T.dtype, index[:, N_Y]
+    zeta_bar = np.zeros((index.shape[0], T.shape[1]), dtype)
+    bias_rates(index, T, zeta, zeta_bar)
     A_port, r_port, F_port, zeta_port = np.empty((3, 3), dtype), np.empty(3, dtype), np.empty((6, k_max), dtype), \
         np.empty(6, dtype)
-    T6, u, w, rate, acc = np.empty((6, 6), dtype), np.empty(6, dtype), np.empty(6, dtype), np.empty(6, dtype), \
-        np.empty(3, dtype)
+    T6, u, w, rate = np.empty((6, 6), dtype), np.empty(6, dtype), np.empty(6, dtype), np.empty(6, dtype)
+    acc, e = np.empty(3, dtype), np.empty(3, dtype)
     for r in range(pins.shape[0]):
         axis = pins[r, 2]
         gamma[r] = 0.0
@@ -582,9 +588,8 @@ def _pin_gamma(pins, points, ports, tree, q, s_dot_tree, gamma):
             for a in range(3):  # v̇_P + ω_P × v_P
                 acc[a] = rate[a]
             add_cross(u[3:], u[:3], acc)
-            for a in range(3):
-                gamma[r] += sign * (R[n, axis, 0] * A_port[0, a] + R[n, axis, 1] * A_port[1, a]
-                                    + R[n, axis, 2] * A_port[2, a]) * acc[a]
+            _inertial_axis(R, n, axis, A_port, e)
+            gamma[r] += sign * (e[0] * acc[0] + e[1] * acc[1] + e[2] * acc[2])
 
 
 def _jacobian(phi, q, t, A):
@@ -996,8 +1001,8 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pin_frame, _port_chain, _pin_values, _pin_jacobian,
-            _pin_gamma, _given_motions,
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pin_frame, _port_chain, _pin_values, _body_jacobians,
+            _inertial_axis, _pin_jacobian, _pin_gamma, _given_motions,
             _matvec, _matmul, _svd, _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms,
             _loaded, _projected, _inverse)
 

@@ -158,6 +158,9 @@ class ConstrainedSystem(Model):
         if phi is None and A is None:
             raise ValueError("phi: give holonomic constraints phi(q, t) and/or Pfaffian ones A(q, t)")
         phi = cut_joints(phi)
+        if point_rows(phi) is not None and phi.tree is not system:
+            raise ValueError("phi: the cut joints hold points of another tree's bodies (PinClosure(tree, ...) "
+                             "takes the tree given to ConstrainedSystem)")
         for name, f in (("phi", phi), ("A", A), ("b", b)):
             if f is not None and not callable(f):
                 raise ValueError(f"{name}: expected a callable {name}(q, t), got {f!r}")
