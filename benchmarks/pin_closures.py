@@ -12,14 +12,17 @@ at eight moving states near q0, the median of the batches' means (ratios from on
 loaded machine, absolute times less so). ``simulate(system, 2.0)``: the CPU time of one run each
 (median of ``--runs``), from the scene's initial state (crank at 3 rad/s), with the default 501
 output rows and with 2 (``run_2_rows``: the integration alone, nearly — each output row evaluates
-Φ, its Jacobian and the projection onto Φ = 0 outside the kernel: for a PinClosure pointwise complex
-steps through the tree's poses in Python, for the hand-written Φ one batched call).
+Φ, its Jacobian and the projection onto Φ = 0 outside the accelerations: for a PinClosure by the
+kernel's own cut-joint rows (``CutJointRows``; on the numpy path pointwise complex steps through
+the tree's poses in Python), for the hand-written Φ one batched call).
 
     PYTHONPATH=. python benchmarks/pin_closures.py [--budget 3] [--runs 3]
 
-Measured 2026-11-28 (2 shared cores, load 1.3): s̈ 28.9 µs compiled, 3076 µs numpy path (106×),
-29.6 µs hand-written Φ (1.02×); simulate 2 s: 2.84 s CPU compiled, 7.50 s numpy path (2.64×),
-0.51 s hand-written Φ (0.18×); with 2 output rows 0.67, 5.54 and 0.21 s; 1372 s̈ evaluations each.
+Measured 2026-11-28 (2 shared cores, load ~1.5): s̈ 47.5 µs compiled, 3549 µs numpy path (75×),
+39.3 µs hand-written Φ (0.83×); simulate 2 s: 0.62 s CPU compiled, 7.90 s numpy path (12.7×),
+0.57 s hand-written Φ (0.91×); with 2 output rows 0.27, 5.29 and 0.26 s; 1372 s̈ evaluations each.
+(Earlier the same day, before the cut-joint rows outside the accelerations were compiled: simulate
+2.84 s compiled vs 0.51 s hand-written.)
 """
 
 from __future__ import annotations
