@@ -53,7 +53,8 @@ def models() -> dict:
 
     compiled, numpy_path = pinned(), pinned()
     assert compiled.compiled_kernel() is not None and scene.compiled_kernel() is not None
-    numpy_path._compiled = None  # the kernel "does not apply": every call takes the numpy path
+    numpy_path._compiled = None  # the kernel "does not apply": every call takes the numpy path,
+    numpy_path._cut_rows = None  # and the cut joints' rows the complex steps through the poses
     assert numpy_path.compiled_kernel() is None and numpy_path.evaluator().accelerations.__name__ == "accelerations"
     assert compiled.evaluator().accelerations.__name__ == "_compiled_accelerations"
     return {"PinClosure, compiled kernel": compiled, "PinClosure, numpy path": numpy_path,

@@ -1071,6 +1071,40 @@ def pin_table(phi, m_h: int) -> tuple:
     return pins, points, ports
 
 
+def tree_arrays(ev, dtype) -> tuple:
+    """The tree's packed arrays and the workspace of ``dtype`` (float; complex for the complex step) of
+    its fast evaluator ``ev``, as the kernels read them (``tree``: those of
+    :func:`projeq.assembly.kernels.chain_terms`, the force laws' rows last)."""
+    ws = ev._real if dtype is float else ev._workspace(dtype)
+    return (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
+            ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist, ev._laws, ev._law_constants)
+
+
+def _joint_table(ev, callbacks, compiled: bool) -> NDArray:
+    """One row (n, first coordinate, n_q, first velocity, n_s, callback) per joint of kind GIVEN of the
+    fast evaluator ``ev`` (:func:`_given_motions`): its C callback's address (``callbacks``), or
+    interpreted its ``compiled_values`` function."""
+    rows = [[n, q_n.start, joint.n_q, s_n.start, joint.n_s, back.address if compiled else joint.compiled_values()]
+            for (n, joint, q_n, s_n, _), back in zip(ev._given_plan, callbacks)]
+    return np.array(rows, dtype=np.int64 if compiled else object).reshape(len(rows), 6)
+
+
+def compiled_cut_joints(system) -> "CutJointRows | None":
+    """The compiled rows of ``system``'s cut joints (:class:`CutJointRows`) where its Φ is made of them
+    and the tree's kinematics compile — K = E, Φ independent of t, the tree's fast evaluator without
+    coupled joints or joints that state their relative motion in Python, its UserJoints' relative
+    motions compiled —, whether or not its constrained s̈ is one compiled call (an AugmentedSystem,
+    a force law without compiled rows, Pfaffian rows with b ≠ 0); else None (the numpy path's
+    complex steps through the poses)."""
+    if point_rows(system._phi) is None or not system._identity or system.rheonomic or not system.compiled_tree():
+        return None
+    ev = system.tree.evaluator("fast")
+    if ev._expansion is not None or _python_joints(ev):
+        return None
+    callbacks = [joint_callback(system.tree.joints[n]) for n in ev._given]
+    return None if None in callbacks else CutJointRows(ev, pin_table(system._phi, system.m_h), callbacks)
+
+
 class CompiledClosure:
     """s̈_tree, A_s, M and b of a constrained model by one call of a compiled kernel
     (:func:`partitioned` or :func:`tangent`) with the C callbacks of Φ, of the Pfaffian rows A
@@ -1093,14 +1127,11 @@ class CompiledClosure:
                 0 if pfaffian is None else pfaffian.address
         else:
             self.kernel, self.phi, self.pfaffian = globals()[rule], callback, pfaffian
-        rows = [[n, q_n.start, joint.n_q, s_n.start, joint.n_s, back.address if compiled else joint.compiled_values()]
-                for (n, joint, q_n, s_n, _), back in zip(ev._given_plan, self._callbacks[1:])]
-        self.joints = np.array(rows, dtype=np.int64 if compiled else object).reshape(len(rows), 6)
+        self.joints = _joint_table(ev, self._callbacks[1:], compiled)
         self._workspace = ev._real
-        self.tree = self.tree_arrays(float)
+        self.tree = tree_arrays(ev, float)
         self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
         self._kept = (None, None)  # (the system, the tangent it keeps) of the last call (_kept_tangent)
-        self.rows = _compiled(ev._width > 6)["cut_joint_rows"] if compiled else cut_joint_rows
 
     def _call(self, system, q: NDArray, s_dot: NDArray, t: float) -> bool:
         """One kernel call for ``system`` (its partition; for a TangentSystem its kept tangent,
@@ -1117,19 +1148,6 @@ class CompiledClosure:
                                system.separation, self.constants[0], self._kept_tangent(system), SINGULAR_PIVOT,
                                self._q_dot, self._s_ddot_tree, self._A, M, b)
         return flag == DONE
-
-    def tree_arrays(self, dtype) -> tuple:
-        """The tree's packed arrays and its fast evaluator's workspace of ``dtype`` (float; complex for
-        the complex step), as the kernels read them (``tree``: those of
-        :func:`projeq.assembly.kernels.chain_terms`, the force laws' rows last)."""
-        ev = self.fast
-        ws = ev._real if dtype is float else ev._workspace(dtype)
-        return (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
-                ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist, ev._laws, ev._law_constants)
-
-    def cut_joints(self) -> "CutJointRows | None":
-        """Φ, Φ_q and Φ″ of the cut joints this kernel evaluates itself (None: Φ is a user's function)."""
-        return CutJointRows(self) if self.pins.shape[0] else None
 
     def _kept_tangent(self, system) -> NDArray:
         """The tangent ``system`` keeps (TangentSystem._tangent) as the array the kernel reads and
@@ -1167,29 +1185,33 @@ class CompiledClosure:
 
 class CutJointRows:
     """Φ, Φ_x and Φ″(v, v) of a ConstrainedSystem whose Φ is made of cut joints (Φ independent of t,
-    K = E), by its compiled kernel's own statement of them (:func:`cut_joint_rows`): what the numpy
-    path's projections, conditions and residuals ask for, in place of its complex steps through the
-    poses (one Python pass over the tree per point). The interface of
+    K = E) by the compiled :func:`cut_joint_rows` on the tree's fast evaluator's workspace
+    (:func:`compiled_cut_joints`): what the numpy path asks for — projections, conditions, residuals,
+    and the A_s, γ of its accelerations where they are not one compiled call — in place of its complex
+    steps through the poses (one Python pass over the tree per point). The interface of
     :class:`~projeq.constraints.batched.BatchedClosure`, and Φ itself. ``complex_safe``: complex
-    arguments too (an outer complex step, the exact Jacobians and the stiffness estimate of
+    arguments too (an outer complex step: the exact Jacobians and the stiffness estimate of
     :mod:`projeq.analysis.jacobians`): the kernel is an analytic function of q and q̇, so at
     q = a + i b it gives f(a) + i f′(a) b exactly; not with joints of kind GIVEN, whose relative
     motions are real C callbacks."""
 
-    def __init__(self, kernel: CompiledClosure):
-        self.kernel = kernel
-        self.complex_safe = kernel.joints.shape[0] == 0
+    def __init__(self, ev, pins: tuple, callbacks: list):
+        self.fast, self.callbacks = ev, callbacks  # the callbacks live as long as this object
+        self.pins, self.points, self.ports = pins
+        self.joints = _joint_table(ev, callbacks, compiled=True)
+        self.kernel = _compiled(ev._width > 6)["cut_joint_rows"]
+        self.complex_safe = not callbacks
         self._trees = {}
 
     def _call(self, q: NDArray, q_dot: NDArray, t: float) -> tuple[NDArray, NDArray, NDArray]:
         """(Φ, A_s, γ) at (q, q̇, t), new arrays of the arguments' dtype."""
-        k, dtype = self.kernel, np.result_type(q, q_dot, float)
+        dtype = np.result_type(q, q_dot, float)
         if dtype not in self._trees:
-            self._trees[dtype] = k.tree_arrays(dtype)
-        m_h, n = k.m_h, k._A.shape[1]
+            self._trees[dtype] = tree_arrays(self.fast, dtype)
+        m_h, n = self.pins.shape[0], len(q)
         values, A, gamma = np.zeros(m_h, dtype), np.zeros((m_h, n), dtype), np.zeros(m_h, dtype)
-        k.rows(k.pins, k.points, k.ports, k.joints, self._trees[dtype], np.ascontiguousarray(q, dtype),
-               np.ascontiguousarray(q_dot, dtype), float(np.real(t)), values, A, gamma)
+        self.kernel(self.pins, self.points, self.ports, self.joints, self._trees[dtype], np.ascontiguousarray(q, dtype),
+                    np.ascontiguousarray(q_dot, dtype), float(np.real(t)), values, A, gamma)
         return values, A, gamma
 
     def values(self, q: NDArray, t: float) -> NDArray:

@@ -76,7 +76,7 @@ from numpy.typing import NDArray
 
 from projeq.assembly.linalg import solve_spd
 from projeq.constraints.batched import batched_closure
-from projeq.constraints.compiled import OWN_RULE, compiled_partition, uncompiled, unsupported
+from projeq.constraints.compiled import OWN_RULE, compiled_cut_joints, compiled_partition, uncompiled, unsupported
 from projeq.constraints.cut_joints import cut_joints, point_rows
 from projeq.checks import depends_on_t, positive, state_vector
 from projeq.analysis.differentiation import (complex_failure, derivative_along, derivative_along_differences,
@@ -235,12 +235,11 @@ class ConstrainedSystem(Model):
     _cut_rows = None  # CutJointRows; None: Φ is not made of cut joints (or their kernel does not apply); False: not looked for
 
     def _cut_joint_rows(self):
-        """The compiled kernel's own Φ, Φ_q and Φ″ of cut joints
-        (:class:`~projeq.constraints.compiled.CutJointRows`), where Φ is made of them and the kernel
-        applies (looked for once the system is built), else None."""
+        """The compiled Φ, Φ_q and Φ″ of cut joints (:class:`~projeq.constraints.compiled.CutJointRows`),
+        where Φ is made of them and the tree's kinematics compile (looked for once the system is
+        built), else None."""
         if self._cut_rows is False:
-            kernel = self.compiled_kernel()
-            self._cut_rows = None if kernel is None else kernel.cut_joints()
+            self._cut_rows = compiled_cut_joints(self)
         return self._cut_rows
 
     def _batched(self):
