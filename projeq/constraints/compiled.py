@@ -385,9 +385,9 @@ def _given_motions(joints, q, s_dot_tree, t, given):
         _given_into(joints[g, 5], q[q0:q0 + n_q], s_dot_tree[s0:s0 + n_s], t, given[n])
 
 
-def _constraint_rows(phi, pins, points, ports, pfaffian, joints, tree, q, t, m_h, A):
+def _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
     """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree): the first ``m_h`` rows Φ_q by :func:`_jacobian`, or for cut
-    joints (``pins``, ``points``: :func:`pin_table`) by :func:`_pin_jacobian` from the tree's chain
+    joints (``pins``, ``fields``: :func:`pin_table`) by :func:`_pin_jacobian` from the tree's chain
     terms at q (its joints of kind GIVEN stated at rest: positions and F⁶ need no velocities); the
     Pfaffian rows A(q) (``pfaffian``, as Φ in :func:`_phi_into`) below them."""
     n, m_p = q.shape[0], A.shape[0] - m_h
@@ -395,7 +395,7 @@ def _constraint_rows(phi, pins, points, ports, pfaffian, joints, tree, q, t, m_h
         rest = np.zeros(n)
         _given_motions(joints, q, rest, t, tree[4])
         _chain_terms(tree, q, rest)
-        _pin_jacobian(pins, points, ports, tree, q, A[:m_h])
+        _pin_jacobian(pins, fields, tree, q, A[:m_h])
     else:
         _jacobian(phi, q, t, A[:m_h])
     if m_p > 0:
@@ -408,14 +408,14 @@ def _constraint_rows(phi, pins, points, ports, pfaffian, joints, tree, q, t, m_h
                 A[m_h + r, j] = value[r, j].real
 
 
-def _constraint_gamma(phi, pins, points, ports, pfaffian, tree, q, q_dot, t, m_h, m):
+def _constraint_gamma(phi, pins, fields, pfaffian, tree, q, q_dot, t, m_h, m):
     """γ = [Φ″(q̇, q̇); (∂(A q̇)/∂q) q̇] at q̇ = ṡ_tree: Φ″ by :func:`_gamma`, or for cut joints by
     :func:`_pin_gamma` from the tree's chain terms at (q, ṡ_tree) (computed before); the Pfaffian
     part as the numpy path takes it, Im (A(q + i h q̇) q̇) / h (A independent of t, b = 0:
     :func:`unsupported`)."""
     gamma = np.zeros(m)
     if pins.shape[0]:
-        _pin_gamma(pins, points, ports, tree, q, q_dot, gamma[:m_h])
+        _pin_gamma(pins, fields, tree, q, q_dot, gamma[:m_h])
     else:
         gamma[:m_h] = _gamma(phi, q, q_dot, t, m_h)
     n, m_p = q.shape[0], m - m_h
@@ -432,26 +432,26 @@ def _constraint_gamma(phi, pins, points, ports, pfaffian, tree, q, q_dot, t, m_h
     return gamma
 
 
-def _pin_frame(pins, points, ports, elastic, r, side, q, s_dot, A_port, r_port, F_port, zeta_port):
+def _pin_frame(pins, fields, elastic, r, side, q, s_dot, A_port, r_port, F_port, zeta_port):
     """The frame P of the point on side ``side`` (0: a, 1: b) of cut-joint row r relative to its
     body n, which it returns (−1: the ground): for a rigid body the point ρ (A = E, r = ρ, F = 0,
-    ζ = 0); for the station of an elastic body (``pins[r, 3 + side]``: its row of ``ports`` =
-    (r₀, Ψ, Q, angles, c)) the station's frame by :func:`projeq.assembly.kernels.port_motion`
-    — its pose, the columns F (k = n_e) of its twist F q̇_e and ζ = Ḟ q̇_e."""
-    n, slot = pins[r, side], pins[r, 3 + side]
+    ζ = 0); for the station of an elastic body (``pins[r, 3 + side]``: its slot of ``fields``,
+    :func:`pin_table`) the station's frame by :func:`projeq.assembly.kernels.port_motion` — its
+    pose, the columns F (k = n_e) of its twist F q̇_e and ζ = Ḟ q̇_e."""
+    n, slot = int(pins[r, side]), int(pins[r, 3 + side])
     if n < 0:
         return n
     if slot >= 0:
-        n_e, e_index = elastic[2], elastic[1]
+        n_e, e_index, k_max = elastic[2], elastic[1], (fields.shape[2] - 2) // 2
         k, i0, s0 = n_e[n], e_index[n, 0], e_index[n, 1]
-        port_r0, port_Psi, port_Q, port_angles, port_c = ports
-        port_motion(port_r0[slot], port_Psi[slot, :, :k], port_Q[slot, :k, :k], port_angles[slot, :, :k],
-                    port_c[slot], q[i0:i0 + k], s_dot[s0:s0 + k], A_port, r_port, F_port[:, :k], zeta_port)
+        field = fields[slot]
+        port_motion(field[:3, 0], field[:3, 2:2 + k], field[3:3 + k, :k], field[:3, 2 + k_max:2 + k_max + k],
+                    field[:3, 1], q[i0:i0 + k], s_dot[s0:s0 + k], A_port, r_port, F_port[:, :k], zeta_port)
         return n
     A_port[:, :] = 0.0
     for a in range(3):
         A_port[a, a] = 1.0
-        r_port[a] = points[r, side, a]
+        r_port[a] = pins[r, 5 + 3 * side + a]
     F_port[:, :] = 0.0
     zeta_port[:] = 0.0
     return n
@@ -466,48 +466,48 @@ def _port_chain(A_port, r_port, T6):
     chain_matrix_into(A_np, r_port, T6)
 
 
-def cut_joint_rows(pins, points, ports, joints, tree, q, q_dot, t, values, A, gamma):
+def cut_joint_rows(pins, fields, joints, tree, q, q_dot, t, values, A, gamma):
     """Φ, Φ_q = A_s (K = E) and γ = Φ″(q̇, q̇) of cut joints alone (the rows a ConstrainedSystem asks
     for outside its accelerations: projections, conditions, residuals), from the tree's chain terms
     at q at rest and (for γ, where q̇ ≠ 0) at (q, q̇)."""
     rest = np.zeros(q.shape[0], q.dtype)
     _given_motions(joints, q, rest, t, tree[4])
     _chain_terms(tree, q, rest)
-    _pin_values(pins, points, ports, tree, q, values)
-    _pin_jacobian(pins, points, ports, tree, q, A)
+    _pin_values(pins, fields, tree, q, values)
+    _pin_jacobian(pins, fields, tree, q, A)
     gamma[:] = 0.0
     if np.any(q_dot != 0.0):
         _given_motions(joints, q, q_dot, t, tree[4])
         _chain_terms(tree, q, q_dot)
-        _pin_gamma(pins, points, ports, tree, q, q_dot, gamma)
+        _pin_gamma(pins, fields, tree, q, q_dot, gamma)
 
 
-def _pin_values(pins, points, ports, tree, q, values):
+def _pin_values(pins, fields, tree, q, values):
     """values[r] ← Φ_r = (P_a − P_b)[axis] of cut-joint row r: P = r_n + R_n r_P with r_P the point's
     frame (:func:`_pin_frame`), or ρ_b itself for the ground."""
-    elastic, R, r_O, k_max, dtype = tree[5], tree[12], tree[13], ports[1].shape[2], q.dtype
+    elastic, R, r_O, k_max, dtype = tree[5], tree[12], tree[13], (fields.shape[2] - 2) // 2, q.dtype
     A_port, r_port = np.empty((3, 3), dtype), np.empty(3, dtype)
     F_port, zeta_port, rest = np.empty((6, k_max), dtype), np.empty(6, dtype), np.zeros(q.shape[0], dtype)
     for r in range(pins.shape[0]):
-        axis, values[r] = pins[r, 2], 0.0
+        axis, values[r] = int(pins[r, 2]), 0.0
         for side in range(2):
             sign = 1.0 if side == 0 else -1.0
-            n = _pin_frame(pins, points, ports, elastic, r, side, q, rest, A_port, r_port, F_port, zeta_port)
+            n = _pin_frame(pins, fields, elastic, r, side, q, rest, A_port, r_port, F_port, zeta_port)
             if n < 0:
-                values[r] += sign * points[r, side, axis]
+                values[r] += sign * pins[r, 5 + 3 * side + axis]
             else:
                 values[r] += sign * (r_O[n, axis] + R[n, axis, 0] * r_port[0] + R[n, axis, 1] * r_port[1]
                                      + R[n, axis, 2] * r_port[2])
 
 
-def _pin_jacobian(pins, points, ports, tree, q, A):
+def _pin_jacobian(pins, fields, tree, q, A):
     """A[r] ← the row ∂Φ_r/∂ṡ_tree of cut-joint row r (one inertial ``axis`` of P_a − P_b; the
     points' frames by :func:`_pin_frame`), from the point's velocity R_n A_P v_P with the twist of
     its frame P, (v_P, ω_P) = T⁶_P (v_n, ω_n) + F_P q̇_e (the chain step of a joint's base frame,
     T⁶ = [[A_Pᵀ, −A_Pᵀ r̃_P], [0, A_Pᵀ]]), and the bodies' twists ẏ_n = J_n ṡ_tree: the Jacobians
     J_n = ∂ẏ_n/∂ṡ_tree by the chain, J_n = T_np J_p + F_n (in the columns of joint n's ṡ_n)."""
     index, elastic, T, F, R = tree[0], tree[5], tree[7], tree[9], tree[12]
-    n_s, k_max, dtype, n_y = A.shape[1], ports[1].shape[2], T.dtype, index[:, N_Y]
+    n_s, k_max, dtype, n_y = A.shape[1], (fields.shape[2] - 2) // 2, T.dtype, index[:, N_Y]
     J = np.zeros((index.shape[0], T.shape[1], n_s), dtype)
     _body_jacobians(index, T, F, J)
     A_port, r_port, F_port, zeta_port = np.empty((3, 3), dtype), np.empty(3, dtype), np.empty((6, k_max), dtype), \
@@ -515,9 +515,9 @@ def _pin_jacobian(pins, points, ports, tree, q, A):
     T6, v, e, rest = np.empty((6, 6), dtype), np.empty(3, dtype), np.empty(3, dtype), np.zeros(q.shape[0], dtype)
     A[:, :] = 0.0
     for r in range(pins.shape[0]):
-        axis = pins[r, 2]
+        axis = int(pins[r, 2])
         for side in range(2):
-            n = _pin_frame(pins, points, ports, elastic, r, side, q, rest, A_port, r_port, F_port, zeta_port)
+            n = _pin_frame(pins, fields, elastic, r, side, q, rest, A_port, r_port, F_port, zeta_port)
             if n < 0:
                 continue
             _port_chain(A_port, r_port, T6)
@@ -553,13 +553,13 @@ def _inertial_axis(R, n, axis, A_port, e):
         e[a] = R[n, axis, 0] * A_port[0, a] + R[n, axis, 1] * A_port[1, a] + R[n, axis, 2] * A_port[2, a]
 
 
-def _pin_gamma(pins, points, ports, tree, q, s_dot_tree, gamma):
+def _pin_gamma(pins, fields, tree, q, s_dot_tree, gamma):
     """γ_r = (Φ̈_r at s̈_tree = 0) of cut-joint row r: the point's acceleration R_n A_P (v̇_P + ω_P × v_P)
     with its frame's twist (v_P, ω_P) = u + w, u = T⁶_P ẏ_n, w = F_P q̇_e, and its rate at s̈ = 0,
     ζ̄_P = T⁶_P ζ̄_n + F_P q̈_e + u × w + ζ_P (the chain's step, docs/theory.md §4), ζ̄_n = T_np ζ̄_p + ζ_n
     the bodies' at s̈ = 0 (the components' derivatives in body axes)."""
     index, elastic, T, zeta, R, twist = tree[0], tree[5], tree[7], tree[8], tree[12], tree[14]
-    k_max, dtype, n_y = ports[1].shape[2], T.dtype, index[:, N_Y]
+    k_max, dtype, n_y = (fields.shape[2] - 2) // 2, T.dtype, index[:, N_Y]
     zeta_bar = np.zeros((index.shape[0], T.shape[1]), dtype)
     bias_rates(index, T, zeta, zeta_bar)
     A_port, r_port, F_port, zeta_port = np.empty((3, 3), dtype), np.empty(3, dtype), np.empty((6, k_max), dtype), \
@@ -567,10 +567,10 @@ def _pin_gamma(pins, points, ports, tree, q, s_dot_tree, gamma):
     T6, u, w, rate = np.empty((6, 6), dtype), np.empty(6, dtype), np.empty(6, dtype), np.empty(6, dtype)
     acc, e = np.empty(3, dtype), np.empty(3, dtype)
     for r in range(pins.shape[0]):
-        axis = pins[r, 2]
+        axis = int(pins[r, 2])
         gamma[r] = 0.0
         for side in range(2):
-            n = _pin_frame(pins, points, ports, elastic, r, side, q, s_dot_tree, A_port, r_port, F_port, zeta_port)
+            n = _pin_frame(pins, fields, elastic, r, side, q, s_dot_tree, A_port, r_port, F_port, zeta_port)
             if n < 0:
                 continue
             _port_chain(A_port, r_port, T6)
@@ -698,7 +698,7 @@ def _projected(tree, F, f_bar, pivot, M, b, s_ddot_tree):
     return DONE
 
 
-def partitioned(phi, pins, points, ports, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
+def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
                 q_dot, s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (module
     docstring) from Φ (``phi``: :func:`_phi_into`; ``m_h`` rows) and the Pfaffian rows A(q)
@@ -708,7 +708,7 @@ def partitioned(phi, pins, points, ports, pfaffian, joints, tree, q, s_dot, t, m
     A_s = [Φ_q; A], M and b; returns DONE, SINGULAR (:func:`_projected`) or DEGENERATE where
     ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
     n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
-    _constraint_rows(phi, pins, points, ports, pfaffian, joints, tree, q, t, m_h, A)
+    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
     A_dep = np.empty((m, m))
     for r in range(m):
         for c in range(m):
@@ -730,7 +730,7 @@ def partitioned(phi, pins, points, ports, pfaffian, joints, tree, q, s_dot, t, m
     _chain_terms(tree, q, s_dot_tree)
     if not _loaded(tree, q, s_dot_tree):
         return UNLOADED
-    gamma = _constraint_gamma(phi, pins, points, ports, pfaffian, tree, q, s_dot_tree, t, m_h, m)
+    gamma = _constraint_gamma(phi, pins, fields, pfaffian, tree, q, s_dot_tree, t, m_h, m)
     f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
     minus_gamma = _matvec(inv, -gamma)
     for r in range(m):
@@ -738,7 +738,7 @@ def partitioned(phi, pins, points, ports, pfaffian, joints, tree, q, s_dot, t, m
     return _projected(tree, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
-def tangent(phi, pins, points, ports, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept,
+def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept,
             pivot, q_dot, s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.tangent.TangentSystem`: F = N N_ind⁻¹ with
     N the null space of A_s = U Σ Vᵀ continued along the branch (``kept``: the tangent kept last,
@@ -746,7 +746,7 @@ def tangent(phi, pins, points, ports, pfaffian, joints, tree, q, s_dot, t, m_h, 
     x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) over the ``rank`` largest singular values above
     ``acting`` σ_max; otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular."""
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
-    _constraint_rows(phi, pins, points, ports, pfaffian, joints, tree, q, t, m_h, A)
+    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
     U, sigma, Vt = _svd(A)
     near = 0  # the singular values below separation σ_max, at least k
     for value in sigma:
@@ -767,7 +767,7 @@ def tangent(phi, pins, points, ports, pfaffian, joints, tree, q, s_dot, t, m_h, 
     _chain_terms(tree, q, s_dot_tree)
     if not _loaded(tree, q, s_dot_tree):
         return UNLOADED
-    gamma = _constraint_gamma(phi, pins, points, ports, pfaffian, tree, q, s_dot_tree, t, m_h, m)
+    gamma = _constraint_gamma(phi, pins, fields, pfaffian, tree, q, s_dot_tree, t, m_h, m)
     count = 0  # the singular values above acting σ_max, at most rank
     for value in sigma:
         count += value > acting * sigma[0]
@@ -1047,28 +1047,28 @@ def _closure(system, rule: str, constant: float) -> "CompiledClosure | None":
 _NO_CALLBACK = types.SimpleNamespace(address=0)
 
 
-def pin_table(phi, m_h: int) -> tuple:
+def pin_table(phi, m_h: int) -> tuple[NDArray, NDArray]:
     """The rows of Φ that are cut joints (:meth:`~projeq.constraints.cut_joints.PinClosure.point_rows`)
-    as the kernels read them: (pins, points, ports) with pins[r] = (a, b, inertial axis, slot_a,
-    slot_b), points[r] = (ρ_a, ρ_b) and ports = (r₀, Ψ, Q, angles, c), one row per slot: the fields
-    of a point's station on a RitzBeam (:class:`~projeq.subsystems.beam.beam.BeamPort`; slot −1: a
-    rigid body's point); empty where Φ is a user's function (its rows by the complex step)."""
+    as the kernels read them, in two arrays (each array argument of a compiled call costs its
+    unboxing, and every closure pays for these): ``pins[r]`` = (a, b, inertial axis, slot_a, slot_b,
+    ρ_a, ρ_b) and ``fields[slot]`` the station of a point on a RitzBeam
+    (:class:`~projeq.subsystems.beam.beam.BeamPort`; slot −1: a rigid body's point): rows 0–2 hold
+    r₀, the offset c, Ψ (k columns) and the angles' rows (k columns), rows 3 … 2 + k hold Q (k = the
+    largest n_e). Empty where Φ is a user's function (its rows by the complex step)."""
     rows = point_rows(phi) or []
     assert not rows or len(rows) == m_h
     stations = list({id(port): port for row in rows for port in row[5:] if port is not None}.values())
     slot = {id(port): i for i, port in enumerate(stations)}
-    slots = [[slot.get(id(port), -1) for port in row[5:]] for row in rows]
-    pins = np.array([[*row[:3], *slot] for row, slot in zip(rows, slots)], dtype=np.int64).reshape(len(rows), 5)
-    points = np.array([row[3:5] for row in rows], dtype=float).reshape(len(rows), 2, 3)
+    pins = np.array([[*row[:3], *(slot.get(id(port), -1) for port in row[5:]), *row[3], *row[4]] for row in rows],
+                    dtype=float).reshape(len(rows), 11)
     k = max([port.beam.n_e for port in stations], default=1)
-    ports = (np.zeros((len(stations), 3)), np.zeros((len(stations), 3, k)), np.zeros((len(stations), k, k)),
-             np.zeros((len(stations), 3, k)), np.zeros((len(stations), 3)))
-    for i, port in enumerate(stations):
+    fields = np.zeros((len(stations), 3 + k, 2 + 2 * k))
+    for field, port in zip(fields, stations):
         n_e = port.beam.n_e
         r0, Psi, Q, angles = port.field
-        ports[0][i], ports[1][i, :, :n_e], ports[2][i, :n_e, :n_e], ports[3][i, :, :n_e] = r0, Psi, Q, angles
-        ports[4][i] = port.offset
-    return pins, points, ports
+        field[:3, 0], field[:3, 1], field[:3, 2:2 + n_e], field[:3, 2 + k:2 + k + n_e] = r0, port.offset, Psi, angles
+        field[3:3 + n_e, :n_e] = Q
+    return pins, fields
 
 
 def tree_arrays(ev, dtype) -> tuple:
@@ -1120,7 +1120,7 @@ class CompiledClosure:
         # the callbacks live as long as this object, which passes their addresses
         ev = self.fast = tree.evaluator("fast")
         self.callback, self.rule, self.constants, self.m_h = callback, rule, constants, m if m_h is None else m_h
-        self.pins, self.points, self.ports = pin_table(None, 0) if pins is None else pins
+        self.pins, self.fields = pin_table(None, 0) if pins is None else pins
         self._callbacks = [pfaffian] + [joint_callback(tree.joints[n]) if compiled else None for n in ev._given]
         if compiled:
             self.kernel, self.phi, self.pfaffian = _compiled(ev._width > 6)[rule], callback.address, \
@@ -1139,11 +1139,11 @@ class CompiledClosure:
         M, b = self._workspace.M_all, self._workspace.b_all
         q, s_dot, t = kernels.kernel_array(q), kernels.kernel_array(s_dot), float(t)
         if self.rule == "partitioned":
-            flag = self.kernel(self.phi, self.pins, self.points, self.ports, self.pfaffian, self.joints, self.tree, q, s_dot, t,
+            flag = self.kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, q, s_dot, t,
                                self.m_h, system.independent, system.dependent,
                                self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b)
         else:
-            flag = self.kernel(self.phi, self.pins, self.points, self.ports, self.pfaffian, self.joints, self.tree, q, s_dot, t,
+            flag = self.kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, q, s_dot, t,
                                self.m_h, system.independent, system.tree.n_s - system.n_s,
                                system.separation, self.constants[0], self._kept_tangent(system), SINGULAR_PIVOT,
                                self._q_dot, self._s_ddot_tree, self._A, M, b)
@@ -1197,7 +1197,7 @@ class CutJointRows:
 
     def __init__(self, ev, pins: tuple, callbacks: list):
         self.fast, self.callbacks = ev, callbacks  # the callbacks live as long as this object
-        self.pins, self.points, self.ports = pins
+        self.pins, self.fields = pins
         self.joints = _joint_table(ev, callbacks, compiled=True)
         self.kernel = _compiled(ev._width > 6)["cut_joint_rows"]
         self.complex_safe = not callbacks
@@ -1210,7 +1210,7 @@ class CutJointRows:
             self._trees[dtype] = tree_arrays(self.fast, dtype)
         m_h, n = self.pins.shape[0], len(q)
         values, A, gamma = np.zeros(m_h, dtype), np.zeros((m_h, n), dtype), np.zeros(m_h, dtype)
-        self.kernel(self.pins, self.points, self.ports, self.joints, self._trees[dtype], np.ascontiguousarray(q, dtype),
+        self.kernel(self.pins, self.fields, self.joints, self._trees[dtype], np.ascontiguousarray(q, dtype),
                     np.ascontiguousarray(q_dot, dtype), float(np.real(t)), values, A, gamma)
         return values, A, gamma
 
