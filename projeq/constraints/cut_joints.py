@@ -167,6 +167,7 @@ def _poses(tree, q, t):
 
 
 def _deforms(tree, n) -> bool:
+    """Subsystem n (None: the ground) has internal coordinates."""
     return n is not None and tree.e_s_slice[n].stop > tree.e_s_slice[n].start
 
 
@@ -183,6 +184,6 @@ def _port(tree, name: str, n: int, rho):
 
 
 def point_rows(phi) -> list | None:
-    """The (a, b, axis, ρ_a, ρ_b) rows of ``phi`` if it is made of cut joints (:class:`PinClosure`,
-    :class:`CutJoints`), else None."""
+    """The rows (a, b, axis, ρ_a, ρ_b, port_a, port_b) of ``phi`` (:meth:`PinClosure.point_rows`) if it
+    is made of cut joints (:class:`PinClosure`, :class:`CutJoints`), else None."""
     return phi.point_rows() if isinstance(phi, (PinClosure, CutJoints)) else None

@@ -180,8 +180,8 @@ class ConstrainedSystem(Model):
             self._constraint_rows("b", b, (q0, 0.0), 1, self.m_p)
         self.n_c = self.n_lambda = self.m_h + self.m_p
         self.exact = self._choose_derivatives(q0)
-        # Φ's derivatives from one call at a batch of points (projeq.constraints.batched); the cut
-        # joints' points are the compiled kernel's own (projeq.constraints.compiled), pointwise here
+        # Φ's derivatives from one call at a batch of points (projeq.constraints.batched); cut joints
+        # have compiled rows of their own once the system is built (_cut_joint_rows), else pointwise
         self._closure = batched_closure(phi, self.n_q, np.append(q0, 0.0), self.m_h) \
             if self.exact and self.m_h and point_rows(phi) is None else None
         if correction == "projection" and self.m_h and depends_on_t(self.phi, q0):  # q is normalised without t
@@ -232,7 +232,7 @@ class ConstrainedSystem(Model):
             return rows.values(q, t)
         return numeric(self._phi(q, t))
 
-    _cut_rows = None  # CutJointRows; None: Φ is not made of cut joints (or their kernel does not apply); False: not looked for
+    _cut_rows = None  # CutJointRows; None: Φ is not made of cut joints, or they do not compile; False: not looked for
 
     def _cut_joint_rows(self):
         """The compiled Φ, Φ_q and Φ″ of cut joints (:class:`~projeq.constraints.compiled.CutJointRows`),
