@@ -70,7 +70,7 @@ def projeq_run(times, n_v: int = 2, **options) -> dict:
 
 
 def exudyn_run(times, n_elements: int = 16, h: float = 1e-3, axial_stiffness: float = 1e7,
-               newton_atol: float = 1e-7) -> dict:
+               newton_atol: float = 1e-6) -> dict:
     """The same quantities by Exudyn (module docstring: the model) and the CPU time of its
     ``SolveDynamic`` (generalized-α, step ``h``)."""
     import exudyn as exu
@@ -153,10 +153,78 @@ def exudyn_run(times, n_elements: int = 16, h: float = 1e-3, axial_stiffness: fl
             "method": f"gen-α h={h:g}", "nfev": None}
 
 
+PROJEQ_TIGHT = {"method": "RK45", "rtol": 1e-10, "atol": 1e-12}
+#: Exudyn's (elements, h): the brief's 8, 16, 32 elements at h = 1e-3 and 16 at 5e-4, then halved steps
+#: (its tip deflection still moves by 1e-4 m from h = 5e-4 to 2.5e-4: generalized-α's period error)
+EXUDYN_RUNS = ((8, 1e-3), (16, 1e-3), (32, 1e-3), (16, 5e-4), (16, 2.5e-4), (32, 2.5e-4), (16, 1.25e-4),
+               (32, 1.25e-4))
+QUANTITIES = {"crank": "crank angle, rad", "rocker": "rocker angle, rad",
+              "tip": "tip deflection v(L) from the root tangent, m", "sag": "mid-span deflection from the chord, m"}
+
+
+def _exudyn_name(n, h):
+    return f"exudyn {n} el h={h:g}"
+
+
+def runs(times, n_vs=(2, 4, 6), exudyn=EXUDYN_RUNS, axial_stiffness=1e7) -> dict:
+    """Name → run (:func:`projeq_run`, :func:`exudyn_run`), all in this process."""
+    out = {"projeq n_v=2 defaults": projeq_run(times, 2)}
+    for n_v in n_vs:
+        out[f"projeq n_v={n_v} tight"] = projeq_run(times, n_v, **PROJEQ_TIGHT)
+    for n, h in exudyn:
+        out[_exudyn_name(n, h)] = exudyn_run(times, n, h, axial_stiffness=axial_stiffness)
+    return out
+
+
+def tables(times, results: dict, exudyn=EXUDYN_RUNS) -> list[Table]:
+    """Per quantity: each code's finest value, their difference and each code's own
+    discretisation error (its finest run's change from the next coarser: projeq's last n_v
+    against the one before; Exudyn's last run against half its elements and against twice
+    its step, the larger) at ``times``; then per run its CPU time and largest differences
+    from both codes' finest runs."""
+    pq_names = [k for k in results if k.startswith("projeq") and k.endswith("tight")]
+    pq_best, pq_next = results[pq_names[-1]], results[pq_names[-2]]
+    n, h = exudyn[-1]
+    ex_name = _exudyn_name(n, h)
+    ex_best = results[ex_name]
+    ex_coarser = [results[k] for k in (_exudyn_name(n // 2, h), _exudyn_name(n, 2 * h)) if k in results]
+    out = []
+    for key, what in QUANTITIES.items():
+        pq_err = np.abs(pq_best[key] - pq_next[key])
+        ex_err = np.max([np.abs(ex_best[key] - r[key]) for r in ex_coarser], axis=0)
+        rows = [(t, p, e, p - e, pe, ee) for t, p, e, pe, ee in zip(times, pq_best[key], ex_best[key], pq_err, ex_err)]
+        out.append(Table(("t", "projeq", "exudyn", "difference", "projeq error", "exudyn error"), rows,
+                         units={"t": "s"}, formats={"t": ".2f", "projeq": ".6f", "exudyn": ".6f", "difference": ".1e",
+                                                    "projeq error": ".1e", "exudyn error": ".1e"},
+                         title=f"{what}: {pq_names[-1]} vs {ex_name} (errors: change from {pq_names[-2]}; "
+                               f"from Exudyn with half the elements or twice the step, the larger)"))
+    quantities = ("crank", "rocker", "tip", "sag")
+    rows = [(name, r["method"], r["cpu"], *[float(np.abs(r[k] - pq_best[k]).max()) for k in quantities],
+             *[float(np.abs(r[k] - ex_best[k]).max()) for k in quantities]) for name, r in results.items()]
+    columns = [f"{k} vs {code}" for code in ("projeq", "exudyn") for k in quantities]
+    out.append(Table(("run", "method", "cpu", *columns), rows, units={"cpu": "s"},
+                     formats={"cpu": ".2f", **{c: ".1e" for c in columns}},
+                     title=f"runs: CPU (time.process_time, this process) and max |difference| over the {len(times)} "
+                           f"times from {pq_names[-1]} and from {ex_name} (rad, m)"))
+    return out
+
+
+def main(argv=None) -> list[Table]:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--t-end", type=float, default=1.0, help="simulated seconds (default 1)")
+    parser.add_argument("--points", type=int, default=10, help="compared times, equally spaced up to t_end (default 10)")
+    parser.add_argument("--axial-stiffness", type=float, default=1e7, help="Exudyn's EA in N (default 1e7)")
+    args = parser.parse_args(argv)
+    times = np.linspace(args.t_end / args.points, args.t_end, args.points)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        results = runs(times, axial_stiffness=args.axial_stiffness)
+    out = tables(times, results)
+    for table in out:
+        print(table.to_text())
+        print()
+    return out
+
+
 if __name__ == "__main__":
-    times = np.linspace(0.1, 1.0, 10)
-    np.set_printoptions(linewidth=200, precision=6)
-    for n in (8, 16):
-        r = exudyn_run(times, n)
-        print(n, r)
-    print(projeq_run(times, 2))
+    main()
