@@ -70,7 +70,7 @@ def projeq_run(times, n_v: int = 2, **options) -> dict:
 
 
 def exudyn_run(times, n_elements: int = 16, h: float = 1e-3, axial_stiffness: float = 1e7,
-               newton_atol: float = 1e-6) -> dict:
+               newton_atol: float = 1e-6, spectral_radius: float | None = None) -> dict:
     """The same quantities by Exudyn (module docstring: the model) and the CPU time of its
     ``SolveDynamic`` (generalized-α, step ``h``)."""
     import exudyn as exu
@@ -137,6 +137,8 @@ def exudyn_run(times, n_elements: int = 16, h: float = 1e-3, axial_stiffness: fl
     settings.timeIntegration.endTime = float(times[-1])
     settings.timeIntegration.verboseMode = 0
     settings.timeIntegration.newton.absoluteTolerance = newton_atol
+    if spectral_radius is not None:
+        settings.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
     settings.solution.file.write = False
     settings.solution.sensors.writePeriod = h
     started = time.process_time()
@@ -174,6 +176,23 @@ def runs(times, n_vs=(2, 4, 6), exudyn=EXUDYN_RUNS, axial_stiffness=1e7) -> dict
     for n, h in exudyn:
         out[_exudyn_name(n, h)] = exudyn_run(times, n, h, axial_stiffness=axial_stiffness)
     return out
+
+
+def axial_table(times, results: dict, stiffnesses=(1e6, 1e7, 1e8), n_elements: int = 16, h: float = 1.25e-4) -> Table:
+    """Exudyn's difference from projeq's finest run against its axial stiffness EA (Newton's
+    absolute tolerance scaled with EA): the share of the difference that is the cable's
+    stretching, absent in projeq's inextensible beam."""
+    pq_names = [k for k in results if k.startswith("projeq") and k.endswith("tight")]
+    pq_best = results[pq_names[-1]]
+    quantities = ("crank", "rocker", "tip", "sag")
+    rows = []
+    for EA in stiffnesses:
+        r = exudyn_run(times, n_elements, h, axial_stiffness=EA, newton_atol=1e-6 * max(1.0, EA / 1e7))
+        rows.append((EA, r["cpu"], *[float(np.abs(r[k] - pq_best[k]).max()) for k in quantities]))
+    return Table(("EA", "cpu", *[f"{k} vs projeq" for k in quantities]), rows, units={"EA": "N", "cpu": "s"},
+                 formats={"EA": ".0e", "cpu": ".2f", **{f"{k} vs projeq": ".1e" for k in quantities}},
+                 title=f"Exudyn {n_elements} el h={h:g} by its axial stiffness: max |difference| from {pq_names[-1]} "
+                       f"over the {len(times)} times (rad, m)")
 
 
 def tables(times, results: dict, exudyn=EXUDYN_RUNS) -> list[Table]:
@@ -214,12 +233,14 @@ def main(argv=None) -> list[Table]:
     parser.add_argument("--t-end", type=float, default=1.0, help="simulated seconds (default 1)")
     parser.add_argument("--points", type=int, default=10, help="compared times, equally spaced up to t_end (default 10)")
     parser.add_argument("--axial-stiffness", type=float, default=1e7, help="Exudyn's EA in N (default 1e7)")
+    parser.add_argument("--n-v", type=int, nargs="+", default=[2, 4, 6],
+                        help="projeq's numbers of bending functions at tight rtol (default 2 4 6; the last two give its error)")
     args = parser.parse_args(argv)
     times = np.linspace(args.t_end / args.points, args.t_end, args.points)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
-        results = runs(times, axial_stiffness=args.axial_stiffness)
-    out = tables(times, results)
+        results = runs(times, n_vs=args.n_v, axial_stiffness=args.axial_stiffness)
+        out = [*tables(times, results), axial_table(times, results)]
     for table in out:
         print(table.to_text())
         print()
