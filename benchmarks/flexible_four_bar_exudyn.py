@@ -117,18 +117,19 @@ change from half the elements or twice the step). Measured (one run, 2 shared co
      1e+08     1.43          1.6e-05           3.3e-06        8.2e-05        1.4e-05
 
 What agrees to what. The crank and rocker angles agree to 3.7e-5 and 1.0e-5 rad over the whole
-second (the crank turns through −4.5 rad); the difference is the cable's stretching: it falls
+second (the crank turns through 4.6 rad); the difference is the cable's stretching: it falls
 as 1/EA (3.8e-4, 3.8e-5 rad at EA = 1e6, 1e7 N) to 1.6e-5 rad at EA = 1e8 N (crank) — within
-projeq's own error there (2.4e-5 at t = 0.5 s). An axial strain N/EA of a loop force N of tens of
-newtons, ~5e-6 at EA = 1e7, moves the joints by ~5 µm, ~2e-5 rad on the 0.3 m crank: the size
-measured. The mid-span deflection from the chord (up to 3.0 mm) agrees to 1.9e-5 m (1.4e-5 m at
+projeq's own error there (2.4e-5 at t = 0.5 s). The cut joint's force in projeq is up to 30 N
+(12 N on average; ``pq.reactions``, n_v = 2): an axial strain N/EA ≤ 3e-6 at EA = 1e7 N lengthens
+the coupler by up to 3 µm, ~1e-5 rad on the 0.3 m crank: the size measured. The mid-span deflection from the chord (up to 3.0 mm) agrees to 1.9e-5 m (1.4e-5 m at
 EA = 1e8), the level of projeq's n_v = 6 → 8 change (1.6e-5 m). The tip deflection from the
 root tangent (up to 10.5 mm) agrees to 1.4e-4 m (8.2e-5 m at EA = 1e8 N), against own errors of
 up to 9.3e-5 m (projeq, n_v = 6 → 8) and 4.3e-5 m (Exudyn, h = 2.5e-4 → 1.25e-4): it is the
 slowest quantity to converge in both codes — it carries the root slope, i.e. the higher bending
 modes (projeq's clamped–free functions converge on it as 2.5e-3, 3.6e-4, 9.3e-5 m for n_v =
-2, 4, 6 against 8; Exudyn's generalized-α has a period error on the modes at 400–1500 rad/s that
-needs h ≤ 2.5e-4; at h = 1e-3, as for the spin-up, its tip is off by 3e-4 m). The geometric
+2, 4, 6 against 8; Exudyn's generalized-α has a period error on the higher modes — pinned–pinned
+(nπ)²√(EI/ρA)/L² = 99, 395, 888, 1579 rad/s — that needs h ≤ 2.5e-4; at h = 1e-3 its tip is off
+by 3e-4 m). The geometric
 terms beyond projeq's second-order beam theory that made the spin-up's difference are
 negligible here: the deflection is ≤ 1.05 % of L, so they are ~(v/L)² ≈ 1e-4 of it, ≤ 1e-6 m,
 below every difference in the tables. So the codes agree within their discretisation errors
@@ -139,7 +140,7 @@ h = 2.5e-4 (already within 4.2e-5 m of it) 0.8 s; projeq's n_v = 6 run at rtol 1
 default n_v = 2 run 4.8 s (but 2.5e-3 m off in the tip deflection: two functions are too few
 for this loop). projeq's explicit integration is bound by the stiff bending modes of the
 pinned beam (the n_v = 8 run: 8e5 evaluations); Radau at rtol 1e-10 did not finish n_v = 4 in
-300 s CPU, and ``simulate``'s default for n_v = 4 over 1 s (DOP853) fails at t = 0.361 s with a
+300 s (one core), and ``simulate``'s default for n_v = 4 over 1 s (DOP853) fails at t = 0.361 s with a
 degenerate partition (q ~ 1e9: the reason the converged runs name RK45).
 """
 
