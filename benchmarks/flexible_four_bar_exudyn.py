@@ -32,11 +32,13 @@ node normal to its slope vector) and the mid-span deflection from the chord (bot
 the point x = L/2 from the line root–tip). projeq: ``simulate`` defaults at n_v = 2, and RK45 at
 rtol 1e-10, atol 1e-12 for n_v = 2, 4, 6, 8 (its own error: the change from n_v = 6 to 8);
 Exudyn: 8, 16, 32 elements at h = 1e-3, then h halved to 1.25e-4 (its own error: the larger
-change from half the elements or twice the step). Measured (one run, 2 shared cores):
+change from half the elements or twice the step). Per quantity: each code's finest run, their
+difference and each code's own error; then every run's CPU time and largest differences from
+both finest runs; then Exudyn's difference by its axial stiffness. Measured (one run, 2 shared cores):
 
     python benchmarks/flexible_four_bar_exudyn.py --n-v 2 4 6 8   # 5 min; default --n-v 2 4 6: 2.5 min
 
-    crank angle, rad: projeq n_v=8 tight vs exudyn 32 el h=0.000125 (errors: change from projeq n_v=6 tight; from Exudyn with half the elements or twice the step, the larger)
+    crank angle, rad: projeq n_v=8 tight vs exudyn 32 el h=0.000125
     t (s)     projeq     exudyn  difference  projeq error  exudyn error
     -----  ---------  ---------  ----------  ------------  ------------
      0.10   0.591839   0.591836     2.1e-06       1.6e-06       7.2e-07
@@ -50,7 +52,7 @@ change from half the elements or twice the step). Measured (one run, 2 shared co
      0.90  -4.085669  -4.085666    -3.3e-06       5.2e-07       5.4e-07
      1.00  -3.998475  -3.998481     6.0e-06       2.2e-06       1.6e-06
 
-    rocker angle, rad: projeq n_v=8 tight vs exudyn 32 el h=0.000125 (errors: change from projeq n_v=6 tight; from Exudyn with half the elements or twice the step, the larger)
+    rocker angle, rad: projeq n_v=8 tight vs exudyn 32 el h=0.000125
     t (s)    projeq    exudyn  difference  projeq error  exudyn error
     -----  --------  --------  ----------  ------------  ------------
      0.10  1.541151  1.541151     6.8e-08       7.8e-08       1.2e-07
@@ -64,7 +66,7 @@ change from half the elements or twice the step). Measured (one run, 2 shared co
      0.90  1.965197  1.965198    -1.1e-06       2.1e-07       9.2e-08
      1.00  1.997717  1.997714     2.5e-06       8.3e-07       5.5e-07
 
-    tip deflection v(L) from the root tangent, m: projeq n_v=8 tight vs exudyn 32 el h=0.000125 (errors: change from projeq n_v=6 tight; from Exudyn with half the elements or twice the step, the larger)
+    tip deflection v(L) from the root tangent, m: projeq n_v=8 tight vs exudyn 32 el h=0.000125
     t (s)     projeq     exudyn  difference  projeq error  exudyn error
     -----  ---------  ---------  ----------  ------------  ------------
      0.10  -0.000988  -0.000978    -9.6e-06       1.9e-05       6.6e-06
@@ -78,7 +80,7 @@ change from half the elements or twice the step). Measured (one run, 2 shared co
      0.90   0.006109   0.006049     6.0e-05       4.2e-05       4.2e-05
      1.00   0.000911   0.000913    -2.8e-06       9.3e-05       3.1e-05
 
-    mid-span deflection from the chord, m: projeq n_v=8 tight vs exudyn 32 el h=0.000125 (errors: change from projeq n_v=6 tight; from Exudyn with half the elements or twice the step, the larger)
+    mid-span deflection from the chord, m: projeq n_v=8 tight vs exudyn 32 el h=0.000125
     t (s)     projeq     exudyn  difference  projeq error  exudyn error
     -----  ---------  ---------  ----------  ------------  ------------
      0.10   0.000340   0.000341    -1.4e-06       4.1e-07       2.9e-07
@@ -116,32 +118,33 @@ change from half the elements or twice the step). Measured (one run, 2 shared co
      1e+07     1.56          3.8e-05           9.5e-06        1.3e-04        1.9e-05
      1e+08     1.43          1.6e-05           3.3e-06        8.2e-05        1.4e-05
 
-What agrees to what. The crank and rocker angles agree to 3.7e-5 and 1.0e-5 rad over the whole
-second (the crank turns through 4.6 rad); the difference is the cable's stretching: it falls
-as 1/EA (3.8e-4, 3.8e-5 rad at EA = 1e6, 1e7 N) to 1.6e-5 rad at EA = 1e8 N (crank) — within
-projeq's own error there (2.4e-5 at t = 0.5 s). The cut joint's force in projeq is up to 30 N
-(12 N on average; ``pq.reactions``, n_v = 2): an axial strain N/EA ≤ 3e-6 at EA = 1e7 N lengthens
-the coupler by up to 3 µm, ~1e-5 rad on the 0.3 m crank: the size measured. The mid-span deflection from the chord (up to 3.0 mm) agrees to 1.9e-5 m (1.4e-5 m at
-EA = 1e8), the level of projeq's n_v = 6 → 8 change (1.6e-5 m). The tip deflection from the
-root tangent (up to 10.5 mm) agrees to 1.4e-4 m (8.2e-5 m at EA = 1e8 N), against own errors of
-up to 9.3e-5 m (projeq, n_v = 6 → 8) and 4.3e-5 m (Exudyn, h = 2.5e-4 → 1.25e-4): it is the
-slowest quantity to converge in both codes — it carries the root slope, i.e. the higher bending
-modes (projeq's clamped–free functions converge on it as 2.5e-3, 3.6e-4, 9.3e-5 m for n_v =
-2, 4, 6 against 8; Exudyn's generalized-α has a period error on the higher modes — pinned–pinned
-(nπ)²√(EI/ρA)/L² = 99, 395, 888, 1579 rad/s — that needs h ≤ 2.5e-4; at h = 1e-3 its tip is off
-by 3e-4 m). The geometric
-terms beyond projeq's second-order beam theory that made the spin-up's difference are
-negligible here: the deflection is ≤ 1.05 % of L, so they are ~(v/L)² ≈ 1e-4 of it, ≤ 1e-6 m,
-below every difference in the tables. So the codes agree within their discretisation errors
-once the cable's stretching is taken out; no difference is left that would point to projeq.
+What agrees to what. The crank and rocker angles agree to 3.7e-5 and 1.0e-5 rad over the
+whole second (the crank turns through 4.6 rad); that difference is the cable's stretching: it
+falls as 1/EA (3.8e-4, 3.8e-5 rad at EA = 1e6, 1e7 N) to 1.6e-5 rad at EA = 1e8 N (crank),
+within projeq's own error there (2.4e-5 rad at t = 0.5 s). The cut joint's force in projeq is
+up to 30 N (12 N on average; ``pq.reactions``, n_v = 2): an axial strain N/EA ≤ 3e-6 at EA =
+1e7 N lengthens the coupler by up to 3 µm, ~1e-5 rad on the 0.3 m crank — the size measured.
+The mid-span deflection from the chord (up to 3.0 mm) agrees to 1.9e-5 m (1.4e-5 m at EA =
+1e8 N), the level of projeq's n_v = 6 → 8 change (1.6e-5 m). The tip deflection from the root
+tangent (up to 10.5 mm) agrees to 1.4e-4 m (8.2e-5 m at EA = 1e8 N), against own errors of up
+to 9.3e-5 m (projeq, n_v = 6 → 8) and 4.3e-5 m (Exudyn, h = 2.5e-4 → 1.25e-4): it is the
+slowest quantity to converge in both codes, as it carries the root slope and so the higher
+bending modes (projeq's clamped–free functions approach n_v = 8 as 2.5e-3, 3.6e-4, 9.3e-5 m
+for n_v = 2, 4, 6; Exudyn's generalized-α has a period error on the higher modes, pinned–pinned
+(nπ)²√(EI/ρA)/L² = 99, 395, 888, 1579 rad/s, that asks for h ≤ 2.5e-4: at h = 1e-3 its tip is
+off by 3e-4 m). The geometric terms beyond projeq's second-order beam theory, which made the
+spin-up's difference (benchmarks/exudyn_spin_up.py), are negligible here: the deflection is at
+most 1.05 % of L, so they are ~(v/L)² ≈ 1e-4 of it, ≤ 1e-6 m, below the differences measured.
+So the codes agree within their discretisation errors once the cable's stretching is taken
+out; no difference is left that would point to projeq.
 
-Cost: Exudyn's converged run (32 elements, h = 1.25e-4) takes 4 s CPU, its 16-element run at
-h = 2.5e-4 (already within 4.2e-5 m of it) 0.8 s; projeq's n_v = 6 run at rtol 1e-10 74 s, the
-default n_v = 2 run 4.8 s (but 2.5e-3 m off in the tip deflection: two functions are too few
-for this loop). projeq's explicit integration is bound by the stiff bending modes of the
-pinned beam (the n_v = 8 run: 8e5 evaluations); Radau at rtol 1e-10 did not finish n_v = 4 in
-300 s (one core), and ``simulate``'s default for n_v = 4 over 1 s (DOP853) fails at t = 0.361 s with a
-degenerate partition (q ~ 1e9: the reason the converged runs name RK45).
+Cost: Exudyn's finest run (32 elements, h = 1.25e-4) takes 4 s CPU, its 16-element run at
+h = 2.5e-4 (within 4.2e-5 m of it) 0.8 s; projeq's n_v = 6 run at rtol 1e-10 74 s, its default
+n_v = 2 run 4.8 s (but 2.5e-3 m off in the tip deflection: two functions are too few for this
+loop). projeq's explicit steps are bound by the beam's stiff bending modes (n_v = 8: 8.0e5
+evaluations of s̈); Radau at rtol 1e-10 did not finish n_v = 4 in 300 s (one core), and
+``simulate``'s default for n_v = 4 over 1 s (DOP853) fails at t = 0.361 s with a degenerate
+partition (q ~ 1e9) — the reason the converged runs name RK45.
 """
 
 from __future__ import annotations
@@ -356,8 +359,7 @@ def tables(times, results: dict, exudyn=EXUDYN_RUNS) -> list[Table]:
         out.append(Table(("t", "projeq", "exudyn", "difference", "projeq error", "exudyn error"), rows,
                          units={"t": "s"}, formats={"t": ".2f", "projeq": ".6f", "exudyn": ".6f", "difference": ".1e",
                                                     "projeq error": ".1e", "exudyn error": ".1e"},
-                         title=f"{what}: {pq_names[-1]} vs {ex_name} (errors: change from {pq_names[-2]}; "
-                               f"from Exudyn with half the elements or twice the step, the larger)"))
+                         title=f"{what}: {pq_names[-1]} vs {ex_name}"))
     quantities = ("crank", "rocker", "tip", "sag")
     rows = [(name, r["method"], r["cpu"], *[float(np.abs(r[k] - pq_best[k]).max()) for k in quantities],
              *[float(np.abs(r[k] - ex_best[k]).max()) for k in quantities]) for name, r in results.items()]
