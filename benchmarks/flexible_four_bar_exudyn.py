@@ -218,9 +218,19 @@ def exudyn_run(times, n_elements: int = 16, h: float = 1e-3, axial_stiffness: fl
     """The same quantities by Exudyn (module docstring: the model) and the CPU time of its
     ``SolveDynamic`` (generalized-α, step ``h``)."""
     import exudyn as exu
-    from exudyn.itemInterface import (LoadMassProportional, MarkerBodyMass, MarkerBodyPosition, MarkerNodePosition,
-                                      NodePoint2DSlope1, NodeRigidBody2D, ObjectANCFCable2D, ObjectGround,
-                                      ObjectRigidBody2D, RevoluteJoint2D, SensorNode)
+    from exudyn.itemInterface import (
+        LoadMassProportional,
+        MarkerBodyMass,
+        MarkerBodyPosition,
+        MarkerNodePosition,
+        NodePoint2DSlope1,
+        NodeRigidBody2D,
+        ObjectANCFCable2D,
+        ObjectGround,
+        ObjectRigidBody2D,
+        RevoluteJoint2D,
+        SensorNode,
+    )
     from exudyn.solver import SolveDynamic
 
     times = np.asarray(times, float)
