@@ -152,3 +152,15 @@ def test_the_cut_joints_force_on_the_beam_leaves_no_joint_loaded_along_its_freed
         scale = np.abs(W["pin"]).max()
         for n, name in enumerate(tree.names):
             assert np.abs(kin.F[n].T @ W[name]).max() < 1e-12 * scale, name
+
+
+def test_the_beam_of_a_closed_loop_is_probed_along_a_run(pinned):
+    """A RitzBeam's probes find it in a ConstrainedSystem's result (its tree's coordinates): the
+    tip's deflection along a short run is the beam's displacement at the run's q_e rows (was an
+    AttributeError: the probe looked for the coordinates' layout on the ConstrainedSystem)."""
+    system, _, _ = pinned
+    beam = system.tree.subsystems[system.tree.index("coupler")]
+    result = pq.simulate(system, 0.02, n_points=5)
+    q_e = result.q[:, system.tree.e_q_slice[system.tree.index("coupler")]]
+    assert np.array_equal(beam.deflection(result, B), beam.displacement(q_e, [B])[:, 0, :])
+    assert np.abs(beam.deflection(result, B)[:, 1]).max() > 0  # it bends

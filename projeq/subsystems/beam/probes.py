@@ -73,13 +73,14 @@ class BeamProbes:
         return self.slice_field(x, self.station_data(x))
 
     def _coordinates(self, result) -> NDArray:
-        """This beam's q_e along a trajectory (rows), found in ``result.system``; a plain
-        array of q_e rows is taken as is."""
+        """This beam's q_e along a trajectory (rows), found in ``result.system`` (a System, or the
+        tree of a ConstrainedSystem: the same coordinates q); a plain array of q_e rows is taken
+        as is."""
         if isinstance(result, np.ndarray):
             return np.atleast_2d(result)
-        system = result.system
-        if system is None:
+        if result.system is None:
             raise ValueError("result: has no system (loaded from a file?); probe a Result from simulate()")
+        system = getattr(result.system, "tree", result.system)
         places = [n for n, sub in enumerate(system.subsystems) if sub is self]
         if len(places) != 1:
             raise ValueError(f"result: this beam appears {len(places)} times in the system; probe it by q_e")
