@@ -265,6 +265,7 @@ class _Run:
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
         self.jac, self.switched, self.note = _jac_option(method, jac), "", ""  # go_implicit's record
         self.pieces, self.nfev, self.njev, self.cause, self.steps, self.calls = [], 0, 0, None, 0, 0
+        self.step_size = None  # the integrator's next step size where the last segment ended (_counted)
         self.dense_output, self.x_end = bool(dense_output), None  # x_end: the state at the end of the last segment
         self.out_of_range = False  # warned that a subsystem left the range of its model
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
@@ -334,7 +335,7 @@ class _Run:
         extra = not dense and not (len(inside) and inside[-1] == b)  # b as an output time
         segment = solve_ivp(self.rhs, (a, b), self.x, method=_counted(self.solver, self),
                             t_eval=np.append(inside, b) if extra else inside, rtol=self.rtol, atol=self.atol,
-                            events=events or None, dense_output=dense, **jac, **self.options)
+                            events=events or None, dense_output=dense, **jac, **self._continued(b - a))
         self.nfev += segment.nfev
         if segment.status == 0:
             self.x_end = segment.sol(b) if dense else segment.y[:, -1].copy()
@@ -344,6 +345,17 @@ class _Run:
             segment.sol = SimpleNamespace(ts=np.array([a, self.reached if segment.status else b]))
         self._keep(segment)
         return segment
+
+    def _continued(self, span: float) -> dict:
+        """The integrator's options for the next segment: the user's, and where they set no first
+        step, the step size the last segment's integrator would have taken next. A restart would
+        guess it from ẋ (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4), blind to stiffness: on
+        a closed loop with stiff bending modes the guess was ~40× the stable step, and the trial
+        stage left the loop's domain (its partition check raised where the step would have been
+        rejected)."""
+        if "first_step" in self.options or self.step_size is None:
+            return self.options
+        return {**self.options, "first_step": min(self.step_size, span)}
 
     def _keep(self, segment) -> None:
         """The segment's rows, ended by the state where a terminal event of the user's
@@ -494,7 +506,8 @@ def _may_be_singular(tree) -> bool:
 
 def _counted(solver, run: _Run) -> type:
     """``solver`` (a method name of solve_ivp or an OdeSolver class) as a subclass that adds
-    each step it takes to ``run.steps`` (solve_ivp counts steps only in a dense solution)."""
+    each step it takes to ``run.steps`` (solve_ivp counts steps only in a dense solution) and keeps
+    its step size in ``run.step_size`` (the next segment starts with it, :meth:`_Run._continued`)."""
     import scipy.integrate
 
     base = getattr(scipy.integrate, solver) if isinstance(solver, str) else solver
@@ -503,6 +516,7 @@ def _counted(solver, run: _Run) -> type:
         def step(self):
             message = super().step()
             run.steps += self.status != "failed"
+            run.step_size = getattr(self, "h_abs", None) or self.step_size  # the next step's, where it has one
             return message
 
     Counted.__name__ = Counted.__qualname__ = base.__name__

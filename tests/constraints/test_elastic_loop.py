@@ -164,3 +164,24 @@ def test_the_beam_of_a_closed_loop_is_probed_along_a_run(pinned):
     q_e = result.q[:, system.tree.e_q_slice[system.tree.index("coupler")]]
     assert np.array_equal(beam.deflection(result, B), beam.displacement(q_e, [B])[:, 0, :])
     assert np.abs(beam.deflection(result, B)[:, 1]).max() > 0  # it bends
+
+
+def test_segments_continue_with_the_integrators_step():
+    """A run's segments restart the integrator; each takes the step size the last one would have
+    taken next. The flexible four-bar with four bending functions (its stiffest bending mode near
+    1600 rad/s) by DOP853 over 0.3 s: restarted with scipy's own first-step guess (from ẋ, blind to
+    stiffness, ~40× the stable step) the trial stage left the loop's domain (q ~ 1e9) and the run
+    stopped at t = 0.056 s with "the dependent velocities cannot be solved for"; continued, it runs
+    through and conserves energy (measured drift 6e-14 of |E|)."""
+    beam = pq.RitzBeam(B, 2.0, 200.0, n_v=4, n_w=0, family="clamped_free")
+    tree = pq.System({"crank": slender_rod(1.0, A), "rocker": slender_rod(1.5, C), "coupler": beam},
+                     {"crank": pq.Revolute(axis="z"), "rocker": pq.Revolute(axis="z", r_pn=(D, 0.0, 0.0)),
+                      "coupler": pq.Revolute(parent="crank", axis="z", r_pn=(A, 0.0, 0.0))},
+                     gravity=(0.0, -9.81, 0.0))
+    pin = pq.PinClosure(tree, "coupler", (B, 0.0, 0.0), "rocker", (C, 0.0, 0.0), axes="xy")
+    theta2, theta3 = four_bar_angles(0.5, A, B, C, D)
+    system = pq.ConstrainedSystem(tree, phi=pin, independent=[0, 3, 4, 5, 6], q0=(0.5, theta3, theta2 - 0.5, 0, 0, 0, 0),
+                                  s_dot0=[3.0, 0, 0, 0, 0])
+    result = pq.simulate(system, 0.3, method="DOP853")
+    assert result.t[-1] == 0.3
+    assert result.energy_drift < 1e-10 and np.abs(result.constraint_residual).max() < 1e-10
