@@ -197,30 +197,31 @@ def spinning_beam_bent(tip: float) -> pq.System:
     return pq.System(dict(zip(beam.names, beam.subsystems)), dict(zip(beam.names, beam.joints)), q0=q0)
 
 
-def test_a_default_run_whose_explicit_steps_crawl_goes_on_with_radau():
+def test_a_run_at_rest_takes_the_steps_nothing_limits():
     """The spinning beam scene (EI = ρA = L = 1, Ω = 2 rad/s, four clamped–free functions per
     plane): ρ at rest is its fourth bending frequency β₄² √(EI/(ρA L⁴)) raised by the spin Ω
     in the co-rotating frame (the eigenvalues ±i(ω_k ± Ω) of a round beam spinning about its
     axis; β₄L = 10.99554 of cos βL cosh βL = −1), so DOP853 needs ρT/6.39 = 192 < 100,000 steps
     for stability over the 10 s and default_method keeps DOP853 (bent by 1 cm it is 4× faster
-    than Radau: benchmarks/default_integrator.py). At rest its steps outgrow the stability
-    limit (ρh = 8.8 by t = 4 s): a forced DOP853 gets the StiffnessWarning, the default run
-    goes on with Radau instead, without one, and says so; bent by 1 cm (over 2 s), DOP853 to
-    the end."""
+    than Radau: benchmarks/default_integrator.py). At exact rest ẋ = 0 in every stage: there is
+    nothing for a step beyond the stability limit to amplify, and DOP853's steps grow from
+    segment to segment (each segment goes on with the step size the last one reached) — no
+    StiffnessWarning, the state exactly 0, 396 evaluations (33 steps). A restart's own guess
+    from ẋ = 0 made the steps look as if they crawled at the limit ("ρh = 8.8 by t = 4 s"), and
+    the default run switched to Radau for nothing. Bent by 1 cm (over 2 s), DOP853 to the end."""
     rest, bent = pq.scenes.spinning_beam(), spinning_beam_bent(0.01)
     x0 = np.zeros(rest.n_q + rest.n_s)
     rho, decays = fastest_mode(None, 0.0, x0, jacobian=rest.evaluator().state_jacobian)
     assert rho == pytest.approx(10.995540734875467**2 + 2.0, rel=1e-9) and not decays
     assert default_method(rest.evaluator(), rest, rest.q0, rest.s_dot0, 0.0, 10.0) == "DOP853"
-    with pytest.warns(pq.StiffnessWarning, match="ρh = 8.8"):
-        assert pq.simulate(rest, 10.0, method="DOP853", n_points=2).method == "DOP853"
     with warnings.catch_warnings():
         warnings.simplefilter("error", pq.StiffnessWarning)
+        forced = pq.simulate(rest, 10.0, method="DOP853", n_points=2)
         chosen = pq.simulate(rest, 10.0, n_points=2)
         assert pq.simulate(bent, 2.0, n_points=2).method == "DOP853"
-    assert chosen.method == "DOP853, Radau from t = 4 s" and chosen.njev > 0
-    assert chosen.message.startswith("DOP853 crawled at its stability limit by t = 4 s (mean step 0.0714 s")
-    np.testing.assert_array_equal(chosen.q[-1], 0.0)
+    for run in (forced, chosen):
+        assert run.method == "DOP853" and run.nfev <= 500
+        np.testing.assert_array_equal(run.q[-1], 0.0)
 
 
 def test_the_default_run_goes_on_from_where_its_explicit_steps_crawled():
