@@ -960,7 +960,7 @@ def _compiled_gauss_form(rigid: bool):
     return _jit(gauss_form, projected_accelerations)
 
 
-def jit(*functions, callees=(), kernels=None, names=None):
+def jit(*functions, callees=(), kernels=None, names=None, **replaced):
     """``functions`` compiled by numba as this module's kernels are (:func:`_jit`): with their
     module's names, this module's callees, ``callees`` (the plain functions they call besides,
     compiled with them) and the compiled ``kernels`` they call by name. numba's disk cache checks
@@ -968,12 +968,13 @@ def jit(*functions, callees=(), kernels=None, names=None):
     ``names``: one function compiled twice with other kernels) and a digest (:func:`_digest`) of
     this module's source, its callees' and its compiled kernels' (the source of their modules —
     their constants too — and their names, which carry the digest of their own callees): an
-    edit to any, in another file than the function's, compiles it anew."""
+    edit to any, in another file than the function's, compiles it anew. ``replaced``: another
+    function under a callee's name (:func:`_jit`), for a variant of the same source."""
     compiled = [k.py_func for k in (kernels or {}).values() if hasattr(k, "py_func")]
     modules = dict.fromkeys(sys.modules[f.__module__] for f in compiled)
     digest = _digest(*callees, *modules, names="".join(f.__qualname__ for f in compiled))
     return _jit(*functions, names=tuple(f"{name}_{digest}" for name in names or [f.__name__ for f in functions]),
-                callees=callees, kernels=kernels)
+                callees=callees, kernels=kernels, **replaced)
 
 
 def _digest(*sources, names: str = "") -> str:

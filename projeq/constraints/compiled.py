@@ -386,18 +386,27 @@ def _given_motions(joints, q, s_dot_tree, t, given):
 
 
 def _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
-    """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree): the first ``m_h`` rows Φ_q by :func:`_jacobian`, or for cut
-    joints (``pins``, ``fields``: :func:`pin_table`) by :func:`_pin_jacobian` from the tree's chain
-    terms at q (its joints of kind GIVEN stated at rest: positions and F⁶ need no velocities); the
-    Pfaffian rows A(q) (``pfaffian``, as Φ in :func:`_phi_into`) below them."""
+    """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree): Φ_q by :func:`_jacobian` in the first ``m_h`` rows, the
+    Pfaffian rows below them (:func:`_pfaffian_rows`). The kernels' variant for cut joints
+    (:func:`_compiled`) calls :func:`_pin_constraint_rows` under this name instead."""
+    _jacobian(phi, q, t, A[:m_h])
+    _pfaffian_rows(pfaffian, q, t, m_h, A)
+
+
+def _pin_constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
+    """:func:`_constraint_rows` of cut joints (``pins``, ``fields``: :func:`pin_table`): their rows
+    by :func:`_pin_jacobian` from the tree's chain terms at q (its joints of kind GIVEN stated at
+    rest: positions and F⁶ need no velocities)."""
+    rest = np.zeros(q.shape[0])
+    _given_motions(joints, q, rest, t, tree[4])
+    _chain_terms(tree, q, rest)
+    _pin_jacobian(pins, fields, tree, q, A[:m_h])
+    _pfaffian_rows(pfaffian, q, t, m_h, A)
+
+
+def _pfaffian_rows(pfaffian, q, t, m_h, A):
+    """A[m_h:] ← the Pfaffian rows A(q) (``pfaffian``, as Φ in :func:`_phi_into`), if any."""
     n, m_p = q.shape[0], A.shape[0] - m_h
-    if pins.shape[0]:
-        rest = np.zeros(n)
-        _given_motions(joints, q, rest, t, tree[4])
-        _chain_terms(tree, q, rest)
-        _pin_jacobian(pins, fields, tree, q, A[:m_h])
-    else:
-        _jacobian(phi, q, t, A[:m_h])
     if m_p > 0:
         x, value = np.empty(n, np.complex128), np.empty((m_p, n), np.complex128)
         for i in range(n):
@@ -408,17 +417,31 @@ def _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
                 A[m_h + r, j] = value[r, j].real
 
 
-def _constraint_gamma(phi, pins, fields, pfaffian, tree, q, q_dot, t, m_h, m):
-    """γ = [Φ″(q̇, q̇); (∂(A q̇)/∂q) q̇] at q̇ = ṡ_tree: Φ″ by :func:`_gamma`, or for cut joints by
-    :func:`_pin_gamma` from the tree's chain terms at (q, ṡ_tree) (computed before); the Pfaffian
-    part as the numpy path takes it, Im (A(q + i h q̇) q̇) / h (A independent of t, b = 0:
-    :func:`unsupported`)."""
+def _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, q_dot, t, m_h, m):
+    """γ = [Φ″(q̇, q̇); (∂(A q̇)/∂q) q̇] at q̇ = ṡ_tree: Φ″ by :func:`_gamma`, the Pfaffian part by
+    :func:`_pfaffian_gamma`. The kernels' variant for cut joints calls :func:`_pin_constraint_gamma`
+    under this name instead."""
     gamma = np.zeros(m)
-    if pins.shape[0]:
-        _pin_gamma(pins, fields, tree, q, q_dot, gamma[:m_h])
-    else:
-        gamma[:m_h] = _gamma(phi, q, q_dot, t, m_h)
-    n, m_p = q.shape[0], m - m_h
+    gamma[:m_h] = _gamma(phi, q, q_dot, t, m_h)
+    _pfaffian_gamma(pfaffian, q, q_dot, t, m_h, gamma)
+    return gamma
+
+
+def _pin_constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, q_dot, t, m_h, m):
+    """:func:`_constraint_gamma` of cut joints: their part by :func:`_pin_gamma` from the tree's chain
+    terms at (q, ṡ_tree) (its joints of kind GIVEN stated there)."""
+    gamma = np.zeros(m)
+    _given_motions(joints, q, q_dot, t, tree[4])
+    _chain_terms(tree, q, q_dot)
+    _pin_gamma(pins, fields, tree, q, q_dot, gamma[:m_h])
+    _pfaffian_gamma(pfaffian, q, q_dot, t, m_h, gamma)
+    return gamma
+
+
+def _pfaffian_gamma(pfaffian, q, q_dot, t, m_h, gamma):
+    """gamma[m_h:] ← (∂(A q̇)/∂q) q̇ as the numpy path takes it, Im (A(q + i h q̇) q̇) / h (A independent
+    of t, b = 0: :func:`unsupported`), if there are Pfaffian rows."""
+    n, m_p = q.shape[0], gamma.shape[0] - m_h
     if m_p > 0:
         x, value = np.empty(n, np.complex128), np.empty((m_p, n), np.complex128)
         for i in range(n):
@@ -429,7 +452,6 @@ def _constraint_gamma(phi, pins, fields, pfaffian, tree, q, q_dot, t, m_h, m):
             for j in range(n):
                 total += value[r, j].imag * q_dot[j]
             gamma[m_h + r] = total / COMPLEX_STEP
-    return gamma
 
 
 def _pin_frame(pins, fields, elastic, r, side, q, s_dot, A_port, r_port, F_port, zeta_port):
@@ -653,19 +675,17 @@ def _chain_terms(tree, q, s_dot_tree):
                 twist)
 
 
-def _loaded(tree, q, s_dot_tree):
-    """The loads of the tree's force laws added to h_n by their compiled rows
-    (:func:`projeq.assembly.loads.add_loads`, the loop of the fast evaluator) after
-    :func:`_chain_terms`; False where a law cannot be evaluated."""
+def _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree):
+    """The tree's M, b at (q, ṡ_tree) by the compiled kernels (its joints of kind GIVEN stated
+    there), the loads of its force laws added to h_n by their compiled rows
+    (:func:`projeq.assembly.loads.add_loads`, the loop of the fast evaluator), then s̈ from
+    Fᵀ(M (F s̈ + f̄) + b) = 0 and s̈_tree ← F s̈ + f̄; DONE, UNLOADED where a law cannot be evaluated,
+    or SINGULAR where a squared pivot of FᵀMF is not above ``pivot`` times its largest diagonal entry."""
     index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist, laws, constants = tree
-    return not (laws.shape[0] and add_loads(laws, constants, index, q, s_dot_tree, R, r_O, twist, F_n, T, h) >= 0)
-
-
-def _projected(tree, F, f_bar, pivot, M, b, s_ddot_tree):
-    """The tree's M, b by the compiled kernels from its chain terms (:func:`_chain_terms`,
-    :func:`_loaded`), then s̈ from Fᵀ(M (F s̈ + f̄) + b) = 0 and s̈_tree ← F s̈ + f̄; DONE, or SINGULAR
-    where a squared pivot of FᵀMF is not above ``pivot`` times its largest diagonal entry."""
-    index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist, laws, constants = tree
+    chain_terms(index, geometry, inertia, gravity, q, s_dot_tree, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O,
+                twist)
+    if laws.shape[0] and add_loads(laws, constants, index, q, s_dot_tree, R, r_O, twist, F_n, T, h) >= 0:
+        return UNLOADED
     gauss_form(index, T, zeta, F_n, M_n, h, M, b)
     n, k = F.shape
     MF, g = np.zeros((n, k)), b.copy()  # M F and M f̄ + b
@@ -727,16 +747,13 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
             F[dependent[r], c] = -total
     s_dot_tree = _matvec(F, s_dot)
     q_dot[:] = s_dot_tree
-    _given_motions(joints, q, s_dot_tree, t, tree[4])
-    _chain_terms(tree, q, s_dot_tree)
-    if not _loaded(tree, q, s_dot_tree):
-        return UNLOADED
-    gamma = _constraint_gamma(phi, pins, fields, pfaffian, tree, q, s_dot_tree, t, m_h, m)
+    gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
     f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
     minus_gamma = _matvec(inv, -gamma)
     for r in range(m):
         f_bar[dependent[r]] = minus_gamma[r]
-    return _projected(tree, F, f_bar, pivot, M, b, s_ddot_tree)
+    _given_motions(joints, q, s_dot_tree, t, tree[4])
+    return _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
 def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept,
@@ -764,16 +781,13 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
         return DEGENERATE
     s_dot_tree = _matvec(F, s_dot)
     q_dot[:] = s_dot_tree
-    _given_motions(joints, q, s_dot_tree, t, tree[4])
-    _chain_terms(tree, q, s_dot_tree)
-    if not _loaded(tree, q, s_dot_tree):
-        return UNLOADED
-    gamma = _constraint_gamma(phi, pins, fields, pfaffian, tree, q, s_dot_tree, t, m_h, m)
+    gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
     count = 0  # the singular values above acting σ_max, at most rank
     for value in sigma:
         count += value > acting * sigma[0]
     f_bar = _particular(U, sigma, Vt, gamma, min(count, rank), F, independent)
-    return _projected(tree, F, f_bar, pivot, M, b, s_ddot_tree)
+    _given_motions(joints, q, s_dot_tree, t, tree[4])
+    return _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
 def _scaled(N: NDArray, independent: NDArray) -> NDArray:
@@ -1002,9 +1016,9 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pin_frame, _port_chain, _pin_values,
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame, _port_chain, _pin_values,
             _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, _given_motions, _matvec, _matmul, _svd,
-            _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms, _loaded, _projected,
+            _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms, _projected,
             _inverse)
 
 
@@ -1125,10 +1139,10 @@ class CompiledClosure:
         self.pins, self.fields = pin_table(None, 0) if pins is None else pins
         self._callbacks = [pfaffian] + [joint_callback(tree.joints[n]) if compiled else None for n in ev._given]
         if compiled:
-            self.kernel, self.phi, self.pfaffian = _compiled(ev._width > 6)[rule], callback.address, \
-                0 if pfaffian is None else pfaffian.address
+            self.kernel = _compiled(ev._width > 6, bool(len(self.pins)))[rule]
+            self.phi, self.pfaffian = callback.address, 0 if pfaffian is None else pfaffian.address
         else:
-            self.kernel, self.phi, self.pfaffian = globals()[rule], callback, pfaffian
+            self.kernel, self.phi, self.pfaffian = _interpreted(rule, bool(len(self.pins))), callback, pfaffian
         self.joints = _joint_table(ev, self._callbacks[1:], compiled)
         self._workspace = ev._real
         self.tree = tree_arrays(ev, float)
@@ -1201,7 +1215,7 @@ class CutJointRows:
         self.fast, self.callbacks = ev, callbacks  # the callbacks live as long as this object
         self.pins, self.fields = pins
         self.joints = _joint_table(ev, callbacks, compiled=True)
-        self.kernel = _compiled(ev._width > 6)["cut_joint_rows"]
+        self.kernel = _compiled(ev._width > 6, True)["cut_joint_rows"]
         self.complex_safe = not callbacks
         self._trees = {}
 
@@ -1230,17 +1244,32 @@ class CutJointRows:
 
 
 @functools.cache
-def _compiled(elastic: bool = False) -> dict:
-    """{"partitioned": …, "tangent": …, "cut_joint_rows": …}: the kernels compiled by numba (cached on disk) as
-    :func:`projeq.assembly.kernels.jit` compiles another module's kernels, calling the compiled
-    kernels of :mod:`projeq.assembly.kernels` (the Gauss form's rigid variant, n_y = 6 a constant,
-    or for trees with ``elastic`` bodies the one that reads each body's n_y), the force laws' loop
-    of :mod:`projeq.assembly.loads`, and Φ, A and the UserJoints' relative motions through their C
-    callbacks' addresses by the intrinsics :func:`_phi_into` and :func:`_given_into`."""
+def _compiled(elastic: bool = False, pinned: bool = False) -> dict:
+    """{"partitioned": …, "tangent": …, "cut_joint_rows": …}: the kernels compiled by numba (cached on
+    disk) as :func:`projeq.assembly.kernels.jit` compiles another module's kernels, calling the
+    compiled kernels of :mod:`projeq.assembly.kernels` (the Gauss form's rigid variant, n_y = 6 a
+    constant, or for trees with ``elastic`` bodies the one that reads each body's n_y), the force
+    laws' loop of :mod:`projeq.assembly.loads`, and Φ, A and the UserJoints' relative motions through
+    their C callbacks' addresses by the intrinsics :func:`_phi_into` and :func:`_given_into`. For a Φ
+    made of cut joints (``pinned``) the same source with :func:`_pin_constraint_rows` and
+    :func:`_pin_constraint_gamma` under the names of :func:`_constraint_rows` and
+    :func:`_constraint_gamma` (as the rigid passes take ``_six`` for ``_rows``): the other closures'
+    kernels hold no code of theirs."""
     rules = ("partitioned", "tangent", "cut_joint_rows")
-    names = tuple(f"elastic_{rule}" for rule in rules) if elastic else None
+    prefix = ("elastic_" if elastic else "") + ("pinned_" if pinned else "")
+    replaced = {"_constraint_rows": _pin_constraint_rows, "_constraint_gamma": _pin_constraint_gamma} if pinned else {}
     return dict(zip(rules, kernels.jit(partitioned, tangent, cut_joint_rows, callees=_HELPERS,
-                                       kernels=_compiled_callees(elastic), names=names)))
+                                       kernels=_compiled_callees(elastic),
+                                       names=tuple(prefix + rule for rule in rules), **replaced)))
+
+
+def _interpreted(rule: str, pinned: bool):
+    """The kernel ``rule`` interpreted (``compiled=False``), with the cut joints' rows for a
+    ``pinned`` Φ as :func:`_compiled` compiles them."""
+    if not pinned:
+        return globals()[rule]
+    namespace = {**globals(), "_constraint_rows": _pin_constraint_rows, "_constraint_gamma": _pin_constraint_gamma}
+    return types.FunctionType(globals()[rule].__code__, namespace, rule)
 
 
 def _compiled_callees(elastic: bool) -> dict:
