@@ -18,11 +18,12 @@ the tree's poses in Python), for the hand-written Φ one batched call).
 
     PYTHONPATH=. python benchmarks/pin_closures.py [--budget 3] [--runs 3]
 
-Measured 2026-11-28 (2 shared cores, load ~1.5): s̈ 47.5 µs compiled, 3549 µs numpy path (75×),
-39.3 µs hand-written Φ (0.83×); simulate 2 s: 0.62 s CPU compiled, 7.90 s numpy path (12.7×),
-0.57 s hand-written Φ (0.91×); with 2 output rows 0.27, 5.29 and 0.26 s; 1372 s̈ evaluations each.
-(Earlier the same day, before the cut-joint rows outside the accelerations were compiled: simulate
-2.84 s compiled vs 0.51 s hand-written.)
+Measured 2026-11-28 (2 shared cores, load ~1): s̈ 33.7 µs compiled, 2810 µs numpy path (83×),
+22.1 µs hand-written Φ (0.66×: the cut joints' kernel passes the chain three times — at rest for A_s,
+at ṡ_tree for γ, then for the Gauss form —, the hand-written Φ's once); simulate 2 s: 0.49 s CPU
+compiled, 6.71 s numpy path (13.6×), 0.53 s hand-written Φ (1.09×); with 2 output rows 0.20, 5.55
+and 0.23 s; 1311 s̈ evaluations each. (Earlier the same day, before the cut-joint rows outside the
+accelerations were compiled: simulate 2.84 s compiled vs 0.51 s hand-written.)
 """
 
 from __future__ import annotations
