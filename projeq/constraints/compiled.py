@@ -578,9 +578,8 @@ def _inertial_axis(R, n, axis, A_port, e):
 def _pin_gamma(pins, fields, tree, q, s_dot_tree, gamma):
     """γ_r = (Φ̈_r at s̈_tree = 0) of cut-joint row r: the point's acceleration R_n A_P (v̇_P + ω_P × v_P)
     with its frame's twist (v_P, ω_P) = u + w, u = T⁶_P ẏ_n, w = F_P q̇_e, and its rate at s̈ = 0,
-    ζ̄_P = T⁶_P ζ̄_n + F_P q̈_e + u × w + ζ_P (the chain's step, docs/theory.md §4),
-    ζ̄_n = T_np ζ̄_p + ζ_n
-    the bodies' at s̈ = 0 (the components' derivatives in body axes)."""
+    ζ̄_P = T⁶_P ζ̄_n + F_P q̈_e + u × w + ζ_P (the chain's step, docs/theory.md §4), with the bodies'
+    rates at s̈ = 0, ζ̄_n = T_np ζ̄_p + ζ_n (the components' derivatives in body axes)."""
     index, elastic, T, zeta, R, twist = tree[0], tree[5], tree[7], tree[8], tree[12], tree[14]
     k_max, dtype, n_y = (fields.shape[2] - 2) // 2, T.dtype, index[:, N_Y]
     zeta_bar = np.zeros((index.shape[0], T.shape[1]), dtype)
@@ -1016,8 +1015,8 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame, _port_chain, _pin_values,
-            _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, _given_motions, _matvec, _matmul, _svd,
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame,
+            _port_chain, _pin_values, _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, _given_motions, _matvec, _matmul, _svd,
             _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms, _projected,
             _inverse)
 
