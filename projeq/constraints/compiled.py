@@ -395,12 +395,8 @@ def _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
 
 def _pin_constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
     """:func:`_constraint_rows` of cut joints (``pins``, ``fields``: :func:`pin_table`): their rows
-    by :func:`_pin_jacobian` from the tree's chain terms at q (its joints of kind GIVEN stated at
-    rest: positions and F⁶ need no velocities)."""
-    rest = np.zeros(q.shape[0])
-    _given_motions(joints, q, rest, t, tree[4])
-    _chain_terms(tree, q, rest)
-    _pin_jacobian(pins, fields, tree, q, A[:m_h])
+    by :func:`_pins_at_rest`, the Pfaffian rows below them."""
+    _pins_at_rest(pins, fields, joints, tree, q, t, A[:m_h])
     _pfaffian_rows(pfaffian, q, t, m_h, A)
 
 
@@ -428,12 +424,10 @@ def _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, q_dot, t, m_
 
 
 def _pin_constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, q_dot, t, m_h, m):
-    """:func:`_constraint_gamma` of cut joints: their part by :func:`_pin_gamma` from the tree's chain
-    terms at (q, ṡ_tree) (its joints of kind GIVEN stated there)."""
+    """:func:`_constraint_gamma` of cut joints: their part by :func:`_pins_moving`, the Pfaffian
+    part below it."""
     gamma = np.zeros(m)
-    _given_motions(joints, q, q_dot, t, tree[4])
-    _chain_terms(tree, q, q_dot)
-    _pin_gamma(pins, fields, tree, q, q_dot, gamma[:m_h])
+    _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma[:m_h])
     _pfaffian_gamma(pfaffian, q, q_dot, t, m_h, gamma)
     return gamma
 
@@ -490,18 +484,31 @@ def _port_chain(A_port, r_port, T6):
 
 def cut_joint_rows(pins, fields, joints, tree, q, q_dot, t, values, A, gamma):
     """Φ, Φ_q = A_s (K = E) and γ = Φ″(q̇, q̇) of cut joints alone (the rows a ConstrainedSystem asks
-    for outside its accelerations: projections, conditions, residuals), from the tree's chain terms
-    at q at rest and (for γ, where q̇ ≠ 0) at (q, q̇)."""
+    for outside its accelerations: projections, conditions, residuals): A_s and Φ from the tree's
+    chain terms at rest (:func:`_pins_at_rest`), γ where q̇ ≠ 0 by :func:`_pins_moving`."""
+    _pins_at_rest(pins, fields, joints, tree, q, t, A)
+    _pin_values(pins, fields, tree, q, values)
+    gamma[:] = 0.0
+    if np.any(q_dot != 0.0):
+        _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma)
+
+
+def _pins_at_rest(pins, fields, joints, tree, q, t, A):
+    """A ← Φ_q of the cut joints (:func:`_pin_jacobian`) from the tree's chain terms at q, its joints
+    of kind GIVEN stated at rest (positions and F⁶ need no velocities); the chain terms stay in the
+    tree's workspace for :func:`_pin_values`."""
     rest = np.zeros(q.shape[0], q.dtype)
     _given_motions(joints, q, rest, t, tree[4])
     _chain_terms(tree, q, rest)
-    _pin_values(pins, fields, tree, q, values)
     _pin_jacobian(pins, fields, tree, q, A)
-    gamma[:] = 0.0
-    if np.any(q_dot != 0.0):
-        _given_motions(joints, q, q_dot, t, tree[4])
-        _chain_terms(tree, q, q_dot)
-        _pin_gamma(pins, fields, tree, q, q_dot, gamma)
+
+
+def _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma):
+    """gamma ← Φ″(q̇, q̇) of the cut joints (:func:`_pin_gamma`) from the tree's chain terms at
+    (q, q̇ = ṡ_tree), its joints of kind GIVEN stated there."""
+    _given_motions(joints, q, q_dot, t, tree[4])
+    _chain_terms(tree, q, q_dot)
+    _pin_gamma(pins, fields, tree, q, q_dot, gamma)
 
 
 def _pin_values(pins, fields, tree, q, values):
@@ -680,9 +687,9 @@ def _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree):
     (:func:`projeq.assembly.loads.add_loads`, the loop of the fast evaluator), then s̈ from
     Fᵀ(M (F s̈ + f̄) + b) = 0 and s̈_tree ← F s̈ + f̄; DONE, UNLOADED where a law cannot be evaluated,
     or SINGULAR where a squared pivot of FᵀMF is not above ``pivot`` times its largest diagonal entry."""
-    index, geometry, inertia, gravity, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O, twist, laws, constants = tree
-    chain_terms(index, geometry, inertia, gravity, q, s_dot_tree, given, elastic, port, T, zeta, F_n, M_n, h, R, r_O,
-                twist)
+    _chain_terms(tree, q, s_dot_tree)
+    index, T, zeta, F_n, M_n, h = tree[0], tree[7], tree[8], tree[9], tree[10], tree[11]
+    R, r_O, twist, laws, constants = tree[12], tree[13], tree[14], tree[15], tree[16]
     if laws.shape[0] and add_loads(laws, constants, index, q, s_dot_tree, R, r_O, twist, F_n, T, h) >= 0:
         return UNLOADED
     gauss_form(index, T, zeta, F_n, M_n, h, M, b)
@@ -1016,9 +1023,9 @@ def _inverse(A: NDArray) -> NDArray:
 
 
 _HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame,
-            _port_chain, _pin_values, _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, _given_motions, _matvec, _matmul, _svd,
-            _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms, _projected,
-            _inverse)
+            _port_chain, _pins_at_rest, _pins_moving, _pin_values, _body_jacobians, _inertial_axis, _pin_jacobian,
+            _pin_gamma, _given_motions, _matvec, _matmul, _svd, _transposed_qr, _reflect, _jacobi, _row_square,
+            _scaled, _particular, _chain_terms, _projected, _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
