@@ -58,7 +58,7 @@ def parts(model, X, T) -> dict:
     constrained = hasattr(model, "project")
 
     def normalise(i):
-        return model.normalized(X[i][:n], T[i]) if constrained else model.normalized(X[i][:n])
+        return model.normalized(X[i][:n], T[i])
 
     Q = [normalise(i) for i in range(N)]
     cost = {"normalise": per_row(normalise, N)}

@@ -85,8 +85,9 @@ class Model(ABC):
         return self.check_q("q", q), state_vector("s_dot", s_dot, self.n_s)
 
     @abstractmethod
-    def normalized(self, q: NDArray) -> NDArray:
-        """q moved onto its manifold (unit quaternions; a ConstrainedSystem's loop closures)."""
+    def normalized(self, q: NDArray, t: float = 0.0) -> NDArray:
+        """q moved onto its manifold at time t (unit quaternions; a ConstrainedSystem's loop
+        closures Φ(q, t) = 0, which depend on t across a joint prescribed in time)."""
 
     @abstractmethod
     def check_configuration(self, q: NDArray, t: float = 0.0) -> None:
@@ -461,8 +462,9 @@ class System(Model):
         ]
         return np.concatenate(parts) if parts else np.zeros(0)
 
-    def normalized(self, q: NDArray) -> NDArray:
-        """q with every joint's coordinates projected onto their manifold (unit quaternions)."""
+    def normalized(self, q: NDArray, t: float = 0.0) -> NDArray:
+        """q with every joint's coordinates projected onto their manifold (unit quaternions, the
+        same at any time t)."""
         q = numeric(np.array(q))  # complex under a complex step (the energy projection's exact gradient)
         for n, joint in enumerate(self.joints):
             sl = slice(self.q_slice[n].start, self.e_q_slice[n].start)

@@ -89,14 +89,16 @@ class BatchedClosure:
         points x + i h e_j."""
         return self._im(x[:, None] + 1j * COMPLEX_STEP * self._unit[:, :columns])
 
-    def second(self, x: NDArray, q_dot: NDArray, rheonomic: bool) -> NDArray:
+    def second(self, x: NDArray, q_dot: NDArray, rheonomic: bool, rate: float = 1.0) -> NDArray:
         """Φ″(v, v) = Φ″(v_q, v_q) + 2 Φ″(v_q, v_t) + Φ″(v_t, v_t), v_q = (q̇, 0), v_t = (0, 1)
         (the rheonomic parts only if ``rheonomic``): each part keeps its own relative accuracy
-        (the first ∝ |q̇|², the rheonomic ones not); one call at the 6 stencil points of each part."""
-        v_q, v_t = np.append(q_dot, 0.0), self._unit[-1]
+        (the first ∝ |q̇|², the rheonomic ones not; along t the stencil steps 1/``rate`` as far,
+        :meth:`~projeq.constraints.partitioned.ConstrainedSystem._time_rate`); one call at the 6
+        stencil points of each part."""
+        v_q, v_t = np.append(q_dot, 0.0), self._unit[-1] / rate
         speed = float(np.linalg.norm(v_q))
-        pairs = ([(v_t, v_t, 1.0)] if rheonomic else []) + (
-            [(v_q / speed, v_q / speed, speed * speed)] + ([(v_q / speed, v_t, 2 * speed)] if rheonomic else [])
+        pairs = ([(v_t, v_t, rate * rate)] if rheonomic else []) + (
+            [(v_q / speed, v_q / speed, speed * speed)] + ([(v_q / speed, v_t, 2 * speed * rate)] if rheonomic else [])
             if speed else [])
         if not pairs:
             return np.zeros(self.m)

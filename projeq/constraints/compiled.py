@@ -102,7 +102,8 @@ def unsupported(system) -> str | None:
         (system.m_p > 0 and _rheonomic_rows(system),
          "Pfaffian constraints A(q, t) q̇ = b(q, t) with b ≠ 0 or A depending on t"),
         (system.m_h == 0, "no holonomic constraints"),
-        (system.rheonomic, "Φ may depend on t (correction other than 'projection')"),
+        (system.rheonomic, "Φ depends on t (a joint prescribed in time in the loop, or a correction other "
+                           "than 'projection')"),
         (not system._identity and bool(_kinematics_joints(tree)), _kinematics_piece(tree)),
         (not system.exact, "Φ does not take complex arguments (no complex step)"),
         (not system.compiled_tree(), "the tree's default evaluator is not the compiled one "
@@ -1244,8 +1245,9 @@ class CutJointRows:
         """Φ_q at x = (q, t) (``columns`` = n_q: Φ independent of t)."""
         return self._call(x[:-1], np.zeros(len(x) - 1), x[-1])[1]
 
-    def second(self, x: NDArray, q_dot: NDArray, rheonomic: bool) -> NDArray:
-        """Φ″(q̇, q̇) at x = (q, t) (``rheonomic`` False: Φ independent of t)."""
+    def second(self, x: NDArray, q_dot: NDArray, rheonomic: bool, rate: float = 1.0) -> NDArray:
+        """Φ″(q̇, q̇) at x = (q, t) (``rheonomic`` False: Φ independent of t; exact, so without the
+        stencils' time ``rate``)."""
         return self._call(x[:-1], q_dot, x[-1])[2]
 
 

@@ -24,8 +24,10 @@ sixth-order stencil on normalised directions, ≈ 1e-14 relative whatever the sp
 motions, 6e-3 relative at 1/1000 of the four-bar's rates). A Φ written with numpy operations on the
 rows q[i] is evaluated at all points of a stencil in one call (:mod:`projeq.constraints.batched`,
 the same stencils; checked once at q0, else point by point after a warning naming Φ); under
-``correction="projection"`` Φ is independent of t (checked at q0 and around it), so ∂Φ/∂t and the rheonomic parts of
-Φ″ are not evaluated, and where every tree joint has q̇ = ṡ_tree (K = E) neither are K, k nor K̇.
+``correction="projection"`` Φ independent of t (checked at q0 and around it) spares ∂Φ/∂t and the
+rheonomic parts of Φ″ (a Φ that depends on t — a cut joint across a joint prescribed in time, a
+driven mechanism — has them, their stencils along t scaled by Φ's rate in t), and where every
+tree joint has q̇ = ṡ_tree (K = E) neither are K, k nor K̇.
 Position drift of the loop closures Φ = 0 is corrected either by a
 Gauss–Newton projection of q onto Φ = 0 wherever :func:`projeq.simulate` normalises q
 (segment ends and outputs; ``correction="projection"``, the default) or by Baumgarte's
@@ -79,9 +81,9 @@ from projeq.constraints.batched import batched_closure
 from projeq.constraints.compiled import OWN_RULE, compiled_cut_joints, compiled_partition, uncompiled, unsupported
 from projeq.constraints.cut_joints import cut_joints, point_rows
 from projeq.checks import depends_on_t, positive, state_vector
-from projeq.analysis.differentiation import (complex_failure, derivative_along, derivative_along_differences,
-                                             second_derivative_along, second_derivative_along_differences,
-                                             warn_differences)
+from projeq.analysis.differentiation import (MIXED_STEP, complex_failure, derivative_along,
+                                             derivative_along_differences, second_derivative_along,
+                                             second_derivative_along_differences, warn_differences)
 from projeq.joints import Joint
 from projeq.spatial import numeric
 from projeq.system import Model
@@ -184,10 +186,9 @@ class ConstrainedSystem(Model):
         # have compiled rows of their own once the system is built (_cut_joint_rows), else pointwise
         self._closure = batched_closure(phi, self.n_q, np.append(q0, 0.0), self.m_h) \
             if self.exact and self.m_h and point_rows(phi) is None else None
-        if correction == "projection" and self.m_h and depends_on_t(self.phi, q0):  # q is normalised without t
-            raise ValueError("correction: 'projection' needs Φ independent of t (q is normalised without the "
-                             "time); use correction='baumgarte' for rheonomic constraints")
-        self.rheonomic = correction != "projection"  # else Φ(q) alone: ∂Φ/∂t and its derivatives are 0
+        # Φ(q, t) through a joint prescribed in time (a driven mechanism) or, with Baumgarte's correction, any
+        # Φ: ∂Φ/∂t and the rheonomic parts of Φ″ are evaluated; else Φ(q) alone, whose are 0
+        self.rheonomic = correction != "projection" or bool(self.m_h and depends_on_t(self.phi, q0))
         self._choose_velocities(q0, independent, repivot)
         self.q0 = self._initial_q(q0, project_q0)
         self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
@@ -531,7 +532,7 @@ class ConstrainedSystem(Model):
 
     def normalized(self, q: NDArray, t: float = 0.0) -> NDArray:
         """The tree's normalisation, then (``correction="projection"``) Gauss–Newton steps
-        q ← q − C_Φ⁺ Φ onto Φ = 0."""
+        q ← q − C_Φ⁺ Φ onto Φ(q, t) = 0 at the time t (a driven mechanism's Φ depends on it)."""
         q = self.tree.normalized(q)
         return self.project(q, t) if self.correction == "projection" else q
 
@@ -614,13 +615,26 @@ class ConstrainedSystem(Model):
         v_t = (0, 1) (:meth:`gamma`; the rheonomic parts only where Φ depends on t), by one call
         at a batch of points where Φ takes them."""
         batched = self._batched()
+        rate = self._time_rate(x) if self.rheonomic else 1.0
         if batched is not None and (batched.complex_safe or not (np.iscomplexobj(x) or np.iscomplexobj(q_dot))):
-            return batched.second(x, q_dot, self.rheonomic)
+            return batched.second(x, q_dot, self.rheonomic, rate)
         v_q, v_t = np.append(q_dot, 0.0), np.eye(len(x))[-1]
         value = self._d2(self._phi_x, x, v_q, v_q)
         if self.rheonomic:
-            value = value + 2 * self._d2(self._phi_x, x, v_q, v_t) + self._d2(self._phi_x, x, v_t, v_t)
+            along_t = {"step": MIXED_STEP / rate} if self.exact else {}
+            value = value + 2 * self._d2(self._phi_x, x, v_q, v_t, **along_t) \
+                + self._d2(self._phi_x, x, v_t, v_t, **along_t)
         return value
+
+    def _time_rate(self, x: NDArray) -> float:
+        """σ = max(1, ‖∂Φ/∂t‖ / max_j ‖∂Φ/∂q_j‖) at x = (q, t): how many unit steps of a coordinate
+        change Φ as much as a unit of time (about a driven crank's rate, in rad/s). The stencils of
+        Φ″'s rheonomic parts step 1/σ as far along t, so that they see the variation of Φ a unit
+        step of q shows: their truncation error grows as σ⁶ h⁶ otherwise (a four-bar driven at
+        2–4 rad/s: 1.4e-10 relative in s̈, 1.4e-12 with the scaled step; tests/constraints/test_driven.py)."""
+        Phi_q, Phi_t = self._phi_derivatives(np.real(x[:-1]), float(np.real(x[-1])))
+        column = np.linalg.norm(Phi_q, axis=0).max(initial=0.0)  # the fastest coordinate's
+        return max(1.0, float(np.linalg.norm(Phi_t) / max(column, np.finfo(float).tiny)))
 
     def _projected(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
         """(A_s, F, f̄, M, b) at (q, ṡ, t): ṡ_tree = F ṡ + f, s̈_tree = F s̈ + f̄, and the tree's

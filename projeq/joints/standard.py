@@ -270,4 +270,4 @@ def _time_function(expr) -> Callable:
     if extra:
         raise ValueError(f"motion: depends on {sorted(map(str, extra))}; only t is allowed")
     f = sp.lambdify(t, [expr, expr.diff(t), expr.diff(t, 2)], modules="numpy")
-    return lambda time: tuple(float(v) for v in f(time))
+    return lambda time: tuple(f(time))  # complex at a complex t: Prescribed.angles keeps the complex step

@@ -234,9 +234,9 @@ class _Run:
     def __init__(self, system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
                  evaluator, n_segments, progress, jac, options, dense_output=False):
         check_model(system)
-        q0 = system.normalized(system.check_q("q0", system.q0 if q0 is None else q0))
-        s_dot0 = state_vector("s_dot0", system.s_dot0 if s_dot0 is None else s_dot0, system.n_s)
         self.t_start = t_start = float(finite_array("t_start", t_start, ()))
+        q0 = system.normalized(system.check_q("q0", system.q0 if q0 is None else q0), t_start)
+        s_dot0 = state_vector("s_dot0", system.s_dot0 if s_dot0 is None else s_dot0, system.n_s)
         self.t_end = t_end = float(finite_array("t_end", t_end, ()))
         if not t_end > t_start:
             raise ValueError(f"t_end: must be after t_start = {t_start}, got {t_end}")
@@ -364,7 +364,7 @@ class _Run:
         t, x = segment.t, np.reshape(segment.y, (n_x, len(segment.t))).T  # no output times: y = []
         for (times, q, s_dot), te, ye in zip(self.fired, segment.t_events or [], segment.y_events or []):
             times.extend(te)
-            q.extend(self.model.normalized(y[:n_q]) for y in ye)
+            q.extend(self.model.normalized(y[:n_q], tau) for tau, y in zip(te, ye))
             s_dot.extend(y[n_q:] for y in ye)
         if segment.status == 1 and not self.model_event_fired(segment):
             t_stop = segment.sol.ts[-1]  # the terminal event, where the dense solution ends
@@ -403,7 +403,7 @@ class _Run:
         """The next segment starts at b, from the state there (not at the last output time)."""
         self.x = self.x_end.copy()
         n_q = self.model.n_q
-        self.x[:n_q] = self.model.normalized(self.x[:n_q])
+        self.x[:n_q] = self.model.normalized(self.x[:n_q], b)
         near_singularity(self.model.tree, self.x[:n_q], b)
         self.out_of_range = self.out_of_range or warn_out_of_range(self.model.tree, self.x[None, :n_q], b)
         if self.progress is not None:
@@ -659,7 +659,7 @@ def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, ND
     q, energies, residual, ranks = [], [], [], []
     for (model, t), xi in zip(rows, x):
         try:
-            qi = model.normalized(xi[:n_q])
+            qi = model.normalized(xi[:n_q], t)
             values = model.output_row(qi, xi[n_q:], t)
         except Exception as exc:  # noqa: BLE001 - a user's function: reported by name with the time
             run.status, run.cause, run.reached = -1, exc, t

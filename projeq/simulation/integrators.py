@@ -88,7 +88,7 @@ def energy_manifold(system, q0, s_dot0, t0: float = 0.0):
                 grad = energy_gradient(system, x, t)
             x -= (E - E0) * grad / (grad @ grad)
             E, scale = energy(x, t)
-        x[:n_q] = system.normalized(x[:n_q])
+        x[:n_q] = system.normalized(x[:n_q], t)
         return x
 
     return project
@@ -107,7 +107,7 @@ def _energy_function(system):
     n_q = system.n_q
 
     def energy(x: NDArray, t: float) -> tuple[float, float]:
-        T, V = system.energy(system.normalized(x[:n_q]), x[n_q:], t)
+        T, V = system.energy(system.normalized(x[:n_q], t), x[n_q:], t)
         return T + V, abs(T) + abs(V)
 
     return energy
@@ -124,7 +124,7 @@ def energy_gradient(system, x: NDArray, t: float) -> NDArray:
 
 def _energy_value(system, x: NDArray, t) -> NDArray:
     """[E(x, t)] with q normalised, complex under a complex step in x or t."""
-    T, V = system.energy(system.normalized(x[:system.n_q]), x[system.n_q:], t)
+    T, V = system.energy(system.normalized(x[:system.n_q], t), x[system.n_q:], t)
     return np.atleast_1d(T + V)
 
 
@@ -148,7 +148,7 @@ def _energy_change(system, x0: NDArray, t0: float) -> tuple[float, float] | None
 def _energy_rate(system, x: NDArray, t: float) -> float | None:
     """dE/dt at (t, x) if it is distinguishable from zero, else None."""
     n_q = system.n_q
-    q, s_dot = system.normalized(x[:n_q]), x[n_q:]
+    q, s_dot = system.normalized(x[:n_q], t), x[n_q:]
     x_dot = np.concatenate((system.q_dot(q, s_dot, t), system.accelerations(q, s_dot, t)))
     grad = energy_gradient(system, x, t)
     # ∂E/∂t apart: a prescribed motion or a time-dependent load may take only real times
