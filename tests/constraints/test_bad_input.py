@@ -122,16 +122,24 @@ def test_unknown_correction(tree):
         ConstrainedSystem(tree, phi=circle, correction="stabilize")
 
 
-def test_time_dependent_loop_with_projection(tree):
-    with pytest.raises(ValueError, match="correction: 'projection' needs Φ independent of t"):
-        ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0 - 0.1 * np.sin(t)])
+def test_time_dependent_loop_is_projected_at_its_time(tree):
+    """A circle whose radius breathes, |q| = 1 + 0.1 sin t, under the default correction: q is
+    projected onto Φ(q, t) = 0 at the time asked (the circle of that time), and the velocity
+    constraint carries ∂Φ/∂t = −0.1 cos t (before: refused, "'projection' needs Φ independent of t")."""
+    system = ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0 - 0.1 * np.sin(t)])
+    assert system.rheonomic
+    q = system.normalized(np.array([0.66, -0.88]), 1.0)
+    assert abs(np.hypot(*q) - (1.0 + 0.1 * np.sin(1.0))) <= 1e-12  # POSITION_TOLERANCE
+    assert abs(system.velocity_constraints(q, 1.0)[1][0] - 0.1 * np.cos(1.0)) <= 1e-15
 
 
 def test_time_dependence_that_vanishes_at_q0_is_seen(tree):
     """Φ = |q| − 1 + 0.1 t (x − 0.6) does not change with t at q0 = (0.6, −0.8) alone: the check
-    looks around q0 too (projection would take ∂Φ/∂t = 0, a wrong γ wherever x ≠ 0.6)."""
-    with pytest.raises(ValueError, match="correction: 'projection' needs Φ independent of t"):
-        ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0 + 0.1 * t * (q[0] - 0.6)])
+    looks around q0 too, so ∂Φ/∂t = 0.1 (x − 0.6) is evaluated (taken as 0, γ and the velocities
+    would be wrong wherever x ≠ 0.6)."""
+    system = ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0 + 0.1 * t * (q[0] - 0.6)])
+    assert system.rheonomic
+    assert abs(system.velocity_constraints(np.array([0.8, -0.6]), 0.0)[1][0] + 0.1 * 0.2) <= 1e-15
 
 
 def test_reactions_of_a_tree(tree):
