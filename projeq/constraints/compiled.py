@@ -102,8 +102,8 @@ def unsupported(system) -> str | None:
         (system.m_p > 0 and _rheonomic_rows(system),
          "Pfaffian constraints A(q, t) q̇ = b(q, t) with b ≠ 0 or A depending on t"),
         (system.m_h == 0, "no holonomic constraints"),
-        (system.rheonomic, "Φ depends on t (a joint prescribed in time in the loop, or a correction other "
-                           "than 'projection')"),
+        (system.correction != "projection", f"correction {system.correction!r} (the kernels project)"),
+        (system.rheonomic and point_rows(system._phi) is None, "Φ depends on t (a function of t, not cut joints)"),
         (not system._identity and bool(_kinematics_joints(tree)), _kinematics_piece(tree)),
         (not system.exact, "Φ does not take complex arguments (no complex step)"),
         (not system.compiled_tree(), "the tree's default evaluator is not the compiled one "
@@ -386,19 +386,23 @@ def _given_motions(joints, q, s_dot_tree, t, given):
         _given_into(joints[g, 5], q[q0:q0 + n_q], s_dot_tree[s0:s0 + n_s], t, given[n])
 
 
-def _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
-    """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree): Φ_q by :func:`_jacobian` in the first ``m_h`` rows, the
-    Pfaffian rows below them (:func:`_pfaffian_rows`). The kernels' variant for cut joints
-    (:func:`_compiled`) calls :func:`_pin_constraint_rows` under this name instead."""
+def _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A, b_s):
+    """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree) and b_s ← the right side of A_s ṡ_tree = b_s, here 0 (Φ and the
+    Pfaffian rows independent of t: :func:`unsupported`): Φ_q by :func:`_jacobian` in the first
+    ``m_h`` rows, the Pfaffian rows below them (:func:`_pfaffian_rows`). The kernels' variant for cut
+    joints (:func:`_compiled`) calls :func:`_pin_constraint_rows` under this name instead."""
     _jacobian(phi, q, t, A[:m_h])
     _pfaffian_rows(pfaffian, q, t, m_h, A)
+    b_s[:] = 0.0
 
 
-def _pin_constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
+def _pin_constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A, b_s):
     """:func:`_constraint_rows` of cut joints (``pins``, ``fields``: :func:`pin_table`): their rows
-    by :func:`_pins_at_rest`, the Pfaffian rows below them."""
-    _pins_at_rest(pins, fields, joints, tree, q, t, A[:m_h])
+    and b_s = −∂Φ/∂t (the motions of the tree's joints prescribed in time) by :func:`_pins_at_rest`,
+    the Pfaffian rows below them."""
+    _pins_at_rest(pins, fields, joints, tree, q, t, A[:m_h], b_s[:m_h])
     _pfaffian_rows(pfaffian, q, t, m_h, A)
+    b_s[m_h:] = 0.0
 
 
 def _pfaffian_rows(pfaffian, q, t, m_h, A):
@@ -483,25 +487,28 @@ def _port_chain(A_port, r_port, T6):
     chain_matrix_into(A_np, r_port, T6)
 
 
-def cut_joint_rows(pins, fields, joints, tree, q, q_dot, t, values, A, gamma):
-    """Φ, Φ_q = A_s (K = E) and γ = Φ″(q̇, q̇) of cut joints alone (the rows a ConstrainedSystem asks
-    for outside its accelerations: projections, conditions, residuals): A_s and Φ from the tree's
-    chain terms at rest (:func:`_pins_at_rest`), γ where q̇ ≠ 0 by :func:`_pins_moving`."""
-    _pins_at_rest(pins, fields, joints, tree, q, t, A)
+def cut_joint_rows(pins, fields, joints, tree, q, q_dot, t, values, A, b_s, gamma):
+    """Φ, Φ_q = A_s (K = E), b_s = −∂Φ/∂t and γ = Φ̈ at s̈_tree = 0 of cut joints alone (the rows a
+    ConstrainedSystem asks for outside its accelerations: projections, conditions, residuals): Φ, A_s
+    and b_s from the tree's chain terms at ṡ_tree = 0 (:func:`_pins_at_rest`), γ by
+    :func:`_pins_moving` where q̇ ≠ 0 or a joint of kind GIVEN moves the tree."""
+    _pins_at_rest(pins, fields, joints, tree, q, t, A, b_s)
     _pin_values(pins, fields, tree, q, values)
     gamma[:] = 0.0
-    if np.any(q_dot != 0.0):
+    if joints.shape[0] or np.any(q_dot != 0.0):
         _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma)
 
 
-def _pins_at_rest(pins, fields, joints, tree, q, t, A):
-    """A ← Φ_q of the cut joints (:func:`_pin_jacobian`) from the tree's chain terms at q, its joints
-    of kind GIVEN stated at rest (positions and F⁶ need no velocities); the chain terms stay in the
+def _pins_at_rest(pins, fields, joints, tree, q, t, A, b_s):
+    """A ← Φ_q of the cut joints (:func:`_pin_jacobian`) and b_s ← −∂Φ/∂t (:func:`_pin_rates`) from the
+    tree's chain terms at q and ṡ_tree = 0, its joints of kind GIVEN stated there (their motions in
+    time alone move the tree; positions and F⁶ need no velocities); the chain terms stay in the
     tree's workspace for :func:`_pin_values`."""
     rest = np.zeros(q.shape[0], q.dtype)
     _given_motions(joints, q, rest, t, tree[4])
     _chain_terms(tree, q, rest)
     _pin_jacobian(pins, fields, tree, q, A)
+    _pin_rates(pins, fields, tree, q, b_s)
 
 
 def _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma):
@@ -528,6 +535,29 @@ def _pin_values(pins, fields, tree, q, values):
             else:
                 values[r] += sign * (r_O[n, axis] + R[n, axis, 0] * r_port[0] + R[n, axis, 1] * r_port[1]
                                      + R[n, axis, 2] * r_port[2])
+
+
+def _pin_rates(pins, fields, tree, q, b_s):
+    """b_s[r] ← −Φ̇_r of cut-joint row r with the bodies' twists in the tree's workspace (at ṡ_tree = 0:
+    those of its joints prescribed in time, so Φ̇ = ∂Φ/∂t): the points' velocities R_n A_P v_P,
+    (v_P, ω_P) = T⁶_P ẏ_n (:func:`_pin_jacobian`; the stations' own rates are 0 at rest)."""
+    index, elastic, T, R, twist = tree[0], tree[5], tree[7], tree[12], tree[14]
+    k_max, dtype = (fields.shape[2] - 2) // 2, T.dtype
+    A_port, r_port, F_port, zeta_port = np.empty((3, 3), dtype), np.empty(3, dtype), np.empty((6, k_max), dtype), \
+        np.empty(6, dtype)
+    T6, e, rest = np.empty((6, 6), dtype), np.empty(3, dtype), np.zeros(q.shape[0], dtype)
+    for r in range(pins.shape[0]):
+        axis = int(pins[r, 2])
+        b_s[r] = 0.0
+        for side in range(2):
+            n = _pin_frame(pins, fields, elastic, r, side, q, rest, A_port, r_port, F_port, zeta_port)
+            if n < 0:
+                continue
+            _port_chain(A_port, r_port, T6)
+            _inertial_axis(R, n, axis, A_port, e)
+            sign = -1.0 if side == 0 else 1.0
+            for a in range(3):
+                b_s[r] += sign * e[a] * dot6(T6[a], twist[n])
 
 
 def _pin_jacobian(pins, fields, tree, q, A):
@@ -732,11 +762,13 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
     docstring) from Φ (``phi``: :func:`_phi_into`; ``m_h`` rows) and the Pfaffian rows A(q)
     (``pfaffian``), the tree's packed arrays and workspace (``tree``: those of
     :func:`projeq.assembly.kernels.chain_terms`) with its joints of kind GIVEN (``joints``:
-    :func:`_given_motions`), q, ṡ, t and the partition; writes q̇ = ṡ_tree (K = E), s̈_tree,
+    :func:`_given_motions`), q, ṡ, t and the partition; ṡ_tree = F ṡ + f with f = [0; A_dep⁻¹ b_s]
+    (b_s = −∂Φ/∂t of cut joints across joints prescribed in time, else 0); writes q̇ = ṡ_tree (K = E), s̈_tree,
     A_s = [Φ_q; A], M and b; returns DONE, SINGULAR (:func:`_projected`) or DEGENERATE where
     ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
     n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
-    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
+    b_s = np.empty(m)
+    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A, b_s)
     A_dep = np.empty((m, m))
     for r in range(m):
         for c in range(m):
@@ -753,6 +785,9 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
                 total += inv[r, i] * A[i, independent[c]]
             F[dependent[r], c] = -total
     s_dot_tree = _matvec(F, s_dot)
+    f = _matvec(inv, b_s)  # ṡ_tree = F ṡ + f, f = [0; A_dep⁻¹ b_s]
+    for r in range(m):
+        s_dot_tree[dependent[r]] += f[r]
     q_dot[:] = s_dot_tree
     gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
     f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
@@ -769,9 +804,11 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     N the null space of A_s = U Σ Vᵀ continued along the branch (``kept``: the tangent kept last,
     n × n_s, NaN where none; overwritten where the null space is separated, its rule), f̄ =
     x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) over the ``rank`` largest singular values above
-    ``acting`` σ_max; otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular."""
+    ``acting`` σ_max, and ṡ_tree = F ṡ + f with f the same particular solution of A_s f = b_s;
+    otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular."""
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
-    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
+    b_s = np.empty(m)
+    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A, b_s)
     U, sigma, Vt = _svd(A)
     near = 0  # the singular values below separation σ_max, at least k
     for value in sigma:
@@ -786,12 +823,15 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     F = _scaled(N, independent)
     if F.shape[0] == 0:
         return DEGENERATE
-    s_dot_tree = _matvec(F, s_dot)
-    q_dot[:] = s_dot_tree
-    gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
     count = 0  # the singular values above acting σ_max, at most rank
     for value in sigma:
         count += value > acting * sigma[0]
+    s_dot_tree = _matvec(F, s_dot)
+    f = _particular(U, sigma, Vt, -b_s, min(count, rank), F, independent)  # A_s f = b_s, f[independent] = 0
+    for i in range(n):
+        s_dot_tree[i] += f[i]
+    q_dot[:] = s_dot_tree
+    gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
     f_bar = _particular(U, sigma, Vt, gamma, min(count, rank), F, independent)
     _given_motions(joints, q, s_dot_tree, t, tree[4])
     return _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree)
@@ -1024,9 +1064,9 @@ def _inverse(A: NDArray) -> NDArray:
 
 
 _HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame,
-            _port_chain, _pins_at_rest, _pins_moving, _pin_values, _body_jacobians, _inertial_axis, _pin_jacobian,
-            _pin_gamma, _given_motions, _matvec, _matmul, _svd, _transposed_qr, _reflect, _jacobi, _row_square,
-            _scaled, _particular, _chain_terms, _projected, _inverse)
+            _port_chain, _pins_at_rest, _pins_moving, _pin_values, _pin_rates, _body_jacobians, _inertial_axis,
+            _pin_jacobian, _pin_gamma, _given_motions, _matvec, _matmul, _svd, _transposed_qr, _reflect, _jacobi,
+            _row_square, _scaled, _particular, _chain_terms, _projected, _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
@@ -1114,12 +1154,12 @@ def _joint_table(ev, callbacks, compiled: bool) -> NDArray:
 
 def compiled_cut_joints(system) -> "CutJointRows | None":
     """The compiled rows of ``system``'s cut joints (:class:`CutJointRows`) where its Φ is made of them
-    and the tree's kinematics compile — K = E, Φ independent of t, the tree's fast evaluator without
+    and the tree's kinematics compile — K = E, the tree's fast evaluator without
     coupled joints or joints that state their relative motion in Python, its UserJoints' relative
     motions compiled —, whether or not its constrained s̈ is one compiled call (an AugmentedSystem,
     a force law without compiled rows, Pfaffian rows with b ≠ 0); else None (the numpy path's
     complex steps through the poses)."""
-    if point_rows(system._phi) is None or not system._identity or system.rheonomic or not system.compiled_tree():
+    if point_rows(system._phi) is None or not system._identity or not system.compiled_tree():
         return None
     ev = system.tree.evaluator("fast")
     if ev._expansion is not None or _python_joints(ev):
@@ -1207,8 +1247,8 @@ class CompiledClosure:
 
 
 class CutJointRows:
-    """Φ, Φ_x and Φ″(v, v) of a ConstrainedSystem whose Φ is made of cut joints (Φ independent of t,
-    K = E) by the compiled :func:`cut_joint_rows` on the tree's fast evaluator's workspace
+    """Φ, Φ_x and Φ″(v, v) of a ConstrainedSystem whose Φ is made of cut joints (K = E; Φ depends on t
+    where they close a loop across a joint prescribed in time) by the compiled :func:`cut_joint_rows` on the tree's fast evaluator's workspace
     (:func:`compiled_cut_joints`): what the numpy path asks for — projections, conditions, residuals,
     and the A_s, γ of its accelerations where they are not one compiled call — in place of its complex
     steps through the poses (one Python pass over the tree per point). The interface of
@@ -1226,29 +1266,31 @@ class CutJointRows:
         self.complex_safe = not callbacks
         self._trees = {}
 
-    def _call(self, q: NDArray, q_dot: NDArray, t: float) -> tuple[NDArray, NDArray, NDArray]:
-        """(Φ, A_s, γ) at (q, q̇, t), new arrays of the arguments' dtype."""
+    def _call(self, q: NDArray, q_dot: NDArray, t: float) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+        """(Φ, A_s, b_s = −∂Φ/∂t, γ) at (q, q̇, t), new arrays of the arguments' dtype."""
         dtype = np.result_type(q, q_dot, float)
         if dtype not in self._trees:
             self._trees[dtype] = tree_arrays(self.fast, dtype)
         m_h, n = self.pins.shape[0], len(q)
-        values, A, gamma = np.zeros(m_h, dtype), np.zeros((m_h, n), dtype), np.zeros(m_h, dtype)
+        values, A, b_s, gamma = np.zeros(m_h, dtype), np.zeros((m_h, n), dtype), np.zeros(m_h, dtype), \
+            np.zeros(m_h, dtype)
         self.kernel(self.pins, self.fields, self.joints, self._trees[dtype], np.ascontiguousarray(q, dtype),
-                    np.ascontiguousarray(q_dot, dtype), float(np.real(t)), values, A, gamma)
-        return values, A, gamma
+                    np.ascontiguousarray(q_dot, dtype), float(np.real(t)), values, A, b_s, gamma)
+        return values, A, b_s, gamma
 
     def values(self, q: NDArray, t: float) -> NDArray:
-        """Φ(q)."""
+        """Φ(q, t)."""
         return self._call(q, np.zeros(len(q)), t)[0]
 
     def jacobian(self, x: NDArray, columns: int) -> NDArray:
-        """Φ_q at x = (q, t) (``columns`` = n_q: Φ independent of t)."""
-        return self._call(x[:-1], np.zeros(len(x) - 1), x[-1])[1]
+        """The first ``columns`` columns of Φ_x = [Φ_q, ∂Φ/∂t] at x = (q, t)."""
+        _, A, b_s, _ = self._call(x[:-1], np.zeros(len(x) - 1), x[-1])
+        return np.hstack((A, -b_s[:, None]))[:, :columns]
 
     def second(self, x: NDArray, q_dot: NDArray, rheonomic: bool, rate: float = 1.0) -> NDArray:
-        """Φ″(q̇, q̇) at x = (q, t) (``rheonomic`` False: Φ independent of t; exact, so without the
-        stencils' time ``rate``)."""
-        return self._call(x[:-1], q_dot, x[-1])[2]
+        """Φ̈ at s̈_tree = 0 along x = (q, t) moving at (q̇, 1) — Φ″(v, v) with its rheonomic parts, exact
+        (so without the stencils' time ``rate``), whether or not Φ depends on t."""
+        return self._call(x[:-1], q_dot, x[-1])[3]
 
 
 @functools.cache

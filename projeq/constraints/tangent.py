@@ -169,7 +169,10 @@ class TangentSystem(ConstrainedSystem):
         return F
 
     def condition(self, q: NDArray, t: float = 0.0) -> float:
-        """κ = 1/σ_min(N_ind) ≥ 1, ‖F‖₂ ≤ κ: how badly the independent velocities describe the motion."""
+        """κ = 1/σ_min(N_ind) ≥ 1, ‖F‖₂ ≤ κ: how badly the independent velocities describe the motion
+        (1 without any: a fully driven mechanism has no free motion to describe)."""
+        if not self.n_s:
+            return 1.0
         sigma = np.linalg.svd(self._null_space(self.constraint_matrix(q, t)[0])[self.independent],
                               compute_uv=False)
         return float(1.0 / sigma[-1]) if sigma[-1] > 0 else np.inf

@@ -7,6 +7,7 @@ kinematics, its ``compiled_kind``; see :mod:`projeq.joints.base` for the contrac
 
 from __future__ import annotations
 
+import functools
 import math
 
 from typing import Callable
@@ -221,7 +222,8 @@ class Prescribed(Joint):
             raise ValueError("joint: Prescribed needs an uncoupled Revolute or Prismatic joint")
         super().__init__(joint.parent, joint.r_pn, joint.orientation)
         self.joint = joint
-        self.motion = motion if callable(motion) else _time_function(motion)
+        self.expression = None if callable(motion) else _expression(motion)  # θ(t) in sympy, or None
+        self.motion = motion if callable(motion) else _time_function(self.expression)
         try:  # the callable's signature, shape and finiteness, checked once here
             self.angles(0.0)
         except TypeError as exc:
@@ -254,20 +256,49 @@ class Prescribed(Joint):
         return SymbolicRelative(inner.A, inner.r, sp.zeros(6, 0), inner.F * motion.diff(t), sp.zeros(0, 0),
                                 sp.zeros(0, 1))
 
+    def compiled_values(self):
+        """``values(q_n, ṡ_n, t)`` -> :meth:`relative_values` (A, r, w, ζ = ḟ) of a motion given in
+        sympy, printed as scalar code that numba compiles, as a UserJoint's
+        (:func:`projeq.joints.user_compiler.printed_values`; one function per kinematics in a
+        process); None for a callable motion (its relative motion is stated in Python)."""
+        if self.expression is None:
+            return None
+        t = sp.Symbol("t")
+        inner = self.symbolic_relative([], [], t, self.expression)
+        return _printed_values(*(sp.ImmutableMatrix(e) for e in (inner.A, inner.r, inner.f)), t)
+
 
 def _label(motion) -> str:
     return f"the prescribed motion {callable_name(motion)}"
 
 
-def _time_function(expr) -> Callable:
+def _expression(motion):
+    """The motion θ(t) as a sympy expression in the symbol t, checked."""
     t = sp.Symbol("t")
     try:
-        expr = sp.sympify(expr)
+        expr = sp.sympify(motion)
     except (sp.SympifyError, SyntaxError, TypeError) as exc:
-        raise ValueError(f"motion: cannot read {expr!r} as an expression in t (a sympy expression or "
+        raise ValueError(f"motion: cannot read {motion!r} as an expression in t (a sympy expression or "
                          "a string such as '0.5*sin(2*t)'), or give a callable t -> (θ, θ̇, θ̈)") from exc
     extra = expr.free_symbols - {t}
     if extra:
         raise ValueError(f"motion: depends on {sorted(map(str, extra))}; only t is allowed")
+    return expr
+
+
+def _time_function(expr) -> Callable:
+    """t ↦ (θ, θ̇, θ̈) of the expression θ(t), lambdified."""
+    t = sp.Symbol("t")
     f = sp.lambdify(t, [expr, expr.diff(t), expr.diff(t, 2)], modules="numpy")
     return lambda time: tuple(f(time))  # complex at a complex t: Prescribed.angles keeps the complex step
+
+
+@functools.lru_cache(maxsize=64)
+def _printed_values(A, r, f, t):
+    """The compiled-form ``values`` of a prescribed motion's kinematics A(t), r(t), w = f(t), ζ = ḟ(t)
+    (no coordinates, no minimal velocities), one function per kinematics in a process so that its
+    numba callback is built once."""
+    from projeq.joints.user_compiler import printed_values
+
+    symbols = {"q": [], "s": [], "t": t, "A": A, "r": r, "F": sp.zeros(6, 0), "f": f, "zeta": f.diff(t)}
+    return printed_values(symbols)()

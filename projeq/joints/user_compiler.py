@@ -211,7 +211,7 @@ def _compiled_values(derived: Derived, p: tuple):
 def value_expressions(symbols: dict) -> list:
     """The entries of :meth:`projeq.joints.base.Joint.relative_values` of a joint from sympy:
     A row by row, r, w = F ṡ + f, ζ = Ḟ ṡ + ḟ, then F column by column."""
-    F, s = symbols["F"], sp.Matrix(symbols["s"])
+    F, s = symbols["F"], sp.Matrix(len(symbols["s"]), 1, list(symbols["s"]))  # (0, 1) without velocities
     return [*symbols["A"], *symbols["r"], *(F * s + symbols["f"]), *symbols["zeta"], *F.T]
 
 

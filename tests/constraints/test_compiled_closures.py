@@ -189,6 +189,16 @@ def _shaken_pendulum():
     return ConstrainedSystem(tree, phi=lambda q, t: [q[0] ** 2 + q[1] ** 2 - 1.0], q0=[0.6, -0.8], independent=[0])
 
 
+def _breathing_circle():
+    """The pendulum of :func:`_pendulum` on a circle whose radius breathes, |q| = 1 + 0.1 sin t: Φ a
+    function of t (a cut joint's dependence on t through a prescribed joint compiles; a function's
+    does not)."""
+    tree = pq.System({"x": pq.Frame(), "bob": pq.PointMass(1.0)},
+                     {"x": pq.Prismatic(axis="x"), "bob": pq.Prismatic(parent="x", axis="z")}, gravity=(0, 0, -9.81))
+    return ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0 - 0.1 * np.sin(t)], q0=[0.6, -0.8],
+                             independent=[0])
+
+
 def _driven_bead():
     """A bead on a circle in the xz-plane, driven along y at a given speed: a Pfaffian row
     A q̇ = b with b ≠ 0 (ẏ = 0.1 m/s)."""
@@ -211,7 +221,8 @@ OUTSIDE = {
     "callable load": (_driven_four_bar, "force law 6 (Force) has no compiled row"),
     "joint with K ≠ E": (_planar_pendulum, "joints with q̇ ≠ ṡ (K ≠ E): 'bob' (Planar)"),
     "joint stating its motion": (_shaken_pendulum, "joint 'base' (Prescribed) states its own relative motion"),
-    "rheonomic": (lambda: pq.scenes.four_bar(correction="baumgarte"), "Φ may depend on t"),
+    "Baumgarte's correction": (lambda: pq.scenes.four_bar(correction="baumgarte"), "correction 'baumgarte'"),
+    "Φ a function of t": (_breathing_circle, "Φ depends on t (a function of t, not cut joints)"),
     "own rule": (lambda: _OwnRule(pq.scenes.four_bar().tree, phi=pq.scenes.four_bar()._phi,
                                   q0=pq.scenes.four_bar().q0, independent=[0]), "F by its own rule"),
 }
