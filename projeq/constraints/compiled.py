@@ -508,7 +508,10 @@ def _pins_at_rest(pins, fields, joints, tree, q, t, A, b_s):
     _given_motions(joints, q, rest, t, tree[4])
     _chain_terms(tree, q, rest)
     _pin_jacobian(pins, fields, tree, q, A)
-    _pin_rates(pins, fields, tree, q, b_s)
+    if joints.shape[0]:  # only joints of kind GIVEN move the tree at ṡ_tree = 0
+        _pin_rates(pins, fields, tree, q, b_s)
+    else:
+        b_s[:] = 0.0
 
 
 def _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma):
