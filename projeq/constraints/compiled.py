@@ -1290,9 +1290,9 @@ class CutJointRows:
         _, A, b_s, _ = self._call(x[:-1], np.zeros(len(x) - 1), x[-1])
         return np.hstack((A, -b_s[:, None]))[:, :columns]
 
-    def second(self, x: NDArray, q_dot: NDArray, rheonomic: bool, rate: float = 1.0) -> NDArray:
-        """Φ̈ at s̈_tree = 0 along x = (q, t) moving at (q̇, 1) — Φ″(v, v) with its rheonomic parts, exact
-        (so without the stencils' time ``rate``), whether or not Φ depends on t."""
+    def second(self, x: NDArray, q_dot: NDArray, rheonomic: bool) -> NDArray:
+        """Φ̈ at s̈_tree = 0 along x = (q, t) moving at (q̇, 1): Φ″(v, v) with its rheonomic parts, exact,
+        whether or not Φ depends on t (``rheonomic``)."""
         return self._call(x[:-1], q_dot, x[-1])[3]
 
 

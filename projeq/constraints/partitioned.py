@@ -77,7 +77,7 @@ import scipy.linalg
 from numpy.typing import NDArray
 
 from projeq.assembly.linalg import solve_spd
-from projeq.constraints.batched import batched_closure
+from projeq.constraints.batched import batched_closure, time_rate
 from projeq.constraints.compiled import OWN_RULE, compiled_cut_joints, compiled_partition, uncompiled, unsupported
 from projeq.constraints.cut_joints import cut_joints, point_rows
 from projeq.checks import depends_on_t, positive, state_vector
@@ -615,26 +615,16 @@ class ConstrainedSystem(Model):
         v_t = (0, 1) (:meth:`gamma`; the rheonomic parts only where Φ depends on t), by one call
         at a batch of points where Φ takes them."""
         batched = self._batched()
-        rate = self._time_rate(x) if self.rheonomic else 1.0
         if batched is not None and (batched.complex_safe or not (np.iscomplexobj(x) or np.iscomplexobj(q_dot))):
-            return batched.second(x, q_dot, self.rheonomic, rate)
+            return batched.second(x, q_dot, self.rheonomic)
         v_q, v_t = np.append(q_dot, 0.0), np.eye(len(x))[-1]
         value = self._d2(self._phi_x, x, v_q, v_q)
-        if self.rheonomic:
-            along_t = {"step": MIXED_STEP / rate} if self.exact else {}
+        if self.rheonomic:  # along t the stencil steps 1/σ as far (time_rate)
+            Phi_x = np.column_stack(self._phi_derivatives(np.real(x[:-1]), float(np.real(x[-1]))))
+            along_t = {"step": MIXED_STEP / time_rate(Phi_x)} if self.exact else {}
             value = value + 2 * self._d2(self._phi_x, x, v_q, v_t, **along_t) \
                 + self._d2(self._phi_x, x, v_t, v_t, **along_t)
         return value
-
-    def _time_rate(self, x: NDArray) -> float:
-        """σ = max(1, ‖∂Φ/∂t‖ / max_j ‖∂Φ/∂q_j‖) at x = (q, t): how many unit steps of a coordinate
-        change Φ as much as a unit of time (about a driven crank's rate, in rad/s). The stencils of
-        Φ″'s rheonomic parts step 1/σ as far along t, so that they see the variation of Φ a unit
-        step of q shows: their truncation error grows as σ⁶ h⁶ otherwise (a four-bar driven at
-        2–4 rad/s: 1.4e-10 relative in s̈, 1.4e-12 with the scaled step; tests/constraints/test_driven.py)."""
-        Phi_q, Phi_t = self._phi_derivatives(np.real(x[:-1]), float(np.real(x[-1])))
-        column = np.linalg.norm(Phi_q, axis=0).max(initial=0.0)  # the fastest coordinate's
-        return max(1.0, float(np.linalg.norm(Phi_t) / max(column, np.finfo(float).tiny)))
 
     def _projected(self, q: NDArray, s_dot: NDArray, t: float, method: str | None) -> tuple:
         """(A_s, F, f̄, M, b) at (q, ṡ, t): ṡ_tree = F ṡ + f, s̈_tree = F s̈ + f̄, and the tree's
