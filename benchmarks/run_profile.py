@@ -101,7 +101,9 @@ def load_numba(load=kernels._numba):  # numba's import where the run does it, th
 
 kernels._numba = timed(load_numba, "  numba's import")
 before = clock()
-import projeq.scenes, projeq.simulation.driver, projeq.simulation.export, projeq.cli.run
+from contextlib import nullcontext
+with getattr(commands, "imports_frozen", nullcontext)():  # as the parser and run_scene import them
+    import projeq.scenes, projeq.simulation.driver, projeq.simulation.export, projeq.cli.run
 preimport = [b - a for a, b in zip(before, clock())]  # the parser's imports, done here to wrap them
 
 def resolve_scene(text, resolve=projeq.scenes.resolve_scene):

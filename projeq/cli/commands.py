@@ -54,7 +54,8 @@ def parser(argv=None) -> argparse.ArgumentParser:
     for name, (module, arguments, text) in COMMANDS.items():
         command = sub.add_parser(name, help=text, description=text)
         if argv is None or name in argv:
-            getattr(importlib.import_module(f"projeq.cli.{module}"), arguments)(command)
+            with imports_frozen():
+                getattr(importlib.import_module(f"projeq.cli.{module}"), arguments)(command)
     return top
 
 
@@ -104,6 +105,25 @@ def command() -> int:
     code = main()
     gc.freeze()
     return code
+
+
+@contextmanager
+def imports_frozen():
+    """The block's imports (a subcommand's modules, the first time in the process: scipy's and
+    numba's) with the cyclic collector paused, and, if the block imported a module, what is alive
+    after it frozen (:func:`gc.freeze`): the ~130,000 long-lived objects of the imports are then
+    neither walked while they are made (some 50 young and 4 middle-generation collections, 0.05 s
+    CPU of ``projeq run``) nor afterwards. A block that imports nothing new freezes nothing; the
+    collector is enabled again as it was."""
+    modules, enabled = len(sys.modules), gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if len(sys.modules) > modules:
+            gc.freeze()
+        if enabled:
+            gc.enable()
 
 
 def _interrupt(signum, frame):

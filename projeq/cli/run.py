@@ -101,14 +101,18 @@ def list_scenes(args) -> int:
 
 
 def run_scene(args) -> int:
-    from projeq.scenes import parse_settings, resolve_scene
-    from projeq.simulation.driver import SimulationError, simulate
+    from projeq.cli.commands import imports_frozen
 
+    with imports_frozen():
+        from projeq.scenes import parse_settings, resolve_scene
+        from projeq.simulation.driver import SimulationError, simulate
     scene = resolve_scene(args.scene)
     overrides = parse_settings(scene, args.set)
     system = scene.build(**overrides)
     t_end = scene.t_end if args.t_end is None else args.t_end
     options = simulate_options(args, scene)
+    with imports_frozen():  # the evaluator simulate takes (cached by the model): numba's import for a compiled one
+        system.evaluator(options.get("evaluator"))
     record = run_record(args, scene, overrides, t_end, options)
     label, parent = scene_label(args.scene), output_directory(args.out)
     cpu, wall = time.process_time(), time.perf_counter()
