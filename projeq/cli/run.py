@@ -25,9 +25,11 @@ import json
 import sys
 import textwrap
 import time
+from contextlib import nullcontext
 from dataclasses import replace
 from datetime import datetime
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -235,10 +237,13 @@ def _write_json(path: Path, document: dict) -> Path:
 
 
 def _progress_bar(t_start: float, t_end: float, quiet: bool):
-    """A tqdm bar over simulated time (silent when quiet or not on a terminal)."""
+    """A tqdm bar over simulated time on a terminal (stderr) unless quiet; else one that shows
+    nothing, without tqdm (its import and the monitor thread that even a disabled bar starts)."""
+    if quiet or (hasattr(sys.stderr, "isatty") and not sys.stderr.isatty()):  # as tqdm's disable=None
+        return nullcontext(SimpleNamespace(n=0.0, update=lambda step: None))
     from tqdm import tqdm
 
-    return tqdm(total=t_end - t_start, unit="s", unit_scale=True, disable=True if quiet else None,
+    return tqdm(total=t_end - t_start, unit="s", unit_scale=True,
                 bar_format="{l_bar}{bar}| t = {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]")
 
 

@@ -344,6 +344,16 @@ def test_run_freezes_scipy_s_and_numba_s_modules_as_it_imports_them(tmp_path):
     assert done.stdout.split(maxsplit=1) == ["0", "[False, False, False]\n"]
 
 
+@pytest.mark.parametrize("option", ["--quiet", "--json", None])
+def test_run_without_a_shown_bar_does_not_import_tqdm(option, tmp_path):
+    """The progress bar is drawn on a terminal only: quiet, as JSON or into a pipe ``projeq run``
+    does not import tqdm (nor start the monitor thread a disabled tqdm bar starts)."""
+    code = "import sys; from projeq.cli import main; code = main(sys.argv[1:]); print(code, 'tqdm' in sys.modules)"
+    argv = ["run", "atwood", "--t-end", "0.2", "--out", str(tmp_path)] + ([option] if option else [])
+    done = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, check=True)
+    assert done.stdout.splitlines()[-1] == "0 False"
+
+
 def test_files_are_complete_after_the_command_s_exit(tmp_path):
     """With the objects frozen at the end of ``python -m projeq run`` (no final collection), every
     file the record names is written, and the NPZ holds the run that the CSV holds."""
