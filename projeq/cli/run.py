@@ -11,7 +11,7 @@ CPU time, status, files), ``<scene>.npz`` (the Result with the same record,
 ``paraview/<scene>.pvd`` and, with ``--plots``, PNG plots ``<scene>_history.png`` ... (a scene
 given as ``FILE.py:FUNCTION`` is called ``FILE-FUNCTION``). The plots are asked for, not
 written by default: matplotlib's import and drawing cost more CPU time (about 1.7 s) than the
-rest of the default run's writing, in a run of about 2.7 s CPU in all (1.8 s of it Python's
+rest of the default run's writing, in a run of about 1.7 s CPU in all (1.2 s of it Python's
 start, the imports of numpy, scipy and projeq and numba's start; ``benchmarks/run_profile.py``
 splits it). A failed or interrupted run (Ctrl-C or SIGTERM) writes its results up to where it
 stopped and exits 1. ``--out`` is checked before the run, the
