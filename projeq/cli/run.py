@@ -108,11 +108,13 @@ def run_scene(args) -> int:
     with imports_frozen():
         from projeq.scenes import parse_settings, resolve_scene
         from projeq.simulation.driver import SimulationError, simulate
+        from projeq.system import check_model
     scene = resolve_scene(args.scene)
     overrides = parse_settings(scene, args.set)
     system = scene.build(**overrides)
     t_end = scene.t_end if args.t_end is None else args.t_end
     options = simulate_options(args, scene)
+    check_model(system)  # as simulate does first: a FILE.py:FUNCTION returning no model is refused by name
     with imports_frozen():  # the evaluator simulate takes (cached by the model): numba's import for a compiled one
         system.evaluator(options.get("evaluator"))
     record = run_record(args, scene, overrides, t_end, options)
