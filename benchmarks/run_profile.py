@@ -5,7 +5,8 @@ Three views of the same command, ``python -m projeq run --quiet --out TMP``:
 1. phases (``--repeat`` processes, the median of each phase): the run's own functions timed
    from inside the process (CPU and wall): Python's start (interpreter, site), the parser
    (importing the CLI, the scenes and what they import), the scene's build, ``simulate``
-   (with, inside it, numba's import, numba's target initialisation — its compiler's
+   (with, inside it, numba's import — done just before ``simulate`` by ``projeq run``, which forms
+   the run's evaluator among its imports —, numba's target initialisation — its compiler's
    registries, which it loads on the first cached function —, the loads of projeq's
    kernels from numba's disk cache, the implicit methods' Jacobians, the output rows'
    energies and the validity checks), the files (NPZ + CSV, ParaView series, run.json) and the
@@ -101,7 +102,9 @@ def load_numba(load=kernels._numba):  # numba's import where the run does it, th
 
 kernels._numba = timed(load_numba, "  numba's import")
 before = clock()
-import projeq.scenes, projeq.simulation.driver, projeq.simulation.export, projeq.cli.run
+from contextlib import nullcontext
+with getattr(commands, "imports_frozen", nullcontext)():  # as the parser and run_scene import them
+    import projeq.scenes, projeq.simulation.driver, projeq.simulation.export, projeq.cli.run
 preimport = [b - a for a, b in zip(before, clock())]  # the parser's imports, done here to wrap them
 
 def resolve_scene(text, resolve=projeq.scenes.resolve_scene):

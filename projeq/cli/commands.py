@@ -54,7 +54,8 @@ def parser(argv=None) -> argparse.ArgumentParser:
     for name, (module, arguments, text) in COMMANDS.items():
         command = sub.add_parser(name, help=text, description=text)
         if argv is None or name in argv:
-            getattr(importlib.import_module(f"projeq.cli.{module}"), arguments)(command)
+            with imports_frozen():
+                getattr(importlib.import_module(f"projeq.cli.{module}"), arguments)(command)
     return top
 
 
@@ -104,6 +105,26 @@ def command() -> int:
     code = main()
     gc.freeze()
     return code
+
+
+@contextmanager
+def imports_frozen():
+    """The block's imports (a subcommand's modules, the first time in the process: scipy's and
+    numba's) with the cyclic collector paused, and, if the block imported a module, what is alive
+    after it frozen (:func:`gc.freeze`): the ~130,000 long-lived objects of the imports are then
+    neither walked while they are made (in ``projeq run`` 10 young-generation collections and a
+    middle-generation one over ~100,000 objects: the collector 0.07 → 0.02 s CPU,
+    ``benchmarks/run_profile.py --compare``) nor afterwards. A block that imports nothing new freezes nothing; the
+    collector is enabled again as it was."""
+    modules, enabled = len(sys.modules), gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if len(sys.modules) > modules:
+            gc.freeze()
+        if enabled:
+            gc.enable()
 
 
 def _interrupt(signum, frame):

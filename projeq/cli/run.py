@@ -11,7 +11,7 @@ CPU time, status, files), ``<scene>.npz`` (the Result with the same record,
 ``paraview/<scene>.pvd`` and, with ``--plots``, PNG plots ``<scene>_history.png`` ... (a scene
 given as ``FILE.py:FUNCTION`` is called ``FILE-FUNCTION``). The plots are asked for, not
 written by default: matplotlib's import and drawing cost more CPU time (about 1.7 s) than the
-rest of the default run's writing, in a run of about 2.7 s CPU in all (1.8 s of it Python's
+rest of the default run's writing, in a run of about 1.7 s CPU in all (1.2 s of it Python's
 start, the imports of numpy, scipy and projeq and numba's start; ``benchmarks/run_profile.py``
 splits it). A failed or interrupted run (Ctrl-C or SIGTERM) writes its results up to where it
 stopped and exits 1. ``--out`` is checked before the run, the
@@ -25,9 +25,11 @@ import json
 import sys
 import textwrap
 import time
+from contextlib import nullcontext
 from dataclasses import replace
 from datetime import datetime
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -101,14 +103,20 @@ def list_scenes(args) -> int:
 
 
 def run_scene(args) -> int:
-    from projeq.scenes import parse_settings, resolve_scene
-    from projeq.simulation.driver import SimulationError, simulate
+    from projeq.cli.commands import imports_frozen
 
+    with imports_frozen():
+        from projeq.scenes import parse_settings, resolve_scene
+        from projeq.simulation.driver import SimulationError, simulate
+        from projeq.system import check_model
     scene = resolve_scene(args.scene)
     overrides = parse_settings(scene, args.set)
     system = scene.build(**overrides)
     t_end = scene.t_end if args.t_end is None else args.t_end
     options = simulate_options(args, scene)
+    check_model(system)  # as simulate does first: a FILE.py:FUNCTION returning no model is refused by name
+    with imports_frozen():  # the evaluator simulate takes (cached by the model): numba's import for a compiled one
+        system.evaluator(options.get("evaluator"))
     record = run_record(args, scene, overrides, t_end, options)
     label, parent = scene_label(args.scene), output_directory(args.out)
     cpu, wall = time.process_time(), time.perf_counter()
@@ -231,10 +239,13 @@ def _write_json(path: Path, document: dict) -> Path:
 
 
 def _progress_bar(t_start: float, t_end: float, quiet: bool):
-    """A tqdm bar over simulated time (silent when quiet or not on a terminal)."""
+    """A tqdm bar over simulated time on a terminal (stderr) unless quiet; else one that shows
+    nothing, without tqdm (its import and the monitor thread that even a disabled bar starts)."""
+    if quiet or (hasattr(sys.stderr, "isatty") and not sys.stderr.isatty()):  # as tqdm's disable=None
+        return nullcontext(SimpleNamespace(n=0.0, update=lambda step: None))
     from tqdm import tqdm
 
-    return tqdm(total=t_end - t_start, unit="s", unit_scale=True, disable=True if quiet else None,
+    return tqdm(total=t_end - t_start, unit="s", unit_scale=True,
                 bar_format="{l_bar}{bar}| t = {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]")
 
 

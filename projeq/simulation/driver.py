@@ -34,7 +34,7 @@ from projeq.analysis.jacobians import state_derivative, state_jacobian
 from projeq.assembly import EVALUATORS
 from projeq.checks import callable_name, closest, count, finite_array, positive, state_vector
 from projeq.simulation.integrators import (
-    EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, stiff_steps, warn_stiff,
+    EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, stiff_steps, warn_stiff, with_direct_lu,
 )
 from projeq.simulation.result import Result, SimulationError
 from projeq.constraints.nonholonomic import near_singularity
@@ -507,12 +507,19 @@ def _may_be_singular(tree) -> bool:
 def _counted(solver, run: _Run) -> type:
     """``solver`` (a method name of solve_ivp or an OdeSolver class) as a subclass that adds
     each step it takes to ``run.steps`` (solve_ivp counts steps only in a dense solution) and keeps
-    its step size in ``run.step_size`` (the next segment starts with it, :meth:`_Run._continued`)."""
+    its step size in ``run.step_size`` (the next segment starts with it, :meth:`_Run._continued`);
+    scipy's Radau and BDF factorise by LAPACK directly
+    (:func:`~projeq.simulation.integrators.with_direct_lu`: the same results, less overhead)."""
     import scipy.integrate
 
     base = getattr(scipy.integrate, solver) if isinstance(solver, str) else solver
 
     class Counted(base):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            if base in (scipy.integrate.Radau, scipy.integrate.BDF):  # scipy's own, not a user's subclass
+                with_direct_lu(self)
+
         def step(self):
             message = super().step()
             run.steps += self.status != "failed"

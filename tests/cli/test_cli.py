@@ -17,7 +17,7 @@ import pytest
 import projeq as pq
 import projeq.cli.studies
 import projeq.simulation.driver
-from projeq.cli.commands import THRESHOLDS, command, main
+from projeq.cli.commands import THRESHOLDS, command, imports_frozen, main
 
 
 def atwood_angle(m1, t, m2=1.0, pulley_mass=0.5, a=0.1, g=9.81):
@@ -298,6 +298,60 @@ def test_the_command_freezes_what_is_alive_and_returns_main_s_code(monkeypatch):
     finally:
         gc.unfreeze()
         gc.set_threshold(*thresholds)
+
+
+def test_imports_are_not_collected_and_frozen_when_new(tmp_path, monkeypatch):
+    """imports_frozen: no collection while its block runs, however many tracked objects it makes
+    (here 30,000 lists, three young generations of THRESHOLDS); what is alive frozen (gc.freeze)
+    when the block imported a module, nothing when it did not; the collector enabled again only
+    if it was."""
+    (tmp_path / "freshly_imported.py").write_text("LISTS = [[] for _ in range(30_000)]\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    collections, thresholds = [], gc.get_threshold()
+    gc.callbacks.append(on_start := lambda phase, info: collections.append(phase) if phase == "start" else None)
+    gc.set_threshold(*THRESHOLDS)
+    try:
+        frozen = gc.get_freeze_count()
+        with imports_frozen():
+            import freshly_imported  # noqa: F401
+        assert collections == [] and gc.isenabled() and gc.get_freeze_count() >= frozen + 30_000
+        frozen = gc.get_freeze_count()
+        with imports_frozen():
+            import freshly_imported  # noqa: F401, F811 - imported before: nothing new
+            made = [[] for _ in range(30_000)]
+            during = len(collections)
+        assert during == 0 and gc.get_freeze_count() == frozen and len(made) == 30_000
+        gc.disable()
+        with imports_frozen():
+            pass
+        assert not gc.isenabled()
+    finally:
+        gc.enable()
+        gc.callbacks.remove(on_start)
+        gc.unfreeze()
+        gc.set_threshold(*thresholds)
+
+
+def test_run_freezes_scipy_s_and_numba_s_modules_as_it_imports_them(tmp_path):
+    """A fresh process's ``projeq run``: the modules of scipy.integrate (the driver's import) and
+    numba (the compiled evaluator's) are frozen, left out of every later collection (gc.get_objects
+    lists the collected generations only)."""
+    code = ("import gc, sys; from projeq.cli import main; code = main(sys.argv[1:]); "
+            "walked = {id(o) for o in gc.get_objects()}; "
+            "print(code, [id(vars(sys.modules[m])) in walked for m in ('scipy.integrate', 'numba', 'projeq.scenes')])")
+    done = subprocess.run([sys.executable, "-c", code, "run", "atwood", "--t-end", "0.2", "--quiet", "--out",
+                           str(tmp_path)], capture_output=True, text=True, check=True)
+    assert done.stdout.split(maxsplit=1) == ["0", "[False, False, False]\n"]
+
+
+@pytest.mark.parametrize("option", ["--quiet", "--json", None])
+def test_run_without_a_shown_bar_does_not_import_tqdm(option, tmp_path):
+    """The progress bar is drawn on a terminal only: quiet, as JSON or into a pipe ``projeq run``
+    does not import tqdm (nor start the monitor thread a disabled tqdm bar starts)."""
+    code = "import sys; from projeq.cli import main; code = main(sys.argv[1:]); print(code, 'tqdm' in sys.modules)"
+    argv = ["run", "atwood", "--t-end", "0.2", "--out", str(tmp_path)] + ([option] if option else [])
+    done = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, check=True)
+    assert done.stdout.splitlines()[-1] == "0 False"
 
 
 def test_files_are_complete_after_the_command_s_exit(tmp_path):

@@ -117,6 +117,17 @@ def test_a_user_scene_from_a_file(tmp_path, capsys):
     assert "did you mean 'length'" in capsys.readouterr().err
 
 
+def test_a_user_function_returning_no_model_is_a_bad_argument(tmp_path, capsys):
+    """``projeq run FILE.py:FUNCTION`` whose function returns something else than a System or a
+    ConstrainedSystem: exit 2 with simulate's own refusal (projeq.system.check_model), nothing run
+    or written — also now that the run's evaluator is formed before simulate."""
+    model = tmp_path / "not_a_model.py"
+    model.write_text("def build():\n    return None\n")
+    assert main(["run", f"{model}:build", "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    assert "system: expected a System or a ConstrainedSystem" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
 def test_projeq_export_writes_paraview_files_of_a_saved_run(tmp_path, capsys):
     assert main(["run", "double_pendulum", "--t-end", "0.1", "--out", str(tmp_path), "--quiet"]) == 0
     npz = run_folder(tmp_path) / "double_pendulum.npz"
