@@ -1,0 +1,73 @@
+"""Bad input to projeq.analysis (linearize, eigenvalue_sweep) is refused by name where it enters.
+
+Each message is matched from its start, so that it begins with the parameter's name; the
+silently wrong answers (a NaN threshold that passed every state as steady) are shown against
+the state's own derivative.
+"""
+
+import numpy as np
+import pytest
+
+import projeq as pq
+from projeq.analysis.linearize import state_derivative
+
+ROD = {"m": 1.0, "r_c": (0, 0, -0.5), "I_c": np.diag([0.1, 0.1, 0.01])}
+
+
+def _pendulum():
+    """One rod on a revolute joint about y under gravity: equilibrium at q = 0 only."""
+    return pq.System({"bob": pq.RigidBody(**ROD)}, {"bob": pq.Revolute(axis="y")}, gravity=(0, 0, -9.81))
+
+
+@pytest.mark.parametrize("tol, problem", [
+    (np.nan, r"non-finite entries \(NaN or inf\)"),
+    (np.inf, r"non-finite entries \(NaN or inf\)"),
+    (-1e-8, "must be positive, got -1e-08"),
+    (0.0, "must be positive, got 0.0"),
+], ids=["nan", "inf", "negative", "zero"])
+def test_tol_must_be_a_positive_threshold(tol, problem):
+    """Passes if a threshold that is no threshold is refused by name. Before: tol = NaN (or
+    inf) passed the pendulum at q = 0.3 rad, where s̈ = −4.14 rad/s² (its own derivative, checked
+    here), as an equilibrium and returned A; a negative tol called the equilibrium q = 0 not steady."""
+    system = _pendulum()
+    assert abs(state_derivative(system, np.array([0.3, 0.0]), 0.0)[1]) > 4.0  # not an equilibrium
+    with pytest.raises(ValueError, match=f"^tol: {problem}"):
+        pq.linearize(system, [0.3], [0.0], tol=tol)
+    with pytest.raises(ValueError, match=f"^tol: {problem}"):
+        pq.linearize(system, [0.0], [0.0], tol=tol)
+
+
+def test_require_steady_must_be_a_bool():
+    """Passes if require_steady="no" (truthy: the checks ran) is refused by name."""
+    with pytest.raises(ValueError, match="^require_steady: expected True or False, got 'no'"):
+        pq.linearize(_pendulum(), [0.0], [0.0], require_steady="no")
+
+
+def test_inputs_as_one_string_is_not_its_letters():
+    """Passes if inputs="bob" is refused with the remedy; before, its letters 'b', 'o', 'b' were
+    taken as joint names ("each joint at most once, got ['b', 'o', 'b']"), and in a system with
+    joints 'a' and 'b' inputs="ab" would silently have meant both."""
+    with pytest.raises(ValueError, match=r"^inputs: expected a sequence of joint names, got the string 'bob' "
+                                         r"\(write \['bob'\]\)"):
+        pq.linearize(_pendulum(), [0.0], [0.0], inputs="bob")
+
+
+def test_ignore_must_be_a_sequence():
+    """Passes if ignore=0 (one index, not a sequence) is refused by name, not a bare
+    "TypeError: 'int' object is not iterable"."""
+    with pytest.raises(ValueError, match="^ignore: must be 'auto', None or a sequence of coordinates, got 0"):
+        pq.linearize(_pendulum(), [0.0], [0.0], ignore=0)
+
+
+@pytest.mark.parametrize("build, values, message", [
+    (lambda v: _pendulum(), 3.0, "^values: expected a sequence of parameter values, got 3.0"),
+    (lambda v: _pendulum(), "abc", "^values: expected a sequence of parameter values, got 'abc'"),
+    (_pendulum(), [1.0], r"^build: expected a callable build\(value\) returning a System, got System"),
+    (lambda v: (_pendulum(), [0.0]), [1.0],
+     r"^build: .*<lambda>\(1.0\) returned a tuple of 2; expected a System or \(system, q, s_dot\)"),
+], ids=["values-scalar", "values-string", "build-not-callable", "build-tuple-of-two"])
+def test_eigenvalue_sweep_arguments(build, values, message):
+    """Passes if each malformed sweep is refused by name; before: bare TypeErrors ('float' object
+    is not iterable, 'System' object is not callable) and "not enough values to unpack"."""
+    with pytest.raises(ValueError, match=message):
+        pq.eigenvalue_sweep(build, values)
