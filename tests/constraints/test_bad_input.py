@@ -203,3 +203,21 @@ def test_a_singular_pose_is_not_called_redundant(tree):
     with pytest.raises(ValueError, match=r"^q0: a singular pose of the constraints \(rank 0 of 1 at q0 = \[0.0, 0.0\], "
                                          r"full rank nearby\)"):
         ConstrainedSystem(tree, phi=lambda q, t: [q[0] * q[1]], q0=(0.0, 0.0))
+
+
+@pytest.mark.parametrize("cut", [
+    PinClosure(four_bar().tree, "coupler", (1.0, 0, 0), "rocker", (0.8, 0, 0), axes="yx"),
+    PinClosure(four_bar().tree, "coupler", (0.9, 0, 0), "rocker", (0.8, 0, 0), axes="xy"),
+], ids=["rows-swapped", "other-point"])
+def test_joint_reactions_with_cuts_that_are_not_phi(four_bar_pin, cut):
+    """Passes if a cut joint with Φ's row count but not Φ's rows (its axes in the other order,
+    or another point of the coupler) is refused. Before, each λ_i was applied along the wrong
+    axis: the crank joint (a revolute about z) transmitted a moment M_z = 17.0 N m about its
+    own free axis (its planar wrench (f_x, f_y, M_z)), which the Projection Equation makes zero
+    (with the right cut: 3e-15)."""
+    system, pin = four_bar_pin
+    right = joint_reactions(system, system.q0, [3.0], cuts={"pin": pin})
+    assert abs(right["crank"][2]) < 1e-13 * np.abs(right["pin"]).max()  # the reference: F_nᵀ W_n = 0
+    with pytest.raises(ValueError, match=r"^cuts: the cut joints \['pin'\] are not the system's Φ \(at q = .*"
+                                         r"give the closures Φ was built from, in the order of its rows"):
+        joint_reactions(system, system.q0, [3.0], cuts={"pin": cut})
