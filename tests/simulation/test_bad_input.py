@@ -1,0 +1,54 @@
+"""Bad input to projeq.sweep refused by name before any point runs, and a sweep's points
+written under their own columns (issue 20's standard: the parameter named, never a bare
+traceback nor a silently wrong table)."""
+
+import concurrent.futures as cf
+
+import numpy as np
+import pytest
+
+import projeq as pq
+from projeq.simulation.sweep import SweepTable
+
+
+def _sweep(**kwargs):
+    return pq.sweep("atwood", **{"outputs": ["t_reached"], "executor": cf.ThreadPoolExecutor(1), "t_end": 0.01,
+                                 "progress": False, **kwargs})
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"grid": {"m1": 2.0}}, r"^grid: m1 must be a sequence of values, got 2.0 \(write \[2.0\]\)"),
+    ({"grid": {"m1": "2.0"}}, r"^grid: m1 must be a sequence of values, got '2.0'"),
+    ({"samples": {"m1": 2.0}}, r"^samples: m1 must be a sequence of values, got 2.0"),
+    ({"samples": [{"m1": 1.0, "m2": 2.0}, {"m1": 3.0}]},
+     r"^samples\[1\]: sets the parameters \['m1'\], the first point \['m1', 'm2'\]; every point must set the same"),
+    ({"samples": [{"m1": 1.0}, {"m1": 3.0, "m2": 2.0}]},
+     r"^samples\[1\]: sets the parameters \['m1', 'm2'\], the first point \['m1'\]"),
+    ({"grid": {"m1": [1.0]}, "t_end": -1.0}, r"^t_end: must be after t_start = 0.0, got -1.0"),
+    ({"grid": {"m1": [1.0]}, "t_end": 0.5, "t_start": 1.0}, r"^t_end: must be after t_start = 1.0, got 0.5"),
+    ({"grid": {"m1": [1.0]}, "t_end": np.nan}, r"^t_end: non-finite entries"),
+    ({"grid": {"m1": [1.0]}, "t_end": "1 s"}, r"^t_end: expected numbers, got '1 s'"),
+], ids=["grid-scalar", "grid-string", "samples-scalar", "samples-missing-parameter", "samples-extra-parameter",
+        "t_end-negative", "t_end-before-t_start", "t_end-nan", "t_end-text"])
+def test_sweep_refuses_before_any_point_runs(kwargs, message):
+    """Passes if each is a ValueError naming the parameter. Before: bare TypeErrors ("object of
+    type 'float' has no len()"), a KeyError 'm2' after every point had run (a point without
+    m2), a table silently without the m2 column that point 2 ran with, a bare "could not
+    convert string to float", and a bad t_end failed every point alike, one by one."""
+    with pytest.raises(ValueError, match=message):
+        _sweep(**kwargs)
+
+
+def test_samples_in_another_key_order_are_logged_under_their_columns(tmp_path, monkeypatch):
+    """Passes if a sample that gives its parameters in another order ({m2, m1}) is appended to
+    path.csv under the right columns: the file a crash leaves (here: the final save fails) holds
+    m1 = 4, m2 = 3 for it, as given. Before, its line was written in the point's own order,
+    m1 = 3, m2 = 4 under the header m1, m2: a crash or a resume read the wrong masses."""
+    def crash(self, path):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(SweepTable, "save", crash)
+    with pytest.raises(OSError, match="disk full"):
+        _sweep(samples=[{"m1": 1.0, "m2": 2.0}, {"m2": 3.0, "m1": 4.0}], path=tmp_path / "run")
+    logged = SweepTable.load(tmp_path / "run")
+    assert logged["m1"].tolist() == [1.0, 4.0] and logged["m2"].tolist() == [2.0, 3.0]
