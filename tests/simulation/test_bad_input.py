@@ -52,3 +52,14 @@ def test_samples_in_another_key_order_are_logged_under_their_columns(tmp_path, m
         _sweep(samples=[{"m1": 1.0, "m2": 2.0}, {"m2": 3.0, "m1": 4.0}], path=tmp_path / "run")
     logged = SweepTable.load(tmp_path / "run")
     assert logged["m1"].tolist() == [1.0, 4.0] and logged["m2"].tolist() == [2.0, 3.0]
+
+
+@pytest.mark.xfail(strict=True, reason="projeq/simulation/driver.py (another engineer's file) checks simulate's "
+                   "options only inside simulate, privately (_check_options): a sweep learns of a misspelt option "
+                   "from every point failing alike; it needs a public check sweep can call at entry")
+def test_a_misspelt_simulate_option_is_refused_before_any_point_runs():
+    """Passes once sweep(..., rtoll=1e-6) raises the ValueError simulate raises for it ("options:
+    unknown option ['rtoll'] for method 'DOP853' ...") before running a point; now every point
+    fails with it (status −1) and the sweep itself returns normally."""
+    with pytest.raises(ValueError, match=r"^options: unknown option \['rtoll'\]"):
+        _sweep(grid={"m1": [1.0, 2.0]}, rtoll=1e-6)
