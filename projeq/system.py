@@ -418,6 +418,9 @@ class System(Model):
             raise ValueError(f"coupling: joint of {self.names[n]!r} must have one dof")
         idx, weights = [], []
         for other, ratio in joint.coupling.items():
+            if other not in self._index:
+                raise ValueError(f"coupling: {self.names[n]!r} follows {other!r}, which is not in the system; "
+                                 f"known subsystems are {list(self.names)}")
             m = self.index(other)
             if self.joints[m].coupling or self.joints[m].n_s != 1 or self.joints[m].n_q != 1:
                 raise ValueError(f"coupling: {self.names[n]!r} may follow only uncoupled one-dof joints, not {other!r}")

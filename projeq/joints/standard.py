@@ -262,10 +262,14 @@ def _label(motion) -> str:
 def _time_function(expr) -> Callable:
     t = sp.Symbol("t")
     try:
-        expr = sp.sympify(expr)
-    except (sp.SympifyError, SyntaxError, TypeError) as exc:
+        read = sp.sympify(expr)
+    except (sp.SympifyError, SyntaxError, TypeError):
+        read = None
+    if not isinstance(read, sp.Expr):
         raise ValueError(f"motion: cannot read {expr!r} as an expression in t (a sympy expression or "
-                         "a string such as '0.5*sin(2*t)'), or give a callable t -> (θ, θ̇, θ̈)") from exc
+                         "a string such as '0.5*sin(2*t)'), or give a callable t -> (θ, θ̇, θ̈)")
+    # the time under any assumptions (sp.Symbol("t", real=True)) is t
+    expr = read.xreplace({symbol: t for symbol in read.free_symbols if symbol.name == "t"})
     extra = expr.free_symbols - {t}
     if extra:
         raise ValueError(f"motion: depends on {sorted(map(str, extra))}; only t is allowed")
