@@ -615,3 +615,15 @@ def test_a_constraint_function_that_raises_late_fails_the_run_and_keeps_the_traj
     assert result.status == -1 and np.allclose(result.t, np.arange(0.0, t_kept + 0.05, 0.1))
     assert np.all(np.isfinite(result.q)) and result.constraint_residual.shape == (len(result.t), 1)
     assert isinstance(info.value.__cause__, (ValueError, RuntimeError))
+
+
+def test_a_joint_spring_needs_rates_equal_to_speeds_everywhere():
+    """Passes if a JointSpring on a planar joint is refused: its K(q) = diag(R(θ), 1) is E at
+    θ = 0 only, where the check looked, so −k (q − q_ref) was applied to the body-axis speeds ṡ
+    instead of Kᵀ ∇V. Before, a planar body on such a spring, started at rest at (0.5 m, 0, 1 rad),
+    gained and lost energy: max |E − E₀| = 6 % of E₀ = 6.25 J over 2 s at rtol 1e-10 (energy
+    conservation, the reference). On a revolute joint (K = E) the same law is accepted."""
+    spring = pq.JointSpring("b", 10.0)
+    with pytest.raises(ValueError, match="^joint: JointSpring needs q̇ = ṡ, which joint 'b' does not have"):
+        pq.System({"b": pq.PlanarBody(1.0, I_c=0.1)}, {"b": pq.Planar()}, forces=[spring])
+    assert _pendulum(forces=[pq.JointSpring("bob", 10.0)]).forces[0].stiffness == 10.0
