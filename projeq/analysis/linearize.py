@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.analysis.jacobians import differentiate, state_derivative, state_jacobian
+from projeq.analysis.jacobians import check_inputs, differentiate, state_derivative, state_jacobian
 from projeq.checks import callable_name, positive
 from projeq.system import check_model
 
@@ -135,7 +135,7 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
     q = system.q0 if q is None else q
     s_dot = system.s_dot0 if s_dot is None else s_dot
     q, s_dot = system.check_state(q, s_dot, t)
-    inputs = _check_inputs(system, inputs)
+    inputs = check_inputs(system, inputs)
     tol = positive("tol", tol)  # a NaN threshold would pass every state as steady
     if not isinstance(require_steady, (bool, np.bool_)):
         raise ValueError(f"require_steady: expected True or False, got {require_steady!r}")
@@ -152,19 +152,6 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
     B = differentiate(lambda u: state_derivative(system, x0, t, u, inputs), np.zeros(n_u), derivatives)[0]
     return Linearization(A[np.ix_(kept, kept)], B[kept], [names[i] for i in kept],
                          [names[i] for i in dropped], inputs)
-
-
-def _check_inputs(system, inputs) -> tuple:
-    if isinstance(inputs, str):  # iterated, a name would be its letters
-        raise ValueError(f"inputs: expected a sequence of joint names, got the string {inputs!r} "
-                         f"(write [{inputs!r}])")
-    inputs = tuple(inputs or ())
-    if len(set(inputs)) != len(inputs):
-        raise ValueError(f"inputs: each joint at most once, got {list(inputs)}")
-    for name in inputs:
-        if name not in system.names:
-            raise ValueError(f"inputs: unknown joint {name!r}; the system has {list(system.names)}")
-    return inputs
 
 
 def _dropped(system, names: list[str], A: NDArray, ignore, tol: float) -> list[int]:

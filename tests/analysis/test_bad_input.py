@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import projeq as pq
+from projeq.analysis.jacobians import state_jacobians
 from projeq.analysis.linearize import state_derivative
 
 ROD = {"m": 1.0, "r_c": (0, 0, -0.5), "I_c": np.diag([0.1, 0.1, 0.01])}
@@ -71,3 +72,22 @@ def test_eigenvalue_sweep_arguments(build, values, message):
     is not iterable, 'System' object is not callable) and "not enough values to unpack"."""
     with pytest.raises(ValueError, match=message):
         pq.eigenvalue_sweep(build, values)
+
+
+@pytest.mark.parametrize("inputs, message", [
+    (["ghost"], r"^inputs: unknown joint 'ghost'; the system has \['bob'\]"),
+    ("bob", r"^inputs: expected a sequence of joint names, got the string 'bob'"),
+], ids=["unknown", "string"])
+def test_state_jacobians_name_their_inputs(inputs, message):
+    """Passes if projeq.analysis.jacobians.state_jacobians refuses the inputs linearize refuses,
+    by the same words (before: "name: unknown subsystem 'ghost'" and, for "bob", "name: unknown
+    subsystem 'b'", the parameter of System.index)."""
+    with pytest.raises(ValueError, match=message):
+        state_jacobians(_pendulum(), [0.0], [0.0], inputs=inputs)
+
+
+def test_state_jacobians_of_a_name_is_refused():
+    """Passes if a scene's name instead of a model is refused by name (before: AttributeError
+    "'str' object has no attribute 'check_state'")."""
+    with pytest.raises(ValueError, match="^system: expected a System or a ConstrainedSystem"):
+        state_jacobians("chain", [0.0], [0.0])
