@@ -341,7 +341,7 @@ class System(Model):
         self._layout_coordinates()
         self.named_coordinates = _named_coordinates(self)  # ((name, unit) of q, of ṡ): coordinates()
         self.coupled = any(j.coupling for j in self.joints)
-        self.forces = tuple(copy.copy(f).bind(self) for f in _check_forces(forces))
+        self.forces = tuple(_bound(i, f, self) for i, f in enumerate(_check_forces(forces)))
         if isinstance(q0, dict):  # by name, the rest at the joints' defaults
             q0 = _set_by_name("q0", self._default_q(), self.named_coordinates[0], q0)
         if isinstance(s_dot0, dict):
@@ -695,6 +695,16 @@ def _check_forces(forces) -> tuple:
         if not all(hasattr(f, a) for a in ("bind", "add_to", "potential")):
             raise ValueError(f"forces[{i}]: {f!r} is not a force law (needs bind, add_to, potential)")
     return forces
+
+
+def _bound(i: int, law, system) -> object:
+    """A copy of force law ``law`` bound to ``system``: what its ``bind`` returns, which the
+    contract (:class:`projeq.forces.ForceLaw`) makes the law itself."""
+    bound = copy.copy(law).bind(system)
+    if not all(hasattr(bound, a) for a in ("add_to", "potential")):
+        raise ValueError(f"forces[{i}]: {type(law).__name__}.bind returned {bound!r}, not the bound law; "
+                         "end bind with `return self`")
+    return bound
 
 
 def _cycle(joints: dict, start: str) -> list[str]:

@@ -627,3 +627,22 @@ def test_a_joint_spring_needs_rates_equal_to_speeds_everywhere():
     with pytest.raises(ValueError, match="^joint: JointSpring needs q̇ = ṡ, which joint 'b' does not have"):
         pq.System({"b": pq.PlanarBody(1.0, I_c=0.1)}, {"b": pq.Planar()}, forces=[spring])
     assert _pendulum(forces=[pq.JointSpring("bob", 10.0)]).forces[0].stiffness == 10.0
+
+
+class _DragWithoutReturn(pq.ForceLaw):
+    """A user's law whose bind forgets ``return self`` (the contract: bind returns the law)."""
+
+    def bind(self, system):
+        self.n = system.index("bob")
+
+    def add_to(self, h, kin, t, q, s_dot):
+        h[self.n][3:] -= 0.1 * kin.twist[self.n][3:]
+
+
+def test_a_force_law_whose_bind_returns_nothing_is_named():
+    """Passes if the System names the law and the remedy when its bind returns None; before, None
+    was kept as the bound law and every evaluation failed deep inside with "AttributeError:
+    'NoneType' object has no attribute 'compiled_terms'"."""
+    with pytest.raises(ValueError, match=r"^forces\[0\]: _DragWithoutReturn.bind returned None, not the bound law; "
+                                         r"end bind with `return self`"):
+        _pendulum(forces=[_DragWithoutReturn()])
