@@ -63,3 +63,38 @@ def test_a_misspelt_simulate_option_is_refused_before_any_point_runs():
     fails with it (status −1) and the sweep itself returns normally."""
     with pytest.raises(ValueError, match=r"^options: unknown option \['rtoll'\]"):
         _sweep(grid={"m1": [1.0, 2.0]}, rtoll=1e-6)
+
+
+def _result(n_t=3):
+    """A Result of n_t rows of a cart (x in m) carrying a pendulum (angle in rad)."""
+    t = np.linspace(0.0, 1.0, n_t)
+    return pq.Result(t=t, q=np.column_stack((t, 0.5 * t)), s_dot=np.ones((n_t, 2)), kinetic=np.ones(n_t),
+                     potential=np.zeros(n_t), constraint_residual=np.zeros((n_t, 0)),
+                     coordinates=(("cart.x", "m"), ("bob.angle", "rad")),
+                     velocities=(("cart.x_dot", "m/s"), ("bob.angle_dot", "rad/s")))
+
+
+def test_planar_trajectory_labels_its_axes_by_the_columns_units():
+    """Passes if the path of (cart.x, bob.angle) has the axes "cart.x (m)" and "bob.angle (rad)",
+    the result's own names and units; before, every axis read "q<i> (m)": an angle in metres."""
+    from projeq import plots
+
+    ax = plots.planar_trajectory(_result(), 0, 1).axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("cart.x (m)", "bob.angle (rad)")
+
+
+@pytest.mark.parametrize("draw, message", [
+    (lambda plots, r: plots.time_history(r, names=["x"]),
+     r"^names: expected 2 labels, one per column of q \(\['cart.x \(m\)', 'bob.angle \(rad\)'\]\), got \['x'\]"),
+    (lambda plots, r: plots.planar_trajectory(r, 0, 2), r"^y: expected a column of q, 0 … 1 .*got 2"),
+    (lambda plots, r: plots.drift(_result(0)), r"^result: has no output rows \(status 0"),
+    (lambda plots, r: plots.planar_trajectory(_result(0)), r"^result: has no output rows"),
+], ids=["time_history-too-few-names", "planar_trajectory-column", "drift-empty", "planar_trajectory-empty"])
+def test_plots_refuse_by_name(draw, message):
+    """Passes if each is a ValueError naming the parameter. Before: names=["x"] for two columns
+    silently drew only q0 (labels are taken by position), a column beyond q an IndexError, and an
+    empty run (one stopped in its first segment) "index 0 is out of bounds"."""
+    from projeq import plots
+
+    with pytest.raises(ValueError, match=message):
+        draw(plots, _result())
