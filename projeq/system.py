@@ -535,6 +535,7 @@ class System(Model):
 
     def K(self, q: NDArray, t: float = 0.0) -> NDArray:
         """K(q) of q̇ = K ṡ + k (block-diagonal over the joints)."""
+        q = np.asarray(q)  # a list's result_type would be read as a structured dtype
         K = np.zeros((self.n_q, self.n_s), dtype=np.result_type(q, float))
         for n, j in enumerate(self.joints):
             if not j.coupling:
@@ -572,7 +573,7 @@ class System(Model):
     def generalized_force(self, q, t: float, joint_forces: dict) -> NDArray:
         """Q with Q[columns] = Σ_j P_jᵀ τ_j, ṡ_j = P_j ṡ[columns] (:meth:`joint_s_columns`:
         a coupled joint's τ acts on the velocities it follows)."""
-        Q = np.zeros(self.n_s, dtype=np.result_type(float, *joint_forces.values()))  # complex in a complex step
+        Q = np.zeros(self.n_s, dtype=np.result_type(float, *map(np.asarray, joint_forces.values())))  # complex step
         for name, tau in joint_forces.items():
             n = self.index(name)
             cols, P = self.joint_s_columns(n)

@@ -646,3 +646,12 @@ def test_a_force_law_whose_bind_returns_nothing_is_named():
     with pytest.raises(ValueError, match=r"^forces\[0\]: _DragWithoutReturn.bind returned None, not the bound law; "
                                          r"end bind with `return self`"):
         _pendulum(forces=[_DragWithoutReturn()])
+
+
+def test_system_K_and_generalized_force_take_plain_lists():
+    """Passes if K and generalized_force accept q and τ as lists, like every other System method:
+    a revolute joint's K = E, and τ on its one velocity is Q = τ. Before, numpy read the list in
+    np.result_type as a structured dtype: "TypeError: Field elements must be 2- or 3-tuples, got '0.3'"."""
+    system = _pendulum()
+    assert system.K([0.3]).tolist() == [[1.0]]
+    assert system.generalized_force([0.3], 0.0, {"bob": [2.5]}).tolist() == [2.5]
