@@ -32,6 +32,12 @@ GROUND = -1
 _GROUND_S = np.zeros((0, 6))
 
 
+#: |Φ(q, t)| / max(1, |q|) up to which the analyses (linearize, state_jacobians, joint_reactions)
+#: take q as on a model's loop closures (Model.check_closed): far above the drift of a stabilised
+#: run (the four-bar with Baumgarte's correction: 8.8e-9 over 5 s), far below a loop left open
+CLOSED = 1e-6
+
+
 class Model(ABC):
     """What :func:`projeq.simulate`, :func:`projeq.linearize`, the reactions
     (:mod:`projeq.constraints.reactions`) and the ParaView export ask of a model, and all
@@ -91,6 +97,10 @@ class Model(ABC):
     @abstractmethod
     def check_configuration(self, q: NDArray, t: float = 0.0) -> None:
         """ValueError naming what makes (q, t) singular (a joint's K or F, a partition)."""
+
+    def check_closed(self, name: str, q: NDArray, t: float = 0.0, tol: float = 1e-9) -> None:
+        """ValueError naming ``name`` if q violates the model's constraint equations Φ(q, t) = 0
+        by more than ``tol`` relative (a tree has none)."""
 
     # -- names ----------------------------------------------------------------------------
     @abstractmethod

@@ -44,7 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import exact_jacobian, jacobian, raised_by, warn_differences
-from projeq.system import check_model
+from projeq.system import CLOSED, check_model
 
 DERIVATIVES = ("exact", "differences")
 
@@ -129,6 +129,7 @@ def state_jacobians(system, q: NDArray, s_dot: NDArray, t: float = 0.0, inputs=(
     whose generalized forces τ are differentiated for (∂s̈/∂τ, zero columns without)."""
     check_model(system)
     q, s_dot = system.check_state(q, s_dot, t)
+    system.check_closed("q", q, t, CLOSED)
     inputs = check_inputs(system, inputs)
     x0 = np.concatenate((q, s_dot))
     J, used = state_jacobian(system, x0, t, derivatives)

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 from projeq.analysis.jacobians import check_inputs, differentiate, state_derivative, state_jacobian
 from projeq.checks import callable_name, positive
-from projeq.system import check_model
+from projeq.system import CLOSED, check_model
 
 _TOL = 1e-8  # relative threshold: zero columns of A, and the steady-motion residual
 
@@ -130,11 +130,15 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
     NotSteadyError
         If the kept states' derivative at (q, ṡ) exceeds ``tol`` (relative to the largest
         entry of ẋ and 1): neither an equilibrium nor a steady motion.
+    ValueError
+        If q does not close a ConstrainedSystem's loops (|Φ(q, t)| above
+        :data:`projeq.system.CLOSED` relative): no state of the mechanism.
     """
     check_model(system)
     q = system.q0 if q is None else q
     s_dot = system.s_dot0 if s_dot is None else s_dot
     q, s_dot = system.check_state(q, s_dot, t)
+    system.check_closed("q", q, t, CLOSED)  # off Φ = 0 the Jacobians describe no motion of the mechanism
     inputs = check_inputs(system, inputs)
     tol = positive("tol", tol)  # a NaN threshold would pass every state as steady
     if not isinstance(require_steady, (bool, np.bool_)):

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.assembly.kinematics import forward, gauss_terms
-from projeq.system import check_model
+from projeq.system import CLOSED, check_model
 
 
 def reactions(system, result) -> NDArray:
@@ -79,6 +79,7 @@ def joint_reactions(system, q, s_dot, t: float = 0.0, cuts=None) -> dict:
     """
     check_model(system)
     q, s_dot = system.check_state(q, s_dot, t)
+    system.check_closed("q", q, t, CLOSED)
     tree, cuts = system.tree, (_check_cuts(system, cuts, q, t) if system.n_lambda else {})
     s_ddot_tree, lam = system.accelerations_tree(q, s_dot, t)
     s_dot_tree = system.tree_velocities(q, s_dot, t)
