@@ -276,6 +276,23 @@ def _points(grid, samples) -> list[dict]:
     return [_same_parameters(i, p, list(points[0])) for i, p in enumerate(points)]
 
 
+def _outputs(outputs, point: dict) -> list:
+    """The outputs as a list of distinct names, none a parameter's: the table has one column per
+    name, so a parameter q0 and the output q0 (the final q[0]) would share it."""
+    if isinstance(outputs, str):
+        raise ValueError(f"outputs: expected a sequence of output names, got the string {outputs!r} "
+                         f"(write [{outputs!r}])")
+    outputs = list(outputs)
+    repeated = sorted({name for name in outputs if outputs.count(name) > 1})
+    if repeated:
+        raise ValueError(f"outputs: {repeated} asked for more than once; the table has one column per name")
+    clash = [name for name in outputs if name in point]
+    if clash:
+        raise ValueError(f"outputs: {clash} are parameters of the sweep too; the table has one column per name "
+                         "(ask for a final coordinate by its name, subsystem.coordinate)")
+    return outputs
+
+
 def _end_time(t_end, t_start) -> float:
     """``t_end`` checked once for all points (else each point would fail alike)."""
     t_end = float(finite_array("t_end", t_end, ()))
@@ -382,7 +399,7 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     points = _points(grid, samples)
     for p in points:
         check_names(scene, p)
-    outputs = list(outputs)
+    outputs = _outputs(outputs, points[0])
     named = [name for name in outputs if _column(name) is not None and _column(name)[0] == "named"]
     if named:  # checked on the model of the first point, before any run
         model = scene.build(**points[0])

@@ -107,3 +107,18 @@ def test_simulate_refuses_n_points_beside_t_eval():
     run returns the 3 rows of t_eval and the 50 asked for are dropped without a word."""
     with pytest.raises(ValueError, match=r"^n_points, t_eval: "):
         pq.simulate(pq.scenes.chain(2), 1.0, t_eval=[0.0, 0.5, 1.0], n_points=50)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"grid": {"n": [1], "q0": [(0.1,), (0.2,)]}, "outputs": ["q0"]},
+     r"^outputs: \['q0'\] are parameters of the sweep too; the table has one column per name"),
+    ({"grid": {"n": [1]}, "outputs": ["q0", "q0"]}, r"^outputs: \['q0'\] asked for more than once"),
+    ({"grid": {"n": [1]}, "outputs": "q0"}, r"^outputs: expected a sequence of output names, got the string 'q0'"),
+], ids=["output-named-like-a-parameter", "output-twice", "outputs-string"])
+def test_sweep_outputs_have_columns_of_their_own(kwargs, message):
+    """Passes if each is refused by name before any point runs. Before, chain's parameter q0
+    (the initial angle, (0.1,) and (0.2,)) and the output q0 (the final q[0]) shared one column:
+    the table held −0.034 and −0.067 under q0 and no longer said which initial angle each row
+    had; a repeated output wrote the header q0 twice; outputs="q0" was read letter by letter."""
+    with pytest.raises(ValueError, match=message):
+        pq.sweep("chain", **{"executor": cf.ThreadPoolExecutor(1), "t_end": 0.01, "progress": False, **kwargs})
