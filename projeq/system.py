@@ -167,9 +167,14 @@ class Model(ABC):
         >>> q0.tolist(), s_dot0.tolist()
         ([0.3, 0.0], [0.0, -1.0])
         """
-        q_values = dict(q or {}) | by_subsystem
-        return (_set_by_name("q", np.array(self.q0, dtype=float), self.coordinates(), q_values),
-                _set_by_name("s_dot", np.array(self.s_dot0, dtype=float), self.velocities(), dict(s_dot or {})))
+        q_values, s_values = _by_name("q", q), _by_name("s_dot", s_dot)
+        twice = sorted(set(q_values) & set(by_subsystem))
+        if twice:
+            raise ValueError(f"q: {twice} set both in q and by keyword; give each once")
+        state = (_set_by_name("q", np.array(self.q0, dtype=float), self.coordinates(), q_values | by_subsystem),
+                 _set_by_name("s_dot", np.array(self.s_dot0, dtype=float), self.velocities(), s_values))
+        self.check_closed("q", state[0])
+        return state
 
     # -- kinematics -----------------------------------------------------------------------
     @abstractmethod
@@ -260,6 +265,16 @@ def _index_by_name(kind: str, named: tuple, key: str):
     """An entry's index, or the slice of a subsystem's entries (:func:`_rows_by_name`)."""
     rows = _rows_by_name(kind, named, key)
     return rows[0] if named[rows[0]][0] == key else slice(rows[0], rows[-1] + 1)
+
+
+def _by_name(kind: str, values) -> dict:
+    """{name: value} of :meth:`Model.state`'s ``q`` or ``s_dot`` (None: none)."""
+    if values is None:
+        return {}
+    if not isinstance(values, dict):
+        raise ValueError(f"{kind}: expected a dict {{name: value}} of the entries to set, got {values!r} "
+                         f"(a whole {kind} goes to simulate as is)")
+    return dict(values)
 
 
 def _set_by_name(kind: str, vector: NDArray, named: tuple, values: dict) -> NDArray:

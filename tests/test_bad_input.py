@@ -655,3 +655,21 @@ def test_system_K_and_generalized_force_take_plain_lists():
     system = _pendulum()
     assert system.K([0.3]).tolist() == [[1.0]]
     assert system.generalized_force([0.3], 0.0, {"bob": [2.5]}).tolist() == [2.5]
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: pq.scenes.double_pendulum().state(q=[0.1, 0.2]),
+     r"^q: expected a dict \{name: value\} of the entries to set, got \[0.1, 0.2\]"),
+    (lambda: pq.scenes.double_pendulum().state(q={"bob1": 0.1}, bob1=0.5),
+     r"^q: \['bob1'\] set both in q and by keyword; give each once"),
+    (lambda: pq.scenes.four_bar().state(crank=0.6),
+     r"^q: violates the loop closures Φ\(q\) = \[-0.0849  0.0976\]; give a consistent q"),
+], ids=["q-a-list", "set-twice", "open-loop"])
+def test_model_state_refuses_what_it_cannot_mean(call, message):
+    """Passes if each is a ValueError naming q. Before: a list was "TypeError: cannot convert
+    dictionary update sequence element #0 to a sequence"; q={"bob1": 0.1} beside bob1=0.5 took 0.5
+    without a word; and the four-bar's state(crank=0.6), documented to have to close its loop,
+    returned the open loop (|Φ| = 0.1 m), which simulate then moved onto Φ = 0 by minimum norm,
+    starting the run at crank = 0.535, not 0.6 (ConstrainedSystem.project, the reference)."""
+    with pytest.raises(ValueError, match=message):
+        call()
