@@ -89,9 +89,10 @@ class Result:
     @property
     def energy_drift(self) -> float:
         """max |E(t) − E(t₀)| relative to the largest kinetic or potential energy of the run
-        (a scale that stays meaningful when E(t₀) = 0)."""
+        (a scale that stays meaningful when E(t₀) = 0); NaN for a run without output rows (one
+        stopped in its first segment), which conserved nothing: a check ``drift < tol`` fails."""
         if len(self.t) == 0:
-            return 0.0
+            return float("nan")
         scale = max(np.abs(self.kinetic).max(), np.abs(self.potential).max(), 1e-300)
         return float(np.abs(self.energy - self.energy[0]).max() / scale)
 

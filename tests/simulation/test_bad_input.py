@@ -122,3 +122,16 @@ def test_sweep_outputs_have_columns_of_their_own(kwargs, message):
     had; a repeated output wrote the header q0 twice; outputs="q0" was read letter by letter."""
     with pytest.raises(ValueError, match=message):
         pq.sweep("chain", **{"executor": cf.ThreadPoolExecutor(1), "t_end": 0.01, "progress": False, **kwargs})
+
+
+def test_the_energy_drift_of_a_run_without_rows_is_nan():
+    """Passes if a Result without output rows (a run stopped in its first segment) has
+    energy_drift NaN, as the sweep's output of it (output_value), so that a check
+    ``energy_drift < 1e-8`` fails. Before it was 0.0: perfect conservation claimed for a run that
+    computed nothing, and such checks passed."""
+    from projeq.simulation.sweep import output_value
+
+    empty = _result(0)
+    assert np.isnan(output_value(empty, "energy_drift"))  # the reference: the sweep's own word
+    assert np.isnan(empty.energy_drift) and not empty.energy_drift < 1e-8
+    assert _result(3).energy_drift == 0.0  # kinetic 1, potential 0 throughout
