@@ -130,6 +130,7 @@ def state_jacobians(system, q: NDArray, s_dot: NDArray, t: float = 0.0, inputs=(
     check_model(system)
     q, s_dot = system.check_state(q, s_dot, t)
     system.check_closed("q", q, t, CLOSED)
+    system.check_configuration(q, t)
     inputs = check_inputs(system, inputs)
     x0 = np.concatenate((q, s_dot))
     J, used = state_jacobian(system, x0, t, derivatives)

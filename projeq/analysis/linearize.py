@@ -132,13 +132,15 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
         entry of ẋ and 1): neither an equilibrium nor a steady motion.
     ValueError
         If q does not close a ConstrainedSystem's loops (|Φ(q, t)| above
-        :data:`projeq.system.CLOSED` relative): no state of the mechanism.
+        :data:`projeq.system.CLOSED` relative): no state of the mechanism; or if q is a
+        coordinate singularity (``check_configuration``: a joint's K or F loses rank).
     """
     check_model(system)
     q = system.q0 if q is None else q
     s_dot = system.s_dot0 if s_dot is None else s_dot
     q, s_dot = system.check_state(q, s_dot, t)
     system.check_closed("q", q, t, CLOSED)  # off Φ = 0 the Jacobians describe no motion of the mechanism
+    system.check_configuration(q, t)  # at a coordinate singularity A would hold K's 1/cos(π/2) ≈ 1e16
     inputs = check_inputs(system, inputs)
     tol = positive("tol", tol)  # a NaN threshold would pass every state as steady
     if not isinstance(require_steady, (bool, np.bool_)):

@@ -91,3 +91,19 @@ def test_state_jacobians_of_a_name_is_refused():
     "'str' object has no attribute 'check_state'")."""
     with pytest.raises(ValueError, match="^system: expected a System or a ConstrainedSystem"):
         state_jacobians("chain", [0.0], [0.0])
+
+
+@pytest.mark.parametrize("jacobians", [
+    lambda system, q, s_dot: pq.linearize(system, q, s_dot, require_steady=False, ignore=None),
+    lambda system, q, s_dot: state_jacobians(system, q, s_dot),
+], ids=["linearize", "state_jacobians"])
+def test_jacobians_at_a_coordinate_singularity_are_refused(jacobians):
+    """Passes if Barhorst's rolling disk at the tilt q2 = π/2, where his Euler angles degenerate
+    (K(q) holds sec q2, Barhorst §3.2, eq. 96), is refused as simulate refuses it, naming K and
+    the joint. Before, linearize returned A with entries of −2.4e14 (sec(π/2) in floating point,
+    1.6e16, times R = 0.015 m): numbers, not a linearisation."""
+    system = pq.scenes.rolling_disk(m_ecc=0.0)
+    flat = np.array([0.0, np.pi / 2, 0.0, 0.0, 0.0])
+    assert abs(1.0 / np.cos(flat[1])) > 1e15  # the reference: sec q2 at the singularity
+    with pytest.raises(ValueError, match=r"^K\(q\) of q̇ = K ṡ loses rank .* for the joint of 'disk'"):
+        jacobians(system, flat, [0.0, 20.0, 0.0])
