@@ -357,6 +357,9 @@ class JointSpring(JointForce):
         self.index = n = _index(system, self.joint, "joint")
         self.parent = system.parent[n]
         joint = system.joints[n]
+        if not joint.n_s:
+            raise ValueError(f"joint: joint {self.joint!r} ({type(joint).__name__}) has no coordinates of its own; "
+                             "a JointSpring on it would act on nothing")
         if not _rates_are_speeds(joint):
             raise ValueError(f"joint: JointSpring needs q̇ = ṡ, which joint {self.joint!r} does not have")
         self.n_s = joint.n_s

@@ -673,3 +673,14 @@ def test_model_state_refuses_what_it_cannot_mean(call, message):
     starting the run at crank = 0.535, not 0.6 (ConstrainedSystem.project, the reference)."""
     with pytest.raises(ValueError, match=message):
         call()
+
+
+@pytest.mark.parametrize("joint", [pq.Fixed(), pq.Prescribed(pq.Revolute(axis="y"), "sin(t)")], ids=["Fixed", "Prescribed"])
+def test_a_joint_spring_on_a_joint_without_coordinates_is_refused(joint):
+    """Passes if a JointSpring (k = 100 N m/rad) on a fixed or prescribed joint, which has no
+    coordinate for it to act on, is refused by name; before, it was accepted and did nothing
+    (its τ had n_s = 0 entries)."""
+    with pytest.raises(ValueError, match=rf"^joint: joint 'b' \({type(joint).__name__}\) has no coordinates of its "
+                                         r"own; a JointSpring on it would act on nothing"):
+        pq.System({"a": pq.RigidBody(**ROD), "b": pq.RigidBody(**ROD)}, {"a": pq.Revolute(axis="x"), "b": joint},
+                  forces=[pq.JointSpring("b", 100.0)])
