@@ -77,3 +77,10 @@ def test_prescribed_motion_in_a_real_time_symbol():
     t = sp.Symbol("t", real=True)
     angles = pq.Prescribed(pq.Revolute(axis="z"), sp.sin(2 * t)).angles(0.3)
     assert angles == pytest.approx((np.sin(0.6), 2 * np.cos(0.6), -4 * np.sin(0.6)), rel=1e-15)
+
+
+def test_a_coupling_ratio_of_zero_is_refused():
+    """Passes if a gear coupled with ratio 0 (its coordinate 0 · q_a ≡ 0: welded, following
+    nothing) is refused by name; before, it was accepted as a joint that never moves."""
+    with pytest.raises(ValueError, match=r"^coupling\['a'\]: a ratio of 0 couples nothing, got 0.0"):
+        pq.Revolute(axis="y", coupling={"a": 0.0})
