@@ -137,7 +137,10 @@ class Result:
     def load(cls, path) -> "Result":
         """Read a Result written by :meth:`save` (without dense output). ValueError saying what
         the file is and what is wrong when it is not one: not an .npz archive (random or
-        truncated bytes), an archive without a Result's arrays, or arrays whose lengths differ."""
+        truncated bytes), an archive without a Result's arrays, or arrays whose lengths differ.
+        A name without ``.npz`` is read as :meth:`save` wrote it, with the suffix appended."""
+        if isinstance(path, (str, Path)) and Path(path).suffix != ".npz" and not Path(path).exists():
+            path = Path(path).with_name(Path(path).name + ".npz")  # save's name for it
         try:
             with np.load(path, allow_pickle=False) as data:
                 meta, events, arrays = _read(data, path)

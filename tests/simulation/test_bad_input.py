@@ -135,3 +135,13 @@ def test_the_energy_drift_of_a_run_without_rows_is_nan():
     assert np.isnan(output_value(empty, "energy_drift"))  # the reference: the sweep's own word
     assert np.isnan(empty.energy_drift) and not empty.energy_drift < 1e-8
     assert _result(3).energy_drift == 0.0  # kinetic 1, potential 0 throughout
+
+
+def test_a_result_loads_under_the_name_it_was_saved_with(tmp_path):
+    """Passes if Result.save("run") — which writes run.npz, as numpy does — and
+    Result.load("run") round-trip (the arrays equal); before, load looked for "run" itself:
+    FileNotFoundError for the name just given to save."""
+    result = _result(3)
+    result.save(tmp_path / "run")
+    loaded = pq.Result.load(tmp_path / "run")
+    assert np.array_equal(loaded.q, result.q) and loaded.coordinates == result.coordinates
