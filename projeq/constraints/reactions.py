@@ -75,7 +75,8 @@ def joint_reactions(system, q, s_dot, t: float = 0.0, cuts=None) -> dict:
     {name: :class:`~projeq.constraints.cut_joints.PinClosure`} of the cut joints whose closures make up
     its Φ, in the order of Φ's rows (ValueError if, stacked, they are not Φ); their multipliers
     λ are the cut joints' forces, applied as the wrenches w_n, and the result also holds, under
-    each cut's name, the wrench of the cut joint on its subsystem a. For a tree System (no multipliers) ``cuts`` is not used (w_n = 0).
+    each cut's name, the wrench of the cut joint on its subsystem a. For a tree System (no
+    multipliers) ``cuts`` is not used (w_n = 0). q must close the loops (:data:`projeq.system.CLOSED`).
     """
     check_model(system)
     q, s_dot = system.check_state(q, s_dot, t)
