@@ -357,7 +357,10 @@ class JointSpring(JointForce):
         self.index = n = _index(system, self.joint, "joint")
         self.parent = system.parent[n]
         joint = system.joints[n]
-        if joint.n_q != joint.n_s or not np.allclose(joint.K(joint.default_q(), 0.0), np.eye(joint.n_q)):
+        if not joint.n_s:
+            raise ValueError(f"joint: joint {self.joint!r} ({type(joint).__name__}) has no coordinates of its own; "
+                             "a JointSpring on it would act on nothing")
+        if not _rates_are_speeds(joint):
             raise ValueError(f"joint: JointSpring needs q̇ = ṡ, which joint {self.joint!r} does not have")
         self.n_s = joint.n_s
         q_ref = finite_array("q_ref", self.q_ref)
@@ -388,6 +391,16 @@ class JointSpring(JointForce):
     def potential(self, kin, q) -> float:
         dq = self._q(q) - self._q_ref
         return 0.5 * self.stiffness * (dq @ dq)
+
+
+def _rates_are_speeds(joint) -> bool:
+    """Whether q̇ = ṡ (K = E) at the joint's reference q and away from it (q + 0.7, every
+    coordinate moved): a planar joint's K = diag(R(θ), 1) is E at θ = 0 only, and −k (q − q_ref)
+    on its ṡ would not be the force of the potential ½ k |q − q_ref|²."""
+    if joint.n_q != joint.n_s:
+        return False
+    q_ref = joint.default_q()
+    return all(np.allclose(joint.K(joint.normalized(q), 0.0), np.eye(joint.n_q)) for q in (q_ref, q_ref + 0.7))
 
 
 class SpringDamper(ForceLaw):

@@ -32,6 +32,12 @@ GROUND = -1
 _GROUND_S = np.zeros((0, 6))
 
 
+#: |Φ(q, t)| / max(1, |q|) up to which the analyses (linearize, state_jacobians, joint_reactions)
+#: take q as on a model's loop closures (Model.check_closed): far above the drift of a stabilised
+#: run (the four-bar with Baumgarte's correction: 8.8e-9 over 5 s), far below a loop left open
+CLOSED = 1e-6
+
+
 class Model(ABC):
     """What :func:`projeq.simulate`, :func:`projeq.linearize`, the reactions
     (:mod:`projeq.constraints.reactions`) and the ParaView export ask of a model, and all
@@ -92,6 +98,10 @@ class Model(ABC):
     @abstractmethod
     def check_configuration(self, q: NDArray, t: float = 0.0) -> None:
         """ValueError naming what makes (q, t) singular (a joint's K or F, a partition)."""
+
+    def check_closed(self, name: str, q: NDArray, t: float = 0.0, tol: float = 1e-9) -> None:
+        """ValueError naming ``name`` if q violates the model's constraint equations Φ(q, t) = 0
+        by more than ``tol`` relative (a tree has none)."""
 
     # -- names ----------------------------------------------------------------------------
     @abstractmethod
@@ -158,9 +168,14 @@ class Model(ABC):
         >>> q0.tolist(), s_dot0.tolist()
         ([0.3, 0.0], [0.0, -1.0])
         """
-        q_values = dict(q or {}) | by_subsystem
-        return (_set_by_name("q", np.array(self.q0, dtype=float), self.coordinates(), q_values),
-                _set_by_name("s_dot", np.array(self.s_dot0, dtype=float), self.velocities(), dict(s_dot or {})))
+        q_values, s_values = _by_name("q", q), _by_name("s_dot", s_dot)
+        twice = sorted(set(q_values) & set(by_subsystem))
+        if twice:
+            raise ValueError(f"q: {twice} set both in q and by keyword; give each once")
+        state = (_set_by_name("q", np.array(self.q0, dtype=float), self.coordinates(), q_values | by_subsystem),
+                 _set_by_name("s_dot", np.array(self.s_dot0, dtype=float), self.velocities(), s_values))
+        self.check_closed("q", state[0])
+        return state
 
     # -- kinematics -----------------------------------------------------------------------
     @abstractmethod
@@ -253,6 +268,16 @@ def _index_by_name(kind: str, named: tuple, key: str):
     return rows[0] if named[rows[0]][0] == key else slice(rows[0], rows[-1] + 1)
 
 
+def _by_name(kind: str, values) -> dict:
+    """{name: value} of :meth:`Model.state`'s ``q`` or ``s_dot`` (None: none)."""
+    if values is None:
+        return {}
+    if not isinstance(values, dict):
+        raise ValueError(f"{kind}: expected a dict {{name: value}} of the entries to set, got {values!r} "
+                         f"(a whole {kind} goes to simulate as is)")
+    return dict(values)
+
+
 def _set_by_name(kind: str, vector: NDArray, named: tuple, values: dict) -> NDArray:
     """``vector`` with the entries named in ``values`` (by full name, or by subsystem: all of
     its entries) replaced; ValueError for an unknown name or a wrong number of values."""
@@ -342,7 +367,7 @@ class System(Model):
         self._layout_coordinates()
         self.named_coordinates = _named_coordinates(self)  # ((name, unit) of q, of ṡ): coordinates()
         self.coupled = any(j.coupling for j in self.joints)
-        self.forces = tuple(copy.copy(f).bind(self) for f in _check_forces(forces))
+        self.forces = tuple(_bound(i, f, self) for i, f in enumerate(_check_forces(forces)))
         if isinstance(q0, dict):  # by name, the rest at the joints' defaults
             q0 = _set_by_name("q0", self._default_q(), self.named_coordinates[0], q0)
         if isinstance(s_dot0, dict):
@@ -419,6 +444,9 @@ class System(Model):
             raise ValueError(f"coupling: joint of {self.names[n]!r} must have one dof")
         idx, weights = [], []
         for other, ratio in joint.coupling.items():
+            if other not in self._index:
+                raise ValueError(f"coupling: {self.names[n]!r} follows {other!r}, which is not in the system; "
+                                 f"known subsystems are {list(self.names)}")
             m = self.index(other)
             if self.joints[m].coupling or self.joints[m].n_s != 1 or self.joints[m].n_q != 1:
                 raise ValueError(f"coupling: {self.names[n]!r} may follow only uncoupled one-dof joints, not {other!r}")
@@ -534,6 +562,7 @@ class System(Model):
 
     def K(self, q: NDArray, t: float = 0.0) -> NDArray:
         """K(q) of q̇ = K ṡ + k (block-diagonal over the joints)."""
+        q = np.asarray(q)  # a list's result_type would be read as a structured dtype
         K = np.zeros((self.n_q, self.n_s), dtype=np.result_type(q, float))
         for n, j in enumerate(self.joints):
             if not j.coupling:
@@ -571,7 +600,7 @@ class System(Model):
     def generalized_force(self, q, t: float, joint_forces: dict) -> NDArray:
         """Q with Q[columns] = Σ_j P_jᵀ τ_j, ṡ_j = P_j ṡ[columns] (:meth:`joint_s_columns`:
         a coupled joint's τ acts on the velocities it follows)."""
-        Q = np.zeros(self.n_s, dtype=np.result_type(float, *joint_forces.values()))  # complex in a complex step
+        Q = np.zeros(self.n_s, dtype=np.result_type(float, *map(np.asarray, joint_forces.values())))  # complex step
         for name, tau in joint_forces.items():
             n = self.index(name)
             cols, P = self.joint_s_columns(n)
@@ -694,6 +723,16 @@ def _check_forces(forces) -> tuple:
         if not all(hasattr(f, a) for a in ("bind", "add_to", "potential")):
             raise ValueError(f"forces[{i}]: {f!r} is not a force law (needs bind, add_to, potential)")
     return forces
+
+
+def _bound(i: int, law, system) -> object:
+    """A copy of force law ``law`` bound to ``system``: what its ``bind`` returns, which the
+    contract (:class:`projeq.forces.ForceLaw`) makes the law itself."""
+    bound = copy.copy(law).bind(system)
+    if not all(hasattr(bound, a) for a in ("add_to", "potential")):
+        raise ValueError(f"forces[{i}]: {type(law).__name__}.bind returned {bound!r}, not the bound law; "
+                         "end bind with `return self`")
+    return bound
 
 
 def _cycle(joints: dict, start: str) -> list[str]:

@@ -615,3 +615,72 @@ def test_a_constraint_function_that_raises_late_fails_the_run_and_keeps_the_traj
     assert result.status == -1 and np.allclose(result.t, np.arange(0.0, t_kept + 0.05, 0.1))
     assert np.all(np.isfinite(result.q)) and result.constraint_residual.shape == (len(result.t), 1)
     assert isinstance(info.value.__cause__, (ValueError, RuntimeError))
+
+
+def test_a_joint_spring_needs_rates_equal_to_speeds_everywhere():
+    """Passes if a JointSpring on a planar joint is refused: its K(q) = diag(R(θ), 1) is E at
+    θ = 0 only, where the check looked, so −k (q − q_ref) was applied to the body-axis speeds ṡ
+    instead of Kᵀ ∇V. Before, a planar body on such a spring, started at rest at (0.5 m, 0, 1 rad),
+    gained and lost energy: max |E − E₀| = 6 % of E₀ = 6.25 J over 2 s at rtol 1e-10 (energy
+    conservation, the reference). On a revolute joint (K = E) the same law is accepted."""
+    spring = pq.JointSpring("b", 10.0)
+    with pytest.raises(ValueError, match="^joint: JointSpring needs q̇ = ṡ, which joint 'b' does not have"):
+        pq.System({"b": pq.PlanarBody(1.0, I_c=0.1)}, {"b": pq.Planar()}, forces=[spring])
+    assert _pendulum(forces=[pq.JointSpring("bob", 10.0)]).forces[0].stiffness == 10.0
+
+
+class _DragWithoutReturn(pq.ForceLaw):
+    """A user's law whose bind forgets ``return self`` (the contract: bind returns the law)."""
+
+    def bind(self, system):
+        self.n = system.index("bob")
+
+    def add_to(self, h, kin, t, q, s_dot):
+        h[self.n][3:] -= 0.1 * kin.twist[self.n][3:]
+
+
+def test_a_force_law_whose_bind_returns_nothing_is_named():
+    """Passes if the System names the law and the remedy when its bind returns None; before, None
+    was kept as the bound law and every evaluation failed deep inside with "AttributeError:
+    'NoneType' object has no attribute 'compiled_terms'"."""
+    with pytest.raises(ValueError, match=r"^forces\[0\]: _DragWithoutReturn.bind returned None, not the bound law; "
+                                         r"end bind with `return self`"):
+        _pendulum(forces=[_DragWithoutReturn()])
+
+
+def test_system_K_and_generalized_force_take_plain_lists():
+    """Passes if K and generalized_force accept q and τ as lists, like every other System method:
+    a revolute joint's K = E, and τ on its one velocity is Q = τ. Before, numpy read the list in
+    np.result_type as a structured dtype: "TypeError: Field elements must be 2- or 3-tuples, got '0.3'"."""
+    system = _pendulum()
+    assert system.K([0.3]).tolist() == [[1.0]]
+    assert system.generalized_force([0.3], 0.0, {"bob": [2.5]}).tolist() == [2.5]
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: pq.scenes.double_pendulum().state(q=[0.1, 0.2]),
+     r"^q: expected a dict \{name: value\} of the entries to set, got \[0.1, 0.2\]"),
+    (lambda: pq.scenes.double_pendulum().state(q={"bob1": 0.1}, bob1=0.5),
+     r"^q: \['bob1'\] set both in q and by keyword; give each once"),
+    (lambda: pq.scenes.four_bar().state(crank=0.6),
+     r"^q: violates the loop closures Φ\(q\) = \[-0.0849  0.0976\]; give a consistent q"),
+], ids=["q-a-list", "set-twice", "open-loop"])
+def test_model_state_refuses_what_it_cannot_mean(call, message):
+    """Passes if each is a ValueError naming q. Before: a list was "TypeError: cannot convert
+    dictionary update sequence element #0 to a sequence"; q={"bob1": 0.1} beside bob1=0.5 took 0.5
+    without a word; and the four-bar's state(crank=0.6), documented to have to close its loop,
+    returned the open loop (|Φ| = 0.1 m), which simulate then moved onto Φ = 0 by minimum norm,
+    starting the run at crank = 0.535, not 0.6 (ConstrainedSystem.project, the reference)."""
+    with pytest.raises(ValueError, match=message):
+        call()
+
+
+@pytest.mark.parametrize("joint", [pq.Fixed(), pq.Prescribed(pq.Revolute(axis="y"), "sin(t)")], ids=["Fixed", "Prescribed"])
+def test_a_joint_spring_on_a_joint_without_coordinates_is_refused(joint):
+    """Passes if a JointSpring (k = 100 N m/rad) on a fixed or prescribed joint, which has no
+    coordinate for it to act on, is refused by name; before, it was accepted and did nothing
+    (its τ had n_s = 0 entries)."""
+    with pytest.raises(ValueError, match=rf"^joint: joint 'b' \({type(joint).__name__}\) has no coordinates of its "
+                                         r"own; a JointSpring on it would act on nothing"):
+        pq.System({"a": pq.RigidBody(**ROD), "b": pq.RigidBody(**ROD)}, {"a": pq.Revolute(axis="x"), "b": joint},
+                  forces=[pq.JointSpring("b", 100.0)])

@@ -44,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import exact_jacobian, jacobian, raised_by, warn_differences
+from projeq.system import CLOSED, check_model
 
 DERIVATIVES = ("exact", "differences")
 
@@ -57,6 +58,20 @@ class StateJacobians(NamedTuple):
     q_dot_q: NDArray
     q_dot_s_dot: NDArray
     derivatives: str
+
+
+def check_inputs(system, inputs) -> tuple:
+    """``inputs`` as a tuple of distinct joint names of ``system``; ValueError naming ``inputs``."""
+    if isinstance(inputs, str):  # iterated, a name would be its letters
+        raise ValueError(f"inputs: expected a sequence of joint names, got the string {inputs!r} "
+                         f"(write [{inputs!r}])")
+    inputs = tuple(inputs or ())
+    if len(set(inputs)) != len(inputs):
+        raise ValueError(f"inputs: each joint at most once, got {list(inputs)}")
+    for name in inputs:
+        if name not in system.names:
+            raise ValueError(f"inputs: unknown joint {name!r}; the system has {list(system.names)}")
+    return inputs
 
 
 def state_derivative(system, x: NDArray, t: float, tau: NDArray | None = None, inputs=()) -> NDArray:
@@ -112,7 +127,11 @@ def state_jacobians(system, q: NDArray, s_dot: NDArray, t: float = 0.0, inputs=(
                     derivatives: str = "exact") -> StateJacobians:
     """The Jacobians of q̇ and s̈ at (q, ṡ, t) (module docstring); ``inputs`` name the joints
     whose generalized forces τ are differentiated for (∂s̈/∂τ, zero columns without)."""
+    check_model(system)
     q, s_dot = system.check_state(q, s_dot, t)
+    system.check_closed("q", q, t, CLOSED)
+    system.check_configuration(q, t)
+    inputs = check_inputs(system, inputs)
     x0 = np.concatenate((q, s_dot))
     J, used = state_jacobian(system, x0, t, derivatives)
     n_u = sum(system.joint(name).n_s for name in inputs)

@@ -31,8 +31,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.analysis.jacobians import differentiate, state_derivative, state_jacobian
-from projeq.system import check_model
+from projeq.analysis.jacobians import check_inputs, differentiate, state_derivative, state_jacobian
+from projeq.checks import callable_name, positive
+from projeq.system import CLOSED, check_model
 
 _TOL = 1e-8  # relative threshold: zero columns of A, and the steady-motion residual
 
@@ -129,12 +130,21 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
     NotSteadyError
         If the kept states' derivative at (q, ṡ) exceeds ``tol`` (relative to the largest
         entry of ẋ and 1): neither an equilibrium nor a steady motion.
+    ValueError
+        If q does not close a ConstrainedSystem's loops (|Φ(q, t)| above
+        :data:`projeq.system.CLOSED` relative): no state of the mechanism; or if q is a
+        coordinate singularity (``check_configuration``: a joint's K or F loses rank).
     """
     check_model(system)
     q = system.q0 if q is None else q
     s_dot = system.s_dot0 if s_dot is None else s_dot
     q, s_dot = system.check_state(q, s_dot, t)
-    inputs = _check_inputs(system, inputs)
+    system.check_closed("q", q, t, CLOSED)  # off Φ = 0 the Jacobians describe no motion of the mechanism
+    system.check_configuration(q, t)  # at a coordinate singularity A would hold K's 1/cos(π/2) ≈ 1e16
+    inputs = check_inputs(system, inputs)
+    tol = positive("tol", tol)  # a NaN threshold would pass every state as steady
+    if not isinstance(require_steady, (bool, np.bool_)):
+        raise ValueError(f"require_steady: expected True or False, got {require_steady!r}")
     x0 = np.concatenate((q, s_dot))
     A, derivatives = state_jacobian(system, x0, t, derivatives)
     names = system.state_names()
@@ -150,23 +160,13 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
                          [names[i] for i in dropped], inputs)
 
 
-def _check_inputs(system, inputs) -> tuple:
-    inputs = tuple(inputs or ())
-    if len(set(inputs)) != len(inputs):
-        raise ValueError(f"inputs: each joint at most once, got {list(inputs)}")
-    for name in inputs:
-        if name not in system.names:
-            raise ValueError(f"inputs: unknown joint {name!r}; the system has {list(system.names)}")
-    return inputs
-
-
 def _dropped(system, names: list[str], A: NDArray, ignore, tol: float) -> list[int]:
     """Indices into x of the coordinates to drop (see :func:`linearize`'s ``ignore``)."""
     if ignore is None:
         return []
     if isinstance(ignore, str) and ignore == "auto":
         return ignorable_coordinates(A, system.n_q, tol)
-    if isinstance(ignore, str):
+    if isinstance(ignore, str) or not np.iterable(ignore):
         raise ValueError(f"ignore: must be 'auto', None or a sequence of coordinates, got {ignore!r}")
     indices = []
     for item in ignore:
@@ -238,12 +238,19 @@ def eigenvalue_sweep(build, values, **options) -> NDArray:
         Row k: the eigenvalues at ``values[k]``, sorted by decreasing real part (rows are
         sorted independently; branches are not tracked).
     """
+    if not callable(build):
+        raise ValueError(f"build: expected a callable build(value) returning a System, got {build!r}")
+    if isinstance(values, str) or not np.iterable(values):
+        raise ValueError(f"values: expected a sequence of parameter values, got {values!r}")
     values = list(values)
     if not values:
         raise ValueError("values: the sweep is empty; give at least one parameter value")
     rows = []
     for value in values:
         built = build(value)
+        if isinstance(built, tuple) and len(built) != 3:
+            raise ValueError(f"build: {callable_name(build)}({value!r}) returned a tuple of {len(built)}; "
+                             "expected a System or (system, q, s_dot)")
         system, q, s_dot = built if isinstance(built, tuple) else (built, None, None)
         rows.append(linearize(system, q, s_dot, **options).eigenvalues())
     if len({len(r) for r in rows}) > 1:

@@ -560,14 +560,18 @@ class ConstrainedSystem(Model):
         )
 
     def _initial_q(self, q0, project_q0) -> NDArray:
-        residual = self.phi(q0, 0.0)
-        if residual.size and np.abs(residual).max() > POSITION_TOLERANCE * 1e3 * max(1.0, np.abs(q0).max()):
-            if not project_q0:
-                raise ValueError(
-                    f"q0: violates the loop closures Φ(q0) = {np.array2string(residual, precision=4)}; "
-                    "give a consistent q0 or pass project_q0=True to project it onto Φ = 0"
-                )
+        if not project_q0:
+            self.check_closed("q0", q0, 0.0, remedy="pass project_q0=True to project it onto Φ = 0")
         return self.project(q0) if self.m_h else q0
+
+    def check_closed(self, name: str, q: NDArray, t: float = 0.0, tol: float = 1e3 * POSITION_TOLERANCE,
+                     remedy: str = "move it onto Φ = 0 with project(q, t)") -> None:
+        """ValueError naming ``name`` if q violates the loop closures: |Φ(q, t)| above
+        tol · max(1, |q|) (the default 1e-9, far above what :meth:`project` leaves, 1e-12)."""
+        residual = self.phi(q, t)
+        if residual.size and np.abs(residual).max() > tol * max(1.0, np.abs(q).max()):
+            raise ValueError(f"{name}: violates the loop closures Φ({name}) = "
+                             f"{np.array2string(residual, precision=4)}; give a consistent {name} or {remedy}")
 
     def energy(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> tuple[float, float]:
         """(kinetic, potential) of the tree at ṡ_tree = F ṡ + f."""

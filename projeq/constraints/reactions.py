@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.assembly.kinematics import forward, gauss_terms
-from projeq.system import check_model
+from projeq.system import CLOSED, check_model
 
 
 def reactions(system, result) -> NDArray:
@@ -73,13 +73,15 @@ def joint_reactions(system, q, s_dot, t: float = 0.0, cuts=None) -> dict:
 
     For a :class:`~projeq.constraints.partitioned.ConstrainedSystem`, ``cuts`` is a dict
     {name: :class:`~projeq.constraints.cut_joints.PinClosure`} of the cut joints whose closures make up
-    its Φ, in the order of Φ's rows; their multipliers λ are the cut joints' forces, applied
-    as the wrenches w_n, and the result also holds, under each cut's name, the wrench of the
-    cut joint on its subsystem a. For a tree System (no multipliers) ``cuts`` is not used (w_n = 0).
+    its Φ, in the order of Φ's rows (ValueError if, stacked, they are not Φ); their multipliers
+    λ are the cut joints' forces, applied as the wrenches w_n, and the result also holds, under
+    each cut's name, the wrench of the cut joint on its subsystem a. For a tree System (no
+    multipliers) ``cuts`` is not used (w_n = 0). q must close the loops (:data:`projeq.system.CLOSED`).
     """
     check_model(system)
-    tree, cuts = system.tree, (_check_cuts(system, cuts) if system.n_lambda else {})
     q, s_dot = system.check_state(q, s_dot, t)
+    system.check_closed("q", q, t, CLOSED)
+    tree, cuts = system.tree, (_check_cuts(system, cuts, q, t) if system.n_lambda else {})
     s_ddot_tree, lam = system.accelerations_tree(q, s_dot, t)
     s_dot_tree = system.tree_velocities(q, s_dot, t)
     kin = forward(tree, q, s_dot_tree, float(t))
@@ -93,7 +95,7 @@ def joint_reactions(system, q, s_dot, t: float = 0.0, cuts=None) -> dict:
     return _transmitted(tree, q, s_dot_tree, s_ddot_tree, t, applied, kin) | cut_wrenches
 
 
-def _check_cuts(system, cuts) -> dict:
+def _check_cuts(system, cuts, q: NDArray, t: float) -> dict:
     if not isinstance(cuts, dict) or not all(callable(getattr(c, "wrenches", None)) for c in cuts.values()):
         raise ValueError(f"cuts: expected a dict {{name: PinClosure}} of the cut joints, got {cuts!r}")
     rows = sum(len(c.rows) for c in cuts.values())
@@ -105,7 +107,27 @@ def _check_cuts(system, cuts) -> dict:
     clash = set(cuts) & set(system.names)
     if clash:
         raise ValueError(f"cuts: names {sorted(clash)} are subsystem names already")
+    _check_cuts_are_phi(system, cuts, q, t)
     return cuts
+
+
+def _check_cuts_are_phi(system, cuts: dict, q: NDArray, t: float) -> None:
+    """The cuts' closures, stacked in the order given, are the system's Φ: λ_i is the force of
+    row i, so other points, axes or an order other than Φ's would apply each λ to another
+    joint. Both vanish on the constraint manifold; they are compared at q moved by
+    0.1 (1 + |q|) along two seeded random directions, to 1e-9 of Φ's size there (the same
+    function agrees to round-off)."""
+    rng = np.random.default_rng(0)
+    for _ in range(2):
+        moved = q + 0.1 * (1.0 + np.abs(q)) * rng.standard_normal(q.size)
+        phi = system.phi(moved, t)
+        stacked = np.concatenate([np.ravel(closure(moved, t)) for closure in cuts.values()])
+        if np.abs(stacked - phi).max() > 1e-9 * max(1.0, np.abs(phi).max()):
+            raise ValueError(
+                f"cuts: the cut joints {list(cuts)} are not the system's Φ (at q = {np.round(moved, 3).tolist()} "
+                f"they give {np.round(stacked, 6).tolist()}, Φ = {np.round(phi, 6).tolist()}); give the closures "
+                "Φ was built from, in the order of its rows"
+            )
 
 
 def _transmitted(tree, q, s_dot, s_ddot, t, applied: dict, kin=None) -> dict:

@@ -173,7 +173,12 @@ def _coupling(coupling, joint) -> dict:
         return {}
     if not isinstance(coupling, dict):
         raise ValueError(f"coupling: expected {{joint_name: ratio}}, got {coupling!r}")
-    return {name: float(finite_array(f"coupling[{name!r}]", ratio, ())) for name, ratio in coupling.items()}
+    ratios = {name: float(finite_array(f"coupling[{name!r}]", ratio, ())) for name, ratio in coupling.items()}
+    for name, ratio in ratios.items():
+        if ratio == 0.0:  # Σ ratio · q_other: this term is nothing
+            raise ValueError(f"coupling[{name!r}]: a ratio of 0 couples nothing, got 0.0; leave {name!r} out "
+                             "(a joint that follows no joint at all is a Fixed joint)")
+    return ratios
 
 
 def pose_twist_mismatch(joint: Joint, q_n: NDArray, s_dot_n: NDArray, t: float, h: float = 1e-7) -> float:

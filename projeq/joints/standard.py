@@ -276,10 +276,14 @@ def _expression(motion):
     """The motion θ(t) as a sympy expression in the symbol t, checked."""
     t = sp.Symbol("t")
     try:
-        expr = sp.sympify(motion)
-    except (sp.SympifyError, SyntaxError, TypeError) as exc:
+        read = sp.sympify(motion)
+    except (sp.SympifyError, SyntaxError, TypeError):
+        read = None
+    if not isinstance(read, sp.Expr):
         raise ValueError(f"motion: cannot read {motion!r} as an expression in t (a sympy expression or "
-                         "a string such as '0.5*sin(2*t)'), or give a callable t -> (θ, θ̇, θ̈)") from exc
+                         "a string such as '0.5*sin(2*t)'), or give a callable t -> (θ, θ̇, θ̈)")
+    # the time under any assumptions (sp.Symbol("t", real=True)) is t
+    expr = read.xreplace({symbol: t for symbol in read.free_symbols if symbol.name == "t"})
     extra = expr.free_symbols - {t}
     if extra:
         raise ValueError(f"motion: depends on {sorted(map(str, extra))}; only t is allowed")

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
 
-from projeq.checks import callable_name, finite_array
+from projeq.checks import callable_name, count, finite_array
 from projeq.joints.base import Joint, SymbolicRelative
 
 if TYPE_CHECKING:
@@ -36,7 +36,10 @@ class UserJoint(Joint):
     def __init__(self, parent, n_q, n_s, relative, K, q_dot, q0=None, r_pn=(0, 0, 0), orientation=None,
                  constraints=None, n_c=0, symbols: dict | None = None, values=None, rates=None, compiled=None):
         super().__init__(parent, r_pn, orientation)
-        self.n_q, self.n_s, self.n_c = n_q, n_s, n_c
+        self.n_q, self.n_s, self.n_c = n_q, n_s, count("n_c", n_c, 0)
+        if n_c and constraints is None:  # the residuals' rows would be announced but never given
+            raise ValueError(f"n_c: {n_c} constraint residual(s) announced, but no constraints function gives "
+                             "them; pass constraints=... or leave n_c = 0")
         self._relative, self._K, self._q_dot = relative, K, q_dot
         self._values = values  # (q_n, ṡ_n, t) as lists -> relative_values, or None: relative packed
         self._rates = rates  # (q_n, ṡ_n, t) as lists -> q̇_n as a list, or None: q_dot alone

@@ -19,7 +19,7 @@ import numpy as np
 import sympy as sp
 
 from projeq.analysis.differentiation import derivative_along
-from projeq.checks import check_rotation, finite_array
+from projeq.checks import callable_name, check_rotation, count, finite_array
 from projeq.joints import Relative, pose_twist_mismatch
 from projeq.spatial import numeric
 from projeq.symbolic import codegen
@@ -248,6 +248,12 @@ def _compile_constraints(C, p, q, q_dot, t):
 def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, orientation,
                         constraints=None, n_c=0):
     """A :class:`UserJoint` from callables (see ``UserJoint.from_functions``)."""
+    n_q, n_s = count("n_q", n_q, 0), count("n_s", n_s, 0)
+    for call, function in (("pose(q, t)", pose), ("F(q, t)", F), ("K(q, t)", K), ("f(q, t)", f), ("k(q, t)", k),
+                           ("constraints(q, q_dot, t)", constraints)):
+        if function is not None and not callable(function):
+            raise ValueError(f"{call.split('(')[0]}: expected a callable {call}, got {type(function).__name__} "
+                             f"{function!r}")
     zero6, zero_q = np.zeros(6), np.zeros(n_q)
     f = f if f is not None else (lambda q_n, time: zero6)
     k = k if k is not None else (lambda q_n, time: zero_q)
@@ -277,19 +283,30 @@ def wrap_user_functions(cls, n_q, n_s, pose, F, K, *, f, k, parent, q0, r_pn, or
 def _check_callables(joint, pose, F, f, k) -> None:
     """Shapes of the user's callables at q0, before anything is combined from them."""
     q0 = joint.default_q()
+    pose_q0 = _called("pose", pose, q0)
     try:
-        A, r = pose(q0, 0.0)
+        A, r = pose_q0
     except (TypeError, ValueError) as exc:
         raise ValueError(f"pose: must return (A, r) = (3×3 rotation, 3-vector) at (q, t): {exc}") from exc
     for name, value, shape in (
         ("pose A", A, (3, 3)),
         ("pose r", r, (3,)),
-        ("F", F(q0, 0.0), (6, joint.n_s)),
-        ("K", joint.K(q0, 0.0), (joint.n_q, joint.n_s)),
-        ("f", f(q0, 0.0), (6,)),
-        ("k", k(q0, 0.0), (joint.n_q,)),
+        ("F", _called("F", F, q0), (6, joint.n_s)),
+        ("K", _called("K", joint.K, q0), (joint.n_q, joint.n_s)),
+        ("f", _called("f", f, q0), (6,)),
+        ("k", _called("k", k, q0), (joint.n_q,)),
     ):
         finite_array(name, value, shape)
+
+
+def _called(name: str, function, q0):
+    """``function(q0, 0)``; an exception of the user's callable as a ValueError naming the
+    parameter and the callable."""
+    try:
+        return function(q0, 0.0)
+    except Exception as exc:  # noqa: BLE001 - the user's callable, reported by name
+        raise ValueError(f"{name}: {callable_name(function)} raised {type(exc).__name__}: {exc} at "
+                         f"q0 = {q0.tolist()}, t = 0") from exc
 
 
 def _check_shapes(joint) -> None:

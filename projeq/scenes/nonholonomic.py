@@ -24,6 +24,7 @@ from functools import cache
 import numpy as np
 import sympy as sp
 
+from projeq.checks import non_negative, positive
 from projeq.constraints.nonholonomic import check_configuration, initial_speeds
 from projeq.forces import Force, Torque
 from projeq.joints import Fixed, UserJoint
@@ -147,6 +148,7 @@ def knife_edge_disc(m: float = 1.0, r: float = 1.0, I: float = 0.25, J: float = 
     remove the coordinate singularity, but for the knife edge ϕ = ±π/2 is also the end of
     the rolling contact.
     """
+    r = positive("r", r)
     q, s, A, pos, F, K, constraints, qd, r_sym = _disc_joint_lecture()
     joint = UserJoint.from_sympy(q, s, A, pos, F, K, constraints=constraints, q_dot=qd,
                                  parameters={r_sym: r}, q0=np.asarray(q0, dtype=float))
@@ -278,6 +280,9 @@ def rolling_disk(m_disk: float = 0.030, R: float = 0.015, m_ecc: float = 0.001, 
     degenerate (Barhorst notes the singularity near q2 = π/2); a construction there
     raises a ValueError naming the coordinate.
     """
+    R, m_ecc, drag = positive("R", R), non_negative("m_ecc", m_ecc), non_negative("drag", drag)
+    if ecc is not None and m_ecc == 0:
+        raise ValueError(f"ecc: the eccentric mass's position {ecc!r} is given, but m_ecc = 0 places no mass there")
     q, s, A, pos, F, K, constraints, qd, R_sym = _rolling_disk_joint()
     joint = UserJoint.from_sympy(q, s, A, pos, F, K, constraints=constraints, q_dot=qd,
                                  parameters={R_sym: R}, q0=np.asarray(q0, dtype=float))
@@ -290,8 +295,6 @@ def rolling_disk(m_disk: float = 0.030, R: float = 0.015, m_ecc: float = 0.001, 
         subsystems["mass"] = PointMass(m_ecc)
         joints["mass"] = Fixed(parent="disk", r_pn=ecc)
     forces = []
-    if drag < 0:
-        raise ValueError(f"drag: must be ≥ 0, got {drag}")
     if drag > 0:
         forces.append(Torque("disk", lambda t, q_, s_: -drag * s_[:3] * np.abs(s_[:3]), frame="body"))
 

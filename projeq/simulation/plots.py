@@ -24,12 +24,20 @@ def _legend_outside(ax) -> None:
     ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
 
 
+def _check_rows(result) -> None:
+    """A result with at least one output row (a run stopped in its first segment has none)."""
+    if not len(result.t):
+        raise ValueError(f"result: has no output rows (status {result.status}: {result.message!r}); nothing to plot")
+
+
 def time_history(result, names=None):
     """q(t) (top) and ṡ(t) (bottom), each line labelled by its name (``names`` for q, default
     the result's, :meth:`projeq.Result.column_names`); :func:`grouped_history` separates
     angles, translations and elastic coordinates."""
-    fig, (ax_q, ax_s) = _figure(2, width=9.0)
     q_names, s_names = result.column_names(units=True)
+    if names is not None and len(names) != len(q_names):  # labels by position: fewer would drop columns
+        raise ValueError(f"names: expected {len(q_names)} labels, one per column of q ({q_names}), got {list(names)}")
+    fig, (ax_q, ax_s) = _figure(2, width=9.0)
     for i, name in enumerate(names or q_names):
         ax_q.plot(result.t, result.q[:, i], label=name)
     for i, name in enumerate(s_names):
@@ -79,13 +87,19 @@ def grouped_history(result):
 
 
 def planar_trajectory(result, x: int = 0, y: int = 1):
-    """The path (q[x], q[y]) in the plane, with start and end marked, equal axis scales."""
+    """The path (q[x], q[y]) in the plane, with start and end marked, equal axis scales; the
+    axes labelled by the columns' names and units (:meth:`projeq.Result.column_names`)."""
+    _check_rows(result)
+    labels = result.column_names(units=True)[0]
+    for name, i in (("x", x), ("y", y)):
+        if isinstance(i, bool) or not isinstance(i, (int, np.integer)) or not 0 <= i < len(labels):
+            raise ValueError(f"{name}: expected a column of q, 0 … {len(labels) - 1} ({labels}), got {i!r}")
     fig, (ax,) = _figure(1)
     ax.plot(result.q[:, x], result.q[:, y], label="path")
     ax.plot(result.q[0, x], result.q[0, y], "o", label="start")
     ax.plot(result.q[-1, x], result.q[-1, y], "s", label="end")
-    ax.set_xlabel(f"q{x} (m)")
-    ax.set_ylabel(f"q{y} (m)")
+    ax.set_xlabel(labels[x])
+    ax.set_ylabel(labels[y])
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")
@@ -97,6 +111,7 @@ def drift(result, energy_conserved: bool | None = None):
     velocity-constraint residual (bottom, its axis floored at round-off, :data:`ROUND_OFF`).
     ``energy_conserved=False`` titles the energy panel with why it need not be constant
     (:func:`projeq.simulation.integrators.conserves_energy`)."""
+    _check_rows(result)
     constrained = result.constraint_residual.size > 0
     fig, axes = _figure(2 if constrained else 1)
     axes[0].plot(result.t, result.energy - result.energy[0])

@@ -89,9 +89,10 @@ class Result:
     @property
     def energy_drift(self) -> float:
         """max |E(t) − E(t₀)| relative to the largest kinetic or potential energy of the run
-        (a scale that stays meaningful when E(t₀) = 0)."""
+        (a scale that stays meaningful when E(t₀) = 0); NaN for a run without output rows (one
+        stopped in its first segment), which conserved nothing: a check ``drift < tol`` fails."""
         if len(self.t) == 0:
-            return 0.0
+            return float("nan")
         scale = max(np.abs(self.kinetic).max(), np.abs(self.potential).max(), 1e-300)
         return float(np.abs(self.energy - self.energy[0]).max() / scale)
 
@@ -136,7 +137,10 @@ class Result:
     def load(cls, path) -> "Result":
         """Read a Result written by :meth:`save` (without dense output). ValueError saying what
         the file is and what is wrong when it is not one: not an .npz archive (random or
-        truncated bytes), an archive without a Result's arrays, or arrays whose lengths differ."""
+        truncated bytes), an archive without a Result's arrays, or arrays whose lengths differ.
+        A name without ``.npz`` is read as :meth:`save` wrote it, with the suffix appended."""
+        if isinstance(path, (str, Path)) and Path(path).suffix != ".npz" and not Path(path).exists():
+            path = Path(path).with_name(Path(path).name + ".npz")  # save's name for it
         try:
             with np.load(path, allow_pickle=False) as data:
                 meta, events, arrays = _read(data, path)

@@ -44,6 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
+from projeq.checks import finite_array
 from projeq.scenes import Scene, check_names, get_scene
 from projeq.simulation.export import written_atomically
 from projeq.studies.table import Table, csv_cells, csv_line
@@ -257,11 +258,13 @@ def _points(grid, samples) -> list[dict]:
     if grid is not None:
         if not isinstance(grid, dict) or not grid:
             raise ValueError(f"grid: expected a non-empty dict name -> values, got {grid!r}")
+        _check_columns("grid", grid)
         empty = [name for name, values in grid.items() if not len(values)]
         if empty:
             raise ValueError(f"grid: {empty[0]} has no values; give it at least one")
         return [dict(zip(grid, values)) for values in itertools.product(*grid.values())]
     if isinstance(samples, dict):
+        _check_columns("samples", samples)
         lengths = {len(v) for v in samples.values()}
         if len(lengths) != 1:
             raise ValueError(f"samples: all columns must have the same length, got {sorted(lengths)}")
@@ -270,7 +273,49 @@ def _points(grid, samples) -> list[dict]:
         points = [dict(p) for p in samples]
     if not points or not points[0]:
         raise ValueError(f"samples: expected at least one point with at least one parameter, got {samples!r}")
-    return points
+    return [_same_parameters(i, p, list(points[0])) for i, p in enumerate(points)]
+
+
+def _outputs(outputs, point: dict) -> list:
+    """The outputs as a list of distinct names, none a parameter's: the table has one column per
+    name, so a parameter q0 and the output q0 (the final q[0]) would share it."""
+    if isinstance(outputs, str):
+        raise ValueError(f"outputs: expected a sequence of output names, got the string {outputs!r} "
+                         f"(write [{outputs!r}])")
+    outputs = list(outputs)
+    repeated = sorted({name for name in outputs if outputs.count(name) > 1})
+    if repeated:
+        raise ValueError(f"outputs: {repeated} asked for more than once; the table has one column per name")
+    clash = [name for name in outputs if name in point]
+    if clash:
+        raise ValueError(f"outputs: {clash} are parameters of the sweep too; the table has one column per name "
+                         "(ask for a final coordinate by its name, subsystem.coordinate)")
+    return outputs
+
+
+def _end_time(t_end, t_start) -> float:
+    """``t_end`` checked once for all points (else each point would fail alike)."""
+    t_end = float(finite_array("t_end", t_end, ()))
+    if not t_end > float(finite_array("t_start", t_start, ())):
+        raise ValueError(f"t_end: must be after t_start = {t_start}, got {t_end}")
+    return t_end
+
+
+def _check_columns(name: str, columns: dict) -> None:
+    """Each parameter's values are a sequence (a bare number or text would be no column)."""
+    for parameter, values in columns.items():
+        if isinstance(values, str) or not np.iterable(values):
+            raise ValueError(f"{name}: {parameter} must be a sequence of values, got {values!r} "
+                             f"(write [{values!r}])")
+
+
+def _same_parameters(i: int, point: dict, names: list) -> dict:
+    """Point i with the parameters of the first point, in their order: the table's columns and
+    each CSV line are written in that order."""
+    if sorted(point) != sorted(names):
+        raise ValueError(f"samples[{i}]: sets the parameters {sorted(point)}, the first point {sorted(names)}; "
+                         "every point must set the same ones (the table has one column per parameter)")
+    return {name: point[name] for name in names}
 
 
 def process_pool(workers: int | None = None) -> cf.ProcessPoolExecutor:
@@ -354,13 +399,13 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     points = _points(grid, samples)
     for p in points:
         check_names(scene, p)
-    outputs = list(outputs)
+    outputs = _outputs(outputs, points[0])
     named = [name for name in outputs if _column(name) is not None and _column(name)[0] == "named"]
     if named:  # checked on the model of the first point, before any run
         model = scene.build(**points[0])
         for name in named:
             _named_column(model.coordinates(), model.velocities(), name)
-    t_end = scene.t_end if t_end is None else float(t_end)
+    t_end = scene.t_end if t_end is None else _end_time(t_end, options.get("t_start", 0.0))
     if resume and path is None:
         raise ValueError("resume: needs path, the table of the sweep to resume")
     header = list(points[0]) + outputs + ["status", "error"]

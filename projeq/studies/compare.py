@@ -508,12 +508,15 @@ def compare(name: str, formulations=None, simulate: bool = True, t_end: float | 
     if name not in COMPARISONS:
         raise ValueError(f"name: unknown comparison {name!r}; choose one of {sorted(COMPARISONS)}")
     t_end = DEFAULT_T_END[name] if t_end is None else t_end
-    if not (isinstance(t_end, (int, float)) and t_end > 0):
-        raise ValueError(f"t_end: must be a positive number of seconds, got {t_end!r}")
+    if not (isinstance(t_end, (int, float)) and 0 < t_end < np.inf):
+        raise ValueError(f"t_end: must be a positive, finite number of seconds, got {t_end!r}")
     if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
         raise ValueError(f"repeats: must be a positive integer (derivations per row), got {repeats!r}")
     if formulations is not None:
         formulations = [formulations] if isinstance(formulations, str) else list(formulations)
+        if not formulations:
+            raise ValueError("formulations: none given; name at least one (the first is the reference) or "
+                             "pass None for all")
     token = derivation_repeats.set(repeats)
     try:
         rows = COMPARISONS[name](formulations, simulate, float(t_end))

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from types import MethodType
 
+import numpy as np
 from numpy.typing import NDArray
 
 from projeq.checks import drop_inherited_twins
@@ -167,14 +168,29 @@ def conform(name: str, sub) -> None:
             f"subsystems[{name!r}]: {sub!r} is not a subsystem (it lacks {', '.join(missing)}; "
             "subclass projeq.Subsystem, which lists the members)"
         )
-    if isinstance(sub, Subsystem):
-        return
-    for member in DEFAULTS:
-        if not hasattr(sub, member):
-            default = getattr(Subsystem, member)
-            _give(name, sub, member, MethodType(default, sub) if callable(default) else default)
-    for flag, methods in CAPABILITIES.items():
-        _give(name, sub, flag, all(hasattr(sub, m) for m in methods))
+    if not isinstance(sub, Subsystem):
+        for member in DEFAULTS:
+            if not hasattr(sub, member):
+                default = getattr(Subsystem, member)
+                _give(name, sub, member, MethodType(default, sub) if callable(default) else default)
+        for flag, methods in CAPABILITIES.items():
+            _give(name, sub, flag, all(hasattr(sub, m) for m in methods))
+    _check_shapes(name, sub)
+
+
+def _check_shapes(name: str, sub) -> None:
+    """``n_y``, ``S`` and the shapes of (M_n, h_n) from ``gauss_terms`` at rest (ẏ = 0, q_e = 0,
+    no gravity): a wrong shape is named here, not by numpy inside an evaluator."""
+    n_y, n_e = sub.n_y, sub.n_e
+    if isinstance(n_y, bool) or not isinstance(n_y, (int, np.integer)) or n_y < 1 or not 0 <= n_e <= n_y:
+        raise ValueError(f"subsystems[{name!r}]: n_y = {n_y!r}, n_e = {n_e!r}; expected integers "
+                         "1 <= n_y and 0 <= n_e <= n_y")
+    if sub.S is not None and np.shape(sub.S) != (n_y, 6):
+        raise ValueError(f"subsystems[{name!r}]: S has shape {np.shape(sub.S)}, expected (n_y, 6) = ({n_y}, 6)")
+    M, h = sub.gauss_terms(np.zeros(n_y), np.eye(3), np.zeros(3), np.zeros(n_e))
+    if np.shape(M) != (n_y, n_y) or np.shape(h) != (n_y,):
+        raise ValueError(f"subsystems[{name!r}]: gauss_terms returned M of shape {np.shape(M)} and h of shape "
+                         f"{np.shape(h)}; with n_y = {n_y} they must be ({n_y}, {n_y}) and ({n_y},)")
 
 
 def _give(name: str, sub, member: str, value) -> None:

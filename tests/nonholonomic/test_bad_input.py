@@ -122,3 +122,27 @@ def test_initial_rates_violating_the_constraints():
     built = pq.scenes.knife_edge_disc(q_dot0=q_dot)
     assert np.allclose(built.s_dot0, s_dot, rtol=1e-14)
     assert np.allclose(pq.scenes.barhorst_particle(q_dot0=(1.0, 4.0)).s_dot0, [1.0])
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"m_ecc": -0.001}, r"^m_ecc: must not be negative, got -0.001"),
+    ({"m_ecc": np.nan}, r"^m_ecc: non-finite entries"),
+    ({"drag": np.nan}, r"^drag: non-finite entries"),
+    ({"R": -0.015}, r"^R: must be positive, got -0.015"),
+    ({"m_ecc": 0.0, "ecc": (0.0, 0.0, 0.01)}, r"^ecc: the eccentric mass's position .* is given, but m_ecc = 0"),
+], ids=["m_ecc-negative", "m_ecc-nan", "drag-nan", "R-negative", "ecc-without-mass"])
+def test_rolling_disk_parameters_are_not_silently_dropped(kwargs, message):
+    """Passes if each is a ValueError naming the parameter. Before, m_ecc = −1 g or NaN failed
+    `m_ecc > 0` and gave the symmetric disk (the system of m_ecc = 0, without its "mass"),
+    drag = NaN failed `drag > 0` and gave no drag, R < 0 a disc of negative radius, and
+    ecc with m_ecc = 0 was ignored."""
+    assert "mass" not in pq.scenes.rolling_disk(m_ecc=0.0).names  # the system the bad masses gave
+    with pytest.raises(ValueError, match=message):
+        pq.scenes.rolling_disk(**kwargs)
+
+
+def test_knife_edge_disc_radius_must_be_positive():
+    """Passes if a negative radius is refused by name (before: a disc with its centre below the
+    plane it rolls on, z_G = −r cos ϕ > 0, accepted)."""
+    with pytest.raises(ValueError, match=r"^r: must be positive, got -1.0"):
+        pq.scenes.knife_edge_disc(r=-1.0)

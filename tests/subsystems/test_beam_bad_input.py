@@ -135,3 +135,20 @@ def test_probe_stations_must_lie_on_the_beam(x):
         beam.displacement(np.array([1.0, 0.0]), [x])
     ends = beam.displacement(np.array([1.0, 0.0]), [0.0, 1.0])
     assert ends[0, 1] == 0.0 and ends[1, 1] == pytest.approx(1.0, rel=1e-14)
+
+
+def test_a_nan_probe_station_is_on_no_beam():
+    """Passes if a station x = NaN is refused like one off the beam; before, it passed the range
+    check (NaN < 0 and NaN > L are both false) and the probe returned a NaN deflection."""
+    beam = pq.RitzBeam(1.0, 1.0, 1.0, n_v=2, n_w=0)
+    with pytest.raises(ValueError, match=r"^x: stations must lie on the beam, 0 ≤ x ≤ 1.0, got \[nan\]"):
+        beam.displacement(np.array([1.0, 0.0]), [np.nan])
+
+
+@pytest.mark.parametrize("switch", ["stiffening", "precomputed_integrals"])
+def test_a_switch_given_as_text_is_refused(switch):
+    """Passes if stiffening="False" (text, as from a settings file: truthy) is refused by name
+    instead of silently switching the option on; True and False themselves are taken."""
+    with pytest.raises(ValueError, match=f"^{switch}: expected True or False, got 'False'"):
+        pq.RitzBeam(1.0, 1.0, 1.0, n_v=2, n_w=0, **{switch: "False"})
+    assert getattr(pq.RitzBeam(1.0, 1.0, 1.0, n_v=2, n_w=0, stiffening=False), "stiffening") is False

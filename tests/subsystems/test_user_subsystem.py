@@ -108,3 +108,32 @@ def test_on_a_fixed_root_the_absorber_is_a_spring_mass_oscillator(method):
         assert system.evaluator("auto").name == "hub_beam"
     s_ddot = system.accelerations(system.q0, system.s_dot0, method=method)
     assert s_ddot == pytest.approx([-40.0 * 0.02 / 0.3], rel=1e-13)
+
+
+class _Blob(pq.Subsystem):
+    """A user subsystem whose terms have the wrong size: n_y = 6, but a 3×3 M and a 3-vector h."""
+
+    n_y = 6
+
+    def gauss_terms(self, y_dot, R, gravity, q_e=None):
+        return np.eye(3), np.zeros(3)
+
+    def kinetic_energy(self, y_dot, q_e=None):
+        return 0.0
+
+    def potential_energy(self, R, r, gravity, q_e=None):
+        return 0.0
+
+
+@pytest.mark.parametrize("sub, message", [
+    (_Blob(), r"gauss_terms returned M of shape \(3, 3\) and h of shape \(3,\); with n_y = 6 they must be "
+              r"\(6, 6\) and \(6,\)"),
+    (type("Selected", (_Blob,), {"S": np.eye(6)[:3]})(), r"S has shape \(3, 6\), expected \(n_y, 6\) = \(6, 6\)"),
+], ids=["terms", "selection"])
+def test_a_user_subsystem_of_inconsistent_size_is_named(sub, message):
+    """Passes if a subsystem whose n_y, S and terms disagree is refused where the System is built,
+    by its name; before, it was accepted and every evaluation failed inside numpy ("could not
+    broadcast input array from shape (1,3,3) into shape (1,6,6)", or matmul's "mismatch in its
+    core dimension 0")."""
+    with pytest.raises(ValueError, match=rf"^subsystems\['blob'\]: {message}"):
+        pq.System({"blob": sub}, {"blob": pq.Revolute(axis="y")})

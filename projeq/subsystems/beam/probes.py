@@ -55,8 +55,8 @@ class BeamProbes:
 
     def _stations(self, x) -> NDArray:
         x = np.atleast_1d(np.asarray(x, dtype=float))
-        if np.any(x < 0) or np.any(x > self.length):
-            raise ValueError(f"x: stations must lie on the beam, 0 ≤ x ≤ {self.length}")
+        if not np.all((x >= 0) & (x <= self.length)):  # NaN is on no beam either
+            raise ValueError(f"x: stations must lie on the beam, 0 ≤ x ≤ {self.length}, got {x.tolist()}")
         return x
 
     def centre_line(self, q_e: NDArray, y_dot: NDArray, stations: int = 21) -> tuple[NDArray, NDArray]:
