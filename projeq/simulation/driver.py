@@ -38,7 +38,7 @@ from projeq.simulation.integrators import (
 )
 from projeq.simulation.result import Result, SimulationError
 from projeq.constraints.nonholonomic import near_singularity
-from projeq.system import Model, check_model
+from projeq.system import CLOSED, Model, check_model
 
 __all__ = ["INTEGRATORS", "Result", "SimulationError", "ValidityWarning", "default_method", "simulate"]
 
@@ -69,9 +69,23 @@ SOLVER_OPTIONS = {
 _SOLVE_IVP_OWN = ("fun", "t0", "y0", "t_bound", "rtol", "atol", "vectorized")  # set by solve_ivp itself
 
 
+def check_options(options: dict) -> None:
+    """ValueError naming a keyword of ``options`` that :func:`simulate` would refuse, before any run
+    (a sweep's points): simulate's own parameters pass, the others are the integrator's options —
+    of ``options["method"]`` if given, else of any built-in method (simulate chooses per model)."""
+    own = set(inspect.signature(simulate).parameters) - {"system", "t_end", "options"}
+    method = options.get("method")
+    if method is not None:
+        _check_method(method)
+    _check_options(method, {name: value for name, value in options.items() if name not in own})
+
+
 def _check_options(method, options: dict) -> None:
-    """ValueError naming an option the integrator does not know (solve_ivp would ignore it)."""
-    if isinstance(method, str):
+    """ValueError naming an option the integrator ``method`` does not know (solve_ivp would ignore
+    it); ``method`` None: an option no built-in method knows."""
+    if method is None:
+        known = tuple(sorted(set().union(*SOLVER_OPTIONS.values())))
+    elif isinstance(method, str):
         known = SOLVER_OPTIONS[PROJECTED[method].__name__ if method in PROJECTED else method]
     else:
         parameters = inspect.signature(method).parameters.values()
@@ -79,7 +93,8 @@ def _check_options(method, options: dict) -> None:
     unknown = sorted(set(options) - set(known))
     if unknown:
         hint = "".join(closest(name, known) for name in unknown[:1])
-        raise ValueError(f"options: unknown option{'s' * (len(unknown) > 1)} {unknown} for method {method!r}{hint}; "
+        which = "any method" if method is None else f"method {method!r}"
+        raise ValueError(f"options: unknown option{'s' * (len(unknown) > 1)} {unknown} for {which}{hint}; "
                          f"it takes {list(known)} (simulate's own: t_start, t_eval, n_points, dense_output, "
                          "evaluator, n_segments, progress, jac)")
 
@@ -111,7 +126,7 @@ def simulate(
     *,
     t_start: float = 0.0,
     t_eval=None,
-    n_points: int = 501,
+    n_points: int | None = None,
     dense_output: bool = False,
     evaluator: str | object | None = None,
     n_segments: int = 20,
@@ -150,7 +165,7 @@ def simulate(
         each fired is in ``Result.t_events`` (times), ``q_events`` and ``s_dot_events``
         (states); a terminal event's exact state is also the Result's last row.
     t_eval : array, optional
-        Output times (default ``n_points`` equally spaced).
+        Output times (default ``n_points`` equally spaced, 501 if not given; not both).
     dense_output : bool
         Keep a continuous solution ``result.sol(t) -> (q, s_dot)``.
     evaluator : "recursive", "dense", "fast" or an object with ``accelerations(q, s_dot, t)``
@@ -235,7 +250,9 @@ class _Run:
                  evaluator, n_segments, progress, jac, options, dense_output=False):
         check_model(system)
         self.t_start = t_start = float(finite_array("t_start", t_start, ()))
-        q0 = system.normalized(system.check_q("q0", system.q0 if q0 is None else q0), t_start)
+        q0 = system.check_q("q0", system.q0 if q0 is None else q0)
+        system.check_closed("q0", q0, t_start, CLOSED)  # an open loop is a mistake, not a start to project
+        q0 = system.normalized(q0, t_start)
         s_dot0 = state_vector("s_dot0", system.s_dot0 if s_dot0 is None else s_dot0, system.n_s)
         self.t_end = t_end = float(finite_array("t_end", t_end, ()))
         if not t_end > t_start:
@@ -246,7 +263,7 @@ class _Run:
         if method is not None:
             _check_method(method)
             _check_options(method, options)
-        self.t_eval = _output_times(t_start, t_end, t_eval, count("n_points", n_points, 2))
+        self.t_eval = _output_times(t_start, t_end, t_eval, n_points)
         self.bounds = np.linspace(t_start, t_end, count("n_segments", n_segments) + 1)
         if progress is not None and not callable(progress):
             raise ValueError(f"progress: expected a callable progress(t), got {progress!r}")
@@ -608,8 +625,12 @@ def _evaluator(system, evaluator):
 
 
 def _output_times(t_start, t_end, t_eval, n_points) -> NDArray:
+    """The output rows' times: ``t_eval``, or ``n_points`` (501 if None) equally spaced; not both."""
     if t_eval is None:
-        return np.linspace(t_start, t_end, n_points)
+        return np.linspace(t_start, t_end, count("n_points", 501 if n_points is None else n_points, 2))
+    if n_points is not None:
+        raise ValueError(f"n_points, t_eval: give one of them (t_eval's times are the output rows), got n_points = "
+                         f"{n_points!r} beside t_eval")
     t_eval = finite_array("t_eval", t_eval)
     if t_eval.ndim != 1 or np.any(np.diff(t_eval) <= 0) or t_eval[0] < t_start or t_eval[-1] > t_end:
         raise ValueError(f"t_eval: must increase strictly within [{t_start}, {t_end}]")

@@ -46,6 +46,7 @@ import numpy as np
 
 from projeq.checks import finite_array
 from projeq.scenes import Scene, check_names, get_scene
+from projeq.simulation.driver import check_options
 from projeq.simulation.export import written_atomically
 from projeq.studies.table import Table, csv_cells, csv_line
 
@@ -406,6 +407,7 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
         for name in named:
             _named_column(model.coordinates(), model.velocities(), name)
     t_end = scene.t_end if t_end is None else _end_time(t_end, options.get("t_start", 0.0))
+    check_options(options)  # a misspelt option is one error here, not every point failing alike
     if resume and path is None:
         raise ValueError("resume: needs path, the table of the sweep to resume")
     header = list(points[0]) + outputs + ["status", "error"]

@@ -251,13 +251,11 @@ def test_analyses_refuse_a_state_off_the_loop_closures(analysis):
     analysis(system, system.q0)  # the closed loop is taken
 
 
-@pytest.mark.xfail(strict=True, reason="projeq/simulation/driver.py (another engineer's file) projects simulate's "
-                   "q0 onto Φ = 0 without a word (system.normalized), where ConstrainedSystem(q0=...) refuses it "
-                   "unless project_q0=True; it should call system.check_closed('q0', q0) first")
 def test_simulate_refuses_q0_off_the_loop_closures():
-    """Passes once simulate(four_bar(), q0=q) with the loop open by 16 cm is a ValueError naming
-    q0; now the run starts from the minimum-norm projection, which also moves the crank angle the
-    user gave, 0.5 → 0.4932 rad."""
+    """simulate(four_bar(), q0=q) with the loop open by 16 cm is a ValueError naming q0, as
+    ConstrainedSystem(q0=...) is (beyond :data:`projeq.system.CLOSED`, far above rounding); it
+    started from the minimum-norm projection, which also moved the crank angle the user gave,
+    0.5 → 0.4932 rad."""
     system = four_bar(omega1=0.0)
     with pytest.raises(ValueError, match=r"^q0: violates the loop closures"):
         pq.simulate(system, 0.1, q0=system.q0 + np.array([0.0, 0.2, 0.0]), n_points=3)

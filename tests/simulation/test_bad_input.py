@@ -54,13 +54,10 @@ def test_samples_in_another_key_order_are_logged_under_their_columns(tmp_path, m
     assert logged["m1"].tolist() == [1.0, 4.0] and logged["m2"].tolist() == [2.0, 3.0]
 
 
-@pytest.mark.xfail(strict=True, reason="projeq/simulation/driver.py (another engineer's file) checks simulate's "
-                   "options only inside simulate, privately (_check_options): a sweep learns of a misspelt option "
-                   "from every point failing alike; it needs a public check sweep can call at entry")
 def test_a_misspelt_simulate_option_is_refused_before_any_point_runs():
-    """Passes once sweep(..., rtoll=1e-6) raises the ValueError simulate raises for it ("options:
-    unknown option ['rtoll'] for method 'DOP853' ...") before running a point; now every point
-    fails with it (status −1) and the sweep itself returns normally."""
+    """sweep(..., rtoll=1e-6) raises the ValueError simulate raises for it ("options: unknown
+    option ['rtoll'] ...") before running a point (every point failed with it, status −1, and the
+    sweep itself returned normally)."""
     with pytest.raises(ValueError, match=r"^options: unknown option \['rtoll'\]"):
         _sweep(grid={"m1": [1.0, 2.0]}, rtoll=1e-6)
 
@@ -100,11 +97,9 @@ def test_plots_refuse_by_name(draw, message):
         draw(plots, _result())
 
 
-@pytest.mark.xfail(strict=True, reason="projeq/simulation/driver.py (another engineer's file): simulate takes "
-                   "n_points and t_eval together and silently ignores n_points")
 def test_simulate_refuses_n_points_beside_t_eval():
-    """Passes once simulate(t_eval=[0, 0.5, 1], n_points=50) is a ValueError naming both; now the
-    run returns the 3 rows of t_eval and the 50 asked for are dropped without a word."""
+    """simulate(t_eval=[0, 0.5, 1], n_points=50) is a ValueError naming both (the run returned the
+    3 rows of t_eval and dropped the 50 asked for without a word)."""
     with pytest.raises(ValueError, match=r"^n_points, t_eval: "):
         pq.simulate(pq.scenes.chain(2), 1.0, t_eval=[0.0, 0.5, 1.0], n_points=50)
 
