@@ -73,11 +73,10 @@ def check_options(options: dict) -> None:
     """ValueError naming a keyword of ``options`` that :func:`simulate` would refuse, before any run
     (a sweep's points): simulate's own parameters pass, the others are the integrator's options —
     of ``options["method"]`` if given, else of any built-in method (simulate chooses per model)."""
-    own = set(inspect.signature(simulate).parameters) - {"system", "t_end", "options"}
     method = options.get("method")
     if method is not None:
         _check_method(method)
-    _check_options(method, {name: value for name, value in options.items() if name not in own})
+    _check_options(method, {name: value for name, value in options.items() if name not in SIMULATE_KEYWORDS})
 
 
 def _check_options(method, options: dict) -> None:
@@ -228,6 +227,10 @@ def simulate(
     if run.status == -1:
         raise _failure(run, result) from run.cause
     return result
+
+
+#: simulate's own keyword parameters (the rest of its keywords are the integrator's options)
+SIMULATE_KEYWORDS = frozenset(inspect.signature(simulate).parameters) - {"system", "t_end", "options"}
 
 
 @dataclass(frozen=True)
