@@ -28,7 +28,10 @@ class BeamProbes:
         """(u + u₂, v, w) at stations x in the beam's reference frame: for one q_e a
         (len(x), 3) array, for a trajectory of q_e (rows) a (n_t, len(x), 3) array."""
         x = self._stations(x)
-        field = self.slice_field(x, self.station_data(x))
+        return self._displacement(q_e, x, self.slice_field(x, self.station_data(x)))
+
+    def _displacement(self, q_e, x, field) -> NDArray:
+        """:meth:`displacement` at the stations x of the slice ``field``."""
         q_e = np.asarray(q_e, dtype=float)
         rows = [self.slices(q, field)[0] - np.outer(x, (1.0, 0.0, 0.0)) for q in np.atleast_2d(q_e)]
         return np.array(rows) if q_e.ndim == 2 else rows[0]
@@ -39,8 +42,8 @@ class BeamProbes:
         against 1: Bremer, *Elastic Multibody Dynamics*, 2008, §6.2): what was reached and what
         to do, or None. Limits: lateral deflection or axial displacement 10 % of L, a slope
         of the centre line 0.2 rad."""
-        x = np.linspace(0.0, self.length, 21)
-        d = self.displacement(np.atleast_2d(q_e), x)
+        x = np.linspace(0.0, self.length, 21)  # the centre line's stations: their field formed once
+        d = self._displacement(np.atleast_2d(q_e), x, self._centre_line_field(len(x)))
         lateral = np.hypot(d[..., 1], d[..., 2])
         reached = {"lateral deflection": lateral.max() / self.length,
                    "axial displacement": np.abs(d[..., 0]).max() / self.length}
