@@ -386,23 +386,40 @@ def _given_motions(joints, q, s_dot_tree, t, given):
         _given_into(joints[g, 5], q[q0:q0 + n_q], s_dot_tree[s0:s0 + n_s], t, given[n])
 
 
-def _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A, b_s):
-    """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree) and b_s ← the right side of A_s ṡ_tree = b_s, here 0 (Φ and the
-    Pfaffian rows independent of t: :func:`unsupported`): Φ_q by :func:`_jacobian` in the first
-    ``m_h`` rows, the Pfaffian rows below them (:func:`_pfaffian_rows`). The kernels' variant for cut
-    joints (:func:`_compiled`) calls :func:`_pin_constraint_rows` under this name instead."""
+def _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
+    """A ← A_s = [Φ_q; A(q)] (q̇ = ṡ_tree): Φ_q by :func:`_jacobian` in the first ``m_h`` rows, the
+    Pfaffian rows below them (:func:`_pfaffian_rows`). The kernels' variant for cut joints
+    (:func:`_compiled`) calls :func:`_pin_constraint_rows` under this name instead."""
     _jacobian(phi, q, t, A[:m_h])
     _pfaffian_rows(pfaffian, q, t, m_h, A)
-    b_s[:] = 0.0
 
 
-def _pin_constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A, b_s):
+def _pin_constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
     """:func:`_constraint_rows` of cut joints (``pins``, ``fields``: :func:`pin_table`): their rows
-    and b_s = −∂Φ/∂t (the motions of the tree's joints prescribed in time) by :func:`_pins_at_rest`,
-    the Pfaffian rows below them."""
-    _pins_at_rest(pins, fields, joints, tree, q, t, A[:m_h], b_s[:m_h])
+    by :func:`_pins_at_rest`, the Pfaffian rows below them."""
+    _pins_at_rest(pins, fields, joints, tree, q, t, A[:m_h])
     _pfaffian_rows(pfaffian, q, t, m_h, A)
-    b_s[m_h:] = 0.0
+
+
+#: the constraints' b_s where they do not move in time (:func:`_constraint_rates`): no rows
+_AT_REST = np.zeros(0)
+
+
+def _constraint_rates(pins, joints, fields, tree, q, m_h, m):
+    """b_s of A_s ṡ_tree = b_s where the constraints move in time, else an empty array: here always
+    (Φ and the Pfaffian rows independent of t: :func:`unsupported`). The kernels' variant for cut
+    joints calls :func:`_pin_constraint_rates` under this name instead."""
+    return _AT_REST
+
+
+def _pin_constraint_rates(pins, joints, fields, tree, q, m_h, m):
+    """:func:`_constraint_rates` of cut joints: b_s = [−∂Φ/∂t; 0] by :func:`_pin_rates` from the chain
+    at ṡ_tree = 0 that :func:`_pin_constraint_rows` leaves in the workspace, where a joint of kind
+    GIVEN moves the tree (the Pfaffian rows' b = 0: :func:`unsupported`)."""
+    b_s = np.zeros(m if joints.shape[0] else 0)
+    if joints.shape[0]:
+        _pin_rates(pins, fields, tree, q, b_s[:m_h])
+    return b_s
 
 
 def _pfaffian_rows(pfaffian, q, t, m_h, A):
@@ -492,26 +509,24 @@ def cut_joint_rows(pins, fields, joints, tree, q, q_dot, t, values, A, b_s, gamm
     ConstrainedSystem asks for outside its accelerations: projections, conditions, residuals): Φ, A_s
     and b_s from the tree's chain terms at ṡ_tree = 0 (:func:`_pins_at_rest`), γ by
     :func:`_pins_moving` where q̇ ≠ 0 or a joint of kind GIVEN moves the tree."""
-    _pins_at_rest(pins, fields, joints, tree, q, t, A, b_s)
+    _pins_at_rest(pins, fields, joints, tree, q, t, A)
     _pin_values(pins, fields, tree, q, values)
+    if joints.shape[0]:  # only joints of kind GIVEN move the tree at ṡ_tree = 0
+        _pin_rates(pins, fields, tree, q, b_s)
     gamma[:] = 0.0
     if joints.shape[0] or np.any(q_dot != 0.0):
         _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma)
 
 
-def _pins_at_rest(pins, fields, joints, tree, q, t, A, b_s):
-    """A ← Φ_q of the cut joints (:func:`_pin_jacobian`) and b_s ← −∂Φ/∂t (:func:`_pin_rates`) from the
-    tree's chain terms at q and ṡ_tree = 0, its joints of kind GIVEN stated there (their motions in
-    time alone move the tree; positions and F⁶ need no velocities); the chain terms stay in the
-    tree's workspace for :func:`_pin_values`."""
+def _pins_at_rest(pins, fields, joints, tree, q, t, A):
+    """A ← Φ_q of the cut joints (:func:`_pin_jacobian`) from the tree's chain terms at q and
+    ṡ_tree = 0, its joints of kind GIVEN stated there (positions and F⁶ need no velocities; their
+    motions in time alone move the tree); the chain terms stay in the tree's workspace for
+    :func:`_pin_values` and :func:`_pin_rates`."""
     rest = np.zeros(q.shape[0], q.dtype)
     _given_motions(joints, q, rest, t, tree[4])
     _chain_terms(tree, q, rest)
     _pin_jacobian(pins, fields, tree, q, A)
-    if joints.shape[0]:  # only joints of kind GIVEN move the tree at ṡ_tree = 0
-        _pin_rates(pins, fields, tree, q, b_s)
-    else:
-        b_s[:] = 0.0
 
 
 def _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma):
@@ -770,8 +785,7 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
     A_s = [Φ_q; A], M and b; returns DONE, SINGULAR (:func:`_projected`) or DEGENERATE where
     ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
     n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
-    b_s = np.empty(m)
-    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A, b_s)
+    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
     A_dep = np.empty((m, m))
     for r in range(m):
         for c in range(m):
@@ -788,9 +802,11 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
                 total += inv[r, i] * A[i, independent[c]]
             F[dependent[r], c] = -total
     s_dot_tree = _matvec(F, s_dot)
-    f = _matvec(inv, b_s)  # ṡ_tree = F ṡ + f, f = [0; A_dep⁻¹ b_s]
-    for r in range(m):
-        s_dot_tree[dependent[r]] += f[r]
+    b_s = _constraint_rates(pins, joints, fields, tree, q, m_h, m)
+    if b_s.shape[0]:  # ṡ_tree = F ṡ + f, f = [0; A_dep⁻¹ b_s]
+        f = _matvec(inv, b_s)
+        for r in range(m):
+            s_dot_tree[dependent[r]] += f[r]
     q_dot[:] = s_dot_tree
     gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
     f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
@@ -810,8 +826,7 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     ``acting`` σ_max, and ṡ_tree = F ṡ + f with f the same particular solution of A_s f = b_s;
     otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular."""
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
-    b_s = np.empty(m)
-    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A, b_s)
+    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
     U, sigma, Vt = _svd(A)
     near = 0  # the singular values below separation σ_max, at least k
     for value in sigma:
@@ -830,9 +845,11 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     for value in sigma:
         count += value > acting * sigma[0]
     s_dot_tree = _matvec(F, s_dot)
-    f = _particular(U, sigma, Vt, -b_s, min(count, rank), F, independent)  # A_s f = b_s, f[independent] = 0
-    for i in range(n):
-        s_dot_tree[i] += f[i]
+    b_s = _constraint_rates(pins, joints, fields, tree, q, m_h, m)
+    if b_s.shape[0]:  # ṡ_tree = F ṡ + f, A_s f = b_s with f[independent] = 0
+        f = _particular(U, sigma, Vt, -b_s, min(count, rank), F, independent)
+        for i in range(n):
+            s_dot_tree[i] += f[i]
     q_dot[:] = s_dot_tree
     gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
     f_bar = _particular(U, sigma, Vt, gamma, min(count, rank), F, independent)
@@ -1066,7 +1083,7 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame,
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _constraint_rates, _pfaffian_rows, _pfaffian_gamma, _pin_frame,
             _port_chain, _pins_at_rest, _pins_moving, _pin_values, _pin_rates, _body_jacobians, _inertial_axis,
             _pin_jacobian, _pin_gamma, _given_motions, _matvec, _matmul, _svd, _transposed_qr, _reflect, _jacobi,
             _row_square, _scaled, _particular, _chain_terms, _projected, _inverse)
@@ -1296,6 +1313,11 @@ class CutJointRows:
         return self._call(x[:-1], q_dot, x[-1])[3]
 
 
+#: the kernels' helpers for a Φ made of cut joints, under the names of the general ones
+_PINNED = {"_constraint_rows": _pin_constraint_rows, "_constraint_gamma": _pin_constraint_gamma,
+           "_constraint_rates": _pin_constraint_rates}
+
+
 @functools.cache
 def _compiled(elastic: bool = False, pinned: bool = False) -> dict:
     """{"partitioned": …, "tangent": …, "cut_joint_rows": …}: the kernels compiled by numba (cached on
@@ -1304,13 +1326,12 @@ def _compiled(elastic: bool = False, pinned: bool = False) -> dict:
     constant, or for trees with ``elastic`` bodies the one that reads each body's n_y), the force
     laws' loop of :mod:`projeq.assembly.loads`, and Φ, A and the UserJoints' relative motions through
     their C callbacks' addresses by the intrinsics :func:`_phi_into` and :func:`_given_into`. For a Φ
-    made of cut joints (``pinned``) the same source with :func:`_pin_constraint_rows` and
-    :func:`_pin_constraint_gamma` under the names of :func:`_constraint_rows` and
-    :func:`_constraint_gamma` (as the rigid passes take ``_six`` for ``_rows``): the other closures'
-    kernels hold no code of theirs."""
+    made of cut joints (``pinned``) the same source with the helpers of :data:`_PINNED` under the
+    names of :func:`_constraint_rows`, :func:`_constraint_gamma` and :func:`_constraint_rates` (as
+    the rigid passes take ``_six`` for ``_rows``): the other closures' kernels hold no code of theirs."""
     rules = ("partitioned", "tangent", "cut_joint_rows")
     prefix = ("elastic_" if elastic else "") + ("pinned_" if pinned else "")
-    replaced = {"_constraint_rows": _pin_constraint_rows, "_constraint_gamma": _pin_constraint_gamma} if pinned else {}
+    replaced = _PINNED if pinned else {}
     return dict(zip(rules, kernels.jit(partitioned, tangent, cut_joint_rows, callees=_HELPERS,
                                        kernels=_compiled_callees(elastic),
                                        names=tuple(prefix + rule for rule in rules), **replaced)))
@@ -1321,7 +1342,7 @@ def _interpreted(rule: str, pinned: bool):
     ``pinned`` Φ as :func:`_compiled` compiles them."""
     if not pinned:
         return globals()[rule]
-    namespace = {**globals(), "_constraint_rows": _pin_constraint_rows, "_constraint_gamma": _pin_constraint_gamma}
+    namespace = {**globals(), **_PINNED}
     return types.FunctionType(globals()[rule].__code__, namespace, rule)
 
 
