@@ -395,9 +395,14 @@ def _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
 
 
 def _pin_constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
-    """:func:`_constraint_rows` of cut joints (``pins``, ``fields``: :func:`pin_table`): their rows
-    by :func:`_pins_at_rest`, the Pfaffian rows below them."""
-    _pins_at_rest(pins, fields, joints, tree, q, t, A[:m_h])
+    """:func:`_constraint_rows` of cut joints (``pins``, ``fields``: :func:`pin_table`): their rows by
+    :func:`_pin_jacobian` from the tree's chain terms at q and ṡ_tree = 0, its joints of kind GIVEN
+    stated there (positions and F⁶ need no velocities; their motions in time alone move the tree),
+    which stay in the workspace (:func:`_pin_values`, :func:`_pin_rates`); the Pfaffian rows below."""
+    rest = np.zeros(q.shape[0], q.dtype)
+    _given_motions(joints, q, rest, t, tree[4])
+    _chain_terms(tree, q, rest)
+    _pin_jacobian(pins, fields, tree, q, A[:m_h])
     _pfaffian_rows(pfaffian, q, t, m_h, A)
 
 
@@ -446,10 +451,12 @@ def _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, q_dot, t, m_
 
 
 def _pin_constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, q_dot, t, m_h, m):
-    """:func:`_constraint_gamma` of cut joints: their part by :func:`_pins_moving`, the Pfaffian
-    part below it."""
-    gamma = np.zeros(m)
-    _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma[:m_h])
+    """:func:`_constraint_gamma` of cut joints: their part by :func:`_pin_gamma` from the tree's chain
+    terms at (q, q̇ = ṡ_tree), its joints of kind GIVEN stated there; the Pfaffian part below it."""
+    gamma = np.zeros(m, q.dtype)
+    _given_motions(joints, q, q_dot, t, tree[4])
+    _chain_terms(tree, q, q_dot)
+    _pin_gamma(pins, fields, tree, q, q_dot, gamma[:m_h])
     _pfaffian_gamma(pfaffian, q, q_dot, t, m_h, gamma)
     return gamma
 
@@ -506,35 +513,20 @@ def _port_chain(A_port, r_port, T6):
 
 def cut_joint_rows(pins, fields, joints, tree, q, q_dot, t, values, A, b_s, gamma):
     """Φ, Φ_q = A_s (K = E), b_s = −∂Φ/∂t and γ = Φ̈ at s̈_tree = 0 of cut joints alone (the rows a
-    ConstrainedSystem asks for outside its accelerations: projections, conditions, residuals): Φ, A_s
-    and b_s from the tree's chain terms at ṡ_tree = 0 (:func:`_pins_at_rest`), γ by
-    :func:`_pins_moving` where q̇ ≠ 0 or a joint of kind GIVEN moves the tree."""
-    _pins_at_rest(pins, fields, joints, tree, q, t, A)
+    ConstrainedSystem asks for outside its accelerations: projections, conditions, residuals), by the
+    kernels' own helpers (a Φ of cut joints alone: no Φ callback, no Pfaffian rows): Φ, A_s and b_s
+    from the chain at ṡ_tree = 0 (:func:`_pin_constraint_rows`, :func:`_pin_values`,
+    :func:`_pin_rates`), γ by :func:`_pin_constraint_gamma` where q̇ ≠ 0 or a joint of kind GIVEN moves
+    the tree."""
+    m_h = pins.shape[0]
+    _pin_constraint_rows(0, pins, fields, 0, joints, tree, q, t, m_h, A)
     _pin_values(pins, fields, tree, q, values)
     if joints.shape[0]:  # only joints of kind GIVEN move the tree at ṡ_tree = 0
         _pin_rates(pins, fields, tree, q, b_s)
-    gamma[:] = 0.0
     if joints.shape[0] or np.any(q_dot != 0.0):
-        _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma)
-
-
-def _pins_at_rest(pins, fields, joints, tree, q, t, A):
-    """A ← Φ_q of the cut joints (:func:`_pin_jacobian`) from the tree's chain terms at q and
-    ṡ_tree = 0, its joints of kind GIVEN stated there (positions and F⁶ need no velocities; their
-    motions in time alone move the tree); the chain terms stay in the tree's workspace for
-    :func:`_pin_values` and :func:`_pin_rates`."""
-    rest = np.zeros(q.shape[0], q.dtype)
-    _given_motions(joints, q, rest, t, tree[4])
-    _chain_terms(tree, q, rest)
-    _pin_jacobian(pins, fields, tree, q, A)
-
-
-def _pins_moving(pins, fields, joints, tree, q, q_dot, t, gamma):
-    """gamma ← Φ″(q̇, q̇) of the cut joints (:func:`_pin_gamma`) from the tree's chain terms at
-    (q, q̇ = ṡ_tree), its joints of kind GIVEN stated there."""
-    _given_motions(joints, q, q_dot, t, tree[4])
-    _chain_terms(tree, q, q_dot)
-    _pin_gamma(pins, fields, tree, q, q_dot, gamma)
+        gamma[:] = _pin_constraint_gamma(0, pins, fields, 0, joints, tree, q, q_dot, t, m_h, m_h)
+    else:
+        gamma[:] = 0.0
 
 
 def _pin_values(pins, fields, tree, q, values):
@@ -1083,10 +1075,11 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _constraint_rates, _pfaffian_rows, _pfaffian_gamma, _pin_frame,
-            _port_chain, _pins_at_rest, _pins_moving, _pin_values, _pin_rates, _body_jacobians, _inertial_axis,
-            _pin_jacobian, _pin_gamma, _given_motions, _matvec, _matmul, _svd, _transposed_qr, _reflect, _jacobi,
-            _row_square, _scaled, _particular, _chain_terms, _projected, _inverse)
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _constraint_rates, _pin_constraint_rows,
+            _pin_constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame, _port_chain, _pin_values, _pin_rates,
+            _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, _given_motions, _matvec, _matmul, _svd,
+            _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms, _projected,
+            _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
