@@ -551,8 +551,8 @@ def _pin_rates(pins, fields, tree, q, b_s):
     """b_s[r] ← −Φ̇_r of cut-joint row r with the bodies' twists in the tree's workspace (at ṡ_tree = 0:
     those of its joints prescribed in time, so Φ̇ = ∂Φ/∂t): the points' velocities R_n A_P v_P,
     (v_P, ω_P) = T⁶_P ẏ_n (:func:`_pin_jacobian`; the stations' own rates are 0 at rest)."""
-    index, elastic, T, R, twist = tree[0], tree[5], tree[7], tree[12], tree[14]
-    k_max, dtype = (fields.shape[2] - 2) // 2, T.dtype
+    elastic, R, twist = tree[5], tree[12], tree[14]
+    k_max, dtype = (fields.shape[2] - 2) // 2, twist.dtype
     A_port, r_port, F_port, zeta_port = np.empty((3, 3), dtype), np.empty(3, dtype), np.empty((6, k_max), dtype), \
         np.empty(6, dtype)
     T6, e, rest = np.empty((6, 6), dtype), np.empty(3, dtype), np.zeros(q.shape[0], dtype)
