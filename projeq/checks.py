@@ -63,6 +63,14 @@ def non_negative(name: str, value) -> float:
     return x
 
 
+def flag(name: str, value) -> bool:
+    """A switch given as True or False: a string such as "False" (from a settings file) would be
+    truthy and silently switch it on."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name}: expected True or False, got {value!r}")
+    return bool(value)
+
+
 def count(name: str, value, minimum: int = 1) -> int:
     """An integer ≥ ``minimum`` (a number of points, segments, ...)."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:

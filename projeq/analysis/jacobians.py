@@ -60,6 +60,18 @@ class StateJacobians(NamedTuple):
     derivatives: str
 
 
+def check_point(system, q, s_dot, t: float, inputs) -> tuple[NDArray, NDArray, tuple]:
+    """(q, ṡ, inputs) of a point to differentiate at, checked: the model, the state's shapes and
+    values, q on the loop closures (:data:`projeq.system.CLOSED`: off Φ = 0 the Jacobians describe no
+    motion of the mechanism), q off a coordinate singularity (``check_configuration``: there A would
+    hold K's 1/cos(π/2) ≈ 1e16) and the inputs (:func:`check_inputs`)."""
+    check_model(system)
+    q, s_dot = system.check_state(q, s_dot, t)
+    system.check_closed("q", q, t, CLOSED)
+    system.check_configuration(q, t)
+    return q, s_dot, check_inputs(system, inputs)
+
+
 def check_inputs(system, inputs) -> tuple:
     """``inputs`` as a tuple of distinct joint names of ``system``; ValueError naming ``inputs``."""
     if isinstance(inputs, str):  # iterated, a name would be its letters
@@ -127,11 +139,7 @@ def state_jacobians(system, q: NDArray, s_dot: NDArray, t: float = 0.0, inputs=(
                     derivatives: str = "exact") -> StateJacobians:
     """The Jacobians of q̇ and s̈ at (q, ṡ, t) (module docstring); ``inputs`` name the joints
     whose generalized forces τ are differentiated for (∂s̈/∂τ, zero columns without)."""
-    check_model(system)
-    q, s_dot = system.check_state(q, s_dot, t)
-    system.check_closed("q", q, t, CLOSED)
-    system.check_configuration(q, t)
-    inputs = check_inputs(system, inputs)
+    q, s_dot, inputs = check_point(system, q, s_dot, t, inputs)
     x0 = np.concatenate((q, s_dot))
     J, used = state_jacobian(system, x0, t, derivatives)
     n_u = sum(system.joint(name).n_s for name in inputs)

@@ -31,9 +31,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.analysis.jacobians import check_inputs, differentiate, state_derivative, state_jacobian
-from projeq.checks import callable_name, positive
-from projeq.system import CLOSED, check_model
+from projeq.analysis.jacobians import check_point, differentiate, state_derivative, state_jacobian
+from projeq.checks import callable_name, flag, positive
+from projeq.system import check_model
 
 _TOL = 1e-8  # relative threshold: zero columns of A, and the steady-motion residual
 
@@ -138,13 +138,9 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
     check_model(system)
     q = system.q0 if q is None else q
     s_dot = system.s_dot0 if s_dot is None else s_dot
-    q, s_dot = system.check_state(q, s_dot, t)
-    system.check_closed("q", q, t, CLOSED)  # off Φ = 0 the Jacobians describe no motion of the mechanism
-    system.check_configuration(q, t)  # at a coordinate singularity A would hold K's 1/cos(π/2) ≈ 1e16
-    inputs = check_inputs(system, inputs)
+    q, s_dot, inputs = check_point(system, q, s_dot, t, inputs)
     tol = positive("tol", tol)  # a NaN threshold would pass every state as steady
-    if not isinstance(require_steady, (bool, np.bool_)):
-        raise ValueError(f"require_steady: expected True or False, got {require_steady!r}")
+    require_steady = flag("require_steady", require_steady)
     x0 = np.concatenate((q, s_dot))
     A, derivatives = state_jacobian(system, x0, t, derivatives)
     names = system.state_names()

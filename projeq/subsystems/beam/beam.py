@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import derivative_along
-from projeq.checks import count, finite_array, non_negative, positive
+from projeq.checks import count, finite_array, flag, non_negative, positive
 from projeq.joints import Relative
 from projeq.spatial import cross, rotation_x, rotation_y, rotation_z, skew, skew_stack
 from projeq.subsystems.beam import shapes
@@ -146,7 +146,7 @@ class RitzBeam(BeamProbes, Subsystem):
         self.support = support
         self.n_y = 6 + self.n_e
         self.S = np.vstack((np.eye(6), np.zeros((self.n_e, 6))))
-        self.stiffening = _flag("stiffening", stiffening)
+        self.stiffening = flag("stiffening", stiffening)
         self.damping = non_negative("damping", damping)
         default_order = 2 * max(self.n_u, self.n_v, self.n_w, self.n_beta) + 6
         order = default_order if quadrature_order is None else quadrature_order
@@ -167,7 +167,7 @@ class RitzBeam(BeamProbes, Subsystem):
         self._stiffness(EI_z, self._EI["y"], EA, GI_t)
         self._rotary(rho_I, rho_I_p)
         self._check_independent()
-        self.integrals = _integration(integration, _flag("precomputed_integrals", precomputed_integrals))(self)
+        self.integrals = _integration(integration, flag("precomputed_integrals", precomputed_integrals))(self)
         bending = np.r_[self.v_cols, self.w_cols] - 6
         M_b = self._mass_at_rest()[np.ix_(bending, bending)]
         self.first_frequency = first_bending_frequency(self.K_e[np.ix_(bending, bending)], M_b)
@@ -531,14 +531,6 @@ def first_bending_frequency(K_b: NDArray, M_b: NDArray) -> float:
     from scipy.linalg import eigh
 
     return float(np.sqrt(max(eigh(K_b, M_b, eigvals_only=True)[0], 0.0)))
-
-
-def _flag(name: str, value) -> bool:
-    """A switch given as True or False: a string such as "False" (from a settings file) would be
-    truthy and silently switch it on."""
-    if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name}: expected True or False, got {value!r}")
-    return bool(value)
 
 
 def _integration(integration, precomputed_integrals: bool):
