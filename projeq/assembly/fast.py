@@ -68,7 +68,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import COMPLEX_STEP
-from projeq.assembly import kernels, loads
+from projeq.assembly import given, kernels, loads
 from projeq.assembly.beam_fast import elastic_unsupported, hub_beam_unsupported
 from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
@@ -110,10 +110,14 @@ class FastEvaluator:
         self._chain_terms, self._passes = kernels.kernel(self.compiled, rigid=rigid)
         self._gauss_form, self._projected_accelerations = kernels.gauss_form_kernel(self.compiled, rigid=rigid)
         self._add_loads = loads.kernel(self.compiled) if len(self._laws) else None
-        # ẋ and ∂ẋ/∂x in one call where no Python runs between the kernels (no joint of kind GIVEN, no
-        # force law without a compiled row, no coupling): then every joint has q̇ = ṡ (K = E)
-        self._x_dot, self._jacobian = kernels.state_kernels(loads, self.compiled, rigid=rigid) \
-            if not (self._given or self._python_laws or system.coupled) else (None, None)
+        # ẋ and ∂ẋ/∂x in one call where no Python runs between the kernels (no force law without a
+        # compiled row, no coupling; joints of kind GIVEN all with compiled values, stated by their C
+        # callbacks, given.py): without joints of kind GIVEN every joint has q̇ = ṡ (K = E)
+        self._given_motions = given.motions_kernel() if self._given and self._printed and self.compiled else None
+        self._x_dot, self._jacobian = None, None
+        if not (self._python_laws or system.coupled or not self._printed):
+            self._x_dot, self._jacobian = given.state_kernels(self.compiled, rigid) if self._given else \
+                kernels.state_kernels(loads, self.compiled, rigid=rigid)
 
     def _pack(self, system) -> None:
         """Flat arrays of the tree (built once) and the real workspace (a complex one on first use,
@@ -123,6 +127,10 @@ class FastEvaluator:
         joints, bodies = system.joints, system.subsystems
         kind = [kernels.KINDS.get(j.compiled_kind, kernels.GIVEN) for j in joints]
         self._given = [n for n in range(N) if kind[n] == kernels.GIVEN]
+        # whether every joint of kind GIVEN has compiled values (given.py); their C callbacks' tables
+        # of each dtype are built on first use (None where numba cannot compile one)
+        self._printed = all(joints[n].compiled_values() is not None for n in self._given)
+        self._tables = {}
         n_cols = [j.n_s + b.n_e for j, b in zip(joints, bodies)]
         # every joint's own coordinates and velocities (and a body's internal ones after them), in
         # the order of the joints (q and ṡ themselves unless joints are coupled: then q_all = P_q q,
@@ -175,11 +183,30 @@ class FastEvaluator:
         return self._workspaces[dtype]
 
     def _relative_motions(self, ws: _Workspace, q_all: NDArray, s_all: NDArray, t: float) -> None:
-        """A, r, w, ζ and F⁶ of the joints of kind GIVEN, by their own ``relative_values`` (the
-        numbers of the ``relative`` the reference evaluators call), one row each."""
+        """A, r, w, ζ and F⁶ of the joints of kind GIVEN, one row each: by their C callbacks in one
+        compiled call where they all have them (:func:`projeq.assembly.given.given_motions`), else by
+        their own ``relative_values`` (the numbers of the ``relative`` the reference evaluators call)."""
         values = ws.given_values
+        table = self._joint_table(values.dtype) if self._given_motions is not None and not isinstance(t, complex) \
+            else None
+        if table is not None:
+            self._given_motions(table, q_all, s_all, float(t), values)
+            return
         for n, joint, q_n, s_n, width in self._given_plan:
             values[n, :width] = joint.relative_values(q_all[q_n], s_all[s_n], t)
+
+    def _joint_table(self, dtype) -> NDArray | None:
+        """The rows of :func:`projeq.assembly.given.joint_table` with the C callbacks of ``dtype`` (float,
+        or complex for the complex step) of the joints of kind GIVEN, built on first use; None where
+        numba cannot compile one (then they are stated in Python). Interpreted (``compiled=False``):
+        their ``compiled_values`` functions."""
+        dtype = np.dtype(dtype)
+        if dtype not in self._tables:
+            joints = [joint for _, joint, _, _, _ in self._given_plan]
+            callbacks = [given.joint_callback(joint, dtype) for joint in joints] if self.compiled else joints
+            self._tables[dtype] = None if None in callbacks else given.joint_table(self._given_plan, callbacks,
+                                                                                     self.compiled)
+        return self._tables[dtype]
 
     def _add_forces(self, ws: _Workspace, q: NDArray, s_dot: NDArray, t: float) -> None:
         """The own ``add_to`` of the laws without a compiled row (a callable load, a user's
@@ -301,11 +328,23 @@ class FastEvaluator:
         an evaluation fails (the caller's checked evaluation then raises, naming it)."""
         if self._x_dot is None or x.dtype.kind != "f":
             return None
+        head = self._head(float, t)
+        if head is None:
+            return None
         self.n_calls += 1
         x_dot = np.empty(len(x))
         tree, workspace = self._one_call_arguments(self._real)
-        failed = self._x_dot(*tree, kernels.kernel_array(x), self.system.n_q, *workspace, x_dot)
+        failed = self._x_dot(*head, *tree, kernels.kernel_array(x), self.system.n_q, *workspace, x_dot)
         return x_dot if failed < 0 else None
+
+    def _head(self, dtype, t: float) -> tuple | None:
+        """The one-call kernels' arguments before the tree's: none without joints of kind GIVEN; else
+        their table of C callbacks of ``dtype`` and the time t (:func:`projeq.assembly.given.given_state_derivative`),
+        None where numba cannot compile one."""
+        if not self._given:
+            return ()
+        table = self._joint_table(dtype)
+        return None if table is None else (table, float(t))
 
     def state_jacobian(self, t: float, x: NDArray) -> NDArray | None:
         """∂ẋ/∂x at the real state x = (q, ṡ) by the complex step through the kernels,
@@ -317,12 +356,17 @@ class FastEvaluator:
         coincident points: the caller's evaluation then raises, naming it)."""
         if self._jacobian is None:
             return None
+        head = self._head(complex, t)
+        if head is None:
+            return None
         self.n_calls += len(x)
         n_q = self.system.n_q
         J = np.zeros((len(x), len(x)))
-        J[:n_q, n_q:] = np.eye(n_q)
+        if not self._given:  # q̇ = ṡ; with joints of kind GIVEN the kernel writes all of ∂ẋ/∂x, ∂q̇/∂x included
+            J[:n_q, n_q:] = np.eye(n_q)
         tree, workspace = self._one_call_arguments(self._workspace(complex))
-        failed = self._jacobian(*tree, kernels.kernel_array(x), n_q, COMPLEX_STEP, *workspace, J[n_q:])
+        rows = J if self._given else J[n_q:]
+        failed = self._jacobian(*head, *tree, kernels.kernel_array(x), n_q, COMPLEX_STEP, *workspace, rows)
         return J if failed < 0 else None
 
     def _one_call_arguments(self, ws: _Workspace) -> tuple[tuple, tuple]:
@@ -349,7 +393,8 @@ class _Workspace:
         self.M = np.zeros((ev.system.n_s,) * 2, dtype)
         self.M_n = np.zeros((N, width, width), dtype)
         self.M_n[:, :6, :6] = ev._rigid_M
-        self.given_values = np.zeros((N, kernels.GIVEN_F + 36), dtype)
+        self.given_values = np.zeros((N, max([kernels.GIVEN_F + 36] + [given.row_width(ev.system.joints[n])
+                                                                          for n in ev._given])), dtype)
         self.F = np.zeros((N, width, depth), dtype)
         self.T, self.zeta = np.zeros((N, width, width), dtype), np.zeros((N, width), dtype)
         self.y_dot = np.zeros((N, width), dtype)

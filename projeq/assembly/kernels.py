@@ -645,7 +645,8 @@ def tree_accelerations(index, geometry, inertia, gravity, laws, constants, x, n_
 def tree_state_derivative(index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port, T,
                           zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, x_dot):
     """ẋ = (q̇, s̈) = (ṡ, s̈) at the real state x = (q, ṡ) into x_dot in one call
-    (:func:`tree_accelerations`; q̇ = ṡ: K = E for the trees it takes), the right-hand side of
+    (:func:`tree_accelerations`; q̇ = ṡ by :func:`_rates`: K = E for the trees it takes; with joints of
+    kind GIVEN, :func:`projeq.assembly.given.given_state_derivative`), the right-hand side of
     :func:`projeq.simulate` without Python between the kernels. Returns −1, or where the
     evaluation failed (:func:`tree_accelerations`' index) or x or ẋ is not finite: a
     non-negative number (the caller's checked evaluation then raises, naming the cause)."""
@@ -653,12 +654,18 @@ def tree_state_derivative(index, geometry, inertia, gravity, laws, constants, x,
                                 T, zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, x_dot[n_q:])
     if failed >= 0:
         return failed
-    for i in range(n_q):
-        x_dot[i] = x[n_q + i]
+    _rates(index, elastic, given, x, n_q, x_dot)
     for i in range(x.shape[0]):
         if not (np.isfinite(x[i]) and np.isfinite(x_dot[i])):
             return x.shape[0] + laws.shape[0]
     return -1
+
+
+def _rates(index, elastic, given, x, n_q, x_dot):
+    """x_dot[:n_q] ← q̇ = ṡ at x = (q, ṡ) (K = E of every joint); the one-call kernels of trees with
+    joints of kind GIVEN take :func:`projeq.assembly.given.given_rates` under this name."""
+    for i in range(n_q):
+        x_dot[i] = x[n_q + i]
 
 
 def tree_jacobian(index, geometry, inertia, gravity, laws, constants, x, n_q, step, given, elastic, port, T,
@@ -890,7 +897,7 @@ def state_kernels(loads, compiled: bool = True, rigid: bool = False):
 
 _CALLEES = (_relative_rotation, chain_matrix_into, add_cross, add_motion_cross, _rigid_h, dot6, dot_first, _rows, bias_rates,
             _add_congruence, _add_congruence_general, cholesky, cholesky_solve, _image, elastic_body, rotary_body,
-            port_motion, hub_motion)
+            port_motion, hub_motion, _rates)
 
 
 @functools.cache

@@ -61,20 +61,17 @@ a value, a spring-damper whose two points coincide).
 from __future__ import annotations
 
 import functools
-import hashlib
-import os
 import re
-import tempfile
 import types
 import warnings
 import weakref
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import kernels, loads
+from projeq.assembly.given import generated_module, given_motions, intrinsics, joint_callback, joint_table
 from projeq.assembly.kernels import (N_COLS, N_Y, PARENT, S_INDEX, add_cross, add_motion_cross, bias_rates,
                                      chain_matrix_into, cholesky, cholesky_solve, dot6, port_motion)
 from projeq.assembly.linalg import SINGULAR_PIVOT
@@ -177,7 +174,7 @@ def compiled_phi(phi, n: int, m, q0: NDArray, name: str = "phi", jitted=None):
     (``m`` rows, or the shape ``m`` of a matrix such as the Pfaffian rows A), real and imaginary
     parts each to 1e-13 relative, at three complex points near q0; else None after one
     :class:`UncompiledClosureWarning` naming ``phi`` (as the argument ``name``); ``jitted``: its
-    compiled form if already built (:func:`_generated_module`), checked the same way."""
+    compiled form if already built (:func:`~projeq.assembly.given.generated_module`), checked the same way."""
     import numba
 
     shape = (m,) if np.ndim(m) == 0 else tuple(m)
@@ -231,7 +228,7 @@ def closure_callback(phi, n: int, m, q0: NDArray, name: str = "phi"):
     callback ``into(x, t, value)`` (value ← Φ(x, t), x and value complex, a matrix row by row),
     built once per Φ source and constants in a process — and, for a function printed by
     :func:`projeq.symbolic.codegen.numeric_function`, compiled once and cached on disk
-    (:func:`_generated_module`); None (after one warning) if Φ does not compile (:func:`compiled_phi`)."""
+    (:func:`~projeq.assembly.given.generated_module`); None (after one warning) if Φ does not compile (:func:`compiled_phi`)."""
     key = (_key(phi), m)
     if key not in _CALLBACKS:
         size = int(np.prod(m))
@@ -241,7 +238,8 @@ def closure_callback(phi, n: int, m, q0: NDArray, name: str = "phi"):
     return _CALLBACKS[key]
 
 
-#: the C callbacks of printed functions (:func:`_generated_module`): Φ or A at complex x, and a joint's relative motion
+#: the C callback of a printed Φ or A at complex x (:func:`~projeq.assembly.given.generated_module`; a joint's relative
+#: motion: :func:`projeq.assembly.given.joint_callback`)
 _ROWS_INTO = """
 @numba.cfunc(nb.void(nb.CPointer(nb.complex128), nb.float64, nb.CPointer(nb.complex128)), cache=True)
 def into(x_pointer, t, value_pointer):
@@ -250,76 +248,18 @@ def into(x_pointer, t, value_pointer):
     for i in range({size}):
         value[i] = found[i]
 """
-_JOINT_INTO = """
-@numba.cfunc(nb.void(nb.CPointer(nb.float64), nb.CPointer(nb.float64), nb.float64, nb.CPointer(nb.float64)), cache=True)
-def into(q_pointer, s_pointer, t, row_pointer):
-    q_n, s_n, row = numba.carray(q_pointer, ({n_q},)), numba.carray(s_pointer, ({n_s},)), numba.carray(row_pointer, ({width},))
-    found = function(q_n, s_n, t)
-    for i in range({width}):
-        row[i] = found[i]
-"""
 
 
 def _printed_module(phi, into: str):
-    """:func:`_generated_module` of a function printed by :mod:`projeq.symbolic.codegen` (its
+    """:func:`~projeq.assembly.given.generated_module` of a function printed by :mod:`projeq.symbolic.codegen` (its
     ``source`` and ``constants``), None for any other or where it does not compile (then
     :func:`compiled_phi` compiles Φ in memory, or warns naming it)."""
     if not (hasattr(phi, "source") and hasattr(phi, "constants")):
         return None
     try:
-        return _generated_module(phi, into)
+        return generated_module(phi, into)
     except Exception:  # noqa: BLE001 — numba's typing and lowering errors have no common base
         return None
-
-
-def _generated_module(f, into: str):
-    """A module of ``f``'s printed source (``f.source``, its constants — the values its closure holds
-    — as globals) compiled by ``numba.njit(cache=True)`` as ``function``, and the C callback ``into``
-    (``cache=True``): written once to a file named by its digest in numba's cache directory (or
-    ~/.cache/projeq) and imported, so that numba's disk cache, which needs a file, keeps both across
-    processes (a temporary directory where that is not writable: compiled anew each process)."""
-    import importlib.util
-    import sys
-
-    import numba
-
-    constants = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
-    source = "\n".join(["import numba", "import numpy", "from numba import types as nb", "",
-                        *(f"{name} = {float(value)!r}" for name, value in sorted(constants.items())), "",
-                        "@numba.njit(cache=True)", f.source.replace(f"def {f.__name__}(", "def function(", 1), into])
-    digest = hashlib.sha1((source + numba.__version__).encode()).hexdigest()[:20]
-    module_name = f"projeq_generated_{digest}"
-    if module_name not in sys.modules:
-        path = _write_once(module_name + ".py", source)
-        spec = importlib.util.spec_from_file_location(module_name, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[module_name] = module  # numba's cache finds the module by its name
-        try:
-            spec.loader.exec_module(module)
-        except Exception:
-            del sys.modules[module_name]
-            raise
-    return sys.modules[module_name]
-
-
-def _write_once(filename: str, source: str) -> Path:
-    """The path of ``filename`` holding ``source`` in the cache directory (written atomically if absent)."""
-    import numba
-
-    for folder in (numba.config.CACHE_DIR or os.path.join(os.environ.get("XDG_CACHE_HOME") or
-                                                           os.path.expanduser("~/.cache"), "projeq"), None):
-        try:
-            folder = Path(folder or tempfile.mkdtemp(prefix="projeq-generated-")) / "generated"
-            folder.mkdir(parents=True, exist_ok=True)
-            path = folder / filename
-            if not path.is_file() or path.read_text() != source:
-                part = folder / f"{filename}.{os.getpid()}.part"
-                part.write_text(source)
-                os.replace(part, path)
-            return path
-        except OSError:
-            continue
-    raise OSError(f"cannot write the generated module {filename} to a cache or a temporary directory")
 
 
 def _callback(jitted, n: int, m):
@@ -346,44 +286,10 @@ def _callback(jitted, n: int, m):
     return numba.cfunc(nb.void(pointer, nb.float64, pointer))(into)
 
 
-def joint_callback(joint):
-    """The relative motion of a UserJoint from sympy (:meth:`~projeq.joints.UserJoint.compiled_values`:
-    A, r, w, ζ, F⁶ as one row) compiled as a C callback ``into(q_n, s_n, t, row)`` (real), built
-    once per expressions in a process and cached on disk (:func:`_generated_module`)."""
-    values = joint.compiled_values()
-    if values not in _CALLBACKS:
-        into = _JOINT_INTO.format(n_q=joint.n_q, n_s=joint.n_s, width=kernels.GIVEN_F + 6 * joint.n_s)
-        try:
-            _CALLBACKS[values] = _generated_module(values, into).into
-        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
-            warnings.warn(f"joint: numba cannot compile the relative motion of {joint!r} ({type(exc).__name__}); "
-                          "the constrained s̈ takes the numpy path (about ten times slower)",
-                          UncompiledClosureWarning, stacklevel=4)
-            _CALLBACKS[values] = None
-    return _CALLBACKS[values]
-
-
-def _phi_into(phi, x, t, value):
+def phi_into(phi, x, t, value):
     """value ← Φ(x, t): in the compiled kernels ``phi`` is the address of Φ's C callback (an
-    intrinsic calls it, :func:`_intrinsics`); interpreted, ``phi`` is Φ itself."""
+    intrinsic calls it, :func:`~projeq.assembly.given.intrinsics`); interpreted, ``phi`` is Φ itself."""
     value[:] = np.asarray(phi(x, t))
-
-
-def _given_into(values, q_n, s_n, t, row):
-    """row ← the relative motion (A, r, w, ζ, F⁶) of a joint of kind GIVEN at (q_n, ṡ_n, t): in the
-    compiled kernels ``values`` is the address of its C callback (:func:`joint_callback`, called by
-    an intrinsic, :func:`_intrinsics`); interpreted, the joint's ``compiled_values`` function itself."""
-    found = values(q_n, s_n, t)
-    row[:found.shape[0]] = found
-
-
-def _given_motions(joints, q, s_dot_tree, t, given):
-    """given[n] ← the relative motions of the tree's joints of kind GIVEN at (q, ṡ_tree, t), the
-    numbers :class:`~projeq.assembly.fast.FastEvaluator` has them state before its kernels run
-    (``joints``: one row (n, first coordinate, n_q, first velocity, n_s, callback) each)."""
-    for g in range(joints.shape[0]):
-        n, q0, n_q, s0, n_s = joints[g, 0], joints[g, 1], joints[g, 2], joints[g, 3], joints[g, 4]
-        _given_into(joints[g, 5], q[q0:q0 + n_q], s_dot_tree[s0:s0 + n_s], t, given[n])
 
 
 def _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A):
@@ -400,7 +306,7 @@ def _pin_constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A
     stated there (positions and F⁶ need no velocities; their motions in time alone move the tree),
     which stay in the workspace (:func:`_pin_values`, :func:`_pin_rates`); the Pfaffian rows below."""
     rest = np.zeros(q.shape[0], q.dtype)
-    _given_motions(joints, q, rest, t, tree[4])
+    given_motions(joints, q, rest, t, tree[4])
     _chain_terms(tree, q, rest)
     _pin_jacobian(pins, fields, tree, q, A[:m_h])
     _pfaffian_rows(pfaffian, q, t, m_h, A)
@@ -428,13 +334,13 @@ def _pin_constraint_rates(pins, joints, fields, tree, q, m_h, m):
 
 
 def _pfaffian_rows(pfaffian, q, t, m_h, A):
-    """A[m_h:] ← the Pfaffian rows A(q) (``pfaffian``, as Φ in :func:`_phi_into`), if any."""
+    """A[m_h:] ← the Pfaffian rows A(q) (``pfaffian``, as Φ in :func:`phi_into`), if any."""
     n, m_p = q.shape[0], A.shape[0] - m_h
     if m_p > 0:
         x, value = np.empty(n, np.complex128), np.empty((m_p, n), np.complex128)
         for i in range(n):
             x[i] = q[i]
-        _phi_into(pfaffian, x, t, value)
+        phi_into(pfaffian, x, t, value)
         for r in range(m_p):
             for j in range(n):
                 A[m_h + r, j] = value[r, j].real
@@ -454,7 +360,7 @@ def _pin_constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, q_dot, t
     """:func:`_constraint_gamma` of cut joints: their part by :func:`_pin_gamma` from the tree's chain
     terms at (q, q̇ = ṡ_tree), its joints of kind GIVEN stated there; the Pfaffian part below it."""
     gamma = np.zeros(m, q.dtype)
-    _given_motions(joints, q, q_dot, t, tree[4])
+    given_motions(joints, q, q_dot, t, tree[4])
     _chain_terms(tree, q, q_dot)
     _pin_gamma(pins, fields, tree, q, q_dot, gamma[:m_h])
     _pfaffian_gamma(pfaffian, q, q_dot, t, m_h, gamma)
@@ -469,7 +375,7 @@ def _pfaffian_gamma(pfaffian, q, q_dot, t, m_h, gamma):
         x, value = np.empty(n, np.complex128), np.empty((m_p, n), np.complex128)
         for i in range(n):
             x[i] = q[i] + 1j * COMPLEX_STEP * q_dot[i]
-        _phi_into(pfaffian, x, t, value)
+        phi_into(pfaffian, x, t, value)
         for r in range(m_p):
             total = 0.0
             for j in range(n):
@@ -670,7 +576,7 @@ def _jacobian(phi, q, t, A):
         for i in range(n):
             x[i] = q[i]
         x[j] = q[j] + 1j * COMPLEX_STEP
-        _phi_into(phi, x, t, value)
+        phi_into(phi, x, t, value)
         for r in range(m):
             A[r, j] = value[r].imag / COMPLEX_STEP
 
@@ -687,7 +593,7 @@ def _gamma(phi, q, q_dot, t, m):
         for i in range(n):
             u = q_dot[i] / speed
             x[i] = q[i] + u * NODES[node] + 1j * COMPLEX_STEP * u
-        _phi_into(phi, x, t, value)
+        phi_into(phi, x, t, value)
         for r in range(m):
             gamma[r] += WEIGHTS[node] * (value[r].imag / COMPLEX_STEP)
     for r in range(m):
@@ -769,10 +675,10 @@ def _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree):
 def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
                 q_dot, s_ddot_tree, A, M, b):
     """The constrained s̈ of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (module
-    docstring) from Φ (``phi``: :func:`_phi_into`; ``m_h`` rows) and the Pfaffian rows A(q)
+    docstring) from Φ (``phi``: :func:`phi_into`; ``m_h`` rows) and the Pfaffian rows A(q)
     (``pfaffian``), the tree's packed arrays and workspace (``tree``: those of
     :func:`projeq.assembly.kernels.chain_terms`) with its joints of kind GIVEN (``joints``:
-    :func:`_given_motions`), q, ṡ, t and the partition; ṡ_tree = F ṡ + f with f = [0; A_dep⁻¹ b_s]
+    :func:`given_motions`), q, ṡ, t and the partition; ṡ_tree = F ṡ + f with f = [0; A_dep⁻¹ b_s]
     (b_s = −∂Φ/∂t of cut joints across joints prescribed in time, else 0); writes q̇ = ṡ_tree (K = E), s̈_tree,
     A_s = [Φ_q; A], M and b; returns DONE, SINGULAR (:func:`_projected`) or DEGENERATE where
     ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
@@ -805,7 +711,7 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
     minus_gamma = _matvec(inv, -gamma)
     for r in range(m):
         f_bar[dependent[r]] = minus_gamma[r]
-    _given_motions(joints, q, s_dot_tree, t, tree[4])
+    given_motions(joints, q, s_dot_tree, t, tree[4])
     return _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
@@ -845,7 +751,7 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     q_dot[:] = s_dot_tree
     gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
     f_bar = _particular(U, sigma, Vt, gamma, min(count, rank), F, independent)
-    _given_motions(joints, q, s_dot_tree, t, tree[4])
+    given_motions(joints, q, s_dot_tree, t, tree[4])
     return _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
@@ -1077,7 +983,7 @@ def _inverse(A: NDArray) -> NDArray:
 
 _HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _constraint_rates, _pin_constraint_rows,
             _pin_constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame, _port_chain, _pin_values, _pin_rates,
-            _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, _given_motions, _matvec, _matmul, _svd,
+            _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, given_motions, _matvec, _matmul, _svd,
             _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms, _projected,
             _inverse)
 
@@ -1156,15 +1062,6 @@ def tree_arrays(ev, dtype) -> tuple:
             ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat, ws.R, ws.r, ws.twist, ev._laws, ev._law_constants)
 
 
-def _joint_table(ev, callbacks, compiled: bool) -> NDArray:
-    """One row (n, first coordinate, n_q, first velocity, n_s, callback) per joint of kind GIVEN of the
-    fast evaluator ``ev`` (:func:`_given_motions`): its C callback's address (``callbacks``), or
-    interpreted its ``compiled_values`` function."""
-    rows = [[n, q_n.start, joint.n_q, s_n.start, joint.n_s, back.address if compiled else joint.compiled_values()]
-            for (n, joint, q_n, s_n, _), back in zip(ev._given_plan, callbacks)]
-    return np.array(rows, dtype=np.int64 if compiled else object).reshape(len(rows), 6)
-
-
 def compiled_cut_joints(system) -> "CutJointRows | None":
     """The compiled rows of ``system``'s cut joints (:class:`CutJointRows`) where its Φ is made of them
     and the tree's kinematics compile — K = E, the tree's fast evaluator without
@@ -1203,7 +1100,7 @@ class CompiledClosure:
             self.phi, self.pfaffian = callback.address, 0 if pfaffian is None else pfaffian.address
         else:
             self.kernel, self.phi, self.pfaffian = _interpreted(rule, bool(len(self.pins))), callback, pfaffian
-        self.joints = _joint_table(ev, self._callbacks[1:], compiled)
+        self.joints = joint_table(ev._given_plan, self._callbacks[1:], compiled)
         self._workspace = ev._real
         self.tree = tree_arrays(ev, float)
         self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
@@ -1274,7 +1171,7 @@ class CutJointRows:
     def __init__(self, ev, pins: tuple, callbacks: list):
         self.fast, self.callbacks = ev, callbacks  # the callbacks live as long as this object
         self.pins, self.fields = pins
-        self.joints = _joint_table(ev, callbacks, compiled=True)
+        self.joints = joint_table(ev._given_plan, callbacks, compiled=True)
         self.kernel = _compiled(ev._width > 6, True)["cut_joint_rows"]
         self.complex_safe = not callbacks
         self._trees = {}
@@ -1318,7 +1215,7 @@ def _compiled(elastic: bool = False, pinned: bool = False) -> dict:
     compiled kernels of :mod:`projeq.assembly.kernels` (the Gauss form's rigid variant, n_y = 6 a
     constant, or for trees with ``elastic`` bodies the one that reads each body's n_y), the force
     laws' loop of :mod:`projeq.assembly.loads`, and Φ, A and the UserJoints' relative motions through
-    their C callbacks' addresses by the intrinsics :func:`_phi_into` and :func:`_given_into`. For a Φ
+    their C callbacks' addresses by the intrinsics :func:`phi_into` and :func:`~projeq.assembly.given.given_into`. For a Φ
     made of cut joints (``pinned``) the same source with the helpers of :data:`_PINNED` under the
     names of :func:`_constraint_rows`, :func:`_constraint_gamma` and :func:`_constraint_rates` (as
     the rigid passes take ``_six`` for ``_rows``): the other closures' kernels hold no code of theirs."""
@@ -1343,35 +1240,4 @@ def _compiled_callees(elastic: bool) -> dict:
     """The compiled functions the kernels call by name: the tree's kernels, the force laws' loop and
     the intrinsics that call the C callbacks."""
     return {"chain_terms": kernels.kernel(True)[0], "gauss_form": kernels.gauss_form_kernel(True, rigid=not elastic)[0],
-            "add_loads": loads.kernel(True), **_intrinsics()}
-
-
-@functools.cache
-def _intrinsics() -> dict:
-    """The compiled :func:`_phi_into` and :func:`_given_into`: each calls the C function at the
-    address its first argument holds with the data pointers of its arrays (numba's own layout of
-    complex128 and float64, that of the C callbacks) and its scalars as they are."""
-    import numba
-    from llvmlite import ir
-    from numba.extending import intrinsic
-
-    def caller(signature, args, context, builder):
-        address, values = args[0], []
-        for kind, value in zip(signature.args[1:], args[1:]):
-            is_array = isinstance(kind, numba.types.Array)
-            values.append(context.make_array(kind)(context, builder, value).data if is_array else value)
-        function = ir.FunctionType(ir.VoidType(), [v.type for v in values])
-        builder.call(builder.inttoptr(address, function.as_pointer()), values)
-        return context.get_dummy_value()
-
-    @intrinsic
-    def phi_into(typingctx, phi, x, t, value):
-        return numba.types.void(phi, x, t, value), lambda context, builder, signature, args: caller(
-            signature, args, context, builder)
-
-    @intrinsic
-    def given_into(typingctx, values, q_n, s_n, t, row):
-        return numba.types.void(values, q_n, s_n, t, row), lambda context, builder, signature, args: caller(
-            signature, args, context, builder)
-
-    return {"_phi_into": phi_into, "_given_into": given_into}
+            "add_loads": loads.kernel(True), **intrinsics()}

@@ -98,7 +98,8 @@ class Joint:
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         drop_inherited_twins(cls, Joint, ("relative", "K", "q_dot"),
-                             ("symbolic_relative", "symbolic_parameters", "compiled_kind", "relative_values"))
+                             ("symbolic_relative", "symbolic_parameters", "compiled_kind", "relative_values",
+                              "compiled_values"))
 
     def relative(self, q_n: NDArray, s_dot_n: NDArray, t: float) -> Relative:
         """Relative kinematics (A, r, F⁶, w, ζ) at (q_n, ṡ_n, t)."""
@@ -113,6 +114,13 @@ class Joint:
         of its expressions)."""
         rel = self.relative(q_n, s_dot_n, t)
         return np.concatenate((rel.A.ravel(), rel.r, rel.w, rel.zeta, rel.F.T.ravel()))
+
+    def compiled_values(self):
+        """``values(q_n, ṡ_n, t)`` -> the numbers of :meth:`relative_values` followed by q̇_n = K ṡ_n + k
+        (n_q entries), printed as scalar numpy code that numba compiles
+        (:func:`projeq.joints.user_compiler.printed_values`), for the compiled kernels
+        (:mod:`projeq.assembly.given`); None (the default) where the joint states them in Python only."""
+        return None
 
     def symbolic_relative(self, q_n, s_n, t: sp.Symbol, **parameters) -> SymbolicRelative:
         """The same kinematics as :meth:`relative` and :meth:`K` in sympy, at the symbols or

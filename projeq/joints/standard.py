@@ -151,6 +151,10 @@ class Planar(Joint):
         K[2, 2] = 1.0
         return K
 
+    def compiled_values(self):
+        """:meth:`projeq.joints.base.Joint.compiled_values` printed from :meth:`symbolic_relative`."""
+        return _compiled_symbolic(self)
+
     def symbolic_relative(self, q_n, s_n, t):
         P = algebra.exact(self._P)
         A = algebra.rotation(algebra.exact(self.normal), q_n[2])
@@ -178,6 +182,12 @@ class Free(Joint):
         K[:3, :3] = quaternion_matrix(quat)
         K[3:, 3:] = quaternion_rate_matrix(quat)
         return K
+
+    def compiled_values(self):
+        """:meth:`projeq.joints.base.Joint.compiled_values` printed from :meth:`symbolic_relative` with the
+        quaternion q/√(qᵀq) put in (as :meth:`relative` and :meth:`K` normalise it: the same numbers
+        off the unit sphere, and the same derivatives)."""
+        return _compiled_symbolic(self, unit=range(3, 7))
 
     def symbolic_relative(self, q_n, s_n, t):
         """With the quaternion taken as unit (the numeric joint normalises it)."""
@@ -304,5 +314,28 @@ def _printed_values(A, r, f, t):
     numba callback is built once."""
     from projeq.joints.user_compiler import printed_values
 
-    symbols = {"q": [], "s": [], "t": t, "A": A, "r": r, "F": sp.zeros(6, 0), "f": f, "zeta": f.diff(t)}
+    symbols = {"q": [], "s": [], "t": t, "A": A, "r": r, "F": sp.zeros(6, 0), "f": f, "zeta": f.diff(t),
+               "K": sp.zeros(0, 0), "k": sp.zeros(0, 1)}
     return printed_values(symbols)()
+
+
+@functools.lru_cache(maxsize=64)
+def _printed_relative(q, s, t, A, r, F, f, K, k):
+    """The compiled-form ``values`` of a joint's sympy form (A, r, F, f, K, k at the symbols q, ṡ, t),
+    ζ derived as for a UserJoint (:func:`projeq.joints.user_compiler.joint_symbols`), one function per
+    form in a process so that its numba callback is built once."""
+    from projeq.joints.user_compiler import joint_symbols, printed_values
+
+    return printed_values(joint_symbols(q, s, t, A, r, F, f, K, k))()
+
+
+def _compiled_symbolic(joint, unit=None):
+    """:func:`_printed_relative` of the joint's own ``symbolic_relative`` at fresh symbols (``unit``:
+    the coordinates whose values are normalised, q/√(qᵀq), put in as the numeric joint does)."""
+    q, s, t = sp.symbols(f"q0:{joint.n_q}"), sp.symbols(f"s0:{joint.n_s}"), sp.Symbol("t")
+    relative = joint.symbolic_relative(list(q), list(s), t)
+    if unit is not None:
+        u = [q[i] for i in unit]
+        length = sp.sqrt(sum(x**2 for x in u))
+        relative = SymbolicRelative(*(sp.Matrix(e).xreplace({x: x / length for x in u}) for e in relative))
+    return _printed_relative(q, s, t, *(sp.ImmutableMatrix(e) for e in relative))

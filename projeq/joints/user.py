@@ -72,8 +72,8 @@ class UserJoint(Joint):
         return SymbolicRelative(*(symbols[key].xreplace(rename) for key in ("A", "r", "F", "f", "K", "k")))
 
     def compiled_values(self):
-        """``values(q_n, ṡ_n, t)`` -> the array of :meth:`relative_values` (A, r, w, ζ, F⁶), the
-        same expressions printed as scalar numpy code that numba compiles
+        """``values(q_n, ṡ_n, t)`` -> the array of :meth:`relative_values` (A, r, w, ζ, F⁶) and q̇_n =
+        K ṡ_n + k (:meth:`projeq.joints.base.Joint.compiled_values`), the same expressions printed as scalar numpy code that numba compiles
         (:func:`projeq.joints.user_compiler.printed_values`), printed once per statement and
         made once per parameter values in a process (:func:`projeq.joints.user_compiler.derive`);
         None for a joint from callables."""

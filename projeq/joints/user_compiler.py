@@ -143,12 +143,8 @@ def derive(statement: Statement) -> Derived:
     A, r, F, K, f, k = (sp.Matrix(e) for e in statement[3:9])
     s_vec = sp.Matrix(s)
     rates = K * s_vec + k  # q̇
-
-    def d_dt(M: sp.Matrix) -> sp.Matrix:
-        return sum((M.diff(qi) * rates[i] for i, qi in enumerate(q)), M.diff(t))
-
-    zeta = d_dt(F) * s_vec + d_dt(f)
-    symbols = {"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k, "zeta": zeta}
+    symbols = joint_symbols(q, s, t, A, r, F, f, K, k)
+    zeta = symbols["zeta"]
     rel = sp.lambdify([p, q, s, t], [A, r, F, F * s_vec + f, zeta], modules="numpy", cse=True)
     K_fun = sp.lambdify([p, q, t], K, modules="numpy", cse=True)
     q_dot_fun = sp.lambdify([p, q, s, t], rates, modules="numpy", cse=True)
@@ -173,6 +169,22 @@ def derive(statement: Statement) -> Derived:
         sp.lambdify([p, q, s, t], list(rates), modules="math", cse=True),
         residual, n_c,
     )
+
+
+def joint_symbols(q, s, t, A, r, F, f, K, k) -> dict:
+    """The expressions {"q", "s", "t", "A", "r", "F", "K", "f", "k", "zeta"} of a joint's sympy form
+    (its symbols q, ṡ (``s``), t and A, r, F, f, K, k as :class:`projeq.joints.base.SymbolicRelative`
+    holds them), with ζ = Ḟ ṡ + ḟ = (∂F/∂q q̇ + ∂F/∂t) ṡ + ∂f/∂q q̇ + ∂f/∂t along q̇ = K ṡ + k."""
+    q, s = list(q), list(s)
+    A, r, F, f, K, k = (sp.Matrix(e) for e in (A, r, F, f, K, k))
+    s_vec = sp.Matrix(len(s), 1, s)
+    rates = K * s_vec + k
+
+    def d_dt(M: sp.Matrix) -> sp.Matrix:
+        return sum((M.diff(qi) * rates[i] for i, qi in enumerate(q)), M.diff(t))
+
+    zeta = d_dt(F) * s_vec + d_dt(f)
+    return {"q": q, "s": s, "t": t, "A": A, "r": r, "F": F, "K": K, "f": f, "k": k, "zeta": zeta}
 
 
 class Derived:
@@ -215,14 +227,22 @@ def value_expressions(symbols: dict) -> list:
     return [*symbols["A"], *symbols["r"], *(F * s + symbols["f"]), *symbols["zeta"], *F.T]
 
 
+def row_expressions(symbols: dict) -> list:
+    """The row of a joint's compiled values: :func:`value_expressions` (A, r, w, ζ, F⁶), then its
+    rates q̇ = K ṡ + k (n_q entries), which the compiled kernels read for ẋ
+    (:mod:`projeq.assembly.given`)."""
+    s = sp.Matrix(len(symbols["s"]), 1, list(symbols["s"]))
+    return [*value_expressions(symbols), *(symbols["K"] * s + symbols["k"])]
+
+
 def printed_values(symbols: dict, parameters=()):
-    """``make(*p)`` -> ``values(q_n, ṡ_n, t)``, the flat array of :func:`value_expressions` at
+    """``make(*p)`` -> ``values(q_n, ṡ_n, t)``, the flat array of :func:`row_expressions` at
     the ``parameters``' values p, printed as scalar numpy code that numba compiles, the values
     its constants (:func:`projeq.symbolic.codegen.numeric_function`; the parameters renamed
     p0, p1, … there, names numba can read)."""
     arguments = [("q", list(symbols["q"])), ("s", list(symbols["s"])), ("t", symbols["t"])]
     names = [sp.Symbol(f"p{i}") for i in range(len(parameters))]
-    expressions = [e.xreplace(dict(zip(parameters, names))) for e in value_expressions(symbols)]
+    expressions = [e.xreplace(dict(zip(parameters, names))) for e in row_expressions(symbols)]
     return codegen.numeric_function("relative_values", arguments, expressions, names)
 
 

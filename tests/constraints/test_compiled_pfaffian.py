@@ -12,6 +12,7 @@ import pytest
 import sympy as sp
 
 import projeq as pq
+from projeq.assembly.given import generated_module
 from projeq.constraints import compiled
 from projeq.constraints.compiled import CompiledClosure
 from projeq.constraints.partitioned import ConstrainedSystem
@@ -162,7 +163,7 @@ def test_a_printed_function_is_compiled_from_a_module_file_numba_caches(bike):
     compiled function gives Φ's own numbers, and whose C callback is the one the kernel calls."""
     from pathlib import Path
 
-    module = compiled._generated_module(bike._phi, compiled._ROWS_INTO.format(n=bike.n_q, size=1))
+    module = generated_module(bike._phi, compiled._ROWS_INTO.format(n=bike.n_q, size=1))
     assert Path(module.__file__).is_file() and Path(module.__file__).parent.name == "generated"
     x = bike.q0 + 0.1 + 1e-30j
     assert np.array_equal(module.function(x, 0.0).real, bike._phi(x, 0.0).real)
