@@ -31,8 +31,16 @@ from pathlib import Path
 import numpy as np
 
 from projeq.assembly import kernels, loads
-from projeq.assembly.kernels import (GIVEN, GIVEN_F, KIND, N_COLS, Q_INDEX, S_INDEX, tree_accelerations,
-                                     tree_state_derivative)
+from projeq.assembly.kernels import (
+    GIVEN,
+    GIVEN_F,
+    KIND,
+    N_COLS,
+    Q_INDEX,
+    S_INDEX,
+    tree_accelerations,
+    tree_state_derivative,
+)
 
 
 class UncompiledJointWarning(UserWarning):

@@ -12,7 +12,7 @@ import sympy as sp
 import projeq as pq
 from projeq.analysis.jacobians import exact_jacobian
 
-LINK = dict(r_c=(0.0, 0.0, -0.5), I_c=np.diag([0.08, 0.09, 0.01]))
+LINK = {"r_c": (0.0, 0.0, -0.5), "I_c": np.diag([0.08, 0.09, 0.01])}
 
 
 def _link(m=1.0):
@@ -128,7 +128,7 @@ def test_planar_and_free_compiled_values_are_their_relative_values(joint):
     for _ in range(3):
         q, s_dot, t = rng.standard_normal(joint.n_q), rng.standard_normal(joint.n_s), 0.4
 
-        def row(q):
+        def row(q, s_dot=s_dot, t=t):
             return np.concatenate((joint.relative_values(q, s_dot.astype(q.dtype), t), joint.K(q, t) @ s_dot))
 
         assert np.abs(values(q, s_dot, t) - row(q)).max() <= 1e-14 * np.abs(row(q)).max()

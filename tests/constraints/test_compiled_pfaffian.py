@@ -113,7 +113,7 @@ def test_a_user_joints_compiled_values_are_its_relative_values():
         values = numba.njit(joint.compiled_values())
         for _ in range(3):
             q_n, s_n, t = joint.default_q() + 0.3 * rng.standard_normal(joint.n_q), rng.standard_normal(joint.n_s), 0.4
-            expected = joint.relative_values(q_n, s_n, t)
+            expected = np.concatenate((joint.relative_values(q_n, s_n, t), joint.q_dot(q_n, s_n, t)))
             assert np.abs(values(q_n, s_n, t) - expected).max() <= 1e-14 * max(1.0, np.abs(expected).max())
     assert joints[0].rates_are_speeds and not joints[1].rates_are_speeds  # the disk's K ≠ E
 
