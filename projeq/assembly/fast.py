@@ -161,6 +161,7 @@ class FastEvaluator:
             for n in self._given
         ]
         self._n_cols = n_cols
+        self._n_x = system.n_q + system.n_s
         self._internal = [(n, system.e_s_slice[n]) for n, b in enumerate(bodies) if b.n_e]  # ṡ_e of ẏ_n
         terms = [law.compiled_terms() for law in system.forces]
         self._laws, self._law_constants = loads.table([row for row in terms if row is not None])
@@ -321,13 +322,16 @@ class FastEvaluator:
         return s_ddot
 
     def state_derivative(self, t: float, x: NDArray) -> NDArray | None:
-        """ẋ = (q̇, s̈) = (ṡ, s̈) at the real state x = (q, ṡ) in one call,
-        :func:`projeq.assembly.kernels.tree_state_derivative` (the compiled force laws' loads
-        included), for :func:`projeq.simulate`'s right-hand side; None where Python runs between
-        the kernels (as :meth:`state_jacobian`), for a complex x, or where x or ẋ is not finite or
-        an evaluation fails (the caller's checked evaluation then raises, naming it)."""
+        """ẋ = (q̇, s̈) at the real state x = (q, ṡ) in one call,
+        :func:`projeq.assembly.kernels.tree_state_derivative` (q̇ = ṡ; the compiled force laws' loads
+        included) or with joints of kind GIVEN :func:`projeq.assembly.given.given_state_derivative`
+        (their rows and q̇ by their C callbacks), for :func:`projeq.simulate`'s right-hand side; None
+        where Python runs between the kernels (as :meth:`state_jacobian`), for a complex x, or where x
+        or ẋ is not finite or an evaluation fails (the caller's checked evaluation then raises, naming
+        it); ValueError for an x that is not the tree's state (the kernels read n_q + n_s entries)."""
         if self._x_dot is None or x.dtype.kind != "f":
             return None
+        self._check_state(x)
         head = self._head(float, t)
         if head is None:
             return None
@@ -336,6 +340,12 @@ class FastEvaluator:
         tree, workspace = self._one_call_arguments(self._real)
         failed = self._x_dot(*head, *tree, kernels.kernel_array(x), self.system.n_q, *workspace, x_dot)
         return x_dot if failed < 0 else None
+
+    def _check_state(self, x: NDArray) -> None:
+        """ValueError unless x has the n_q + n_s entries of the tree's state (q, ṡ)."""
+        if x.shape != (self._n_x,):
+            raise ValueError(f"x: expected the tree's state (q, ṡ) of n_q + n_s = {self._n_x} entries, got shape "
+                             f"{x.shape}")
 
     def _head(self, dtype, t: float) -> tuple | None:
         """The one-call kernels' arguments before the tree's: none without joints of kind GIVEN; else
@@ -349,13 +359,15 @@ class FastEvaluator:
     def state_jacobian(self, t: float, x: NDArray) -> NDArray | None:
         """∂ẋ/∂x at the real state x = (q, ṡ) by the complex step through the kernels,
         :func:`projeq.assembly.kernels.tree_jacobian`: all n_x columns of ∂s̈/∂x in one call on
-        the complex workspace, the compiled force laws' loads included, ∂q̇/∂x = [0, E] (q̇ = ṡ);
-        None where Python runs between the kernels (joints of kind GIVEN, a force law without a
-        compiled row, coupled joints: the caller takes the complex step column by column through
-        :meth:`accelerations`) or an evaluation fails (a singular pivot, a spring-damper's
-        coincident points: the caller's evaluation then raises, naming it)."""
+        the complex workspace, the compiled force laws' loads included, ∂q̇/∂x = [0, E] (q̇ = ṡ); with
+        joints of kind GIVEN :func:`projeq.assembly.given.given_jacobian`, ∂q̇/∂x included (their
+        complex callbacks); None where Python runs between the kernels (joints stated in Python only,
+        a force law without a compiled row, coupled joints: the caller takes the complex step column
+        by column through :meth:`accelerations`) or an evaluation fails (a singular pivot, a
+        spring-damper's coincident points: the caller's evaluation then raises, naming it)."""
         if self._jacobian is None:
             return None
+        self._check_state(x)
         head = self._head(complex, t)
         if head is None:
             return None

@@ -159,3 +159,16 @@ def test_a_user_joint_from_callables_keeps_the_python_path():
     assert fast.state_derivative(t, x) is None and fast.state_jacobian(t, x) is None
     want = _reference(model, "recursive", t)(x)[model.n_q:]
     assert np.abs(fast.accelerations(x[:model.n_q], x[model.n_q:], t) - want).max() <= 1e-13 * np.abs(want).max()
+
+
+@pytest.mark.parametrize("extra", [1, -2], ids=["longer", "shorter"])
+def test_a_state_of_another_size_is_refused_by_name(extra):
+    """The one-call kernels read n_q + n_s entries of x without bounds checks: another size (a constrained
+    system's state handed to its tree) is a ValueError naming x and the size, not memory read or written
+    past its end."""
+    model = pq.scenes.rolling_disk()
+    fast = model.evaluator("fast")
+    x = np.zeros(model.n_q + model.n_s + extra)
+    for one_call in (fast.state_derivative, fast.state_jacobian):
+        with pytest.raises(ValueError, match=r"x: expected the tree's state \(q, ṡ\) of n_q \+ n_s = 8 entries"):
+            one_call(0.0, x)
