@@ -22,8 +22,10 @@ give the same equations as the selected ones, docs/theory.md §3) on any joint: 
 computes the relative motion of the joints whose ``compiled_kind`` it has
 (:class:`~projeq.Revolute`, :class:`~projeq.Prismatic`, :class:`~projeq.Fixed`); every
 other joint (Planar, Free, Spherical, Screw, Prescribed, UserJoint — non-holonomic ones
-too) states it by its own ``relative`` before each call, which the kernel reads (kind
-``GIVEN``, 0–6 minimal velocities). Coupled joints (gears, ropes: shared minimal
+too) states it before each call, which the kernel reads (kind ``GIVEN``, 0–6 minimal
+velocities): by the C callbacks of its ``compiled_values`` in one compiled call where every
+such joint has them (:mod:`projeq.assembly.given`: UserJoints from sympy, Prescribed motions
+in sympy, Planar, Free), else by its own ``relative_values``. Coupled joints (gears, ropes: shared minimal
 velocities) are evaluated in every joint's own velocities ṡ_all = P ṡ and projected,
 M = Pᵀ M_all P, b = Pᵀ b_all (B(14) with ∂ṡ_all/∂ṡ = P), by the compiled Gauss form.
 Under gravity and any force laws: between the compiled kinematics and the compiled passes
@@ -161,7 +163,7 @@ class FastEvaluator:
             for n in self._given
         ]
         self._n_cols = n_cols
-        self._n_x = system.n_q + system.n_s
+        self._x_shape = (system.n_q + system.n_s,)
         self._internal = [(n, system.e_s_slice[n]) for n, b in enumerate(bodies) if b.n_e]  # ṡ_e of ẏ_n
         terms = [law.compiled_terms() for law in system.forces]
         self._laws, self._law_constants = loads.table([row for row in terms if row is not None])
@@ -331,8 +333,9 @@ class FastEvaluator:
         it); ValueError for an x that is not the tree's state (the kernels read n_q + n_s entries)."""
         if self._x_dot is None or x.dtype.kind != "f":
             return None
-        self._check_state(x)
-        head = self._head(float, t)
+        if x.shape != self._x_shape:
+            self._refuse(x)
+        head = self._head(float, t) if self._given else ()
         if head is None:
             return None
         self.n_calls += 1
@@ -341,18 +344,15 @@ class FastEvaluator:
         failed = self._x_dot(*head, *tree, kernels.kernel_array(x), self.system.n_q, *workspace, x_dot)
         return x_dot if failed < 0 else None
 
-    def _check_state(self, x: NDArray) -> None:
-        """ValueError unless x has the n_q + n_s entries of the tree's state (q, ṡ)."""
-        if x.shape != (self._n_x,):
-            raise ValueError(f"x: expected the tree's state (q, ṡ) of n_q + n_s = {self._n_x} entries, got shape "
-                             f"{x.shape}")
+    def _refuse(self, x: NDArray) -> None:
+        """ValueError: x is not the tree's state (q, ṡ) of n_q + n_s entries."""
+        raise ValueError(f"x: expected the tree's state (q, ṡ) of n_q + n_s = {self._x_shape[0]} entries, got shape "
+                         f"{x.shape}")
 
     def _head(self, dtype, t: float) -> tuple | None:
-        """The one-call kernels' arguments before the tree's: none without joints of kind GIVEN; else
-        their table of C callbacks of ``dtype`` and the time t (:func:`projeq.assembly.given.given_state_derivative`),
+        """The one-call kernels' arguments before the tree's where it has joints of kind GIVEN: their
+        table of C callbacks of ``dtype`` and the time t (:func:`projeq.assembly.given.given_state_derivative`),
         None where numba cannot compile one."""
-        if not self._given:
-            return ()
         table = self._joint_table(dtype)
         return None if table is None else (table, float(t))
 
@@ -367,8 +367,9 @@ class FastEvaluator:
         spring-damper's coincident points: the caller's evaluation then raises, naming it)."""
         if self._jacobian is None:
             return None
-        self._check_state(x)
-        head = self._head(complex, t)
+        if x.shape != self._x_shape:
+            self._refuse(x)
+        head = self._head(complex, t) if self._given else ()
         if head is None:
             return None
         self.n_calls += len(x)
