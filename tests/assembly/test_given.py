@@ -185,3 +185,15 @@ def test_a_state_of_another_size_is_refused_by_name(extra):
     for one_call in (fast.state_derivative, fast.state_jacobian):
         with pytest.raises(ValueError, match=r"x: expected the tree's state \(q, ṡ\) of n_q \+ n_s = 8 entries"):
             one_call(0.0, x)
+
+
+def test_the_interpreted_kernels_are_the_reference():
+    """compiled=False runs the same one-call source interpreted (the joints' printed functions called as
+    they are, q̇ from their rows): ẋ = the recursive path's on the mixed tree."""
+    from projeq.assembly.fast import FastEvaluator
+
+    model = _mixed_tree()
+    x, t = _state(model, 3)
+    x_dot = FastEvaluator(model, compiled=False).state_derivative(t, x)
+    want = _reference(model, "recursive", t)(x)
+    assert np.abs(x_dot - want).max() <= 1e-13 * np.abs(want).max()
