@@ -20,7 +20,8 @@ Compiled by default: a RitzBeam, rotary inertia and torsion included (its slice 
 fields, which the compiled kernel evaluates, :func:`projeq.assembly.kernels.elastic_body` and
 :func:`~projeq.assembly.kernels.rotary_body`, the same statement of the beam's terms as the
 order-n kernel's elastic block) on a Prescribed Revolute or Prismatic, a Fixed joint or any
-joint without coordinates (read by its ``relative_values``) is one call of
+joint without coordinates (read by its ``relative_values``; a motion given in sympy by the C
+callback of its printed row, :mod:`projeq.assembly.given`, in one compiled call) is one call of
 :func:`projeq.assembly.kernels.hub_beam` per s̈. Any other subsystem with internal
 coordinates and the beam's layout ẏ = (twist, q̇_e) (a user's subsystem, a RitzBeam that
 restates its terms) takes the interpreted path through its ``elastic_terms``
@@ -44,7 +45,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import COMPLEX_STEP
-from projeq.assembly import kernels
+from projeq.assembly import given, kernels
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.joints import Prescribed
 
@@ -133,9 +134,17 @@ class HubBeamEvaluator:
         inner = joint.joint if isinstance(joint, Prescribed) else joint
         kind = kernels.KINDS.get(getattr(inner, "compiled_kind", None), kernels.GIVEN)
         self._kind = kind if isinstance(joint, Prescribed) or kind == kernels.FIXED else kernels.GIVEN
+        # a hub whose motion is printed (a Prescribed motion in sympy): its row by its C callback in one
+        # compiled call (projeq.assembly.given), in place of the motion's Python per evaluation
+        callback = given.joint_callback(joint) if self._kind != kernels.FIXED else None
+        self._kind = kernels.GIVEN if callback is not None else self._kind
         self._axis = np.array(inner.axis if self._kind in (kernels.REVOLUTE, kernels.PRISMATIC) else np.zeros(3),
                               dtype=float)
-        self._angles, self._given = np.zeros(3), np.zeros(24)
+        self._rows = np.zeros((1, max(kernels.GIVEN_F, given.row_width(joint))))
+        self._angles, self._given = np.zeros(3), self._rows[0]
+        self._table = None if callback is None else given.joint_table(
+            [(0, joint, slice(0, 0), slice(0, 0), None)], [callback])
+        self._motions = given.motions_kernel() if callback is not None else None
         self._orientation, self._gravity = np.array(joint.orientation, dtype=float), np.array(system.gravity, float)
         self._field = (np.array(beam.mass_weights, dtype=float), *(np.ascontiguousarray(a) for a in beam.slice_field()),
                        np.array(beam.K_e, dtype=float), float(beam.damping),
@@ -215,10 +224,13 @@ class HubBeamEvaluator:
         return float(0.5 * (y_dot @ M @ y_dot)), float(self.system.potential_energy(self._pose, x[: len(q)]))
 
     def _hub(self, t: float) -> None:
-        """The hub's (θ, θ̇, θ̈) of a Prescribed joint (its checked ``angles``) or the numbers of
-        its ``relative_values`` at t into the kernel's rows."""
-        if self._kind == kernels.GIVEN:
-            self._given[:] = self.joint.relative_values(self._empty, self._empty, t)[:24]
+        """The hub's row at t into the kernel's: by its C callback where its motion is printed
+        (:func:`projeq.assembly.given.given_motions`), else the (θ, θ̇, θ̈) of a Prescribed joint
+        (its checked ``angles``) or the numbers of its ``relative_values``."""
+        if self._table is not None:
+            self._motions(self._table, self._empty, self._empty, float(t), self._rows)
+        elif self._kind == kernels.GIVEN:
+            self._given[:24] = self.joint.relative_values(self._empty, self._empty, t)[:24]
         elif self._kind != kernels.FIXED:
             angles = self._angles
             angles[0], angles[1], angles[2] = self.joint.angles(t)

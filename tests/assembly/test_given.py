@@ -197,3 +197,20 @@ def test_the_interpreted_kernels_are_the_reference():
     x_dot = FastEvaluator(model, compiled=False).state_derivative(t, x)
     want = _reference(model, "recursive", t)(x)
     assert np.abs(x_dot - want).max() <= 1e-13 * np.abs(want).max()
+
+
+def test_a_hub_beam_on_a_motion_in_sympy_reads_it_by_its_callback():
+    """A RitzBeam on a Prescribed hub whose motion is given in sympy (method "hub_beam"): the hub's row by
+    its C callback in one compiled call per evaluation; s̈ and the one-call ẋ = (ṡ, s̈) = the recursive
+    evaluator's to round-off at three times."""
+    beam = pq.RitzBeam(1.2, 1.5, 25.0, EI_y=35.0, n_v=3, n_w=2, family="clamped_free", damping=0.02)
+    hub = pq.Prescribed(pq.Revolute(axis=(0.3, -0.5, 0.8), r_pn=(0.1, 0.2, -0.1)), "0.5*sin(2*t) + 0.3*t**2")
+    model = pq.System({"beam": beam}, {"beam": hub}, gravity=(0.0, 0.0, -9.81))
+    ev = model.evaluator("hub_beam")
+    rng = np.random.default_rng(4)
+    for t in (0.3, 2.0, 7.5):
+        q, s_dot = 0.05 * rng.standard_normal(model.n_q), rng.standard_normal(model.n_s)
+        want = model.accelerations(q, s_dot, t, method="recursive")
+        assert np.abs(ev.accelerations(q, s_dot, t) - want).max() <= 1e-13 * max(1.0, np.abs(want).max())
+        x_dot = ev.state_derivative(t, np.concatenate((q, s_dot)))
+        assert np.abs(x_dot - np.concatenate((s_dot, want))).max() <= 1e-13 * max(1.0, np.abs(want).max())
