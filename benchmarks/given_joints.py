@@ -56,9 +56,9 @@ def main(argv=None) -> None:
         ev = model.evaluator("fast")
         q, s_dot = state(model)
         x = np.concatenate((q, s_dot))
-        s_ddot = per_call(lambda: ev.accelerations(q, s_dot, 0.0), args.budget)
+        s_ddot = per_call(lambda ev=ev, q=q, s_dot=s_dot: ev.accelerations(q, s_dot, 0.0), args.budget)
         one_call = ev.state_derivative(0.0, x) is not None
-        x_dot = per_call(lambda: ev.state_derivative(0.0, x), args.budget) if one_call else None
+        x_dot = per_call(lambda ev=ev, x=x: ev.state_derivative(0.0, x), args.budget) if one_call else None
         print(f"{name:16} {s_ddot:8.2f} {'-' if x_dot is None else f'{x_dot:.2f}':>14}")
     if args.simulate:
         for name in ("rolling_disk", "car", "knife_edge_disc"):
