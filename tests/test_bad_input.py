@@ -153,6 +153,8 @@ def test_subsystems_and_joints_must_match(subsystems, joints, message):
         (lambda s: s.energy([0.1], [0.0, 1.0]), "s_dot"),
         (lambda s: pq.simulate(s, 1.0, q0=[0.1, 0.2]), "q0"),
         (lambda s: pq.simulate(s, 1.0, s_dot0=[]), "s_dot0"),
+        (lambda s: s.q_dot([0.1, 0.2], [0.0]), "q"),
+        (lambda s: s.q_dot([0.1], [0.0, 1.0]), "s_dot"),
         (lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, q0=[0.1, 0.2]), "q0"),
         (
             lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, s_dot0=[0, 1]),
@@ -168,6 +170,8 @@ def test_subsystems_and_joints_must_match(subsystems, joints, message):
         "energy-s_dot",
         "simulate-q0",
         "simulate-s_dot0",
+        "q_dot-q",
+        "q_dot-s_dot",
         "System-q0",
         "System-s_dot0",
     ],
@@ -187,6 +191,8 @@ def test_state_of_the_wrong_length(call, name):
         (lambda s: s.energy([0.1], [np.nan]), "s_dot"),
         (lambda s: pq.simulate(s, 1.0, q0=[np.nan]), "q0"),
         (lambda s: pq.simulate(s, 1.0, s_dot0=[-np.inf]), "s_dot0"),
+        (lambda s: s.q_dot([np.nan], [0.0]), "q"),
+        (lambda s: s.q_dot([0.1], [np.inf]), "s_dot"),
         (lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, q0=[np.nan]), "q0"),
         (
             lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, s_dot0=[np.nan]),
@@ -201,6 +207,8 @@ def test_state_of_the_wrong_length(call, name):
         "energy-s_dot",
         "simulate-q0",
         "simulate-s_dot0",
+        "q_dot-q",
+        "q_dot-s_dot",
         "System-q0",
         "System-s_dot0",
     ],
@@ -655,6 +663,18 @@ def test_system_K_and_generalized_force_take_plain_lists():
     system = _pendulum()
     assert system.K([0.3]).tolist() == [[1.0]]
     assert system.generalized_force([0.3], 0.0, {"bob": [2.5]}).tolist() == [2.5]
+
+
+@pytest.mark.parametrize("joint", [pq.Revolute(axis="y"), pq.Free()], ids=["Revolute", "Free"])
+def test_system_q_dot_takes_plain_lists(joint):
+    """Passes if q̇ from lists equals K(q) ṡ, the block-diagonal K of the joints formed apart
+    (docs/theory.md, "Kinematic chain and joints"), for a revolute joint (K = E) and a free joint (quaternion rates).
+    Before, numpy read the list in np.result_type as a structured dtype: "TypeError: Field
+    elements must be 2- or 3-tuples, got '0.3'"."""
+    system = pq.System({"b": pq.RigidBody(**ROD)}, {"b": joint})
+    q = np.linspace(0.3, 0.9, system.n_q)
+    s_dot = np.linspace(-1.0, 2.0, system.n_s)
+    np.testing.assert_allclose(system.q_dot(q.tolist(), s_dot.tolist()), system.K(q) @ s_dot, rtol=1e-15, atol=1e-15)
 
 
 @pytest.mark.parametrize("call, message", [
