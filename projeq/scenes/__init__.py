@@ -16,6 +16,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
+from projeq.checks import positives
 from projeq.subsystems import inertia
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
@@ -55,6 +56,7 @@ def double_pendulum(m1: float = 1.0, m2: float = 1.0, l1: float = 1.0, l2: float
     """Two point masses on massless rods, hinged about y, hanging along −z (Problem 8 of
     the Lagrange problem book). q = (θ₁, θ₂), θ₂ relative to the first rod.
     Default: released from rest with the first rod horizontal."""
+    m1, m2, l1, l2 = positives(m1=m1, m2=m2, l1=l1, l2=l2)
     return System(
         {"bob1": PointMass(m1, (0.0, 0.0, -l1)), "bob2": PointMass(m2, (0.0, 0.0, -l2))},
         {"bob1": Revolute(axis="y"), "bob2": Revolute(parent="bob1", axis="y", r_pn=(0.0, 0.0, -l1))},
