@@ -74,10 +74,10 @@ def atwood(m1: float = 2.0, m2: float = 1.0, pulley_mass: float = 0.5, radius: f
     to the pulley (shared minimal velocity, evaluated by the dense Gauss form).
     Reference: ẍ₁ = (m1 − m2) g / (m1 + m2 + I/a²) downwards for mass 1 (Problem 1).
     """
-    a = radius
+    m1, m2, pulley_mass, a = positives(m1=m1, m2=m2, pulley_mass=pulley_mass, radius=radius)
     return System(
         {
-            "pulley": RigidBody(pulley_mass, I_c=inertia.disk(pulley_mass, radius, axis="y")),
+            "pulley": RigidBody(pulley_mass, I_c=inertia.disk(pulley_mass, a, axis="y")),
             "mass1": PointMass(m1),
             "mass2": PointMass(m2),
         },

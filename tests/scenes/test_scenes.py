@@ -110,6 +110,7 @@ def test_the_registry_makes_a_symbolic_scene_on_first_use_and_takes_new_ones(mon
 #: every scene's sizes and masses (SI), each of which must be positive
 SIZES = {
     "double_pendulum": ("m1", "m2", "l1", "l2"),
+    "atwood": ("m1", "m2", "pulley_mass", "radius"),
     "quick_return": ("A", "H", "m_a", "m_b"),
     "four_bar": ("a", "b", "c", "d"),
     "sphere_on_sphere": ("a", "b", "m"),
@@ -156,3 +157,12 @@ def test_the_four_bar_names_its_bad_mass(m, message):
     bare IndexError."""
     with pytest.raises(ValueError, match=message):
         pq.scenes.four_bar(m=m)
+
+
+@pytest.mark.parametrize("name", ["m1", "m2", "pulley_mass"])
+def test_build_scene_names_the_atwood_mass_it_was_given(name):
+    """Passes if build_scene("atwood", m1=nan) (and m2, pulley_mass) is a ValueError that begins
+    with that parameter; before, all three were named "m" (the PointMass's or RigidBody's own
+    parameter), so that the message did not say which of the three masses was wrong."""
+    with pytest.raises(ValueError, match=rf"^{name}: non-finite entries \(NaN or inf\)"):
+        pq.scenes.build_scene("atwood", **{name: float("nan")})
