@@ -187,13 +187,17 @@ def test_a_real_ctrl_c_during_sweep_keeps_finished_and_partial_points(tmp_path):
         (["run", "atwood", "--set", "m1=heavy"], "m1: expected a number"),
         (["run", "chain", "--set", "planar=maybe"], "planar: expected a bool"),
         (["run", "chain", "--set", "n=0"], "n: number of links"),
+        (["run", "atwood", "--set", "m1=3", "--set", " m1 =4"],
+         "projeq run: --set: m1 is set twice ('m1=3' and ' m1 =4'); set it once"),
+        (["sweep", "atwood", "--grid", "m2=1:2:2", "--set", "g=9", "--set", "g=10"],
+         "projeq sweep: --set: g is set twice ('g=9' and 'g=10'); set it once"),
         (["list", "nope"], "unknown scene 'nope'"),
         (["sweep", "chain", "--grid", "n=1:3"], "--grid: expected NAME=A:B:N"),
         (["sweep", "chain", "--grid", "links=1:3:3"], "links: unknown parameter"),
         (["sweep", "chain", "--grid", "n=1:2:2", "--workers", "0"], "--workers: expected a positive count"),
     ],
-    ids=["scene", "parameter", "int", "setting", "float", "bool", "scene-check", "list", "grid", "grid-name",
-         "workers"],
+    ids=["scene", "parameter", "int", "setting", "float", "bool", "scene-check", "set-twice-run", "set-twice-sweep",
+         "list", "grid", "grid-name", "workers"],
 )
 def test_bad_arguments_exit_2_with_the_reason(argv, message, capsys, tmp_path):
     assert main(argv + (["--out", str(tmp_path)] if argv[0] in ("run", "sweep") else [])) == 2
