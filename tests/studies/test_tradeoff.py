@@ -172,9 +172,13 @@ def test_cli_help_and_missing_scene(capsys):
 
 
 def test_plot_returns_a_figure_with_one_line_per_method_and_knob():
+    """Passes if the six successful settings are drawn and the two failed ones are named in a
+    note on the figure (before, they were left out without a word)."""
     table = _constructed_table()
     fig = tr.plot(table)
     assert len(fig.axes[0].lines) == 6  # A, B, C, D, G, H succeeded; E, F failed and are not drawn
+    assert [t.get_text() for t in fig.axes[0].texts] == [
+        "not drawn: E rtol=1e-06 [k] (timeout), F rtol=1e-06 [k] (diverged)"]
 
 
 def test_every_study_names_existing_knobs_and_scene_parameters():
