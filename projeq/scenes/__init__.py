@@ -22,7 +22,8 @@ from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
 from projeq.scenes.elastic import elastic_arm, flexible_arm, spin_up_beam, spinning_beam
 from projeq.scenes.iftomm import andrews_squeezer, bricard, flyball_governor, n_four_bar, simple_pendulum
-from projeq.scenes.mechanisms import bar_on_wall, four_bar, quick_return, slider_pendulum, sphere_on_sphere
+from projeq.scenes.mechanisms import (bar_on_wall, flexible_four_bar, four_bar, quick_return, slider_pendulum,
+                                      sphere_on_sphere)
 from projeq.scenes.parameters import Parameter, check_names, closest, parse_settings, scene_parameters
 from projeq.system import System
 
@@ -271,7 +272,7 @@ __all__ = [
     "chain", "double_pendulum", "atwood", "spin_up_beam", "spinning_beam", "elastic_arm", "flexible_arm",
     "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed", "rolling_disk_inertia",
     "barhorst_particle", "nonholonomic_particle", "whipple_bicycle", "whipple_eigenvalues",
-    "quick_return", "four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",
+    "quick_return", "four_bar", "flexible_four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",
     "simple_pendulum", "n_four_bar", "bricard", "andrews_squeezer", "flyball_governor",
     "Scene", "SCENES", "DEFAULT_SCENE", "get_scene", "resolve_scene", "build_scene", "scene_parameters", "parse_settings", "Parameter",
 ]

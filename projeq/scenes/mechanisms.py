@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from projeq.checks import positive, positives
+from projeq.checks import count, positive, positives
+from projeq.constraints.cut_joints import PinClosure
 from projeq.constraints.partitioned import ConstrainedSystem
 from projeq.joints import Prismatic, Revolute
-from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody
+from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, RitzBeam
 from projeq.system import System
 
 
@@ -92,6 +93,33 @@ def four_bar(a: float = 0.3, b: float = 1.0, c: float = 0.8, d: float = 1.0, m=(
     theta2, theta3 = four_bar_angles(theta1, a, b, c, d)
     return ConstrainedSystem(tree, phi=closure, independent=[0], q0=(theta1, theta3, theta2 - theta1),
                              s_dot0=[omega1], **options)
+
+
+def flexible_four_bar(a: float = 0.3, b: float = 1.0, c: float = 0.8, d: float = 1.0, m=(1.0, 2.0, 1.5),
+                      EI: float = 200.0, n_v: int = 2, g: float = 9.81, theta1: float = 0.5, omega1: float = 3.0,
+                      **options) -> ConstrainedSystem:
+    """:func:`four_bar` with an elastic coupler: a RitzBeam of length b and mass m[1] (ρA = m[1]/b),
+    bending stiffness ``EI`` (N m²) and ``n_v`` clamped–free bending functions in the plane
+    (n_w = 0; docs/theory.md §10), clamped at the crank pin; its tip is held on the rocker's by a
+    cut joint (:class:`~projeq.constraints.cut_joints.PinClosure` at the beam's station x = b,
+    which moves with the bending, Φ = (P_coupler − P_rocker) in x, y: docs/theory.md §7).
+    The tree orders q = (q1, q3, q2, q_e): crank, rocker, coupler relative to the crank, the
+    beam's amplitudes; the independent velocities are the crank's rate and the amplitudes'.
+    Initial state: the undeformed loop at crank angle ``theta1``, the crank turning at ``omega1``.
+    """
+    a, b, c, d, EI = positives(a=a, b=b, c=c, d=d, EI=EI)
+    m_crank, m_coupler, m_rocker = _link_masses(m)
+    n_v = count("n_v", n_v)
+    beam = RitzBeam(b, rho_A=m_coupler / b, EI_z=EI, n_v=n_v, n_w=0, family="clamped_free")
+    tree = System({"crank": slender_rod(m_crank, a), "rocker": slender_rod(m_rocker, c), "coupler": beam},
+                  {"crank": Revolute(axis="z"), "rocker": Revolute(axis="z", r_pn=(d, 0.0, 0.0)),
+                   "coupler": Revolute(parent="crank", axis="z", r_pn=(a, 0.0, 0.0))},
+                  gravity=(0.0, -g, 0.0))
+    pin = PinClosure(tree, "coupler", (b, 0.0, 0.0), "rocker", (c, 0.0, 0.0), axes="xy")
+    theta2, theta3 = four_bar_angles(theta1, a, b, c, d)
+    amplitudes = list(range(3, 3 + n_v))
+    return ConstrainedSystem(tree, phi=pin, independent=[0, *amplitudes], q0=(theta1, theta3, theta2 - theta1, *[0.0] * n_v),
+                             s_dot0=[omega1, *[0.0] * n_v], **options)
 
 
 def _link_masses(m) -> tuple[float, float, float]:

@@ -113,6 +113,7 @@ SIZES = {
     "atwood": ("m1", "m2", "pulley_mass", "radius"),
     "quick_return": ("A", "H", "m_a", "m_b"),
     "four_bar": ("a", "b", "c", "d"),
+    "flexible_four_bar": ("a", "b", "c", "d", "EI"),
     "sphere_on_sphere": ("a", "b", "m"),
     "bar_on_wall": ("l", "m"),
     "slider_pendulum": ("l", "m"),
