@@ -414,6 +414,11 @@ def test_an_integrator_that_fails_reports_its_message_and_keeps_the_trajectory()
             r"^events\[1\]: expected a callable event\(t, q, s_dot\)",
         ),
         ({"progress": True}, r"^progress: expected a callable progress\(t\), got True"),
+        ({"max_step": 0.0}, "^max_step: must be positive, got 0.0"),
+        ({"max_step": np.nan}, r"^max_step: non-finite entries \(NaN or inf\)"),
+        ({"first_step": -1e-3, "method": "RK45"}, "^first_step: must be positive, got -0.001"),
+        ({"min_step": -1.0, "method": "LSODA"}, "^min_step: must not be negative, got -1.0"),
+        ({"dense_output": "no"}, "^dense_output: expected True or False, got 'no'"),
     ],
     ids=[
         "t_end-equal",
@@ -433,12 +438,25 @@ def test_an_integrator_that_fails_reports_its_message_and_keeps_the_trajectory()
         "n_segments-float",
         "events",
         "progress",
+        "max_step-zero",
+        "max_step-nan",
+        "first_step",
+        "min_step",
+        "dense_output-text",
     ],
 )
 def test_simulate_arguments(kwargs, message):
     kwargs = {"t_end": 1.0, **kwargs}
     with pytest.raises(ValueError, match=message):
         pq.simulate(_pendulum(), **kwargs)
+
+
+def test_an_unlimited_max_step_is_solve_ivps_default():
+    """Passes if max_step = inf, solve_ivp's own default, is accepted and gives the run without it
+    bit for bit (the step-size check refuses 0, negative and NaN, not inf)."""
+    plain = pq.simulate(_pendulum(), 0.3, method="RK45", n_points=4)
+    unlimited = pq.simulate(_pendulum(), 0.3, method="RK45", n_points=4, max_step=np.inf)
+    assert np.array_equal(plain.q, unlimited.q) and np.array_equal(plain.s_dot, unlimited.s_dot)
 
 
 @pytest.mark.parametrize("method", ["newton", 3])

@@ -32,7 +32,7 @@ from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
 from projeq.analysis.jacobians import state_derivative, state_jacobian
 from projeq.assembly import EVALUATORS
-from projeq.checks import callable_name, closest, count, finite_array, positive, state_vector
+from projeq.checks import callable_name, closest, count, finite_array, flag, non_negative, positive, state_vector
 from projeq.simulation.integrators import (
     EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, stiff_steps, warn_stiff, with_direct_lu,
 )
@@ -96,6 +96,17 @@ def _check_options(method, options: dict) -> None:
         raise ValueError(f"options: unknown option{'s' * (len(unknown) > 1)} {unknown} for {which}{hint}; "
                          f"it takes {list(known)} (simulate's own: t_start, t_eval, n_points, dense_output, "
                          "evaluator, n_segments, progress, jac)")
+    _check_step_sizes(options)
+
+
+def _check_step_sizes(options: dict) -> None:
+    """ValueError naming a step size that is not a positive number (max_step may be inf, solve_ivp's
+    default; min_step 0): scipy refuses one at t = 0 as a failed run, and ignores a NaN."""
+    for name in ("first_step", "max_step", "min_step"):
+        value = options.get(name)
+        if value is None or (name == "max_step" and isinstance(value, (int, float, np.number)) and value == np.inf):
+            continue
+        (non_negative if name == "min_step" else positive)(name, value)
 
 
 def _event_wrapper(event, n_q, label):
@@ -286,7 +297,7 @@ class _Run:
         self.jac, self.switched, self.note = _jac_option(method, jac), "", ""  # go_implicit's record
         self.pieces, self.nfev, self.njev, self.cause, self.steps, self.calls = [], 0, 0, None, 0, 0
         self.step_size = None  # the integrator's next step size where the last segment ended (_counted)
-        self.dense_output, self.x_end = bool(dense_output), None  # x_end: the state at the end of the last segment
+        self.dense_output, self.x_end = flag("dense_output", dense_output), None  # x_end: the state at the end of the last segment
         self.out_of_range = False  # warned that a subsystem left the range of its model
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
