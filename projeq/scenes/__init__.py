@@ -252,10 +252,21 @@ def _load_file(path: Path):
         sys.modules[name] = module
         try:
             spec.loader.exec_module(module)
+        except (SyntaxError, ImportError) as exc:  # the file cannot be read as Python: a bad argument
+            del sys.modules[name]
+            raise ValueError(f"scene: {path} cannot be imported: {_import_error(exc)}") from None
         except Exception:
             del sys.modules[name]
             raise
     return sys.modules[name]
+
+
+def _import_error(exc: SyntaxError | ImportError) -> str:
+    """What is wrong with a file that cannot be imported: the line of a syntax error, the
+    module missing, in one line."""
+    if isinstance(exc, SyntaxError):
+        return f"{type(exc).__name__} at line {exc.lineno}: {exc.msg}: {(exc.text or '').strip()!r}"
+    return f"{type(exc).__name__}: {exc}"
 
 
 def build_scene(name: str, **overrides) -> System:
