@@ -261,6 +261,14 @@ def test_bench_budgets_must_be_positive_seconds(option, value, capsys):
     assert f"argument {option}: expected {expected}, got '{value}'" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("value", ["-1", "2.5", "many"])
+def test_bench_exact_up_to_must_be_a_chain_length(value, capsys):
+    """Passes if --exact-up-to below 0 or not an integer is a usage error (exit 2) naming the option
+    and the value, before anything is timed; before, -1 ran the benchmark (as 0 would) without a word."""
+    assert main(["bench", "--exact-up-to", value, "--chain-only", "--sizes", "2"]) == 2
+    assert f"argument --exact-up-to: expected a chain length >= 0, got '{value}'" in capsys.readouterr().err
+
+
 def test_sweep_writes_one_table(tmp_path, capsys):
     """projeq sweep: a 3-point grid of the Atwood machine, final angles = closed form."""
     argv = ["sweep", "atwood", "--grid", "m1=1:3:3", "--t-end", "0.5", "--rtol", "1e-10", "--outputs", "q0",
