@@ -294,7 +294,7 @@ class _Run:
         self.method, self.progress, self.options = method, progress, options
         self.solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
-        self.jac, self.switched, self.note = _jac_option(method, jac), "", ""  # go_implicit's record
+        self.jac, self.switched, self.note = _jac_option(method, jac, self.x.size), "", ""  # go_implicit's record
         self.pieces, self.nfev, self.njev, self.cause, self.steps, self.calls = [], 0, 0, None, 0, 0
         self.step_size = None  # the integrator's next step size where the last segment ended (_counted)
         self.dense_output, self.x_end = flag("dense_output", dense_output), None  # x_end: the state at the end of the last segment
@@ -358,7 +358,7 @@ class _Run:
         t_eval = self.t_eval
         inside = t_eval[(t_eval > a) & (t_eval <= b)] if self.pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
         n_q = self.model.n_q
-        jac = {"jac": self.jacobian if self.jac == "exact" else self.jac} if self.method in IMPLICIT else {}
+        jac = {"jac": self.jacobian if isinstance(self.jac, str) else self.jac} if self.method in IMPLICIT else {}
         labels = [f"events[{i}] ({callable_name(e)})" for i, e in enumerate(self.events)]
         labels += [f"the model's event {callable_name(e)}" for e in self.model.events()]
         events = [_event_wrapper(e, n_q, label) for e, label in zip(self.events + list(self.model.events()), labels)]
@@ -561,13 +561,16 @@ def _counted(solver, run: _Run) -> type:
     return Counted
 
 
-def _jac_option(method, jac):
-    """``jac`` of :func:`simulate`: "exact", "differences" (scipy's own, None) or the user's."""
-    if isinstance(jac, str) and jac not in ("exact", "differences"):
-        raise ValueError(f"jac: expected 'exact', 'differences', a callable jac(t, x) or a matrix, got {jac!r}")
-    if jac is not None and not isinstance(jac, str) and method not in IMPLICIT:
+def _jac_option(method, jac, n_x: int):
+    """``jac`` of :func:`simulate`: "exact", "differences" (scipy's own, None) or the user's
+    callable or (n_x, n_x) matrix (a matrix compared with a string is an array, not a bool)."""
+    if isinstance(jac, str):
+        if jac not in ("exact", "differences"):
+            raise ValueError(f"jac: expected 'exact', 'differences', a callable jac(t, x) or a matrix, got {jac!r}")
+        return None if jac == "differences" else jac
+    if jac is not None and method not in IMPLICIT:
         raise ValueError(f"jac: only the implicit methods {list(IMPLICIT)} use a Jacobian, not {method!r}")
-    return None if jac == "differences" else jac
+    return jac if jac is None or callable(jac) else finite_array("jac", jac, (n_x, n_x))
 
 
 class ValidityWarning(UserWarning):
