@@ -649,7 +649,9 @@ def _output_times(t_start, t_end, t_eval, n_points) -> NDArray:
         raise ValueError(f"n_points, t_eval: give one of them (t_eval's times are the output rows), got n_points = "
                          f"{n_points!r} beside t_eval")
     t_eval = finite_array("t_eval", t_eval)
-    if t_eval.ndim != 1 or np.any(np.diff(t_eval) <= 0) or t_eval[0] < t_start or t_eval[-1] > t_end:
+    if t_eval.ndim != 1 or not t_eval.size:
+        raise ValueError(f"t_eval: expected a 1-D array of output times, got shape {t_eval.shape}")
+    if np.any(np.diff(t_eval) <= 0) or t_eval[0] < t_start or t_eval[-1] > t_end:
         raise ValueError(f"t_eval: must increase strictly within [{t_start}, {t_end}]")
     return t_eval
 
