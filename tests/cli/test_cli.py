@@ -224,6 +224,19 @@ def test_compare_hands_its_options_to_the_library(monkeypatch, capsys):
     assert capsys.readouterr().out.startswith("compare car")
 
 
+@pytest.mark.parametrize("where, message", [
+    ("file/table.csv", "cannot write to directory"), ("", "is a directory, not a file")], ids=["under-a-file", "a-directory"])
+def test_compare_refuses_a_csv_it_cannot_write_before_comparing(where, message, monkeypatch, tmp_path, capsys):
+    """Passes if ``projeq compare --csv PATH`` with a PATH that cannot be written exits 2 naming
+    --csv before the comparison runs (the library's compare is never called). Before, the whole
+    comparison ran (derivations and simulations) and then failed to write, exit 1."""
+    (tmp_path / "file").write_text("")
+    monkeypatch.setattr(projeq.cli.studies, "compare", lambda *args, **options: pytest.fail("compare ran"))
+    assert main(["compare", "car", "--csv", str(tmp_path / where)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("projeq compare: --csv: ") and message in err
+
+
 @pytest.mark.parametrize("error, code", [(ValueError("t_end: must be positive"), 2),
                                          (RuntimeError("reference: the run failed"), 1),
                                          (KeyboardInterrupt(), 1)])
