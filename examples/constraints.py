@@ -7,9 +7,10 @@ A(q, t) q̇ = b; coordinate partitioning inserts them before the projection (doc
    loop closure does no work, so the energy is conserved (a conservation law), and the
    loop stays closed (|Φ| at round-off, Gauss–Newton projection at every output). The
    closure's multipliers λ are the forces the cut joint transmits (``pq.reactions``).
-2. A flexible loop: the same four-bar with its coupler a RitzBeam (two bending functions), the
-   beam's tip held on the rocker's by a cut joint (``pq.PinClosure`` at the beam's station x = L,
-   which bends with it): compiled like the rigid loop, its energy conserved and the loop closed.
+2. A flexible loop (scene ``flexible_four_bar``): the same four-bar with its coupler a RitzBeam
+   (two bending functions), the beam's tip held on the rocker's by a cut joint (``pq.PinClosure``
+   at the beam's station x = L, which bends with it): compiled like the rigid loop, its energy
+   conserved and the loop closed.
 3. The bicycle's upright straight running at 5 m/s, linearised: its four eigenvalues equal
    those of Meijaard, Papadopoulos, Ruina & Schwab (2007), Proc. R. Soc. A 463, Table 2,
    v = 5 m/s. Without PROJEQ_QUICK also the weave and capsize speeds, MJPR's 4.292 382 536 341 11
@@ -25,7 +26,6 @@ from scipy.optimize import brentq
 
 import projeq as pq
 from projeq.scenes import whipple_eigenvalues
-from projeq.scenes.mechanisms import four_bar_angles, slender_rod
 
 QUICK = bool(os.environ.get("PROJEQ_QUICK"))
 
@@ -37,16 +37,7 @@ print(f"four-bar: energy drift {result.energy_drift:.1e}, largest |Φ| or veloci
       f"largest cut-joint force {np.abs(forces).max():.3g} N")
 assert closure < 1e-8  # Gauss–Newton projection to round-off; 1e-8 allows the velocity rows' rtol-level error
 
-a, b, c, d = 0.3, 1.0, 0.8, 1.0  # crank, coupler (the beam), rocker, ground link, m
-beam = pq.RitzBeam(b, rho_A=2.0, EI_z=200.0, n_v=2, n_w=0, family="clamped_free")
-tree = pq.System({"crank": slender_rod(1.0, a), "rocker": slender_rod(1.5, c), "coupler": beam},
-                 {"crank": pq.Revolute(axis="z"), "rocker": pq.Revolute(axis="z", r_pn=(d, 0.0, 0.0)),
-                  "coupler": pq.Revolute(parent="crank", axis="z", r_pn=(a, 0.0, 0.0))},
-                 gravity=(0.0, -9.81, 0.0))
-pin = pq.PinClosure(tree, "coupler", (b, 0.0, 0.0), "rocker", (c, 0.0, 0.0), axes="xy")
-theta2, theta3 = four_bar_angles(0.5, a, b, c, d)
-flexible_loop = pq.ConstrainedSystem(tree, phi=pin, independent=[0, 3, 4], q0=(0.5, theta3, theta2 - 0.5, 0.0, 0.0),
-                                     s_dot0=[3.0, 0.0, 0.0])
+flexible_loop = pq.scenes.flexible_four_bar()  # the coupler a RitzBeam, pinned at its tip to the rocker
 flexible = pq.simulate(flexible_loop, 0.2 if QUICK else 1.0)
 print(f"flexible four-bar: energy drift {flexible.energy_drift:.1e}, largest |Φ| "
       f"{np.abs(flexible.constraint_residual).max():.1e}, largest tip deflection amplitude "

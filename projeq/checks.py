@@ -55,6 +55,12 @@ def positive(name: str, value) -> float:
     return x
 
 
+def positives(**values) -> tuple[float, ...]:
+    """Each keyword's value checked by :func:`positive` under the keyword's name, in order:
+    ``m, l = positives(m=m, l=l)``."""
+    return tuple(positive(name, value) for name, value in values.items())
+
+
 def non_negative(name: str, value) -> float:
     """A finite float ≥ 0."""
     x = float(finite_array(name, value, ()))

@@ -536,7 +536,11 @@ class System(Model):
 
     def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
         """q̇ = K(q) ṡ + k(q, t): q̇ = ṡ in one step where K = E (revolute and prismatic
-        joints, elastic coordinates), joint by joint elsewhere."""
+        joints, elastic coordinates), joint by joint elsewhere. q and ṡ given otherwise than as
+        arrays (lists, tuples) are checked as :meth:`check_state` does; arrays, as the
+        integrators pass them, go straight on."""
+        if not (isinstance(q, np.ndarray) and isinstance(s_dot, np.ndarray)):
+            q, s_dot = self.check_state(q, s_dot, t)
         if self._q_dot_is_s_dot:  # K = E throughout (one copy: the right-hand side of every step calls it)
             return np.array(s_dot, dtype=np.result_type(q, s_dot, float))
         q_dot = np.empty(self.n_q, dtype=np.result_type(q, s_dot, float))  # complex for a complex step

@@ -153,6 +153,8 @@ def test_subsystems_and_joints_must_match(subsystems, joints, message):
         (lambda s: s.energy([0.1], [0.0, 1.0]), "s_dot"),
         (lambda s: pq.simulate(s, 1.0, q0=[0.1, 0.2]), "q0"),
         (lambda s: pq.simulate(s, 1.0, s_dot0=[]), "s_dot0"),
+        (lambda s: s.q_dot([0.1, 0.2], [0.0]), "q"),
+        (lambda s: s.q_dot([0.1], [0.0, 1.0]), "s_dot"),
         (lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, q0=[0.1, 0.2]), "q0"),
         (
             lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, s_dot0=[0, 1]),
@@ -168,6 +170,8 @@ def test_subsystems_and_joints_must_match(subsystems, joints, message):
         "energy-s_dot",
         "simulate-q0",
         "simulate-s_dot0",
+        "q_dot-q",
+        "q_dot-s_dot",
         "System-q0",
         "System-s_dot0",
     ],
@@ -187,6 +191,8 @@ def test_state_of_the_wrong_length(call, name):
         (lambda s: s.energy([0.1], [np.nan]), "s_dot"),
         (lambda s: pq.simulate(s, 1.0, q0=[np.nan]), "q0"),
         (lambda s: pq.simulate(s, 1.0, s_dot0=[-np.inf]), "s_dot0"),
+        (lambda s: s.q_dot([np.nan], [0.0]), "q"),
+        (lambda s: s.q_dot([0.1], [np.inf]), "s_dot"),
         (lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, q0=[np.nan]), "q0"),
         (
             lambda s: pq.System({"b": pq.RigidBody(**ROD)}, {"b": pq.Revolute(axis="y")}, s_dot0=[np.nan]),
@@ -201,6 +207,8 @@ def test_state_of_the_wrong_length(call, name):
         "energy-s_dot",
         "simulate-q0",
         "simulate-s_dot0",
+        "q_dot-q",
+        "q_dot-s_dot",
         "System-q0",
         "System-s_dot0",
     ],
@@ -398,6 +406,8 @@ def test_an_integrator_that_fails_reports_its_message_and_keeps_the_trajectory()
         ({"atol": -1e-9}, "^atol: must be positive"),
         ({"t_eval": [0.0, 2.0]}, r"^t_eval: must increase strictly within \[0.0, 1.0\]"),
         ({"t_eval": [0.5, 0.2]}, "^t_eval: must increase strictly"),
+        ({"t_eval": [[0.1, 0.2]]}, r"^t_eval: expected a 1-D array of output times, got shape \(1, 2\)"),
+        ({"t_eval": []}, r"^t_eval: expected a 1-D array of output times, got shape \(0,\)"),
         ({"n_points": 1}, "^n_points: expected an integer >= 2, got 1"),
         ({"n_segments": 0}, "^n_segments: expected an integer >= 1, got 0"),
         ({"n_segments": 2.5}, "^n_segments: expected an integer >= 1, got 2.5"),
@@ -406,6 +416,11 @@ def test_an_integrator_that_fails_reports_its_message_and_keeps_the_trajectory()
             r"^events\[1\]: expected a callable event\(t, q, s_dot\)",
         ),
         ({"progress": True}, r"^progress: expected a callable progress\(t\), got True"),
+        ({"max_step": 0.0}, "^max_step: must be positive, got 0.0"),
+        ({"max_step": np.nan}, r"^max_step: non-finite entries \(NaN or inf\)"),
+        ({"first_step": -1e-3, "method": "RK45"}, "^first_step: must be positive, got -0.001"),
+        ({"min_step": -1.0, "method": "LSODA"}, "^min_step: must not be negative, got -1.0"),
+        ({"dense_output": "no"}, "^dense_output: expected True or False, got 'no'"),
     ],
     ids=[
         "t_end-equal",
@@ -420,17 +435,46 @@ def test_an_integrator_that_fails_reports_its_message_and_keeps_the_trajectory()
         "atol",
         "t_eval-outside",
         "t_eval-decreasing",
+        "t_eval-2d",
+        "t_eval-empty",
         "n_points",
         "n_segments",
         "n_segments-float",
         "events",
         "progress",
+        "max_step-zero",
+        "max_step-nan",
+        "first_step",
+        "min_step",
+        "dense_output-text",
     ],
 )
 def test_simulate_arguments(kwargs, message):
     kwargs = {"t_end": 1.0, **kwargs}
     with pytest.raises(ValueError, match=message):
         pq.simulate(_pendulum(), **kwargs)
+
+
+def test_a_jacobian_matrix_is_taken_and_checked():
+    """Passes if jac given as a matrix, which the docstring offers, runs Radau (a constant
+    approximation of ∂ẋ/∂x: Newton's iteration converges to the same steps' equations) to the
+    exact Jacobian's run within the tolerances, and a matrix of the wrong shape is refused by name.
+    Before, any matrix failed with numpy's "The truth value of an array with more than one element
+    is ambiguous" (jac == "differences" compared elementwise)."""
+    exact = pq.simulate(_pendulum(), 0.5, [0.8], method="Radau", rtol=1e-10, atol=1e-12, n_points=3)
+    frozen = pq.simulate(_pendulum(), 0.5, [0.8], method="Radau", rtol=1e-10, atol=1e-12, n_points=3,
+                         jac=[[0.0, 1.0], [-15.0, 0.0]])
+    np.testing.assert_allclose(frozen.q, exact.q, rtol=0, atol=1e-8)
+    with pytest.raises(ValueError, match=r"^jac: expected shape \(2, 2\), got \(3, 3\)"):
+        pq.simulate(_pendulum(), 0.5, method="Radau", jac=np.eye(3))
+
+
+def test_an_unlimited_max_step_is_solve_ivps_default():
+    """Passes if max_step = inf, solve_ivp's own default, is accepted and gives the run without it
+    bit for bit (the step-size check refuses 0, negative and NaN, not inf)."""
+    plain = pq.simulate(_pendulum(), 0.3, method="RK45", n_points=4)
+    unlimited = pq.simulate(_pendulum(), 0.3, method="RK45", n_points=4, max_step=np.inf)
+    assert np.array_equal(plain.q, unlimited.q) and np.array_equal(plain.s_dot, unlimited.s_dot)
 
 
 @pytest.mark.parametrize("method", ["newton", 3])
@@ -655,6 +699,18 @@ def test_system_K_and_generalized_force_take_plain_lists():
     system = _pendulum()
     assert system.K([0.3]).tolist() == [[1.0]]
     assert system.generalized_force([0.3], 0.0, {"bob": [2.5]}).tolist() == [2.5]
+
+
+@pytest.mark.parametrize("joint", [pq.Revolute(axis="y"), pq.Free()], ids=["Revolute", "Free"])
+def test_system_q_dot_takes_plain_lists(joint):
+    """Passes if q̇ from lists equals K(q) ṡ, the block-diagonal K of the joints formed apart
+    (docs/theory.md, "Kinematic chain and joints"), for a revolute joint (K = E) and a free joint (quaternion rates).
+    Before, numpy read the list in np.result_type as a structured dtype: "TypeError: Field
+    elements must be 2- or 3-tuples, got '0.3'"."""
+    system = pq.System({"b": pq.RigidBody(**ROD)}, {"b": joint})
+    q = np.linspace(0.3, 0.9, system.n_q)
+    s_dot = np.linspace(-1.0, 2.0, system.n_s)
+    np.testing.assert_allclose(system.q_dot(q.tolist(), s_dot.tolist()), system.K(q) @ s_dot, rtol=1e-15, atol=1e-15)
 
 
 @pytest.mark.parametrize("call, message", [

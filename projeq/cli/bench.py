@@ -35,7 +35,7 @@ def bench_arguments(parser) -> None:
 
 def exact_option(parser: argparse.ArgumentParser) -> None:
     """``--exact-up-to N`` (for ``projeq bench`` and ``benchmarks/chain_scaling.py``)."""
-    parser.add_argument("--exact-up-to", type=int, default=EXACT_UP_TO, metavar="N",
+    parser.add_argument("--exact-up-to", type=_chain_length, default=EXACT_UP_TO, metavar="N",
                         help=f"compare with the exact s̈ (projeq.studies.bench_exact) for n <= N (default {EXACT_UP_TO}; "
                              f"it costs about 0.5 s at n = 100, 4 s at n = 300)")
 
@@ -77,6 +77,17 @@ def _non_negative_seconds(text: str) -> float:
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a number of seconds >= 0, got {text!r}") from None
     return seconds
+
+
+def _chain_length(text: str) -> int:
+    """A chain length ≥ 0 (0: no comparison with the exact s̈); argparse names the option."""
+    try:
+        n = int(text)
+        if n < 0:
+            raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a chain length >= 0, got {text!r}") from None
+    return n
 
 
 def _sizes(text: str) -> tuple:

@@ -75,8 +75,9 @@ def scene_label(scene: str) -> str:
     return "".join(c if c.isalnum() or c in "_-" else "-" for c in Path(scene.replace(".py:", "-")).name)
 
 
-def output_directory(text: str) -> Path:
-    """The output directory ``--out``, created; ValueError when it cannot be written."""
+def output_directory(text: str, option: str = "--out") -> Path:
+    """The output directory ``text`` of ``option`` (``--out``), created; ValueError naming the
+    option when it cannot be written."""
     out = Path(text)
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -84,8 +85,18 @@ def output_directory(text: str) -> Path:
         probe.write_text("")
         probe.unlink()
     except OSError as exc:
-        raise ValueError(f"--out: cannot write to directory {text!r}: {exc.strerror or exc}") from None
+        raise ValueError(f"{option}: cannot write to directory {text!r}: {exc.strerror or exc}") from None
     return out
+
+
+def output_file(text: str, option: str) -> Path:
+    """The file ``text`` of ``option`` (``--csv``) to be written after the work: its directory
+    created and writable, and no directory itself; ValueError naming the option, before the work."""
+    path = Path(text)
+    if path.is_dir():
+        raise ValueError(f"{option}: {text!r} is a directory, not a file")
+    output_directory(str(path.parent), option)
+    return path
 
 
 def number(option: str, text: str) -> float:

@@ -74,8 +74,9 @@ def export_result(args) -> int:
         raise ValueError(f"result: no file {args.result!r}")
     if args.stations < 2:
         raise ValueError(f"--stations: expected at least 2 points, got {args.stations}")
+    result = Result.load(path)  # a file that is no Result is refused before the directory is made
     out = output_directory(args.out or str(path.parent / "paraview"))
-    print(f"wrote {write_vtu_series(Result.load(path), out, name=path.stem, stations=args.stations)}")
+    print(f"wrote {write_vtu_series(result, out, name=path.stem, stations=args.stations)}")
     return 0
 
 

@@ -14,7 +14,7 @@ import sys
 
 import numpy as np
 
-from projeq.cli.options import json_option, jsonable, number, output_directory, scene_settings_option
+from projeq.cli.options import json_option, jsonable, number, output_directory, output_file, scene_settings_option
 from projeq.studies.compare import COMPARISONS, TEXT_WIDTH, compare
 from projeq.studies.effort import DERIVATION_REPEATS
 from projeq.studies.tradeoff import METHODS, QUICK_TOLERANCES, format_table, get_study, plot, save_csv, tradeoff
@@ -34,6 +34,8 @@ def compare_arguments(parser) -> None:
 
 
 def compare_formulations(args) -> int:
+    if args.csv:
+        output_file(args.csv, "--csv")
     table = compare(args.name, args.formulation, simulate=not args.no_simulate, t_end=args.t_end,
                     repeats=args.repeats)
     if args.json:

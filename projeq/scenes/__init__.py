@@ -16,12 +16,14 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
+from projeq.checks import positives
 from projeq.subsystems import inertia
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
 from projeq.scenes.elastic import elastic_arm, flexible_arm, spin_up_beam, spinning_beam
 from projeq.scenes.iftomm import andrews_squeezer, bricard, flyball_governor, n_four_bar, simple_pendulum
-from projeq.scenes.mechanisms import bar_on_wall, four_bar, quick_return, slider_pendulum, sphere_on_sphere
+from projeq.scenes.mechanisms import (bar_on_wall, flexible_four_bar, four_bar, quick_return, slider_pendulum,
+                                      sphere_on_sphere)
 from projeq.scenes.parameters import Parameter, check_names, closest, parse_settings, scene_parameters
 from projeq.system import System
 
@@ -55,6 +57,7 @@ def double_pendulum(m1: float = 1.0, m2: float = 1.0, l1: float = 1.0, l2: float
     """Two point masses on massless rods, hinged about y, hanging along −z (Problem 8 of
     the Lagrange problem book). q = (θ₁, θ₂), θ₂ relative to the first rod.
     Default: released from rest with the first rod horizontal."""
+    m1, m2, l1, l2 = positives(m1=m1, m2=m2, l1=l1, l2=l2)
     return System(
         {"bob1": PointMass(m1, (0.0, 0.0, -l1)), "bob2": PointMass(m2, (0.0, 0.0, -l2))},
         {"bob1": Revolute(axis="y"), "bob2": Revolute(parent="bob1", axis="y", r_pn=(0.0, 0.0, -l1))},
@@ -72,10 +75,10 @@ def atwood(m1: float = 2.0, m2: float = 1.0, pulley_mass: float = 0.5, radius: f
     to the pulley (shared minimal velocity, evaluated by the dense Gauss form).
     Reference: ẍ₁ = (m1 − m2) g / (m1 + m2 + I/a²) downwards for mass 1 (Problem 1).
     """
-    a = radius
+    m1, m2, pulley_mass, a = positives(m1=m1, m2=m2, pulley_mass=pulley_mass, radius=radius)
     return System(
         {
-            "pulley": RigidBody(pulley_mass, I_c=inertia.disk(pulley_mass, radius, axis="y")),
+            "pulley": RigidBody(pulley_mass, I_c=inertia.disk(pulley_mass, a, axis="y")),
             "mass1": PointMass(m1),
             "mass2": PointMass(m2),
         },
@@ -249,10 +252,21 @@ def _load_file(path: Path):
         sys.modules[name] = module
         try:
             spec.loader.exec_module(module)
+        except (SyntaxError, ImportError) as exc:  # the file cannot be read as Python: a bad argument
+            del sys.modules[name]
+            raise ValueError(f"scene: {path} cannot be imported: {_import_error(exc)}") from None
         except Exception:
             del sys.modules[name]
             raise
     return sys.modules[name]
+
+
+def _import_error(exc: SyntaxError | ImportError) -> str:
+    """What is wrong with a file that cannot be imported: the line of a syntax error, the
+    module missing, in one line."""
+    if isinstance(exc, SyntaxError):
+        return f"{type(exc).__name__} at line {exc.lineno}: {exc.msg}: {(exc.text or '').strip()!r}"
+    return f"{type(exc).__name__}: {exc}"
 
 
 def build_scene(name: str, **overrides) -> System:
@@ -269,7 +283,7 @@ __all__ = [
     "chain", "double_pendulum", "atwood", "spin_up_beam", "spinning_beam", "elastic_arm", "flexible_arm",
     "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed", "rolling_disk_inertia",
     "barhorst_particle", "nonholonomic_particle", "whipple_bicycle", "whipple_eigenvalues",
-    "quick_return", "four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",
+    "quick_return", "four_bar", "flexible_four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",
     "simple_pendulum", "n_four_bar", "bricard", "andrews_squeezer", "flyball_governor",
     "Scene", "SCENES", "DEFAULT_SCENE", "get_scene", "resolve_scene", "build_scene", "scene_parameters", "parse_settings", "Parameter",
 ]

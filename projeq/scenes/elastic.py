@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from projeq.subsystems import inertia
-from projeq.checks import count, finite_array, positive
+from projeq.checks import count, finite_array, positive, positives
 from projeq.forces import JointSpring
 from projeq.joints import Fixed, Prescribed, Revolute
 from projeq.spatial import rotation_y, rotation_z
@@ -62,6 +62,7 @@ def spin_up_beam(
     is quadratic in q; faster per call up to ~5 functions per plane).
     """
     n_shapes, n_axial = count("n_shapes", n_shapes), count("n_axial", n_axial, minimum=0)
+    length, EI, EA, rho_A = positives(length=length, EI=EI, EA=EA, rho_A=rho_A)
     beam = RitzBeam(
         length, rho_A, EI, EA=EA if n_axial else None, n_v=n_shapes, n_w=n_shapes, n_u=n_axial,
         family=family, stiffening=stiffening, precomputed_integrals=precomputed_integrals,
@@ -90,6 +91,7 @@ def elastic_arm(
     is off by default. Initial state: the first joint spinning at ``omega0`` rad/s, the
     beam slightly bent (1 cm tip deflection in the plane)."""
     n_shapes = count("n_shapes", n_shapes)
+    l1, m1, length, rho_A, EI, tip_mass = positives(l1=l1, m1=m1, length=length, rho_A=rho_A, EI=EI, tip_mass=tip_mass)
     beam = RitzBeam(length, rho_A, EI, n_v=n_shapes, n_w=n_shapes, stiffening=stiffening)
     system = System(
         {
@@ -156,6 +158,8 @@ def spinning_beam(
     the co-rotating frame with ``n_shapes`` functions each; ``rho_I`` (per length, kg m)
     adds the rotary inertia ρI of both bending axes (polar 2ρI, circular section)."""
     n_shapes, omega = count("n_shapes", n_shapes), float(finite_array("omega", omega, ()))
+    length, EI, rho_A = positives(length=length, EI=EI, rho_A=rho_A)
+    rho_I = None if rho_I is None else positive("rho_I", rho_I)
     beam = RitzBeam(
         length, rho_A, EI, n_v=n_shapes, n_w=n_shapes, family=family,
         rho_I=None if rho_I is None else (rho_I, rho_I),

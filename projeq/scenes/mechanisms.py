@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from projeq.checks import count, positive, positives
+from projeq.constraints.cut_joints import PinClosure
 from projeq.constraints.partitioned import ConstrainedSystem
 from projeq.joints import Prismatic, Revolute
-from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody
+from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, RitzBeam
 from projeq.system import System
 
 
@@ -34,6 +36,7 @@ def quick_return(A: float = 1.0, H: float = 1.0 / 3.0, m_a: float = 0.5, m_b: fl
     given to 5 digits), projected onto the loop closures; at rest, no drive (T_m = T_d = 0).
     ``options`` go to :class:`~projeq.constraints.partitioned.ConstrainedSystem` (``correction``, ``beta``).
     """
+    A, H, m_a, m_b = positives(A=A, H=H, m_a=m_a, m_b=m_b)
     B = A + 1.5 * H
     tree = System(
         {"crank": slender_rod(m_a, H), "follower": slender_rod(m_b, B), "slider": Frame()},
@@ -74,6 +77,8 @@ def four_bar(a: float = 0.3, b: float = 1.0, c: float = 0.8, d: float = 1.0, m=(
     ``four_bar().with_independent([1], repivot=True)`` starts the same motion in the rocker's
     rate q̇3, which degenerates at the rocker's extreme positions).
     """
+    a, b, c, d = positives(a=a, b=b, c=c, d=d)
+    m = _link_masses(m)
     tree = System(
         {"crank": slender_rod(m[0], a), "rocker": slender_rod(m[2], c), "coupler": slender_rod(m[1], b)},
         {"crank": Revolute(axis="z"), "rocker": Revolute(axis="z", r_pn=(d, 0.0, 0.0)),
@@ -88,6 +93,40 @@ def four_bar(a: float = 0.3, b: float = 1.0, c: float = 0.8, d: float = 1.0, m=(
     theta2, theta3 = four_bar_angles(theta1, a, b, c, d)
     return ConstrainedSystem(tree, phi=closure, independent=[0], q0=(theta1, theta3, theta2 - theta1),
                              s_dot0=[omega1], **options)
+
+
+def flexible_four_bar(a: float = 0.3, b: float = 1.0, c: float = 0.8, d: float = 1.0, m=(1.0, 2.0, 1.5),
+                      EI: float = 200.0, n_v: int = 2, g: float = 9.81, theta1: float = 0.5, omega1: float = 3.0,
+                      **options) -> ConstrainedSystem:
+    """:func:`four_bar` with an elastic coupler: a RitzBeam of length b and mass m[1] (ρA = m[1]/b),
+    bending stiffness ``EI`` (N m²) and ``n_v`` clamped–free bending functions in the plane
+    (n_w = 0; docs/theory.md §10), clamped at the crank pin; its tip is held on the rocker's by a
+    cut joint (:class:`~projeq.constraints.cut_joints.PinClosure` at the beam's station x = b,
+    which moves with the bending, Φ = (P_coupler − P_rocker) in x, y: docs/theory.md §7).
+    The tree orders q = (q1, q3, q2, q_e): crank, rocker, coupler relative to the crank, the
+    beam's amplitudes; the independent velocities are the crank's rate and the amplitudes'.
+    Initial state: the undeformed loop at crank angle ``theta1``, the crank turning at ``omega1``.
+    """
+    a, b, c, d, EI = positives(a=a, b=b, c=c, d=d, EI=EI)
+    m_crank, m_coupler, m_rocker = _link_masses(m)
+    n_v = count("n_v", n_v)
+    beam = RitzBeam(b, rho_A=m_coupler / b, EI_z=EI, n_v=n_v, n_w=0, family="clamped_free")
+    tree = System({"crank": slender_rod(m_crank, a), "rocker": slender_rod(m_rocker, c), "coupler": beam},
+                  {"crank": Revolute(axis="z"), "rocker": Revolute(axis="z", r_pn=(d, 0.0, 0.0)),
+                   "coupler": Revolute(parent="crank", axis="z", r_pn=(a, 0.0, 0.0))},
+                  gravity=(0.0, -g, 0.0))
+    pin = PinClosure(tree, "coupler", (b, 0.0, 0.0), "rocker", (c, 0.0, 0.0), axes="xy")
+    theta2, theta3 = four_bar_angles(theta1, a, b, c, d)
+    amplitudes = list(range(3, 3 + n_v))
+    return ConstrainedSystem(tree, phi=pin, independent=[0, *amplitudes], q0=(theta1, theta3, theta2 - theta1, *[0.0] * n_v),
+                             s_dot0=[omega1, *[0.0] * n_v], **options)
+
+
+def _link_masses(m) -> tuple[float, float, float]:
+    """The four-bar's masses (crank, coupler, rocker), each positive: ValueError naming m[i]."""
+    if np.ndim(m) != 1 or len(m) != 3:
+        raise ValueError(f"m: expected the three masses (crank, coupler, rocker) in kg, got {m!r}")
+    return tuple(positive(f"m[{i}]", value) for i, value in enumerate(m))
 
 
 def _sliders(body) -> tuple[dict, dict]:
@@ -107,7 +146,8 @@ def sphere_on_sphere(a: float = 0.1, b: float = 1.0, m: float = 1.0, g: float = 
     multiplier is the normal force) and the rolling condition n_z ẋ − n_x ż − a ψ̇ = 0
     (contact point at rest, n = (x, z)/|(x, z)|). Starts at rest at angle ``theta0`` from the top.
     """
-    if not 0 < a < b:
+    a, b, m = positives(a=a, b=b, m=m)
+    if not a < b:
         raise ValueError(f"a: the rolling sphere's radius must be in (0, b = {b}), got {a}")
     subsystems, joints = _sliders(RigidBody(m, (0.0, 0.0, 0.0), np.eye(3) * 0.4 * m * a * a))
     tree = System(subsystems, joints, gravity=(0.0, 0.0, -g))
@@ -131,6 +171,7 @@ def bar_on_wall(l: float = 0.5, m: float = 1.0, g: float = 9.81, theta0: float =
     body z-axis, ψ = −θ with θ its tilt from the vertical. Constraints: Φ_wall = x + l sin ψ
     (multiplier: the wall's push along +x) and Φ_floor = z − l cos ψ. Starts at rest at tilt θ0.
     """
+    l, m = positives(l=l, m=m)
     subsystems, joints = _sliders(RigidBody(m, (0.0, 0.0, 0.0), np.eye(3) * m * l * l / 3))
     tree = System(subsystems, joints, gravity=(0.0, 0.0, -g))
 
@@ -145,6 +186,7 @@ def slider_pendulum(l: float = 1.0, m: float = 1.0, g: float = 9.81, theta0: flo
     """A point mass on x and z sliders held at distance l from the origin by Φ = √(x² + z²) − l
     (a pendulum whose rod is a constraint equation; the multiplier is minus the rod tension).
     Starts at rest at angle θ0 from the downward vertical; gravity −z."""
+    l, m = positives(l=l, m=m)
     tree = System({"x": Frame(), "bob": PointMass(m)},
                   {"x": Prismatic(axis="x"), "bob": Prismatic(parent="x", axis="z")}, gravity=(0.0, 0.0, -g))
     return ConstrainedSystem(tree, phi=lambda q, t: [np.sqrt(q[0] ** 2 + q[1] ** 2) - l],

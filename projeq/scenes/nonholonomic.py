@@ -24,7 +24,7 @@ from functools import cache
 import numpy as np
 import sympy as sp
 
-from projeq.checks import non_negative, positive
+from projeq.checks import finite_array, non_negative, positives
 from projeq.constraints.nonholonomic import check_configuration, initial_speeds
 from projeq.forces import Force, Torque
 from projeq.joints import Fixed, UserJoint
@@ -76,6 +76,7 @@ def car(m: float = 1200.0, C0: float = 3228.0, c: float = 1.2, f_x=0.0, M_z=0.0,
         [x, y, g], [vx, wz], A, [x, y, 0], F, K,
         constraints=[-sp.sin(g) * xd + sp.cos(g) * yd], q_dot=[xd, yd, gd],
     )
+    m, C0, c = *positives(m=m, C0=C0), float(finite_array("c", c, ()))
     C_c = C0 - m * c * c
     if not C_c > 0:
         raise ValueError(f"C0: the moment of inertia about O must exceed m c² = {m * c * c}, got {C0}")
@@ -148,7 +149,7 @@ def knife_edge_disc(m: float = 1.0, r: float = 1.0, I: float = 0.25, J: float = 
     remove the coordinate singularity, but for the knife edge ϕ = ±π/2 is also the end of
     the rolling contact.
     """
-    r = positive("r", r)
+    m, r, I, J = positives(m=m, r=r, I=I, J=J)
     q, s, A, pos, F, K, constraints, qd, r_sym = _disc_joint_lecture()
     joint = UserJoint.from_sympy(q, s, A, pos, F, K, constraints=constraints, q_dot=qd,
                                  parameters={r_sym: r}, q0=np.asarray(q0, dtype=float))
@@ -174,6 +175,7 @@ def knife_edge_circle(kappa: float, phi0: float, m: float = 1.0, r: float = 1.0,
     Returns (v, q0, s_dot0) at t = 0 (G at (0, −1/κ), heading ψ = 0); ``v`` overrides the
     speed (to start *off* the steady motion).
     """
+    m, r, I, J = positives(m=m, r=r, I=I, J=J)
     mu, nu = I / (m * r * r), J / (m * r * r)
     k = kappa * r
     v2 = g * r * np.tan(phi0) / (k * (k * mu * np.sin(phi0) + nu + 1.0))
@@ -280,7 +282,8 @@ def rolling_disk(m_disk: float = 0.030, R: float = 0.015, m_ecc: float = 0.001, 
     degenerate (Barhorst notes the singularity near q2 = π/2); a construction there
     raises a ValueError naming the coordinate.
     """
-    R, m_ecc, drag = positive("R", R), non_negative("m_ecc", m_ecc), non_negative("drag", drag)
+    m_disk, R = positives(m_disk=m_disk, R=R)
+    m_ecc, drag = non_negative("m_ecc", m_ecc), non_negative("drag", drag)
     if ecc is not None and m_ecc == 0:
         raise ValueError(f"ecc: the eccentric mass's position {ecc!r} is given, but m_ecc = 0 places no mass there")
     q, s, A, pos, F, K, constraints, qd, R_sym = _rolling_disk_joint()

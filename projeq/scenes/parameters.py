@@ -109,11 +109,16 @@ def parse_value(scene, name: str, text: str):
 
 
 def parse_settings(scene, settings) -> dict:
-    """``{"m": 2.0}`` from ``["m=2.0"]``; ValueError naming a malformed setting."""
-    overrides = {}
+    """``{"m": 2.0}`` from ``["m=2.0"]``; ValueError naming a malformed setting or a name set
+    twice (which of the two values was meant, the command line does not say)."""
+    overrides, given = {}, {}
     for setting in settings or ():
         name, sep, text = setting.partition("=")
-        if not sep or not name.strip():
+        name = name.strip()
+        if not sep or not name:
             raise ValueError(f"--set: expected name=value, got {setting!r}")
-        overrides[name.strip()] = parse_value(scene, name.strip(), text.strip())
+        if name in given:
+            raise ValueError(f"--set: {name} is set twice ({given[name]!r} and {setting!r}); set it once")
+        given[name] = setting
+        overrides[name] = parse_value(scene, name, text.strip())
     return overrides

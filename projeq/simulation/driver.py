@@ -32,7 +32,7 @@ from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
 from projeq.analysis.jacobians import state_derivative, state_jacobian
 from projeq.assembly import EVALUATORS
-from projeq.checks import callable_name, closest, count, finite_array, positive, state_vector
+from projeq.checks import callable_name, closest, count, finite_array, flag, non_negative, positive, state_vector
 from projeq.simulation.integrators import (
     EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, stiff_steps, warn_stiff, with_direct_lu,
 )
@@ -96,6 +96,17 @@ def _check_options(method, options: dict) -> None:
         raise ValueError(f"options: unknown option{'s' * (len(unknown) > 1)} {unknown} for {which}{hint}; "
                          f"it takes {list(known)} (simulate's own: t_start, t_eval, n_points, dense_output, "
                          "evaluator, n_segments, progress, jac)")
+    _check_step_sizes(options)
+
+
+def _check_step_sizes(options: dict) -> None:
+    """ValueError naming a step size that is not a positive number (max_step may be inf, solve_ivp's
+    default; min_step 0): scipy refuses one at t = 0 as a failed run, and ignores a NaN."""
+    for name in ("first_step", "max_step", "min_step"):
+        value = options.get(name)
+        if value is None or (name == "max_step" and isinstance(value, (int, float, np.number)) and value == np.inf):
+            continue
+        (non_negative if name == "min_step" else positive)(name, value)
 
 
 def _event_wrapper(event, n_q, label):
@@ -283,10 +294,10 @@ class _Run:
         self.method, self.progress, self.options = method, progress, options
         self.solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
-        self.jac, self.switched, self.note = _jac_option(method, jac), "", ""  # go_implicit's record
+        self.jac, self.switched, self.note = _jac_option(method, jac, self.x.size), "", ""  # go_implicit's record
         self.pieces, self.nfev, self.njev, self.cause, self.steps, self.calls = [], 0, 0, None, 0, 0
         self.step_size = None  # the integrator's next step size where the last segment ended (_counted)
-        self.dense_output, self.x_end = bool(dense_output), None  # x_end: the state at the end of the last segment
+        self.dense_output, self.x_end = flag("dense_output", dense_output), None  # x_end: the state at the end of the last segment
         self.out_of_range = False  # warned that a subsystem left the range of its model
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
@@ -347,7 +358,7 @@ class _Run:
         t_eval = self.t_eval
         inside = t_eval[(t_eval > a) & (t_eval <= b)] if self.pieces else t_eval[(t_eval >= a) & (t_eval <= b)]
         n_q = self.model.n_q
-        jac = {"jac": self.jacobian if self.jac == "exact" else self.jac} if self.method in IMPLICIT else {}
+        jac = {"jac": self.jacobian if isinstance(self.jac, str) else self.jac} if self.method in IMPLICIT else {}
         labels = [f"events[{i}] ({callable_name(e)})" for i, e in enumerate(self.events)]
         labels += [f"the model's event {callable_name(e)}" for e in self.model.events()]
         events = [_event_wrapper(e, n_q, label) for e, label in zip(self.events + list(self.model.events()), labels)]
@@ -550,13 +561,16 @@ def _counted(solver, run: _Run) -> type:
     return Counted
 
 
-def _jac_option(method, jac):
-    """``jac`` of :func:`simulate`: "exact", "differences" (scipy's own, None) or the user's."""
-    if isinstance(jac, str) and jac not in ("exact", "differences"):
-        raise ValueError(f"jac: expected 'exact', 'differences', a callable jac(t, x) or a matrix, got {jac!r}")
-    if jac is not None and not isinstance(jac, str) and method not in IMPLICIT:
+def _jac_option(method, jac, n_x: int):
+    """``jac`` of :func:`simulate`: "exact", "differences" (scipy's own, None) or the user's
+    callable or (n_x, n_x) matrix (a matrix compared with a string is an array, not a bool)."""
+    if isinstance(jac, str):
+        if jac not in ("exact", "differences"):
+            raise ValueError(f"jac: expected 'exact', 'differences', a callable jac(t, x) or a matrix, got {jac!r}")
+        return None if jac == "differences" else jac
+    if jac is not None and method not in IMPLICIT:
         raise ValueError(f"jac: only the implicit methods {list(IMPLICIT)} use a Jacobian, not {method!r}")
-    return None if jac == "differences" else jac
+    return jac if jac is None or callable(jac) else finite_array("jac", jac, (n_x, n_x))
 
 
 class ValidityWarning(UserWarning):
@@ -635,7 +649,9 @@ def _output_times(t_start, t_end, t_eval, n_points) -> NDArray:
         raise ValueError(f"n_points, t_eval: give one of them (t_eval's times are the output rows), got n_points = "
                          f"{n_points!r} beside t_eval")
     t_eval = finite_array("t_eval", t_eval)
-    if t_eval.ndim != 1 or np.any(np.diff(t_eval) <= 0) or t_eval[0] < t_start or t_eval[-1] > t_end:
+    if t_eval.ndim != 1 or not t_eval.size:
+        raise ValueError(f"t_eval: expected a 1-D array of output times, got shape {t_eval.shape}")
+    if np.any(np.diff(t_eval) <= 0) or t_eval[0] < t_start or t_eval[-1] > t_end:
         raise ValueError(f"t_eval: must increase strictly within [{t_start}, {t_end}]")
     return t_eval
 

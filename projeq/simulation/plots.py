@@ -129,6 +129,17 @@ def drift(result, energy_conserved: bool | None = None):
     return fig
 
 
+def _work_precision_row(i: int, row) -> tuple[str, float, float]:
+    """(label, error, cpu) of ``rows[i]``: error finite and ≥ 0, cpu finite and > 0."""
+    label, error, cpu = row
+    error, cpu = float(error), float(cpu)
+    if not (np.isfinite(error) and error >= 0.0):
+        raise ValueError(f"rows[{i}]: the error of {label!r} must be finite and >= 0, got {error}")
+    if not (np.isfinite(cpu) and cpu > 0.0):
+        raise ValueError(f"rows[{i}]: the CPU time of {label!r} must be finite and > 0 s, got {cpu}")
+    return label, error, cpu
+
+
 def tip_deflection(result, beam, x=None):
     """The deflection (u, v, w) of ``beam`` (a RitzBeam) at station x (default its tip)."""
     fig, (ax,) = _figure(1)
@@ -147,15 +158,26 @@ def work_precision(rows, legend: bool = True):
     """Work-precision diagram: CPU time over error, one line per label.
 
     ``rows``: iterable of ``(label, error, cpu_seconds)``, e.g. one per tolerance and method;
-    ``legend=False`` leaves the legend to the caller.
+    ``legend=False`` leaves the legend to the caller. A log axis has no 0: an error of exactly
+    0 (a setting that reproduces the reference) is drawn at a floor, 1e-16 or a decade below the
+    smallest positive error, circled, and a note on the axes says so. A negative or non-finite
+    error, or a CPU time that is not positive and finite, is a ValueError naming the row (the
+    axis would drop the point without a word).
     """
     fig, (ax,) = _figure(1)
+    rows = [_work_precision_row(i, row) for i, row in enumerate(rows)]
+    floor = min([ROUND_OFF] + [0.1 * error for _, error, _ in rows if error > 0])
     series = {}
     for label, error, cpu in rows:
-        series.setdefault(label, []).append((float(error), float(cpu)))
+        series.setdefault(label, []).append((error if error > 0 else floor, cpu))
     for label, points in series.items():
         error, cpu = np.array(sorted(points)).T
         ax.loglog(error, cpu, "o-", label=label)
+    exact = [cpu for _, error, cpu in rows if error == 0]
+    if exact:
+        ax.scatter([floor] * len(exact), exact, s=120, facecolors="none", edgecolors="k", label="_exact")
+        ax.text(0.01, 0.02, f"circled: error exactly 0, drawn at {floor:.0e}", transform=ax.transAxes,
+                fontsize="x-small")
     ax.set_xlabel("error")
     ax.set_ylabel("CPU time (s)")
     ax.grid(alpha=0.3, which="both")

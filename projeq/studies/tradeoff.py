@@ -200,7 +200,18 @@ def _check_settings(study: Study, methods, tolerances, knobs, t_end) -> tuple:
             raise ValueError(f"knobs: unknown knob {label!r} of the {study.scene} study; knobs: {', '.join(by_label)}")
     if not methods or not knobs:
         raise ValueError("methods, knobs: give at least one of each")
+    for name, values in (("methods", methods), ("tolerances", tolerances.tolist()), ("knobs", knobs)):
+        _once(name, values)
     return methods, tolerances.tolist(), [by_label[k] for k in knobs], positive("t_end", t_end)
+
+
+def _once(name: str, values: list) -> None:
+    """ValueError naming ``name`` and the repeated entries: each setting would run, and be
+    tabulated and drawn, more than once."""
+    repeated = [v for i, v in enumerate(values) if v in values[:i]]
+    if repeated:
+        raise ValueError(f"{name}: {sorted(set(repeated), key=values.index)} given more than once; "
+                         "each setting would run more than once")
 
 
 def tradeoff(scene, methods=METHODS, tolerances=None, knobs=None, *, quick: bool = False, t_end=None,

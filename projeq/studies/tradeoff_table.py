@@ -95,13 +95,21 @@ def format_table(table: dict, levels=ERROR_LEVELS, width: int | None = None) -> 
 
 def plot(table: dict):
     """Work-precision figure of the successful rows: CPU time over error, one line per
-    (integrator, knob). An error of exactly 0 is drawn at 1e-16 (a log axis has no 0)."""
+    (integrator, knob). An error of exactly 0 is drawn at a floor and circled
+    (:func:`projeq.simulation.plots.work_precision`); the settings left out (failed, or no
+    finite error) are counted in a note on the figure."""
     from projeq.simulation import plots
 
-    ok = np.flatnonzero((table["failure"] == "") & np.isfinite(table["error"]))
-    rows = [(f"{table['method'][i]} [{table['knob'][i]}]", max(table["error"][i], 1e-16), table["cpu"][i]) for i in ok]
+    drawn = (table["failure"] == "") & np.isfinite(table["error"])
+    ok = np.flatnonzero(drawn)
+    rows = [(f"{table['method'][i]} [{table['knob'][i]}]", table["error"][i], table["cpu"][i]) for i in ok]
     fig = plots.work_precision(rows, legend=False)
     ax = fig.axes[0]
+    if not drawn.all():
+        left_out = ", ".join(f"{_setting(table, i)} ({table['failure'][i] or 'no finite error'})"
+                             for i in np.flatnonzero(~drawn))
+        ax.text(0.01, 0.98, f"not drawn: {left_out}", transform=ax.transAxes, fontsize="x-small", va="top",
+                wrap=True)
     methods, knobs = (list(dict.fromkeys(table[name][ok])) for name in ("method", "knob"))
     color = {method: f"C{i % 10}" for i, method in enumerate(methods)}
     style = {knob: dict(linestyle=("-", "--", ":", "-.")[k % 4], marker="os^vDP"[k % 6]) for k, knob in enumerate(knobs)}

@@ -187,13 +187,17 @@ def test_a_real_ctrl_c_during_sweep_keeps_finished_and_partial_points(tmp_path):
         (["run", "atwood", "--set", "m1=heavy"], "m1: expected a number"),
         (["run", "chain", "--set", "planar=maybe"], "planar: expected a bool"),
         (["run", "chain", "--set", "n=0"], "n: number of links"),
+        (["run", "atwood", "--set", "m1=3", "--set", " m1 =4"],
+         "projeq run: --set: m1 is set twice ('m1=3' and ' m1 =4'); set it once"),
+        (["sweep", "atwood", "--grid", "m2=1:2:2", "--set", "g=9", "--set", "g=10"],
+         "projeq sweep: --set: g is set twice ('g=9' and 'g=10'); set it once"),
         (["list", "nope"], "unknown scene 'nope'"),
         (["sweep", "chain", "--grid", "n=1:3"], "--grid: expected NAME=A:B:N"),
         (["sweep", "chain", "--grid", "links=1:3:3"], "links: unknown parameter"),
         (["sweep", "chain", "--grid", "n=1:2:2", "--workers", "0"], "--workers: expected a positive count"),
     ],
-    ids=["scene", "parameter", "int", "setting", "float", "bool", "scene-check", "list", "grid", "grid-name",
-         "workers"],
+    ids=["scene", "parameter", "int", "setting", "float", "bool", "scene-check", "set-twice-run", "set-twice-sweep",
+         "list", "grid", "grid-name", "workers"],
 )
 def test_bad_arguments_exit_2_with_the_reason(argv, message, capsys, tmp_path):
     assert main(argv + (["--out", str(tmp_path)] if argv[0] in ("run", "sweep") else [])) == 2
@@ -218,6 +222,19 @@ def test_compare_hands_its_options_to_the_library(monkeypatch, capsys):
     assert main(["compare", "car", "--no-simulate", "--t-end", "1.5", "--formulation", "hamel", "--repeats", "3"]) == 0
     assert seen == [(("car", ["hamel"]), {"simulate": False, "t_end": 1.5, "repeats": 3})]
     assert capsys.readouterr().out.startswith("compare car")
+
+
+@pytest.mark.parametrize("where, message", [
+    ("file/table.csv", "cannot write to directory"), ("", "is a directory, not a file")], ids=["under-a-file", "a-directory"])
+def test_compare_refuses_a_csv_it_cannot_write_before_comparing(where, message, monkeypatch, tmp_path, capsys):
+    """Passes if ``projeq compare --csv PATH`` with a PATH that cannot be written exits 2 naming
+    --csv before the comparison runs (the library's compare is never called). Before, the whole
+    comparison ran (derivations and simulations) and then failed to write, exit 1."""
+    (tmp_path / "file").write_text("")
+    monkeypatch.setattr(projeq.cli.studies, "compare", lambda *args, **options: pytest.fail("compare ran"))
+    assert main(["compare", "car", "--csv", str(tmp_path / where)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("projeq compare: --csv: ") and message in err
 
 
 @pytest.mark.parametrize("error, code", [(ValueError("t_end: must be positive"), 2),
@@ -255,6 +272,14 @@ def test_bench_budgets_must_be_positive_seconds(option, value, capsys):
     assert main(["bench", option, value, "--chain-only", "--sizes", "2"]) == 2
     expected = "a positive number of seconds" if option == "--total" else "a number of seconds >= 0"
     assert f"argument {option}: expected {expected}, got '{value}'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("value", ["-1", "2.5", "many"])
+def test_bench_exact_up_to_must_be_a_chain_length(value, capsys):
+    """Passes if --exact-up-to below 0 or not an integer is a usage error (exit 2) naming the option
+    and the value, before anything is timed; before, -1 ran the benchmark (as 0 would) without a word."""
+    assert main(["bench", "--exact-up-to", value, "--chain-only", "--sizes", "2"]) == 2
+    assert f"argument --exact-up-to: expected a chain length >= 0, got '{value}'" in capsys.readouterr().err
 
 
 def test_sweep_writes_one_table(tmp_path, capsys):

@@ -128,6 +128,32 @@ def test_a_user_function_returning_no_model_is_a_bad_argument(tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("source, message", [
+    ("def build(:\n", "cannot be imported: SyntaxError at line 1: invalid syntax: 'def build(:'"),
+    ("import no_such_module_of_projeq\n", "cannot be imported: ModuleNotFoundError: No module named "
+                                          "'no_such_module_of_projeq'"),
+], ids=["syntax", "import"])
+def test_a_user_file_that_cannot_be_imported_is_a_bad_argument(source, message, tmp_path, capsys):
+    """Passes if ``projeq run FILE.py:build`` of a file with a syntax error or a missing import
+    exits 2 with one line naming the file and what is wrong, nothing written. Before: a bare
+    traceback (main caught neither SyntaxError nor ImportError)."""
+    model = tmp_path / "broken.py"
+    model.write_text(source)
+    assert main(["run", f"{model}:build", "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    assert capsys.readouterr().err == f"projeq run: scene: {model} {message}\n"
+    assert not (tmp_path / "out").exists()
+
+
+def test_export_of_a_file_that_is_no_result_writes_nothing(tmp_path, capsys):
+    """Passes if ``projeq export`` of a .npz that is no Result exits 2 naming it and leaves no
+    paraview/ directory behind (before, the directory was made first, empty)."""
+    npz = tmp_path / "other.npz"
+    np.savez(npz, x=np.arange(3.0))
+    assert main(["export", str(npz)]) == 2
+    assert "is not a projeq Result" in capsys.readouterr().err
+    assert not (tmp_path / "paraview").exists()
+
+
 def test_projeq_export_writes_paraview_files_of_a_saved_run(tmp_path, capsys):
     assert main(["run", "double_pendulum", "--t-end", "0.1", "--out", str(tmp_path), "--quiet"]) == 0
     npz = run_folder(tmp_path) / "double_pendulum.npz"

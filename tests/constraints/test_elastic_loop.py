@@ -14,7 +14,7 @@ import pytest
 
 import projeq as pq
 from projeq.assembly.kinematics import forward
-from projeq.scenes.mechanisms import four_bar_angles, slender_rod
+from projeq.scenes.mechanisms import four_bar_angles
 
 A, B, C, D = 0.3, 1.0, 0.8, 1.0  # crank, coupler (the beam), rocker, ground
 
@@ -26,14 +26,23 @@ def _tip(beam, q_e):
 
 
 @pytest.fixture(scope="module")
-def loop():
-    """The flexible four-bar: q = (crank q1, rocker q3, coupler q2 relative to the crank, the
-    beam's two bending amplitudes); Φ = coupler tip − rocker tip in the plane."""
-    beam = pq.RitzBeam(B, 2.0, 200.0, n_v=2, n_w=0, family="clamped_free")
-    tree = pq.System({"crank": slender_rod(1.0, A), "rocker": slender_rod(1.5, C), "coupler": beam},
-                     {"crank": pq.Revolute(axis="z"), "rocker": pq.Revolute(axis="z", r_pn=(D, 0.0, 0.0)),
-                      "coupler": pq.Revolute(parent="crank", axis="z", r_pn=(A, 0.0, 0.0))},
-                     gravity=(0.0, -9.81, 0.0))
+def scene():
+    """The flexible four-bar (projeq.scenes.flexible_four_bar): q = (crank q1, rocker q3, coupler
+    q2 relative to the crank, the beam's two bending amplitudes), the loop closed by a cut joint at
+    the beam's tip; compiled and exact (no UncompiledClosureWarning, no differences)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        system = pq.scenes.flexible_four_bar()
+        assert system.compiled_kernel() is not None
+    return system
+
+
+@pytest.fixture(scope="module")
+def loop(scene):
+    """The scene's tree closed by a hand-written Φ = coupler tip − rocker tip in the plane, the
+    tip through the beam's slices (another statement of the cut joint), at three projected states."""
+    tree = scene.tree
+    beam = tree.subsystems[tree.index("coupler")]
 
     def closure(q, t):
         q1, q3, q2 = q[0], q[1], q[2]
@@ -100,18 +109,13 @@ def test_energy_is_conserved(loop):
 
 
 @pytest.fixture(scope="module")
-def pinned(loop):
-    """The same flexible four-bar with its loop closed by a cut joint at the beam's tip
-    (PinClosure: the tip as the frame at the beam's station x = L, which the compiled closure
-    kernel evaluates itself), at the same states."""
-    system, states = loop
-    pin = pq.PinClosure(system.tree, "coupler", (B, 0.0, 0.0), "rocker", (C, 0.0, 0.0), axes="xy")
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")  # compiled and exact: no UncompiledClosureWarning, no differences
-        pinned = pq.ConstrainedSystem(system.tree, phi=pin, independent=[0, 3, 4], q0=system.q0,
-                                      s_dot0=system.s_dot0)
-        assert pinned.compiled_kernel() is not None
-    return pinned, pin, states
+def pinned(scene, loop):
+    """The scene (its loop closed by a cut joint at the beam's tip: PinClosure at the beam's
+    station x = L, which the compiled closure kernel evaluates itself), its cut joint stated
+    again for the reactions, and the loop's states."""
+    _, states = loop
+    pin = pq.PinClosure(scene.tree, "coupler", (B, 0.0, 0.0), "rocker", (C, 0.0, 0.0), axes="xy")
+    return scene, pin, states
 
 
 def test_a_cut_joint_on_the_beam_is_the_loops_closure(pinned, loop):
@@ -173,15 +177,7 @@ def test_segments_continue_with_the_integrators_step():
     stiffness, ~40× the stable step) the trial stage left the loop's domain (q ~ 1e9) and the run
     stopped at t = 0.056 s with "the dependent velocities cannot be solved for"; continued, it runs
     through and conserves energy (measured drift 6e-14 of |E|)."""
-    beam = pq.RitzBeam(B, 2.0, 200.0, n_v=4, n_w=0, family="clamped_free")
-    tree = pq.System({"crank": slender_rod(1.0, A), "rocker": slender_rod(1.5, C), "coupler": beam},
-                     {"crank": pq.Revolute(axis="z"), "rocker": pq.Revolute(axis="z", r_pn=(D, 0.0, 0.0)),
-                      "coupler": pq.Revolute(parent="crank", axis="z", r_pn=(A, 0.0, 0.0))},
-                     gravity=(0.0, -9.81, 0.0))
-    pin = pq.PinClosure(tree, "coupler", (B, 0.0, 0.0), "rocker", (C, 0.0, 0.0), axes="xy")
-    theta2, theta3 = four_bar_angles(0.5, A, B, C, D)
-    system = pq.ConstrainedSystem(tree, phi=pin, independent=[0, 3, 4, 5, 6], q0=(0.5, theta3, theta2 - 0.5, 0, 0, 0, 0),
-                                  s_dot0=[3.0, 0, 0, 0, 0])
+    system = pq.scenes.flexible_four_bar(n_v=4)
     result = pq.simulate(system, 0.3, method="DOP853")
     assert result.t[-1] == 0.3
     assert result.energy_drift < 1e-10 and np.abs(result.constraint_residual).max() < 1e-10

@@ -105,3 +105,65 @@ def test_the_registry_makes_a_symbolic_scene_on_first_use_and_takes_new_ones(mon
     mine = pq.scenes.Scene(pq.scenes.chain, "a chain of mine", 1.0)
     monkeypatch.setitem(pq.scenes.SCENES, "mine", mine)
     assert pq.scenes.get_scene("mine") is mine and list(pq.scenes.SCENES)[-1] == "mine"
+
+
+#: every scene's sizes and masses (SI), each of which must be positive
+SIZES = {
+    "double_pendulum": ("m1", "m2", "l1", "l2"),
+    "atwood": ("m1", "m2", "pulley_mass", "radius"),
+    "quick_return": ("A", "H", "m_a", "m_b"),
+    "four_bar": ("a", "b", "c", "d"),
+    "flexible_four_bar": ("a", "b", "c", "d", "EI"),
+    "sphere_on_sphere": ("a", "b", "m"),
+    "bar_on_wall": ("l", "m"),
+    "slider_pendulum": ("l", "m"),
+    "spin_up_beam": ("t_s", "length", "EI", "EA", "rho_A"),
+    "spinning_beam": ("length", "EI", "rho_A", "rho_I"),
+    "elastic_arm": ("l1", "m1", "length", "rho_A", "EI", "tip_mass"),
+    "simple_pendulum": ("m", "L"),
+    "n_four_bar": ("m", "L"),
+    "bricard": ("m", "L", "side"),
+    "flyball_governor": ("K", "s0"),
+    "knife_edge_disc": ("m", "r", "I", "J"),
+    "rolling_disk": ("m_disk", "R"),
+    "car": ("m", "C0"),
+    "barhorst_particle": ("m",),
+    "nonholonomic_particle": ("m",),
+}
+
+
+@pytest.mark.parametrize("value", [0.0, -0.5, float("nan")], ids=["zero", "negative", "nan"])
+@pytest.mark.parametrize("scene, name", [(s, n) for s, names in SIZES.items() for n in names],
+                         ids=[f"{s}-{n}" for s, names in SIZES.items() for n in names])
+def test_a_scene_refuses_a_size_or_mass_that_is_not_positive_by_its_own_name(scene, name, value):
+    """Passes if a zero, negative or NaN size or mass is a ValueError that begins with the
+    scene's parameter name (a mass may add " (mass)"). Before, double_pendulum(l1=-1),
+    slider_pendulum(l=0), bar_on_wall(l=-1), quick_return(A=0), four_bar(d=0) were built (silent
+    nonsense: the slider pendulum's Φ = |x| holds the bob at the origin); others were refused
+    under another name (elastic_arm(l1=0) as "length", spin_up_beam(EI=-1) as "EI_z",
+    knife_edge_disc(I=0) as "I_c", rolling_disk(m_disk=0) as "m (mass)"); spin_up_beam(EA=-1)
+    passed unchecked."""
+    problem = "non-finite" if np.isnan(value) else "must be positive"
+    with pytest.raises(ValueError, match=rf"^{name}( \(mass\))?: {problem}"):
+        getattr(pq.scenes, scene)(**{name: value})
+
+
+@pytest.mark.parametrize("m, message", [
+    ((1.0, -2.0, 1.5), r"^m\[1\]: must be positive, got -2.0"),
+    ((1.0, 2.0), r"^m: expected the three masses \(crank, coupler, rocker\) in kg, got \(1.0, 2.0\)"),
+], ids=["negative", "two"])
+def test_the_four_bar_names_its_bad_mass(m, message):
+    """Passes if a bad link mass of the four-bar is named by its index; before, (1, −2, 1.5) was
+    refused as the coupler rod's "I_c (moment about the plane normal)", and two masses raised a
+    bare IndexError."""
+    with pytest.raises(ValueError, match=message):
+        pq.scenes.four_bar(m=m)
+
+
+@pytest.mark.parametrize("name", ["m1", "m2", "pulley_mass"])
+def test_build_scene_names_the_atwood_mass_it_was_given(name):
+    """Passes if build_scene("atwood", m1=nan) (and m2, pulley_mass) is a ValueError that begins
+    with that parameter; before, all three were named "m" (the PointMass's or RigidBody's own
+    parameter), so that the message did not say which of the three masses was wrong."""
+    with pytest.raises(ValueError, match=rf"^{name}: non-finite entries \(NaN or inf\)"):
+        pq.scenes.build_scene("atwood", **{name: float("nan")})

@@ -58,3 +58,27 @@ def test_work_precision_sorts_each_method_by_error():
     (rk_error, rk_cpu), (dop_error, _) = lines(fig.axes[0])
     assert rk_error.tolist() == [1e-9, 1e-6, 1e-3] and rk_cpu.tolist() == [0.5, 0.2, 0.1]
     assert dop_error.tolist() == [1e-10] and fig.axes[0].get_xscale() == "log"
+
+
+@pytest.mark.parametrize("smallest, floor", [(1e-9, 1e-16), (1e-17, 1e-18)], ids=["round-off", "below-round-off"])
+def test_work_precision_draws_an_exact_error_at_a_stated_floor(smallest, floor):
+    """Passes if an error of exactly 0 is drawn at the floor (1e-16, or a decade below a smaller
+    positive error), circled, with a note naming the floor. Before, the log axis dropped the
+    point without a word (matplotlib masks x ≤ 0)."""
+    rows = [("RK45", 0.0, 0.4), ("RK45", smallest, 0.2), ("RK45", 1e-3, 0.1)]
+    fig = plots.work_precision(rows)
+    ((error, cpu),) = lines(fig.axes[0])
+    assert error.tolist() == [floor, smallest, 1e-3] and cpu.tolist() == [0.4, 0.2, 0.1]
+    assert fig.axes[0].collections[0].get_offsets().tolist() == [[floor, 0.4]]
+    assert [t.get_text() for t in fig.axes[0].texts] == [f"circled: error exactly 0, drawn at {floor:.0e}"]
+
+
+@pytest.mark.parametrize("row, message", [
+    (("RK45", -1e-8, 0.2), r"^rows\[1\]: the error of 'RK45' must be finite and >= 0, got -1e-08"),
+    (("RK45", np.nan, 0.2), r"^rows\[1\]: the error of 'RK45' must be finite and >= 0, got nan"),
+    (("RK45", 1e-8, 0.0), r"^rows\[1\]: the CPU time of 'RK45' must be finite and > 0 s, got 0.0"),
+], ids=["negative-error", "nan-error", "zero-cpu"])
+def test_work_precision_refuses_a_point_a_log_axis_cannot_show(row, message):
+    """Passes if a point the log axes would drop is a ValueError naming its row."""
+    with pytest.raises(ValueError, match=message):
+        plots.work_precision([("RK45", 1e-3, 0.1), row])

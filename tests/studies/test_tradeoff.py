@@ -164,6 +164,19 @@ def test_cli_bad_arguments_exit_2_naming_the_argument(argv, name, capsys, tmp_pa
     assert f"projeq tradeoff: {name}" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("argv, message", [
+    (["--methods", "RK45", "DOP853", "RK45"], "methods: ['RK45'] given more than once"),
+    (["--tolerances", "1e-3", "1e-6", "1e-3"], "tolerances: [0.001] given more than once"),
+    (["--knobs", "recursive", "recursive"], "knobs: ['recursive'] given more than once"),
+], ids=["methods", "tolerances", "knobs"])
+def test_cli_refuses_a_setting_given_twice(argv, message, capsys, tmp_path):
+    """Passes if a method, tolerance or knob given twice is exit 2 naming it, before any run.
+    Before, each such setting ran twice and its rows appeared twice in the table and the figure
+    (as a repeated --grid value of projeq sweep, which is refused)."""
+    assert projeq_main(["tradeoff", "chain", "--quick", "--set", "n=1", "--t-end", "0.1", *argv, "--out", str(tmp_path)]) == 2
+    assert f"projeq tradeoff: {message}; each setting would run more than once" in capsys.readouterr().err
+
+
 def test_cli_help_and_missing_scene(capsys):
     assert projeq_main(["tradeoff", "--help"]) == 0
     assert "--tolerances" in capsys.readouterr().out
@@ -172,9 +185,13 @@ def test_cli_help_and_missing_scene(capsys):
 
 
 def test_plot_returns_a_figure_with_one_line_per_method_and_knob():
+    """Passes if the six successful settings are drawn and the two failed ones are named in a
+    note on the figure (before, they were left out without a word)."""
     table = _constructed_table()
     fig = tr.plot(table)
     assert len(fig.axes[0].lines) == 6  # A, B, C, D, G, H succeeded; E, F failed and are not drawn
+    assert [t.get_text() for t in fig.axes[0].texts] == [
+        "not drawn: E rtol=1e-06 [k] (timeout), F rtol=1e-06 [k] (diverged)"]
 
 
 def test_every_study_names_existing_knobs_and_scene_parameters():

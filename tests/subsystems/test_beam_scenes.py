@@ -96,7 +96,7 @@ def test_elastic_arm_links_tip_mass_and_initial_state():
         (lambda: spin_up_beam(omega_s=float("nan")), "omega_s"),
         (lambda: spin_up_beam(n_shapes=0), "n_shapes"),
         (lambda: spin_up_beam(n_axial=-1), "n_axial"),
-        (lambda: spin_up_beam(EI=-1.0), "EI_z"),  # passed on to RitzBeam, named there
+        (lambda: spin_up_beam(EI=-1.0), "^EI: must be positive"),  # the scene's name (was RitzBeam's EI_z)
         (lambda: elastic_arm(n_shapes=2.5), "n_shapes"),
         (lambda: spinning_beam(omega=float("inf")), "omega"),
         (lambda: spinning_beam(rho_I=-1e-3), "rho_I"),

@@ -1,6 +1,8 @@
 """RitzBeam torsion, pinned support, shear-force probes and frequencies about a steady spin,
 against closed forms (issue 6)."""
 
+import warnings
+
 import numpy as np
 import pytest
 from scipy.linalg import eigh
@@ -213,3 +215,42 @@ def test_bad_torsion_and_support_input_names_the_parameter(kwargs, match):
     args.update(kwargs)
     with pytest.raises(ValueError, match=match):
         RitzBeam(**args)
+
+
+@pytest.mark.parametrize("unused, count_name, deformation", [
+    ({"EA": 50.0}, "n_u", "axial"),
+    ({"GI_t": 5.0}, "n_beta", "torsional"),
+], ids=["EA", "GI_t"])
+def test_a_stiffness_without_ritz_functions_warns_by_name(unused, count_name, deformation):
+    """Passes if EA given with n_u = 0 (GI_t with n_beta = 0) gives a UserWarning naming it and
+    the count that would use it, and K_e is that of the beam without it (the stiffness has no
+    effect). Before, it was dropped without a word."""
+    name = next(iter(unused))
+    with pytest.warns(UserWarning, match=rf"^{name}: given but unused, since {count_name} = 0 \(no {deformation} "
+                                         rf"Ritz functions\); give {count_name} > 0"):
+        beam = RitzBeam(2.0, 1.0, 20.0, n_v=2, n_w=1, **unused)
+    np.testing.assert_array_equal(beam.K_e, RitzBeam(2.0, 1.0, 20.0, n_v=2, n_w=1).K_e)
+
+
+def test_defaults_and_used_stiffnesses_are_silent():
+    """Passes if neither the defaults nor EA, GI_t with their Ritz functions warn."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        RitzBeam(2.0, 1.0, 20.0, n_v=2, n_w=1)
+        RitzBeam(2.0, 1.0, 20.0, n_v=2, n_w=1, n_u=1, EA=50.0, n_beta=1, GI_t=5.0, rho_I_p=1e-3)
+
+
+def test_rho_I_p_without_torsion_is_the_spin_inertia():
+    """Passes if ρI_p given with n_beta = 0 adds ρI_p L to the rigid beam's inertia about its
+    axis x, and nothing else, in the mass matrix at rest (slices' polar moments summed along
+    the beam, docs/theory.md §10): it acts, so it is accepted without a warning."""
+    rho_I_p, length = 3e-3, 2.0
+    plain = RitzBeam(length, 1.0, 20.0, n_v=2, n_w=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        spinning = RitzBeam(length, 1.0, 20.0, n_v=2, n_w=1, rho_I_p=rho_I_p)
+    rest = (np.zeros(plain.n_y), np.eye(3), np.zeros(3), np.zeros(plain.n_e))
+    difference = spinning.gauss_terms(*rest)[0] - plain.gauss_terms(*rest)[0]
+    expected = np.zeros_like(difference)
+    expected[3, 3] = rho_I_p * length
+    np.testing.assert_allclose(difference, expected, rtol=1e-14, atol=1e-15)

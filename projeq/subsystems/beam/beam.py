@@ -43,6 +43,16 @@ from projeq.subsystems.base import Subsystem
 from projeq.subsystems.beam.probes import BeamProbes
 
 
+def _warn_unused(name: str, stiffness, count_name: str, n: int, deformation: str) -> None:
+    """A UserWarning that ``name``, given, has no effect: its deformation has no Ritz functions
+    (n = 0). A warning, not an error: the counts are the accuracy knob, and a convergence
+    study keeps the material data while it turns a deformation off."""
+    if stiffness is not None and n == 0:
+        warnings.warn(f"{name}: given but unused, since {count_name} = 0 (no {deformation} Ritz functions); "
+                      f"give {count_name} > 0 for {deformation} deformation, or leave {name} out",
+                      UserWarning, stacklevel=3)
+
+
 class RitzBeam(BeamProbes, Subsystem):
     """A beam subsystem: Euler–Bernoulli bending in two planes, optional axial and torsional
     deformation and rotary inertia, dynamic stiffening, stiffness-proportional damping.
@@ -56,16 +66,19 @@ class RitzBeam(BeamProbes, Subsystem):
     EI_z, EI_y : float or callable
         Bending stiffness for v (x–y plane) and w (x–z plane), N m²; EI_y defaults to EI_z.
     EA : float or callable, optional
-        Axial stiffness (N), needed when ``n_u > 0``.
+        Axial stiffness (N), needed when ``n_u > 0``; given with ``n_u = 0`` it has no effect
+        and a UserWarning says so.
     rho_I : (float, float), optional
         Rotary inertia per length (ρI_y, ρI_z) in kg m; polar ρ(I_y + I_z). None: none.
     n_v, n_w, n_u, n_beta : int
         Number of Ritz functions for v, w, u and the torsion angle β (the accuracy knob).
     GI_t : float or callable, optional
-        Torsional stiffness (N m²), needed when ``n_beta > 0``.
+        Torsional stiffness (N m²), needed when ``n_beta > 0``; given with ``n_beta = 0`` it
+        has no effect and a UserWarning says so.
     rho_I_p : float, optional
         Polar mass moment per length ρI_p (kg m) of the torsion, needed when ``n_beta > 0``
-        unless ``rho_I`` gives it as ρ(I_y + I_z).
+        unless ``rho_I`` gives it as ρ(I_y + I_z). With ``n_beta = 0`` it still acts: it is the
+        slices' inertia about the beam's axis (ρI_p L in the rigid beam's spin about x).
     family : "polynomial", "clamped_free", "pinned_free" or a callable ``(n, L) -> shapes``
         Bending family; the axial and torsional families are chosen alike ("polynomial" or
         "clamped_free": the fixed–free bar's sines; "pinned_free" uses the latter; a
@@ -141,6 +154,8 @@ class RitzBeam(BeamProbes, Subsystem):
             raise ValueError("GI_t: torsion (n_beta > 0) needs the torsional stiffness GI_t")
         if self.n_beta and rho_I_p is None and rho_I is None:
             raise ValueError("rho_I_p: torsion (n_beta > 0) needs the polar mass moment per length ρI_p")
+        _warn_unused("EA", EA, "n_u", self.n_u, "axial")
+        _warn_unused("GI_t", GI_t, "n_beta", self.n_beta, "torsional")
         if support not in ("clamped", "pinned"):
             raise ValueError(f"support: must be 'clamped' or 'pinned', got {support!r}")
         self.support = support
