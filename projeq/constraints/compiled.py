@@ -132,7 +132,7 @@ def _tree_piece(tree) -> str | None:
     if python:
         n = python[0]
         return (f"joint {tree.names[n]!r} ({type(tree.joints[n]).__name__}) states its own relative motion in "
-                "Python (not a UserJoint from sympy)")
+                "Python (no compiled values: a UserJoint from callables, a Prescribed motion that is a callable)")
     if ev._expansion is not None:
         return "coupled joints (shared minimal velocities)"
     for i, law in enumerate(tree.forces):

@@ -41,7 +41,7 @@ def numeric_function(name: str, arguments, expressions, constants=()):
     array argument, a single symbol a scalar argument; ``constants``: symbols whose values
     ``make`` takes (captured by the function, constants to numba). The function's ``source``
     attribute is its own source (in the names of ``constants``, its ``constants`` attribute), to
-    be compiled where the constants are module globals (:func:`projeq.constraints.compiled.joint_callback`)."""
+    be compiled where the constants are module globals (:func:`projeq.assembly.given.joint_callback`)."""
     rename = {}
     for argument, symbols in arguments:
         if isinstance(symbols, sp.Symbol):
