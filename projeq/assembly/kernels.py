@@ -150,10 +150,11 @@ def chain_terms(index, geometry, inertia, gravity, q, s_dot, given, elastic, por
                 r_rel[a] = given[n, GIVEN_R + a]
                 for b in range(3):
                     A_rel[a, b] = given[n, GIVEN_A + 3 * a + b]
+            k_s = n_cols[n] - n_e[n]  # the joint's own columns: its row goes on with q̇ after them
             for a in range(6):
                 w[a] = given[n, GIVEN_W + a]
                 for c in range(6):  # F⁶ column by column
-                    F[n, a, c] = given[n, GIVEN_F + 6 * c + a]
+                    F[n, a, c] = given[n, GIVEN_F + 6 * c + a] if c < k_s else 0.0
         else:
             x = q[q_index[n]] if k != FIXED else 0.0
             _relative_rotation(k, e, x, A_rel)
