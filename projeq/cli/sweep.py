@@ -22,6 +22,7 @@ import sys
 
 import numpy as np
 
+from projeq.checks import positive
 from projeq.cli.options import output_directory, scene_label, simulate_options, simulation_options
 
 
@@ -58,6 +59,7 @@ def sweep_scene(args) -> int:
         raise ValueError(f"--workers: expected a positive count, got {args.workers}")
     client = _dask_client(args.scheduler, args.scheduler_timeout) if args.scheduler else None
     options = simulate_options(args, scene)
+    t_end = None if args.t_end is None else positive("t_end", args.t_end)  # before anything is printed or made
     quiet = args.quiet or args.json
     with client if client is not None else contextlib.nullcontext():  # a Dask client is closed also when --out is refused
         out = output_directory(args.out)
@@ -65,7 +67,7 @@ def sweep_scene(args) -> int:
             where = f"the Dask scheduler at {args.scheduler}" if client else f"{args.workers or os.cpu_count()} local processes"
             print(f"sweep {args.scene}: {n_points} points on {where}; each is appended to "
                   f"{out / f'sweep_{label}.csv'} as it finishes", flush=True)
-        table = sweep(scene, grid=grid, outputs=args.outputs.split(","), executor=client, t_end=args.t_end,
+        table = sweep(scene, grid=grid, outputs=args.outputs.split(","), executor=client, t_end=t_end,
                       progress=not quiet, path=out / f"sweep_{label}", resume=args.resume,
                       workers=None if client else args.workers, **options)
     files = [out / f"sweep_{label}.csv", out / f"sweep_{label}.npz"]

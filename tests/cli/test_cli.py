@@ -204,6 +204,17 @@ def test_bad_arguments_exit_2_with_the_reason(argv, message, capsys, tmp_path):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("t_end", ["nan", "inf", "-1", "0"])
+def test_a_sweep_refuses_its_end_time_before_it_announces_or_writes(t_end, capsys, tmp_path):
+    """Exit 2 naming t_end, with nothing printed on stdout and no output directory made (before, the
+    sweep printed its "N points on ..." line and created --out, then every point failed the same way)."""
+    out = tmp_path / "out"
+    assert main(["sweep", "atwood", "--grid", "m1=1:2:2", "--workers", "1", "--t-end", t_end, "--out", str(out)]) == 2
+    said = capsys.readouterr()
+    assert "projeq sweep: t_end:" in said.err and said.out == ""
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("command", [["run", "chain"], ["sweep", "atwood", "--grid", "m1=1:2:2", "--workers", "1"]])
 def test_an_output_directory_that_cannot_be_written(command, tmp_path, capsys):
     (tmp_path / "file").write_text("")
