@@ -275,7 +275,7 @@ class Prescribed(Joint):
             return None
         t = sp.Symbol("t")
         inner = self.symbolic_relative([], [], t, self.expression)
-        return _printed_values(*(sp.ImmutableMatrix(e) for e in (inner.A, inner.r, inner.f)), t)
+        return _printed_relative((), (), t, *(sp.ImmutableMatrix(e) for e in inner))
 
 
 def _label(motion) -> str:
@@ -305,18 +305,6 @@ def _time_function(expr) -> Callable:
     t = sp.Symbol("t")
     f = sp.lambdify(t, [expr, expr.diff(t), expr.diff(t, 2)], modules="numpy")
     return lambda time: tuple(f(time))  # complex at a complex t: Prescribed.angles keeps the complex step
-
-
-@functools.lru_cache(maxsize=64)
-def _printed_values(A, r, f, t):
-    """The compiled-form ``values`` of a prescribed motion's kinematics A(t), r(t), w = f(t), ζ = ḟ(t)
-    (no coordinates, no minimal velocities), one function per kinematics in a process so that its
-    numba callback is built once."""
-    from projeq.joints.user_compiler import printed_values
-
-    symbols = {"q": [], "s": [], "t": t, "A": A, "r": r, "F": sp.zeros(6, 0), "f": f, "zeta": f.diff(t),
-               "K": sp.zeros(0, 0), "k": sp.zeros(0, 1)}
-    return printed_values(symbols)()
 
 
 @functools.lru_cache(maxsize=64)
