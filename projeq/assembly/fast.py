@@ -115,9 +115,10 @@ class FastEvaluator:
         # ẋ and ∂ẋ/∂x in one call where no Python runs between the kernels (no force law without a
         # compiled row, no coupling; joints of kind GIVEN all with compiled values, stated by their C
         # callbacks, given.py): without joints of kind GIVEN every joint has q̇ = ṡ (K = E)
-        self._given_motions = given.motions_kernel() if self._given and self._printed and self.compiled else None
+        self._given_motions = given.motions_kernel() if self._given and not self._python_joints and self.compiled \
+            else None
         self._x_dot, self._jacobian = None, None
-        if not (self._python_laws or system.coupled or not self._printed):
+        if not (self._python_laws or system.coupled or self._python_joints):
             self._x_dot, self._jacobian = given.state_kernels(self.compiled, rigid) if self._given else \
                 kernels.state_kernels(loads, self.compiled, rigid=rigid)
 
@@ -129,9 +130,10 @@ class FastEvaluator:
         joints, bodies = system.joints, system.subsystems
         kind = [kernels.KINDS.get(j.compiled_kind, kernels.GIVEN) for j in joints]
         self._given = [n for n in range(N) if kind[n] == kernels.GIVEN]
-        # whether every joint of kind GIVEN has compiled values (given.py); their C callbacks' tables
-        # of each dtype are built on first use (None where numba cannot compile one)
-        self._printed = all(joints[n].compiled_values() is not None for n in self._given)
+        # the joints of kind GIVEN without compiled values (given.py), stated in Python; where there are
+        # none, their C callbacks' tables of each dtype are built on first use (None where numba cannot
+        # compile one)
+        self._python_joints = [n for n in self._given if joints[n].compiled_values() is None]
         self._tables = {}
         n_cols = [j.n_s + b.n_e for j, b in zip(joints, bodies)]
         # every joint's own coordinates and velocities (and a body's internal ones after them), in

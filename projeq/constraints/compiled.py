@@ -128,7 +128,7 @@ def _tree_piece(tree) -> str | None:
     """The first piece of the tree whose terms the kernels do not compute in the closure kernel
     (named), else None."""
     ev = tree.evaluator("fast")
-    python = _python_joints(ev)
+    python = ev._python_joints
     if python:
         n = python[0]
         return (f"joint {tree.names[n]!r} ({type(tree.joints[n]).__name__}) states its own relative motion in "
@@ -162,11 +162,6 @@ def _rheonomic_rows(system) -> bool:
     """Whether the Pfaffian rows A(q, t) q̇ = b(q, t) have a b or an A that depends on t
     (:func:`~projeq.checks.depends_on_t`: at q0 and around it)."""
     return system._b is not None or depends_on_t(system._A, system.q0)
-
-
-def _python_joints(ev) -> list:
-    """The joints of kind GIVEN whose relative motion has no compiled form (UserJoint.compiled_values)."""
-    return [n for n in ev._given if getattr(ev.system.joints[n], "compiled_values", lambda: None)() is None]
 
 
 def compiled_phi(phi, n: int, m, q0: NDArray, name: str = "phi", jitted=None):
@@ -1072,7 +1067,7 @@ def compiled_cut_joints(system) -> "CutJointRows | None":
     if point_rows(system._phi) is None or not system._identity or not system.compiled_tree():
         return None
     ev = system.tree.evaluator("fast")
-    if ev._expansion is not None or _python_joints(ev):
+    if ev._expansion is not None or ev._python_joints:
         return None
     callbacks = [joint_callback(system.tree.joints[n]) for n in ev._given]
     return None if None in callbacks else CutJointRows(ev, pin_table(system._phi, system.m_h), callbacks)
