@@ -97,8 +97,7 @@ def generated_module(f, into: str):
     processes (a temporary directory where that is not writable: compiled anew each process)."""
     import importlib.util
 
-    import numba
-
+    numba = kernels.numba_module()
     constants = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
     source = "\n".join(["import numba", "import numpy", "from numba import types as nb", "",
                         *(f"{name} = {float(value)!r}" for name, value in sorted(constants.items())), "",
