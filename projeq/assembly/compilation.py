@@ -33,7 +33,7 @@ class CacheWarning(UserWarning):
 
 
 def _ours(function) -> bool:
-    return getattr(function, "__module__", "").startswith("projeq")
+    return (getattr(function, "__module__", None) or "").startswith("projeq")
 
 
 class _Announcer:

@@ -146,8 +146,9 @@ class Joint:
         (n_q entries), printed as scalar numpy code that numba compiles
         (:func:`projeq.joints.statement.printed`), for the compiled kernels (:mod:`projeq.assembly.given`):
         by default from the joint's sympy form (:meth:`symbolic_relative`, traced from its statement
-        or its own, built once per joint); None where the joint has no sympy form without
-        parameters (it is stated in Python only)."""
+        or its own, built once per joint; its numbers passed to the compiled code as data); None
+        where the joint has no sympy form, or one that needs ``symbolic_parameters`` (it is then
+        stated in Python only)."""
         if not (self.states_motion() or type(self).symbolic_relative is not Joint.symbolic_relative) \
                 or self.symbolic_parameters:
             return None

@@ -271,7 +271,7 @@ class Prescribed(Joint):
             return None
         t = sp.Symbol("t")
         inner = self.symbolic_relative([], [], t, self.expression)
-        return statement.printed_form((), (), t, *(sp.ImmutableMatrix(e) for e in inner))
+        return statement.printed_form((), (), t, *(sp.ImmutableMatrix(e) for e in inner))()
 
 
 def _label(motion) -> str:

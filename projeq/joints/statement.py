@@ -129,8 +129,7 @@ class _Symbolic:
 
     @staticmethod
     def rotation(axis, angle):
-        algebra = lazy_import("projeq.symbolic.algebra")
-        return algebra.rotation(algebra.exact(np.asarray(axis, dtype=float)), angle)
+        return lazy_import("projeq.symbolic.algebra").rotation(sp.Matrix([_exact(e) for e in axis]), angle)
 
     @staticmethod
     def quaternion_matrix(quat):
@@ -206,25 +205,59 @@ def traced(joint, q_n, t) -> tuple:
 
 
 def printed(joint, unit=None):
-    """The joint's compiled values (:meth:`projeq.joints.Joint.compiled_values`): its sympy form
-    ``symbolic_relative`` (traced from its statement, or its own) at fresh symbols, ζ derived and
-    everything printed as scalar code that numba compiles; ``unit``: the coordinates whose values
-    are normalised, q/√(qᵀq), put in as the numeric joint does (a quaternion). One function per
-    form in a process (:func:`printed_form`), so that its numba callback is built once."""
+    """The joint's compiled values (:meth:`projeq.joints.Joint.compiled_values`): its sympy form at
+    fresh symbols — its statement traced with its parameters as symbols (:func:`parameterized`), or
+    its own ``symbolic_relative`` —, ζ derived and everything printed as scalar code that numba
+    compiles, the parameters' values its constants (so joints of one class that differ in their
+    parameters share the printed source, and one compiled callback: :mod:`projeq.assembly.given`);
+    ``unit``: the coordinates whose values are normalised, q/√(qᵀq), put in as the numeric joint does
+    (a quaternion)."""
     q, s, t = sp.symbols(f"q0:{joint.n_q}"), sp.symbols(f"s0:{joint.n_s}"), sp.Symbol("t")
-    form = joint.symbolic_relative(list(q), list(s), t)
+    form, symbols, values = parameterized(joint, q, t) if joint.states_motion() else \
+        (tuple(joint.symbolic_relative(list(q), list(s), t)), (), ())
     if unit is not None:
         u = [q[i] for i in unit]
         length = sp.sqrt(sum(x**2 for x in u))
-        form = type(form)(*(sp.Matrix(e).xreplace({x: x / length for x in u}) for e in form))
-    return printed_form(q, s, t, *(sp.ImmutableMatrix(e) for e in form))
+        form = tuple(sp.Matrix(e).xreplace({x: x / length for x in u}) for e in form)
+    return printed_form(q, s, t, *(sp.ImmutableMatrix(e) for e in form), parameters=symbols)(*values)
+
+
+#: the members of a joint that place it in the tree (not parameters of its statement)
+_PLACEMENT = ("parent", "r_pn", "orientation", "coupling")
+
+
+def parameterized(joint, q, t) -> tuple[tuple, tuple, tuple]:
+    """(form, symbols, values): the statement traced with the joint's own numbers — its float and
+    float-array members — as symbols p0, p1, … (``symbols``, their ``values``), so that the form,
+    and the code printed from it, is the same for every joint of its class; where the statement
+    cannot take symbols for them (a comparison, a numpy function of a parameter), traced with the
+    numbers themselves (no symbols)."""
+    import copy
+
+    symbols, values, members = [], [], {}
+    for name, value in vars(joint).items():
+        if name in _PLACEMENT or name.startswith("_printed"):
+            continue
+        array = np.asarray(value) if isinstance(value, (float, np.ndarray)) else None
+        if array is None or array.dtype.kind != "f":
+            continue
+        entries = [sp.Symbol(f"p{len(symbols) + i}") for i in range(array.size)]
+        symbols += entries
+        values += [float(v) for v in array.ravel()]
+        members[name] = entries[0] if array.ndim == 0 else np.array(entries, dtype=object).reshape(array.shape)
+    tracer = copy.copy(joint)
+    vars(tracer).update(members)
+    try:
+        return traced(tracer, q, t), tuple(symbols), tuple(values)
+    except Exception:  # noqa: BLE001 — a statement that needs its numbers: traced with them
+        return traced(joint, q, t), (), ()
 
 
 @functools.lru_cache(maxsize=64)
-def printed_form(q, s, t, A, r, F, f, K, k):
-    """The compiled-form ``values`` of a joint's sympy form (A, r, F, f, K, k at the symbols q, ṡ, t),
-    ζ derived as for a UserJoint (:func:`projeq.joints.user_compiler.joint_symbols`), one function per
-    form in a process so that its numba callback is built once."""
+def printed_form(q, s, t, A, r, F, f, K, k, parameters=()):
+    """``make(*p)`` -> the compiled-form ``values`` of a joint's sympy form (A, r, F, f, K, k at the
+    symbols q, ṡ, t and the ``parameters``, whose values p it takes), ζ derived as for a UserJoint
+    (:func:`projeq.joints.user_compiler.joint_symbols`), one per form in a process."""
     from projeq.joints.user_compiler import joint_symbols, printed_values
 
-    return printed_values(joint_symbols(q, s, t, A, r, F, f, K, k))()
+    return printed_values(joint_symbols(q, s, t, A, r, F, f, K, k), parameters)

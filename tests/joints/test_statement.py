@@ -101,7 +101,9 @@ def _compiled_row(joint, q, s_dot, t):
     row = np.zeros(given_joints.row_width(joint))
     pointer = ctypes.POINTER(ctypes.c_double)
     q, s_dot = np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(s_dot, dtype=float)
-    callback.ctypes(q.ctypes.data_as(pointer), s_dot.ctypes.data_as(pointer), t, row.ctypes.data_as(pointer))
+    p = given_joints.parameters(joint.compiled_values())
+    callback.ctypes(q.ctypes.data_as(pointer), s_dot.ctypes.data_as(pointer), t, p.ctypes.data_as(pointer),
+                    row.ctypes.data_as(pointer))
     return row
 
 
