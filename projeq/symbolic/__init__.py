@@ -30,11 +30,13 @@ _LAZY = {
     "CanonicalForm": ".canonical", "lagrangian_canonical": ".canonical", "projective_canonical": ".canonical",
     "energy_rate": ".canonical",
     "poisson_bracket": ".hamiltonian", "constant_of_motion_rate": ".hamiltonian",
-    "is_constant_of_motion": ".hamiltonian", "Separation": ".hamiltonian", "separate_hamilton_jacobi": ".hamiltonian",
+    "is_constant_of_motion": ".hamiltonian", "Separation": ".hamiltonian",
+    "separate_hamilton_jacobi": ".hamiltonian",
     "principal_function": ".hamiltonian", "CanonicalTransformation": ".hamiltonian",
     "canonical_transformation": ".hamiltonian", "Libration": ".hamiltonian", "Routhian": ".hamiltonian",
     "routhian": ".hamiltonian",
-    "ProgramEquations": ".program", "program_motion_equations": ".program",
+    "ProgramEquations": ".program", "program_motion_equations": ".program", "nielsen_equations": ".program",
+    "tzenoff_equations": ".program", "pseudo_regular_precession": ".program",
 }
 
 __all__ = list(_LAZY)

@@ -322,9 +322,16 @@ def routhian(L, q: Sequence, q_dot: Sequence, cyclic: Sequence, momenta: Sequenc
     if len(c) != len(cyclic):
         raise ValueError(f"momenta: expected {len(cyclic)} symbols (one per cyclic coordinate), got {len(c)}")
     velocities = [q_dot[q.index(qk)] for qk in cyclic]
-    solutions = sp.solve([L.diff(v) - ck for v, ck in zip(velocities, c)], velocities, dict=True)
-    if len(solutions) != 1:
-        raise ValueError(f"L: ∂L/∂q̇_k = c_k has {len(solutions)} solutions for {velocities}; expected one")
-    solved = {v: sp.simplify(solutions[0][v]) for v in velocities}
+    momenta_equations = sp.Matrix([L.diff(v) - ck for v, ck in zip(velocities, c)])
+    A = momenta_equations.jacobian(velocities)
+    if A.has(*velocities):  # not quadratic in the cyclic velocities: sympy's general solver
+        solutions = sp.solve(list(momenta_equations), velocities, dict=True)
+        if len(solutions) != 1:
+            raise ValueError(f"L: ∂L/∂q̇_k = c_k has {len(solutions)} solutions for {velocities}; "
+                             f"expected one")
+        column = sp.Matrix([solutions[0][v] for v in velocities])
+    else:
+        column = A.LUsolve(-momenta_equations.subs({v: 0 for v in velocities}))
+    solved = {v: sp.factor(sp.cancel(e)) for v, e in zip(velocities, column)}
     R = (L - sum(ck * v for ck, v in zip(c, velocities))).subs(solved)
-    return Routhian(sp.simplify(R), cyclic, c, solved)
+    return Routhian(sp.expand(R), cyclic, c, solved)
