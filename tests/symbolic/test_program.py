@@ -116,7 +116,7 @@ def test_nielsen_and_tzenoff_forms_are_lagranges_for_a_non_quadratic_T(form):
     """Nielsen (5.1), ∂Ṫ/∂q̇ − 2 ∂T/∂q = Q, and Tzenoff (5.2), ½(∂T̈/∂q̈ − 3 ∂T/∂q) = Q, equal Lagrange's
     equations by the identity (6.6), which does not assume T quadratic (remark after (6.7)): the
     relativistic particle in polar coordinates, T = m c² (1 − √(1 − (ṙ² + r²θ̇²)/c²)); checked at 5 random
-    states to 1e-12 relative (the difference is round-off, measured ≤ 4e-15)."""
+    states to 100 ε relative (the difference is round-off, measured ≤ 3.4e-16)."""
     r, th = dynamicsymbols("r theta")
     m, Qr, Qt = sp.symbols("m Q_r Q_theta")
     T_rel = relativistic_T(r.diff(t) ** 2 + r**2 * th.diff(t) ** 2, m)
@@ -130,14 +130,14 @@ def test_nielsen_and_tzenoff_forms_are_lagranges_for_a_non_quadratic_T(form):
     for values in rng.uniform(0.1, 0.6, (5, 11)):
         values[0] += 1  # r ≥ 1.1: speed² = ṙ² + r² θ̇² ≤ 0.36 (1 + 1.6²) < c²
         ours, reference = np.split(both(*values).ravel(), 2)
-        assert np.allclose(ours, reference, rtol=1e-12, atol=1e-12)
+        assert np.allclose(ours, reference, rtol=100 * np.finfo(float).eps, atol=0)
 
 
 def test_non_quadratic_T_program_motion_keeps_curvature_and_relativistic_energy():
     """A relativistic particle (T not quadratic, remark after (6.7)) on the signed curvature program
     constraint ẋÿ − ẏẍ = Φ (ẋ² + ẏ²)^{3/2}, Φ = 1.5, pushed by Q = (F, 0), F = 0.7, from speed 1 over 3 time
-    units: the path's curvature stays Φ (to 1e-8, measured 3e-11) and the energy integral
-    m c² (γ − 1) − F x of the relativistic particle stays constant (1e-9, measured 4e-11) while the
+    units: the path's curvature stays Φ (to 100 ε × Φ, measured 4e-16) and the energy integral
+    m c² (γ − 1) − F x of the relativistic particle stays constant (5e-10, measured 4.4e-11) while the
     speed changes by 0.68 — the Newtonian ½ m v² − F x drifts by 0.31, so the test tells the two T apart."""
     F, Phi = 0.7, 1.5
     gpme = program_motion_equations(relativistic_T(xd**2 + yd**2), [x, y], [N - Phi * (xd**2 + yd**2) ** 1.5],
@@ -145,10 +145,10 @@ def test_non_quadratic_T_program_motion_keeps_curvature_and_relativistic_energy(
     sol = gpme.simulate([0, 0, 1, 0], (0, 3), np.linspace(0, 3, 31), rtol=1e-11, atol=1e-12)
     assert sol.success
     accelerations = np.array([gpme.rhs(ti, xi)[2:] for ti, xi in zip(sol.t, sol.y.T)]).T
-    assert np.abs(curvature([*sol.y, *accelerations]) - Phi).max() < 1e-8
+    assert np.abs(curvature([*sol.y, *accelerations]) - Phi).max() < 100 * np.finfo(float).eps * Phi
     speed_squared = sol.y[2] ** 2 + sol.y[3] ** 2
     energy = LIGHT**2 * (1 / np.sqrt(1 - speed_squared / LIGHT**2) - 1) - F * sol.y[0]
-    assert np.ptp(energy) < 1e-9 and np.ptp(np.sqrt(speed_squared)) > 0.5
+    assert np.ptp(energy) < 5e-10 and np.ptp(np.sqrt(speed_squared)) > 0.5
     assert np.ptp(speed_squared / 2 - F * sol.y[0]) > 0.1
 
 
@@ -181,10 +181,10 @@ def test_grioli_condition_is_4_2_with_psi_dot_not_phi_dot():
 
 def test_pseudo_regular_precession_keeps_the_axis_on_a_cone_of_half_angle_arccot_lambda():
     """A free symmetric body (A = 1, C = 3/2) under the program constraint (4.1)–(4.2), λ = 1/2, from a
-    non-regular state (ϑ̇ = 0.3): the GPME (6.33) with p = 2. Over 5 time units ϑ varies by 0.31 and ψ̇
+    non-regular state (ϑ̇ = 0.3): the GPME (6.33) with p = 2. Over 5 time units ϑ varies by 0.65 and ψ̇
     by 0.06 (not a regular precession), yet the symmetry axis e = (sin ϑ sin ψ, −sin ϑ cos ψ, cos ϑ)
     stays in one plane n·e = cos β with cot β = λ — on a circular cone of half-angle arccot λ: plane
-    residual < 1e-8 (measured 1.2e-10), |cos β − λ/√(1 + λ²)| < 1e-8 (measured 3e-11)."""
+    residual < 3e-9 (measured 2.9e-10), |cos β − λ/√(1 + λ²)| < 3e-10 (measured 2.3e-11)."""
     rates = [f.diff(t) for f in (phi, psi, theta)]
     transverse = rates[1] ** 2 * sp.sin(theta) ** 2 + rates[2] ** 2
     spin = rates[1] * sp.cos(theta) + rates[0]
@@ -194,13 +194,13 @@ def test_pseudo_regular_precession_keeps_the_axis_on_a_cone_of_half_angle_arccot
     gpme = program_motion_equations(T_top, [phi, psi, theta], [constraint], t)
     assert gpme.p == 2
     sol = gpme.simulate([0, 0, 1.0, 2.0, 0.5, 0.3], (0, 5), np.linspace(0, 5, 51), rtol=RTOL, atol=ATOL)
-    assert sol.success and np.ptp(sol.y[2]) > 0.2 and np.ptp(sol.y[4]) > 0.03
+    assert sol.success and np.ptp(sol.y[2]) > 0.5 and np.ptp(sol.y[4]) > 0.03
     _, ps, th = sol.y[:3]
     axis = np.array([np.sin(th) * np.sin(ps), -np.sin(th) * np.cos(ps), np.cos(th)]).T
     *_, plane = np.linalg.svd(np.hstack([axis, np.ones((len(axis), 1))]))[2]
     normal, offset = plane[:3] / np.linalg.norm(plane[:3]), -plane[3] / np.linalg.norm(plane[:3])
-    assert np.abs(axis @ normal - offset).max() < 1e-8
-    assert abs(abs(offset) - float(lam / sp.sqrt(1 + lam**2))) < 1e-8
+    assert np.abs(axis @ normal - offset).max() < 3e-9
+    assert abs(abs(offset) - float(lam / sp.sqrt(1 + lam**2))) < 3e-10
 
 
 def test_nonlinear_constraint_is_refused_with_the_offer_to_differentiate():
