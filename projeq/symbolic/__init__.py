@@ -5,6 +5,8 @@
 - :mod:`.projection`, :mod:`.system`: the Projection Equation from velocity expressions
   (B(10)–(12)) and from a numeric :class:`projeq.System` (``gauss_form``);
 - :mod:`.hamel`: Hamel's coefficients and equations (B(3)–(4));
+- :mod:`.central`: Bremer's Central Equation B(2) as code — Hamel's, the Projection Equation's, Kane's
+  and Lagrange's (with multipliers) equations derived from one description;
 - :mod:`.lagrange`, :mod:`.canonical`: Lagrange/Hamilton with multipliers, the canonical
   momentum forms of A. A. Barhorst, "Generalized momenta in constrained non-holonomic systems";
 - :mod:`.hamiltonian`: Poisson brackets, constants of motion, Hamilton–Jacobi separation, the
@@ -35,6 +37,7 @@ _LAZY = {
     "principal_function": ".hamiltonian", "CanonicalTransformation": ".hamiltonian",
     "canonical_transformation": ".hamiltonian", "Libration": ".hamiltonian", "Routhian": ".hamiltonian",
     "routhian": ".hamiltonian",
+    "CentralEquation": ".central", "central_equation": ".central",
     "ProgramEquations": ".program", "program_motion_equations": ".program", "nielsen_equations": ".program",
     "tzenoff_equations": ".program", "pseudo_regular_precession": ".program",
 }

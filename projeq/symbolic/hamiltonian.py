@@ -206,7 +206,7 @@ def canonical_transformation(F, kind: int, q: Sequence, p: Sequence, Q: Sequence
 
     >>> q, p, Q, P = sp.symbols("q p Q P")
     >>> canonical_transformation(q * P, 2, [q], [p], [Q], [P]).relations   # the identity
-    (p - P, Q - q)
+    (-P + p, Q - q)
     """
     if kind not in _GENERATING_RELATIONS:
         raise ValueError(f"kind: expected 1, 2, 3 or 4 (F(q, Q), F(q, P), F(p, Q), F(p, P)), got {kind!r}")
