@@ -28,6 +28,7 @@ from typing import Mapping, Sequence
 
 import sympy as sp
 
+from .algebra import trig_normal
 from .hamel import check_regular, hamel_equations
 from .lagrange import MultiplierSystem, multiplier_system
 from .projection import Body, GaussForm, projection_equation, t
@@ -62,9 +63,12 @@ class CentralEquation:
 
     @cached_property
     def T(self) -> sp.Expr:
-        """T = Σ ½ (m v_cᵀ v_c + ωᵀ I_c ω), with every speed (constrained ones included)."""
-        return sp.expand(sum((b["m"] * b["v_c"].dot(b["v_c"]) + b["omega"].dot(b["I_c"] * b["omega"])) / 2
-                             for b in self._vectors.values()))
+        """T = Σ ½ (m v_cᵀ v_c + ωᵀ I_c ω), with every speed (constrained ones included), reduced modulo
+        sin² + cos² = 1 (:func:`trig_normal`; velocities in a turning frame R carry its rotation,
+        which cancels in T and would otherwise swell every derivative Hamel's equations take)."""
+        T = sum((b["m"] * b["v_c"].dot(b["v_c"]) + b["omega"].dot(b["I_c"] * b["omega"])) / 2
+                for b in self._vectors.values())
+        return sp.expand(trig_normal(T, self.q))
 
     @cached_property
     def Q(self) -> sp.Matrix:
