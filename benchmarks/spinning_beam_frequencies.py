@@ -1,7 +1,7 @@
 """The spinning beam without rotary inertia (ρI = 0): Ritz frequencies against the closed form.
 
 H. Bremer, "Problems in fast moving non-holonomic elastic systems", B(23) with ρI = 0 at the constant
-spin α̇ = Ω: with u = v + i w the field equations are ρA(ü + 2iΩu̇ − Ω²u) + EI u'''' = 0 with the
+spin α̇ = Ω: with u = v + i w the field equations are ρA(ü + 2iΩu̇ − Ω²u) + EI ∂⁴u/∂x⁴ = 0 with the
 cantilever's boundary conditions (clamped at 0; B₁ = EI u″ = 0, B₀ = −EI u‴ = 0 at L,
 ``projection_boundary_operators``), so the modes are the non-rotating cantilever's, u = φ_k(x) e^{iλt},
 and (λ + Ω)² = ω_k²: the frequencies seen in the co-rotating frame are |ω_k ± Ω|, ω_k = (β_k L)²
