@@ -85,14 +85,18 @@ class CentralEquation:
     def _free(self) -> list[int]:
         return [self.s.index(x) for x in self.independent]
 
+    @cached_property
+    def K_independent(self) -> sp.Matrix:
+        """q̇ = K_I u on the constraints: the columns of K of the independent speeds u."""
+        return self.K.extract(list(range(len(self.q))), self._free)
+
     def _on_constraints(self, expr):
         return expr.subs({x: 0 for x in self.constrained})
 
     def _gauss(self, residual: sp.Matrix, s_ddot: Sequence) -> GaussForm:
         """The Gauss form M s̈ = rhs of residuals linear in s̈ (independent speeds)."""
         M, rhs = sp.linear_eq_to_matrix([sp.expand(r) for r in residual], list(s_ddot))
-        return GaussForm(M, rhs, self.q, self.independent, self.K.extract(list(range(len(self.q))), self._free), t,
-                         self.parameters)
+        return GaussForm(M, rhs, self.q, self.independent, self.K_independent, t, self.parameters)
 
     def hamel_residuals(self, s_ddot: Sequence | None = None) -> sp.Matrix:
         """B(3) for every speed, before the constraints (the car's B(8)); s̈ as ``s_ddot``
@@ -116,8 +120,8 @@ class CentralEquation:
 
     def projection(self) -> GaussForm:
         """The Projection Equation B(10) with the constraints in the velocities first (B(11)–(12))."""
-        K = self.K.extract(list(range(len(self.q))), self._free)
-        return projection_equation(self._constrained_bodies(), self.q, self.independent, K, self.parameters)
+        return projection_equation(self._constrained_bodies(), self.q, self.independent, self.K_independent,
+                                   self.parameters)
 
     def kane(self) -> GaussForm:
         """Kane's equations F_r + F_r* = 0 for the independent speeds u: partial velocities ∂v_c/∂u,
@@ -125,7 +129,7 @@ class CentralEquation:
         a = v̇_c + ω_IR × v_c, α = ω̇ + ω_IR × ω (in R's coordinates) and Euler's I_c α + ω × I_c ω."""
         u = sp.Matrix(self.independent)
         u_dot = sp.Matrix(sp.symbols([f"{x}_dot" for x in self.independent]))
-        q_dot = self.K.extract(list(range(len(self.q))), self._free) * u
+        q_dot = self.K_independent * u
 
         def rate(x):  # d/dt x(q, u, t) with u̇ = u_dot
             return x.jacobian(u) * u_dot + x.jacobian(sp.Matrix(self.q)) * q_dot + x.diff(t)
