@@ -202,7 +202,7 @@ def test_zero_rotary_inertia_frequencies_are_the_cantilevers_shifted_by_the_spin
     """ρI = 0 at constant spin Ω = 1.3 (ρA = EI = L = 1): the PDE's co-rotating frequencies are |ω_k ± Ω|
     with ω_k = (β_k L)² of the cantilever, 1 + cos βL cosh βL = 0 (benchmarks/spinning_beam_frequencies.py,
     which prints n = 2 … 8; this runs its quick mode, n = 2). The Ritz model of the Projection Equation
-    splits each ω̃_k into ω̃_k ± Ω exactly (f₂ − f₁ = 2Ω to 1e-12, measured 4e-15) and has the first two
+    splits each ω̃_k into ω̃_k ± Ω exactly (f₂ − f₁ = 2Ω to 1e-12, measured 1e-14) and has the first two
     frequencies within 1e-2 relative at n = 2 (measured 7.5e-3, 3.5e-3; 1.4e-10 at n = 6)."""
     import runpy
     from pathlib import Path
