@@ -250,7 +250,9 @@ def _outline(shape: dict) -> list[NDArray]:
 
 def write_movie(result, path, system=None, stations: int = 21, fps: int = 25, max_frames: int = 250) -> Path:
     """A GIF (Pillow) or MP4 (ffmpeg) of ``result`` at ``fps`` frames per second of simulated time
-    (at most ``max_frames``, else slower): the geometry of :func:`motion` projected on the plane
+    (fewer where the run has fewer output rows or more than ``max_frames`` would be needed; the
+    movie then shows an output row per frame at a rate that keeps it in real time as far as
+    whole frames per second allow): the geometry of :func:`motion` projected on the plane
     normal to the page's viewing direction, with the time written on it. RuntimeError when the
     suffix's writer is missing (ffmpeg for MP4), naming what to install or write instead."""
     import matplotlib
@@ -281,8 +283,10 @@ def write_movie(result, path, system=None, stations: int = 21, fps: int = 25, ma
     pairs = np.array(doc["links"]["pairs"]).reshape(-1, 2)
     tubes = [np.array(tube["points"]).reshape(len(t), tube["stations"], 3) for tube in doc["tubes"]]
     outlines = [(shape["frame"], shape["color"], _outline(shape)) for shape in doc["shapes"]]
-    count = int(min(max_frames, max(2, np.ceil((t[-1] - t[0]) * fps) + 1)))
+    duration = t[-1] - t[0]
+    count = int(min(max_frames, len(t), np.ceil(duration * fps) + 1))  # no frame twice
     rows = np.searchsorted(t, np.linspace(t[0], t[-1], count), side="right") - 1
+    rate = max(1, round((count - 1) / duration)) if duration > 0 else fps  # real time where it can be
     every = np.concatenate([joints.reshape(-1, 3)] + [tube.reshape(-1, 3) for tube in tubes]) @ screen
     half = 0.6 * doc["scale"]
     centres = np.array(doc["centre"]).reshape(len(t), 3) @ screen
@@ -305,12 +309,11 @@ def write_movie(result, path, system=None, stations: int = 21, fps: int = 25, ma
         else:
             ax.set_xlim(every[:, 0].min() - 0.2 * half, every[:, 0].max() + 0.2 * half)
             ax.set_ylim(every[:, 1].min() - 0.2 * half, every[:, 1].max() + 0.2 * half)
-        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_aspect("equal", adjustable="box")
         ax.set_title(f"t = {t[i]:.3f} s", loc="left", fontsize=10)
         ax.set_xticks([]), ax.set_yticks([])
 
     movie = animation.FuncAnimation(fig, draw, frames=count)
-    rate = fps if (t[-1] - t[0]) * fps + 1 <= max_frames else max(1, round(count / max(t[-1] - t[0], 1e-9)))
     writer = animation.PillowWriter(fps=rate) if path.suffix == ".gif" else animation.FFMpegWriter(fps=rate)
     try:
         with written_atomically(path) as temporary:
