@@ -18,9 +18,12 @@ from projeq.cli.options import output_file
 def view_arguments(parser) -> None:
     parser.add_argument("run", help="a run folder of projeq run, or the .npz of a run (Result.save)")
     parser.add_argument("--out", default=None,
-                        help="the file to write: .html (default: RUN's <scene>.html beside its .npz), .gif or .mp4")
-    parser.add_argument("--stations", type=int, default=21, help="points along each beam's centre line (default 21)")
-    parser.add_argument("--fps", type=int, default=25, help="frames per second of simulated time of a .gif/.mp4 (default 25)")
+                        help="the file to write: .html (default: RUN's <scene>.html beside its .npz), "
+                             ".gif or .mp4")
+    parser.add_argument("--stations", type=int, default=21,
+                        help="points along each beam's centre line (default 21)")
+    parser.add_argument("--fps", type=int, default=25,
+                        help="frames per second of simulated time of a .gif/.mp4 (default 25)")
     parser.set_defaults(execute=view_run)
 
 

@@ -55,8 +55,10 @@ def equivalent_shape(m: float, I_c, symmetric: float = 1e-3) -> Shape:
     largest size. ValueError for m ≤ 0 or an I_c that is not a symmetric 3 × 3 matrix with
     positive moments."""
     I_c = np.asarray(I_c, dtype=float)
-    if not m > 0 or I_c.shape != (3, 3) or not np.allclose(I_c, I_c.T, rtol=0, atol=1e-12 * np.abs(I_c).max()):
-        raise ValueError(f"I_c: expected a symmetric 3 x 3 inertia tensor and m > 0, got m = {m}, I_c = {I_c.tolist()}")
+    symmetric_3x3 = I_c.shape == (3, 3) and np.allclose(I_c, I_c.T, rtol=0, atol=1e-12 * np.abs(I_c).max())
+    if not m > 0 or not symmetric_3x3:
+        raise ValueError(f"I_c: expected a symmetric 3 x 3 inertia tensor and m > 0, got m = {m}, "
+                         f"I_c = {I_c.tolist()}")
     lam, V = np.linalg.eigh(I_c)
     if not lam[2] > 0 or lam[0] < -1e-12 * lam[2]:
         raise ValueError(f"I_c: principal moments {lam.tolist()} (expected ≥ 0, not all zero)")
@@ -70,7 +72,7 @@ def equivalent_shape(m: float, I_c, symmetric: float = 1e-3) -> Shape:
         r2, l2 = 2.0 * lam[axis] / m, 12.0 * across / m
         r = np.sqrt(max(r2, 0.025**2 * l2))  # a rod without axial moment: a radius of 2.5 % of its length
         length = np.sqrt(max(l2 - 3.0 * r * r, (0.05 * r) ** 2))
-        order = [(axis + 2) % 3, axis, (axis + 1) % 3]  # the symmetry axis as y; an even permutation: det = +1
+        order = [(axis + 2) % 3, axis, (axis + 1) % 3]  # the symmetry axis as y, an even permutation
         return Shape("cylinder", (float(r), float(length)), V[:, order])
     edges2 = 6.0 * (lam.sum() - 2.0 * lam) / m
     edges = np.sqrt(np.maximum(edges2, (0.05 * np.sqrt(edges2.max())) ** 2))
@@ -173,13 +175,15 @@ def motion(result, system=None, stations: int = 21) -> dict:
         "t": _rounded(result.t, 9), "frames": list(tree.names), "poses": _rounded(np.concatenate(
             (r, _quaternions(R)), axis=-1), 6, scale),
         "shapes": shapes,
-        "tubes": [{"name": tree.names[n], "stations": stations, "radius": 0.012 * scale, "color": COLORS[n % len(COLORS)],
+        "tubes": [{"name": tree.names[n], "stations": stations, "radius": 0.012 * scale,
+                   "color": COLORS[n % len(COLORS)],
                    "points": _rounded(lines[:, k], 6, scale)} for k, n in enumerate(deforming)],
         "links": {"pairs": drawing.links["lines"].ravel().tolist(), "count": joints.shape[1],
                   "points": _rounded(joints, 6, scale), "radius": 0.006 * scale},
         "scale": scale, "up": up.tolist(), "view": _view(flat, up).tolist(),
         "distance": 3.2 * scale if travel > scale else 2.4 * float(np.ptp(flat, axis=0).max()),
-        "centre": _rounded(centre, 6, scale), "target": ((flat.min(axis=0) + flat.max(axis=0)) / 2).tolist(), "follow": travel > scale, "axes": 0.1 * scale,
+        "centre": _rounded(centre, 6, scale), "target": ((flat.min(axis=0) + flat.max(axis=0)) / 2).tolist(),
+        "follow": travel > scale, "axes": 0.1 * scale,
         "grid": {"size": size, "divisions": 20, "centre": ground.tolist()},
     }
 
@@ -239,7 +243,7 @@ def _outline(shape: dict) -> list[NDArray]:
     circle = np.column_stack((np.cos(angle), np.zeros_like(angle), np.sin(angle)))  # about y
     if shape["kind"] == "box":
         corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * np.array(s) / 2
-        pairs = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
+        pairs = [(a, b) for a in range(8) for b in range(a + 1, 8) if (a ^ b).bit_count() == 1]
         local = [corners[[a, b]] for a, b in pairs]
     elif shape["kind"] == "cylinder":
         rim = s[0] * circle
@@ -271,7 +275,8 @@ def write_movie(result, path, system=None, stations: int = 21, fps: int = 25, ma
         raise ValueError(f"path: a movie is written as .gif or .mp4, got {str(path)!r}")
     if not animation.writers.is_available(writers[path.suffix]):
         raise RuntimeError(f"path: {path.suffix} needs {writers[path.suffix]} (matplotlib's "
-                           f"'{writers[path.suffix]}' movie writer), which was not found; install it or write "
+                           f"'{writers[path.suffix]}' movie writer), which was not found; install it or "
+                           "write "
                            ".gif (Pillow, which comes with matplotlib) or .html instead")
     if not (isinstance(fps, (int, np.integer)) and fps > 0):
         raise ValueError(f"fps: expected a positive integer, got {fps!r}")
