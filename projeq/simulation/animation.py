@@ -312,8 +312,8 @@ def write_movie(result, path, system=None, stations: int = 21, fps: int = 25, ma
         for tube, spec in zip(tubes, doc["tubes"]):
             ax.plot(*(tube[i] @ screen).T, color=spec["color"], lw=4, solid_capstyle="round")
         if doc["follow"]:
-            ax.set_xlim(centres[i, 0] - 1.5 * half, centres[i, 0] + 1.5 * half)
-            ax.set_ylim(centres[i, 1] - half, centres[i, 1] + half)
+            ax.set_xlim(centres[i, 0] - 2.0 * half, centres[i, 0] + 2.0 * half)  # the mechanism's size
+            ax.set_ylim(centres[i, 1] - 1.5 * half, centres[i, 1] + 1.5 * half)  # and a margin, at 4:3
         else:
             ax.set_xlim(every[:, 0].min() - 0.2 * half, every[:, 0].max() + 0.2 * half)
             ax.set_ylim(every[:, 1].min() - 0.2 * half, every[:, 1].max() + 0.2 * half)
