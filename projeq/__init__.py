@@ -11,7 +11,7 @@ docs/theory.md, and that page by its numbered sections ("docs/theory.md §6").
 
 from projeq.subsystems import inertia
 from projeq.assembly import SingularMassError
-from projeq.forces import Force, ForceLaw, JointForce, JointSpring, SpringDamper, Torque
+from projeq.forces import BodyLoad, Force, ForceLaw, JointForce, JointSpring, SpringDamper, Torque
 from projeq.analysis.linearize import Linearization, NotSteadyError, eigenvalue_sweep, linearize
 from projeq.joints import Fixed, Free, Joint, Planar, Prescribed, Prismatic, Revolute, UserJoint
 from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, RitzBeam, Subsystem
@@ -22,7 +22,7 @@ __version__ = "0.1.0"
 __all__ = [
     "GROUND", "System", "SystemBuilder", "Subsystem", "RigidBody", "PlanarBody", "PointMass", "Frame", "RitzBeam",
     "Joint", "Revolute", "Prismatic", "Fixed", "Planar", "Free", "Prescribed", "UserJoint",
-    "ForceLaw", "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
+    "ForceLaw", "BodyLoad", "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
     "inertia", "simulate", "Result", "SimulationError", "scenes", "linearize", "Linearization", "NotSteadyError",
     "eigenvalue_sweep", "compare", "ComparisonTable", "ConstrainedSystem", "reactions", "joint_reactions", "PinClosure",
     "contact_event", "StiffnessWarning", "plots", "sweep", "SweepTable", "symbolic",

@@ -28,12 +28,14 @@ real parts only.
 
 from __future__ import annotations
 
+import functools
 from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray
 
 from projeq.checks import drop_inherited_twins, finite_array, non_negative
+from projeq.joints import statement
 from projeq.symbolic import lazy_import
 from projeq.spatial import numeric
 
@@ -300,6 +302,96 @@ class Torque(_BodyLoad):
         tau = algebra.exact(self.torque.constant)
         tau = algebra.mul(links[self.index].R.T, tau) if self.frame == "world" else tau
         return {self.index: sp.Matrix.vstack(sp.zeros(3, 1), tau)}
+
+
+class BodyLoad(ForceLaw):
+    """A load on one body stated once: ``statement(R, r, v, omega, t, m)`` returns its wrench
+    (f; M_O) about the body's origin in body coordinates (six entries) from the body's pose (R body →
+    world, r) and twist (v, ω, body coordinates), written as plain scalar code over the namespace
+    ``m`` (:mod:`projeq.joints.statement`: ``m.sqrt``, ``m.vector``, …). From that one statement:
+    :meth:`add_to` (numpy, the reference evaluators; complex under a complex step),
+    :meth:`symbolic_wrenches` (traced with sympy, for :func:`projeq.symbolic.gauss_form`) and the
+    compiled loop's row (:meth:`compiled_terms`, :meth:`compiled_wrench`: the traced wrench printed
+    for numba, its numbers passed as data; :mod:`projeq.assembly.loads`). A wrench that depends on t
+    runs in Python in the compiled kernel (named once by its PythonPieceWarning). The potential is
+    0 unless the subclass states :meth:`potential`.
+
+    >>> import numpy as np
+    >>> class Drag(BodyLoad):  # −c |v| v at the body's origin
+    ...     def __init__(self, body, c):
+    ...         super().__init__(body)
+    ...         self.c = float(c)
+    ...     def statement(self, R, r, v, omega, t, m):
+    ...         return m.vector([*(-self.c * m.sqrt(v[0]**2 + v[1]**2 + v[2]**2) * v), 0.0, 0.0, 0.0])
+    >>> from projeq.joints.statement import NUMERIC
+    >>> Drag("ball", 0.5).statement(np.eye(3), np.zeros(3), np.array([3.0, 4.0, 0.0]), np.zeros(3), 0.0, NUMERIC).tolist()
+    [-7.5, -10.0, -0.0, 0.0, 0.0, 0.0]
+    """
+
+    def __init__(self, body: str):
+        self.body = body
+
+    def statement(self, R, r, v, omega, t, m):
+        """The wrench (f; M_O) on the body, body coordinates, at its pose, twist and t (class docstring)."""
+        raise NotImplementedError
+
+    def bind(self, system) -> "BodyLoad":
+        self.index = _index(system, self.body, "body")
+        self.S = system.subsystems[self.index].S
+        return self
+
+    def add_to(self, h, kin, t, q, s_dot) -> None:
+        n, twist = self.index, kin.twist[self.index]
+        wrench = np.asarray(self.statement(kin.R[n], kin.r[n], twist[:3], twist[3:], t, statement.NUMERIC)).reshape(6)
+        h[n] += wrench if self.S is None else self.S @ wrench
+
+    def symbolic_unsupported(self) -> str | None:
+        return None
+
+    def symbolic_wrenches(self, links) -> dict:
+        link = links[self.index]
+        twist = sp.Matrix(link.twist)
+        found = self.statement(sp.Matrix(link.R), sp.Matrix(link.r), twist[:3, :], twist[3:, :], sp.Symbol("t"),
+                               statement.SYMBOLIC)
+        return {self.index: sp.Matrix(found).reshape(6, 1)}
+
+    def compiled_wrench(self):
+        """``wrench(R, r, w, t)``, the statement traced with sympy at symbols of R (row by row), r and the
+        twist w = (v, ω), the law's numbers as constants (:func:`projeq.joints.statement.parameterized`),
+        printed as scalar code that numba compiles (:func:`projeq.symbolic.codegen.numeric_function`);
+        None where the wrench depends on t. Built once per law."""
+        if "_printed" not in self.__dict__:
+            self._printed = _printed_wrench(self)
+        return self._printed
+
+    def compiled_terms(self) -> tuple | None:
+        values = self.compiled_wrench()
+        if values is None:
+            return None
+        held = dict(zip(values.__code__.co_freevars, (c.cell_contents for c in values.__closure__ or ())))
+        return "stated", (self.index,), np.array([held[name] for name in values.constants], dtype=float)
+
+
+def _printed_wrench(law):
+    """:meth:`BodyLoad.compiled_wrench` of ``law`` (None where its traced wrench depends on t)."""
+    R, r, w, t = sp.symbols("R0:9"), sp.symbols("r0:3"), sp.symbols("w0:6"), sp.Symbol("t")
+
+    def trace(tracer):
+        return sp.Matrix(tracer.statement(sp.Matrix(3, 3, R), sp.Matrix(r), sp.Matrix(w[:3]), sp.Matrix(w[3:]), t,
+                                          statement.SYMBOLIC)).reshape(6, 1)
+
+    wrench, symbols, values = statement.parameterized(law, trace, ("S",))
+    if t in wrench.free_symbols:
+        return None
+    return _print_wrench(R, r, w, t, sp.ImmutableMatrix(wrench), symbols)(*values)
+
+
+@functools.lru_cache(maxsize=64)
+def _print_wrench(R, r, w, t, wrench, symbols):
+    """``make(*p)`` of a traced wrench, one per form in a process (its numba callback is built once)."""
+    codegen = lazy_import("projeq.symbolic.codegen")
+    return codegen.numeric_function("wrench", [("R", list(R)), ("r", list(r)), ("w", list(w)), ("t", t)], wrench,
+                                    constants=list(symbols))
 
 
 class JointForce(ForceLaw):

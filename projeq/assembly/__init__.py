@@ -6,7 +6,7 @@ test_fast.py). Each evaluates the systems it knows and refuses the others with a
 ValueError saying why, when it is built; ``"auto"`` picks one (:mod:`projeq.assembly.auto`).
 """
 
-from projeq.assembly.auto import AutoEvaluator, InterpretedWarning
+from projeq.assembly.auto import AutoEvaluator, InterpretedWarning, PythonPieceWarning
 from projeq.assembly.beam_fast import HubBeamEvaluator
 from projeq.assembly.dense import DenseEvaluator
 from projeq.assembly.fast import FastEvaluator
@@ -23,6 +23,6 @@ EVALUATORS = {
 
 __all__ = [
     "EVALUATORS", "AutoEvaluator", "DenseEvaluator", "FastEvaluator", "HubBeamEvaluator", "InterpretedWarning",
-    "RecursiveEvaluator",
+    "PythonPieceWarning", "RecursiveEvaluator",
     "SingularMassError",
 ]

@@ -38,9 +38,9 @@ import warnings
 
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import hub_beam_unsupported
-from projeq.assembly.fast import InterpretedWarning, unsupported
+from projeq.assembly.fast import InterpretedWarning, PythonPieceWarning, unsupported
 
-__all__ = ["AutoEvaluator", "InterpretedWarning", "pick", "why_not_compiled"]
+__all__ = ["AutoEvaluator", "InterpretedWarning", "PythonPieceWarning", "pick", "why_not_compiled"]
 
 
 def why_not_compiled(system) -> str | None:

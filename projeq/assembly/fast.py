@@ -79,16 +79,21 @@ from projeq.subsystems.rigid import rigid_mass_matrix
 
 
 class InterpretedWarning(UserWarning):
-    """A piece of a System runs in Python, not compiled: the default evaluator fell back to an
-    interpreted reference evaluator, or the compiled kernel states a joint or a force law in Python
-    at every evaluation (the message names the piece and how to compile it)."""
+    """The default evaluator fell back to an interpreted reference evaluator (the message names the
+    joint, subsystem or force law the compiled kernel does not know)."""
 
 
-#: how to keep a joint and a force law on the compiled path (:class:`InterpretedWarning`)
+class PythonPieceWarning(UserWarning):
+    """The compiled kernel evaluates a System but states one of its joints or force laws in Python at
+    every evaluation (the message names the piece and says how to compile it)."""
+
+
+#: how to keep a joint and a force law on the compiled path (:class:`PythonPieceWarning`)
 HOW_TO_COMPILE = {
     "joint": "state a joint's motion once as statement(q_n, t, m) (docs/architecture.md, 'Adding a joint') or in "
              "sympy (UserJoint.from_sympy; a Prescribed motion as an expression in t)",
-    "force law": "build the loads from the laws of projeq.forces (constant or sympy loads), which compile",
+    "force law": "build the loads from the laws of projeq.forces (constant loads) or state a load on a body once as a "
+                 "projeq.BodyLoad (docs/architecture.md, 'Adding a force law')",
 }
 
 
@@ -107,7 +112,7 @@ class FastEvaluator:
 
     Attributes: ``name`` ("fast"), ``compiled``, ``n_calls``, ``interpreted`` (the joints and force
     laws it states in Python at every evaluation, by name: compiled, it warns once naming them,
-    :class:`InterpretedWarning`). The workspace (T_np, ζ_n,
+    :class:`PythonPieceWarning`). The workspace (T_np, ζ_n,
     f_n, M̂_n, ĥ_n) is allocated once and overwritten by every call.
     """
 
@@ -140,7 +145,7 @@ class FastEvaluator:
             how = "; ".join(hint for piece, hint in HOW_TO_COMPILE.items()
                             if any(name.startswith(piece) for name in self.interpreted))
             warnings.warn(f"system: {', '.join(self.interpreted)} run in Python at every evaluation, between the "
-                          f"compiled kernels (several times slower); to compile: {how}", InterpretedWarning,
+                          f"compiled kernels (several times slower); to compile: {how}", PythonPieceWarning,
                           stacklevel=3)
         self._x_dot, self._jacobian = None, None
         if not (self._python_laws or system.coupled or self._python_joints):
@@ -193,7 +198,12 @@ class FastEvaluator:
         self._x_shape = (system.n_q + system.n_s,)
         self._internal = [(n, system.e_s_slice[n]) for n, b in enumerate(bodies) if b.n_e]  # ṡ_e of ẏ_n
         terms = [law.compiled_terms() for law in system.forces]
-        self._laws, self._law_constants = loads.table([row for row in terms if row is not None])
+        addresses = [loads.stated_addresses(law.compiled_wrench(), self.compiled) if row and row[0] == "stated"
+                     else None for law, row in zip(system.forces, terms)]
+        terms = [None if row and row[0] == "stated" and address is None else row  # numba refused it (it warned)
+                 for row, address in zip(terms, addresses)]
+        kept = [(row, address) for row, address in zip(terms, addresses) if row is not None]
+        self._laws, self._law_constants = loads.table([row for row, _ in kept], [address for _, address in kept])
         self._python_laws = [law for law, row in zip(system.forces, terms) if row is None]  # their own add_to
         # the h_n the force laws load in the reference evaluators' coordinates: rows of n_y for
         # the bodies with a selection S (zeroed before each evaluation), the workspace's rows for

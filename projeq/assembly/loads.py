@@ -16,7 +16,11 @@ The kinds and their rows (``laws``: kind, first, second; ``constants``):
 - ``"joint_force"``: joint n and its parent p; τ — :func:`projeq.forces.joint_wrench`;
 - ``"joint_spring"``: joint n and its parent p; (k, d, q_ref) — τ by
   :func:`projeq.forces.spring_force` of the joint's coordinates and velocities (read at
-  its places in q and ṡ, ``index``), then :func:`projeq.forces.joint_wrench`.
+  its places in q and ṡ, ``index``), then :func:`projeq.forces.joint_wrench`;
+- ``"stated"`` (a :class:`~projeq.forces.BodyLoad`: a law that states its body wrench once as
+  scalar code): body n; its parameters' values — the wrench by the C callback of its printed
+  statement (:func:`projeq.assembly.generated.law_callback`, float64 and complex128: the
+  callbacks' addresses in the row's last two columns), :func:`wrench_into`.
 
 On an elastic body (a RitzBeam) the loads act on its reference frame (the first six rows of
 h_n, as its S = [E; 0] selects them in the reference); a joint's pair takes the n_y rows of
@@ -35,24 +39,51 @@ import functools
 import numpy as np
 
 from projeq.assembly import kernels
+from projeq.assembly.generated import intrinsics, law_callback
 from projeq.assembly.kernels import N_COLS, N_Y, Q_INDEX, S_INDEX
 from projeq.forces import body_wrench, joint_wrench, spring_damper, spring_end, spring_force
 
-WRENCH, SPRING_DAMPER, JOINT_FORCE, JOINT_SPRING = range(4)
-KINDS = {"wrench": WRENCH, "spring_damper": SPRING_DAMPER, "joint_force": JOINT_FORCE, "joint_spring": JOINT_SPRING}
-#: the columns of ``laws``: the kind, then its two indices
-KIND, FIRST, SECOND = range(3)
+WRENCH, SPRING_DAMPER, JOINT_FORCE, JOINT_SPRING, STATED = range(5)
+KINDS = {"wrench": WRENCH, "spring_damper": SPRING_DAMPER, "joint_force": JOINT_FORCE, "joint_spring": JOINT_SPRING,
+         "stated": STATED}
+#: the columns of ``laws``: the kind, its two indices, the addresses of a stated law's callbacks
+KIND, FIRST, SECOND, CALLBACK, COMPLEX_CALLBACK = range(5)
+_INTERPRETED: dict = {}  # a stated law's "address" in the interpreted loop -> its printed wrench
 
 
-def table(rows) -> tuple[np.ndarray, np.ndarray]:
-    """(laws, constants): the ``compiled_terms`` rows (kind, indices, constants) as an int
-    array (L × 3: kind code, the two indices) and a float array (L × the most constants,
-    zero-padded)."""
-    laws = np.array([[KINDS[kind], *indices] for kind, indices, _ in rows], dtype=np.int64).reshape(len(rows), 3)
+def table(rows, addresses=()) -> tuple[np.ndarray, np.ndarray]:
+    """(laws, constants): the ``compiled_terms`` rows (kind, indices, constants) as an int array
+    (L × 5: kind code, the two indices, and a stated law's two callbacks' ``addresses``, one entry
+    per row, None for the others: :func:`stated_addresses`) and a float array (L × the most
+    constants, zero-padded)."""
+    laws = np.zeros((len(rows), 5), dtype=np.int64)
+    for i, ((kind, indices, _), address) in enumerate(zip(rows, list(addresses) + [None] * len(rows))):
+        laws[i, :1 + len(indices)] = (KINDS[kind], *indices)
+        if address is not None:
+            laws[i, CALLBACK:] = address
     constants = np.zeros((len(rows), max((len(c) for _, _, c in rows), default=0)))
     for i, (_, _, c) in enumerate(rows):
         constants[i, :len(c)] = c
     return laws, constants
+
+
+def stated_addresses(values, compiled: bool) -> tuple[int, int] | None:
+    """The addresses of the float64 and complex128 C callbacks of a stated law's printed wrench
+    ``values`` (:func:`projeq.assembly.generated.law_callback`; None where one does not compile);
+    interpreted, a key of the printed function itself (:func:`wrench_into` looks it up)."""
+    if not compiled:
+        _INTERPRETED[id(values)] = values
+        return id(values), id(values)
+    callbacks = [law_callback(values, dtype) for dtype in (float, complex)]
+    return None if None in callbacks else tuple(back.address for back in callbacks)
+
+
+def wrench_into(address, complex_address, R, r, w, t, p, wrench):
+    """wrench ← the body wrench (f; M_O) of a stated law at the body's pose R, r and twist w: in the
+    compiled loop, by the C callback at ``address`` (``complex_address`` under the complex step;
+    an intrinsic, :func:`projeq.assembly.generated.intrinsics`) with the law's parameters p;
+    interpreted, by its printed function (its parameters in its closure)."""
+    wrench[:] = _INTERPRETED[address](R.ravel(), r, w, t)
 
 
 def add_loads(laws, constants, index, q, s_dot, R, r, twist, F, T, h):
@@ -66,6 +97,10 @@ def add_loads(laws, constants, index, q, s_dot, R, r, twist, F, T, h):
         kind, a, b, c = laws[i, KIND], laws[i, FIRST], laws[i, SECOND], constants[i]
         if kind == WRENCH:
             body_wrench(R[a], c[0:3], c[3:6], c[6:9], b == 1, wrench_a)
+            for j in range(6):
+                h[a, j] += wrench_a[j]
+        elif kind == STATED:
+            wrench_into(laws[i, CALLBACK], laws[i, COMPLEX_CALLBACK], R[a], r[a], twist[a], 0.0, c, wrench_a)
             for j in range(6):
                 h[a, j] += wrench_a[j]
         elif kind == SPRING_DAMPER:
@@ -102,4 +137,4 @@ CALLEES = (body_wrench, spring_end, spring_damper, spring_force, joint_wrench)
 
 @functools.cache
 def _compiled():
-    return kernels.jit(add_loads, callees=CALLEES)
+    return kernels.jit(add_loads, callees=CALLEES, kernels={"wrench_into": intrinsics()["wrench_into"]})

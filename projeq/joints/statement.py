@@ -213,8 +213,8 @@ def printed(joint, unit=None):
     ``unit``: the coordinates whose values are normalised, q/√(qᵀq), put in as the numeric joint does
     (a quaternion)."""
     q, s, t = sp.symbols(f"q0:{joint.n_q}"), sp.symbols(f"s0:{joint.n_s}"), sp.Symbol("t")
-    form, symbols, values = parameterized(joint, q, t) if joint.states_motion() else \
-        (tuple(joint.symbolic_relative(list(q), list(s), t)), (), ())
+    form, symbols, values = parameterized(joint, lambda tracer: traced(tracer, q, t), _PLACEMENT) \
+        if joint.states_motion() else (tuple(joint.symbolic_relative(list(q), list(s), t)), (), ())
     if unit is not None:
         u = [q[i] for i in unit]
         length = sp.sqrt(sum(x**2 for x in u))
@@ -226,17 +226,17 @@ def printed(joint, unit=None):
 _PLACEMENT = ("parent", "r_pn", "orientation", "coupling")
 
 
-def parameterized(joint, q, t) -> tuple[tuple, tuple, tuple]:
-    """(form, symbols, values): the statement traced with the joint's own numbers — its float and
-    float-array members — as symbols p0, p1, … (``symbols``, their ``values``), so that the form,
-    and the code printed from it, is the same for every joint of its class; where the statement
-    cannot take symbols for them (a comparison, a numpy function of a parameter), traced with the
-    numbers themselves (no symbols)."""
+def parameterized(plugin, trace, placement=()) -> tuple[Any, tuple, tuple]:
+    """(form, symbols, values): ``trace(plugin)`` — a plug-in's statement traced with sympy — with the
+    plug-in's own numbers, its float and float-array members but those named in ``placement``, as
+    symbols p0, p1, … (``symbols``, their ``values``), so that the form, and the code printed from
+    it, is the same for every plug-in of its class; where the statement cannot take symbols for them
+    (a comparison, a numpy function of a parameter), traced with the numbers themselves."""
     import copy
 
     symbols, values, members = [], [], {}
-    for name, value in vars(joint).items():
-        if name in _PLACEMENT or name.startswith("_printed"):
+    for name, value in vars(plugin).items():
+        if name in placement or name.startswith("_printed"):
             continue
         array = np.asarray(value) if isinstance(value, (float, np.ndarray)) else None
         if array is None or array.dtype.kind != "f":
@@ -245,12 +245,12 @@ def parameterized(joint, q, t) -> tuple[tuple, tuple, tuple]:
         symbols += entries
         values += [float(v) for v in array.ravel()]
         members[name] = entries[0] if array.ndim == 0 else np.array(entries, dtype=object).reshape(array.shape)
-    tracer = copy.copy(joint)
+    tracer = copy.copy(plugin)
     vars(tracer).update(members)
     try:
-        return traced(tracer, q, t), tuple(symbols), tuple(values)
+        return trace(tracer), tuple(symbols), tuple(values)
     except Exception:  # noqa: BLE001 — a statement that needs its numbers: traced with them
-        return traced(joint, q, t), (), ()
+        return trace(plugin), (), ()
 
 
 @functools.lru_cache(maxsize=64)

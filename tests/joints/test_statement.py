@@ -20,7 +20,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import projeq as pq
-from projeq.assembly import InterpretedWarning, given as given_joints, kernels
+from projeq.assembly import InterpretedWarning, PythonPieceWarning, given as given_joints, kernels
 from projeq.joints import Stated, pose_twist_mismatch
 from projeq.joints.user_compiler import joint_symbols, row_expressions
 
@@ -180,6 +180,7 @@ def test_random_trees_of_stated_joints_run_compiled_and_agree(kinds, seed):
     q, s_dot, t = rng.uniform(-1, 1, system.n_q), rng.uniform(-1, 1, system.n_s), float(rng.uniform(0, 1))
     with warnings.catch_warnings():
         warnings.simplefilter("error", InterpretedWarning)
+        warnings.simplefilter("error", PythonPieceWarning)
         default = system.evaluator()
     assert default.name == "fast" and default.evaluator.interpreted == []
     compiled = default.accelerations(q, s_dot, t)
@@ -264,7 +265,7 @@ def test_an_overridden_relative_is_never_bypassed():
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
             evaluator = _nut(joint).evaluator()
-        assert [type(w.message) for w in said] == [InterpretedWarning]
+        assert [type(w.message) for w in said] == [PythonPieceWarning]
         assert "joint 'nut' (ScrewInPython) run in Python" in str(said[0].message)
         assert "statement(q_n, t, m)" in str(said[0].message)
         assert "ScrewInPython" in evaluator.reason and "knows every" not in evaluator.reason
@@ -291,6 +292,6 @@ def test_a_force_law_in_python_is_named_once():
         warnings.simplefilter("always")
         system.evaluator()
         system.evaluator()
-    assert [type(w.message) for w in said] == [InterpretedWarning]
+    assert [type(w.message) for w in said] == [PythonPieceWarning]
     assert "force law Push" in str(said[0].message) and "projeq.forces" in str(said[0].message)
     assert math.isfinite(system.accelerations([0.1], [0.2])[0])

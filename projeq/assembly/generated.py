@@ -1,0 +1,189 @@
+"""Code projeq generates at run time and the compiled kernels call through addresses (docs/theory.md §4).
+
+A plug-in's statement, traced with sympy and printed as scalar code (:mod:`projeq.symbolic.codegen`),
+is compiled by numba into a C callback — a joint's relative motion (:mod:`projeq.assembly.given`), a
+force law's body wrench (:func:`law_callback`), a constraint Φ (:mod:`projeq.constraints.compiled`) —
+in a module written once per printed source (:func:`generated_module`) and cached on disk; the
+numbers of the plug-in (its parameters) are data, passed by the address of an array
+(:func:`parameters`); the compiled kernels call the callbacks through their addresses by the
+intrinsics of :func:`intrinsics`.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+import sys
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from projeq.assembly import kernels
+
+_PARAMETERS: dict = {}  # printed function -> the values of its constants (float64), which its callback reads
+DTYPES = {np.dtype(float): "float64", np.dtype(complex): "complex128"}
+
+
+class UncompiledLawWarning(UserWarning):
+    """numba could not compile a force law's printed wrench: it is stated in Python."""
+
+
+def parameters(f) -> np.ndarray:
+    """The values of the constants (``f.constants``) that the printed function ``f`` of
+    :mod:`projeq.symbolic.codegen` holds in its closure, in their order, as float64 (kept alive here
+    while the process runs: the compiled kernels read them through their address)."""
+    if f not in _PARAMETERS:
+        held = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
+        _PARAMETERS[f] = np.array([float(held[name]) for name in f.constants], dtype=float)
+    return _PARAMETERS[f]
+
+
+def generated_module(f, into: str, parameters: bool = False):
+    """A module of ``f``'s printed source (``f.source``) compiled by ``numba.njit(cache=True)`` as
+    ``function``, and the C callback ``into`` (``cache=True``): written once to a file named by its
+    digest in numba's cache directory (or ~/.cache/projeq) and imported, so that numba's disk cache,
+    which needs a file, keeps both across processes (a temporary directory where that is not
+    writable: compiled anew each process). ``f``'s constants (``f.constants``) are, with
+    ``parameters``, the entries of a last argument p of ``function`` (one module for all their
+    values), else module globals holding the values its closure holds."""
+    import importlib.util
+
+    numba = kernels.numba_module()
+    header = f.source.split("\n", 1)
+    if parameters:
+        signature = header[0].replace(f"def {f.__name__}(", "def function(", 1).replace("):", ", p):", 1)
+        unpacked = [f"    {name} = p[{i}]" for i, name in enumerate(f.constants)]
+        constants, body = [], "\n".join([signature, *unpacked, header[1]])
+    else:
+        held = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
+        constants = [f"{name} = {float(value)!r}" for name, value in sorted(held.items())]
+        body = f.source.replace(f"def {f.__name__}(", "def function(", 1)
+    source = "\n".join(["import numba", "import numpy", "from numba import types as nb", "", *constants, "",
+                        "@numba.njit(cache=True)", body, into])
+    digest = hashlib.sha1((source + numba.__version__).encode()).hexdigest()[:20]
+    module_name = f"projeq_generated_{digest}"
+    if module_name not in sys.modules:
+        path = write_once(module_name + ".py", source)
+        spec = importlib.util.spec_from_file_location(module_name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[module_name] = module  # numba's cache finds the module by its name
+        try:
+            spec.loader.exec_module(module)
+        except Exception:
+            del sys.modules[module_name]
+            raise
+    return sys.modules[module_name]
+
+
+def write_once(filename: str, source: str) -> Path:
+    """The path of ``filename`` holding ``source`` in the cache directory (written atomically if absent)."""
+    import numba
+
+    for folder in (numba.config.CACHE_DIR or os.path.join(os.environ.get("XDG_CACHE_HOME") or
+                                                           os.path.expanduser("~/.cache"), "projeq"), None):
+        try:
+            folder = Path(folder or tempfile.mkdtemp(prefix="projeq-generated-")) / "generated"
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / filename
+            if not path.is_file() or path.read_text() != source:
+                part = folder / f"{filename}.{os.getpid()}.part"
+                part.write_text(source)
+                os.replace(part, path)
+            return path
+        except OSError:
+            continue
+    raise OSError(f"cannot write the generated module {filename} to a cache or a temporary directory")
+
+
+
+#: the C callback of a force law's printed body wrench (:func:`law_callback`): at the body's pose R
+#: (row by row), r and twist (v, ω) of one dtype, t float64 and the law's parameters p (float64)
+LAW_INTO = """
+@numba.cfunc(nb.void(nb.CPointer(nb.{dtype}), nb.CPointer(nb.{dtype}), nb.CPointer(nb.{dtype}), nb.float64,
+                     nb.CPointer(nb.float64), nb.CPointer(nb.{dtype})), cache=True)
+def into(R_pointer, r_pointer, w_pointer, t, p_pointer, wrench_pointer):
+    R, r, w = numba.carray(R_pointer, (9,)), numba.carray(r_pointer, (3,)), numba.carray(w_pointer, (6,))
+    found = function(R, r, w, t, numba.carray(p_pointer, ({n_p},)))
+    wrench = numba.carray(wrench_pointer, (6,))
+    for i in range(6):
+        wrench[i] = found[i]
+"""
+
+_LAW_CALLBACKS: dict = {}  # (source, constants, dtype) -> the C callback, or None where numba cannot compile it
+
+
+def law_callback(values, dtype=float):
+    """The printed body wrench ``values(R, r, w, t)`` of a force law (:meth:`projeq.forces.BodyLoad.compiled_wrench`)
+    compiled as a C callback ``into(R, r, w, t, p, wrench)`` of ``dtype`` (float, or complex for the
+    complex step), its constants p passed as data (:func:`parameters`): one per printed source and
+    dtype in a process, cached on disk; None (after one :class:`UncompiledLawWarning`) where numba
+    cannot compile it."""
+    key = (values.source, values.constants, np.dtype(dtype))
+    if key not in _LAW_CALLBACKS:
+        into = LAW_INTO.format(dtype=DTYPES[np.dtype(dtype)], n_p=len(values.constants))
+        try:
+            _LAW_CALLBACKS[key] = generated_module(values, into, parameters=True).into
+        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+            warnings.warn(f"forces: numba cannot compile a force law's wrench for {np.dtype(dtype)} "
+                          f"({type(exc).__name__}); it is stated in Python at every evaluation",
+                          UncompiledLawWarning, stacklevel=3)
+            _LAW_CALLBACKS[key] = None
+    return _LAW_CALLBACKS[key]
+
+
+@functools.cache
+def intrinsics() -> dict:
+    """The compiled :func:`projeq.assembly.given.given_into`, ``phi_into`` (Φ's values of
+    :mod:`projeq.constraints.compiled`) and :func:`projeq.assembly.loads.wrench_into`:
+    each calls the C function at the address its first argument holds with the data pointers of its
+    arrays (numba's own layout of complex128 and float64, that of the C callbacks) and its scalars
+    as they are."""
+    import numba
+    from llvmlite import ir
+    from numba.extending import intrinsic
+
+    def caller(signature, args, context, builder, pointers=()):
+        """Call the C function at the address ``args[0]`` with the arrays' data pointers, the
+        arguments at the positions ``pointers`` (addresses, int64) as float64 pointers and the other
+        scalars as they are."""
+        address, values = args[0], []
+        for i, (kind, value) in enumerate(zip(signature.args[1:], args[1:]), start=1):
+            if isinstance(kind, numba.types.Array):
+                values.append(context.make_array(kind)(context, builder, value).data)
+            else:
+                values.append(builder.inttoptr(value, ir.PointerType(ir.DoubleType())) if i in pointers else value)
+        function = ir.FunctionType(ir.VoidType(), [v.type for v in values])
+        builder.call(builder.inttoptr(address, function.as_pointer()), values)
+        return context.get_dummy_value()
+
+    @intrinsic
+    def phi_into(typingctx, phi, x, t, value):
+        return numba.types.void(phi, x, t, value), lambda context, builder, signature, args: caller(
+            signature, args, context, builder)
+
+    @intrinsic
+    def given_into(typingctx, values, p, q_n, s_n, t, row):  # the C callback's order: q_n, ṡ_n, t, p, row
+        def call(context, builder, signature, args):
+            values_, p_, q_, s_, t_, row_ = args
+            kinds = signature.args
+            reordered = numba.types.void(kinds[0], kinds[2], kinds[3], kinds[4], kinds[1], kinds[5])
+            return caller(reordered, (values_, q_, s_, t_, p_, row_), context, builder, pointers=(4,))
+
+        return numba.types.void(values, p, q_n, s_n, t, row), call
+
+
+    @intrinsic
+    def wrench_into(typingctx, address, complex_address, R, r, w, t, p, wrench):
+        # the callback of the arrays' dtype: complex128 under the complex step, else float64
+        def call(context, builder, signature, args):
+            kinds = signature.args
+            chosen = 1 if isinstance(kinds[2].dtype, numba.types.Complex) else 0
+            reordered = numba.types.void(kinds[chosen], *kinds[2:])
+            return caller(reordered, (args[chosen], *args[2:]), context, builder)
+
+        return numba.types.void(address, complex_address, R, r, w, t, p, wrench), call
+
+    return {"phi_into": phi_into, "given_into": given_into, "wrench_into": wrench_into}
