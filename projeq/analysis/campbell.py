@@ -141,7 +141,7 @@ class CampbellDiagram:
     eigenvalues : ndarray (n_speeds, n_branches), complex
         λ of each branch (Im λ > 0).
     labels : tuple of str
-        Each branch's name (``"flapwise 1"``, ``"forward whirl 2"``, ``"mode 3"``).
+        Each branch's name (columns in the order of the frequencies at the lowest nonzero speed) (``"flapwise 1"``, ``"forward whirl 2"``, ``"mode 3"``).
     orders : tuple of int
         The engine orders k of :attr:`critical_speeds`.
     critical_speeds : list of CriticalSpeed
@@ -268,6 +268,8 @@ def campbell(system, speeds, joint: str | None = None, orders=(1, 2, 3), n_modes
     model, q, s_dot, _ = found[reference]
     labels = branch_labels(model, q, s_dot, t, lam[reference], shapes[reference][:, keep],
                            found[reference][3].coordinates)
+    by_frequency = np.argsort(np.abs(lam[reference].imag), kind="stable")  # columns in the order of the labels' numbers
+    lam, labels = lam[:, by_frequency], [labels[j] for j in by_frequency]
     frequencies = np.abs(lam.imag)
     return CampbellDiagram(speeds, frequencies, -lam.real / np.abs(lam), lam, labels, orders)
 
