@@ -28,8 +28,8 @@ motion at the lowest nonzero speed, relative to the beam frame's angular velocit
   within each kind. Other systems: ``mode 1, 2, …`` by frequency at the first speed.
 
 Critical speeds are where a branch's frequency equals an engine order k Ω (k = 1, 2, …: an
-excitation k times per revolution), by linear interpolation between the neighbouring
-speeds of the sweep (error O(ΔΩ²) times the curvature of the branch).
+excitation k times per revolution), bracketed by neighbouring speeds of the sweep and found
+by Brent's method on the branch (or by linear interpolation, ``refine=False``).
 """
 
 from __future__ import annotations
@@ -141,17 +141,17 @@ class CampbellDiagram:
     eigenvalues : ndarray (n_speeds, n_branches), complex
         λ of each branch (Im λ > 0).
     labels : tuple of str
-        Each branch's name (columns in the order of the frequencies at the lowest nonzero speed) (``"flapwise 1"``, ``"forward whirl 2"``, ``"mode 3"``).
+        Each branch's name (``"flapwise 1"``, ``"forward whirl 2"``, ``"mode 3"``); the
+        columns in the order of the frequencies at the lowest nonzero speed.
     orders : tuple of int
         The engine orders k of :attr:`critical_speeds`.
     critical_speeds : list of CriticalSpeed
         Where a branch crosses k Ω, by speed.
     """
 
-    def __init__(self, speeds, frequencies, damping, eigenvalues, labels, orders):
+    def __init__(self, speeds, frequencies, damping, eigenvalues, labels, orders, critical):
         self.speeds, self.frequencies, self.damping, self.eigenvalues = speeds, frequencies, damping, eigenvalues
-        self.labels, self.orders = tuple(labels), tuple(orders)
-        self.critical_speeds = critical_speeds(speeds, frequencies, self.labels, self.orders)
+        self.labels, self.orders, self.critical_speeds = tuple(labels), tuple(orders), list(critical)
 
     def branch(self, label: str) -> NDArray:
         """The frequencies (rad/s) of the branch ``label`` at every speed."""
@@ -211,7 +211,7 @@ class CampbellDiagram:
 
 
 def campbell(system, speeds, joint: str | None = None, orders=(1, 2, 3), n_modes: int | None = None,
-             t: float = 0.0, **options) -> CampbellDiagram:
+             refine: bool = True, t: float = 0.0, **options) -> CampbellDiagram:
     """The Campbell diagram: frequencies and damping of the modes against rotation speed Ω,
     each mode tracked by its shape (module docstring), labelled, with its critical speeds.
 
@@ -231,6 +231,10 @@ def campbell(system, speeds, joint: str | None = None, orders=(1, 2, 3), n_modes
     n_modes : int, optional
         Keep the lowest ``n_modes`` branches (by frequency at the first speed); default all.
         All modes are tracked either way.
+    refine : bool
+        Find each critical speed by Brent's method on the branch (a linearisation per step,
+        the branch followed by its shape; to 1e-12 relative), not by linear interpolation
+        between the speeds of the sweep (error O(ΔΩ²)).
     t : float
         Time of the linearisation (a prescribed rotation is steady: any t).
     **options
@@ -253,8 +257,10 @@ def campbell(system, speeds, joint: str | None = None, orders=(1, 2, 3), n_modes
     found = []
     for speed in speeds:
         model, q, s_dot = build(speed)
-        q, s_dot = (model.q0 if q is None else q), (model.s_dot0 if s_dot is None else s_dot)
         found.append((model, q, s_dot, modes(model, q, s_dot, t, **options)))
+        # the coordinates dropped as ignorable at the first speed, at every speed (at a speed
+        # where K − Ω² M is singular an elastic coordinate's column of A would vanish too)
+        options.setdefault("ignore", [c for c in model.state_names()[: model.n_q] if c not in found[0][3].coordinates])
     counts = [len(m.frequencies) for *_, m in found]
     if len(set(counts)) > 1:
         k = next(i for i, c in enumerate(counts) if c != counts[0])
@@ -268,10 +274,23 @@ def campbell(system, speeds, joint: str | None = None, orders=(1, 2, 3), n_modes
     model, q, s_dot, _ = found[reference]
     labels = branch_labels(model, q, s_dot, t, lam[reference], shapes[reference][:, keep],
                            found[reference][3].coordinates)
-    by_frequency = np.argsort(np.abs(lam[reference].imag), kind="stable")  # columns in the order of the labels' numbers
+    by_frequency = np.argsort(np.abs(lam[reference].imag), kind="stable")  # the order of the labels' numbers
     lam, labels = lam[:, by_frequency], [labels[j] for j in by_frequency]
+    shapes = shapes[:, :, keep][:, :, by_frequency]
+
+    def branch_at(j: int, i: int, speed: float) -> float:
+        """Branch j's frequency at ``speed`` in (speeds[i], speeds[i + 1]): the mode there that
+        continues it best from speeds[i] (:func:`track`'s costs)."""
+        model, q, s_dot = build(speed)
+        found_here = modes(model, q, s_dot, t, **options)
+        predicted = np.interp(speed, speeds[i: i + 2], lam[i: i + 2, j].imag)
+        direct, conjugate = _costs(shapes[i][:, [j]], np.array([predicted]), found_here)
+        best = np.minimum(direct, conjugate)[0].argmin()
+        return float(found_here.frequencies[best])
+
     frequencies = np.abs(lam.imag)
-    return CampbellDiagram(speeds, frequencies, -lam.real / np.abs(lam), lam, labels, orders)
+    critical = critical_speeds(speeds, frequencies, labels, orders, branch_at if refine else None)
+    return CampbellDiagram(speeds, frequencies, -lam.real / np.abs(lam), lam, labels, orders, critical)
 
 
 def track(found: list, speeds: NDArray) -> tuple[NDArray, NDArray]:
@@ -294,9 +313,7 @@ def track(found: list, speeds: NDArray) -> tuple[NDArray, NDArray]:
         if k >= 2:
             slope = (lam[-1].imag - lam[-2].imag) / (speeds[k - 1] - speeds[k - 2])
             predicted = predicted + slope * (speeds[k] - speeds[k - 1])
-        scale = max(np.abs(current.frequencies).max(initial=0.0), 1e-300)
-        direct = 1.0 - mac(shapes[-1], current.shapes) + np.abs(predicted[:, None] - current.frequencies) / scale
-        conjugate = 1.0 - mac(shapes[-1], current.shapes.conj()) + np.abs(predicted[:, None] + current.frequencies) / scale
+        direct, conjugate = _costs(shapes[-1], predicted, current)
         rows, columns = linear_sum_assignment(np.minimum(direct, conjugate))
         flip = conjugate[rows, columns] < direct[rows, columns]
         chosen_lam = np.where(flip, current.eigenvalues[columns].conj(), current.eigenvalues[columns])
@@ -306,9 +323,23 @@ def track(found: list, speeds: NDArray) -> tuple[NDArray, NDArray]:
     return np.array(lam), np.array(shapes)
 
 
-def critical_speeds(speeds: NDArray, frequencies: NDArray, labels, orders) -> list[CriticalSpeed]:
+def _costs(previous: NDArray, predicted: NDArray, current: Modes) -> tuple[NDArray, NDArray]:
+    """Costs of continuing the branches (shapes ``previous``, signed frequencies ``predicted``)
+    with each of ``current``'s modes as it is (λ, φ) or as its conjugate (λ̄, φ̄, frequency −ω):
+    1 − MAC plus the frequency's distance from the prediction over the largest frequency."""
+    scale = max(np.abs(current.frequencies).max(initial=0.0), 1e-300)
+    direct = 1.0 - mac(previous, current.shapes) + np.abs(predicted[:, None] - current.frequencies) / scale
+    conjugate = 1.0 - mac(previous, current.shapes.conj()) + np.abs(predicted[:, None] + current.frequencies) / scale
+    return direct, conjugate
+
+
+def critical_speeds(speeds: NDArray, frequencies: NDArray, labels, orders, branch_at=None) -> list[CriticalSpeed]:
     """Where ω_j(Ω) − k |Ω| changes sign between neighbouring speeds (or vanishes at one),
-    by linear interpolation; sorted by speed."""
+    sorted by speed: by linear interpolation, or, given ``branch_at(j, i, speed)`` (branch j's
+    frequency at a speed between ``speeds[i]`` and ``speeds[i + 1]``), by Brent's method to
+    1e-12 relative."""
+    from scipy.optimize import brentq
+
     found = []
     for k in orders:
         for j, label in enumerate(labels):
@@ -317,6 +348,10 @@ def critical_speeds(speeds: NDArray, frequencies: NDArray, labels, orders) -> li
                 if g[i] == 0.0 or g[i] * g[i + 1] < 0.0:
                     a = g[i] / (g[i] - g[i + 1])
                     speed = speeds[i] + a * (speeds[i + 1] - speeds[i])
+                    if branch_at is not None and g[i] != 0.0:
+                        gap = lambda x, i=i, j=j: branch_at(j, i, x) - k * abs(x)  # noqa: E731
+                        tol = 1e-12 * max(abs(speeds[i]), abs(speeds[i + 1]))
+                        speed = brentq(gap, speeds[i], speeds[i + 1], xtol=tol, rtol=1e-12)
                     found.append(CriticalSpeed(label, k, float(speed), float(k * abs(speed))))
             if g[-1] == 0.0:
                 found.append(CriticalSpeed(label, k, float(speeds[-1]), float(k * abs(speeds[-1]))))
@@ -339,7 +374,8 @@ def branch_labels(system, q, s_dot, t: float, lam: NDArray, shapes: NDArray, coo
     full = np.zeros((system.n_q, shapes.shape[1]), dtype=complex)
     full[[names.index(c) for c in coordinates]] = shapes
     for j in range(shapes.shape[1]):
-        kinds.append(_kind(tree.subsystems[n], full[tree.e_q_slice[n], j], np.linalg.norm(full[:, j]), lam[j], omega_b))
+        elastic = full[tree.e_q_slice[n], j]
+        kinds.append(_kind(tree.subsystems[n], elastic, np.linalg.norm(full[:, j]), lam[j], omega_b))
     return _numbered(kinds, order)
 
 
@@ -402,9 +438,10 @@ def _builder(system, joint):
                     raise ValueError(f"system: {callable_name(system)}({speed!r}) returned a tuple of {len(built)}; "
                                      "expected a System or (system, q, s_dot)")
                 check_model(built[0])
-                return built
+                model, q, s_dot = built
+                return model, (model.q0 if q is None else q), (model.s_dot0 if s_dot is None else s_dot)
             check_model(built)
-            return built, None, None
+            return built, built.q0, built.s_dot0
 
         return build
     check_model(system)

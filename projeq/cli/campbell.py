@@ -73,7 +73,8 @@ def parse_speeds(text: str) -> np.ndarray:
         if len(parts) != 3 or count < 2 or not np.isfinite([start, stop]).all():
             raise ValueError
     except (ValueError, IndexError):
-        raise ValueError(f"--speeds: expected START:STOP:COUNT with COUNT >= 2, or a list S,S,..., got {text!r}") from None
+        raise ValueError(f"--speeds: expected START:STOP:COUNT with COUNT >= 2, or a list S,S,..., "
+                         f"got {text!r}") from None
     return np.linspace(start, stop, count)
 
 

@@ -47,7 +47,7 @@ def test_blade_flapwise_and_lead_lag_against_the_frobenius_series(hub_radius):
     lead-lag branches (found by their labels) equal the roots of the Frobenius series to
     1e-4 relative (measured ≤ 1.0e-5, at R/L = 1, η = 5: Ritz upper bounds)."""
     diagram = campbell(lambda omega: pq.scenes.rotating_blade(omega=omega, hub_radius=hub_radius, n_shapes=10),
-                       [1.0, 3.0, 5.0], n_modes=4)
+                       [1.0, 3.0, 5.0], n_modes=4, refine=False)
     assert sorted(diagram.labels) == ["flapwise 1", "flapwise 2", "lead-lag 1", "lead-lag 2"]
     for k, eta in enumerate(diagram.speeds):
         flap = frobenius_frequencies(eta, hub_radius, 2)
@@ -62,9 +62,27 @@ def test_blade_first_flapwise_frequency_matches_wright_et_al():
     """At zero hub radius the first flapwise branch reproduces Wright et al. (1982), Table 1
     (η = 0 … 5) within the table's rounding 5e-5 plus the Ritz error (< 1.2e-6): 6e-5
     (measured ≤ 5.2e-5, at η = 5)."""
-    diagram = campbell(lambda omega: pq.scenes.rotating_blade(omega=omega, n_shapes=10), sorted(WRIGHT_1982), n_modes=2)
+    diagram = campbell(lambda omega: pq.scenes.rotating_blade(omega=omega, n_shapes=10), sorted(WRIGHT_1982), n_modes=2,
+                       refine=False)
     table = np.array([WRIGHT_1982[eta] for eta in sorted(WRIGHT_1982)])
     assert np.abs(diagram.branch("flapwise 1") - table).max() < 6e-5
+
+
+def test_critical_speed_of_the_blade_against_the_frobenius_series():
+    """Lead-lag 1 meets the engine order 2Ω where √(λ_flap(η)² − η²) = 2η (the Frobenius
+    series, solved by brentq): Brent's method on the branch between two speeds of the sweep
+    finds it to 4e-7 relative (measured 4.4e-8: the Ritz error of ten functions), the linear
+    interpolation between η = 1.5 and 1.95 only to 3e-3 (measured 3.0e-4)."""
+    from scipy.optimize import brentq
+
+    exact = brentq(lambda eta: np.sqrt(frobenius_frequencies(eta, 0.0, 1)[0] ** 2 - eta**2) - 2 * eta, 1.5, 1.95,
+                   xtol=1e-13)
+    for refine, bound in ((True, 4e-7), (False, 3e-3)):
+        diagram = campbell(lambda omega: pq.scenes.rotating_blade(omega=omega, n_shapes=10), [1.5, 1.95], orders=[2],
+                           n_modes=2, refine=refine)
+        (critical,) = diagram.critical_speeds
+        assert critical.mode == "lead-lag 1" and critical.order == 2
+        assert abs(critical.speed / exact - 1) < bound, (refine, critical.speed / exact - 1)
 
 
 def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
@@ -75,14 +93,14 @@ def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
     over Ω = 0 … 30 where the forward whirls pass through zero (at Ω = ω₁, ω₂) and cross the
     backward ones: a diagram sorted by frequency would mix the branches."""
     speeds = np.linspace(0.0, 30.0, 16)
-    diagram = campbell(lambda omega: pq.scenes.spinning_beam(omega=omega, n_shapes=4), speeds)
+    diagram = campbell(lambda omega: pq.scenes.spinning_beam(omega=omega, n_shapes=4), speeds, orders=[1])
     omega_k = clamped_free_roots(4) ** 2
     for k in range(4):
         assert np.abs(diagram.branch(f"forward whirl {k + 1}") / np.abs(omega_k[k] - speeds) - 1).max() < 1e-10
         assert np.abs(diagram.branch(f"backward whirl {k + 1}") / (omega_k[k] + speeds) - 1).max() < 1e-10
     assert np.abs(diagram.damping).max() < 1e-10
     first = [c for c in diagram.critical_speeds if c.mode == "forward whirl 1" and c.order == 1]
-    # |ω₁ − Ω| = Ω at Ω = ω₁/2, between grid points 0 and 2 where the branch is linear: exact
+    # |ω₁ − Ω| = Ω at Ω = ω₁/2 (Brent's method on the branch: 1e-10, measured 2e-16)
     assert len(first) == 1 and first[0].speed == pytest.approx(omega_k[0] / 2, rel=1e-10)
 
 
@@ -105,7 +123,7 @@ def test_tracking_by_shape_crosses_and_veers(coupling):
     continuously, never crossing, while the shapes exchange (MAC with the start ≈ 0 at
     the end). Frequencies to 1e-12 relative (measured 2e-16)."""
     speeds = np.linspace(0.0, 2.0, 41)
-    diagram = campbell(lambda omega: _oscillators(1.0 + omega, coupling), speeds, orders=[1])
+    diagram = campbell(lambda omega: _oscillators(1.0 + omega, coupling), speeds, orders=[1], refine=False)
     a = diagram.frequencies[:, 0] if diagram.frequencies[0, 0] < diagram.frequencies[0, 1] else diagram.frequencies[:, 1]
     if coupling == 0.0:
         assert np.abs(a / np.sqrt(1.0 + speeds) - 1).max() < 1e-12
@@ -120,7 +138,8 @@ def test_tracking_by_shape_crosses_and_veers(coupling):
 def test_diagram_files(tmp_path):
     """The CSV holds one row per speed with each branch's frequency and damping (read back
     equal to the diagram's numbers); the plot has a line per branch and per engine order."""
-    diagram = campbell(lambda omega: pq.scenes.rotating_blade(omega=omega, n_shapes=2), [0.0, 2.0, 4.0], n_modes=2)
+    diagram = campbell(lambda omega: pq.scenes.rotating_blade(omega=omega, n_shapes=2), [0.0, 2.0, 4.0], n_modes=2,
+                       refine=False)
     diagram.write_csv(tmp_path / "campbell.csv")
     rows = list(csv.reader(open(tmp_path / "campbell.csv", encoding="utf-8")))
     assert rows[0][0] == "speed (rad/s)" and len(rows) == 4 and len(rows[0]) == 1 + 2 * 2
@@ -156,7 +175,21 @@ def test_a_free_hub_at_a_steady_speed():
     beam = pq.RitzBeam(1.0, 1.0, 1.0, n_v=4, n_w=4, family="clamped_free")
     free = pq.System({"hub": pq.RigidBody(1.0, I_c=np.diag([1.0, 1.0, 0.5])), "beam": beam},
                      {"hub": pq.Revolute(axis="z"), "beam": pq.Fixed(parent="hub", r_pn=(0.5, 0.0, 0.0))})
-    diagram = campbell(free, [1.0, 2.0], joint="hub", n_modes=3)
-    prescribed = campbell(lambda w: pq.scenes.rotating_blade(omega=w, hub_radius=0.5, n_shapes=4), [1.0, 2.0], n_modes=3)
+    diagram = campbell(free, [1.0, 2.0], joint="hub", n_modes=3, refine=False)
+    prescribed = campbell(lambda w: pq.scenes.rotating_blade(omega=w, hub_radius=0.5, n_shapes=4), [1.0, 2.0], n_modes=3,
+                          refine=False)
     assert np.abs(diagram.branch("flapwise 1") / prescribed.branch("flapwise 1") - 1).max() < 1e-10
     assert np.all(diagram.branch("lead-lag 1") > prescribed.branch("lead-lag 1") * (1 + 1e-3))
+
+
+def test_the_benchmark_quick_mode():
+    """benchmarks/campbell.py --quick (≤ 3 s): the spinning beam's whirls against |ω_k ∓ Ω|
+    and the blade's ω_lag² = ω_flap² − Ω² to 1e-10 (measured 1.5e-14, 2.3e-15); exit code 0."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parents[2] / "benchmarks" / "campbell.py"
+    spec = importlib.util.spec_from_file_location("campbell_benchmark", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert module.main(["--quick"]) == 0
