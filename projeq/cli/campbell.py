@@ -9,7 +9,7 @@ SCENE_critical_speeds.csv and SCENE_campbell.png into --out; prints the table.
 
 Frequencies are in rad/s in the frame of the scene's coordinates (co-rotating for
 rotating_blade and spinning_beam). Example: ``projeq campbell rotating_blade --set
-hub_radius=0.5 --speeds 0:8:33``."""
+hub_radius=0.5 --speeds 0:8:17``."""
 
 from __future__ import annotations
 
