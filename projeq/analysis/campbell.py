@@ -28,7 +28,7 @@ motion at the lowest nonzero speed, relative to the beam frame's angular velocit
   within each kind. Other systems: ``mode 1, 2, …`` by frequency at the first speed.
 
 Critical speeds are where a branch's frequency equals an engine order k Ω (k = 1, 2, …: an
-excitation k times per revolution), bracketed by neighbouring speeds of the sweep and found
+excitation k times per revolution; k = 0: a frequency through zero), bracketed by neighbouring speeds of the sweep and found
 by Brent's method on the branch (or by linear interpolation, ``refine=False``).
 """
 
@@ -227,7 +227,11 @@ def campbell(system, speeds, joint: str | None = None, orders=(1, 2, 3), n_modes
     joint : str, optional
         With a System: the joint whose velocity is the speed.
     orders : sequence of int
-        Engine orders k (positive integers) whose lines k Ω give the critical speeds.
+        Engine orders k ≥ 0 whose lines k Ω give the critical speeds. In the co-rotating frame
+        of the scenes a load fixed in space (a blade passing k obstacles, gravity on a shaft)
+        has the frequency k Ω; a load fixed in the rotor (an unbalance) the frequency 0:
+        k = 0 finds where a frequency passes through zero (the forward whirl's critical speed
+        of a shaft: its whirl in the inertial frame turns at Ω).
     n_modes : int, optional
         Keep the lowest ``n_modes`` branches (by frequency at the first speed); default all.
         All modes are tracked either way.
@@ -279,17 +283,17 @@ def campbell(system, speeds, joint: str | None = None, orders=(1, 2, 3), n_modes
     shapes = shapes[:, :, keep][:, :, by_frequency]
 
     def branch_at(j: int, i: int, speed: float) -> float:
-        """Branch j's frequency at ``speed`` in (speeds[i], speeds[i + 1]): the mode there that
-        continues it best from speeds[i] (:func:`track`'s costs)."""
+        """Branch j's signed frequency at ``speed`` in (speeds[i], speeds[i + 1]): the mode there
+        that continues it best from speeds[i] (:func:`track`'s costs)."""
         model, q, s_dot = build(speed)
         found_here = modes(model, q, s_dot, t, **options)
         predicted = np.interp(speed, speeds[i: i + 2], lam[i: i + 2, j].imag)
         direct, conjugate = _costs(shapes[i][:, [j]], np.array([predicted]), found_here)
         best = np.minimum(direct, conjugate)[0].argmin()
-        return float(found_here.frequencies[best])
+        return float(found_here.frequencies[best] * (-1.0 if conjugate[0, best] < direct[0, best] else 1.0))
 
     frequencies = np.abs(lam.imag)
-    critical = critical_speeds(speeds, frequencies, labels, orders, branch_at if refine else None)
+    critical = critical_speeds(speeds, lam.imag, labels, orders, branch_at if refine else None)
     return CampbellDiagram(speeds, frequencies, -lam.real / np.abs(lam), lam, labels, orders, critical)
 
 
@@ -333,25 +337,29 @@ def _costs(previous: NDArray, predicted: NDArray, current: Modes) -> tuple[NDArr
     return direct, conjugate
 
 
-def critical_speeds(speeds: NDArray, frequencies: NDArray, labels, orders, branch_at=None) -> list[CriticalSpeed]:
-    """Where ω_j(Ω) − k |Ω| changes sign between neighbouring speeds (or vanishes at one),
-    sorted by speed: by linear interpolation, or, given ``branch_at(j, i, speed)`` (branch j's
-    frequency at a speed between ``speeds[i]`` and ``speeds[i + 1]``), by Brent's method to
-    1e-12 relative."""
+def critical_speeds(speeds: NDArray, signed: NDArray, labels, orders, branch_at=None) -> list[CriticalSpeed]:
+    """Where |ω_j(Ω)| − k |Ω| changes sign between neighbouring speeds (or vanishes at one);
+    for k = 0 where the signed frequency ω_j of :func:`track` does (a frequency through zero).
+    By linear interpolation, or, given ``branch_at(j, i, speed)`` (branch j's signed frequency
+    at a speed between ``speeds[i]`` and ``speeds[i + 1]``), by Brent's method to 1e-12
+    relative; sorted by speed."""
     from scipy.optimize import brentq
+
+    def gap(omega, speed, k):
+        return omega - 0.0 * speed if k == 0 else np.abs(omega) - k * np.abs(speed)
 
     found = []
     for k in orders:
         for j, label in enumerate(labels):
-            g = frequencies[:, j] - k * np.abs(speeds)
+            g = gap(signed[:, j], speeds, k)
             for i in range(len(speeds) - 1):
                 if g[i] == 0.0 or g[i] * g[i + 1] < 0.0:
                     a = g[i] / (g[i] - g[i + 1])
                     speed = speeds[i] + a * (speeds[i + 1] - speeds[i])
                     if branch_at is not None and g[i] != 0.0:
-                        gap = lambda x, i=i, j=j: branch_at(j, i, x) - k * abs(x)  # noqa: E731
                         tol = 1e-12 * max(abs(speeds[i]), abs(speeds[i + 1]))
-                        speed = brentq(gap, speeds[i], speeds[i + 1], xtol=tol, rtol=1e-12)
+                        speed = brentq(lambda x, i=i, j=j, k=k: gap(branch_at(j, i, x), x, k), speeds[i],
+                                       speeds[i + 1], xtol=tol, rtol=1e-12)
                     found.append(CriticalSpeed(label, k, float(speed), float(k * abs(speed))))
             if g[-1] == 0.0:
                 found.append(CriticalSpeed(label, k, float(speeds[-1]), float(k * abs(speeds[-1]))))
@@ -472,8 +480,8 @@ def _speeds(speeds) -> NDArray:
 
 def _orders(orders) -> tuple[int, ...]:
     values = finite_array("orders", orders)
-    if values.ndim != 1 or np.any(values < 1) or np.any(values != np.round(values)):
-        raise ValueError(f"orders: expected positive integers (engine orders), got {np.asarray(orders).tolist()}")
+    if values.ndim != 1 or np.any(values < 0) or np.any(values != np.round(values)):
+        raise ValueError(f"orders: expected integers >= 0 (engine orders), got {np.asarray(orders).tolist()}")
     return tuple(int(k) for k in values)
 
 

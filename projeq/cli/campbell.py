@@ -29,7 +29,9 @@ def campbell_arguments(parser) -> None:
                         help="rotation speeds in rad/s: COUNT evenly spaced from START to STOP, or a list "
                              "(default 0:8:17)")
     parser.add_argument("--parameter", default="omega", help="the scene parameter that is the speed (default omega)")
-    parser.add_argument("--orders", default="1,2,3", metavar="K,K,...", help="engine orders (default 1,2,3)")
+    parser.add_argument("--orders", default="1,2,3", metavar="K,K,...",
+                        help="engine orders k of the lines k Ω (default 1,2,3; 0: where a frequency passes through "
+                             "zero, a shaft's forward-whirl critical speed)")
     parser.add_argument("--modes", type=int, default=6, help="how many of the lowest modes to show (default 6)")
     scene_settings_option(parser)
     parser.add_argument("--out", default="projeq-out", help="output directory (default ./projeq-out)")

@@ -93,13 +93,20 @@ def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
     over Ω = 0 … 30 where the forward whirls pass through zero (at Ω = ω₁, ω₂) and cross the
     backward ones: a diagram sorted by frequency would mix the branches."""
     speeds = np.linspace(0.0, 30.0, 16)
-    diagram = campbell(lambda omega: pq.scenes.spinning_beam(omega=omega, n_shapes=4), speeds, orders=[1])
+    diagram = campbell(lambda omega: pq.scenes.spinning_beam(omega=omega, n_shapes=4), speeds, orders=[0, 1])
     omega_k = clamped_free_roots(4) ** 2
     for k in range(4):
         assert np.abs(diagram.branch(f"forward whirl {k + 1}") / np.abs(omega_k[k] - speeds) - 1).max() < 1e-10
         assert np.abs(diagram.branch(f"backward whirl {k + 1}") / (omega_k[k] + speeds) - 1).max() < 1e-10
     assert np.abs(diagram.damping).max() < 1e-10
     first = [c for c in diagram.critical_speeds if c.mode == "forward whirl 1" and c.order == 1]
+    # an unbalance (fixed in the rotor, order 0) resonates where a forward whirl's co-rotating
+    # frequency passes through zero: Ω = ω₁, ω₂ (Brent on the signed branch, down to the
+    # frequency below which modes() counts an eigenvalue as real, 1e-9 max |λ|: 3e-7 relative,
+    # measured 3.5e-8)
+    unbalance = [c for c in diagram.critical_speeds if c.order == 0]
+    assert [c.mode for c in unbalance] == ["forward whirl 1", "forward whirl 2"]
+    assert np.allclose([c.speed for c in unbalance], omega_k[:2], rtol=3e-7, atol=0)
     # |ω₁ − Ω| = Ω at Ω = ω₁/2 (Brent's method on the branch: 1e-10, measured 2e-16)
     assert len(first) == 1 and first[0].speed == pytest.approx(omega_k[0] / 2, rel=1e-10)
 
@@ -154,7 +161,7 @@ def test_diagram_files(tmp_path):
     [
         (lambda: campbell(lambda w: pq.scenes.rotating_blade(omega=w, n_shapes=1), [1.0]), "speeds: expected at least two"),
         (lambda: campbell(lambda w: pq.scenes.rotating_blade(omega=w, n_shapes=1), [2.0, 1.0]), "speeds: must increase"),
-        (lambda: campbell(lambda w: pq.scenes.rotating_blade(omega=w, n_shapes=1), [0.0, 1.0], orders=[0]), "orders"),
+        (lambda: campbell(lambda w: pq.scenes.rotating_blade(omega=w, n_shapes=1), [0.0, 1.0], orders=[-1]), "orders"),
         (lambda: campbell(lambda w: pq.scenes.rotating_blade(omega=w, n_shapes=1), [0.0, 1.0], n_modes=0), "n_modes"),
         (lambda: campbell(pq.scenes.chain(2), [0.0, 1.0]), "joint: campbell of a System needs"),
         (lambda: campbell(lambda w: 3, [0.0, 1.0]), "system: expected a System"),
