@@ -262,9 +262,9 @@ def campbell(system, speeds, joint: str | None = None, orders=(1, 2, 3), n_modes
     for speed in speeds:
         model, q, s_dot = build(speed)
         found.append((model, q, s_dot, modes(model, q, s_dot, t, **options)))
-        # the coordinates dropped as ignorable at the first speed, at every speed (at a speed
-        # where K − Ω² M is singular an elastic coordinate's column of A would vanish too)
-        options.setdefault("ignore", [c for c in model.state_names()[: model.n_q] if c not in found[0][3].coordinates])
+        if len(found) == 1:  # its ignorable coordinates dropped at every speed (where K − Ω² M is
+            kept = found[0][3].coordinates  # singular an elastic coordinate's column of A vanishes too)
+            options.setdefault("ignore", [c for c in model.state_names()[: model.n_q] if c not in kept])
     counts = [len(m.frequencies) for *_, m in found]
     if len(set(counts)) > 1:
         k = next(i for i, c in enumerate(counts) if c != counts[0])
