@@ -38,12 +38,9 @@ import warnings
 
 from projeq.assembly import kernels
 from projeq.assembly.beam_fast import hub_beam_unsupported
-from projeq.assembly.fast import unsupported
+from projeq.assembly.fast import InterpretedWarning, unsupported
 
-
-class InterpretedWarning(UserWarning):
-    """The default evaluator fell back to an interpreted reference evaluator (the message
-    names the joint, subsystem or force law the compiled kernel does not know)."""
+__all__ = ["AutoEvaluator", "InterpretedWarning", "pick", "why_not_compiled"]
 
 
 def why_not_compiled(system) -> str | None:
@@ -74,6 +71,8 @@ class AutoEvaluator:
     def __init__(self, system):
         self.name, self.reason = pick(system)
         self.evaluator = system.evaluator(self.name)
+        if getattr(self.evaluator, "interpreted", None):  # the compiled kernel with pieces in Python (it warned)
+            self.reason = f"the compiled order-n kernel, with {', '.join(self.evaluator.interpreted)} in Python"
         self.accelerations = self.evaluator.accelerations  # the picked one's, called directly (one layer less per s̈)
         if hasattr(self.evaluator, "state_derivative"):  # ẋ in one call (projeq.simulate's right-hand side)
             self.state_derivative = self.evaluator.state_derivative

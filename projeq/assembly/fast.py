@@ -65,6 +65,7 @@ True
 from __future__ import annotations
 
 import functools
+import warnings
 
 import numpy as np
 from numpy.typing import NDArray
@@ -75,6 +76,20 @@ from projeq.assembly.beam_fast import elastic_unsupported, hub_beam_unsupported
 from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
 from projeq.subsystems.rigid import rigid_mass_matrix
+
+
+class InterpretedWarning(UserWarning):
+    """A piece of a System runs in Python, not compiled: the default evaluator fell back to an
+    interpreted reference evaluator, or the compiled kernel states a joint or a force law in Python
+    at every evaluation (the message names the piece and how to compile it)."""
+
+
+#: how to keep a joint and a force law on the compiled path (:class:`InterpretedWarning`)
+HOW_TO_COMPILE = {
+    "joint": "state a joint's motion once as statement(q_n, t, m) (docs/architecture.md, 'Adding a joint') or in "
+             "sympy (UserJoint.from_sympy; a Prescribed motion as an expression in t)",
+    "force law": "build the loads from the laws of projeq.forces (constant or sympy loads), which compile",
+}
 
 
 class FastEvaluator:
@@ -90,7 +105,9 @@ class FastEvaluator:
         True (default): compiled by numba (ValueError if it is not installed); False: the
         same kernel interpreted.
 
-    Attributes: ``name`` ("fast"), ``compiled``, ``n_calls``. The workspace (T_np, ζ_n,
+    Attributes: ``name`` ("fast"), ``compiled``, ``n_calls``, ``interpreted`` (the joints and force
+    laws it states in Python at every evaluation, by name: compiled, it warns once naming them,
+    :class:`InterpretedWarning`). The workspace (T_np, ζ_n,
     f_n, M̂_n, ĥ_n) is allocated once and overwritten by every call.
     """
 
@@ -117,6 +134,14 @@ class FastEvaluator:
         # callbacks, given.py): without joints of kind GIVEN every joint has q̇ = ṡ (K = E)
         self._given_motions = given.motions_kernel() if self._given and not self._python_joints and self.compiled \
             else None
+        self.interpreted = [f"joint {system.names[n]!r} ({type(system.joints[n]).__name__})" for n in self._python_joints] \
+            + [f"force law {type(law).__name__}" for law in self._python_laws]
+        if self.interpreted and self.compiled:
+            how = "; ".join(hint for piece, hint in HOW_TO_COMPILE.items()
+                            if any(name.startswith(piece) for name in self.interpreted))
+            warnings.warn(f"system: {', '.join(self.interpreted)} run in Python at every evaluation, between the "
+                          f"compiled kernels (several times slower); to compile: {how}", InterpretedWarning,
+                          stacklevel=3)
         self._x_dot, self._jacobian = None, None
         if not (self._python_laws or system.coupled or self._python_joints):
             self._x_dot, self._jacobian = given.state_kernels(self.compiled, rigid) if self._given else \

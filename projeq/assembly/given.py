@@ -47,17 +47,20 @@ class UncompiledJointWarning(UserWarning):
     """numba could not compile a joint's printed relative motion: it is stated in Python."""
 
 
-#: the C callback of a joint's printed row (:func:`joint_callback`), at q_n, ṡ_n of one dtype
+#: the C callback of a joint's printed row (:func:`joint_callback`), at q_n, ṡ_n of one dtype and the
+#: joint's parameters p (float64)
 JOINT_INTO = """
-@numba.cfunc(nb.void(nb.CPointer(nb.{dtype}), nb.CPointer(nb.{dtype}), nb.float64, nb.CPointer(nb.{dtype})), cache=True)
-def into(q_pointer, s_pointer, t, row_pointer):
+@numba.cfunc(nb.void(nb.CPointer(nb.{dtype}), nb.CPointer(nb.{dtype}), nb.float64, nb.CPointer(nb.float64),
+                     nb.CPointer(nb.{dtype})), cache=True)
+def into(q_pointer, s_pointer, t, p_pointer, row_pointer):
     q_n, s_n, row = numba.carray(q_pointer, ({n_q},)), numba.carray(s_pointer, ({n_s},)), numba.carray(row_pointer, ({width},))
-    found = function(q_n, s_n, t)
+    found = function(q_n, s_n, t, numba.carray(p_pointer, ({n_p},)))
     for i in range({width}):
         row[i] = found[i]
 """
 
-_CALLBACKS: dict = {}  # (compiled_values, dtype) -> its C callback, or None where numba cannot compile it
+_CALLBACKS: dict = {}  # (source, dtype) -> its C callback, or None where numba cannot compile it
+_PARAMETERS: dict = {}  # compiled_values -> the values of its constants (float64), which its callback reads
 _DTYPES = {np.dtype(float): "float64", np.dtype(complex): "complex128"}
 
 
@@ -69,18 +72,20 @@ def row_width(joint) -> int:
 
 def joint_callback(joint, dtype=float):
     """The joint's ``compiled_values()`` (its row, :func:`row_width` entries) compiled as a C callback
-    ``into(q_n, ṡ_n, t, row)`` at q_n, ṡ_n and row of ``dtype`` (float or complex) and t float64,
-    built once per expressions and dtype in a process and cached on disk (:func:`generated_module`);
-    None for a joint without compiled values, or (after one :class:`UncompiledJointWarning`) where
-    numba cannot compile them."""
+    ``into(q_n, ṡ_n, t, p, row)`` at q_n, ṡ_n and row of ``dtype`` (float or complex), t float64 and
+    the values p of its constants (:func:`parameters`: data, not code, so joints that differ only in
+    their parameters' values share one callback), built once per printed source and dtype in a process
+    and cached on disk (:func:`generated_module`); None for a joint without compiled values, or (after
+    one :class:`UncompiledJointWarning`) where numba cannot compile them."""
     values = joint.compiled_values()
     if values is None:
         return None
-    key = (values, np.dtype(dtype))
+    key = (values.source, values.constants, joint.n_q, joint.n_s, np.dtype(dtype))
     if key not in _CALLBACKS:
-        into = JOINT_INTO.format(dtype=_DTYPES[np.dtype(dtype)], n_q=joint.n_q, n_s=joint.n_s, width=row_width(joint))
+        into = JOINT_INTO.format(dtype=_DTYPES[np.dtype(dtype)], n_q=joint.n_q, n_s=joint.n_s, width=row_width(joint),
+                                 n_p=len(values.constants))
         try:
-            _CALLBACKS[key] = generated_module(values, into).into
+            _CALLBACKS[key] = generated_module(values, into, parameters=True).into
         except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
             warnings.warn(f"joint: numba cannot compile the relative motion of {joint!r} for {np.dtype(dtype)} "
                           f"({type(exc).__name__}); it is stated in Python at every evaluation",
@@ -89,20 +94,38 @@ def joint_callback(joint, dtype=float):
     return _CALLBACKS[key]
 
 
-def generated_module(f, into: str):
-    """A module of ``f``'s printed source (``f.source``, its constants — the values its closure holds
-    — as globals) compiled by ``numba.njit(cache=True)`` as ``function``, and the C callback ``into``
-    (``cache=True``): written once to a file named by its digest in numba's cache directory (or
-    ~/.cache/projeq) and imported, so that numba's disk cache, which needs a file, keeps both across
-    processes (a temporary directory where that is not writable: compiled anew each process)."""
+def parameters(f) -> np.ndarray:
+    """The values of the constants (``f.constants``) that the printed function ``f`` of
+    :mod:`projeq.symbolic.codegen` holds in its closure, in their order, as float64 (kept alive here
+    while the process runs: the compiled kernels read them through their address)."""
+    if f not in _PARAMETERS:
+        held = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
+        _PARAMETERS[f] = np.array([float(held[name]) for name in f.constants], dtype=float)
+    return _PARAMETERS[f]
+
+
+def generated_module(f, into: str, parameters: bool = False):
+    """A module of ``f``'s printed source (``f.source``) compiled by ``numba.njit(cache=True)`` as
+    ``function``, and the C callback ``into`` (``cache=True``): written once to a file named by its
+    digest in numba's cache directory (or ~/.cache/projeq) and imported, so that numba's disk cache,
+    which needs a file, keeps both across processes (a temporary directory where that is not
+    writable: compiled anew each process). ``f``'s constants (``f.constants``) are, with
+    ``parameters``, the entries of a last argument p of ``function`` (one module for all their
+    values), else module globals holding the values its closure holds."""
     import importlib.util
 
-    import numba
-
-    constants = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
-    source = "\n".join(["import numba", "import numpy", "from numba import types as nb", "",
-                        *(f"{name} = {float(value)!r}" for name, value in sorted(constants.items())), "",
-                        "@numba.njit(cache=True)", f.source.replace(f"def {f.__name__}(", "def function(", 1), into])
+    numba = kernels.numba_module()
+    header = f.source.split("\n", 1)
+    if parameters:
+        signature = header[0].replace(f"def {f.__name__}(", "def function(", 1).replace("):", ", p):", 1)
+        unpacked = [f"    {name} = p[{i}]" for i, name in enumerate(f.constants)]
+        constants, body = [], "\n".join([signature, *unpacked, header[1]])
+    else:
+        held = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
+        constants = [f"{name} = {float(value)!r}" for name, value in sorted(held.items())]
+        body = f.source.replace(f"def {f.__name__}(", "def function(", 1)
+    source = "\n".join(["import numba", "import numpy", "from numba import types as nb", "", *constants, "",
+                        "@numba.njit(cache=True)", body, into])
     digest = hashlib.sha1((source + numba.__version__).encode()).hexdigest()[:20]
     module_name = f"projeq_generated_{digest}"
     if module_name not in sys.modules:
@@ -139,19 +162,24 @@ def write_once(filename: str, source: str) -> Path:
 
 
 def joint_table(plan, callbacks, compiled: bool = True) -> np.ndarray:
-    """One row (n, first coordinate, n_q, first velocity, n_s, callback) per joint of kind GIVEN of a
-    fast evaluator's ``plan`` (its (n, joint, q slice, ṡ slice, width) rows), as :func:`given_motions`
-    reads them: its C callback's address (``callbacks``), or interpreted (``compiled=False``) its
-    ``compiled_values`` function."""
-    rows = [[n, q_n.start, joint.n_q, s_n.start, joint.n_s, back.address if compiled else joint.compiled_values()]
-            for (n, joint, q_n, s_n, _), back in zip(plan, callbacks)]
-    return np.array(rows, dtype=np.int64 if compiled else object).reshape(len(rows), 6)
+    """One row (n, first coordinate, n_q, first velocity, n_s, callback, parameters) per joint of kind
+    GIVEN of a fast evaluator's ``plan`` (its (n, joint, q slice, ṡ slice, width) rows), as
+    :func:`given_motions` reads them: its C callback's address (``callbacks``) and that of its
+    parameters' values (:func:`parameters`), or interpreted (``compiled=False``) its
+    ``compiled_values`` function (its constants in its closure) and None."""
+    rows = []
+    for (n, joint, q_n, s_n, _), back in zip(plan, callbacks):
+        values = joint.compiled_values()
+        rows.append([n, q_n.start, joint.n_q, s_n.start, joint.n_s, back.address, parameters(values).ctypes.data]
+                    if compiled else [n, q_n.start, joint.n_q, s_n.start, joint.n_s, values, None])
+    return np.array(rows, dtype=np.int64 if compiled else object).reshape(len(rows), 7)
 
 
-def given_into(values, q_n, s_n, t, row):
+def given_into(values, p, q_n, s_n, t, row):
     """row ← the compiled row (A, r, w, ζ, F⁶, q̇) of a joint of kind GIVEN at (q_n, ṡ_n, t): in the
     compiled kernels ``values`` is the address of its C callback (:func:`joint_callback`, called by
-    an intrinsic, :func:`intrinsics`); interpreted, the joint's ``compiled_values`` function itself."""
+    an intrinsic, :func:`intrinsics`) and ``p`` that of its parameters' values; interpreted, the
+    joint's ``compiled_values`` function itself (its constants in its closure)."""
     found = values(q_n, s_n, t)
     row[:found.shape[0]] = found
 
@@ -161,7 +189,7 @@ def given_motions(joints, q, s_dot, t, given):
     :func:`joint_table` each), the numbers the fast evaluator's kernels read."""
     for g in range(joints.shape[0]):
         n, q0, n_q, s0, n_s = joints[g, 0], joints[g, 1], joints[g, 2], joints[g, 3], joints[g, 4]
-        given_into(joints[g, 5], q[q0:q0 + n_q], s_dot[s0:s0 + n_s], t, given[n])
+        given_into(joints[g, 5], joints[g, 6], q[q0:q0 + n_q], s_dot[s0:s0 + n_s], t, given[n])
 
 
 def given_rates(index, elastic, given, x, n_q, x_dot):
@@ -256,11 +284,16 @@ def intrinsics() -> dict:
     from llvmlite import ir
     from numba.extending import intrinsic
 
-    def caller(signature, args, context, builder):
+    def caller(signature, args, context, builder, pointers=()):
+        """Call the C function at the address ``args[0]`` with the arrays' data pointers, the
+        arguments at the positions ``pointers`` (addresses, int64) as float64 pointers and the other
+        scalars as they are."""
         address, values = args[0], []
-        for kind, value in zip(signature.args[1:], args[1:]):
-            is_array = isinstance(kind, numba.types.Array)
-            values.append(context.make_array(kind)(context, builder, value).data if is_array else value)
+        for i, (kind, value) in enumerate(zip(signature.args[1:], args[1:]), start=1):
+            if isinstance(kind, numba.types.Array):
+                values.append(context.make_array(kind)(context, builder, value).data)
+            else:
+                values.append(builder.inttoptr(value, ir.PointerType(ir.DoubleType())) if i in pointers else value)
         function = ir.FunctionType(ir.VoidType(), [v.type for v in values])
         builder.call(builder.inttoptr(address, function.as_pointer()), values)
         return context.get_dummy_value()
@@ -271,8 +304,13 @@ def intrinsics() -> dict:
             signature, args, context, builder)
 
     @intrinsic
-    def given_into(typingctx, values, q_n, s_n, t, row):
-        return numba.types.void(values, q_n, s_n, t, row), lambda context, builder, signature, args: caller(
-            signature, args, context, builder)
+    def given_into(typingctx, values, p, q_n, s_n, t, row):  # the C callback's order: q_n, ṡ_n, t, p, row
+        def call(context, builder, signature, args):
+            values_, p_, q_, s_, t_, row_ = args
+            kinds = signature.args
+            reordered = numba.types.void(kinds[0], kinds[2], kinds[3], kinds[4], kinds[1], kinds[5])
+            return caller(reordered, (values_, q_, s_, t_, p_, row_), context, builder, pointers=(4,))
+
+        return numba.types.void(values, p, q_n, s_n, t, row), call
 
     return {"phi_into": phi_into, "given_into": given_into}

@@ -61,10 +61,23 @@ def kernel_array(a, dtype=float) -> np.ndarray:
 
 
 def _numba():
+    """numba (None where it is not installed), with projeq's compilation notice and safe cache loading
+    installed (:func:`projeq.assembly.compilation.prepare`)."""
     try:
         import numba
     except ImportError:
         return None
+    from projeq.assembly.compilation import prepare
+
+    prepare()
+    return numba
+
+
+def numba_module():
+    """numba, ready for projeq's kernels (:func:`_numba`); ImportError where it is not installed."""
+    numba = _numba()
+    if numba is None:
+        raise ImportError("numba is not installed (pip install numba)")
     return numba
 
 

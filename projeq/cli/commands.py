@@ -36,6 +36,7 @@ COMMANDS = {
     "list": ("run", "list_arguments", "list the scenes, or one scene's parameters"),
     "run": ("run", "run_arguments", "simulate a scene and write the results"),
     "export": ("run", "export_arguments", "write ParaView files of a saved run (its .npz)"),
+    "view": ("view", "view_arguments", "write an HTML page (or GIF, MP4) that plays a saved run's motion"),
     "sweep": ("sweep", "sweep_arguments", "simulate a scene on a parameter grid, in parallel"),
     "compare": ("studies", "compare_arguments", "compare derivations of one system (Projection Equation, Lagrange, Kane ...)"),
     "bench": ("bench", "bench_arguments", "run the performance benchmarks"),

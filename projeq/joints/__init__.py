@@ -2,14 +2,17 @@
 
 - :mod:`.base`: the joint contract (:class:`Joint`, :class:`Relative`, :class:`SymbolicRelative`)
   and the pose/twist check;
+- :mod:`.statement`: a joint's one statement (:class:`Stated`: pose, F⁶, f⁶, K, k as scalar code
+  over a namespace), run on numpy, traced with sympy and printed for numba;
 - :mod:`.standard`: Revolute, Prismatic, Fixed, Planar, Free, Prescribed, each with its sympy
   form (written with :mod:`projeq.symbolic.algebra`) and compiled kind next to ``relative``;
 - :mod:`.user`: :class:`UserJoint` from sympy or callables, compiled by :mod:`.user_compiler`.
 """
 
 from projeq.joints.base import Joint, Relative, SymbolicRelative, pose_twist_mismatch
+from projeq.joints.statement import Stated
 from projeq.joints.standard import Fixed, Free, Planar, Prescribed, Prismatic, Revolute
 from projeq.joints.user import UserJoint
 
-__all__ = ["Joint", "Relative", "SymbolicRelative", "pose_twist_mismatch", "Revolute", "Prismatic", "Fixed",
+__all__ = ["Joint", "Relative", "Stated", "SymbolicRelative", "pose_twist_mismatch", "Revolute", "Prismatic", "Fixed",
            "Planar", "Free", "Prescribed", "UserJoint"]

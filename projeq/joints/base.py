@@ -12,13 +12,18 @@ the parent p (placed at ``r_pn`` with ``orientation`` J → p). Every joint retu
 The chain matrix T_np follows from (A, r) once, in :mod:`projeq.assembly.kinematics`, for every
 joint alike; positions follow q̇_n = K_n(q) ṡ_n + k_n(q, t).
 
-A joint class states its terms in one place: next to ``relative`` (and ``K``) its sympy
-form ``symbolic_relative`` (a :class:`SymbolicRelative`, used by
-:func:`projeq.symbolic.gauss_form`) and ``compiled_kind``, the kind of the compiled
-kernel that computes the same (:mod:`projeq.assembly.kernels`). No evaluator keeps a
-list of joint types. A subclass that restates ``relative``, ``K`` or ``q_dot`` loses the
-symbolic and compiled forms it inherits unless it restates them as well, so an override
-is never bypassed.
+A joint states its terms once, in ``statement(q_n, t, m)``: the pose (A, r), F⁶ and, where
+they are not zero or the identity, f⁶, K and k, as plain scalar code over the namespace ``m``
+(:mod:`projeq.joints.statement`). Everything else follows from it: ``relative``, ``K`` and
+``q_dot`` (numpy, the reference evaluators; ζ by the complex step through the statement),
+``symbolic_relative`` (the statement traced with sympy, for :func:`projeq.symbolic.gauss_form`)
+and ``compiled_values`` (the traced form printed for numba: the compiled kernels' C callbacks).
+A joint may instead state ``relative`` (and ``K``) and its sympy form ``symbolic_relative``
+beside it; its compiled values are then printed from that sympy form. The standard Revolute,
+Prismatic and Fixed joints name the compiled kernel that computes the same kinematics,
+``compiled_kind`` (:mod:`projeq.assembly.kernels`). A subclass that restates ``statement``,
+``relative``, ``K`` or ``q_dot`` loses the forms it inherits that were derived from the
+restated terms, unless it restates them as well, so an override is never bypassed.
 
 Letters: ``K`` is q̇ = K ṡ (never a stiffness); ``A`` a rotation; ``t`` time.
 """
@@ -32,6 +37,8 @@ from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import central
 from projeq.checks import drop_inherited_twins, finite_array
+from projeq.joints import statement
+from projeq.joints.statement import Stated
 from projeq.spatial import vee
 
 if TYPE_CHECKING:
@@ -97,13 +104,32 @@ class Joint:
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        drop_inherited_twins(cls, Joint, ("relative", "K", "q_dot"),
+        drop_inherited_twins(cls, Joint, ("statement",), ("relative", "K", "q_dot"))
+        drop_inherited_twins(cls, Joint, ("statement", "relative", "K", "q_dot"),
                              ("symbolic_relative", "symbolic_parameters", "compiled_kind", "relative_values",
                               "compiled_values"))
 
-    def relative(self, q_n: NDArray, s_dot_n: NDArray, t: float) -> Relative:
-        """Relative kinematics (A, r, F⁶, w, ζ) at (q_n, ṡ_n, t)."""
+    def statement(self, q_n, t, m) -> Stated:
+        """The joint's one statement: pose, F⁶ (and f⁶, K, k) at (q_n, t), written over the
+        namespace ``m`` (numpy, or sympy when traced; :mod:`projeq.joints.statement`). A joint that
+        states it gets :meth:`relative`, :meth:`K`, :meth:`q_dot`, :meth:`symbolic_relative` and
+        :meth:`compiled_values` from it."""
         raise NotImplementedError
+
+    @classmethod
+    def states_motion(cls) -> bool:
+        """Whether the class's :meth:`statement` is all it says of its motion (it states one and
+        restates none of :meth:`relative`, :meth:`K`, :meth:`q_dot`): then its symbolic and
+        compiled forms are traced from the statement."""
+        return cls.statement is not Joint.statement and all(
+            getattr(cls, member) is getattr(Joint, member) for member in ("relative", "K", "q_dot"))
+
+    def relative(self, q_n: NDArray, s_dot_n: NDArray, t: float) -> Relative:
+        """Relative kinematics (A, r, F⁶, w, ζ) at (q_n, ṡ_n, t): by default from :meth:`statement`
+        (:func:`projeq.joints.statement.relative`)."""
+        if type(self).statement is Joint.statement:
+            raise NotImplementedError(f"{type(self).__name__}: state its statement(q_n, t, m) or its relative")
+        return Relative(*statement.relative(self, q_n, s_dot_n, t))
 
     def relative_values(self, q_n: NDArray, s_dot_n: NDArray, t: float):
         """The numbers of :meth:`relative` at (q_n, ṡ_n, t) as one flat sequence of 24 + 6 n_s
@@ -118,26 +144,41 @@ class Joint:
     def compiled_values(self):
         """``values(q_n, ṡ_n, t)`` -> the numbers of :meth:`relative_values` followed by q̇_n = K ṡ_n + k
         (n_q entries), printed as scalar numpy code that numba compiles
-        (:func:`projeq.joints.user_compiler.printed_values`), for the compiled kernels
-        (:mod:`projeq.assembly.given`); None (the default) where the joint states them in Python only."""
-        return None
+        (:func:`projeq.joints.statement.printed`), for the compiled kernels (:mod:`projeq.assembly.given`):
+        by default from the joint's sympy form (:meth:`symbolic_relative`, traced from its statement
+        or its own, built once per joint; its numbers passed to the compiled code as data); None
+        where the joint has no sympy form, or one that needs ``symbolic_parameters`` (it is then
+        stated in Python only)."""
+        if not (self.states_motion() or type(self).symbolic_relative is not Joint.symbolic_relative) \
+                or self.symbolic_parameters:
+            return None
+        if "_printed" not in self.__dict__:
+            self._printed = statement.printed(self)
+        return self._printed
 
     def symbolic_relative(self, q_n, s_n, t: sp.Symbol, **parameters) -> SymbolicRelative:
         """The same kinematics as :meth:`relative` and :meth:`K` in sympy, at the symbols or
         expressions q_n, ṡ_n (``s_n``) and t; ``parameters`` are the fields named in
-        ``symbolic_parameters``. Raises NotImplementedError with the reason (completing
-        "joint 'name' ...") when the joint has no symbolic form."""
+        ``symbolic_parameters``; by default the :meth:`statement` traced with sympy. Raises
+        NotImplementedError with the reason (completing "joint 'name' ...") when the joint has no
+        symbolic form."""
+        if self.states_motion():
+            return SymbolicRelative(*statement.traced(self, q_n, t))
         raise NotImplementedError(
             f"({type(self).__name__}) is not supported symbolically; state its symbolic_relative, "
             "or use projection_equation with its velocity expressions"
         )
 
     def K(self, q_n: NDArray, t: float) -> NDArray:
-        """K_n(q) of q̇_n = K_n ṡ_n + k_n (identity for q̇ = ṡ)."""
+        """K_n(q) of q̇_n = K_n ṡ_n + k_n: the statement's, else the identity (q̇ = ṡ)."""
+        if type(self).statement is not Joint.statement:
+            return statement.stated(self, q_n, t).K
         return np.eye(self.n_q, self.n_s)
 
     def q_dot(self, q_n: NDArray, s_dot_n: NDArray, t: float) -> NDArray:
         """q̇_n = K_n(q) ṡ_n + k_n(q, t)."""
+        if type(self).statement is not Joint.statement and type(self).K is Joint.K:
+            return statement.rates(self, q_n, s_dot_n, t)
         return self.K(q_n, t) @ s_dot_n
 
     def coordinates(self) -> tuple:

@@ -7,7 +7,6 @@ kinematics, its ``compiled_kind``; see :mod:`projeq.joints.base` for the contrac
 
 from __future__ import annotations
 
-import functools
 import math
 
 from typing import Callable
@@ -15,6 +14,7 @@ from typing import Callable
 import numpy as np
 
 from projeq.checks import callable_name
+from projeq.joints import statement
 from projeq.joints.base import Joint, Relative, SymbolicRelative
 from projeq.spatial import axis_spin, norm, numeric, quaternion_matrix, quaternion_rate_matrix, rodrigues, unit_axis
 from projeq.symbolic import lazy_import
@@ -151,10 +151,6 @@ class Planar(Joint):
         K[2, 2] = 1.0
         return K
 
-    def compiled_values(self):
-        """:meth:`projeq.joints.base.Joint.compiled_values` printed from :meth:`symbolic_relative`."""
-        return _compiled_symbolic(self)
-
     def symbolic_relative(self, q_n, s_n, t):
         P = algebra.exact(self._P)
         A = algebra.rotation(algebra.exact(self.normal), q_n[2])
@@ -187,7 +183,7 @@ class Free(Joint):
         """:meth:`projeq.joints.base.Joint.compiled_values` printed from :meth:`symbolic_relative` with the
         quaternion q/√(qᵀq) put in (as :meth:`relative` and :meth:`K` normalise it: the same numbers
         off the unit sphere, and the same derivatives)."""
-        return _compiled_symbolic(self, unit=range(3, 7))
+        return statement.printed(self, unit=range(3, 7))
 
     def symbolic_relative(self, q_n, s_n, t):
         """With the quaternion taken as unit (the numeric joint normalises it)."""
@@ -275,7 +271,7 @@ class Prescribed(Joint):
             return None
         t = sp.Symbol("t")
         inner = self.symbolic_relative([], [], t, self.expression)
-        return _printed_relative((), (), t, *(sp.ImmutableMatrix(e) for e in inner))
+        return statement.printed_form((), (), t, *(sp.ImmutableMatrix(e) for e in inner))()
 
 
 def _label(motion) -> str:
@@ -305,25 +301,3 @@ def _time_function(expr) -> Callable:
     t = sp.Symbol("t")
     f = sp.lambdify(t, [expr, expr.diff(t), expr.diff(t, 2)], modules="numpy")
     return lambda time: tuple(f(time))  # complex at a complex t: Prescribed.angles keeps the complex step
-
-
-@functools.lru_cache(maxsize=64)
-def _printed_relative(q, s, t, A, r, F, f, K, k):
-    """The compiled-form ``values`` of a joint's sympy form (A, r, F, f, K, k at the symbols q, ṡ, t),
-    ζ derived as for a UserJoint (:func:`projeq.joints.user_compiler.joint_symbols`), one function per
-    form in a process so that its numba callback is built once."""
-    from projeq.joints.user_compiler import joint_symbols, printed_values
-
-    return printed_values(joint_symbols(q, s, t, A, r, F, f, K, k))()
-
-
-def _compiled_symbolic(joint, unit=None):
-    """:func:`_printed_relative` of the joint's own ``symbolic_relative`` at fresh symbols (``unit``:
-    the coordinates whose values are normalised, q/√(qᵀq), put in as the numeric joint does)."""
-    q, s, t = sp.symbols(f"q0:{joint.n_q}"), sp.symbols(f"s0:{joint.n_s}"), sp.Symbol("t")
-    relative = joint.symbolic_relative(list(q), list(s), t)
-    if unit is not None:
-        u = [q[i] for i in unit]
-        length = sp.sqrt(sum(x**2 for x in u))
-        relative = SymbolicRelative(*(sp.Matrix(e).xreplace({x: x / length for x in u}) for e in relative))
-    return _printed_relative(q, s, t, *(sp.ImmutableMatrix(e) for e in relative))

@@ -120,13 +120,13 @@ def vtu_lines(points, lines, point_data: dict | None = None, cell_data: dict | N
     return _VtuTemplate(points, lines, point_data, cell_data).text(points, *(point_data or {}).values())
 
 
-def _tree_poses(system, q, s_dot, t):
+def tree_poses(system, q, s_dot, t):
     """(tree, poses) of the model at one state: its tree moving with the tree velocities (a
     ConstrainedSystem's F ṡ + f, a System's ṡ), computed once for both parts of a frame."""
     return system.tree, poses(system.tree, q, system.tree_velocities(q, s_dot, t), t)
 
 
-class _Drawing:
+class Drawing:
     """What the frames of a ``tree``'s series share, formed once: the bodies' line cells (a
     deforming subsystem's centre line of ``stations`` points, every other subsystem's frame glyph
     of ``frame_size``: three segments along its axes) and the mechanism's (lines from each
@@ -166,7 +166,7 @@ class _Drawing:
 
     def bodies(self, kin, q) -> tuple[NDArray, NDArray]:
         """Points and velocities (inertial) of the bodies' part in the poses ``kin``
-        (:func:`_tree_poses`) at q."""
+        (:func:`tree_poses`) at q."""
         points, velocities, tree = [], [], self.tree
         for n, sub in enumerate(tree.subsystems):
             if sub.deforms:
@@ -210,7 +210,7 @@ def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21
     """Write ``result`` as ``directory/name_####.vtu`` files (the bodies: beam centre lines,
     frame glyphs), ``directory/name_mechanism_####.vtu`` (the mechanism: lines joining each
     subsystem's joint to its children's joints and to its centre of mass, cell data ``body``
-    and ``kind``, :class:`_Drawing`), ``directory/name_bodies.csv`` (body number, subsystem
+    and ``kind``, :class:`Drawing`), ``directory/name_bodies.csv`` (body number, subsystem
     name, joint type) and ``directory/name.pvd``, which ParaView opens as a time series of
     the two parts.
 
@@ -220,10 +220,10 @@ def write_vtu_series(result, directory, name: str = "projeq", stations: int = 21
     system = system if system is not None else system_of(result)
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    drawing, entries, reference, templates = _Drawing(system.tree, stations, frame_size), [], None, None
+    drawing, entries, reference, templates = Drawing(system.tree, stations, frame_size), [], None, None
     links = drawing.links["lines"]
     for k, (model, t, q, s_dot) in enumerate(zip(system.row_models(result), result.t, result.q, result.s_dot)):
-        kin = _tree_poses(model, q, s_dot, t)[1]
+        kin = tree_poses(model, q, s_dot, t)[1]
         points, velocity = drawing.bodies(kin, q)
         reference = points if reference is None else reference
         joints = drawing.mechanism(kin) if len(links) else None

@@ -111,6 +111,16 @@ class Result:
         """True when the run reached its end or a terminal event."""
         return self.status in (0, 1)
 
+    def animate(self, path, system=None, stations: int = 21, **options):
+        """Write the motion to ``path``: ``.html`` a self-contained page that plays it in a browser,
+        offline (three.js inlined; bodies as solids of their inertia, beams as deformed tubes, joint
+        frames, time slider, play/pause, speed), ``.gif`` or ``.mp4`` a movie
+        (:func:`projeq.simulation.animation.animate`). ``system``: the model, default the Result's
+        own or the scene its run record names. Returns the path."""
+        from projeq.simulation.animation import animate
+
+        return animate(self, path, system, stations, **options)
+
     def save(self, path) -> None:
         """Write the arrays and metadata to an ``.npz`` file (readable by numpy alone; ``.npz``
         is appended to a name without it, as numpy does), under a temporary name renamed when

@@ -69,6 +69,7 @@ class ComparisonTable:
             lines.append("derivations from the Central Equation B(2), d/dt[(∂T/∂ṡ) δs] − δT − δW = 0 "
                          "(docs/theory.md):")
             lines += [line for text in derivations for line in _wrap(text, "- ", "  ")]
+            lines += _wrap(CENTRAL_EQUATION_CODE, "in code: ", "  ")
         if self.effort:
             lines += _wrap(self.effort, "effort: ", "  ")
         lines += [line for claim in self.claims for line in _wrap(claim, "- ", "  ")]
@@ -410,6 +411,13 @@ COMPARISONS = {
 DEFAULT_T_END = {"car": 2.0, "knife_edge_disc": 2.0, "spinning_beam": 3.0, "n_link_pendulum": 2.0}
 COMPARISONS.update(BARHORST_STUDIES)  # A. A. Barhorst's formulation study (projeq.studies.compare_barhorst)
 DEFAULT_T_END.update(BARHORST_T_END)
+
+
+#: Where the derivations from B(2) are code, not only text.
+CENTRAL_EQUATION_CODE = ("projeq.symbolic.central_equation(bodies, q, s, H, constrained) takes T (from the bodies' "
+                         "velocities), ṡ = H q̇ and δW once and derives Hamel's equations (.hamel()), the Projection "
+                         "Equation (.projection()), Kane's (.kane()) and Lagrange's with multipliers (.lagrange()); "
+                         "tests/symbolic/test_central.py checks them against B(8), B(9), B(12) and KanesMethod.")
 
 
 #: How each formulation follows from the Central Equation B(2) (docs/theory.md), by the first

@@ -5,10 +5,14 @@
 - :mod:`.projection`, :mod:`.system`: the Projection Equation from velocity expressions
   (B(10)–(12)) and from a numeric :class:`projeq.System` (``gauss_form``);
 - :mod:`.hamel`: Hamel's coefficients and equations (B(3)–(4));
+- :mod:`.central`: Bremer's Central Equation B(2) as code — Hamel's, the Projection Equation's, Kane's
+  and Lagrange's (with multipliers) equations derived from one description;
 - :mod:`.lagrange`, :mod:`.canonical`: Lagrange/Hamilton with multipliers, the canonical
   momentum forms of A. A. Barhorst, "Generalized momenta in constrained non-holonomic systems";
-- :mod:`.hamiltonian`: Poisson brackets, constants of motion, Hamilton–Jacobi separation (the
-  problem-seminar book on Lagrange's equations, Seminars 10–11);
+- :mod:`.hamiltonian`: Poisson brackets, constants of motion, Hamilton–Jacobi separation, the
+  principal function, canonical transformations from generating functions, action-angle variables,
+  Routh's elimination of cyclic coordinates (the problem-seminar book on Lagrange's equations,
+  lecture notes §II.7, §§VI–VII, Seminars 10–11);
 - :mod:`.program`: high-order program constraints (the generalized program motion
   equations of "On derivation of motion equations for systems with non-holonomic
   high-order program constraints", eqs. 6.30–6.33);
@@ -28,8 +32,14 @@ _LAZY = {
     "CanonicalForm": ".canonical", "lagrangian_canonical": ".canonical", "projective_canonical": ".canonical",
     "energy_rate": ".canonical",
     "poisson_bracket": ".hamiltonian", "constant_of_motion_rate": ".hamiltonian",
-    "is_constant_of_motion": ".hamiltonian", "Separation": ".hamiltonian", "separate_hamilton_jacobi": ".hamiltonian",
-    "ProgramEquations": ".program", "program_motion_equations": ".program",
+    "is_constant_of_motion": ".hamiltonian", "Separation": ".hamiltonian",
+    "separate_hamilton_jacobi": ".hamiltonian",
+    "principal_function": ".hamiltonian", "CanonicalTransformation": ".hamiltonian",
+    "canonical_transformation": ".hamiltonian", "Libration": ".hamiltonian", "Routhian": ".hamiltonian",
+    "routhian": ".hamiltonian",
+    "CentralEquation": ".central", "central_equation": ".central",
+    "ProgramEquations": ".program", "program_motion_equations": ".program", "nielsen_equations": ".program",
+    "tzenoff_equations": ".program", "pseudo_regular_precession": ".program",
 }
 
 __all__ = list(_LAZY)

@@ -18,8 +18,8 @@ from .canonical import CanonicalForm, projective_canonical
 from .lagrange import MultiplierSystem, multiplier_system
 from .projection import Body, t
 
-__all__ = ["DISC_UNITS", "hamel_disc", "lecture_disc", "lecture_disc_state", "particle", "projection_disc",
-           "projective_disc"]
+__all__ = ["DISC_UNITS", "central_disc", "hamel_disc", "lecture_disc", "lecture_disc_state", "particle",
+           "projection_disc", "projective_disc"]
 
 m, g, r, I, J = sp.symbols("m g r I J", positive=True)
 DISC_UNITS = {m: 1.0, g: 1.0, r: 1.0, I: 0.25, J: 0.5}  # the scene's defaults: μ = 1/4, ν = 1/2
@@ -93,6 +93,32 @@ def particle() -> MultiplierSystem:
     return multiplier_system((x.diff(t) ** 2 + y.diff(t) ** 2) / 2 - 10 * y, q, t, A=[[-y**2, 1]])
 
 
+def _disc_speeds_K(q) -> sp.Matrix:
+    """q̇ = K ṡ for the scene's q = (x, y, ψ, ϕ, θ) and ṡ = (ψ̇, ϕ̇, θ̇, c₁, c₂): the rolling rows of slide
+    30 (z = −r cos ϕ eliminated), with c₁, c₂ the rolling constraints' violations added to ẋ, ẏ."""
+    x, y, psi, phi, th = q
+    K_rolling = _disc_K([x, y, None, psi, phi, th])  # rows ẋ, ẏ, ż, ψ̇, ϕ̇, θ̇ from (ψ̇, ϕ̇, θ̇)
+    return sp.Matrix.hstack(K_rolling.extract([0, 1, 3, 4, 5], [0, 1, 2]), sp.eye(5)[:, :2])
+
+
+@cache
+def central_disc():
+    """The disc as Bremer's Central Equation B(2) (:func:`projeq.symbolic.central.central_equation`): the
+    body of :func:`projection_disc` in R = E, with the speeds ṡ = (ψ̇, ϕ̇, θ̇, c₁, c₂) of :func:`hamel_disc`
+    and c₁ = c₂ = 0 the rolling constraints."""
+    from .central import central_equation
+
+    q = x, y, psi, phi, th = sp.symbols("x y psi phi theta")
+    s = sp.symbols("psi_d phi_d theta_d c_1 c_2")
+    K = _disc_speeds_K(q)
+    q_dot = K * sp.Matrix(s)
+    R_E = sp.rot_axis3(-psi) * sp.rot_axis1(-phi)
+    v_G = R_E.T * sp.Matrix([q_dot[0], q_dot[1], r * sp.sin(phi) * q_dot[3]])
+    in_E = _disc_in_E([x, y, None, psi, phi, th], s[:3])
+    disc = Body(v_c=v_G, omega=in_E.omega, m=m, I_c=in_E.I_c, f=in_E.f, omega_IR=in_E.omega_IR)
+    return central_equation({"disc": disc}, q, s, K.inv().applyfunc(sp.simplify), s[3:], (I, J, g, m, r))
+
+
 def hamel_disc(constraints_first: bool = False):
     """The disc by Hamel's equations B(3) in the scene's q = (x, y, ψ, ϕ, θ): speeds
     ṡ = H q̇ = (ψ̇, ϕ̇, θ̇, c₁, c₂) with c₁, c₂ the rolling constraints of slide 30 (z = −r cos ϕ
@@ -109,8 +135,7 @@ def hamel_disc(constraints_first: bool = False):
     s = sp.symbols("psi_d phi_d theta_d c_1 c_2")
     s_ddot = sp.symbols("psi_dd phi_dd theta_dd c_1_d c_2_d")
     x, y, psi, phi, th = q
-    K_rolling = _disc_K([x, y, None, psi, phi, th])  # rows ẋ, ẏ, ż, ψ̇, ϕ̇, θ̇ from (ψ̇, ϕ̇, θ̇)
-    K = sp.Matrix.hstack(K_rolling.extract([0, 1, 3, 4, 5], [0, 1, 2]), sp.eye(5)[:, :2])  # ẋ, ẏ gain c₁, c₂
+    K = _disc_speeds_K(q)
     H = K.inv().applyfunc(sp.simplify)
     q_dot = K * sp.Matrix(s)
     z_dot = r * sp.sin(phi) * q_dot[3]

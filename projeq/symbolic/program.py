@@ -13,6 +13,12 @@ By Tsenov's identity ∂T^(p)/∂q^(p) = p d/dt ∂T/∂q̇ + ∂T/∂q, so ∂R
 expression d/dt ∂T/∂q̇ − ∂T/∂q − Q for every p: the GPME are second order, the
 constraints of order p, and both are integrated together as the linear system for the
 highest derivative q^(m), m = max(2, p), with state (q, q̇, …, q^(m−1)).
+
+The same left-hand sides for p = 1 and p = 2 are Nielsen's equations (5.1) and Tzenoff's
+equations of the second kind (5.2) (:func:`nielsen_equations`, :func:`tzenoff_equations`); none of
+this assumes T quadratic in q̇ (Jarzębowska (2002), remark after (6.7)). Grioli's condition for a
+pseudo-regular precession, (4.1) with the body rates (4.1a), is a second-order program constraint
+(:func:`pseudo_regular_precession`).
 """
 
 from __future__ import annotations
@@ -26,7 +32,8 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 from sympy.core.function import AppliedUndef
 
-__all__ = ["ProgramEquations", "program_motion_equations"]
+__all__ = ["ProgramEquations", "nielsen_equations", "program_motion_equations", "pseudo_regular_precession",
+           "tzenoff_equations"]
 
 
 def _order(expr: sp.Expr, q: Sequence, t: sp.Symbol) -> int:
@@ -178,17 +185,11 @@ def program_motion_equations(T, q: Sequence, constraints: Sequence, t: sp.Symbol
     >>> gpme.p, gpme.dependent
     (2, (x(t),))
     """
-    q = tuple(q)
     parameters = dict(parameters or {})
-    if not q or not all(isinstance(qi, AppliedUndef) and qi.args == (t,) for qi in q):
-        raise ValueError(f"q: expected functions of {t} such as dynamicsymbols('x'), got {list(q)}")
-    Q = sp.Matrix(Q if Q is not None else [0] * len(q))
-    if Q.shape != (len(q), 1):
-        raise ValueError(f"Q: expected {len(q)} generalized forces (one per coordinate), got {Q.rows}")
+    q, Q = _checked(T, q, t, Q, parameters)
     c = [sp.sympify(ci) for ci in constraints]
     if not 0 < len(c) < len(q):
         raise ValueError(f"constraints: expected between 1 and {len(q) - 1} constraints, got {len(c)}")
-    check_declared([T, *Q], q, t, parameters, "T, Q")
     check_declared(c, q, t, parameters, "constraints")
     c = [_linearised(ci, q, t, differentiate) for ci in c]
     orders = sorted({_order(ci, q, t) for ci in c})
@@ -238,3 +239,60 @@ def _gpme_gradient(T, q: Sequence, t: sp.Symbol, p: int, Q: sp.Matrix) -> sp.Mat
     T_p = sp.diff(T, t, p)
     return sp.Matrix([sp.expand((sp.diff(T_p, d) - (p + 1) * sp.diff(T, qi)) / p - Qi)
                       for qi, d, Qi in zip(q, D, Q)])
+
+
+def _checked(T, q: Sequence, t: sp.Symbol, Q, parameters: Mapping) -> tuple[tuple, sp.Matrix]:
+    """(q, Q as a column, zero by default) after checking q, Q and the symbols of T and Q."""
+    q = tuple(q)
+    if not q or not all(isinstance(qi, AppliedUndef) and qi.args == (t,) for qi in q):
+        raise ValueError(f"q: expected functions of {t} such as dynamicsymbols('x'), got {list(q)}")
+    Q = sp.Matrix(Q if Q is not None else [0] * len(q))
+    if Q.shape != (len(q), 1):
+        raise ValueError(f"Q: expected {len(q)} generalized forces (one per coordinate), got {Q.rows}")
+    check_declared([T, *Q], q, t, parameters, "T, Q")
+    return q, Q
+
+
+def _program_equations(T, q: Sequence, t: sp.Symbol, p: int, Q, parameters) -> sp.Matrix:
+    """(6.7) of order ``p`` minus Q, after checking the input."""
+    q, Q = _checked(T, q, t, Q, dict(parameters or {}))
+    return _gpme_gradient(sp.sympify(T), q, t, p, Q)
+
+
+def nielsen_equations(T, q: Sequence, t: sp.Symbol, Q: Sequence | None = None,
+                      parameters: Mapping | None = None) -> sp.Matrix:
+    """Nielsen's equations, Jarzębowska (2002) eq. (5.1): the left-hand sides of
+    ∂Ṫ/∂q̇_σ − 2 ∂T/∂q_σ − Q_σ = 0 (the GPME (6.7) for p = 1), for any T(t, q, q̇) — by the identity
+    (6.6) they equal d/dt ∂T/∂q̇ − ∂T/∂q − Q, also when T is not quadratic in q̇.
+    ``parameters``: the other symbols of T and Q (their values are not used here)."""
+    return _program_equations(T, q, t, 1, Q, parameters)
+
+
+def tzenoff_equations(T, q: Sequence, t: sp.Symbol, Q: Sequence | None = None,
+                      parameters: Mapping | None = None) -> sp.Matrix:
+    """Tzenoff's equations of the second kind, Jarzębowska (2002) eq. (5.2): the left-hand sides of
+    ½ (∂T̈/∂q̈_σ − 3 ∂T/∂q_σ) − Q_σ = 0 (the GPME (6.7) for p = 2), for any T(t, q, q̇)."""
+    return _program_equations(T, q, t, 2, Q, parameters)
+
+
+def pseudo_regular_precession(phi, psi, theta, t: sp.Symbol, lam) -> sp.Expr:
+    """Grioli's condition for a pseudo-regular precession, Jarzębowska (2002) eq. (4.1),
+
+        p q̇ − q ṗ + r (p² + q²) − λ (p² + q²)^{3/2} = 0,
+
+    with the body rates (4.1a) of the Euler angles φ (spin), ψ (precession), ϑ (nutation),
+    p = ψ̇ sin ϑ sin φ + ϑ̇ cos φ, q = ψ̇ sin ϑ cos φ − ϑ̇ sin φ, r = ψ̇ cos ϑ + φ̇: a second-order program
+    constraint, linear in ψ̈ and ϑ̈. Expanded it is the paper's (4.2) with ψ̇² sin² ϑ in the radicand
+    (p² + q² = ψ̇² sin² ϑ + ϑ̇²), where (4.2) prints φ̇² sin² ϑ, a misprint (tests/symbolic/test_program.py).
+    Geometrically the symmetry axis moves on a circular cone of half-angle arccot λ (λ is the
+    geodesic curvature of its path on the unit sphere), at any rate: the regular precession
+    (ϑ̇ = 0, φ̇, ψ̇ constant) satisfies it iff λ = cot ϑ.
+    """
+    rate = [f.diff(t) for f in (phi, psi, theta)]
+    p = rate[1] * sp.sin(theta) * sp.sin(phi) + rate[2] * sp.cos(phi)
+    q = rate[1] * sp.sin(theta) * sp.cos(phi) - rate[2] * sp.sin(phi)
+    r = rate[1] * sp.cos(theta) + rate[0]
+    unit = {sp.cos(phi) ** 2: 1 - sp.sin(phi) ** 2}  # φ drops out: sin²φ + cos²φ = 1
+    transverse, turning = (sp.expand(sp.expand(e).subs(unit))
+                           for e in (p**2 + q**2, p * q.diff(t) - q * p.diff(t)))
+    return sp.expand(turning + r * transverse) - lam * transverse ** sp.Rational(3, 2)

@@ -10,7 +10,8 @@ linearised in (v, w):
   (α̇, −ẇ′, v̇′) of B(17); reproduces B(18).
 * :func:`projection_field_equations` — Newton–Euler residuals of a slice in R projected
   with the operator D̄ of B(22) and its adjoint D (B(21)); reproduces B(23) (with the
-  signs of docs/theory.md, "The spinning beam's rotary inertia").
+  signs of docs/theory.md, "The spinning beam's rotary inertia"); the same integration by
+  parts gives the boundary operators B₀, B₁ (:func:`projection_boundary_operators`).
 
 They differ only in the ρI α̈ coupling of the v equation (:func:`field_difference`): the
 Cardan axes (x, y′, z″) are not orthogonal, so Hamilton's v equation is the directional
@@ -136,10 +137,11 @@ def _newton_euler_residuals() -> sp.Matrix:
     return sp.Matrix([_linear(e) for e in list(f) + list(m)])
 
 
-def _slice_residual() -> list:
+@lru_cache(maxsize=None)
+def _slice_residual() -> tuple:
     """B(23)'s middle factor dMÿ + dGẏ − dQ on the rows of D_BAR: (f_y, f_z, m_y, m_z, EIv″, EIw″)."""
     f_m = _newton_euler_residuals()
-    return [f_m[1], f_m[2], f_m[4], f_m[5], EI * _d(v, x, 2), EI * _d(w, x, 2)]
+    return (f_m[1], f_m[2], f_m[4], f_m[5], EI * _d(v, x, 2), EI * _d(w, x, 2))
 
 
 # D̄ of B(22), the rows of ẏ = (v̇_y, v̇_z, −ẇ′, v̇′, v̇″, ẇ″) that depend on (v̇, ẇ):
@@ -160,6 +162,34 @@ def projection_field_equations() -> tuple[sp.Expr, sp.Expr]:
         terms = [c * (-1) ** k * _d(r_i, *([x] * k)) for r_i, (f, c, k) in zip(r, D_BAR) if f == field]
         equations.append(sp.expand(sum(terms)))
     return tuple(equations)
+
+
+@lru_cache(maxsize=None)
+def projection_boundary_operators() -> dict:
+    """Bremer's boundary operators B₀, B₁ of B(21) for the v and w fields: ``{v: (B₀, B₁), w: (B₀, B₁)}``.
+
+    The virtual work B(20) with δy = D̄ ∘ δs (B(22)) is integrated by parts in x; each row of D̄ with a
+    k-th derivative, ∫ c δf⁽ᵏ⁾ rᵢ dx, gives (−1)ᵏ ∫ c δf rᵢ⁽ᵏ⁾ dx (the field equations,
+    :func:`projection_field_equations`) and the boundary terms Σ_{j<k} [c (−1)^(k−1−j) δf⁽ʲ⁾ rᵢ^(k−1−j)]₀ᴸ
+    ("successive degeneration of the differentiation grade with once more changing sign", after B(22)).
+    Collected by δf⁽ʲ⁾: δW_bound = [Σ_f (δf B₀,f + δf′ B₁,f)]₀ᴸ, so that
+
+        ∫₀ᴸ δyᵀ r dx = ∫₀ᴸ (δv E_v + δw E_w) dx + [δv B₀,v + δv′ B₁,v + δw B₀,w + δw′ B₁,w]₀ᴸ.
+
+    At a clamped end δf = δf′ = 0; at a free end B₀ = B₁ = 0 are the dynamic boundary conditions:
+    B₁ = EI f″ (no bending moment) and B₀ the shear force with the slice's rotary inertia
+    (for v: ρI(v̈′ + α̇² v′ + α̈ w′) − EI v‴, at α̇ = 0 the Rayleigh beam's free end).
+    """
+    r = _slice_residual()
+    operators = {}
+    for field in (v, w):
+        B = [sp.S.Zero, sp.S.Zero]
+        for r_i, (f, c, k) in zip(r, D_BAR):
+            if f == field:
+                for j in range(k):
+                    B[j] += c * (-1) ** (k - 1 - j) * _d(r_i, *([x] * (k - 1 - j)))
+        operators[field] = tuple(sp.expand(b) for b in B)
+    return operators
 
 
 def field_difference() -> tuple[sp.Expr, sp.Expr]:
@@ -313,8 +343,8 @@ def ritz_models(n: int = 2, length: float = 1.0, rho_A_value: float = 1.0, rho_I
         raise ValueError(f"kinds: unknown {unknown}; available: {list(_RITZ)}")
     values = {L: length, rho_A: rho_A_value, rho_I: rho_I_value, EI: EI_value}
     for symbol, value in values.items():
-        if not value > 0:
-            raise ValueError(f"{symbol}: must be positive, got {value!r}")
+        if not (value >= 0 if symbol == rho_I else value > 0):  # ρI = 0: the Euler–Bernoulli beam
+            raise ValueError(f"{symbol}: must be {'≥ 0' if symbol == rho_I else 'positive'}, got {value!r}")
     return {
         kind: RitzModel(*(np.array(m.subs(values), dtype=float) for m in _RITZ[kind](int(n))))
         for kind in kinds

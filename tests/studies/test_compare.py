@@ -253,6 +253,7 @@ def test_format_and_csv(car_table, tmp_path):
     text = car_table.format()
     assert "hamel" in text and "deriv_s" in text and "why: constraint inserted before the derivation" in text
     assert "[-c*m*omega_z**2, c*m*omega_z*v_x]" in text and "Central Equation B(2)" in text
+    assert "in code: projeq.symbolic.central_equation" in text
     assert max(len(line) for line in text.splitlines()) <= 100
     path = tmp_path / "car.csv"
     car_table.to_csv(path)

@@ -1,0 +1,49 @@
+"""What a user sees of numba's compilation (projeq/assembly/compilation.py): one line when a
+projeq kernel is first compiled, nothing when it loads from the cache, and a damaged cache entry
+discarded with one warning and compiled anew instead of a traceback on every later run.
+
+The kernel here is a generated module's function (projeq writes the modules of its joints'
+callbacks under the name ``projeq_generated_<digest>``), so that the test compiles in a second,
+not the minute of the tree kernels; the mechanism is the same for every projeq kernel."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("numba")
+
+ROOT = Path(__file__).resolve().parents[2]
+KERNEL = '''import numba
+
+@numba.njit(cache=True)
+def twice(x):
+    return 2.0 * x
+'''
+RUN = "from projeq.assembly import kernels; kernels.numba_module(); import projeq_generated_probe as m; print(m.twice(1.5))"
+
+
+def _run(folder: Path) -> subprocess.CompletedProcess:
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(folder / "cache"), PYTHONPATH=os.pathsep.join([str(folder), str(ROOT)]))
+    return subprocess.run([sys.executable, "-c", RUN], cwd=folder, env=env, capture_output=True, text=True, timeout=120)
+
+
+def test_first_compilation_is_announced_and_a_damaged_cache_is_rebuilt(tmp_path):
+    (tmp_path / "projeq_generated_probe.py").write_text(KERNEL)
+    first = _run(tmp_path)
+    assert first.returncode == 0 and first.stdout.strip() == "3.0", first.stderr
+    assert first.stderr.count("projeq: compiling the compiled kernels") == 1
+    cached = [p for p in (tmp_path / "cache").rglob("*") if p.suffix in (".nbi", ".nbc")]
+    assert cached, "numba wrote no cache entry"
+    again = _run(tmp_path)
+    assert again.returncode == 0 and again.stdout.strip() == "3.0" and "compiling" not in again.stderr
+    for path in cached:  # truncated: as a full disk or a killed process leaves them
+        path.write_bytes(path.read_bytes()[:10])
+    damaged = _run(tmp_path)
+    assert damaged.returncode == 0 and damaged.stdout.strip() == "3.0", damaged.stderr
+    assert damaged.stderr.count("CacheWarning") == 1 and "discarded, compiling it anew" in damaged.stderr
+    assert "Traceback" not in damaged.stderr
+    rebuilt = _run(tmp_path)
+    assert rebuilt.returncode == 0 and rebuilt.stderr == "", rebuilt.stderr
