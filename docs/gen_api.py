@@ -31,7 +31,7 @@ GROUPS = (
     ("Simulation", ("simulate", "Result", "SimulationError", "StiffnessWarning", "SingularMassError",
                     "sweep", "SweepTable", "plots")),
     ("Analysis and comparisons", ("linearize", "Linearization", "NotSteadyError", "eigenvalue_sweep",
-                                  "compare", "ComparisonTable")),
+                                  "modes", "Modes", "campbell", "CampbellDiagram", "compare", "ComparisonTable")),
     ("Scenes and symbolic derivations", ("scenes", "symbolic")),
 )
 #: Hand-written introductions of groups (Markdown), placed under the group's heading.

@@ -24,13 +24,15 @@ __all__ = [
     "Joint", "Revolute", "Prismatic", "Fixed", "Planar", "Free", "Prescribed", "UserJoint",
     "ForceLaw", "BodyLoad", "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
     "inertia", "simulate", "Result", "SimulationError", "scenes", "linearize", "Linearization", "NotSteadyError",
-    "eigenvalue_sweep", "compare", "ComparisonTable", "ConstrainedSystem", "reactions", "joint_reactions", "PinClosure",
+    "eigenvalue_sweep", "modes", "Modes", "campbell", "CampbellDiagram", "compare", "ComparisonTable", "ConstrainedSystem", "reactions", "joint_reactions", "PinClosure",
     "contact_event", "StiffnessWarning", "plots", "sweep", "SweepTable", "symbolic",
 ]
 
 
 # names loaded on first use (they import scipy, matplotlib or tqdm): keeps `import projeq` light
 _LAZY = {
+    "modes": "projeq.analysis.campbell", "Modes": "projeq.analysis.campbell", "campbell": "projeq.analysis.campbell",
+    "CampbellDiagram": "projeq.analysis.campbell",
     "simulate": "projeq.simulation.driver", "Result": "projeq.simulation.driver", "SimulationError": "projeq.simulation.driver",
     "compare": "projeq.studies.compare", "ComparisonTable": "projeq.studies.compare",
     "ConstrainedSystem": "projeq.constraints.partitioned",

@@ -138,21 +138,27 @@ def joint_wrench(F, T, tau, L, y, w_n, w_p) -> None:
 
 
 def _load(name: str, value, shape: tuple) -> Callable:
-    """A constant or a callable ``(t, q, s_dot) -> array`` as a checked callable."""
+    """A constant or a callable ``(t, q, s_dot) -> array`` as a checked callable; where one
+    number is expected (shape (1,), a one-dof joint's τ) a scalar is taken as it."""
     if callable(value):
         def load(t, q, s_dot):
-            out = numeric(value(t, q, s_dot))  # complex in a complex step
+            out = _one_number(numeric(value(t, q, s_dot)), shape)  # complex in a complex step
             finite_array(name, np.real(out), shape)
             return out
         load.constant = None
         return load
-    constant = finite_array(name, value, shape)
+    constant = finite_array(name, _one_number(value, shape), shape)
 
     def load(t, q, s_dot):
         return constant
 
     load.constant = constant  # the value, for the symbolic forms
     return load
+
+
+def _one_number(value, shape: tuple):
+    """``value`` as shape (1,) if it is a scalar and ``shape`` is (1,), else unchanged."""
+    return np.reshape(value, (1,)) if shape == (1,) and np.ndim(value) == 0 else value
 
 
 def _callable(parameter: str, load: Callable) -> str | None:

@@ -382,6 +382,7 @@ class System(Model):
         self.plan = Plan(self)  # what the forward pass needs, once (projeq.assembly.kinematics)
         self._frozen = True
         self._check_planar()
+        self._check_slender()
         self.check_configuration(self.q0)  # K(q0), F(q0) regular: no coordinate singularity at the start
 
     def __setattr__(self, name: str, value) -> None:
@@ -691,6 +692,29 @@ class System(Model):
                         f"{getattr(sub, 'plane', '?')}) would move out of its plane: its joint axis "
                         f"or its parent {parent} is not in the same plane"
                     )
+
+    def _check_slender(self) -> None:
+        """A body with a zero principal moment (``slender_axis``, a slender rod) is accepted
+        when its joint cannot turn it about that axis: F_nᵀ M_n F_n positive definite at q0
+        (else the mass matrix is singular whatever the rest of the tree)."""
+        slender = [n for n, sub in enumerate(self.subsystems) if getattr(sub, "slender_axis", None) is not None]
+        if not slender:
+            return
+        from projeq.assembly.kinematics import forward
+
+        kin = forward(self, self.q0, self.s_dot0, 0.0)
+        for n in slender:
+            sub, F = self.subsystems[n], kin.F[n]
+            M = sub.gauss_terms(np.zeros(sub.n_y), np.eye(3), np.zeros(3))[0]
+            block = F.T @ M @ F
+            if block.size and np.linalg.eigvalsh(block)[0] <= 1e-12 * np.abs(M).max():
+                axis = np.round(sub.slender_axis, 12) + 0.0
+                raise ValueError(
+                    f"joints[{self.names[n]!r}]: the body {self.names[n]!r} has no inertia about its axis "
+                    f"{axis.tolist()} (body coordinates; a zero principal moment of I_c) and its joint "
+                    f"{type(self.joints[n]).__name__} can turn it about that axis (F_nᵀ M_n F_n is singular "
+                    f"at q0): give I_c a moment about that axis or use a joint that cannot turn it so"
+                )
 
     def __repr__(self) -> str:
         return f"System({len(self.names)} subsystems, n_q={self.n_q}, n_s={self.n_s})"

@@ -41,6 +41,7 @@ COMMANDS = {
     "compare": ("studies", "compare_arguments", "compare derivations of one system (Projection Equation, Lagrange, Kane ...)"),
     "bench": ("bench", "bench_arguments", "run the performance benchmarks"),
     "tradeoff": ("studies", "tradeoff_arguments", "work-precision trade-off of integrators for a scene"),
+    "campbell": ("campbell", "campbell_arguments", "Campbell diagram of a rotating scene: frequencies against speed"),
 }
 
 

@@ -20,7 +20,7 @@ from projeq.checks import positives
 from projeq.subsystems import inertia
 from projeq.joints import Prismatic, Revolute
 from projeq.subsystems import PlanarBody, PointMass, RigidBody
-from projeq.scenes.elastic import elastic_arm, flexible_arm, spin_up_beam, spinning_beam
+from projeq.scenes.elastic import elastic_arm, flexible_arm, rotating_blade, spin_up_beam, spinning_beam
 from projeq.scenes.iftomm import andrews_squeezer, bricard, flyball_governor, n_four_bar, simple_pendulum
 from projeq.scenes.mechanisms import (bar_on_wall, flexible_four_bar, four_bar, quick_return, slider_pendulum,
                                       sphere_on_sphere)
@@ -180,6 +180,8 @@ SCENES = Registry({
     "spin_up_beam": Scene(spin_up_beam, "a cantilever spun up to Ωs = 6 rad/s, with dynamic stiffening", 20.0,
                           settings=SPIN_UP_SETTINGS),
     "spinning_beam": Scene(spinning_beam, "a cantilever spinning about its own axis (B(16)-(23))", 10.0),
+    "rotating_blade": Scene(rotating_blade, "a cantilever blade on a hub turning about a transverse axis "
+                            "(flapwise stiffening, lead-lag softening)", 10.0),
     "elastic_arm": Scene(elastic_arm, "rigid link + elastic link with a tip mass, turning freely", 5.0),
     "chain": Scene(chain, "n links on revolute joints hanging from the origin (default n = 5)", 10.0),
     "double_pendulum": Scene(double_pendulum, "two point masses on massless rods, released horizontally", 10.0),
@@ -280,7 +282,7 @@ def build_scene(name: str, **overrides) -> System:
     return scene.build(**overrides)
 
 __all__ = [
-    "chain", "double_pendulum", "atwood", "spin_up_beam", "spinning_beam", "elastic_arm", "flexible_arm",
+    "chain", "double_pendulum", "atwood", "spin_up_beam", "spinning_beam", "rotating_blade", "elastic_arm", "flexible_arm",
     "car", "knife_edge_disc", "knife_edge_circle", "rolling_disk", "rolling_disk_critical_speed", "rolling_disk_inertia",
     "barhorst_particle", "nonholonomic_particle", "whipple_bicycle", "whipple_eigenvalues",
     "quick_return", "four_bar", "flexible_four_bar", "sphere_on_sphere", "bar_on_wall", "slider_pendulum",

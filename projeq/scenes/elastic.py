@@ -13,7 +13,7 @@ from projeq.forces import JointSpring
 from projeq.joints import Fixed, Prescribed, Revolute
 from projeq.spatial import rotation_y, rotation_z
 from projeq.subsystems.beam.beam import RitzBeam
-from projeq.subsystems.rigid import PointMass, RigidBody
+from projeq.subsystems.rigid import Frame, PointMass, RigidBody
 from projeq.system import System
 
 
@@ -166,6 +166,38 @@ def spinning_beam(
     )
     spin = Prescribed(Revolute(axis="x"), lambda t: (omega * t, omega, 0.0))
     return System({"beam": beam}, {"beam": spin})
+
+
+def rotating_blade(
+    omega: float = 3.0,
+    hub_radius: float = 0.0,
+    length: float = 1.0,
+    EI: float = 1.0,
+    rho_A: float = 1.0,
+    n_shapes: int = 4,
+    family: str = "clamped_free",
+) -> System:
+    """A cantilever blade on a hub turning at the constant rate ``omega`` about the transverse
+    axis z: the massless hub (subsystem ``"hub"``, :class:`projeq.Frame`) turns by α = Ω t
+    (prescribed), the beam (``"beam"``) is clamped to it at ``hub_radius`` along the hub's x
+    axis and lies along x. Lead-lag v (in the plane of rotation, y) and flapwise w (along the
+    axis z) use ``n_shapes`` functions each; inextensible, with dynamic stiffening.
+
+    Centrifugal stiffening raises both bending frequencies; in the plane of rotation the
+    centrifugal load also softens (−ρA Ω² v), so ω_lag² = ω_flap² − Ω² (Wright, Smith, Thresher
+    & Wang (1982), "Vibration modes of centrifugally stiffened beams", J. Appl. Mech. 49:197–202).
+    The defaults are nondimensional (L = EI = ρA = 1: Ω is their η, ``hub_radius`` their R/L);
+    the Campbell diagram is ``projeq campbell rotating_blade`` (:mod:`projeq.analysis.campbell`).
+    """
+    n_shapes, omega = count("n_shapes", n_shapes), float(finite_array("omega", omega, ()))
+    length, EI, rho_A = positives(length=length, EI=EI, rho_A=rho_A)
+    hub_radius = float(finite_array("hub_radius", hub_radius, ()))
+    if hub_radius < 0.0:
+        raise ValueError(f"hub_radius: must be zero or positive, got {hub_radius}")
+    beam = RitzBeam(length, rho_A, EI, n_v=n_shapes, n_w=n_shapes, family=family)
+    hub = Prescribed(Revolute(axis="z"), lambda t: (omega * t, omega, 0.0))
+    return System({"hub": Frame(), "beam": beam},
+                  {"hub": hub, "beam": Fixed(parent="hub", r_pn=(hub_radius, 0.0, 0.0))})
 
 
 def _cardan_joint(parent: str, r_pn) -> "UserJoint":

@@ -35,7 +35,7 @@ UNITS = {
     "a": "m", "b": "m", "d": "m", "l": "m", "A": "m", "H": "m", "m_a": "kg", "m_b": "kg",
     "theta0": "rad", "theta1": "rad", "roll": "rad", "steer": "rad",
     "omega1": "rad/s", "roll_rate": "rad/s", "steer_rate": "rad/s", "speed": "m/s",
-    "L": "m", "side": "m",
+    "L": "m", "side": "m", "hub_radius": "m",
 }
 
 

@@ -83,7 +83,15 @@ class RigidBody(Subsystem):
         Body origin O (where its joint attaches) → mass centre, body coordinates, m.
     I_c : 3×3 array
         Inertia tensor about the mass centre in body coordinates, kg m², symmetric
-        positive definite with principal moments obeying the triangle inequality.
+        positive definite with principal moments obeying the triangle inequality; or with
+        one principal moment zero (a slender rod, as sympy/PyDy models have it): then no
+        joint may turn the body about that axis (:attr:`slender_axis`), checked when the
+        System is built.
+
+    Attributes
+    ----------
+    slender_axis : ndarray or None
+        The unit axis (body coordinates) of a zero principal moment of I_c, else None.
 
     Examples
     --------
@@ -100,12 +108,16 @@ class RigidBody(Subsystem):
         self.m = positive("m (mass)", m)
         self.r_c = finite_array("r_c", r_c, (3,))
         self.I_c = self._check_inertia(np.eye(3) * 0.0 if I_c is None else I_c)
+        self.slender_axis = slender_axis(self.I_c)
         self.M6 = rigid_mass_matrix(self.m, self.r_c, self.I_c)
         self.M6.flags.writeable = False
 
     @staticmethod
     def _check_inertia(I_c) -> NDArray:
-        return inertia_tensor("I_c", I_c)
+        I_c = inertia_tensor("I_c", I_c, allow_zero=True)  # semi-definite: a slender rod
+        if not np.any(I_c):
+            raise ValueError("I_c: inertia tensor is not positive definite (all zero); a particle is a PointMass")
+        return I_c
 
     @property
     def rigid_inertia(self) -> tuple:
@@ -128,6 +140,14 @@ class RigidBody(Subsystem):
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(m={self.m}, r_c={self.r_c.tolist()})"
+
+
+def slender_axis(I_c: NDArray) -> NDArray | None:
+    """The unit principal axis of a single zero principal moment of I_c (a slender rod's
+    axis), or None (none zero, or all: a point mass)."""
+    moments, axes = np.linalg.eigh(I_c)
+    zero = moments <= 1e-12 * max(np.abs(moments).max(), 1e-300)
+    return axes[:, 0] if zero.sum() == 1 else None
 
 
 class PointMass(RigidBody):

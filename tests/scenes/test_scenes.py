@@ -119,6 +119,7 @@ SIZES = {
     "slider_pendulum": ("l", "m"),
     "spin_up_beam": ("t_s", "length", "EI", "EA", "rho_A"),
     "spinning_beam": ("length", "EI", "rho_A", "rho_I"),
+    "rotating_blade": ("length", "EI", "rho_A"),
     "elastic_arm": ("l1", "m1", "length", "rho_A", "EI", "tip_mass"),
     "simple_pendulum": ("m", "L"),
     "n_four_bar": ("m", "L"),
@@ -167,3 +168,10 @@ def test_build_scene_names_the_atwood_mass_it_was_given(name):
     parameter), so that the message did not say which of the three masses was wrong."""
     with pytest.raises(ValueError, match=rf"^{name}: non-finite entries \(NaN or inf\)"):
         pq.scenes.build_scene("atwood", **{name: float("nan")})
+
+
+@pytest.mark.parametrize("value", [-0.5, float("nan")], ids=["negative", "nan"])
+def test_rotating_blade_refuses_a_hub_radius_below_zero(value):
+    """The hub radius may be zero (a blade clamped on the axis), not negative or NaN."""
+    with pytest.raises(ValueError, match=r"^hub_radius: "):
+        pq.scenes.rotating_blade(hub_radius=value)

@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 from scipy.linalg import eigh
-from scipy.optimize import brentq
 
 import projeq as pq
 from projeq.analysis.linearize import linearize
 from projeq.scenes.elastic import elastic_arm, spin_up_beam
 from projeq.subsystems import RitzBeam
 from projeq.subsystems.beam.shapes import clamped_free_roots
+from tests.analysis.rotating_cantilever import WRIGHT_1982, frobenius_frequencies
 
 L, EI, RHO_A = 10.0, 1.4e4, 1.2
 
@@ -50,13 +50,6 @@ def test_polynomial_ritz_converges_from_above():
     assert np.all(errors[2:] < errors[:-2] / 100)
 
 
-# Wright, Smith, Thresher & Wang (1982), "Vibration modes of centrifugally stiffened
-# beams", J. Appl. Mech. 49:197–202, Table 1 (reproduced by Banerjee 2000, J. Sound Vib.
-# 233:857–875): first flapwise frequency ω/√(EI/(ρA L⁴)) of a uniform cantilever with zero
-# hub radius at the nondimensional spin η = Ω/√(EI/(ρA L⁴)).
-WRIGHT_1982 = {0: 3.5160, 1: 3.6816, 2: 4.1373, 3: 4.7973, 4: 5.5850, 5: 6.4495}
-
-
 def _spinning(eta, n_v, n_w):
     beam = RitzBeam(1.0, 1.0, 1.0, n_v=n_v, n_w=n_w, family="clamped_free")
     spin = pq.Prescribed(pq.Revolute(axis="z"), lambda t: (eta * t, eta, 0.0))
@@ -86,39 +79,15 @@ def test_rotating_cantilever_lead_lag_frequency(eta):
     assert lag == pytest.approx(np.sqrt(flap**2 - eta**2), rel=1e-8)
 
 
-def _frobenius_determinant(lam, eta, terms=200):
-    """Frequency determinant of the rotating uniform cantilever (zero hub radius) by the
-    Frobenius power series of Wright et al. (1982): w'''' − (η²/2)((1 − ξ²) w′)′ = λ² w on
-    0 ≤ ξ ≤ 1 (EI = ρA = L = 1, N = ρAΩ²(L² − x²)/2) has w = Σ a_k ξ^k with
-    a_(k+4) = [(η²/2)((k+1)(k+2) a_(k+2) − k(k+1) a_k) + λ² a_k] / ((k+1)(k+2)(k+3)(k+4));
-    clamped: a₀ = a₁ = 0; free: w″(1) = w‴(1) = 0 (N(1) = 0). The series is entire; 200
-    terms reach round-off for λ < 100."""
-    ends = []
-    for a_2, a_3 in ((1.0, 0.0), (0.0, 1.0)):
-        a = np.zeros((terms + 4,) + np.shape(lam))  # λ may be an array of trial values
-        a[2], a[3] = a_2, a_3
-        for k in range(terms):
-            stiffening = 0.5 * eta**2 * ((k + 1) * (k + 2) * a[k + 2] - k * (k + 1) * a[k])
-            a[k + 4] = (stiffening + lam * lam * a[k]) / ((k + 1) * (k + 2) * (k + 3) * (k + 4))
-        k = np.arange(len(a))
-        ends.append(((k * (k - 1)) @ a, (k * (k - 1) * (k - 2)) @ a))
-    (moment_1, shear_1), (moment_2, shear_2) = ends
-    return moment_1 * shear_2 - moment_2 * shear_1
-
-
 @pytest.mark.parametrize("eta", [1, 3, 5], ids=["eta=1", "eta=3", "eta=5"])
 def test_rotating_cantilever_three_flapwise_modes_against_the_power_series(eta):
     """The first three flapwise frequencies at several spin rates against the exact
-    Frobenius solution (a second, independent formulation); its first root reproduces
+    Frobenius solution (tests/analysis/rotating_cantilever.py; a second, independent formulation); its first root reproduces
     Wright et al.'s Table 1 (within the table's rounding, 5e-5), the others continue it
     (22.181, 61.842 at η = 1). Ten eigenfunctions: Rayleigh–Ritz upper bounds (the flap
     motion has no Coriolis coupling), measured 3e-9 (η = 1) … 1.6e-6 (η = 5) above;
     asserted 5e-6 (and ≥ −1e-9: the linearisation's round-off)."""
-    grid = np.linspace(0.5, 70.0, 1500)
-    values = _frobenius_determinant(grid, eta)
-    brackets = np.flatnonzero(np.sign(values[:-1]) != np.sign(values[1:]))[:3]
-    roots = [brentq(_frobenius_determinant, grid[i], grid[i + 1], args=(eta,), xtol=1e-13) for i in brackets]
-    exact = np.array(roots)
+    exact = frobenius_frequencies(eta)
     assert abs(exact[0] - WRIGHT_1982[eta]) < 5e-5
     error = _spinning(eta, n_v=0, n_w=10)[:3] / exact - 1.0
     assert np.all(error > -1e-9) and np.all(error < 5e-6)
