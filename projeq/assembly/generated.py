@@ -112,26 +112,32 @@ def into(R_pointer, r_pointer, w_pointer, t, p_pointer, wrench_pointer):
         wrench[i] = found[i]
 """
 
-_LAW_CALLBACKS: dict = {}  # (source, constants, dtype) -> the C callback, or None where numba cannot compile it
+_CALLBACKS: dict = {}  # (source, constants, into) -> the C callback, or None where numba cannot compile it
+
+
+def callback(values, into: str, what: str, category):
+    """``into`` of :func:`generated_module` (the printed function ``values``, its constants passed as
+    data, :func:`parameters`): one per printed source and callback in a process, cached on disk;
+    None where numba cannot compile it, after one warning of ``category`` naming ``what``."""
+    key = (values.source, values.constants, into)
+    if key not in _CALLBACKS:
+        try:
+            _CALLBACKS[key] = generated_module(values, into, parameters=True).into
+        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+            warnings.warn(f"{what} ({type(exc).__name__}); it is stated in Python at every evaluation", category,
+                          stacklevel=4)
+            _CALLBACKS[key] = None
+    return _CALLBACKS[key]
 
 
 def law_callback(values, dtype=float):
     """The printed body wrench ``values(R, r, w, t)`` of a force law (:meth:`projeq.forces.BodyLoad.compiled_wrench`)
     compiled as a C callback ``into(R, r, w, t, p, wrench)`` of ``dtype`` (float, or complex for the
-    complex step), its constants p passed as data (:func:`parameters`): one per printed source and
-    dtype in a process, cached on disk; None (after one :class:`UncompiledLawWarning`) where numba
-    cannot compile it."""
-    key = (values.source, values.constants, np.dtype(dtype))
-    if key not in _LAW_CALLBACKS:
-        into = LAW_INTO.format(dtype=DTYPES[np.dtype(dtype)], n_p=len(values.constants))
-        try:
-            _LAW_CALLBACKS[key] = generated_module(values, into, parameters=True).into
-        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
-            warnings.warn(f"forces: numba cannot compile a force law's wrench for {np.dtype(dtype)} "
-                          f"({type(exc).__name__}); it is stated in Python at every evaluation",
-                          UncompiledLawWarning, stacklevel=3)
-            _LAW_CALLBACKS[key] = None
-    return _LAW_CALLBACKS[key]
+    complex step), its constants p passed as data (:func:`callback`); None (after one
+    :class:`UncompiledLawWarning`) where numba cannot compile it."""
+    into = LAW_INTO.format(dtype=DTYPES[np.dtype(dtype)], n_p=len(values.constants))
+    return callback(values, into, f"forces: numba cannot compile a force law's wrench for {np.dtype(dtype)}",
+                    UncompiledLawWarning)
 
 
 @functools.cache

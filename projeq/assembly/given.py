@@ -26,7 +26,7 @@ import warnings
 import numpy as np
 
 from projeq.assembly import kernels, loads
-from projeq.assembly.generated import DTYPES, generated_module, intrinsics, parameters
+from projeq.assembly.generated import DTYPES, callback, generated_module, intrinsics, parameters
 from projeq.assembly.kernels import (
     GIVEN,
     GIVEN_F,
@@ -55,7 +55,6 @@ def into(q_pointer, s_pointer, t, p_pointer, row_pointer):
         row[i] = found[i]
 """
 
-_CALLBACKS: dict = {}  # (source, dtype) -> its C callback, or None where numba cannot compile it
 
 
 def row_width(joint) -> int:
@@ -74,18 +73,10 @@ def joint_callback(joint, dtype=float):
     values = joint.compiled_values()
     if values is None:
         return None
-    key = (values.source, values.constants, joint.n_q, joint.n_s, np.dtype(dtype))
-    if key not in _CALLBACKS:
-        into = JOINT_INTO.format(dtype=DTYPES[np.dtype(dtype)], n_q=joint.n_q, n_s=joint.n_s, width=row_width(joint),
-                                 n_p=len(values.constants))
-        try:
-            _CALLBACKS[key] = generated_module(values, into, parameters=True).into
-        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
-            warnings.warn(f"joint: numba cannot compile the relative motion of {joint!r} for {np.dtype(dtype)} "
-                          f"({type(exc).__name__}); it is stated in Python at every evaluation",
-                          UncompiledJointWarning, stacklevel=3)
-            _CALLBACKS[key] = None
-    return _CALLBACKS[key]
+    into = JOINT_INTO.format(dtype=DTYPES[np.dtype(dtype)], n_q=joint.n_q, n_s=joint.n_s, width=row_width(joint),
+                             n_p=len(values.constants))
+    return callback(values, into, f"joint: numba cannot compile the relative motion of {joint!r} for {np.dtype(dtype)}",
+                    UncompiledJointWarning)
 
 
 def joint_table(plan, callbacks, compiled: bool = True) -> np.ndarray:
