@@ -536,11 +536,10 @@ def _load(tmp_path, kind):
         np.save(path, np.array([object()], dtype=object))
     else:
         result = pq.simulate(_pendulum(), 0.1, n_points=5)
-        if kind == "inconsistent":
-            from dataclasses import replace
-
-            result = replace(result, q=result.q[:3])
         result.save(path)
+        if kind == "inconsistent":  # Result.save refuses to write it: altered afterwards
+            with np.load(path) as data:
+                np.savez(path, **{name: data[name][:3] if name == "q" else data[name] for name in data.files})
         if kind == "truncated":
             path.write_bytes(path.read_bytes()[:400])
     return pq.Result.load(path)
@@ -598,7 +597,7 @@ BAD_INPUT = [
     ("load-truncated", lambda tmp: _load(tmp, "truncated"), ValueError, r"^path: .* is a truncated or damaged archive"),
     ("load-pickled-npy", lambda tmp: _load(tmp, "pickled"), ValueError, r"^path: .*run.npy' is not a projeq Result"),
     ("load-inconsistent", lambda tmp: _load(tmp, "inconsistent"), ValueError,
-     r"^path: .* is inconsistent: t has shape \(5,\) but \{'q': \(3, 1\)\}"),
+     r"^path: .* field 'q' has shape \(3, 1\) where t has 5 rows: expected \(5, 1\), one column per coordinate"),
 ]
 
 
