@@ -4,8 +4,8 @@ local processes or on a Dask cluster; writes ``sweep_SCENE.csv`` and ``.npz``.
 Each finished point is appended to ``sweep_SCENE.csv`` at once, so a crash loses only the
 points in flight, and ``--resume`` runs only the points not finished there. Ctrl-C or
 SIGTERM stops the workers and writes the table with the points finished (and the running
-ones' partial results). A point that failed or was interrupted makes the exit code 1 (the
-table is written). The grid is checked first: no parameter twice (in ``--grid`` or in both
+ones' partial results). A point that failed, was interrupted or stopped where its model left
+its range (status 3) makes the exit code 1 (the table is written). The grid is checked first: no parameter twice (in ``--grid`` or in both
 ``--grid`` and ``--set``), no repeated values, and at most :data:`MAX_POINTS` points
 unless ``--allow-large``. The number of points is printed first, and before a large sweep
 (more than :data:`projeq.simulation.sweep.ESTIMATE_ABOVE` points) an estimate of its time
@@ -71,18 +71,19 @@ def sweep_scene(args) -> int:
                       progress=not quiet, path=out / f"sweep_{label}", resume=args.resume,
                       workers=None if client else args.workers, **options)
     files = [out / f"sweep_{label}.csv", out / f"sweep_{label}.npz"]
-    failed, partial = int((table["status"] == -1).sum()), int((table["status"] == 2).sum())
+    failed, partial = int(np.isin(table["status"], (-1, 4)).sum()), int((table["status"] == 2).sum())
+    beyond = int((table["status"] == 3).sum())  # stopped where the model left its range
     if args.json:
         print(json.dumps({"scene": args.scene, "options": options, "points": len(table["status"]), "failed": failed,
-                          "interrupted": partial, "files": [str(f) for f in files],
+                          "interrupted": partial, "out_of_range": beyond, "files": [str(f) for f in files],
                           "table": {k: np.asarray(v).tolist() for k, v in table.items()}}, indent=2, default=repr))
     elif not args.quiet:
-        print(f"{len(table['status'])} points, {failed} failed or not run, {partial} interrupted with partial results; "
-              "wrote " + ", ".join(str(f) for f in files))
-    for i in np.flatnonzero(table["status"] == -1):
+        print(f"{len(table['status'])} points, {failed} failed or not run, {partial} interrupted with partial results, "
+              f"{beyond} stopped out of their model's range; wrote " + ", ".join(str(f) for f in files))
+    for i in np.flatnonzero(np.isin(table["status"], (-1, 4))):
         point = ", ".join(f"{k}={table[k][i]}" for k in grid)
         print(f"projeq: point {point} failed: {table['error'][i]}", file=sys.stderr)
-    return 1 if failed or partial else 0
+    return 1 if failed or partial or beyond else 0
 
 
 def _grid(scene, texts: list[str], fixed: dict, allow_large: bool) -> dict:

@@ -142,7 +142,7 @@ def simulate(
     n_segments: int = 20,
     progress=None,
     jac="exact",
-    out_of_range: str = "stop",
+    out_of_range: str = "warn",
     **options,
 ) -> Result:
     """Integrate the equations of motion of ``system`` from ``t_start`` to ``t_end``.
@@ -187,12 +187,14 @@ def simulate(
         For Radau, BDF and LSODA: ∂ẋ/∂x by the complex step through the model ("exact",
         the default; exact to round-off, n complex evaluations per Jacobian, counted in
         ``Result.njev``), by scipy's finite differences ("differences"), or the user's.
-    out_of_range : "stop" or "warn"
+    out_of_range : "warn" or "stop"
         What a subsystem leaving the range its model describes (a beam beyond moderate
         deflections, :meth:`projeq.subsystems.base.Subsystem.out_of_range`, checked on the output
-        rows of each segment) does besides its :class:`ValidityWarning`: "stop" (default) ends
-        the run there with ``Result.status`` 3 (:data:`projeq.simulation.result.OUT_OF_RANGE`),
-        the rows up to the end of that segment kept; "warn" goes on.
+        rows of each segment) does besides its :class:`ValidityWarning`: "warn" (default) goes
+        on, for studies of the model beyond its physical range (a divergence rate, the
+        conservation of its energy); "stop" ends the run there with ``Result.status`` 3
+        (:data:`projeq.simulation.result.OUT_OF_RANGE`), the rows up to the end of that segment
+        kept, as ``projeq run`` and ``projeq sweep`` do.
     **options
         Further options for the integrator (max_step, first_step, ...; see ``SOLVER_OPTIONS``): an option the method does not take is a ValueError naming the
         valid ones (solve_ivp would ignore it).
@@ -203,8 +205,8 @@ def simulate(
         On failure of the integrator (``status`` −1) or a non-finite state (``status`` 4: q, ṡ or
         their derivative not finite, or an output row whose energy is not: a state beyond
         floating-point range), :class:`SimulationError` is raised with ``.result`` holding the
-        trajectory computed so far and a message giving the time reached; a run that left its
-        model's range returns with ``status = 3`` (``out_of_range``); Ctrl-C returns the partial
+        trajectory computed so far and a message giving the time reached; a run stopped where it
+        left its model's range returns with ``status = 3`` (``out_of_range="stop"``); Ctrl-C returns the partial
         trajectory with ``status = 2``. Bad
         arguments raise ``ValueError`` naming the argument before the run starts, and a
         model that cannot be evaluated at the initial state raises its own error there
@@ -213,7 +215,7 @@ def simulate(
         state approaching a coordinate singularity (K or F with condition number above 1e5,
         checked every ``MONITOR_EVERY`` right-hand sides) is such a failure; a subsystem
         leaving the range its model describes (a beam beyond moderate deflections) gets a
-        :class:`ValidityWarning` (and ends the run, see ``out_of_range``).
+        :class:`ValidityWarning` (and with ``out_of_range="stop"`` ends the run).
     """
     run = _Run(system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
                evaluator, n_segments, progress, jac, options, dense_output, out_of_range)
@@ -256,6 +258,18 @@ def simulate(
 SIMULATE_KEYWORDS = frozenset(inspect.signature(simulate).parameters) - {"system", "t_end", "options"}
 
 
+def check_arguments(system: Model, t_end: float, **options) -> None:
+    """The ValueError naming an argument that :func:`simulate` would raise for these arguments
+    before its run starts (a tolerance, a method, an option, the initial state, the evaluator),
+    without running: a sweep checks its first point's run with it before any point runs."""
+    arguments = inspect.signature(simulate).bind(system, t_end, **options)
+    arguments.apply_defaults()
+    a = arguments.arguments
+    _Run(system, t_end, a["q0"], a["s_dot0"], a["method"], a["rtol"], a["atol"], a["events"], a["t_start"],
+         a["t_eval"], a["n_points"], a["evaluator"], a["n_segments"], a["progress"], a["jac"], a["options"],
+         a["dense_output"], a["out_of_range"])
+
+
 @dataclass(frozen=True)
 class _Piece:
     """What one segment gave: the model its ṡ rows are in, the output times t and states x
@@ -273,7 +287,7 @@ class _Run:
     and what the finished segments gave (pieces, the user's events, nfev, status)."""
 
     def __init__(self, system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
-                 evaluator, n_segments, progress, jac, options, dense_output=False, out_of_range="stop"):
+                 evaluator, n_segments, progress, jac, options, dense_output=False, out_of_range="warn"):
         check_model(system)
         if out_of_range not in ("stop", "warn"):
             raise ValueError(f"out_of_range: expected 'stop' or 'warn', got {out_of_range!r}")

@@ -231,7 +231,7 @@ def test_a_run_whose_state_overflows_exits_4(tmp_path, capsys, monkeypatch):
     CLI does not offer) ends with exit code 4 and status "non-finite state", its results up to the
     last finite output row written (before: exit 0, "finished", final energy NaN)."""
     real = projeq.simulation.driver.simulate
-    monkeypatch.setattr(projeq.simulation.driver, "simulate", lambda *a, **k: real(*a, out_of_range="warn", **k))
+    monkeypatch.setattr(projeq.simulation.driver, "simulate", lambda *a, **k: real(*a, **(k | {"out_of_range": "warn"})))
     argv = ["run", "spin_up_beam", "--set", "omega_s=200", "--set", "t_s=2", "--t-end", "3", "--quiet",
             "--out", str(tmp_path)]
     assert main(argv) == 4
