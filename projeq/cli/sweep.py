@@ -61,7 +61,7 @@ def sweep_scene(args) -> int:
     options = simulate_options(args, scene)
     t_end = None if args.t_end is None else positive("t_end", args.t_end)  # before anything is printed or made
     quiet = args.quiet or args.json
-    with client if client is not None else contextlib.nullcontext():  # a Dask client is closed also when --out is refused
+    with _closed(client):  # a Dask client is closed also when --out is refused
         out = output_directory(args.out)
         if not quiet:
             where = f"the Dask scheduler at {args.scheduler}" if client else f"{args.workers or os.cpu_count()} local processes"
@@ -88,7 +88,8 @@ def sweep_scene(args) -> int:
 
 def _grid(scene, texts: list[str], fixed: dict, allow_large: bool) -> dict:
     """The swept axes of ``--grid`` (integer parameters rounded); ValueError for a parameter
-    given twice or in both ``--grid`` and ``--set``, repeated values, or more than
+    given twice or in both ``--grid`` and ``--set``, one that is no number (text, a switch, a
+    tuple: every point would fail), repeated values, or more than
     :data:`MAX_POINTS` points without ``allow_large`` (refused before any array is made)."""
     from projeq.scenes import check_names, scene_parameters
 
@@ -105,6 +106,9 @@ def _grid(scene, texts: list[str], fixed: dict, allow_large: bool) -> dict:
         if name in fixed:
             raise ValueError(f"--grid: {name} is also given in --set; give it in one of them")
         check_names(scene, {name: None})
+        if isinstance(defaults[name], (str, bool, tuple)):  # None: an optional number (rolling_disk's ecc)
+            raise ValueError(f"--grid: {name} is not a number (its default is {defaults[name]!r}); a grid sweeps "
+                             "numbers: give its value with --set, or sweep a numeric parameter")
         values = np.linspace(a, b, n)
         if type(defaults[name]) is int:
             values = values.round().astype(int)
@@ -128,6 +132,21 @@ def _grid_axis(text: str) -> tuple[str, float, float, int]:
     except (ValueError, IndexError):
         raise ValueError(f"--grid: expected NAME=A:B:N (numbers A, B, a count N >= 1), got {text!r}") from None
     return name.strip(), a, b, n
+
+
+@contextlib.contextmanager
+def _closed(client):
+    """The block, then ``client`` (a Dask client, or None) closed; a client whose scheduler was
+    lost during the sweep cannot close cleanly, and that is no error of the sweep (its table is
+    written, its lost points named)."""
+    try:
+        yield
+    finally:
+        if client is not None:
+            try:
+                client.close(timeout=5)
+            except Exception:  # noqa: BLE001, S110 - the connection is gone already
+                pass
 
 
 def _dask_client(address: str, timeout: float):
