@@ -5,8 +5,9 @@ Each finished point is appended to ``sweep_SCENE.csv`` at once, so a crash loses
 points in flight, and ``--resume`` runs only the points not finished there. Ctrl-C or
 SIGTERM stops the workers and writes the table with the points finished (and the running
 ones' partial results). A point that failed, was interrupted or stopped where its model left
-its range (status 3) makes the exit code 1 (the table is written). The grid is checked first: no parameter twice (in ``--grid`` or in both
-``--grid`` and ``--set``), no repeated values, and at most :data:`MAX_POINTS` points
+its range (status 3) makes the exit code 1 (the table is written). The grid is checked first:
+no parameter twice (in ``--grid`` or in both ``--grid`` and ``--set``), no repeated values, and
+at most :data:`MAX_POINTS` points
 unless ``--allow-large``. The number of points is printed first, and before a large sweep
 (more than :data:`projeq.simulation.sweep.ESTIMATE_ABOVE` points) an estimate of its time
 from its first two points, run here (the second timed) before the others start.
@@ -78,8 +79,8 @@ def sweep_scene(args) -> int:
                           "interrupted": partial, "out_of_range": beyond, "files": [str(f) for f in files],
                           "table": {k: np.asarray(v).tolist() for k, v in table.items()}}, indent=2, default=repr))
     elif not args.quiet:
-        print(f"{len(table['status'])} points, {failed} failed or not run, {partial} interrupted with partial results, "
-              f"{beyond} stopped out of their model's range; wrote " + ", ".join(str(f) for f in files))
+        print(f"{len(table['status'])} points, {failed} failed or not run, {partial} interrupted with partial "
+              f"results, {beyond} stopped out of their model's range; wrote " + ", ".join(str(f) for f in files))
     for i in np.flatnonzero(np.isin(table["status"], (-1, 4))):
         point = ", ".join(f"{k}={table[k][i]}" for k in grid)
         print(f"projeq: point {point} failed: {table['error'][i]}", file=sys.stderr)

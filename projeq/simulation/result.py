@@ -38,9 +38,8 @@ class Result:
     constraint_residual : (n, m) residuals of velocity constraints (m = 0 without any)
     nfev : right-hand-side evaluations; wall_time : seconds
     njev : Jacobians by the complex step for an implicit method (each n_q + n_s complex evaluations)
-    status : 0 finished, 1 stopped by a terminal event, -1 failed, 2 interrupted, 3 stopped where a
-    subsystem left the range its model describes (:class:`projeq.simulation.driver.ValidityWarning`),
-    4 a non-finite state (the solution blew up) — :data:`STATUSES`
+    status : 0 finished, 1 stopped by an event, -1 failed, 2 interrupted, 3 out of range, 4 non-finite
+    (:data:`STATUSES`; 3: stopped where a subsystem left the range its model describes, 4: the solution blew up)
     message : the integrator's message
     t_events, q_events, s_dot_events : for each of the user's events, the times where it
     fired and the states (k, n_q) and (k, n_s) there. A terminal event's state is also the
@@ -222,14 +221,16 @@ def _check_fields(arrays: dict, meta: dict, events: dict, where: str) -> None:
         refuse("t", f"runs backwards at row {k} ({t[k - 1]:.6g} s, then {t[k]:.6g} s); output times increase")
     if not isinstance(meta["names"], (list, tuple)) or not all(isinstance(n, str) for n in meta["names"]):
         refuse("names", f"must be the subsystems' names (strings), got {meta['names']!r}")
-    columns = {"q": len(meta.get("coordinates") or ()) or None, "s_dot": len(meta.get("velocities") or ()) or None}
+    columns = {"q": len(meta.get("coordinates") or ()) or None,  # None: any number of columns (older files)
+               "s_dot": len(meta.get("velocities") or ()) or None}
     for name in _ROWS[1:] + ("rank", "mobility"):
         a = arrays.get(name, np.zeros(0))
         if name in ("rank", "mobility") and a.shape == (0,):  # a model without constraint equations
             continue
         expected = (len(t), columns.get(name)) if name in ("q", "s_dot", "constraint_residual") else (len(t),)
         if a.ndim != len(expected) or any(e is not None and n != e for n, e in zip(a.shape, expected)):
-            shown = "(" + ", ".join("m" if e is None else str(e) for e in expected) + ("," * (len(expected) == 1)) + ")"
+            shown = "(" + ", ".join("m" if e is None else str(e) for e in expected) + "," * (len(expected) == 1)
+            shown += ")"
             per_name = {"q": ", one column per coordinate name", "s_dot": ", one column per velocity name"}
             refuse(name, f"has shape {a.shape} where t has {len(t)} rows: expected {shown}"
                          + (per_name[name] if columns.get(name) else ""))

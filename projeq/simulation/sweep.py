@@ -773,7 +773,8 @@ def _same_record(path: Path, record: dict) -> None:
     if differ.get("options"):
         was, now = differ.pop("options")
         was = was if isinstance(was, dict) else {}
-        differ |= {f"options[{k!r}]": (was.get(k), now.get(k)) for k in sorted(set(was) | set(now)) if was.get(k) != now.get(k)}
+        differ |= {f"options[{k!r}]": (was.get(k), now.get(k))
+                   for k in sorted(set(was) | set(now)) if was.get(k) != now.get(k)}
     if differ:
         said = "; ".join(f"{key} {old!r} there, {new!r} now" for key, (old, new) in differ.items())
         raise ValueError(f"resume: {str(path)!r} was made with other settings ({said}); resume with the same "
@@ -798,7 +799,7 @@ def _check_first_run(scene, points: list, outputs: list, t_end: float, options: 
         check_arguments(models[0], t_end, **options)
     except ValueError:
         raise
-    except Exception:  # noqa: BLE001, S110 - a model that cannot run (singular ...) is its points' failure, in the table
+    except Exception:  # noqa: BLE001, S110 - a model that cannot run (singular ...): its points fail, named
         pass
     for name in outputs:
         column = _column(name)

@@ -227,14 +227,23 @@ def test_a_run_out_of_range_exits_3_and_records_every_warning(tmp_path, capsys):
 
 
 def test_a_run_whose_state_overflows_exits_4(tmp_path, capsys, monkeypatch):
-    """Passes if the same run let go on past its range (simulate's out_of_range="warn", which the
-    CLI does not offer) ends with exit code 4 and status "non-finite state", its results up to the
-    last finite output row written (before: exit 0, "finished", final energy NaN)."""
+    """Passes if a run that simulate ends at a non-finite state (SimulationError, status 4: the
+    spin-up beam at omega_s = 200 let go on past its range does, tests/simulation/test_physics_range;
+    here a short chain run whose Result says so) exits with 4 and records "non-finite state",
+    its results up to there written (before: a non-finite state was "failed", exit 1, like any
+    failure)."""
+    from dataclasses import replace
+
     real = projeq.simulation.driver.simulate
-    monkeypatch.setattr(projeq.simulation.driver, "simulate", lambda *a, **k: real(*a, **(k | {"out_of_range": "warn"})))
-    argv = ["run", "spin_up_beam", "--set", "omega_s=200", "--set", "t_s=2", "--t-end", "3", "--quiet",
-            "--out", str(tmp_path)]
-    assert main(argv) == 4
+
+    def overflowing(system, t_end, **options):
+        kept = replace(real(system, t_end / 2, **options), status=4)
+        raise projeq.simulation.driver.SimulationError(f"integration failed at t = {t_end / 2} s: the energy (T, V) "
+                                                       "= (nan, 1e+155) is not finite", kept)
+
+    monkeypatch.setattr(projeq.simulation.driver, "simulate", overflowing)
+    assert main(["run", "chain", "--t-end", "0.2", "--quiet", "--out", str(tmp_path)]) == 4
     record = json.loads((run_folder(tmp_path) / "run.json").read_text())
-    assert record["status"] == "non-finite state" and record["exit_code"] == 4 and 2.0 < record["t_reached"] < 3.0
-    assert np.isfinite(record["energy"]["final"]) and "is not finite" in capsys.readouterr().err
+    assert record["status"] == "non-finite state" and record["exit_code"] == 4 and record["t_reached"] == 0.1
+    assert "is not finite" in capsys.readouterr().err
+    assert pq.Result.load(run_folder(tmp_path) / "chain.npz").status == 4

@@ -19,7 +19,8 @@ from tests.simulation.test_monitors import _NaNAfter, sagging_cantilever
 def test_leaving_the_beam_range_ends_the_run_with_status_out_of_range():
     """Passes if the sagging cantilever (g = 2: it swings to ≈ 0.5 L, far past the 0.1 L of the
     moderate-deflection range) stops with status 3 at the end of the segment (0.1 s each) where its
-    rows first pass 0.1 L with out_of_range="stop" (projeq run's choice): its first mode (ω₁ = 3.516 √(EI/ρA L⁴) rad/s, Timoshenko & Gere 1972)
+    rows first pass 0.1 L with out_of_range="stop" (projeq run's choice): its first mode
+    (ω₁ = 3.516 √(EI/ρA L⁴) rad/s, Timoshenko & Gere 1972)
     gives a tip at (1 − cos ω₁t) g/8, 0.1 L at t = 0.264 s and 0.127 L at 0.3 s (0.128 L measured),
     so by t = 0.3 s; warned once, its 31 rows up to then kept; the default, out_of_range="warn",
     runs on to t_end with status 0, for studies beyond the range."""

@@ -145,9 +145,9 @@ def test_a_users_scene_reaches_dask_workers(dask_processes, tmp_path):
     (tmp_path / "my_scene.py").write_text(USER_SCENE.format(imports="", length="1.0"))
     scene = resolve_scene(f"{tmp_path / 'my_scene.py'}:build")
     grid = {"m": [1.0, 2.0]}
-    on_dask = _in_time(lambda: sweep(scene, grid=grid, outputs=["q0"], executor=dask_processes, t_end=0.1,
+    on_dask = _in_time(lambda: sweep(scene, grid=grid, outputs=["q0"], executor=dask_processes, t_end=0.02,
                                      progress=False, evaluator="recursive"), 30)
-    on_threads = sweep(scene, grid=grid, outputs=["q0"], executor=cf.ThreadPoolExecutor(1), t_end=0.1,
+    on_threads = sweep(scene, grid=grid, outputs=["q0"], executor=cf.ThreadPoolExecutor(1), t_end=0.02,
                        progress=False, evaluator="recursive")
     assert on_dask["status"].tolist() == [0, 0] and np.array_equal(on_dask["q0"], on_threads["q0"])
 
