@@ -249,6 +249,8 @@ def simulate(
                 if run.status == OUT_OF_RANGE:
                     break
     result = _assemble(run, _time.perf_counter() - started, dense_output)
+    if not run.out_of_range and len(result.t) and result.q.shape[1] == system.tree.n_q:  # rows of a failed or
+        warn_out_of_range(system.tree, result.q, result.t[-1])  # interrupted segment: warned, the run over anyway
     if run.status in (FAILED, NON_FINITE):
         raise _failure(run, result) from run.cause
     return result
