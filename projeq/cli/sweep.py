@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import math
 import os
 import sys
@@ -139,7 +140,12 @@ def _grid_axis(text: str) -> tuple[str, float, float, int]:
 def _closed(client):
     """The block, then ``client`` (a Dask client, or None) closed; a client whose scheduler was
     lost during the sweep cannot close cleanly, and that is no error of the sweep (its table is
-    written, its lost points named)."""
+    written, its lost points named): Dask's client logs only critical errors meanwhile, not the
+    tracebacks of its attempts to reconnect."""
+    quiet = [logging.getLogger(name) for name in ("distributed.client", "distributed.core")] if client else []
+    levels = [logger.level for logger in quiet]
+    for logger in quiet:  # a lost scheduler is said once per point it held, not as Dask's tracebacks
+        logger.setLevel(logging.CRITICAL)
     try:
         yield
     finally:
@@ -148,6 +154,8 @@ def _closed(client):
                 client.close(timeout=5)
             except Exception:  # noqa: BLE001, S110 - the connection is gone already
                 pass
+        for logger, level in zip(quiet, levels):
+            logger.setLevel(level)
 
 
 def _dask_client(address: str, timeout: float):
