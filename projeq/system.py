@@ -285,7 +285,8 @@ def _set_by_name(kind: str, vector: NDArray, named: tuple, values: dict) -> NDAr
     its entries) replaced; ValueError for an unknown name or a wrong number of values."""
     for key, value in values.items():
         rows = _rows_by_name(kind, named, key)
-        vector[rows] = state_vector(f"{kind}[{key!r}]", np.atleast_1d(np.asarray(value, dtype=float)), len(rows))
+        label = f"{kind}[{key!r}] ({', '.join(named[i][0] for i in rows)})"
+        vector[rows] = state_vector(label, np.atleast_1d(finite_array(label, value)), len(rows))
     return vector
 
 
@@ -731,6 +732,7 @@ def _check_names(subsystems, joints) -> None:
     if extra:
         raise ValueError(f"joints: joint(s) for unknown subsystem(s) {sorted(extra)}")
     for name, sub in subsystems.items():
+        _check_name(name, subsystems)
         conform(name, sub)
     for name, joint in joints.items():
         if not isinstance(joint, Joint):
@@ -742,6 +744,20 @@ def _check_names(subsystems, joints) -> None:
             )
         if joint.parent == name:
             raise ValueError(f"joints[{name!r}]: a subsystem cannot be its own parent")
+
+
+def _check_name(name, subsystems: dict) -> None:
+    """A subsystem's name: a non-empty string without ``.``, which separates a subsystem from its
+    coordinate in the full names (``"elbow.angle"``, :meth:`Model.coordinates`): ``"a.b"`` beside
+    ``"a"`` would make ``q_index("a")`` and ``state(a=...)`` span both."""
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"subsystems: a name must be a non-empty string, got {name!r}")
+    if "." in name:
+        shadowed = name.partition(".")[0]
+        clash = f"; it would shadow the subsystem {shadowed!r}" if shadowed in subsystems else ""
+        raise ValueError(f"subsystems[{name!r}]: a name must not contain '.', which separates a subsystem from its "
+                         f"coordinate (a coordinate {name + '.angle'!r} would read as one of subsystem "
+                         f"{shadowed!r}){clash}; use another character, e.g. {name.replace('.', '_')!r}")
 
 
 def _check_forces(forces) -> tuple:

@@ -51,7 +51,7 @@ def test_a_state_by_name():
     with pytest.raises(ValueError, match=r"elbow: no entry of q has that name; valid are the subsystems "
                                          r"\['link1', 'link2', 'link3'\]"):
         system.state(elbow=0.3)
-    with pytest.raises(ValueError, match=r"s_dot\['link1'\]: expected 1 entries"):
+    with pytest.raises(ValueError, match=r"s_dot\['link1'\] \(link1.angle_dot\): expected 1 entries"):
         system.state(s_dot={"link1": [1.0, 2.0]})
     assert system.q_index("link2.angle") == 1 and system.q_index("link3") == slice(2, 3)
 

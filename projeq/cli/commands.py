@@ -10,7 +10,14 @@ subcommand alike:
   input, naming it: a scene, a parameter, a value, ``--out``) — nothing is run;
 - 1: a failed or interrupted run (a RuntimeError such as a failed simulation, Ctrl-C or
   SIGTERM, a file that cannot be written, or a command's own report of failed points,
-  settings or benchmarks); what was computed is written, each file complete or not at all.
+  settings or benchmarks); what was computed is written, each file complete or not at all;
+- 3: ``projeq run`` stopped where a subsystem left the range its model describes (status "out of
+  range": a beam beyond moderate deflections, :class:`projeq.simulation.driver.ValidityWarning`);
+- 4: ``projeq run`` ended at a non-finite state (status "non-finite state": the solution blew up).
+  For 3 and 4 the results up to there are written, as for 1.
+
+Warnings are printed on stderr as one line each, ``projeq run: ValidityWarning: ...``
+(:func:`one_line_warnings`), not as Python's with their source line.
 
 SIGTERM (``kill``, a batch scheduler's time limit) is handled as Ctrl-C: a KeyboardInterrupt
 that each command turns into partial results.
@@ -27,9 +34,10 @@ import importlib
 import signal
 import sys
 import threading
+import warnings
 from contextlib import contextmanager
 
-OK, FAILED, BAD_ARGUMENTS = 0, 1, 2
+OK, FAILED, BAD_ARGUMENTS, OUT_OF_RANGE, NON_FINITE = 0, 1, 2, 3, 4
 
 #: name → (module of projeq.cli, its function adding the subcommand's arguments, one-line help)
 COMMANDS = {
@@ -71,7 +79,7 @@ def main(argv=None) -> int:
     except SystemExit as exit_:  # --help (0) or a usage error (2), printed by argparse
         return OK if exit_.code is None else int(exit_.code)
     try:
-        with sigterm_as_ctrl_c():
+        with sigterm_as_ctrl_c(), one_line_warnings(f"projeq {args.command}"):
             return int(args.execute(args) or OK)
     except ValueError as exc:
         print(f"projeq {args.command}: {exc}", file=sys.stderr)
@@ -127,6 +135,25 @@ def imports_frozen():
             gc.freeze()
         if enabled:
             gc.enable()
+
+
+@contextmanager
+def one_line_warnings(prefix: str):
+    """Within the block every warning shown (once per place it is raised, Python's "default"
+    action) is printed on stderr as one line, ``<prefix>: <Category>: <message>``, without
+    Python's file name and source line, and recorded: the block gets the list of
+    ``{"category": ..., "message": ...}`` (``projeq run`` writes it into run.json)."""
+    raised = []
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        text = " ".join(str(message).split())
+        raised.append({"category": category.__name__, "message": text})
+        print(f"{prefix}: {category.__name__}: {text}", file=sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        warnings.showwarning = show
+        yield raised
 
 
 def _interrupt(signum, frame):

@@ -65,9 +65,10 @@ def simulation_options(parser: argparse.ArgumentParser, out: str = "projeq-out")
 def simulate_options(args, scene) -> dict:
     """The keywords of :func:`projeq.simulate` given by :func:`simulation_options` over the
     scene's own settings (:class:`projeq.scenes.Scene` ``settings``); what neither gives is
-    left to ``simulate``'s defaults."""
+    left to ``simulate``'s defaults, except that a run leaving its model's range stops there
+    (``out_of_range="stop"``: status "out of range", exit code 3 of ``projeq run``)."""
     given = {name: getattr(args, name) for name in ("method", "rtol", "atol", "evaluator") if getattr(args, name) is not None}
-    return (scene.settings or {}) | given
+    return (scene.settings or {}) | given | {"out_of_range": "stop"}  # a run leaving its model's range ends
 
 
 def scene_label(scene: str) -> str:

@@ -35,7 +35,6 @@ import numpy as np
 
 from projeq.cli.options import json_option, jsonable, output_directory, scene_label, simulate_options, simulation_options
 
-STATUS = {0: "finished", 1: "stopped by an event", -1: "failed", 2: "interrupted"}
 WIDTH = 100  # columns of the text output
 
 
@@ -104,11 +103,21 @@ def list_scenes(args) -> int:
 
 
 def run_scene(args) -> int:
+    from projeq.cli.commands import one_line_warnings
+
+    with one_line_warnings("projeq run") as raised:
+        return _run_scene(args, raised)
+
+
+def _run_scene(args, raised: list) -> int:
+    """``projeq run``; ``raised``: the warnings of the run so far, printed as they come and
+    recorded in run.json (``warnings``)."""
     from projeq.cli.commands import imports_frozen
 
     with imports_frozen():
         from projeq.scenes import parse_settings, resolve_scene
         from projeq.simulation.driver import SimulationError, simulate
+        from projeq.simulation.result import OUT_OF_RANGE
         from projeq.system import check_model
     scene = resolve_scene(args.scene)
     overrides = parse_settings(scene, args.set)
@@ -126,11 +135,13 @@ def run_scene(args) -> int:
             # simulate's segments (20): Ctrl-C loses at most the current 5 % of the run; each segment
             # restarts the step size and an implicit method's Jacobian (100 segments cost the spin-up
             # beam by Radau 1.4× the CPU time of 20)
-            result, code = simulate(system, t_end, n_points=201, events=list(scene.events) or None,
-                                    progress=lambda t: bar.update(t - bar.n), **options), 0
+            result = simulate(system, t_end, n_points=201, events=list(scene.events) or None,
+                              progress=lambda t: bar.update(t - bar.n), **options)
+            code = _exit_code(result.status)
         except SimulationError as exc:
             print(f"projeq: {exc}", file=sys.stderr)
-            result, code = exc.result, 1
+            result = exc.result
+            code = _exit_code(result.status) or 1  # a failure, whatever the status of the rows kept
     record.update(cpu_time=time.process_time() - cpu, wall_time=time.perf_counter() - wall,
                   method=result.method or record["method"])  # the integrator simulate used
     result = replace(result, metadata=dict(record))
@@ -141,11 +152,13 @@ def run_scene(args) -> int:
     if result.status == 2:
         reached = result.t[-1] if len(result.t) else 0.0
         print(f"projeq: interrupted at t = {reached:.6g} s; the results up to there are written", file=sys.stderr)
-        code = 1
+    elif result.status == OUT_OF_RANGE:
+        print(f"projeq: {result.message}; the results up to there are written", file=sys.stderr)
     out = run_directory(parent, label)
     try:
         files = _write_all(result, system, scene, out, label, args.plots)
-        record.update(_outcome(system, result, code, notes), files=[str(f.relative_to(out)) for f in files])
+        record.update(_outcome(system, result, code, notes), warnings=list(raised),
+                      files=[str(f.relative_to(out)) for f in files])
         files.append(_write_json(out / "run.json", record))
     except OSError:  # nothing half-written: the folder goes too if no file in it is complete
         if not any(out.rglob("*")):
@@ -207,10 +220,22 @@ def run_directory(out: Path, label: str) -> Path:
     raise ValueError(f"--out: cannot make a new run folder in {str(out)!r} (999 runs of {label} at {stamp})")
 
 
+def _exit_code(status: int) -> int:
+    """``projeq run``'s exit code for a Result's status (:mod:`projeq.cli.commands`): 0 finished
+    or stopped by an event, 1 failed or interrupted, 3 out of range, 4 non-finite state."""
+    from projeq.cli import commands
+    from projeq.simulation import result as ends
+
+    return {ends.FINISHED: commands.OK, ends.STOPPED: commands.OK, ends.OUT_OF_RANGE: commands.OUT_OF_RANGE,
+            ends.NON_FINITE: commands.NON_FINITE}.get(status, commands.FAILED)
+
+
 def _outcome(system, result, code: int, notes: list) -> dict:
     """How the run ended, for run.json: status, exit code, message, time reached, evaluations,
     the final state by name and the energies."""
-    outcome = {"status": STATUS.get(result.status, str(result.status)), "exit_code": code,
+    from projeq.simulation.result import STATUSES
+
+    outcome = {"status": STATUSES.get(result.status, str(result.status)), "exit_code": code,
                "message": "; ".join(notes) or result.message, "nfev": result.nfev}
     if len(result.t):
         q_names, s_names = result.column_names()

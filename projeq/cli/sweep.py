@@ -4,9 +4,10 @@ local processes or on a Dask cluster; writes ``sweep_SCENE.csv`` and ``.npz``.
 Each finished point is appended to ``sweep_SCENE.csv`` at once, so a crash loses only the
 points in flight, and ``--resume`` runs only the points not finished there. Ctrl-C or
 SIGTERM stops the workers and writes the table with the points finished (and the running
-ones' partial results). A point that failed or was interrupted makes the exit code 1 (the
-table is written). The grid is checked first: no parameter twice (in ``--grid`` or in both
-``--grid`` and ``--set``), no repeated values, and at most :data:`MAX_POINTS` points
+ones' partial results). A point that failed, was interrupted or stopped where its model left
+its range (status 3) makes the exit code 1 (the table is written). The grid is checked first:
+no parameter twice (in ``--grid`` or in both ``--grid`` and ``--set``), no repeated values, and
+at most :data:`MAX_POINTS` points
 unless ``--allow-large``. The number of points is printed first, and before a large sweep
 (more than :data:`projeq.simulation.sweep.ESTIMATE_ABOVE` points) an estimate of its time
 from its first two points, run here (the second timed) before the others start.
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import math
 import os
 import sys
@@ -61,7 +63,7 @@ def sweep_scene(args) -> int:
     options = simulate_options(args, scene)
     t_end = None if args.t_end is None else positive("t_end", args.t_end)  # before anything is printed or made
     quiet = args.quiet or args.json
-    with client if client is not None else contextlib.nullcontext():  # a Dask client is closed also when --out is refused
+    with _closed(client):  # a Dask client is closed also when --out is refused
         out = output_directory(args.out)
         if not quiet:
             where = f"the Dask scheduler at {args.scheduler}" if client else f"{args.workers or os.cpu_count()} local processes"
@@ -71,23 +73,25 @@ def sweep_scene(args) -> int:
                       progress=not quiet, path=out / f"sweep_{label}", resume=args.resume,
                       workers=None if client else args.workers, **options)
     files = [out / f"sweep_{label}.csv", out / f"sweep_{label}.npz"]
-    failed, partial = int((table["status"] == -1).sum()), int((table["status"] == 2).sum())
+    failed, partial = int(np.isin(table["status"], (-1, 4)).sum()), int((table["status"] == 2).sum())
+    beyond = int((table["status"] == 3).sum())  # stopped where the model left its range
     if args.json:
         print(json.dumps({"scene": args.scene, "options": options, "points": len(table["status"]), "failed": failed,
-                          "interrupted": partial, "files": [str(f) for f in files],
+                          "interrupted": partial, "out_of_range": beyond, "files": [str(f) for f in files],
                           "table": {k: np.asarray(v).tolist() for k, v in table.items()}}, indent=2, default=repr))
     elif not args.quiet:
-        print(f"{len(table['status'])} points, {failed} failed or not run, {partial} interrupted with partial results; "
-              "wrote " + ", ".join(str(f) for f in files))
-    for i in np.flatnonzero(table["status"] == -1):
+        print(f"{len(table['status'])} points, {failed} failed or not run, {partial} interrupted with partial "
+              f"results, {beyond} stopped out of their model's range; wrote " + ", ".join(str(f) for f in files))
+    for i in np.flatnonzero(np.isin(table["status"], (-1, 4))):
         point = ", ".join(f"{k}={table[k][i]}" for k in grid)
         print(f"projeq: point {point} failed: {table['error'][i]}", file=sys.stderr)
-    return 1 if failed or partial else 0
+    return 1 if failed or partial or beyond else 0
 
 
 def _grid(scene, texts: list[str], fixed: dict, allow_large: bool) -> dict:
     """The swept axes of ``--grid`` (integer parameters rounded); ValueError for a parameter
-    given twice or in both ``--grid`` and ``--set``, repeated values, or more than
+    given twice or in both ``--grid`` and ``--set``, one that is no number (text, a switch, a
+    tuple: every point would fail), repeated values, or more than
     :data:`MAX_POINTS` points without ``allow_large`` (refused before any array is made)."""
     from projeq.scenes import check_names, scene_parameters
 
@@ -104,6 +108,9 @@ def _grid(scene, texts: list[str], fixed: dict, allow_large: bool) -> dict:
         if name in fixed:
             raise ValueError(f"--grid: {name} is also given in --set; give it in one of them")
         check_names(scene, {name: None})
+        if isinstance(defaults[name], (str, bool, tuple)):  # None: an optional number (rolling_disk's ecc)
+            raise ValueError(f"--grid: {name} is not a number (its default is {defaults[name]!r}); a grid sweeps "
+                             "numbers: give its value with --set, or sweep a numeric parameter")
         values = np.linspace(a, b, n)
         if type(defaults[name]) is int:
             values = values.round().astype(int)
@@ -127,6 +134,28 @@ def _grid_axis(text: str) -> tuple[str, float, float, int]:
     except (ValueError, IndexError):
         raise ValueError(f"--grid: expected NAME=A:B:N (numbers A, B, a count N >= 1), got {text!r}") from None
     return name.strip(), a, b, n
+
+
+@contextlib.contextmanager
+def _closed(client):
+    """The block, then ``client`` (a Dask client, or None) closed; a client whose scheduler was
+    lost during the sweep cannot close cleanly, and that is no error of the sweep (its table is
+    written, its lost points named): Dask's client logs only critical errors meanwhile, not the
+    tracebacks of its attempts to reconnect."""
+    quiet = [logging.getLogger(name) for name in ("distributed.client", "distributed.core")] if client else []
+    levels = [logger.level for logger in quiet]
+    for logger in quiet:  # a lost scheduler is said once per point it held, not as Dask's tracebacks
+        logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        if client is not None:
+            try:
+                client.close(timeout=5)
+            except Exception:  # noqa: BLE001, S110 - the connection is gone already
+                pass
+        for logger, level in zip(quiet, levels):
+            logger.setLevel(level)
 
 
 def _dask_client(address: str, timeout: float):

@@ -36,7 +36,7 @@ from projeq.checks import callable_name, closest, count, finite_array, flag, non
 from projeq.simulation.integrators import (
     EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, stiff_steps, warn_stiff, with_direct_lu,
 )
-from projeq.simulation.result import Result, SimulationError
+from projeq.simulation.result import FAILED, NON_FINITE, OUT_OF_RANGE, Result, SimulationError
 from projeq.constraints.nonholonomic import near_singularity
 from projeq.system import CLOSED, Model, check_model
 
@@ -142,6 +142,7 @@ def simulate(
     n_segments: int = 20,
     progress=None,
     jac="exact",
+    out_of_range: str = "warn",
     **options,
 ) -> Result:
     """Integrate the equations of motion of ``system`` from ``t_start`` to ``t_end``.
@@ -186,6 +187,14 @@ def simulate(
         For Radau, BDF and LSODA: ∂ẋ/∂x by the complex step through the model ("exact",
         the default; exact to round-off, n complex evaluations per Jacobian, counted in
         ``Result.njev``), by scipy's finite differences ("differences"), or the user's.
+    out_of_range : "warn" or "stop"
+        What a subsystem leaving the range its model describes (a beam beyond moderate
+        deflections, :meth:`projeq.subsystems.base.Subsystem.out_of_range`, checked on the output
+        rows of each segment) does besides its :class:`ValidityWarning`: "warn" (default) goes
+        on, for studies of the model beyond its physical range (a divergence rate, the
+        conservation of its energy); "stop" ends the run there with ``Result.status`` 3
+        (:data:`projeq.simulation.result.OUT_OF_RANGE`), the rows up to the end of that segment
+        kept, as ``projeq run`` and ``projeq sweep`` do.
     **options
         Further options for the integrator (max_step, first_step, ...; see ``SOLVER_OPTIONS``): an option the method does not take is a ValueError naming the
         valid ones (solve_ivp would ignore it).
@@ -193,9 +202,12 @@ def simulate(
     Returns
     -------
     Result
-        On failure of the integrator or a non-finite state, :class:`SimulationError` is
-        raised with ``.result`` holding the trajectory computed so far and a message giving
-        the time reached; Ctrl-C returns the partial trajectory with ``status = 2``. Bad
+        On failure of the integrator (``status`` −1) or a non-finite state (``status`` 4: q, ṡ or
+        their derivative not finite, or an output row whose energy is not: a state beyond
+        floating-point range), :class:`SimulationError` is raised with ``.result`` holding the
+        trajectory computed so far and a message giving the time reached; a run stopped where it
+        left its model's range returns with ``status = 3`` (``out_of_range="stop"``); Ctrl-C returns the partial
+        trajectory with ``status = 2``. Bad
         arguments raise ``ValueError`` naming the argument before the run starts, and a
         model that cannot be evaluated at the initial state raises its own error there
         (:class:`projeq.SingularMassError`, a force law's ``ValueError``). During the run a
@@ -203,10 +215,10 @@ def simulate(
         state approaching a coordinate singularity (K or F with condition number above 1e5,
         checked every ``MONITOR_EVERY`` right-hand sides) is such a failure; a subsystem
         leaving the range its model describes (a beam beyond moderate deflections) gets a
-        :class:`ValidityWarning`.
+        :class:`ValidityWarning` (and with ``out_of_range="stop"`` ends the run).
     """
     run = _Run(system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
-               evaluator, n_segments, progress, jac, options, dense_output)
+               evaluator, n_segments, progress, jac, options, dense_output, out_of_range)
     started, stiff, checked = _time.perf_counter(), None, 0  # one stiffness verdict per run at most
     with run.stopping():
         segments = deque(zip(run.bounds[:-1], run.bounds[1:]))  # a model event splits one
@@ -221,6 +233,8 @@ def simulate(
                     segments.appendleft((a, b))
             elif segment.status != 0:
                 run.status, run.message = segment.status, segment.message
+                if segment.status == 1:  # a terminal event of the user's: its rows are checked as a segment's
+                    run.check_rows(run.pieces[-1].x, run.pieces[-1].t[-1] if len(run.pieces[-1].t) else a)
                 break
             else:
                 if stiff is None and run.steps >= 2 * checked:  # ρ at most log₂(steps) times per run
@@ -232,16 +246,30 @@ def simulate(
                     elif stiff is not None:
                         warn_stiff(run.method, stiff)
                 run.end_segment(b)
+                if run.status == OUT_OF_RANGE:
+                    break
     result = _assemble(run, _time.perf_counter() - started, dense_output)
-    if not run.out_of_range and len(result.t) and result.q.shape[1] == system.tree.n_q:
-        warn_out_of_range(system.tree, result.q, result.t[-1])
-    if run.status == -1:
+    if not run.out_of_range and len(result.t) and result.q.shape[1] == system.tree.n_q:  # rows of a failed or
+        warn_out_of_range(system.tree, result.q, result.t[-1])  # interrupted segment: warned, the run over anyway
+    if run.status in (FAILED, NON_FINITE):
         raise _failure(run, result) from run.cause
     return result
 
 
 #: simulate's own keyword parameters (the rest of its keywords are the integrator's options)
 SIMULATE_KEYWORDS = frozenset(inspect.signature(simulate).parameters) - {"system", "t_end", "options"}
+
+
+def check_arguments(system: Model, t_end: float, **options) -> None:
+    """The ValueError naming an argument that :func:`simulate` would raise for these arguments
+    before its run starts (a tolerance, a method, an option, the initial state, the evaluator),
+    without running: a sweep checks its first point's run with it before any point runs."""
+    arguments = inspect.signature(simulate).bind(system, t_end, **options)
+    arguments.apply_defaults()
+    a = arguments.arguments
+    _Run(system, t_end, a["q0"], a["s_dot0"], a["method"], a["rtol"], a["atol"], a["events"], a["t_start"],
+         a["t_eval"], a["n_points"], a["evaluator"], a["n_segments"], a["progress"], a["jac"], a["options"],
+         a["dense_output"], a["out_of_range"])
 
 
 @dataclass(frozen=True)
@@ -261,8 +289,11 @@ class _Run:
     and what the finished segments gave (pieces, the user's events, nfev, status)."""
 
     def __init__(self, system, t_end, q0, s_dot0, method, rtol, atol, events, t_start, t_eval, n_points,
-                 evaluator, n_segments, progress, jac, options, dense_output=False):
+                 evaluator, n_segments, progress, jac, options, dense_output=False, out_of_range="warn"):
         check_model(system)
+        if out_of_range not in ("stop", "warn"):
+            raise ValueError(f"out_of_range: expected 'stop' or 'warn', got {out_of_range!r}")
+        self.stop_out_of_range = out_of_range == "stop"
         self.t_start = t_start = float(finite_array("t_start", t_start, ()))
         q0 = system.check_q("q0", system.q0 if q0 is None else q0)
         system.check_closed("q0", q0, t_start, CLOSED)  # an open loop is a mistake, not a start to project
@@ -326,12 +357,12 @@ class _Run:
         n_q = self.model.n_q
         q, s_dot = x[:n_q], x[n_q:]
         if not np.isfinite(x).all():  # the ufunc and the array's own all(): half the cost of np.all
-            raise FloatingPointError(f"the state is not finite at t = {t:.6g} (q = {q}, s_dot = {s_dot}): the "
+            raise NonFiniteState(f"the state is not finite at t = {t:.6g} (q = {q}, s_dot = {s_dot}): the "
                                      "solution blew up (or a tolerance too loose let it)")
         self._monitor(q, t)
         x_dot = np.concatenate((self.model.q_dot(q, s_dot, t), self.ev.accelerations(q, s_dot, t)))
         if not np.isfinite(x_dot).all():
-            raise FloatingPointError(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
+            raise NonFiniteState(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
         return x_dot
 
     def exact_rhs(self, t: float, x: NDArray) -> NDArray:
@@ -431,14 +462,34 @@ class _Run:
         self.method = self.solver = "Radau"
 
     def end_segment(self, b: float) -> None:
-        """The next segment starts at b, from the state there (not at the last output time)."""
+        """The next segment starts at b, from the state there (not at the last output time),
+        after the checks of the segment's output rows and end state (not of every right-hand
+        side): a non-finite one ends the run (:class:`NonFiniteState`), and one where a subsystem
+        leaves its model's range warns and, with ``out_of_range="stop"``, ends it (status 3)."""
+        self.check_rows(np.vstack((self.pieces[-1].x, self.x_end)), b)
         self.x = self.x_end.copy()
         n_q = self.model.n_q
         self.x[:n_q] = self.model.normalized(self.x[:n_q], b)
         near_singularity(self.model.tree, self.x[:n_q], b)
-        self.out_of_range = self.out_of_range or warn_out_of_range(self.model.tree, self.x[None, :n_q], b)
         if self.progress is not None:
             self.progress(b)
+
+    def check_rows(self, rows: NDArray, t: float) -> None:
+        """The states ``rows`` (q, ṡ) of a finished segment, up to time t: NonFiniteState if one is
+        not finite; a ValidityWarning if a subsystem leaves its model's range in them (the first
+        time in the run), which with ``out_of_range="stop"`` ends the run with status 3."""
+        finite = np.isfinite(rows).all(axis=1)
+        if not finite.all():  # the segment's rows are kept up to the first non-finite one
+            piece, first = self.pieces[-1], int(np.argmin(finite))
+            self.pieces[-1] = replace(piece, t=piece.t[:first], x=piece.x[:first])
+            raise NonFiniteState(f"the state is not finite by t = {t:.6g}: the solution blew up (or a tolerance "
+                                 "too loose let it)")
+        if not self.out_of_range and warn_out_of_range(self.model.tree, rows[:, :self.model.n_q], t):
+            self.out_of_range = True
+            if self.stop_out_of_range:
+                self.status, self.message = OUT_OF_RANGE, (
+                    f"stopped at t = {t:.6g} s: a subsystem left the range its model describes (the "
+                    "ValidityWarning says which, how far and what to do)")
 
     @contextmanager
     def stopping(self):
@@ -448,7 +499,8 @@ class _Run:
         except KeyboardInterrupt:
             self.status, self.message = 2, "interrupted (Ctrl-C): the trajectory up to the last finished segment is kept"
         except Exception as exc:  # noqa: BLE001 - a user's force law or event failed: keep the trajectory
-            self.status, self.message, self.cause = -1, _described(exc), exc
+            self.status = NON_FINITE if isinstance(exc, NonFiniteState) else FAILED
+            self.message, self.cause = _described(exc), exc
 
 
 FAST_MODE_STEPS = 500  # RK45 steps forced by stability alone beyond which DOP853 is the default
@@ -575,6 +627,11 @@ def _jac_option(method, jac, n_x: int):
 
 class ValidityWarning(UserWarning):
     """A run left the range its model describes (a beam beyond moderate deflections)."""
+
+
+class NonFiniteState(FloatingPointError):
+    """The state x = (q, ṡ), its derivative or an output row's energy is not finite: the run
+    ends with ``Result.status`` 4 (:data:`projeq.simulation.result.NON_FINITE`)."""
 
 
 def warn_out_of_range(tree, q_rows: NDArray, t: float) -> bool:
@@ -708,8 +765,12 @@ def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, ND
         try:
             qi = model.normalized(xi[:n_q], t)
             values = model.output_row(qi, xi[n_q:], t)
+            if not np.isfinite(values[0]).all():
+                raise NonFiniteState(f"the energy (T, V) = {tuple(map(float, values[0]))} is not finite at t = "
+                                     f"{t:.6g} (largest |q| {np.abs(qi).max():.3g}): the state is beyond "
+                                     "floating-point range (the solution blew up)")
         except Exception as exc:  # noqa: BLE001 - a user's function: reported by name with the time
-            run.status, run.cause, run.reached = -1, exc, t
+            run.status, run.cause, run.reached = NON_FINITE if isinstance(exc, NonFiniteState) else FAILED, exc, t
             run.message = _described(exc) + ("" if f"t = {t:.6g}" in str(exc) else f" (at the output time t = {t:.6g})")
             break
         q.append(qi)

@@ -13,6 +13,11 @@ from numpy.typing import NDArray
 
 _EVENT_ARRAYS = ("t_events", "q_events", "s_dot_events")  # tuples of arrays, one per event
 
+FINISHED, STOPPED, FAILED, INTERRUPTED, OUT_OF_RANGE, NON_FINITE = 0, 1, -1, 2, 3, 4
+#: Result.status → what it means (the ``status`` of ``projeq run``'s run.json)
+STATUSES = {FINISHED: "finished", STOPPED: "stopped by an event", FAILED: "failed", INTERRUPTED: "interrupted",
+            OUT_OF_RANGE: "out of range", NON_FINITE: "non-finite state"}
+
 
 class SimulationError(RuntimeError):
     """The integration failed; ``.result`` holds the trajectory up to ``.result.t[-1]``."""
@@ -33,7 +38,8 @@ class Result:
     constraint_residual : (n, m) residuals of velocity constraints (m = 0 without any)
     nfev : right-hand-side evaluations; wall_time : seconds
     njev : Jacobians by the complex step for an implicit method (each n_q + n_s complex evaluations)
-    status : 0 finished, 1 stopped by a terminal event, -1 failed, 2 interrupted
+    status : 0 finished, 1 stopped by an event, -1 failed, 2 interrupted, 3 out of range, 4 non-finite
+    (:data:`STATUSES`; 3: stopped where a subsystem left the range its model describes, 4: the solution blew up)
     message : the integrator's message
     t_events, q_events, s_dot_events : for each of the user's events, the times where it
     fired and the states (k, n_q) and (k, n_s) there. A terminal event's state is also the
@@ -124,7 +130,9 @@ class Result:
     def save(self, path) -> None:
         """Write the arrays and metadata to an ``.npz`` file (readable by numpy alone; ``.npz``
         is appended to a name without it, as numpy does), under a temporary name renamed when
-        complete: a full disk or a killed process never leaves a truncated file."""
+        complete: a full disk or a killed process never leaves a truncated file. A Result that
+        :meth:`load` would refuse (arrays of the wrong shapes, t not increasing, an unknown
+        status) is a ValueError naming the field, and nothing is written."""
         arrays = {f.name: getattr(self, f.name) for f in fields(self) if isinstance(getattr(self, f.name), np.ndarray)}
         meta = {
             "nfev": self.nfev, "njev": self.njev, "wall_time": self.wall_time, "status": self.status,
@@ -134,6 +142,8 @@ class Result:
             "metadata": self.metadata,
         }
         events = {f"{name}_{i}": np.asarray(e) for name in _EVENT_ARRAYS for i, e in enumerate(getattr(self, name))}
+        _check_fields(arrays, meta, {name: tuple(map(np.asarray, getattr(self, name))) for name in _EVENT_ARRAYS},
+                      f"Result.save({str(getattr(path, 'name', path) if hasattr(path, 'write') else path)!r})")
         if hasattr(path, "write"):  # an open file
             np.savez(path, **arrays, **events, meta=json.dumps(meta))
             return
@@ -147,7 +157,10 @@ class Result:
     def load(cls, path) -> "Result":
         """Read a Result written by :meth:`save` (without dense output). ValueError saying what
         the file is and what is wrong when it is not one: not an .npz archive (random or
-        truncated bytes), an archive without a Result's arrays, or arrays whose lengths differ.
+        truncated bytes), an archive without a Result's arrays, metadata without a field of
+        the Result or with an unknown one, arrays whose shapes do not match t and the coordinate
+        names (one row per output time, one column per coordinate), t not increasing, a status
+        not in :data:`STATUSES`.
         A name without ``.npz`` is read as :meth:`save` wrote it, with the suffix appended."""
         if isinstance(path, (str, Path)) and Path(path).suffix != ".npz" and not Path(path).exists():
             path = Path(path).with_name(Path(path).name + ".npz")  # save's name for it
@@ -159,11 +172,11 @@ class Result:
                              f"Result (.npz written by Result.save): {exc}") from exc
         except ValueError as exc:  # numpy's words for bytes that are no .npy/.npz, or the checks of _read
             raise ValueError(f"path: {str(path)!r} is not a projeq Result (.npz written by Result.save): {exc}") from exc
+        _check_fields(arrays, meta, events, f"path: {str(path)!r}")
         meta["names"] = tuple(meta["names"])
         meta["partitions"] = tuple((t, tuple(independent)) for t, independent in meta.get("partitions", ()))
         for key in ("coordinates", "velocities"):  # absent from files of earlier versions
             meta[key] = tuple(tuple(pair) for pair in meta.get(key, ()))
-        _check_rows(arrays, path)
         return cls(**arrays, **meta, **events)
 
 
@@ -184,16 +197,62 @@ def _read(data, path) -> tuple[dict, dict, dict]:
 
 
 _ROWS = ("t", "q", "s_dot", "kinetic", "potential", "constraint_residual")  # one row per output time
+_META = {"nfev", "njev", "wall_time", "status", "message", "names", "method", "partitions", "coordinates",
+         "velocities", "metadata"}  # what save writes besides the arrays
+_META_OPTIONAL = {"njev", "partitions", "coordinates", "velocities", "metadata"}  # absent from earlier versions
 
 
-def _check_rows(arrays: dict, path) -> None:
-    """Every per-time array has one row per entry of t."""
-    n = len(arrays["t"])
-    wrong = {name: arrays[name].shape for name in _ROWS if arrays[name].ndim == 0 or len(arrays[name]) != n}
-    if arrays["t"].ndim != 1 or wrong:
-        raise ValueError(f"path: {str(path)!r} is inconsistent: t has shape {arrays['t'].shape} but "
-                         f"{wrong} (one row per output time expected); the file was not written by "
-                         "Result.save or was altered")
+def _check_fields(arrays: dict, meta: dict, events: dict, where: str) -> None:
+    """ValueError beginning with ``where`` (the file, or Result.save) and naming the field, unless
+    the Result's fields fit together: the metadata's fields, each array one row per entry of t
+    (rank and mobility: or none), q and s_dot one column per coordinate and velocity name where
+    these are given, t increasing and finite, the status one of :data:`STATUSES`, and each event's
+    times and states alike."""
+    def refuse(field_name: str, problem: str):
+        raise ValueError(f"{where}: field {field_name!r} {problem}; the file was not written by Result.save or "
+                         "was altered" if where.startswith("path") else f"{where}: field {field_name!r} {problem}")
+
+    if not isinstance(meta, dict):
+        refuse("meta", f"is {type(meta).__name__}, not the dict of fields Result.save writes")
+    for name in sorted(_META - _META_OPTIONAL - set(meta)):
+        refuse(name, "is missing from the metadata")
+    for name in sorted(set(meta) - _META):
+        refuse(name, f"is not a field of a Result (they are {sorted(_META)})")
+    if meta["status"] not in STATUSES or isinstance(meta["status"], bool):
+        refuse("status", f"is {meta['status']!r}, not one of {STATUSES}")
+    unknown = sorted(set(arrays) - set(_ROWS) - {"rank", "mobility"})
+    if unknown:
+        refuse(unknown[0], "is not an array of a Result")
+    t = arrays["t"]
+    if t.ndim != 1 or not np.issubdtype(t.dtype, np.number) or not np.isfinite(t).all():
+        refuse("t", f"must be one finite time per output row, got shape {t.shape} ({t.dtype})")
+    if np.any(np.diff(t) < 0):
+        k = int(np.argmax(np.diff(t) < 0)) + 1
+        refuse("t", f"runs backwards at row {k} ({t[k - 1]:.6g} s, then {t[k]:.6g} s); output times increase")
+    if not isinstance(meta["names"], (list, tuple)) or not all(isinstance(n, str) for n in meta["names"]):
+        refuse("names", f"must be the subsystems' names (strings), got {meta['names']!r}")
+    columns = {"q": len(meta.get("coordinates") or ()) or None,  # None: any number of columns (older files)
+               "s_dot": len(meta.get("velocities") or ()) or None}
+    for name in _ROWS[1:] + ("rank", "mobility"):
+        a = arrays.get(name, np.zeros(0))
+        if name in ("rank", "mobility") and a.shape == (0,):  # a model without constraint equations
+            continue
+        expected = (len(t), columns.get(name)) if name in ("q", "s_dot", "constraint_residual") else (len(t),)
+        if a.ndim != len(expected) or any(e is not None and n != e for n, e in zip(a.shape, expected)):
+            shown = "(" + ", ".join("m" if e is None else str(e) for e in expected) + "," * (len(expected) == 1)
+            shown += ")"
+            per_name = {"q": ", one column per coordinate name", "s_dot": ", one column per velocity name"}
+            refuse(name, f"has shape {a.shape} where t has {len(t)} rows: expected {shown}"
+                         + (per_name[name] if columns.get(name) else ""))
+    n_q, n_s = arrays["q"].shape[1], arrays["s_dot"].shape[1]
+    counts = {len(events.get(name, ())) for name in _EVENT_ARRAYS}
+    if len(counts) > 1:
+        refuse("t_events", f"has {len(events.get('t_events', ()))} events but q_events and s_dot_events "
+                           f"{len(events.get('q_events', ()))} and {len(events.get('s_dot_events', ()))}")
+    for i, (te, qe, se) in enumerate(zip(*(events.get(name, ()) for name in _EVENT_ARRAYS))):
+        if te.ndim != 1 or qe.shape != (len(te), n_q) or se.shape != (len(te), n_s):
+            refuse(f"t_events_{i}", f"has shape {te.shape}, q_events_{i} {qe.shape} and s_dot_events_{i} {se.shape}: "
+                                    f"expected ({len(te)},), ({len(te)}, {n_q}) and ({len(te)}, {n_s})")
 
 
 def _numbered(data, name: str) -> tuple:

@@ -32,6 +32,7 @@ import concurrent.futures as cf
 import csv
 import io
 import itertools
+import json
 import os
 import pickle
 import signal
@@ -46,7 +47,7 @@ import numpy as np
 
 from projeq.checks import finite_array
 from projeq.scenes import Scene, check_names, get_scene
-from projeq.simulation.driver import check_options
+from projeq.simulation.driver import SimulationError, check_arguments, check_options
 from projeq.simulation.export import written_atomically
 from projeq.studies.table import Table, csv_cells, csv_line
 
@@ -137,7 +138,8 @@ def _exit_with_parent(parent: int) -> None:
 
 
 def run_point(scene: Scene, parameters: dict, outputs, t_end: float, options: dict):
-    """Simulate one point; returns (status, output values, error message). Runs on a worker."""
+    """Simulate one point; returns (status, output values, error message). Runs on a worker.
+    A SimulationError keeps its Result's status (−1 failed, 4 non-finite state)."""
     from projeq.simulation.driver import simulate
 
     global _simulating
@@ -146,9 +148,75 @@ def run_point(scene: Scene, parameters: dict, outputs, t_end: float, options: di
         result = simulate(scene.build(**parameters), t_end, **options)
         return result.status, [output_value(result, o) for o in outputs], ""
     except Exception as exc:  # noqa: BLE001 - a failed point is reported in the table, never dropped
-        return -1, [np.nan] * len(outputs), " ".join(f"{type(exc).__name__}: {exc}".splitlines())  # one line
+        status = exc.result.status if isinstance(exc, SimulationError) else -1
+        return status, [np.nan] * len(outputs), _one_line(exc)
     finally:
         _simulating = False
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(f"{type(exc).__name__}: {exc}".splitlines())
+
+
+def run_shipped_point(shipped: bytes, parameters: dict, outputs, t_end: float, options: dict):
+    """:func:`run_point` of a scene sent by value (:func:`ship`), on a Dask worker: a scene the
+    worker cannot load (a module it cannot import) is this point's failure, named."""
+    try:
+        scene = _unship(shipped)
+    except Exception as exc:  # noqa: BLE001 - reported in the table, never a worker's death
+        return -1, [np.nan] * len(outputs), f"the worker cannot load the scene: {_one_line(exc)}"
+    return run_point(scene, parameters, outputs, t_end, options)
+
+
+def ship(scene: Scene) -> bytes:
+    """``scene`` pickled by value where workers may not have its code: the module of its build
+    function, unless it is projeq's or an installed package's (a user's file, loaded by
+    :func:`projeq.scenes.resolve_scene`, or a module of the user's own), goes with it (cloudpickle,
+    which Dask brings), so that Dask workers need only projeq."""
+    import cloudpickle
+
+    module = sys.modules.get(getattr(scene.build, "__module__", None) or "")
+    by_value = module is not None and _users(module)
+    if by_value:
+        cloudpickle.register_pickle_by_value(module)
+    try:
+        return cloudpickle.dumps(scene)
+    finally:
+        if by_value:
+            cloudpickle.unregister_pickle_by_value(module)
+
+
+def _users(module) -> bool:
+    """A module of the user's: not projeq's, the standard library's or an installed package's."""
+    path = getattr(module, "__file__", None) or ""
+    return (module.__name__.partition(".")[0] != "projeq" and bool(path)
+            and not any(part in Path(path).parts for part in ("site-packages", "dist-packages"))
+            and not path.startswith(sys.base_prefix + os.sep))
+
+
+def _unship(shipped: bytes) -> Scene:
+    import cloudpickle
+
+    return cloudpickle.loads(shipped)
+
+
+WORKERS_ANSWER = 30.0  # s within which a Dask worker must load the scene before the sweep starts
+
+
+def _check_workers(pool, shipped: bytes) -> None:
+    """ValueError unless a Dask worker loads the shipped scene within :data:`WORKERS_ANSWER` s:
+    naming the module it cannot import, or saying that no worker answered (workers without
+    projeq or cloudpickle cannot even read the task: they would never return it)."""
+    future = pool.submit(_unship, shipped)
+    try:
+        future.result(timeout=WORKERS_ANSWER)
+    except cf.TimeoutError:
+        future.cancel()
+        raise ValueError(f"executor: no Dask worker loaded the scene within {WORKERS_ANSWER:g} s; do the workers "
+                         "run, with projeq and cloudpickle installed (the same versions as here)?") from None
+    except Exception as exc:  # noqa: BLE001 - whatever the worker raised while loading
+        raise ValueError(f"executor: the Dask workers cannot load the scene ({_one_line(exc)}): install that module "
+                         "on the workers, or put its code into the scene's file") from None
 
 
 class SweepTable(dict):
@@ -352,8 +420,10 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     Parameters
     ----------
     scene : str or Scene
-        A registered scene name or a :class:`projeq.scenes.Scene` (its build function must be
-        importable by the workers).
+        A registered scene name or a :class:`projeq.scenes.Scene`. Local worker processes
+        inherit its build function; to Dask workers it is sent by value (:func:`ship`: the
+        user's own module goes with it), and a worker that cannot load it within
+        :data:`WORKERS_ANSWER` s is a ValueError naming the module, before any point runs.
     grid : dict name -> sequence, optional
         The Cartesian product of the values is swept.
     samples : list of dicts or dict name -> equal-length sequences, optional
@@ -376,11 +446,19 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
         when the sweep returns (also after an interrupt).
     resume : bool
         Keep the finished points (status 0 or 1) of an earlier ``path.csv`` of the same sweep
-        and run only the others (failed, interrupted or not run).
+        and run only the others (failed, interrupted or not run). ``path.json``, written when
+        the sweep starts, records its scene, end time and options: a table made with others
+        (or without that record) is refused, naming what differs.
     workers : int, optional
         Processes of the default pool (default one per core).
     **options
         Passed to :func:`projeq.simulate` (method, rtol, atol, n_points ...).
+
+    Before any point runs, the first and the last point are built (one of them at least must
+    be), the first buildable point's run is checked as :func:`projeq.simulate` checks its
+    arguments (:func:`check_arguments`) and each output name against their models: a grid whose
+    ends cannot be built, a bad option value or an output no model has is a ValueError here,
+    not every point failing alike.
 
     Returns
     -------
@@ -389,7 +467,8 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
         were running with their partial results (status 2), the others marked status −1,
         error "interrupted". A point whose worker process died has status −1 and an error
         saying so (on the default pool: only a point that killed its worker twice, the second
-        time running alone).
+        time running alone). Points that an executor cancels (a Dask scheduler lost) or no
+        longer takes have status −1 and an error saying so; the sweep returns its table.
 
     >>> table = sweep("chain", grid={"n": [1, 2]}, outputs=["q0"], executor=cf.ThreadPoolExecutor(2),
     ...               t_end=0.1, progress=False)
@@ -401,22 +480,26 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
     for p in points:
         check_names(scene, p)
     outputs = _outputs(outputs, points[0])
-    named = [name for name in outputs if _column(name) is not None and _column(name)[0] == "named"]
-    if named:  # checked on the model of the first point, before any run
-        model = scene.build(**points[0])
-        for name in named:
-            _named_column(model.coordinates(), model.velocities(), name)
     t_end = scene.t_end if t_end is None else _end_time(t_end, options.get("t_start", 0.0))
     check_options(options)  # a misspelt option is one error here, not every point failing alike
+    _check_first_run(scene, points, outputs, t_end, options)
     if resume and path is None:
         raise ValueError("resume: needs path, the table of the sweep to resume")
     header = list(points[0]) + outputs + ["status", "error"]
     rows = [None] * len(points)  # (status, outputs, error) of each point, None until it is done
+    made_with = _record(scene, t_end, options)
     if resume:
-        _resumed(Path(path).with_suffix(".csv"), header, points, rows)
+        _resumed(Path(path).with_suffix(".csv"), header, points, rows, made_with)
     if executor is None or isinstance(executor, cf.ProcessPoolExecutor):
         _check_picklable(scene, options)
     pool, owned = _executor(executor, workers)
+    task = lambda p: (run_point, scene, p, outputs, t_end, options)  # noqa: E731
+    if hasattr(executor, "get_executor"):  # Dask: the scene by value, checked on a worker first
+        shipped = ship(scene)
+        _check_workers(pool, shipped)
+        task = lambda p: (run_shipped_point, shipped, p, outputs, t_end, options)  # noqa: E731
+    if path is not None:
+        _write_record(Path(path).with_suffix(".json"), made_with)
     log = None if path is None else _Log(Path(path).with_suffix(".csv"), header,
                                          [_row(points[i], r) for i, r in enumerate(rows) if r is not None])
     from tqdm import tqdm
@@ -429,7 +512,7 @@ def sweep(scene, grid=None, samples=None, outputs=("energy_drift", "t_reached"),
             log.append(_row(points[i], row))
         bar.update()
 
-    run = _Run(pool, owned, workers, lambda p: (run_point, scene, p, outputs, t_end, options), len(outputs))
+    run = _Run(pool, owned, workers, task, len(outputs))
     todo = [i for i, r in enumerate(rows) if r is None]
     try:
         with tqdm(total=len(points), initial=len(points) - len(todo), unit="run",
@@ -500,6 +583,10 @@ class _Run:
                         self.running[self.pool.submit(*self.task(points[i]))] = i
                     except cf.BrokenExecutor as exc:  # an executor not ours, broken: nothing more runs
                         record(i, self._failure(f"not run: the executor is broken ({exc})"))
+                    except Exception as exc:  # noqa: BLE001 - e.g. a Dask client whose scheduler is gone
+                        if self.owned:
+                            raise
+                        record(i, self._failure(f"not run: the executor refused it ({_one_line(exc)})"))
                 self.processes.update(getattr(self.pool, "_processes", None) or {})
                 for future in _finished(self.running):
                     self._done(future, record)
@@ -532,7 +619,8 @@ class _Run:
         """Record a finished point (or queue it to run again alone), then forget its future:
         in this order, so that an interrupt in between cannot lose it."""
         i = self.running[future]
-        if self.owned and isinstance(future.exception(), cf.BrokenExecutor) and i not in self.retried:
+        broken = not future.cancelled() and isinstance(future.exception(), cf.BrokenExecutor)
+        if self.owned and broken and i not in self.retried:
             self.retried.add(i)
             self.suspects.append(i)
         else:
@@ -540,6 +628,9 @@ class _Run:
         del self.running[future]
 
     def _outcome(self, future, alone: bool):
+        if future.cancelled():
+            return self._failure("cancelled by the executor while it ran or waited (a Dask scheduler lost?); "
+                                 "with resume=True / --resume it runs again")
         exc = future.exception()
         if exc is None:
             return future.result()
@@ -628,10 +719,26 @@ def _row(point: dict, row) -> list:
     return list(point.values()) + list(values) + [status, error]
 
 
-def _resumed(path: Path, header: list, points: list, rows: list) -> None:
-    """Fill ``rows`` with the finished points (status 0 or 1) of an earlier ``path``."""
+def _record(scene, t_end: float, options: dict) -> dict:
+    """What a sweep's table depends on besides its columns: the scene (its build function's name,
+    not its module's, which depends on how it was imported), the end time and simulate's options,
+    as JSON values (others by their repr)."""
+    build = getattr(scene.build, "__qualname__", repr(scene.build))
+    return json.loads(json.dumps({"scene": build, "t_end": t_end, "options": options}, default=repr))
+
+
+def _write_record(path: Path, record: dict) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with written_atomically(path) as temporary:
+        temporary.write_text(json.dumps(record, indent=2) + "\n")
+
+
+def _resumed(path: Path, header: list, points: list, rows: list, record: dict) -> None:
+    """Fill ``rows`` with the finished points (status 0 or 1) of an earlier ``path`` made with
+    the same ``record`` (scene, end time, options: ``path`` with ``.json``)."""
     if not path.exists():
         return
+    _same_record(path, record)
     found, lines = _read_csv(path)
     if found != header:
         raise ValueError(f"resume: {str(path)!r} has the columns {found}, this sweep writes {header}; "
@@ -652,6 +759,60 @@ def _resumed(path: Path, header: list, points: list, rows: list) -> None:
     for i, key in enumerate(keys):
         if finished.get(key):
             rows[i] = finished[key].pop(0)
+
+
+def _same_record(path: Path, record: dict) -> None:
+    """ValueError unless the table ``path`` was made with ``record`` (its ``.json``)."""
+    try:
+        earlier = json.loads(path.with_suffix(".json").read_text())
+    except (OSError, ValueError):
+        raise ValueError(f"resume: {str(path)!r} has no readable record of the scene, end time and options it was "
+                         f"made with ({str(path.with_suffix('.json'))!r}); its values may mean another sweep: "
+                         "write elsewhere") from None
+    differ = {key: (earlier.get(key), record[key]) for key in record if earlier.get(key) != record[key]}
+    if differ.get("options"):
+        was, now = differ.pop("options")
+        was = was if isinstance(was, dict) else {}
+        differ |= {f"options[{k!r}]": (was.get(k), now.get(k))
+                   for k in sorted(set(was) | set(now)) if was.get(k) != now.get(k)}
+    if differ:
+        said = "; ".join(f"{key} {old!r} there, {new!r} now" for key, (old, new) in differ.items())
+        raise ValueError(f"resume: {str(path)!r} was made with other settings ({said}); resume with the same "
+                         "scene, end time and options, or write elsewhere")
+
+
+def _check_first_run(scene, points: list, outputs: list, t_end: float, options: dict) -> None:
+    """Before any point runs: the first and last points are built (a ValueError naming them when
+    neither can be), the first buildable one's run checked as simulate checks its arguments
+    (:func:`projeq.simulation.driver.check_arguments`), and each output found in their models
+    (a ``q<i>`` beyond every one of them, a name none has)."""
+    models, failures = [], []
+    for point in (points[0], points[-1]) if len(points) > 1 else points[:1]:
+        try:
+            models.append(scene.build(**point))
+        except Exception as exc:  # noqa: BLE001 - a scene's build raises what it raises
+            failures.append(f"{point}: {_one_line(exc)}")
+    if not models:  # one point that cannot be built is its row's failure; both ends, the sweep's
+        raise ValueError(f"grid: neither the first nor the last point can be built ({'; '.join(failures)}); "
+                         "nothing was run")
+    try:
+        check_arguments(models[0], t_end, **options)
+    except ValueError:
+        raise
+    except Exception:  # noqa: BLE001, S110 - a model that cannot run (singular ...): its points fail, named
+        pass
+    for name in outputs:
+        column = _column(name)
+        if column is None:
+            continue
+        if column[0] == "named":
+            _named_column(models[0].coordinates(), models[0].velocities(), name)
+            continue
+        sizes = [model.n_q if column[0] == "q" else model.n_s for model in models]
+        if column[1] >= max(sizes):
+            raise ValueError(f"outputs: {name!r} asks for {column[0]}[{column[1]}], but the models of the first and "
+                             f"last points have {' and '.join(map(str, sizes))} entries ({column[0]}0 … "
+                             f"{column[0]}{max(sizes) - 1})")
 
 
 def _table(points, outputs, rows) -> SweepTable:

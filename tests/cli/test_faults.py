@@ -233,14 +233,14 @@ def test_a_sweep_whose_table_cannot_be_completed_keeps_the_appended_points(tmp_p
     monkeypatch.setitem(SCENES, "faulty", FAULTY)
     renamed = []
 
-    def replace_once(source, target):  # the table's header goes in, the final CSV and NPZ do not
+    def replace_once(source, target):  # the sweep's record and the table's header go in, the final CSV and NPZ do not
         renamed.append(target)
-        return os.rename(source, target) if len(renamed) == 1 else _full_disk()
+        return os.rename(source, target) if len(renamed) <= 2 else _full_disk()
 
     monkeypatch.setattr(os, "replace", replace_once)
     assert main(sweep_argv(tmp_path, "k=0:3:4")) == 1
     assert "No space left on device" in capsys.readouterr().err
-    assert [p.name for p in tmp_path.iterdir()] == ["sweep_faulty.csv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sweep_faulty.csv", "sweep_faulty.json"]
     table = SweepTable.load(tmp_path / "sweep_faulty")
     assert sorted(table["k"].tolist()) == [0, 1, 2, 3] and set(table["status"]) == {0}
 
@@ -267,12 +267,20 @@ def test_sigterm_to_a_run_writes_the_trajectory_so_far(tmp_path):
          "--grid: 120,000 points (400 x 300) is more than 100,000; give --allow-large"),
         (["atwood", "--grid", "m1=1:nan:3"], "--grid: expected NAME=A:B:N"),
         (["chain", "--grid", "n=1:3:3", "--outputs", "q0", "--resume"], "resume: "),
+        (["chain", "--grid", "n=1:3:3", "--rtol", "-1"], "rtol: must be positive, got -1.0"),
+        (["chain", "--grid", "n=1:3:3", "--outputs", "q99"],
+         "outputs: 'q99' asks for q[99], but the models of the first and last points have 1 and 3 entries"),
+        (["chain", "--grid", "n=-4:0:3"], "grid: neither the first nor the last point can be built"),
+        (["spin_up_beam", "--grid", "family=1:2:2"], "--grid: family is not a number (its default is 'polynomial')"),
     ],
-    ids=["twice", "grid-and-set", "integer-repeats", "float-repeats", "huge", "nan", "resume-other-sweep"],
+    ids=["twice", "grid-and-set", "integer-repeats", "float-repeats", "huge", "nan", "resume-other-sweep",
+         "rtol-negative", "output-q99", "no-point-builds", "text-parameter"],
 )
 def test_the_grid_is_checked_before_any_work(argv, message, tmp_path, capsys):
     """Each refusal names the option and the problem (exit 2), and nothing is run or
-    written: an earlier table in --out (here of another sweep) is left as it was."""
+    written: an earlier table in --out (here of another sweep) is left as it was. A negative
+    rtol, an output no model has, a grid none of whose ends can be built and a text parameter
+    swept as numbers were found only after every point had run and failed (issue 37)."""
     earlier = "n,energy_drift,status,error\n7,0.0,0,\n"
     (tmp_path / f"sweep_{argv[0]}.csv").write_text(earlier)
     assert main(["sweep", *argv, "--out", str(tmp_path)]) == 2
@@ -315,3 +323,32 @@ def test_a_large_sweep_says_how_long_it_will_take(api, tmp_path, capsys, monkeyp
     with cf.ThreadPoolExecutor(1) as pool:
         sweep_module.sweep("atwood", grid={"m1": [1.0, 2.0]}, executor=pool, t_end=0.05)
     assert "points, about" not in capsys.readouterr().out
+
+
+def test_a_lost_dask_scheduler_fails_the_points_it_held_exit_1_no_traceback(tmp_path, capsys, monkeypatch):
+    """Passes if a Dask scheduler lost after the first point (the client's futures cancelled, its
+    submissions refused: tests/simulation/test_sweep_faults.LostScheduler, behind a client) ends
+    the sweep with exit 1, each lost point named on stderr with the reason, no traceback, and the
+    table written (before: a concurrent.futures.CancelledError traceback, the running points
+    unrecorded)."""
+    pytest.importorskip("cloudpickle")  # the scene goes to Dask workers by value
+    import projeq.cli.sweep
+    from tests.simulation.test_sweep_faults import LostScheduler
+
+    class Client:  # what sweep uses of a dask.distributed.Client
+        status = "running"
+
+        def get_executor(self):
+            return LostScheduler(2)  # the check that a worker loads the scene, then the first point
+
+        def close(self, timeout=None):
+            raise OSError("the scheduler is gone")
+
+    monkeypatch.setattr(projeq.cli.sweep, "_dask_client", lambda address, timeout: Client())
+    argv = ["sweep", "atwood", "--grid", "m1=1:2:3", "--scheduler", "tcp://lost:8786", "--t-end", "0.05",
+            "--out", str(tmp_path), "--quiet"]
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "point m1=1.5 failed: cancelled by the executor" in err
+    assert "point m1=2.0 failed: not run: the executor refused it" in err
+    assert SweepTable.load(tmp_path / "sweep_atwood")["status"].tolist() == [0, -1, -1]

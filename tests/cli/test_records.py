@@ -10,6 +10,7 @@ import pytest
 
 import projeq as pq
 import projeq.cli.studies
+import projeq.simulation.driver
 from projeq.cli.commands import main
 
 
@@ -201,3 +202,48 @@ def test_run_uses_the_scenes_settings_then_simulates_defaults(tmp_path, capsys):
     record = json.loads(capsys.readouterr().out)
     assert record["tolerances"] == {"rtol": "default", "atol": "default"}
     assert record["method"] == pq.Result.load(next((tmp_path / "pendulum").rglob("*.npz"))).method != "default"
+
+
+def test_a_run_out_of_range_exits_3_and_records_every_warning(tmp_path, capsys):
+    """Passes if `projeq run spin_up_beam --set omega_s=200 --set t_s=2 --t-end 3 --json` (issue 37:
+    exit 0, "finished", q ≈ 1e88 m, energy NaN) stops at t = 0.3 s, where the beam's tip passes its
+    moderate-deflection range, with exit code 3, status "out of range" in run.json and the NPZ,
+    the ValidityWarning in run.json's warnings, and every warning on stderr as one line
+    "projeq run: <Category>: <message>" (no Python source lines)."""
+    argv = ["run", "spin_up_beam", "--set", "omega_s=200", "--set", "t_s=2", "--t-end", "3", "--json",
+            "--out", str(tmp_path)]
+    assert main(argv) == 3
+    said = capsys.readouterr()
+    record = json.loads((run_folder(tmp_path) / "run.json").read_text())
+    assert json.loads(said.out)["status"] == record["status"] == "out of range" and record["exit_code"] == 3
+    assert record["t_reached"] == pytest.approx(0.3) and np.isfinite(record["energy"]["final"])
+    validity = [w for w in record["warnings"] if w["category"] == "ValidityWarning"]
+    assert len(validity) == 1 and validity[0]["message"].startswith("'beam' by t = 0.3 s: lateral deflection 0.33")
+    lines = said.err.splitlines()
+    assert [line for line in lines if line.startswith("projeq run: ")] == [f"projeq run: {w['category']}: {w['message']}"
+                                                             for w in record["warnings"]]
+    assert "projeq: stopped at t = 0.3 s: a subsystem left the range" in said.err and "warnings.warn" not in said.err
+    assert pq.Result.load(run_folder(tmp_path) / "spin_up_beam.npz").status == 3
+
+
+def test_a_run_whose_state_overflows_exits_4(tmp_path, capsys, monkeypatch):
+    """Passes if a run that simulate ends at a non-finite state (SimulationError, status 4: the
+    spin-up beam at omega_s = 200 let go on past its range does, tests/simulation/test_physics_range;
+    here a short chain run whose Result says so) exits with 4 and records "non-finite state",
+    its results up to there written (before: a non-finite state was "failed", exit 1, like any
+    failure)."""
+    from dataclasses import replace
+
+    real = projeq.simulation.driver.simulate
+
+    def overflowing(system, t_end, **options):
+        kept = replace(real(system, t_end / 2, **options), status=4)
+        raise projeq.simulation.driver.SimulationError(f"integration failed at t = {t_end / 2} s: the energy (T, V) "
+                                                       "= (nan, 1e+155) is not finite", kept)
+
+    monkeypatch.setattr(projeq.simulation.driver, "simulate", overflowing)
+    assert main(["run", "chain", "--t-end", "0.2", "--quiet", "--out", str(tmp_path)]) == 4
+    record = json.loads((run_folder(tmp_path) / "run.json").read_text())
+    assert record["status"] == "non-finite state" and record["exit_code"] == 4 and record["t_reached"] == 0.1
+    assert "is not finite" in capsys.readouterr().err
+    assert pq.Result.load(run_folder(tmp_path) / "chain.npz").status == 4
