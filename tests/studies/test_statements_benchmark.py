@@ -22,3 +22,17 @@ def test_the_quick_mode_runs_and_the_stated_plug_ins_are_compiled(capsys):
     assert found["Jacobian"] == "exact"
     assert found["drag in Python"] == [] and found["drag compiled vs recursive"] <= 1e-12  # measured 2e-16
     assert len(found["ratios"]) == 2 and "median ratio" in capsys.readouterr().out
+
+
+def test_code_size_counts_code_lines_only(tmp_path, capsys):
+    """benchmarks/code_size.py counts the lines that hold code (a docstring, comments and blank lines
+    left out) and prints both lists with their ratio."""
+    spec = importlib.util.spec_from_file_location("code_size", SCRIPT.parent / "code_size.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    sample = tmp_path / "sample.py"
+    sample.write_text('"""A module\ndocstring."""\n\n# a comment\ndef f(x):\n    """Its docstring."""\n'
+                      '    return (x +  # a trailing comment\n            1)\n')
+    assert module.code_lines(sample) == 3
+    report = module.main(["--json"])
+    assert report["totals"]["compiled"] > 0 and report["ratio"] == report["totals"]["compiled"] / report["totals"]["interpreted"]
