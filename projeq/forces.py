@@ -374,8 +374,7 @@ class BodyLoad(ForceLaw):
         values = self.compiled_wrench()
         if values is None:
             return None
-        held = dict(zip(values.__code__.co_freevars, (c.cell_contents for c in values.__closure__ or ())))
-        return "stated", (self.index,), np.array([held[name] for name in values.constants], dtype=float)
+        return "stated", (self.index,), np.array(values.values, dtype=float)
 
 
 def _printed_wrench(law):

@@ -32,12 +32,11 @@ class UncompiledLawWarning(UserWarning):
 
 
 def parameters(f) -> np.ndarray:
-    """The values of the constants (``f.constants``) that the printed function ``f`` of
-    :mod:`projeq.symbolic.codegen` holds in its closure, in their order, as float64 (kept alive here
-    while the process runs: the compiled kernels read them through their address)."""
+    """The values of the constants (``f.constants``) of the printed function ``f`` of
+    :mod:`projeq.symbolic.codegen` (``f.values``) as float64, kept alive here while the process runs:
+    the compiled kernels read them through their address."""
     if f not in _PARAMETERS:
-        held = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
-        _PARAMETERS[f] = np.array([float(held[name]) for name in f.constants], dtype=float)
+        _PARAMETERS[f] = np.array(f.values, dtype=float)
     return _PARAMETERS[f]
 
 
@@ -48,7 +47,7 @@ def generated_module(f, into: str, parameters: bool = False):
     which needs a file, keeps both across processes (a temporary directory where that is not
     writable: compiled anew each process). ``f``'s constants (``f.constants``) are, with
     ``parameters``, the entries of a last argument p of ``function`` (one module for all their
-    values), else module globals holding the values its closure holds."""
+    values), else module globals holding their values (``f.values``)."""
     import importlib.util
 
     numba = kernels.numba_module()
@@ -58,8 +57,7 @@ def generated_module(f, into: str, parameters: bool = False):
         unpacked = [f"    {name} = p[{i}]" for i, name in enumerate(f.constants)]
         constants, body = [], "\n".join([signature, *unpacked, header[1]])
     else:
-        held = dict(zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ())))
-        constants = [f"{name} = {float(value)!r}" for name, value in sorted(held.items())]
+        constants = [f"{name} = {float(value)!r}" for name, value in sorted(zip(f.constants, f.values))]
         body = f.source.replace(f"def {f.__name__}(", "def function(", 1)
     source = "\n".join(["import numba", "import numpy", "from numba import types as nb", "", *constants, "",
                         "@numba.njit(cache=True)", body, into])

@@ -41,7 +41,8 @@ def numeric_function(name: str, arguments, expressions, constants=()):
     array argument, a single symbol a scalar argument; ``constants``: symbols whose values
     ``make`` takes (captured by the function, constants to numba). The function's ``source``
     attribute is its own source (in the names of ``constants``, its ``constants`` attribute), to
-    be compiled where the constants are module globals (:func:`projeq.assembly.given.joint_callback`)."""
+    be compiled where the constants are module globals or the entries of an array argument
+    (:func:`projeq.assembly.generated.generated_module`), ``values`` the values ``make`` was given."""
     rename = {}
     for argument, symbols in arguments:
         if isinstance(symbols, sp.Symbol):
@@ -65,7 +66,8 @@ def numeric_function(name: str, arguments, expressions, constants=()):
     signature = f"def {name}({', '.join(a for a, _ in arguments)}):"
     body = [f"    {s} = {printer.doprint(e)}" for s, e in temporaries] + [f"    return numpy.array([{body}])"]
     lines = [f"def make({', '.join(names)}):", "    " + signature, *("    " + line for line in body),
-             f"    {name}.source = source", f"    {name}.constants = {tuple(names)!r}", f"    return {name}"]
+             f"    {name}.source = source", f"    {name}.constants = {tuple(names)!r}",
+             f"    {name}.values = ({''.join(n + ', ' for n in names)})", f"    return {name}"]
     source = "\n".join(lines) + "\n"
     namespace = {"numpy": np, "source": "\n".join([signature, *body]) + "\n"}
     exec(compile(source, f"<projeq.symbolic.codegen {name}>", "exec"), namespace)  # noqa: S102 — our own printout
