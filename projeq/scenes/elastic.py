@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from projeq.subsystems import inertia
-from projeq.checks import count, finite_array, positive, positives
+from projeq.checks import count, finite_array, non_negative, positive, positives
 from projeq.forces import JointSpring
 from projeq.joints import Fixed, Prescribed, Revolute
 from projeq.spatial import rotation_y, rotation_z
@@ -191,9 +191,7 @@ def rotating_blade(
     """
     n_shapes, omega = count("n_shapes", n_shapes), float(finite_array("omega", omega, ()))
     length, EI, rho_A = positives(length=length, EI=EI, rho_A=rho_A)
-    hub_radius = float(finite_array("hub_radius", hub_radius, ()))
-    if hub_radius < 0.0:
-        raise ValueError(f"hub_radius: must be zero or positive, got {hub_radius}")
+    hub_radius = non_negative("hub_radius", hub_radius)
     beam = RitzBeam(length, rho_A, EI, n_v=n_shapes, n_w=n_shapes, family=family)
     hub = Prescribed(Revolute(axis="z"), lambda t: (omega * t, omega, 0.0))
     return System({"hub": Frame(), "beam": beam},
