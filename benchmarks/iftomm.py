@@ -6,7 +6,7 @@ simulation software", Multibody System Dynamics 16 (2006) 179–190): A01 simple
 A02 N-four-bar mechanism (through singular positions; N = 2 and the benchmark's N = 40), A03
 Andrews' squeezing mechanism, A04 Bricard's mechanism (a redundant constraint), from
 :mod:`projeq.scenes.iftomm`, each run to its horizon with
-:class:`projeq.constraints.tangent.TangentSystem`. Per problem: CPU time, right-hand-side
+:class:`projeq.constraints.partitioned.TangentSystem`. Per problem: CPU time, right-hand-side
 evaluations, the largest loop-closure residual |Φ| and velocity-constraint residual
 |A_s ṡ_tree − b_s| at the outputs, the largest change of the energy (A03: of the energy balance
 T + V − E₀ − mom (β − β₀)), and the largest error against a reference: A01 Jacobi's closed form
@@ -44,7 +44,7 @@ import numpy as np
 import projeq as pq
 from projeq.constraints.augmented import AugmentedSystem
 from projeq.constraints.partitioned import ConstrainedSystem
-from projeq.constraints.tangent import TangentSystem
+from projeq.constraints.partitioned import TangentSystem
 from projeq.scenes.iftomm import (
     ANDREWS_REFERENCE, _flyball_geometry, andrews_balance, andrews_error, andrews_squeezer, bricard, flyball_balance,
     flyball_governor, flyball_steady_state, n_four_bar, parallelogram_motion, pendulum_angle, point_b0,

@@ -69,7 +69,7 @@ def repivoting(t_end: float, rtol: float) -> None:
             print(f"{label:<26}stopped: {str(error)[:90]}")
             continue
         reference = r if reference is None else reference
-        switches = " ".join(f"{t_k:.3f}{list(independent)}" for t_k, independent in r.partitions[1:]) or "-"
+        switches = " ".join(f"{t_k:.3f}{list(independent)}" for t_k, independent, _ in r.partitions[1:]) or "-"
         print(f"{label:<26}{switches:<34}{np.abs(r.q[:, 0] - reference.q[:, 0]).max():>10.2e}"
               f"{r.energy_drift:>10.2e}{r.nfev:>7d}{time.perf_counter() - started:>7.1f}")
 

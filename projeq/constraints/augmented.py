@@ -30,7 +30,7 @@ every combination of rows that cancels): λ = Σ_i u_i f_i (u_iᵀ r̃) / σ_i²
 The rank of A_s and the mobility are computed at every evaluation (:meth:`AugmentedSystem.rank`,
 :meth:`AugmentedSystem.mobility`); nothing stops the run at a singular position.
 
-Measured against :class:`~projeq.constraints.tangent.TangentSystem` (``benchmarks/iftomm.py``, double
+Measured against :class:`~projeq.constraints.partitioned.TangentSystem` (``benchmarks/iftomm.py``, double
 four-bar to 10 s): both run through the singular positions; here the released directions drift
 while they are released and the stabilisation pulls them back, so that point B0 is off the
 parallelogram motion by 6.6e-6 at rtol 1e-9 (TangentSystem: 7.6e-6) with 1.2 times the

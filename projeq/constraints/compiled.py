@@ -4,7 +4,7 @@
 Jacobian A_s = Φ_q of the loop closures and their second derivative γ = Φ″(q̇, q̇) by the complex
 step, the minimal velocities ṡ_tree = F ṡ, s̈_tree = F s̈ + f̄ — by coordinate partitioning,
 F = [E; −A_dep⁻¹ A_ind], f̄ = [0; −A_dep⁻¹ γ], or in
-:class:`~projeq.constraints.tangent.TangentSystem` by the null space N of A_s = U Σ Vᵀ,
+:class:`~projeq.constraints.partitioned.TangentSystem` by the null space N of A_s = U Σ Vᵀ,
 F = N N_ind⁻¹, f̄ = x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) —,
 the tree's Gauss form M s̈_tree + b at ṡ_tree, and solves the Projection Equation with the
 constraint inserted before the projection,
@@ -712,7 +712,7 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
 
 def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept,
             pivot, q_dot, s_ddot_tree, A, M, b):
-    """The constrained s̈ of :class:`~projeq.constraints.tangent.TangentSystem`: F = N N_ind⁻¹ with
+    """The constrained s̈ of :class:`~projeq.constraints.partitioned.TangentSystem`: F = N N_ind⁻¹ with
     N the null space of A_s = U Σ Vᵀ continued along the branch (``kept``: the tangent kept last,
     n × n_s, NaN where none; overwritten where the null space is separated, its rule), f̄ =
     x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) over the ``rank`` largest singular values above

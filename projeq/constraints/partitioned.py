@@ -49,7 +49,10 @@ t_start); energies and constraint residuals are computed in each row's own parti
 Where the constraint rows themselves become nearly dependent at the event (cond(A_s) above a
 tenth of the limit: every partition is as bad, a singular position of the mechanism such as
 links coming into line) re-pivoting would carry on along another branch of the motion: the run
-stops there and says so (:class:`projeq.constraints.tangent.TangentSystem` runs through).
+goes on from there in the null-space form (:class:`TangentSystem`, its branch started along
+the partition's F there; :meth:`~ConstrainedSystem.after_event`), which runs through, and
+``Result.partitions`` records the switch. Rows redundant along the whole motion (Bricard's
+mechanism) or nearly dependent at q0 take that form from the start (``formulation``).
 A user-fixed partition (``repivot=False``) stops the run at the same event with a
 ValueError naming (q, t): integrated on, the solver could step across the degeneracy
 (where ṡ_tree = F ṡ is ∞ · 0) and lose accuracy silently.
@@ -73,13 +76,16 @@ from __future__ import annotations
 import copy
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 
 from projeq.assembly.linalg import solve_spd
 from projeq.constraints.batched import batched_closure, time_rate
 from projeq.constraints.compiled import OWN_RULE, compiled_cut_joints, compiled_partition, uncompiled, unsupported
 from projeq.constraints.cut_joints import cut_joints, point_rows
+from projeq.constraints.matrices import (
+    RANK_TOLERANCE, REPIVOT_CONDITION, independent_indices, minimum_norm_solution, numerical_rank, pivoted_columns,
+)
+from projeq.constraints.tangent import SEPARATION, NullSpaceForm
 from projeq.checks import depends_on_t, positive, state_vector
 from projeq.analysis.differentiation import (MIXED_STEP, complex_failure, derivative_along,
                                              derivative_along_differences, second_derivative_along,
@@ -89,17 +95,12 @@ from projeq.spatial import numeric
 from projeq.system import Model
 
 CORRECTIONS = ("projection", "baumgarte", "none")
+# the forms of the minimal velocities: chosen at construction ("auto"), or as the user says
+FORMULATIONS = ("auto", "partitioned", "null_space")
 # condition number κ = ‖A_s‖ ‖A_dep⁻¹‖ above which the partition is degenerate
 PARTITION_CONDITION = 1e8
-# re-pivot when κ exceeds this (or 10 × its value where the partition was chosen): up to
-# there ‖F‖ ≤ κ amplifies the constraint terms' round-off at most ~κ-fold, and the integrator
-# has not met the ∞ · 0 of ṡ_tree = F ṡ at the degeneracy
-REPIVOT_CONDITION = 1e2
 # |Φ| (relative to the largest coordinate, at least 1) accepted as on the manifold: 1e4 × round-off
 POSITION_TOLERANCE = 1e-12
-# singular values of A_s below this fraction of the largest count as zero (rank, mobility): the
-# differences' errors (~1e-10 relative) lie below, a constraint that still acts far above
-RANK_TOLERANCE = 1e-7
 
 
 class ConstrainedSystem(Model):
@@ -133,6 +134,17 @@ class ConstrainedSystem(Model):
         default: True for the automatic partition, False for a user-fixed ``independent``
         (then a run stops with an error naming the configuration where κ reaches
         the limit, rather than lose accuracy silently).
+    formulation : "auto", "partitioned" or "null_space"
+        How the minimal velocities are formed (docs/theory.md §7). "auto" (the default)
+        partitions the tree velocities where the constraint rows are independent on the
+        constraint surface and well conditioned at q0 (the cheaper form, measured in
+        ``benchmarks/iftomm.py``), and takes the null-space form
+        (:class:`TangentSystem`) where rows are redundant along the motion (Bricard's
+        mechanism) or nearly dependent at q0; a run that meets a singular position (links
+        coming into line) goes on in the null-space form from there (``Result.partitions``
+        records it). "partitioned" refuses redundant rows; "null_space" takes that form
+        throughout. ``redundant`` lists the rows found redundant (their multipliers are the
+        minimum-norm solution, :meth:`accelerations_tree`).
 
     Examples
     --------
@@ -153,10 +165,11 @@ class ConstrainedSystem(Model):
     """
 
     limit = REPIVOT_CONDITION  # κ of the partition that triggers re-pivoting; per partition once chosen
+    formulation = "partitioned"  # the form of the minimal velocities (TangentSystem: "null space")
 
     def __init__(self, system, phi=None, A=None, b=None, independent=None, q0=None, s_dot0=None,
                  project_q0: bool = False, correction: str = "projection", beta: float = 10.0,
-                 repivot: bool | None = None):
+                 repivot: bool | None = None, formulation: str = "auto"):
         if phi is None and A is None:
             raise ValueError("phi: give holonomic constraints phi(q, t) and/or Pfaffian ones A(q, t)")
         phi = cut_joints(phi)
@@ -170,6 +183,8 @@ class ConstrainedSystem(Model):
             raise ValueError("b: given without A (Pfaffian constraints are A(q, t) q̇ = b(q, t))")
         if correction not in CORRECTIONS:
             raise ValueError(f"correction: unknown method {correction!r}; use one of {list(CORRECTIONS)}")
+        if formulation not in FORMULATIONS:
+            raise ValueError(f"formulation: unknown form {formulation!r}; use one of {list(FORMULATIONS)}")
         self.tree, self._phi, self._A, self._b = system, phi, A, b
         self.correction, self.beta = correction, positive("beta", beta)
         self.names, self.subsystems, self.n_q = system.names, system.subsystems, system.n_q
@@ -189,6 +204,7 @@ class ConstrainedSystem(Model):
         # Φ(q, t) through a joint prescribed in time (a driven mechanism) or, with Baumgarte's correction, any
         # Φ: ∂Φ/∂t and the rheonomic parts of Φ″ are evaluated; else Φ(q) alone, whose are 0
         self.rheonomic = correction != "projection" or bool(self.m_h and depends_on_t(self.phi, q0))
+        self._choose_form(q0, formulation, independent)
         self._choose_velocities(q0, independent, repivot)
         self.q0 = self._initial_q(q0, project_q0)
         self.s_dot0 = state_vector("s_dot0", np.zeros(self.n_s) if s_dot0 is None else s_dot0, self.n_s)
@@ -231,7 +247,14 @@ class ConstrainedSystem(Model):
         rows = self._cut_joint_rows()
         if rows is not None and (rows.complex_safe or not np.iscomplexobj(q)):
             return rows.values(q, t)
-        return numeric(self._phi(q, t))
+        try:
+            value = numeric(self._phi(q, t))
+        except ValueError as error:  # rows of different shapes
+            raise ValueError(f"phi: returns rows numpy cannot stack at t = {np.real(t):.6g} ({error})") from None
+        if value.shape != (self.m_h,):
+            raise ValueError(f"phi: returns shape {value.shape} at t = {np.real(t):.6g}, {(self.m_h,)} at q0: the "
+                             "number of constraint rows must not change during a run")
+        return value
 
     _cut_rows = None  # CutJointRows; None: Φ is not made of cut joints, or they do not compile; False: not looked for
 
@@ -291,7 +314,6 @@ class ConstrainedSystem(Model):
     # -- partition --------------------------------------------------------------------------
     def _choose_velocities(self, q0, independent, repivot) -> None:
         """The minimal velocities: the partition (checked at q0) and its re-pivoting limit."""
-        self._check_rank(q0)
         self.repivot = independent is None if repivot is None else _check_repivot(repivot)
         self.independent, self.dependent = self._partition(q0, independent)
         self.n_s = len(self.independent)
@@ -307,26 +329,107 @@ class ConstrainedSystem(Model):
             return C, c
         return C @ self.tree.K(q, t), c - C @ self.tree.q_dot(q, np.zeros(self.tree.n_s), t)
 
-    def _check_rank(self, q0) -> None:
+    redundant = ()  # rows that depend on the others along the motion (found at construction, _rows_on_surface)
+
+    def _choose_form(self, q0, formulation: str, independent) -> None:
+        """The form of the minimal velocities (the ``formulation`` parameter): this class's
+        partition where the rows are independent on the constraint surface and well conditioned
+        at q0, else the null-space form (:class:`TangentSystem`, into which this object turns)."""
+        self.redundant = self._rows_on_surface(q0)
+        self.automatic = formulation == "auto"  # goes on in the null-space form from a singular position
+        if isinstance(self, NullSpaceForm):
+            return
+        if formulation == "partitioned" or (formulation == "auto" and independent is not None and not self.redundant):
+            if self.redundant:
+                raise ValueError(
+                    f"phi: rows {list(self.redundant)} depend on the others along the motion (the rank of the "
+                    f"constraints is {self.n_c - len(self.redundant)} of {self.n_c} at q0 and on the constraint surface "
+                    "around it); formulation='partitioned' needs independent rows: remove them, or leave "
+                    "formulation at its default, which takes redundant rows as they are")
+            if self.n_c > self.tree.n_s:
+                raise ValueError(f"phi: {self.n_c} constraints on only {self.tree.n_s} tree velocities")
+            return
+        if formulation == "null_space" or self.redundant or not self._well_conditioned(q0):
+            self.__class__, self.separation = TangentSystem, SEPARATION
+
+    def _well_conditioned(self, q0) -> bool:
+        """Whether the rows are far from a singular position at q0: σ_min ≥ σ_max / REPIVOT_CONDITION
+        of A_s (every partition's κ ≥ cond(A_s) would start at the re-pivoting limit otherwise)."""
+        sigma = np.linalg.svd(self.constraint_matrix(q0)[0], compute_uv=False)
+        return not sigma.size or sigma[-1] * REPIVOT_CONDITION >= sigma[0]
+
+    def _rows_on_surface(self, q0) -> tuple:
+        """The rows that depend on those before them at q0 and on the constraint surface around it
+        (redundant along the motion); ValueError naming phi (or A) and the cause for a row whose
+        gradient vanishes at q0, and naming q0 where rows lose rank only there (a singular position)."""
         A_s = self.constraint_matrix(q0)[0]
-        if self.n_c > self.tree.n_s:
-            raise ValueError(f"phi: {self.n_c} constraints on only {self.tree.n_s} tree velocities")
+        if not np.all(np.isfinite(A_s)):
+            raise ValueError(f"phi: the constraint derivatives are not finite at q0 = {np.round(q0, 6).tolist()}")
         tol = 1e-9 * max(np.abs(A_s).max(initial=0.0), 1.0)  # far above round-off, far below a real row
-        kept, redundant = [], []
-        for i in range(self.n_c):  # a row is redundant if it lies in the span of the rows kept before it
-            (kept if np.linalg.matrix_rank(A_s[kept + [i]], tol) > len(kept) else redundant).append(i)
-        if redundant and _full_rank_nearby(lambda q: self.constraint_matrix(q)[0], q0, self.n_c, tol):
+        for i in np.flatnonzero(np.abs(A_s).max(axis=1, initial=0.0) <= tol):
+            raise self._vanishing_row(int(i), q0, tol)
+        redundant = _dependent_rows(A_s, tol)
+        if not redundant:
+            return ()
+        nearby = self._nearby_on_surface(q0)
+        if all(len(_dependent_rows(self.constraint_matrix(q)[0], tol)) < len(redundant) for q in nearby):
             raise ValueError(
-                f"q0: a singular pose of the constraints (rank {len(kept)} of {self.n_c} at q0 = "
-                f"{np.round(q0, 6).tolist()}, full rank nearby): rows {redundant} lose their direction here "
-                "(a dead-centre or aligned-links position); start the mechanism away from it"
-            )
-        if redundant:
-            raise ValueError(
-                f"phi: the constraint rows are rank-deficient at q0 (rank {len(kept)} of {self.n_c}): rows "
-                f"{redundant} depend on rows {kept} (rows count Φ first, then A); remove the redundant ones, or use TangentSystem "
-                "(projeq.constraints.tangent), which takes redundant constraints as they are"
-            )
+                f"q0: a singular position of the constraints (rank {self.n_c - len(redundant)} of {self.n_c} at "
+                f"q0 = {np.round(q0, 6).tolist()}, {self.n_c} on the constraint surface around it): rows "
+                f"{redundant} lose their direction here (a dead-centre or aligned-links position), so the "
+                "mobility at q0 is not the mechanism's; start the mechanism away from it")
+        return tuple(redundant)
+
+    def _nearby_on_surface(self, q0, count: int = 2) -> list:
+        """``count`` points 1e-3 from q0, moved onto Φ(q, 0) = 0 (the constraint surface, where the rank
+        of redundant rows stays low: off it they are independent); those that cannot be moved there
+        are left out."""
+        rng, points = np.random.default_rng(1), []
+        for _ in range(count):
+            q = self.tree.normalized(q0 + 1e-3 * rng.standard_normal(len(q0)))
+            try:
+                points.append(self.project(q) if self.m_h else q)
+            except ValueError:
+                continue
+        return points
+
+    def _vanishing_row(self, i: int, q0, tol: float) -> ValueError:
+        """The error for row i of the constraints whose gradient vanishes at q0: a row of A; a
+        Φ row zero around q0 too (it constrains nothing); a Φ row with a saddle at q0 (its surface
+        branches: a singular position); with an extremum (its solutions are isolated: the mechanism
+        cannot move); or one that is only stationary there (curvature of one sign, some zero)."""
+        where = f"q0 = {np.round(q0, 6).tolist()}"
+        if i >= self.m_h:
+            return ValueError(f"A: row {i - self.m_h} vanishes at {where}: it constrains no velocity there; "
+                              "remove it, or start where it acts")
+        hessian = self._phi_hessian(i, q0)
+        if np.abs(hessian).max(initial=0.0) <= tol and all(
+                abs(self.phi(q)[i]) <= tol for q in q0 + 1e-2 * np.random.default_rng(2).standard_normal((3, len(q0)))):
+            return ValueError(f"phi: row {i} is zero at and around {where} (value and gradient): it constrains "
+                              "nothing; remove it")
+        curvature = np.linalg.eigvalsh((hessian + hessian.T) / 2)
+        if curvature[0] < -tol and curvature[-1] > tol:
+            return ValueError(
+                f"q0: a singular position of the constraints: Φ[{i}]'s gradient vanishes at {where}, where "
+                f"the surface Φ[{i}] = 0 branches (like x z = 0 at the origin, two lines crossing), so the motion's "
+                "directions are not determined there; start the mechanism away from it")
+        if curvature[0] * curvature[-1] > 0 and min(abs(curvature[0]), abs(curvature[-1])) > tol:
+            return ValueError(
+                f"phi: row {i} holds only at isolated points around {where}: Φ[{i}] has a "
+                f"{'minimum' if curvature[0] > 0 else 'maximum'} there and its gradient vanishes (like a two-link "
+                "arm stretched to its full reach), so no motion keeps it; it fixes every coordinate, not a "
+                "degree of freedom: write the constraints the mechanism holds, or start where it can move")
+        return ValueError(
+            f"phi: row {i}'s gradient ∂Φ[{i}]/∂q vanishes at {where}: Φ[{i}] is stationary there, so it fixes "
+            "coordinates only to second order (like 1 − cos q = 0 at q = 0) and its velocity constraint is "
+            "empty; write it with a gradient that does not vanish (q = 0), or start where it does not")
+
+    def _phi_hessian(self, i: int, q0) -> NDArray:
+        """∂²Φ[i]/∂q² at q0 by central differences of the exact first derivatives (step 1e-5):
+        enough to tell the sign of its curvature."""
+        h, n = 1e-5, self.n_q
+        columns = [(self.phi_q(q0 + h * e)[i] - self.phi_q(q0 - h * e)[i]) / (2 * h) for e in np.eye(n)]
+        return np.array(columns).T
 
     def _partition(self, q0, independent) -> tuple[NDArray, NDArray]:
         n_s = self.tree.n_s
@@ -374,6 +477,8 @@ class ConstrainedSystem(Model):
         pivoted QR picks at (q, t), the same tree, the same tree velocities
         ṡ_tree = F_old ṡ_old + f_old, ṡ_new = ṡ_tree[independent_new]; the new system
         starts at (q, ṡ_new). Without ``repivot``: ValueError naming (q, t)."""
+        if self._near_dependent(q, t) and self.automatic:  # a singular position: every partition is as bad
+            return self._in_null_space(q, s_dot, t)
         if not self.repivot:
             raise self._degenerate(q, t, self.condition(q, t), self.limit)
         if self._near_dependent(q, t):  # re-pivoting here would carry on along another branch, silently
@@ -381,6 +486,26 @@ class ConstrainedSystem(Model):
         dependent = pivoted_columns(self.constraint_matrix(q, t)[0], self.n_c)
         new = self._in_partition(np.setdiff1d(np.arange(self.tree.n_s), dependent), q, t)
         new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
+        return new, new.s_dot0.copy()
+
+    def _in_null_space(self, q: NDArray, s_dot: NDArray, t: float) -> tuple["TangentSystem", NDArray]:
+        """(system, s_dot) going on from a singular position in the null-space form: a copy that is a
+        :class:`TangentSystem` whose branch starts along this partition's F at (q, t) (the
+        motion's tangent before the singular position), the same independent velocities if the
+        user fixed them (else those pivoted QR picks from that tangent), the same tree velocities
+        ṡ_tree = F ṡ + f."""
+        F, f = self.F(q, t)
+        new = copy.copy(self)
+        new.__class__, new.separation = TangentSystem, SEPARATION
+        new._inverse, new._compiled, new._uncompiled = (None, None), False, None
+        new._tangent = np.linalg.qr(F)[0]
+        if self.repivot:
+            new.independent = pivoted_columns(new._tangent.T, self.n_s)
+            new.dependent = np.setdiff1d(np.arange(self.tree.n_s), new.independent)
+        new.q0 = np.array(q, dtype=float)
+        new.check_configuration(q, t)
+        new.limit = max(REPIVOT_CONDITION, 10 * new.condition(q, t))
+        new.s_dot0 = (F @ s_dot + f)[new.independent]
         return new, new.s_dot0.copy()
 
     def with_independent(self, independent, repivot: bool | None = None) -> "ConstrainedSystem":
@@ -395,16 +520,21 @@ class ConstrainedSystem(Model):
 
     def row_models(self, result) -> list:
         """This system in the partition of each row of ``result`` (``Result.partitions``:
-        (t_k, independent_k) holds for t_k < t ≤ t_k+1, the first one from the start)."""
+        (t_k, independent_k, formulation_k) holds for t_k < t ≤ t_k+1, the first one from the start)."""
         if not result.partitions:
             return [self] * len(result.t)
-        starts = [t for t, _ in result.partitions]
-        systems = [self._in_partition(np.asarray(independent), self.q0) for _, independent in result.partitions]
+        starts = [t for t, *_ in result.partitions]
+        systems = [self._in_partition(np.asarray(independent), self.q0, formulation=formulation)
+                   for _, independent, formulation in result.partitions]
         return [systems[max(k - 1, 0)] for k in np.searchsorted(starts, result.t, side="left")]
 
-    def _in_partition(self, independent, q, t=0.0) -> "ConstrainedSystem":
-        """A copy with the partition ``independent`` (unchecked), starting at q."""
+    def _in_partition(self, independent, q, t=0.0, formulation: str | None = None) -> "ConstrainedSystem":
+        """A copy with the partition ``independent`` (unchecked) in ``formulation`` (default: this
+        system's), starting at q."""
         new = copy.copy(self)
+        if formulation is not None and formulation != self.formulation:
+            new.__class__ = TangentSystem if formulation == "null space" else ConstrainedSystem
+            new.separation, new._compiled = SEPARATION, False
         new.independent, new.dependent = independent, np.setdiff1d(np.arange(self.tree.n_s), independent)
         new._inverse = (None, None)  # A_dep⁻¹ of the old partition
         new.q0 = np.array(q, dtype=float)
@@ -429,7 +559,7 @@ class ConstrainedSystem(Model):
         return ValueError(
             f"independent: the dependent velocities {self.dependent.tolist()} cannot be solved for at "
             f"{where}, reached within one step before the partition could be re-chosen; pass a smaller "
-            "max_step to simulate, or use TangentSystem (projeq.constraints.tangent), which needs no partition"
+            "max_step to simulate, or pass formulation='null_space', which needs no partition"
         )
 
     def _near_dependent(self, q, t) -> bool:
@@ -443,17 +573,18 @@ class ConstrainedSystem(Model):
             f"phi: the mechanism reaches a singular position at q = {np.round(q, 6).tolist()}, "
             f"t = {t:.6g}: its {self.n_c} constraint equations become dependent there (links coming into "
             "line, where the motion can branch), so that no choice of independent velocities carries the "
-            "motion through it; TangentSystem (projeq.constraints.tangent) does"
+            "motion through it; the null-space form does (leave independent and repivot at their defaults, "
+            "which go on in it from here, or pass formulation='null_space')"
         )
 
     def rank(self, q: NDArray, t: float = 0.0) -> int:
         """The numerical rank of A_s at (q, t): its singular values above RANK_TOLERANCE ‖A_s‖₂."""
-        return self._rank_and_mobility(self.constraint_matrix(q, t)[0])[0]
+        return self._rank_and_mobility(self.constraint_matrix(self.check_q("q", q), t)[0])[0]
 
     def mobility(self, q: NDArray, t: float = 0.0) -> int:
         """Degrees of freedom at (q, t): the tree's velocities minus :meth:`rank` (Grübler's count
         n_s,tree − n_c when no constraint is redundant)."""
-        return self._rank_and_mobility(self.constraint_matrix(q, t)[0])[1]
+        return self._rank_and_mobility(self.constraint_matrix(self.check_q("q", q), t)[0])[1]
 
     def _rank_and_mobility(self, A_s: NDArray) -> tuple[int, int]:
         """(rank, n_s,tree − rank) of the constraint matrix A_s."""
@@ -734,6 +865,41 @@ class ConstrainedSystem(Model):
         return f"ConstrainedSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian)"
 
 
+class TangentSystem(NullSpaceForm, ConstrainedSystem):
+    """The null-space form of a :class:`ConstrainedSystem` (:mod:`projeq.constraints.tangent`): F
+    spans the null space of the constraints, so that the model runs through singular positions and
+    takes redundant constraints as they are. A ConstrainedSystem takes this form where its rows are
+    redundant or nearly dependent at q0, with ``formulation="null_space"``, and from a singular
+    position its run meets on; built directly, it is that form throughout.
+
+    The arguments are those of :class:`~projeq.constraints.partitioned.ConstrainedSystem`; its
+    n_s is the mobility at q0 (tree velocities minus the rank of the constraints there), and
+    ``independent`` (default: column-pivoted QR of the null space) names n_s tree velocities.
+    ``separation`` (default SEPARATION = 1e-2): singular values of A_s below this fraction of the
+    largest count as near-null, where N continues the branch's tangent; 0 takes the n_s smallest
+    singular vectors everywhere (no continuation: an integrator stage off the constraint manifold
+    near a singular position can then take a direction that has come free, module docstring).
+
+    Examples
+    --------
+    A pendulum on x and z sliders, its constraint written twice (a redundant row):
+
+    >>> import numpy as np, projeq as pq
+    >>> tree = pq.System({"x": pq.Frame(), "bob": pq.PointMass(1.0)},
+    ...     {"x": pq.Prismatic(axis="x"), "bob": pq.Prismatic(parent="x", axis="z")},
+    ...     gravity=(0, 0, -9.81))
+    >>> circle = lambda q, t: [np.hypot(q[0], q[1]) - 1.0, 2 * (np.hypot(q[0], q[1]) - 1.0)]
+    >>> pendulum = pq.ConstrainedSystem(tree, phi=circle, q0=[0.6, -0.8])
+    >>> pendulum.n_c, pendulum.rank(pendulum.q0), pendulum.n_s, pendulum.redundant, pendulum.formulation
+    (2, 1, 1, (1,), 'null space')
+    >>> r = pq.simulate(pendulum, 0.2, n_points=5, n_segments=2)
+    >>> bool(np.abs(r.constraint_residual).max() < 1e-10)
+    True
+    """
+
+    formulation = "null space"
+
+
 class PartitionedEvaluator:
     """s̈ = s̈_tree[independent] of a ConstrainedSystem by the tree evaluator ``method``
     (checked here: an unknown name raises ValueError); the state is not checked.
@@ -801,71 +967,16 @@ def _partition_condition(A_s: NDArray, dependent: NDArray) -> float:
     return float(np.linalg.svd(A_s, compute_uv=False)[0] / sigma[-1]) if sigma[-1] > 0 else np.inf
 
 
-def independent_indices(independent, count: int, n_tree: int, why: str) -> NDArray:
-    """``independent`` as sorted indices of ṡ_tree: ``count`` distinct integers in 0..n_tree − 1
-    (ValueError naming the parameter and ``why`` that many otherwise)."""
-    chosen = np.asarray(independent)
-    if chosen.ndim != 1 or not np.issubdtype(chosen.dtype, np.integer) or len(chosen) != count \
-            or len(set(chosen.tolist())) != count or np.any((chosen < 0) | (chosen >= n_tree)):
-        raise ValueError(f"independent: expected {count} distinct indices of ṡ_tree in 0..{n_tree - 1} "
-                         f"({why}), got {independent!r}")
-    return np.sort(chosen)
 
 
-def minimum_norm_solution(A: NDArray, c: NDArray, rcond: float = RANK_TOLERANCE, rank: int | None = None) -> NDArray:
-    """A⁺ c, the minimum-norm least-squares solution, with A⁺ over the singular values of A above
-    ``rcond`` σ_max (at most ``rank`` of them). Complex-safe: for A = A₀ + i A₁, c carrying a
-    complex step (|A₁| ~ 1e-30) it is (A₀⁺ + i dA⁺) c with the derivative of a pseudo-inverse
-    of constant rank (Golub & Pereyra, "The differentiation of pseudo-inverses and nonlinear
-    least squares problems whose variables separate", SIAM J. Numer. Anal. 10, 1973, Theorem 4.3)
-
-        dA⁺ = −A⁺ dA A⁺ + A⁺A⁺ᵀ dAᵀ (E − A A⁺) + (E − A⁺A) dAᵀ A⁺ᵀA⁺,
-
-    transposes, not conjugates (``np.linalg.lstsq`` conjugates: the complex step through it
-    would be silently wrong), so that the complex step gives the exact derivative."""
-    A0 = np.real(A)
-    if not A0.size:
-        return np.zeros(A0.shape[1:] + np.shape(c)[1:], dtype=np.result_type(A, c))
-    P = _pseudo_inverse(A0, rcond, rank)
-    if not (np.iscomplexobj(A) or np.iscomplexobj(c)):
-        return P @ c
-    dA = A - A0
-    dP = -P @ dA @ P + P @ P.T @ dA.T @ (np.eye(len(A0)) - A0 @ P) + (np.eye(A0.shape[1]) - P @ A0) @ dA.T @ P.T @ P
-    return (P + dP) @ c
 
 
-_LATEST_PSEUDO_INVERSE = (None, None)  # (key, A₀⁺) of the latest _pseudo_inverse: f and f̄ of one state share A_s
 
 
-def _pseudo_inverse(A0: NDArray, rcond: float, rank: int | None) -> NDArray:
-    """A₀⁺ over the singular values of the real A₀ above ``rcond`` σ_max (at most ``rank`` of
-    them), kept for the latest (A₀, rcond, rank)."""
-    global _LATEST_PSEUDO_INVERSE
-    key = (A0.shape, A0.tobytes(), rcond, rank)
-    latest = _LATEST_PSEUDO_INVERSE  # one read: another thread may replace it
-    if latest[0] == key:
-        return latest[1]
-    U, sigma, Vt = np.linalg.svd(A0, full_matrices=False)
-    k = min(int(np.count_nonzero(sigma > rcond * sigma[0])), len(sigma) if rank is None else rank)
-    P = Vt[:k].T @ (U[:, :k].T / sigma[:k, None])
-    _LATEST_PSEUDO_INVERSE = (key, P)
-    return P
 
 
-def numerical_rank(A: NDArray) -> int:
-    """The number of singular values of A above RANK_TOLERANCE times the largest (0 for no rows)."""
-    if not A.size:
-        return 0
-    sigma = np.linalg.svd(A, compute_uv=False)
-    return int(np.count_nonzero(sigma > RANK_TOLERANCE * sigma[0]))
 
 
-def pivoted_columns(A: NDArray, k: int) -> NDArray:
-    """The k columns of A that column-pivoted QR takes first, sorted: those with the
-    best-conditioned block (a ConstrainedSystem's dependent velocities, columns of A_s; a
-    TangentSystem's independent ones, columns of Nᵀ). In numpy's index type: LAPACK's pivots are
-    int32, which cost a conversion at every indexing and a second compilation of the closure kernel."""
-    return np.sort(scipy.linalg.qr(A, pivoting=True)[2][:k]).astype(np.intp)
 
 
 def _pfaffian_residual(system: ConstrainedSystem, q_t, q_dot) -> NDArray:
@@ -873,9 +984,9 @@ def _pfaffian_residual(system: ConstrainedSystem, q_t, q_dot) -> NDArray:
     return A @ q_dot - b
 
 
-def _full_rank_nearby(matrix, q0: NDArray, rank: int, tol: float) -> bool:
-    """Whether ``matrix(q)`` has ``rank`` at two points 1e-3 from q0 (q0 is then a singular
-    pose, not a set of redundant rows, which lose rank everywhere)."""
-    rng = np.random.default_rng(1)
-    return all(np.linalg.matrix_rank(matrix(q0 + 1e-3 * rng.standard_normal(len(q0))), tol) == rank
-               for _ in range(2))
+def _dependent_rows(A_s: NDArray, tol: float) -> list:
+    """The rows of A_s in the span of the rows before them (rank test at ``tol``)."""
+    kept, dependent = [], []
+    for i in range(len(A_s)):
+        (kept if np.linalg.matrix_rank(A_s[kept + [i]], tol) > len(kept) else dependent).append(i)
+    return dependent

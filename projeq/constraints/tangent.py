@@ -55,9 +55,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.constraints.compiled import OWN_RULE, compiled_tangent, uncompiled
-from projeq.constraints.partitioned import (
-    RANK_TOLERANCE, REPIVOT_CONDITION, ConstrainedSystem, independent_indices, minimum_norm_solution, numerical_rank,
-    pivoted_columns,
+from projeq.system import Model
+from projeq.constraints.matrices import (
+    REPIVOT_CONDITION, independent_indices, minimum_norm_solution, numerical_rank, pivoted_columns,
 )
 
 
@@ -70,35 +70,12 @@ ACTING = 1e-6
 SEPARATION = 1e-2
 
 
-class TangentSystem(ConstrainedSystem):
-    """A tree System with constraint equations in minimal velocities whose matrix F spans the
-    null space of the constraints (module docstring): runs through singular positions and takes
-    redundant constraints as they are.
-
-    The arguments are those of :class:`~projeq.constraints.partitioned.ConstrainedSystem`; its
-    n_s is the mobility at q0 (tree velocities minus the rank of the constraints there), and
-    ``independent`` (default: column-pivoted QR of the null space) names n_s tree velocities.
-    ``separation`` (default SEPARATION = 1e-2): singular values of A_s below this fraction of the
-    largest count as near-null, where N continues the branch's tangent; 0 takes the n_s smallest
-    singular vectors everywhere (no continuation: an integrator stage off the constraint manifold
-    near a singular position can then take a direction that has come free, module docstring).
-
-    Examples
-    --------
-    A pendulum on x and z sliders, its constraint written twice (a redundant row):
-
-    >>> import numpy as np, projeq as pq
-    >>> tree = pq.System({"x": pq.Frame(), "bob": pq.PointMass(1.0)},
-    ...     {"x": pq.Prismatic(axis="x"), "bob": pq.Prismatic(parent="x", axis="z")},
-    ...     gravity=(0, 0, -9.81))
-    >>> circle = lambda q, t: [np.hypot(q[0], q[1]) - 1.0, 2 * (np.hypot(q[0], q[1]) - 1.0)]
-    >>> pendulum = TangentSystem(tree, phi=circle, q0=[0.6, -0.8])
-    >>> pendulum.n_c, pendulum.rank(pendulum.q0), pendulum.n_s
-    (2, 1, 1)
-    >>> r = pq.simulate(pendulum, 0.2, n_points=5, n_segments=2)
-    >>> bool(np.abs(r.constraint_residual).max() < 1e-10)
-    True
-    """
+class NullSpaceForm(Model):
+    """The null-space form of a :class:`~projeq.constraints.partitioned.ConstrainedSystem`
+    (module docstring): F spans the null space of the constraints, so that the model runs
+    through singular positions and takes redundant constraints as they are. Mixed into
+    :class:`~projeq.constraints.partitioned.TangentSystem`, the class a ConstrainedSystem
+    becomes where it takes this form (a Model, so that an object can change between the two)."""
 
     _latest = (None, None)  # (key of (q, t), (C, c)) of the latest velocity_constraints call
     _svd = (None, None)  # (key of A_s, its SVD) of the latest decomposition
@@ -195,7 +172,7 @@ class TangentSystem(ConstrainedSystem):
         new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
         return new, new.s_dot0.copy()
 
-    def with_independent(self, independent, repivot: bool | None = None) -> "TangentSystem":
+    def with_independent(self, independent, repivot: bool | None = None) -> "NullSpaceForm":
         """This system with the tree velocities ``independent`` as its minimal velocities."""
         new = self._in_partition(np.sort(np.asarray(independent)), self.q0)
         new.check_configuration(self.q0)
@@ -237,7 +214,7 @@ class TangentSystem(ConstrainedSystem):
     def _compiled_rule(self):
         """The compiled kernel of the tangent space (:func:`projeq.constraints.compiled.tangent`),
         None (after one warning) for a subclass that forms F by its own rule."""
-        if type(self).F is not TangentSystem.F or type(self).particular is not TangentSystem.particular:
+        if type(self).F is not NullSpaceForm.F or type(self).particular is not NullSpaceForm.particular:
             return uncompiled(self, OWN_RULE)
         return compiled_tangent(self, ACTING)
 
@@ -257,7 +234,8 @@ class TangentSystem(ConstrainedSystem):
         return x0 - self._scaled(self._null_space(A_s)) @ x0[self.independent]
 
     def __repr__(self) -> str:
-        return f"TangentSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian)"
+        return (f"ConstrainedSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian, "
+                f"null-space form)")
 
 
 def ratio_rate(A: NDArray, A_dot: NDArray, r: int) -> float:

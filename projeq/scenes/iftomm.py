@@ -2,7 +2,7 @@
 (M. González, D. Dopico, U. Lugrís, J. Cuadrado, "A benchmarking system for MBS simulation
 software: problem standardization and performance measurement", Multibody System Dynamics 16
 (2006) 179–190; problems A01 simple pendulum, A02 N-four-bar mechanism, A03 Andrews' mechanism,
-A04 Bricard's mechanism), as :class:`~projeq.constraints.tangent.TangentSystem` s: trees closed by
+A04 Bricard's mechanism), as :class:`~projeq.constraints.partitioned.TangentSystem` s: trees closed by
 constraint equations, run through singular positions and with redundant constraints; and A05, the
 stiff flyball governor, a tree with two stiff spring-dampers (:func:`flyball_governor`).
 
@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from projeq.checks import count, non_negative, positive
-from projeq.constraints.tangent import TangentSystem
+from projeq.constraints.partitioned import ConstrainedSystem, TangentSystem
 from projeq.forces import JointForce, SpringDamper
 from projeq.joints import Fixed, Prismatic, Revolute
 from projeq.scenes.mechanisms import slender_rod
@@ -28,7 +28,7 @@ def simple_pendulum(m: float = 1.0, L: float = 1.0, g: float = 9.81, **options) 
     """IFToMM A01: a point mass m on a massless rod of length L, in natural coordinates — the
     mass on x and y sliders held at distance L from the pivot by Φ = x² + y² − L² = 0;
     gravity −y. Starts at rest with the rod horizontal, (x, y) = (L, 0), the benchmark's start.
-    ``options`` go to :class:`~projeq.constraints.tangent.TangentSystem`."""
+    ``options`` go to :class:`~projeq.constraints.partitioned.TangentSystem`."""
     tree = System({"x": Frame(), "mass": PointMass(positive("m", m))},
                   {"x": Prismatic(axis="x"), "mass": Prismatic(parent="x", axis="y")}, gravity=(0.0, -g, 0.0))
     return TangentSystem(tree, phi=lambda q, t: [q[0] ** 2 + q[1] ** 2 - L * L], q0=(positive("L", L), 0.0),
@@ -56,7 +56,7 @@ def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, spee
     positions). Starts with the cranks vertical and point B0 (the tip of crank0) moving at
     ``speed`` along +x. The benchmark specifies n = 40 (and 2 in the double four-bar of
     González, Dopico, Pastorino & Cuadrado, Nonlinear Dynamics 85 (2016) 1491–1508).
-    ``options`` go to :class:`~projeq.constraints.tangent.TangentSystem`."""
+    ``options`` go to :class:`~projeq.constraints.partitioned.TangentSystem`."""
     n = count("n", n)
     rod = slender_rod(positive("m", m), positive("L", L))
     cranks, couplers = [f"crank{i}" for i in range(n + 1)], [f"coupler{i}" for i in range(1, n + 1)]
@@ -127,15 +127,16 @@ _CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, -1, 0], [1, -1, 1], [0, -1, 1], [
 _AXES = "yzxyzx"
 
 
-def bricard(m: float = 1.0, L: float = 1.0, side: float = 0.1, g: float = 9.81, **options) -> TangentSystem:
+def bricard(m: float = 1.0, L: float = 1.0, side: float = 0.1, g: float = 9.81, **options) -> ConstrainedSystem:
     """IFToMM A04: Bricard's overconstrained mechanism, five rods (mass m, length L, square section
     ``side``) in a chain of revolute joints from the ground at the origin (axis y) over the
     corners (L, 0, 0) z, (L, −L, 0) x, (L, −L, L) y, (0, −L, L) z back to the ground at (0, 0, L),
     axis x — the benchmark's figure; gravity −y. The last joint is cut: rod5's end on (0, 0, L)
     (3 rows) and its x-axis perpendicular to the ground's y and z (2 rows). Grübler's count is
     5 − 5 = 0, but the five rows have rank 4 everywhere: mobility 1, one row redundant (not
-    removed). Starts at rest in the figure's configuration (q = 0).
-    ``options`` go to :class:`~projeq.constraints.tangent.TangentSystem`."""
+    removed: a ConstrainedSystem finds it on the constraint surface and takes the null-space form,
+    ``redundant`` = (4,)). Starts at rest in the figure's configuration (q = 0).
+    ``options`` go to :class:`~projeq.constraints.partitioned.ConstrainedSystem`."""
     m, L, side = positive("m", m), positive("L", L), positive("side", side)
     corners = L * _CORNERS
     names = [f"rod{i}" for i in range(1, 6)]
@@ -176,7 +177,7 @@ def bricard(m: float = 1.0, L: float = 1.0, side: float = 0.1, g: float = 9.81, 
         r[3], r[4] = R[3], R[6]
         return r
 
-    return TangentSystem(tree, phi=closure, q0=np.zeros(tree.n_q), **options)
+    return ConstrainedSystem(tree, phi=closure, q0=np.zeros(tree.n_q), **options)
 
 
 # Andrews' squeezing mechanism: the data of Hairer & Wanner, "Solving Ordinary Differential Equations II",
@@ -205,7 +206,7 @@ def andrews_squeezer(**options) -> TangentSystem:
     the three ends of theta, gamma, phi and omega meet at point E (six closure rows, mobility 1).
     The subsystems are named after Hairer & Wanner's angles (:data:`ANDREWS_ANGLES`), each the one
     coordinate of its joint; starts at rest at their consistent angles (:data:`ANDREWS_Q0`).
-    ``options`` go to :class:`~projeq.constraints.tangent.TangentSystem`."""
+    ``options`` go to :class:`~projeq.constraints.partitioned.TangentSystem`."""
     a = ANDREWS
     m, I = dict(zip(ANDREWS_ANGLES, a["m"])), dict(zip(ANDREWS_ANGLES, a["I"]))
     centre = {"beta": (a["ra"], 0.0), "theta": (-a["da"], 0.0), "gamma": (a["sb"], -a["sa"]),

@@ -723,7 +723,7 @@ def _assemble(run: _Run, wall_time: float, dense_output: bool) -> Result:
     q, energies, residual, ranks = _row_values(run, rows, x)
     t, s_dot = np.array([ti for _, ti in rows[:len(q)]]), x[:len(q), n_q:]
     partitions = tuple(
-        (float(p.sol.ts[0]), p.model.partition) for i, p in enumerate(pieces)
+        (float(p.sol.ts[0]), p.model.partition, p.model.formulation) for i, p in enumerate(pieces)
         if p.model.partition is not None and (i == 0 or p.model is not pieces[i - 1].model)
     )
     t_events, q_events, s_dot_events = (

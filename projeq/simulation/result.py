@@ -50,9 +50,11 @@ class Result:
     changed its partition has velocities ``("s_dot[i]", "")`` (see ``partitions``)
     metadata : what the caller records with the run (the command line: scene, parameters,
     tolerances, method, evaluator, projeq version), saved with it
-    partitions : ((t_k, independent_k), ...) of a ConstrainedSystem, one per partition used
-    (more than one if it re-pivoted): rows (and ``sol(t)``) with t_k < t ≤ t_k+1 hold the
-    tree velocities independent_k in ``s_dot`` (:mod:`projeq.constraints.partitioned`); empty for other systems
+    partitions : ((t_k, independent_k, formulation_k), ...) of a ConstrainedSystem, one per
+    partition used (more than one if it re-pivoted, or went on in the null-space form from a
+    singular position: formulation_k "partitioned" or "null space"): rows (and ``sol(t)``)
+    with t_k < t ≤ t_k+1 hold the tree velocities independent_k in ``s_dot``
+    (:mod:`projeq.constraints.partitioned`); empty for other systems
     rank, mobility : (n,) integers, for a model with constraint equations (a ConstrainedSystem,
     TangentSystem, ...): the numerical rank of its constraint matrix A_s at each output time
     (singular values above RANK_TOLERANCE times the largest,
@@ -137,7 +139,7 @@ class Result:
         meta = {
             "nfev": self.nfev, "njev": self.njev, "wall_time": self.wall_time, "status": self.status,
             "message": self.message, "names": list(self.names), "method": self.method,
-            "partitions": [[t, list(independent)] for t, independent in self.partitions],
+            "partitions": [[t, list(independent), formulation] for t, independent, formulation in self.partitions],
             "coordinates": [list(c) for c in self.coordinates], "velocities": [list(v) for v in self.velocities],
             "metadata": self.metadata,
         }
@@ -174,7 +176,8 @@ class Result:
             raise ValueError(f"path: {str(path)!r} is not a projeq Result (.npz written by Result.save): {exc}") from exc
         _check_fields(arrays, meta, events, f"path: {str(path)!r}")
         meta["names"] = tuple(meta["names"])
-        meta["partitions"] = tuple((t, tuple(independent)) for t, independent in meta.get("partitions", ()))
+        meta["partitions"] = tuple((entry[0], tuple(entry[1]), entry[2] if len(entry) > 2 else "partitioned")
+                                   for entry in meta.get("partitions", ()))  # files before the null-space form: 2
         for key in ("coordinates", "velocities"):  # absent from files of earlier versions
             meta[key] = tuple(tuple(pair) for pair in meta.get(key, ()))
         return cls(**arrays, **meta, **events)

@@ -158,7 +158,7 @@ def test_tangent_system_jacobians_are_the_partitioned_ones():
     twice (a redundant row) and as a ConstrainedSystem with it once, both with ẋ independent,
     have the same F, f̄ and s̈, so their exact Jacobians agree to round-off (measured 1.6e-15 of the
     largest entry; 1e-12 allowed)."""
-    from projeq.constraints.tangent import TangentSystem
+    from projeq.constraints.partitioned import TangentSystem
 
     q0, s_dot = [0.6, -0.8], [0.7]
     tangent = TangentSystem(*_pendulum_on_sliders(2), q0=q0, independent=[0])

@@ -74,10 +74,15 @@ def test_b_without_A(tree):
 
 
 def test_rank_deficient_rows_are_named(tree):
-    """The Pfaffian row 1, 2x ẋ + 2z ż = 0, repeats the circle's velocity constraint (row 0)."""
-    match = r"rank-deficient at q0 \(rank 1 of 2\): rows \[1\] depend on rows \[0\]"
-    with pytest.raises(ValueError, match=match):
-        ConstrainedSystem(tree, phi=circle, A=lambda q, t: [[2 * q[0], 2 * q[1]]])
+    """The Pfaffian row 1, 2x ẋ + 2z ż = 0, repeats the circle's velocity constraint (row 0) on the
+    whole constraint surface: the default takes it in the null-space form and names it;
+    formulation="partitioned" refuses it, naming the rows."""
+    redundant = lambda q, t: [[2 * q[0], 2 * q[1]]]  # noqa: E731
+    system = ConstrainedSystem(tree, phi=circle, A=redundant)
+    assert (system.redundant, system.formulation, system.n_s) == ((1,), "null space", 1)
+    with pytest.raises(ValueError, match=r"phi: rows \[1\] depend on the others along the motion \(the rank "
+                                         r"of the constraints is 1 of 2"):
+        ConstrainedSystem(tree, phi=circle, A=redundant, formulation="partitioned")
 
 
 def test_wrong_number_of_independent_velocities(tree):
@@ -208,9 +213,9 @@ def test_cut_named_like_a_subsystem(four_bar_pin):
 
 def test_a_singular_pose_is_not_called_redundant(tree):
     """Passes if Φ = x z at q0 = (0, 0), whose gradient (z, x) vanishes there only, is named a
-    singular pose (full rank nearby), not a set of redundant rows to remove."""
-    with pytest.raises(ValueError, match=r"^q0: a singular pose of the constraints \(rank 0 of 1 at q0 = \[0.0, 0.0\], "
-                                         r"full rank nearby\)"):
+    singular position (the surface branches there: a saddle of Φ), not a set of redundant rows."""
+    with pytest.raises(ValueError, match=r"^q0: a singular position of the constraints: Φ\[0\]'s gradient vanishes "
+                                         r"at q0 = \[0.0, 0.0\], where the surface Φ\[0\] = 0 branches"):
         ConstrainedSystem(tree, phi=lambda q, t: [q[0] * q[1]], q0=(0.0, 0.0))
 
 

@@ -146,7 +146,7 @@ def test_the_tangent_kernel_takes_the_pfaffian_rows_too(bike):
     """TangentSystem (F = N N_ind⁻¹ from the null space of A_s) of the same bicycle: the compiled
     call gives its numpy path's s̈_tree (the tangent kept along the branch reset before each, so that
     both start from the same null space)."""
-    from projeq.constraints.tangent import TangentSystem
+    from projeq.constraints.partitioned import TangentSystem
 
     model = TangentSystem(bike.tree, phi=bike._phi, A=bike._A, independent=bike.independent, q0=bike.q0,
                           s_dot0=bike.s_dot0)

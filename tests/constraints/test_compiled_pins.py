@@ -24,7 +24,7 @@ from projeq.constraints.batched import PointwiseWarning
 from projeq.constraints.compiled import UncompiledClosureWarning
 from projeq.constraints.cut_joints import PinClosure
 from projeq.constraints.partitioned import ConstrainedSystem
-from projeq.constraints.tangent import TangentSystem
+from projeq.constraints.partitioned import TangentSystem
 from projeq.scenes.mechanisms import four_bar_angles
 
 G = 9.81

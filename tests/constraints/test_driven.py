@@ -19,7 +19,7 @@ import sympy as sp
 import projeq as pq
 from projeq.constraints.compiled import UncompiledClosureWarning
 from projeq.constraints.reactions import joint_reactions
-from projeq.constraints.tangent import TangentSystem
+from projeq.constraints.partitioned import TangentSystem
 from projeq.scenes.mechanisms import four_bar_angles, slender_rod
 
 A, B, C, D = 0.3, 1.0, 0.8, 1.0  # crank, coupler, rocker, ground

@@ -115,15 +115,37 @@ def test_separation_is_checked():
             n_four_bar(2, separation=bad)
 
 
+def test_a_users_double_four_bar_in_constrained_system_runs_through(double_four_bar):
+    """A02 (N = 2) as a user writes it: pq.ConstrainedSystem with the tree and Φ, no other class
+    and no option. It starts partitioned (the cheaper form) and at the first singular position
+    (t = 0.70 s, the bars horizontal) goes on in the null-space form along the partition's
+    tangent, recorded in Result.partitions; to 10 s (ten crossings) B0 stays within 1e-4 of the
+    parallelogram motion (the issue's bound; measured 1.19e-5 at the default rtol 1e-8) and the
+    mobility is 1 at every output."""
+    scene, _ = double_four_bar
+    user = pq.ConstrainedSystem(scene.tree, phi=scene.phi, q0=scene.q0, independent=[0], s_dot0=[-1.0])
+    assert user.formulation == "partitioned"
+    r = pq.simulate(user, 10.0, n_points=201)
+    assert r.status == 0 and r.t[-1] == 10.0
+    assert [(independent, form) for _, independent, form in r.partitions] == [((0,), "partitioned"),
+                                                                              ((0,), "null space")]
+    assert 0.69 < r.partitions[1][0] < 0.71
+    b0 = np.array([point_b0(model, q, s_dot)[0] for model, q, s_dot in zip(user.row_models(r), r.q, r.s_dot)])
+    error = np.abs(b0[:, :2] - parallelogram_motion(r.t, 2)[:, :2]).max()
+    assert 1e-7 < error < 1e-4, error
+    assert set(r.mobility.tolist()) == {1}
+
+
 def test_partitioned_formulation_stops_at_the_singular_position_saying_so(double_four_bar):
-    """ConstrainedSystem cannot pass where the constraints become dependent: it stops there with
-    a physical statement (rank, degrees of freedom, links in line), not 'pass repivot=True'."""
+    """formulation="partitioned" cannot pass where the constraints become dependent: it stops there
+    with a physical statement (rank, degrees of freedom, links in line) and names the form that
+    passes, not 'pass repivot=True'."""
     system, _ = double_four_bar
     partitioned = ConstrainedSystem(system.tree, phi=system.phi, q0=system.q0, independent=[0],
-                                    s_dot0=[-1.0], repivot=True)
+                                    s_dot0=[-1.0], repivot=True, formulation="partitioned")
     with pytest.raises(pq.SimulationError, match="singular position") as info:
         pq.simulate(partitioned, 1.0, n_points=3)
-    assert "repivot=True" not in str(info.value) and "TangentSystem" in str(info.value)
+    assert "repivot=True" not in str(info.value) and "formulation='null_space'" in str(info.value)
 
 
 @pytest.fixture(scope="module")
@@ -139,7 +161,8 @@ def test_bricard_runs_without_removing_a_row(bricard_run):
     2.5e-12 and 3e-9)."""
     system, r = bricard_run
     assert (system.n_c, system.rank(system.q0), system.n_s) == (5, 4, 1)
-    assert r.status == 0 and r.t[-1] == 10.0
+    assert isinstance(system, pq.ConstrainedSystem) and (system.formulation, system.redundant) == ("null space", (4,))
+    assert r.status == 0 and r.t[-1] == 10.0 and set(r.mobility.tolist()) == {1}
     assert np.abs(r.constraint_residual).max() <= 1e-8
     energy = r.kinetic + r.potential
     assert np.abs(energy - energy[0]).max() <= 1e-8

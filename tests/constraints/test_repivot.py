@@ -44,7 +44,7 @@ def test_rocker_partition_repivots_before_the_rocker_extreme(run, reference):
     and carries on to t_end."""
     _, r = run
     assert r.status == 0 and r.t[-1] == T_END
-    assert [independent for _, independent in r.partitions] == [(1,), (2,)]  # rocker, then coupler
+    assert [independent for _, independent, _ in r.partitions] == [(1,), (2,)]  # rocker, then coupler
     t_switch = r.partitions[1][0]
     a, b, c, d = (PARAMS[k] for k in "abcd")
     theta_star = np.arccos((d * d + (a + b) ** 2 - c * c) / (2 * d * (a + b)))
@@ -73,7 +73,7 @@ def test_multipliers_are_those_of_the_crank_partition(run):
     system, r = run
     crank = four_bar(**PARAMS, theta1=THETA1, omega1=OMEGA1)
     lam, errors = reactions(system, r), []
-    (_, rocker), (t_switch, coupler) = r.partitions
+    (_, rocker, _), (t_switch, coupler, _) = r.partitions
     for rows, independent in ((r.t <= t_switch, rocker), (r.t > t_switch, coupler)):
         partition = system.with_independent(independent)
         for t, q, s_dot, lam_row in zip(r.t[rows], r.q[rows], r.s_dot[rows], lam[rows]):
@@ -112,7 +112,7 @@ def test_energy_projection_follows_the_new_partition():
     system = ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0], q0=[0.6, -0.8],
                                independent=[0], s_dot0=[4.0], repivot=True)
     r = pq.simulate(system, 0.3, n_points=11, rtol=1e-6, atol=1e-8, method="RK45-projected")
-    assert [independent for _, independent in r.partitions] == [(0,), (1,)]
+    assert [independent for _, independent, _ in r.partitions] == [(0,), (1,)]
     # the loop-closure projection that follows the energy projection moves q by up to
     # POSITION_TOLERANCE (1e-12), E by |∇_q E| times that (achieved 7e-12; RK45: 9e-7)
     assert r.energy_drift < 1e-10
