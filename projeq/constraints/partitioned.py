@@ -214,7 +214,10 @@ class ConstrainedSystem(Model):
     def _constraint_rows(self, name, f, args, ndim, n_cols=None) -> int:
         if f is None:
             return 0
-        value = np.asarray(f(*args), dtype=float)
+        try:
+            value = np.asarray(f(*args), dtype=float)
+        except (TypeError, ValueError) as error:  # rows of different shapes, or not numbers
+            raise ValueError(f"{name}: returns no array of numbers at q0 ({error})") from None
         expected = (n_cols,) if n_cols is not None else ((None, self.n_q) if ndim == 2 else (None,))
         if value.ndim != ndim or (ndim == 2 and value.shape[1] != self.n_q) or (
             n_cols is not None and value.shape != expected

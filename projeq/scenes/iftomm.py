@@ -46,6 +46,27 @@ def pendulum_angle(t, L: float = 1.0, g: float = 9.81, theta0: float = np.pi / 2
     return 2 * np.arcsin(k * sn)
 
 
+def reference_solution(path) -> np.ndarray:
+    """The rows (t, x, y) of a published reference file of the IFToMM benchmark library
+    (``A01_solution_data.txt``: point P1 of A01 every 0.5 s; ``A02_solution_data.txt``: point B0 of
+    A02 with N = 40 every 0.05 s, an ADAMS output whose header and trailing zero columns are
+    skipped): every line that is numbers only, its first three columns. ValueError naming the
+    file if it holds no such line or its times do not increase."""
+    rows = []
+    with open(path, encoding="latin-1") as lines:
+        for line in lines:
+            try:
+                numbers = [float(word) for word in line.split()]
+            except ValueError:
+                continue
+            if len(numbers) >= 3:
+                rows.append(numbers[:3])
+    data = np.array(rows).reshape(-1, 3)
+    if not len(data) or not np.all(np.diff(data[:, 0]) > 0):
+        raise ValueError(f"path: {path} holds no rows (t, x, y) with increasing t")
+    return data
+
+
 def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, speed: float = 1.0,
                **options) -> TangentSystem:
     """IFToMM A02: n four-bar linkages in a row, 2n + 1 uniform bars of mass m and length L in the

@@ -264,3 +264,59 @@ def test_simulate_refuses_q0_off_the_loop_closures():
     system = four_bar(omega1=0.0)
     with pytest.raises(ValueError, match=r"^q0: violates the loop closures"):
         pq.simulate(system, 0.1, q0=system.q0 + np.array([0.0, 0.2, 0.0]), n_points=3)
+
+
+# -- rows judged on the constraint surface (issue 35, item 2) ------------------------------------
+def test_an_isolated_solution_is_named(tree):
+    """Φ = cos x + cos(x + z) − 2 (a two-link arm stretched to its full reach) holds only at q0 =
+    (0, 0), where its gradient vanishes: refused as an isolated solution, not accepted with n_s = 2
+    (before: accepted, then 'cannot be projected … residual −2.7e-13' during the run)."""
+    with pytest.raises(ValueError, match=r"^phi: row 0 holds only at isolated points around q0 = \[0.0, 0.0\]: "
+                                         r"Φ\[0\] has a maximum there"):
+        ConstrainedSystem(tree, phi=lambda q, t: [np.cos(q[0]) + np.cos(q[0] + q[1]) - 2.0], q0=(0.0, 0.0))
+
+
+def test_a_row_that_is_identically_zero_is_named(tree):
+    """A row 0 · x constrains nothing: refused (before: taken silently as redundant)."""
+    with pytest.raises(ValueError, match=r"^phi: row 1 is zero at and around q0 = \[0.6, -0.8\] \(value and "
+                                         r"gradient\): it constrains nothing"):
+        ConstrainedSystem(tree, phi=lambda q, t: [np.sqrt(q[0] ** 2 + q[1] ** 2) - 1.0, 0.0 * q[0]])
+
+
+def test_a_row_stationary_at_q0_is_named(tree):
+    """Φ = 1 − cos z fixes z = 0 only to second order: its gradient vanishes at q0, so its velocity
+    constraint is empty there (before: accepted with the mobility of the tree, then lowered to 0
+    during the run without a word)."""
+    with pytest.raises(ValueError, match=r"^phi: row 0's gradient ∂Φ\[0\]/∂q vanishes at q0 = \[0.5, 0.0\]: "
+                                         r"Φ\[0\] is stationary there"):
+        ConstrainedSystem(tree, phi=lambda q, t: [1.0 - np.cos(q[1])], q0=(0.5, 0.0))
+
+
+def test_rank_of_a_non_finite_state_names_q(tree):
+    """Before: numpy's 'SVD did not converge'."""
+    system = ConstrainedSystem(tree, phi=lambda q, t: [np.sqrt(q[0] ** 2 + q[1] ** 2) - 1.0])
+    for method in (system.rank, system.mobility):
+        with pytest.raises(ValueError, match=r"^q: .*finite"):
+            method([np.nan, 0.0])
+
+
+def test_phi_changing_its_rows_during_a_run_is_named(tree):
+    """Before: numpy's 'inhomogeneous shape' (ragged rows) or a broadcasting error deep in the
+    projection, without naming phi."""
+    def growing(q, t):
+        radius = np.sqrt(q[0] ** 2 + q[1] ** 2) - 1.0
+        return [radius] if np.real(t) < 0.05 else [radius, radius]
+
+    def ragged(q, t):
+        radius = np.sqrt(q[0] ** 2 + q[1] ** 2) - 1.0
+        return [radius] if np.real(t) < 0.05 else [radius, [radius, radius]]
+
+    system = ConstrainedSystem(tree, phi=growing)
+    with pytest.raises(ValueError, match=r"^phi: returns shape \(2,\) at t = 0.1, \(1,\) at q0"):
+        system.phi(system.q0, 0.1)
+    with pytest.raises(pq.SimulationError, match=r"phi: returns shape \(2,\)"):
+        pq.simulate(system, 0.2, n_points=3, method="RK45")
+    with pytest.raises(ValueError, match=r"^phi: returns rows numpy cannot stack at t = 0.1"):
+        ConstrainedSystem(tree, phi=ragged).phi(system.q0, 0.1)
+    with pytest.raises(ValueError, match=r"^phi: returns no array of numbers at q0"):
+        ConstrainedSystem(tree, phi=lambda q, t: [q[0], [q[1], q[0]]])
