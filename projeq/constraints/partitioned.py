@@ -74,6 +74,7 @@ tree, M s̈_free + b = 0, so that M s̈_tree + b = M (s̈_tree − s̈_free): al
 from __future__ import annotations
 
 import copy
+from numbers import Real
 
 import numpy as np
 from numpy.typing import NDArray
@@ -145,6 +146,9 @@ class ConstrainedSystem(Model):
         records it). "partitioned" refuses redundant rows; "null_space" takes that form
         throughout. ``redundant`` lists the rows found redundant (their multipliers are the
         minimum-norm solution, :meth:`accelerations_tree`).
+    separation : float
+        The null-space form's continuation of the branch near singular positions
+        (:class:`TangentSystem`; default SEPARATION).
 
     Examples
     --------
@@ -169,7 +173,7 @@ class ConstrainedSystem(Model):
 
     def __init__(self, system, phi=None, A=None, b=None, independent=None, q0=None, s_dot0=None,
                  project_q0: bool = False, correction: str = "projection", beta: float = 10.0,
-                 repivot: bool | None = None, formulation: str = "auto"):
+                 repivot: bool | None = None, formulation: str = "auto", separation: float = SEPARATION):
         if phi is None and A is None:
             raise ValueError("phi: give holonomic constraints phi(q, t) and/or Pfaffian ones A(q, t)")
         phi = cut_joints(phi)
@@ -185,6 +189,10 @@ class ConstrainedSystem(Model):
             raise ValueError(f"correction: unknown method {correction!r}; use one of {list(CORRECTIONS)}")
         if formulation not in FORMULATIONS:
             raise ValueError(f"formulation: unknown form {formulation!r}; use one of {list(FORMULATIONS)}")
+        if isinstance(separation, bool) or not isinstance(separation, Real) or not 0.0 <= separation < 1.0:
+            raise ValueError(f"separation: expected a fraction of the largest singular value in [0, 1) "
+                             f"(0: no continuation of the branch), got {separation!r}")
+        self.separation = float(separation)
         self.tree, self._phi, self._A, self._b = system, phi, A, b
         self.correction, self.beta = correction, positive("beta", beta)
         self.names, self.subsystems, self.n_q = system.names, system.subsystems, system.n_q
@@ -353,7 +361,7 @@ class ConstrainedSystem(Model):
                 raise ValueError(f"phi: {self.n_c} constraints on only {self.tree.n_s} tree velocities")
             return
         if formulation == "null_space" or self.redundant or not self._well_conditioned(q0):
-            self.__class__, self.separation = TangentSystem, SEPARATION
+            self.__class__ = TangentSystem
 
     def _well_conditioned(self, q0) -> bool:
         """Whether the rows are far from a singular position at q0: σ_min ≥ σ_max / REPIVOT_CONDITION
@@ -499,7 +507,7 @@ class ConstrainedSystem(Model):
         ṡ_tree = F ṡ + f."""
         F, f = self.F(q, t)
         new = copy.copy(self)
-        new.__class__, new.separation = TangentSystem, SEPARATION
+        new.__class__ = TangentSystem
         new._inverse, new._compiled, new._uncompiled = (None, None), False, None
         new._tangent = np.linalg.qr(F)[0]
         if self.repivot:
@@ -537,7 +545,7 @@ class ConstrainedSystem(Model):
         new = copy.copy(self)
         if formulation is not None and formulation != self.formulation:
             new.__class__ = TangentSystem if formulation == "null space" else ConstrainedSystem
-            new.separation, new._compiled = SEPARATION, False
+            new._compiled = False
         new.independent, new.dependent = independent, np.setdiff1d(np.arange(self.tree.n_s), independent)
         new._inverse = (None, None)  # A_dep⁻¹ of the old partition
         new.q0 = np.array(q, dtype=float)

@@ -49,8 +49,6 @@ motion (a crank at a dead centre, N_ind singular) the independent set is re-chos
 
 from __future__ import annotations
 
-from numbers import Real
-
 import numpy as np
 from numpy.typing import NDArray
 
@@ -80,13 +78,6 @@ class NullSpaceForm(Model):
     _latest = (None, None)  # (key of (q, t), (C, c)) of the latest velocity_constraints call
     _svd = (None, None)  # (key of A_s, its SVD) of the latest decomposition
     _tangent = None  # N where the null space was last separated: the branch's tangent (_branch)
-
-    def __init__(self, system, *args, separation: float = SEPARATION, **options):
-        if isinstance(separation, bool) or not isinstance(separation, Real) or not 0.0 <= separation < 1.0:
-            raise ValueError(f"separation: expected a fraction of the largest singular value in [0, 1) "
-                             f"(0: no continuation of the branch), got {separation!r}")
-        self.separation = float(separation)
-        super().__init__(system, *args, **options)
 
     def _choose_velocities(self, q0, independent, repivot) -> None:
         A_s = self.constraint_matrix(q0)[0]

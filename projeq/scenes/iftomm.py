@@ -2,8 +2,9 @@
 (M. González, D. Dopico, U. Lugrís, J. Cuadrado, "A benchmarking system for MBS simulation
 software: problem standardization and performance measurement", Multibody System Dynamics 16
 (2006) 179–190; problems A01 simple pendulum, A02 N-four-bar mechanism, A03 Andrews' mechanism,
-A04 Bricard's mechanism), as :class:`~projeq.constraints.partitioned.TangentSystem` s: trees closed by
-constraint equations, run through singular positions and with redundant constraints; and A05, the
+A04 Bricard's mechanism), as :class:`~projeq.constraints.partitioned.ConstrainedSystem` s in their
+null-space form: trees closed by constraint equations, run through singular positions and with
+redundant constraints (Bricard's mechanism takes that form by itself); and A05, the
 stiff flyball governor, a tree with two stiff spring-dampers (:func:`flyball_governor`).
 
 Each problem also has a reference that does not use the constraint equations: the pendulum's
@@ -16,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from projeq.checks import count, non_negative, positive
-from projeq.constraints.partitioned import ConstrainedSystem, TangentSystem
+from projeq.constraints.partitioned import ConstrainedSystem
 from projeq.forces import JointForce, SpringDamper
 from projeq.joints import Fixed, Prismatic, Revolute
 from projeq.scenes.mechanisms import slender_rod
@@ -24,15 +25,15 @@ from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, inertia
 from projeq.system import System
 
 
-def simple_pendulum(m: float = 1.0, L: float = 1.0, g: float = 9.81, **options) -> TangentSystem:
+def simple_pendulum(m: float = 1.0, L: float = 1.0, g: float = 9.81, **options) -> ConstrainedSystem:
     """IFToMM A01: a point mass m on a massless rod of length L, in natural coordinates — the
     mass on x and y sliders held at distance L from the pivot by Φ = x² + y² − L² = 0;
     gravity −y. Starts at rest with the rod horizontal, (x, y) = (L, 0), the benchmark's start.
-    ``options`` go to :class:`~projeq.constraints.partitioned.TangentSystem`."""
+    ``options`` go to :class:`~projeq.constraints.partitioned.ConstrainedSystem` (default: its null-space form)."""
     tree = System({"x": Frame(), "mass": PointMass(positive("m", m))},
                   {"x": Prismatic(axis="x"), "mass": Prismatic(parent="x", axis="y")}, gravity=(0.0, -g, 0.0))
-    return TangentSystem(tree, phi=lambda q, t: [q[0] ** 2 + q[1] ** 2 - L * L], q0=(positive("L", L), 0.0),
-                         **options)
+    return ConstrainedSystem(tree, phi=lambda q, t: [q[0] ** 2 + q[1] ** 2 - L * L], q0=(positive("L", L), 0.0),
+                             **{"formulation": "null_space", **options})
 
 
 def pendulum_angle(t, L: float = 1.0, g: float = 9.81, theta0: float = np.pi / 2) -> np.ndarray:
@@ -68,7 +69,7 @@ def reference_solution(path) -> np.ndarray:
 
 
 def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, speed: float = 1.0,
-               **options) -> TangentSystem:
+               **options) -> ConstrainedSystem:
     """IFToMM A02: n four-bar linkages in a row, 2n + 1 uniform bars of mass m and length L in the
     x–y plane, gravity −y: cranks ``crank0`` … ``crank<n>`` turn about (i L, 0) (absolute angles
     θ_i), coupler i hangs at the tip of crank i − 1 (angle relative to it) and is pinned at its
@@ -77,7 +78,7 @@ def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, spee
     positions). Starts with the cranks vertical and point B0 (the tip of crank0) moving at
     ``speed`` along +x. The benchmark specifies n = 40 (and 2 in the double four-bar of
     González, Dopico, Pastorino & Cuadrado, Nonlinear Dynamics 85 (2016) 1491–1508).
-    ``options`` go to :class:`~projeq.constraints.partitioned.TangentSystem`."""
+    ``options`` go to :class:`~projeq.constraints.partitioned.ConstrainedSystem` (default: its null-space form)."""
     n = count("n", n)
     rod = slender_rod(positive("m", m), positive("L", L))
     cranks, couplers = [f"crank{i}" for i in range(n + 1)], [f"coupler{i}" for i in range(1, n + 1)]
@@ -104,8 +105,8 @@ def n_four_bar(n: int = 2, m: float = 1.0, L: float = 1.0, g: float = 9.81, spee
     q0[list(crank)], q0[list(coupler)] = np.pi / 2, -np.pi / 2
     # ẋ_B0 = −L sin θ0 θ̇0; couplers translate
     s_dot0[list(crank)], s_dot0[list(coupler)] = -speed / L, speed / L
-    return TangentSystem(tree, phi=closure, q0=q0, independent=[tree.s_slice[tree.index("crank0")].start],
-                         s_dot0=[-speed / L], **options)
+    return ConstrainedSystem(tree, phi=closure, q0=q0, independent=[tree.s_slice[tree.index("crank0")].start],
+                             s_dot0=[-speed / L], **{"formulation": "null_space", **options})
 
 
 def point_b0(system, q, s_dot) -> np.ndarray:
@@ -218,7 +219,7 @@ ANDREWS_Q0 = (-0.0617138900142764496358948458001, 0.0, 0.45527981916307038025591
 ANDREWS_ANGLES = ("beta", "theta", "gamma", "phi", "delta", "omega", "epsilon")
 
 
-def andrews_squeezer(**options) -> TangentSystem:
+def andrews_squeezer(**options) -> ConstrainedSystem:
     """IFToMM A03: Andrews' squeezing mechanism, seven planar bodies driven by the torque mom on the
     crank β against a spring (stiffness c0, rest length l0) from the triangle γ to the ground point
     C; no gravity (Hairer & Wanner 1996, §VII.7, data of :data:`ANDREWS`). The tree: the crank
@@ -227,7 +228,7 @@ def andrews_squeezer(**options) -> TangentSystem:
     the three ends of theta, gamma, phi and omega meet at point E (six closure rows, mobility 1).
     The subsystems are named after Hairer & Wanner's angles (:data:`ANDREWS_ANGLES`), each the one
     coordinate of its joint; starts at rest at their consistent angles (:data:`ANDREWS_Q0`).
-    ``options`` go to :class:`~projeq.constraints.partitioned.TangentSystem`."""
+    ``options`` go to :class:`~projeq.constraints.partitioned.ConstrainedSystem` (default: its null-space form)."""
     a = ANDREWS
     m, I = dict(zip(ANDREWS_ANGLES, a["m"])), dict(zip(ANDREWS_ANGLES, a["I"]))
     centre = {"beta": (a["ra"], 0.0), "theta": (-a["da"], 0.0), "gamma": (a["sb"], -a["sa"]),
@@ -263,8 +264,8 @@ def andrews_squeezer(**options) -> TangentSystem:
 
     q0 = np.zeros(tree.n_q)
     q0[[column[name] for name in ANDREWS_ANGLES]] = ANDREWS_Q0
-    return TangentSystem(tree, phi=closure, q0=q0, independent=[tree.s_slice[tree.index("beta")].start],
-                         **options)
+    return ConstrainedSystem(tree, phi=closure, q0=q0, independent=[tree.s_slice[tree.index("beta")].start],
+                             **{"formulation": "null_space", **options})
 
 
 def andrews_angles(system, q) -> np.ndarray:
