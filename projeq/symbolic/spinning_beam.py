@@ -11,7 +11,9 @@ linearised in (v, w):
 * :func:`projection_field_equations` — Newton–Euler residuals of a slice in R projected
   with the operator D̄ of B(22) and its adjoint D (B(21)); reproduces B(23) (with the
   signs of docs/theory.md, "The spinning beam's rotary inertia"); the same integration by
-  parts gives the boundary operators B₀, B₁ (:func:`projection_boundary_operators`).
+  parts gives the boundary operators B₀, B₁ (:func:`projection_boundary_operators`);
+  at constant spin they make a boundary-value problem for the whirl modes (:func:`whirl_equations`),
+  solved without Ritz functions by :func:`whirl_frequencies` (Chebyshev collocation).
 
 They differ only in the ρI α̈ coupling of the v equation (:func:`field_difference`): the
 Cardan axes (x, y′, z″) are not orthogonal, so Hamilton's v equation is the directional
@@ -374,3 +376,98 @@ def simulate_ritz(model: RitzModel, motion, a0, a_dot0, t_end: float, rtol: floa
     a, a_dot, W = sol.y[:n].T, sol.y[n:2 * n].T, sol.y[2 * n]
     E = np.array([model.energy(ai, adi, motion(ti)[1]) for ti, ai, adi in zip(sol.t, a, a_dot)])
     return sol.t, a, a_dot, E, W
+
+
+_lam, _U = sp.Symbol("lambda"), sp.Function("U")
+
+
+@lru_cache(maxsize=None)
+def whirl_equations() -> tuple[sp.Expr, sp.Expr, sp.Expr]:
+    """The boundary-value problem of the constant spin α̇ = Ω for a whirl v + i w = U(x) e^{iλt}.
+
+    The field equation E_v of :func:`projection_field_equations` and the boundary operators B₀,v, B₁,v of
+    :func:`projection_boundary_operators` with v = U cos λt, w = U sin λt, α = Ω t, at t = 0 (the w plane
+    gives the same at λt = π/2):
+
+        E = EI U⁗ + ρI(λ² − Ω²) U″ − ρA(λ + Ω)² U,   B₀ = −EI U‴ − ρI(λ² − Ω²) U′,   B₁ = EI U″.
+
+    Returned as ``(E, B₀, B₁)`` in ``U(x)`` with the symbols ``lambda`` and ``Omega``; U(0) = U′(0) = 0
+    (clamped) and B₀ = B₁ = 0 at x = L (free) close the problem (B(21): δv, δv′ free at L).
+    """
+    whirl = {alpha: _Om * t, v: _U(x) * sp.cos(_lam * t), w: _U(x) * sp.sin(_lam * t)}
+    B0, B1 = projection_boundary_operators()[v]
+    return tuple(sp.expand(e.subs(whirl).doit().subs(t, 0)) for e in (projection_field_equations()[0], B0, B1))
+
+
+def _operator_rows(expr, values: dict, derivatives: list) -> np.ndarray:
+    """The rows Σₖ cₖ(λ) U⁽ᵏ⁾ of ``expr`` as an array [λ power, rows of the ``derivatives`` matrices]:
+    result[j] = Σₖ (coefficient of λʲ U⁽ᵏ⁾) derivatives[k]."""
+    polynomial = sp.Poly(expr.subs(values), _lam, *[_d(_U(x), *([x] * k)) for k in range(5)])
+    rows = np.zeros((3,) + derivatives[0].shape)
+    for (power, *orders), coefficient in polynomial.terms():
+        rows[power] += float(coefficient) * derivatives[orders.index(1)]
+    return rows
+
+
+def whirl_frequencies(omega: float, rho_I_value: float, count: int = 3, degree: int = 18, length: float = 1.0,
+                      rho_A_value: float = 1.0, EI_value: float = 1.0) -> np.ndarray:
+    """The lowest ``count`` co-rotating frequencies |λ| of the spinning beam's boundary-value problem
+    (:func:`whirl_equations`), ascending: the PDE's own, without Ritz functions.
+
+    Chebyshev spectral collocation (numpy.polynomial.chebyshev): U is a Chebyshev series of ``degree``
+    on [0, L]; the field equation holds at degree − 3 Gauss–Chebyshev points, the four boundary
+    conditions U(0) = U′(0) = 0, B₀(L) = B₁(L) = 0 close the system. The quadratic eigenproblem
+    (A₀ + λA₁ + λ²A₂) c = 0 is solved in companion form by ``scipy.linalg.eig``; the boundary rows make
+    A₂ singular, and the infinite eigenvalues this gives are dropped; each of the lowest is then refined
+    by Newton's method (:func:`_newton_polish`). The error falls exponentially in ``degree``: at ρI = 0,
+    Ω = 1.3 (ρA = EI = L = 1) against |ω_k ± Ω| the first three are within 9e-8 relative at degree 12 and
+    1e-14 at 18 (the default) to 32.
+    Each whirl (forward and backward) counts once; at Ω = 0 they coincide and each |λ| appears twice.
+    """
+    from numpy.polynomial import chebyshev as cheb
+    from scipy.linalg import eig
+
+    values = {L: length, rho_A: rho_A_value, rho_I: rho_I_value, EI: EI_value, _Om: omega}
+    for symbol, value in values.items():
+        if not np.isfinite(value) or not (value >= 0 if symbol in (rho_I, _Om) else value > 0):
+            raise ValueError(f"{symbol}: must be {'≥ 0' if symbol in (rho_I, _Om) else 'positive'} "
+                             f"and finite, got {value!r}")
+    if int(degree) != degree or degree < 8:
+        raise ValueError(f"degree: the Chebyshev degree must be an integer ≥ 8, got {degree!r}")
+    if int(count) != count or not 1 <= count <= degree // 4:
+        raise ValueError(f"count: must be an integer from 1 to degree // 4 = {degree // 4}, got {count!r}")
+    inside = cheb.chebpts1(degree - 3)
+    scale = 2.0 / length  # d/dx = (2/L) d/dξ, x = L(ξ + 1)/2
+
+    def derivative_matrices(xi):
+        identity = np.eye(degree + 1)
+        return [scale**k * cheb.chebvander(xi, degree) @ np.column_stack(
+            [np.pad(cheb.chebder(column, k), (0, k)) for column in identity]) for k in range(5)]
+
+    at_root, at_tip, field = (derivative_matrices(np.atleast_1d(xi)) for xi in (-1.0, 1.0, inside))
+    E, B0, B1 = whirl_equations()
+    A = np.concatenate([
+        np.stack([at_root[0], 0 * at_root[0], 0 * at_root[0]]),
+        np.stack([at_root[1], 0 * at_root[1], 0 * at_root[1]]),
+        _operator_rows(B0, values, at_tip), _operator_rows(B1, values, at_tip), _operator_rows(E, values, field),
+    ], axis=1)
+    A /= np.abs(A).max(axis=(0, 2))[None, :, None]  # each row to unit size: the k-th derivative rows grow as degree²ᵏ
+    size = degree + 1
+    zero, one = np.zeros((size, size)), np.eye(size)
+    eigenvalues = eig(np.block([[zero, one], [-A[0], -A[1]]]), np.block([[one, zero], [zero, A[2]]]),
+                      right=False)
+    finite = eigenvalues[np.isfinite(eigenvalues)]
+    real = finite[np.abs(finite.imag) < 1e-6 * (1 + np.abs(finite))].real
+    return np.sort([abs(_newton_polish(A, lam)) for lam in real[np.argsort(np.abs(real))][:count]])
+
+
+def _newton_polish(A: np.ndarray, lam: float, steps: int = 4) -> float:
+    """λ of (A₀ + λA₁ + λ²A₂) x = 0 refined from the QZ value by Newton's method on the eigenpair
+    (inverse iteration with T′(λ), Ruhe 1973, "Algorithms for the nonlinear eigenvalue problem", SIAM J.
+    Numer. Anal. 10): the QZ step loses ~1e-9 to the boundary rows of A₂; this recovers rounding level."""
+    x = np.linalg.svd(A[0] + lam * A[1] + lam**2 * A[2])[2][-1]
+    for _ in range(steps):
+        u = np.linalg.solve(A[0] + lam * A[1] + lam**2 * A[2], (A[1] + 2 * lam * A[2]) @ x)
+        lam -= (x @ x) / (x @ u)
+        x = u / np.linalg.norm(u)
+    return lam
