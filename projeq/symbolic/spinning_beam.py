@@ -94,16 +94,28 @@ def slice_velocity() -> sp.Matrix:
     return _d(r, t) + omega_IR.cross(r)
 
 
-def _variational_derivative(density, f):
-    """δ/δf of ∫∫ density dx dt: Σ (−1)^(i+j) ∂ₓⁱ∂ₜʲ ∂density/∂(∂ₓⁱ∂ₜʲ f)."""
-    result = sp.diff(density, f)
+def _variational_terms(density, f) -> list:
+    """The terms of δ/δf of ∫∫ density dx dt: ∂density/∂f and, for each derivative ∂ₓⁱ∂ₜʲ f in the
+    density, (−1)^(i+j) ∂ₓⁱ∂ₜʲ ∂density/∂(∂ₓⁱ∂ₜʲ f) (its integrations by parts in x and t)."""
+    terms = [sp.diff(density, f)]
     for d in density.atoms(sp.Derivative):
         if d.expr != f:
             continue
         orders = dict(d.variable_count)
         i, j = orders.get(x, 0), orders.get(t, 0)
-        result += (-1) ** (i + j) * _d(sp.diff(density, d), *([x] * i + [t] * j))
-    return result
+        terms.append((-1) ** (i + j) * _d(sp.diff(density, d), *([x] * i + [t] * j)))
+    return terms
+
+
+def hamilton_field_steps() -> dict:
+    """The expressions Hamilton's principle forms on the way to B(18), by name: the quadratic density
+    T − V per length (B(16)–(17)), its integrations by parts (:func:`_variational_terms`, per field) and
+    the field equations."""
+    density = _quadratic_density()
+    by_parts = {f: _variational_terms(density, f) for f in (v, w)}
+    return {"T − V per length (B(16)–(17))": [density],
+            "integrations by parts (δ/δv, δ/δw)": [term for terms in by_parts.values() for term in terms],
+            "field equations (B(18))": [_linear(-sum(by_parts[f])) for f in (v, w)]}
 
 
 @lru_cache(maxsize=None)
@@ -113,8 +125,7 @@ def hamilton_field_equations() -> tuple[sp.Expr, sp.Expr]:
     Lagrangian density ½ρA v_cᵀv_c + ½ω_cᵀ ρ diag(2I, I, I) ω_c − ½EI(v″² + w″²); sign
     chosen so that the ρA v̈ (ρA ẅ) term is positive.
     """
-    density = _quadratic_density()
-    return tuple(_linear(-_variational_derivative(density, f)) for f in (v, w))
+    return tuple(hamilton_field_steps()["field equations (B(18))"])
 
 
 @lru_cache(maxsize=None)
@@ -151,6 +162,19 @@ def _slice_residual() -> tuple:
 D_BAR = ((v, 1, 0), (w, 1, 0), (w, -1, 1), (v, 1, 1), (v, 1, 2), (w, 1, 2))
 
 
+def projection_field_steps() -> dict:
+    """The expressions the Projection Equation forms on the way to B(23), by name: the slice's
+    Newton–Euler residuals in R (B(19)), their projections with the adjoint D of D̄ (B(21)) and the
+    field equations."""
+    residuals = _newton_euler_residuals()
+    r = _slice_residual()
+    projections = {field: [c * (-1) ** k * _d(r_i, *([x] * k)) for r_i, (f, c, k) in zip(r, D_BAR) if f == field]
+                   for field in (v, w)}
+    return {"slice residuals (B(19))": list(residuals),
+            "projections D r (B(21))": [term for terms in projections.values() for term in terms],
+            "field equations (B(23))": [sp.expand(sum(projections[field])) for field in (v, w)]}
+
+
 @lru_cache(maxsize=None)
 def projection_field_equations() -> tuple[sp.Expr, sp.Expr]:
     """The v and w field equations of the Projection Equation, B(19)–(23), linear in (v, w).
@@ -158,12 +182,7 @@ def projection_field_equations() -> tuple[sp.Expr, sp.Expr]:
     The slice residual r = (f_y, f_z, m_y, m_z, EIv″, EIw″) (B(23)'s middle factor) is
     projected with D = adjoint of D̄ (B(21)): odd derivatives change sign.
     """
-    r = _slice_residual()
-    equations = []
-    for field in (v, w):
-        terms = [c * (-1) ** k * _d(r_i, *([x] * k)) for r_i, (f, c, k) in zip(r, D_BAR) if f == field]
-        equations.append(sp.expand(sum(terms)))
-    return tuple(equations)
+    return tuple(projection_field_steps()["field equations (B(23))"])
 
 
 @lru_cache(maxsize=None)
@@ -258,21 +277,38 @@ def _matrices(E: sp.Matrix, q, q_dot, q_ddot) -> RitzModel:
     )
 
 
-def _lagrange_ritz(Lagrangian, q, q_dot, q_ddot) -> RitzModel:
+def _lagrange_steps(Lagrangian, q, q_dot, q_ddot) -> dict:
     """Lagrange's equations d/dt ∂L/∂ȧ − ∂L/∂a = 0 of a discretised Lagrangian in the plain
-    symbols of :func:`_state_symbols`; α̇ is prescribed, so d/dt also acts through α̈."""
+    symbols of :func:`_state_symbols`, with the expressions formed on the way, by name; α̇ is
+    prescribed, so d/dt also acts through α̈."""
     p = sp.Matrix([Lagrangian]).jacobian(q_dot).T
     p_dot = p.jacobian(q) * sp.Matrix(q_dot) + p.jacobian(q_dot) * sp.Matrix(q_ddot) + p.diff(_Om) * _Om_dot
-    return _matrices(p_dot - sp.Matrix([Lagrangian]).jacobian(q).T, q, q_dot, q_ddot)
+    dL_dq = sp.Matrix([Lagrangian]).jacobian(q).T
+    return {"∂L/∂ȧ": list(p), "d/dt ∂L/∂ȧ": list(p_dot), "∂L/∂a": list(dL_dq), "equations": p_dot - dL_dq}
+
+
+def _lagrange_ritz(Lagrangian, q, q_dot, q_ddot) -> RitzModel:
+    """The :class:`RitzModel` of Lagrange's equations (:func:`_lagrange_steps`)."""
+    return _matrices(_lagrange_steps(Lagrangian, q, q_dot, q_ddot)["equations"], q, q_dot, q_ddot)
+
+
+def hamilton_ritz_steps(n: int) -> tuple[dict, tuple]:
+    """Hamilton's principle, B(16), with the Cardan rates of B(17), discretised with n functions per plane:
+    the expressions formed on the way by name (T − V per length with the Ritz fields, L = ∫(T − V) dx,
+    ∂L/∂ȧ, d/dt ∂L/∂ȧ, ∂L/∂a, the equations) and the plain symbols (a, ȧ, ä)."""
+    a, phi, fields = _ritz_coordinates(n)
+    symbols, rates = _state_symbols(a)
+    density = sp.expand(_quadratic_density().subs(fields).doit().subs(rates))
+    Lagrangian = sp.integrate(density, (x, 0, L))
+    steps = {"T − V per length": [density], "L = ∫(T − V) dx": [Lagrangian], **_lagrange_steps(Lagrangian, *symbols)}
+    return steps, symbols
 
 
 @lru_cache(maxsize=None)
 def _hamilton_ritz(n: int) -> RitzModel:
-    """Hamilton's principle, B(16), with the Cardan rates of B(17), discretised."""
-    a, phi, fields = _ritz_coordinates(n)
-    (q, q_dot, q_ddot), rates = _state_symbols(a)
-    Lagrangian = sp.integrate(sp.expand(_quadratic_density().subs(fields).doit().subs(rates)), (x, 0, L))
-    return _lagrange_ritz(Lagrangian, q, q_dot, q_ddot)
+    """Hamilton's principle, B(16), with the Cardan rates of B(17), discretised (:func:`hamilton_ritz_steps`)."""
+    steps, symbols = hamilton_ritz_steps(n)
+    return _matrices(steps["equations"], *symbols)
 
 
 def geometric_twist(v_field, w_field) -> sp.Expr:
@@ -311,18 +347,24 @@ def _torsion_free_ritz(n: int) -> RitzModel:
     return _lagrange_ritz(Lagrangian, q, q_dot, q_ddot)
 
 
-@lru_cache(maxsize=None)
-def _projection_ritz(n: int) -> RitzModel:
-    """∫ Ψᵀ r dx = 0 with Ψ = D̄ ∘ φ (B(20), B(22)): no boundary terms needed."""
+def projection_ritz_steps(n: int) -> tuple[dict, tuple]:
+    """∫ Ψᵀ r dx = 0 with Ψ = D̄ ∘ φ (B(20), B(22)), n functions per plane, no boundary terms needed: the
+    expressions formed on the way by name (the slice residual r of B(19) with the Ritz fields, the
+    projected integrands Ψᵀ r, the equations) and the plain symbols (a, ȧ, ä)."""
     a, phi, fields = _ritz_coordinates(n)
     r = [sp.expand(r_i.subs(fields).doit()) for r_i in _slice_residual()]
-    (q, q_dot, q_ddot), rates = _state_symbols(a)
-    equations = []
-    for field in (v, w):
-        for phi_i in phi:
-            integrand = sum(c * _d(phi_i, *([x] * k)) * r_i for r_i, (f, c, k) in zip(r, D_BAR) if f == field)
-            equations.append(sp.integrate(sp.expand(integrand.subs(rates)), (x, 0, L)))
-    return _matrices(sp.Matrix(equations), q, q_dot, q_ddot)
+    symbols, rates = _state_symbols(a)
+    integrands = [sp.expand(sum(c * _d(phi_i, *([x] * k)) * r_i for r_i, (f, c, k) in zip(r, D_BAR) if f == field)
+                            .subs(rates)) for field in (v, w) for phi_i in phi]
+    equations = sp.Matrix([sp.integrate(integrand, (x, 0, L)) for integrand in integrands])
+    return {"slice residual r": r, "projections Ψᵀ r": integrands, "equations": equations}, symbols
+
+
+@lru_cache(maxsize=None)
+def _projection_ritz(n: int) -> RitzModel:
+    """The Projection Equation's Ritz model (:func:`projection_ritz_steps`)."""
+    steps, symbols = projection_ritz_steps(n)
+    return _matrices(steps["equations"], *symbols)
 
 
 _RITZ = {"hamilton": _hamilton_ritz, "projection": _projection_ritz, "torsion_free": _torsion_free_ritz}
