@@ -75,7 +75,8 @@ def _pieces(derived, values):
         M, p0 = dL_dq_dot.jacobian(q_dot), dL_dq_dot.subs({v: 0 for v in q_dot})
         force = sp.Matrix([L]).jacobian(derived.q_symbols).T + Q
         pieces = {"M": M, "p0": p0, "force": force, "A": A, "b": b}
-        return "hamilton", (len(q_dot), A.rows), {k: _printed(k, symbols, X, values) for k, X in pieces.items()}
+        printed = {k: _printed(k, symbols, X, values) for k, X in pieces.items()}
+        return "hamilton", (len(q_dot), A.rows), printed
     if isinstance(derived, CanonicalForm):
         u = sp.Matrix(derived.u)
         J = sp.zeros(len(derived.q), 1) if derived.J is None else derived.J
@@ -87,7 +88,8 @@ def _pieces(derived, values):
     gauss = derived[2]
     pieces = {"K": gauss.K, "M": gauss.M, "rhs": gauss.rhs}
     symbols = (gauss.t, gauss.q, gauss.s)
-    return "kane", (len(gauss.q), len(gauss.s)), {k: _printed(k, symbols, X, values) for k, X in pieces.items()}
+    printed = {k: _printed(k, symbols, X, values) for k, X in pieces.items()}
+    return "kane", (len(gauss.q), len(gauss.s)), printed
 
 
 def _hamilton_rhs(n, c, M, p0, force, A, b):

@@ -240,7 +240,8 @@ def _pendulum(formulations, simulate, t_end):
 
 
 def _lagrange(bodies, q, s, parameters):
-    """Lagrange's equations of the 2nd kind as a Gauss form (:func:`projeq.studies.effort_growth.lagrange_steps`)."""
+    """Lagrange's equations of the 2nd kind as a Gauss form
+    (:func:`projeq.studies.effort_growth.lagrange_steps`)."""
     from projeq.studies.effort_growth import lagrange_steps
     from projeq.symbolic import GaussForm
 
@@ -353,8 +354,10 @@ def _spinning_beam(formulations, simulate, t_end):
         sb._torsion_free_ritz(2)
         return {}
 
-    derivations = {  # (the field equations' steps, the Ritz model's steps at n = 2), each a dict of expressions
-        "projection (field equations, Ritz)": (sb.projection_field_steps, lambda: sb.projection_ritz_steps(2)[0]),
+    # (the field equations' steps, the Ritz model's steps at n = 2), each a dict of expressions
+    derivations = {
+        "projection (field equations, Ritz)": (sb.projection_field_steps,
+                                               lambda: sb.projection_ritz_steps(2)[0]),
         "hamilton (field equations, Ritz)": (sb.hamilton_field_steps, lambda: sb.hamilton_ritz_steps(2)[0]),
         "torsion_free (Ritz, = RitzBeam)": (dict, torsion_free),
     }
@@ -464,9 +467,10 @@ EFFORT_CLAIMS = {
                         "\"This goes along with a considerable reduction of calculation effort.\"",
                         "projection (symbolic)", _ANALYTICAL),
     "spinning_beam": ("§4.2: the Projection Equation gives B(23) \"along with much less effort in calculation\" "
-                      "than Hamilton's principle gives B(18). n_ops here: every expression each derivation forms "
-                      "(Hamilton: T − V, its integrations by parts, L, ∂L/∂ȧ, d/dt ∂L/∂ȧ, ∂L/∂a; Projection "
-                      "Equation: the slice residuals, their projections), field equations and Ritz model n = 2; "
+                      "than Hamilton's principle gives B(18). n_ops here: every expression each derivation "
+                      "forms (Hamilton: T − V, its integrations by parts, L, ∂L/∂ȧ, d/dt ∂L/∂ȧ, ∂L/∂a; "
+                      "Projection Equation: the slice residuals, their projections), field equations and Ritz "
+                      "model n = 2; "
                       "its growth with 1…4 Ritz functions and 1…3 bodies: projeq.studies.effort_growth "
                       "(benchmarks/effort_growth.py).", "projection (field equations, Ritz)",
                       ("hamilton (field equations, Ritz)",)),

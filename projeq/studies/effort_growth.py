@@ -46,7 +46,7 @@ def lagrange_steps(bodies, q, s) -> dict:
 
 
 def _projection_steps(bodies, q, s, parameters) -> dict:
-    """The Projection Equation B(10) for ``bodies`` with each body's intermediate expressions merged by name."""
+    """The Projection Equation B(10) for ``bodies``, each body's intermediate expressions merged by name."""
     from projeq.symbolic import projection_equation
 
     trace = []
@@ -61,7 +61,9 @@ def pendulum_steps(links: int, method: str) -> dict:
     from projeq.symbolic.examples import n_link_pendulum
 
     bodies, q, s, parameters = n_link_pendulum(links)
-    return lagrange_steps(bodies, q, s) if method == "lagrange" else _projection_steps(bodies, q, s, parameters)
+    if method == "lagrange":
+        return lagrange_steps(bodies, q, s)
+    return _projection_steps(bodies, q, s, parameters)
 
 
 def _derivations(case: str, size: int, method: str):
@@ -102,7 +104,8 @@ def effort_rows(sizes=None) -> list[dict]:
     for case, values in sizes.items():
         for size in values:
             for method in ("hamilton", "projection"):
-                rows.append({"case": case, "size": size, "method": method, **effort(_derivations(case, size, method))})
+                measured = effort(_derivations(case, size, method))
+                rows.append({"case": case, "size": size, "method": method, **measured})
     return rows
 
 

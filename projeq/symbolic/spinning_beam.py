@@ -168,8 +168,8 @@ def projection_field_steps() -> dict:
     field equations."""
     residuals = _newton_euler_residuals()
     r = _slice_residual()
-    projections = {field: [c * (-1) ** k * _d(r_i, *([x] * k)) for r_i, (f, c, k) in zip(r, D_BAR) if f == field]
-                   for field in (v, w)}
+    projections = {field: [c * (-1) ** k * _d(r_i, *([x] * k))
+                           for r_i, (f, c, k) in zip(r, D_BAR) if f == field] for field in (v, w)}
     return {"slice residuals (B(19))": list(residuals),
             "projections D r (B(21))": [term for terms in projections.values() for term in terms],
             "field equations (B(23))": [sp.expand(sum(projections[field])) for field in (v, w)]}
@@ -292,21 +292,24 @@ def _lagrange_ritz(Lagrangian, q, q_dot, q_ddot) -> RitzModel:
     return _matrices(_lagrange_steps(Lagrangian, q, q_dot, q_ddot)["equations"], q, q_dot, q_ddot)
 
 
+@lru_cache(maxsize=None)
 def hamilton_ritz_steps(n: int) -> tuple[dict, tuple]:
     """Hamilton's principle, B(16), with the Cardan rates of B(17), discretised with n functions per plane:
     the expressions formed on the way by name (T − V per length with the Ritz fields, L = ∫(T − V) dx,
-    ∂L/∂ȧ, d/dt ∂L/∂ȧ, ∂L/∂a, the equations) and the plain symbols (a, ȧ, ä)."""
+    ∂L/∂ȧ, d/dt ∂L/∂ȧ, ∂L/∂a, the equations) and the plain symbols (a, ȧ, ä); cached (shared: read only)."""
     a, phi, fields = _ritz_coordinates(n)
     symbols, rates = _state_symbols(a)
     density = sp.expand(_quadratic_density().subs(fields).doit().subs(rates))
     Lagrangian = sp.integrate(density, (x, 0, L))
-    steps = {"T − V per length": [density], "L = ∫(T − V) dx": [Lagrangian], **_lagrange_steps(Lagrangian, *symbols)}
+    steps = {"T − V per length": [density], "L = ∫(T − V) dx": [Lagrangian],
+             **_lagrange_steps(Lagrangian, *symbols)}
     return steps, symbols
 
 
 @lru_cache(maxsize=None)
 def _hamilton_ritz(n: int) -> RitzModel:
-    """Hamilton's principle, B(16), with the Cardan rates of B(17), discretised (:func:`hamilton_ritz_steps`)."""
+    """Hamilton's principle, B(16), with the Cardan rates of B(17), discretised
+    (:func:`hamilton_ritz_steps`)."""
     steps, symbols = hamilton_ritz_steps(n)
     return _matrices(steps["equations"], *symbols)
 
@@ -347,15 +350,17 @@ def _torsion_free_ritz(n: int) -> RitzModel:
     return _lagrange_ritz(Lagrangian, q, q_dot, q_ddot)
 
 
+@lru_cache(maxsize=None)
 def projection_ritz_steps(n: int) -> tuple[dict, tuple]:
     """∫ Ψᵀ r dx = 0 with Ψ = D̄ ∘ φ (B(20), B(22)), n functions per plane, no boundary terms needed: the
     expressions formed on the way by name (the slice residual r of B(19) with the Ritz fields, the
-    projected integrands Ψᵀ r, the equations) and the plain symbols (a, ȧ, ä)."""
+    projected integrands Ψᵀ r, the equations) and the plain symbols (a, ȧ, ä); cached (shared: read only)."""
     a, phi, fields = _ritz_coordinates(n)
     r = [sp.expand(r_i.subs(fields).doit()) for r_i in _slice_residual()]
     symbols, rates = _state_symbols(a)
-    integrands = [sp.expand(sum(c * _d(phi_i, *([x] * k)) * r_i for r_i, (f, c, k) in zip(r, D_BAR) if f == field)
-                            .subs(rates)) for field in (v, w) for phi_i in phi]
+    integrands = [sp.expand(sum(c * _d(phi_i, *([x] * k)) * r_i
+                                for r_i, (f, c, k) in zip(r, D_BAR) if f == field).subs(rates))
+                  for field in (v, w) for phi_i in phi]
     equations = sp.Matrix([sp.integrate(integrand, (x, 0, L)) for integrand in integrands])
     return {"slice residual r": r, "projections Ψᵀ r": integrands, "equations": equations}, symbols
 
@@ -438,7 +443,8 @@ def whirl_equations() -> tuple[sp.Expr, sp.Expr, sp.Expr]:
     """
     whirl = {alpha: _Om * t, v: _U(x) * sp.cos(_lam * t), w: _U(x) * sp.sin(_lam * t)}
     B0, B1 = projection_boundary_operators()[v]
-    return tuple(sp.expand(e.subs(whirl).doit().subs(t, 0)) for e in (projection_field_equations()[0], B0, B1))
+    return tuple(sp.expand(e.subs(whirl).doit().subs(t, 0))
+                 for e in (projection_field_equations()[0], B0, B1))
 
 
 def _operator_rows(expr, values: dict, derivatives: list) -> np.ndarray:
@@ -491,9 +497,10 @@ def whirl_frequencies(omega: float, rho_I_value: float, count: int = 3, degree: 
     A = np.concatenate([
         np.stack([at_root[0], 0 * at_root[0], 0 * at_root[0]]),
         np.stack([at_root[1], 0 * at_root[1], 0 * at_root[1]]),
-        _operator_rows(B0, values, at_tip), _operator_rows(B1, values, at_tip), _operator_rows(E, values, field),
+        _operator_rows(B0, values, at_tip), _operator_rows(B1, values, at_tip),
+        _operator_rows(E, values, field),
     ], axis=1)
-    A /= np.abs(A).max(axis=(0, 2))[None, :, None]  # each row to unit size: the k-th derivative rows grow as degree²ᵏ
+    A /= np.abs(A).max(axis=(0, 2))[None, :, None]  # rows to unit size: k-th derivative rows grow as degree²ᵏ
     size = degree + 1
     zero, one = np.zeros((size, size)), np.eye(size)
     eigenvalues = eig(np.block([[zero, one], [-A[0], -A[1]]]), np.block([[one, zero], [zero, A[2]]]),
