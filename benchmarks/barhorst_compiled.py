@@ -40,17 +40,19 @@ def table(study: str, runs) -> list[dict]:
     baseline = runs[0].radau_s
     rows = []
     for run in runs:
+        dop853_ratio = None if run.dop853_s is None else run.dop853_s / baseline
         rows.append({"formulation": run.formulation, "generate_s": run.generate_s, "compile_s": run.compile_s,
-                     "radau_s": run.radau_s, "radau_ratio": run.radau_s / baseline, "radau_steps": run.radau_steps,
-                     "dop853_s": run.dop853_s, "dop853_ratio": None if run.dop853_s is None else run.dop853_s / baseline,
+                     "radau_s": run.radau_s, "radau_ratio": run.radau_s / baseline,
+                     "radau_steps": run.radau_steps, "dop853_s": run.dop853_s, "dop853_ratio": dop853_ratio,
                      "dop853_steps": run.dop853_steps, "paper": PAPER[study][run.formulation],
                      "gap": float(np.abs(run.q[:, -1] - runs[0].q[:, -1]).max())})
-    print(f"\n{study}: CPU s of a warm run (ratio to the first row's Radau IIA), generation and compilation beside")
+    print(f"\n{study}: CPU s of a warm run (ratio to the first row's Radau IIA), "
+          "generation and compilation beside")
     print(f"{'formulation':40} {'gen_s':>6} {'comp_s':>6} {'Radau s':>8} {'ratio':>5} {'steps':>5} "
           f"{'DOP853 s':>8} {'ratio':>5} {'steps':>5} {'|Δq(end)|':>9}  Barhorst")
     for r in rows:
-        dop = ("—", "—", "—") if r["dop853_s"] is None else (f"{r['dop853_s']:.3f}", f"{r['dop853_ratio']:.2f}",
-                                                             str(r["dop853_steps"]))
+        dop = ("—", "—", "—") if r["dop853_s"] is None else (
+            f"{r['dop853_s']:.3f}", f"{r['dop853_ratio']:.2f}", str(r["dop853_steps"]))
         print(f"{r['formulation']:40} {r['generate_s']:6.2f} {r['compile_s']:6.2f} {r['radau_s']:8.3f} "
               f"{r['radau_ratio']:5.2f} {r['radau_steps']:5d} {dop[0]:>8} {dop[1]:>5} {dop[2]:>5} "
               f"{r['gap']:9.1e}  {r['paper']}")
@@ -64,7 +66,8 @@ def main(argv=None) -> dict:
     if args.quick:
         return {"barhorst_particle": table("barhorst_particle",
                                            compiled_study("barhorst_particle", 1.0, compile=False, repeat=1))}
-    return {study: table(study, compiled_study(study, 10.0)) for study in ("barhorst_particle", "quick_return")}
+    return {study: table(study, compiled_study(study, 10.0))
+            for study in ("barhorst_particle", "quick_return")}
 
 
 if __name__ == "__main__":

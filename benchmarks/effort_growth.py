@@ -20,8 +20,9 @@ import os
 
 from projeq.studies.effort_growth import CASES, effort_rows, verdict
 
-CLAIMS = ("H. Bremer, §4.2: B(23) \"along with much less effort in calculation\" than Hamilton's principle's B(18); "
-          "§3: the Projection Equation \"leads to minimum effort when compared to the analytical procedures\".")
+CLAIMS = ("H. Bremer, §4.2: B(23) \"along with much less effort in calculation\" than Hamilton's "
+          "principle's B(18); §3: the Projection Equation \"leads to minimum effort when compared to the "
+          "analytical procedures\".")
 
 
 def main(argv=None) -> list:
@@ -32,7 +33,8 @@ def main(argv=None) -> list:
     rows = effort_rows(sizes)
     print(f"{'case':22} {'size':>4} {'method':10} {'ops':>6} {'cpu_s':>7}  operations per step")
     for row in rows:
-        print(f"{row['case']:22} {row['size']:4d} {row['method']:10} {row['total_ops']:6d} {row['cpu_s']:7.3f}  "
+        print(f"{row['case']:22} {row['size']:4d} {row['method']:10} {row['total_ops']:6d} "
+              f"{row['cpu_s']:7.3f}  "
               + ", ".join(f"{name} {ops}" for name, ops in row["ops"].items()))
     print(CLAIMS)
     print(verdict(rows))

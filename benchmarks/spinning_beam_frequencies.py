@@ -120,7 +120,8 @@ def main(argv=None) -> dict:
     print(f"ρI = {RHO_I}: PDE by Chebyshev collocation against the boundary determinant's roots: relative "
           + ", ".join(f"{e:.1e}" for e in np.abs(pde / determinant - 1)))
     inertia_rows = convergence(f"ρI = {RHO_I}, the PDE's frequencies, Ω = {OMEGA}", pde, sizes, RHO_I)
-    return {"exact": exact, "rows": rows, "pde": pde, "determinant": determinant, "inertia_rows": inertia_rows}
+    return {"exact": exact, "rows": rows, "pde": pde, "determinant": determinant,
+            "inertia_rows": inertia_rows}
 
 
 if __name__ == "__main__":

@@ -205,6 +205,7 @@ def rows() -> list[str]:
             entry = found[document].get(number, {"code": [], "tests": []})
             code = ", ".join(f"`{c}`" for c in entry["code"][:2]) or "—"
             tests = ", ".join(f"`{c}`" for c in entry["tests"][:2])
-            why = tests or reason(document, number) or "no test cites it" + (" (code only)" if entry["code"] else "")
+            why = (tests or reason(document, number)
+                   or "no test cites it" + (" (code only)" if entry["code"] else ""))
             lines.append(f"| {DOCUMENTS[document]} | {number} | {code} | {why} |")
     return lines

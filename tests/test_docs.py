@@ -51,21 +51,25 @@ def test_the_architecture_examples_run():
 SOURCE_EQUATIONS = {
     'H. Bremer, "Problems in fast moving non-holonomic elastic systems"': [str(k) for k in range(1, 26)],
     "lecture on non-holonomic systems and Lagrange multipliers (Orsino 2020)": [str(k) for k in range(1, 27)],
-    'A. A. Barhorst, "Generalized momenta in constrained non-holonomic systems"': [str(k) for k in range(1, 117)],
+    'A. A. Barhorst, "Generalized momenta in constrained non-holonomic systems"': [
+        str(k) for k in range(1, 117)],
     '"On derivation of motion equations for systems with non-holonomic high-order program constraints"': [
         "1", "1.1", "2", "2.1", "2.2a", "2.2", "3.1a", "3.1", "3.2", "4.1a", "4.1", "4.2", "4.3a", "4.3",
         *(f"5.{k}" for k in range(1, 10)), *(f"6.{k}" for k in range(1, 35)), "6.34a"],
     "problem seminars on Lagrange's equations (worked problems)": [
-        *(f"Problem {k}" for k in (1, 2, 3, 4, 7, 8, 10, 11, 12, 14, 15, 16, 17, 19, 20, 23, 26, 27, 40, 41, 43, 44)),
+        *(f"Problem {k}"
+          for k in (1, 2, 3, 4, 7, 8, 10, 11, 12, 14, 15, 16, 17, 19, 20, 23, 26, 27, 40, 41, 43, 44)),
         *(f"Seminar {k}" for k in (1, 2, 3, 4, 5, 6, 7, 10, 11)),
         *(f"Notes {k}" for k in ("I", "II", "III", "IV", "V", "VI", "VII"))],
 }
 
 
 def test_every_source_equation_has_a_validation_row():
-    """docs/validation.md, "Source documents, equation by equation" (python docs/gen_validation.py --equations):
-    one row per equation of SOURCE_EQUATIONS, with a test or a stated reason (never "no test cites it")."""
-    section = (ROOT / "docs" / "validation.md").read_text().split("## Source documents, equation by equation")[1]
+    """docs/validation.md, "Source documents, equation by equation" (``python docs/gen_validation.py
+    --equations``): one row per equation of SOURCE_EQUATIONS, with a test or a stated reason (never "no
+    test cites it")."""
+    text = (ROOT / "docs" / "validation.md").read_text()
+    section = text.split("## Source documents, equation by equation")[1]
     rows = {}
     for line in section.splitlines():
         cells = [cell.strip() for cell in line.strip().strip("|").split("|")]
