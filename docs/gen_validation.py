@@ -10,6 +10,9 @@ Two tables, both from runs made now (nothing is copied from elsewhere):
    (pytest), its duration and the reference its docstring cites (each test asserts projeq
    against that reference within the tolerance stated in the test). Bad-input tests are
    left out: they check messages, not physics.
+3. Every numbered equation and worked example of the five source documents with the code and tests
+   that cite it, or the reason it has none (``docs/source_equations.py``); ``--equations`` rewrites only
+   this table (no test run).
 """
 
 from __future__ import annotations
@@ -89,9 +92,38 @@ def main() -> int:
     for nodeid, outcome, duration in collector.rows:
         doc = collector.docs.get(nodeid, "").replace("|", "\\|")
         lines.append(f"| `{nodeid.split('tests/')[-1]}` | {outcome} | {duration:.2f} | {doc} |")
+    lines += source_equations_section()
     (ROOT / "docs" / "validation.md").write_text("\n".join(lines) + "\n")
     return int(code)
 
 
+SOURCE_HEADING = "## Source documents, equation by equation"
+
+
+def source_equations_section() -> list[str]:
+    """The rows of docs/source_equations.py: every numbered equation and worked example of the five
+    source documents with the code and tests whose docstrings cite it, or the stated reason."""
+    sys.path.insert(0, str(ROOT / "docs"))
+    import source_equations
+
+    return ["", SOURCE_HEADING, "",
+            "Found in the docstrings of projeq/ and tests/ (docs/source_equations.py: the citation forms); an "
+            "equation none cites has its reason. tests/test_docs.py keeps the documents' equation numbers and "
+            "checks that each has a row.", "",
+            "| document | equation | code | tests (or the reason) |", "| --- | --- | --- | --- |",
+            *source_equations.rows()]
+
+
+def update_source_equations() -> None:
+    """Rewrite only the source-documents section of docs/validation.md (``--equations``)."""
+    path = ROOT / "docs" / "validation.md"
+    text = path.read_text()
+    kept = text.split("\n" + SOURCE_HEADING)[0].rstrip("\n")
+    path.write_text(kept + "\n" + "\n".join(source_equations_section()) + "\n")
+
+
 if __name__ == "__main__":
+    if "--equations" in sys.argv[1:]:
+        update_source_equations()
+        sys.exit(0)
     sys.exit(main())

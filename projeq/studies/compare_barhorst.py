@@ -33,7 +33,7 @@ import sympy as sp
 
 from projeq.studies.effort import cse_ops, derivation_timed
 
-__all__ = ["PAPER", "BARHORST_STUDIES", "BARHORST_T_END", "study_rows"]
+__all__ = ["PAPER", "BARHORST_STUDIES", "BARHORST_T_END", "study_formulations", "study_rows"]
 
 RTOL, ATOL = 1e-8, 1e-10  # one tolerance for every row (Radau IIA)
 
@@ -83,12 +83,15 @@ class Run:
 
 @dataclass(frozen=True)
 class StudyFormulation:
-    """``derive()`` → the equations (timed); ``run(derived, t_end, t_eval)`` → :class:`Run`; ``note``."""
+    """``derive()`` → the equations (timed); ``run(derived, t_end, t_eval)`` → :class:`Run`; ``note``;
+    ``start``: the initial coordinates and the formulation's initial velocities (q̇ for the multiplier
+    forms, the independent speeds u otherwise)."""
 
     name: str
     derive: Callable
     run: Callable
     note: str = ""
+    start: tuple = ()
 
 
 def _integrate(fun, y0, t_end, t_eval, mass=None, index=None):
@@ -110,7 +113,8 @@ def _hamilton(example, q0, q_dot0, note="index 2: 0 = A ∂H/∂p, Radau IIA on 
             raise RuntimeError(f"Radau IIA failed: {sol.message}")
         return Run(sol.t, sol.q, sol.q_dot, time.perf_counter() - start, sol.nfev, sol.n_steps)
 
-    return StudyFormulation("hamilton canonical + multipliers (DAE)", example.multiplier_system, run, note)
+    return StudyFormulation("hamilton canonical + multipliers (DAE)", example.multiplier_system, run, note,
+                            (q0, q_dot0))
 
 
 def _kane(name, example, u, K, q0, u0, note="Projection Equation B(10) = Kane's form, M u̇ = rhs"):
@@ -134,7 +138,7 @@ def _kane(name, example, u, K, q0, u0, note="Projection Equation B(10) = Kane's 
         q_dot = np.array([K_of(qi) @ ui for qi, ui in zip(sol.y[:n].T, sol.y[n:].T)]).T
         return Run(sol.t, sol.y[:n], q_dot, seconds, sol.nfev, sol.n_steps)
 
-    return StudyFormulation(name, derive, run, note)
+    return StudyFormulation(name, derive, run, note, (q0, u0))
 
 
 def _canonical(name, build, q0, u0, note):
@@ -146,7 +150,7 @@ def _canonical(name, build, q0, u0, note):
         q_dot = np.array([form.q_dot(ti, yi[:n], ui) for ti, yi, ui in zip(sol.t, sol.y.T, u)]).T
         return Run(sol.t, sol.y[:n], q_dot, seconds, sol.nfev, sol.n_steps)
 
-    return StudyFormulation(name, build, run, note)
+    return StudyFormulation(name, build, run, note, (q0, u0))
 
 
 def _projective_rows(example, speeds, u, K, q0, u0, independent, notes):
@@ -269,7 +273,7 @@ def _compare_motions(study: str, rows: list[dict], runs: dict) -> None:
 
 
 # -- the three studies ------------------------------------------------------------------------
-def _particle(formulations, simulate, t_end):
+def _particle_formulations():
     """§3.1: the particle from (2, 2) at rest, m = 1, g = 10; u = ẏ independent as Barhorst (A12 = 1/y²)."""
     from projeq.symbolic.barhorst_examples import barhorst_particle
 
@@ -282,10 +286,15 @@ def _particle(formulations, simulate, t_end):
                           ("eqs. 71–72 = B(10)", "eqs. 79–80: ṗ2 = −m g − 2 p2² y³/(m (1 + y⁴)²)",
                            "eqs. 86–87 (the same equations as eqs. 79–80)")),
     ]
+    return example, available
+
+
+def _particle(formulations, simulate, t_end):
+    example, available = _particle_formulations()
     return study_rows("barhorst_particle", available, example, formulations, simulate, t_end)
 
 
-def _rolling_disk(formulations, simulate, t_end):
+def _rolling_disk_formulations():
     """§3.2: the disk of projeq's scene ``rolling_disk`` (his values in SI), tilt 0.15 rad, q̇3 = 20 rad/s."""
     from projeq.symbolic.barhorst_examples import disk_kinematics, disk_speeds, rolling_disk
     from projeq.symbolic.canonical import lagrangian_canonical, projective_canonical
@@ -319,7 +328,13 @@ def _rolling_disk(formulations, simulate, t_end):
         _canonical("barhorst lagrangian canonical, eq. 93 speeds", lagrangian, q0, body_u0,
                    "eqs. 47–52 with u = Y q̇ (93), §3.2.4"),
     ]
+    return example, available
+
+
+def _rolling_disk(formulations, simulate, t_end):
+    example, available = _rolling_disk_formulations()
     rows = study_rows("rolling_disk", available, example, formulations, simulate, t_end)
+    q0, q_dot0 = available[0].start
     E0 = example.energy_function()(q0, q_dot0)
     for row in rows:
         if row["formulation"] == "barhorst lagrangian canonical, eq. 93 speeds":
@@ -328,8 +343,9 @@ def _rolling_disk(formulations, simulate, t_end):
     return rows
 
 
-def _quick_return(formulations, simulate, t_end):
-    """§3.3: undriven quick return from his configuration at rest (T_m = T_d = 0)."""
+def _quick_return_formulations():
+    """§3.3: undriven quick return from his configuration at rest (T_m = T_d = 0); the first row (Hamilton's
+    form) is not available."""
     from projeq.symbolic.barhorst_examples import quick_return, quick_return_start
     from projeq.symbolic.canonical import lagrangian_canonical
 
@@ -340,11 +356,16 @@ def _quick_return(formulations, simulate, t_end):
     unavailable = StudyFormulation(
         "hamilton canonical + multipliers (DAE)", lambda: None, None,
         "not available: the massless slider leaves ∂²L/∂q̇² singular, so p = ∂L/∂q̇ has no inverse (no H)")
-    available = [
+    return example, [
         unavailable,
         *_projective_rows(example, "u = q̇1", u, K, q0, u0, [0],
                           ("B(10) with q̇ = K̄ q̇1 (109)", "eqs. 36–37", "eqs. 112–116")),
     ]
+
+
+def _quick_return(formulations, simulate, t_end):
+    example, available = _quick_return_formulations()
+    unavailable = available[0]
     wanted = [f.name for f in available] if formulations is None else formulations
     rows = study_rows("quick_return", available[1:], example, [w for w in wanted if w != unavailable.name],
                       simulate, t_end)
@@ -354,6 +375,18 @@ def _quick_return(formulations, simulate, t_end):
                         "Barhorst (paper) time": paper[0], "Barhorst (paper) energy": paper[1],
                         "Barhorst (paper) constraint": paper[2]})
     return rows
+
+
+def study_formulations(study: str):
+    """``(example, formulations)`` of one of Barhorst's studies (``barhorst_particle``, ``rolling_disk``,
+    ``quick_return``): his example (:mod:`projeq.symbolic.barhorst_examples`) and the
+    :class:`StudyFormulation` rows, each with its ``derive`` and ``start``; a row whose form does not
+    exist for the example has ``run = None``."""
+    builders = {"barhorst_particle": _particle_formulations, "rolling_disk": _rolling_disk_formulations,
+                "quick_return": _quick_return_formulations}
+    if study not in builders:
+        raise ValueError(f"study: unknown {study!r}; available: {list(builders)}")
+    return builders[study]()
 
 
 BARHORST_STUDIES = {"barhorst_particle": _particle, "rolling_disk": _rolling_disk, "quick_return": _quick_return}

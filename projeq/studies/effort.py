@@ -52,7 +52,8 @@ derivation_repeats = contextvars.ContextVar("derivation_repeats", default=DERIVA
 EFFORT = ("derivation_s: median of {repeats} runs, each from the same state: sympy.core.cache.clear_cache() and "
           "projeq's memoised derivations (functools caches in projeq.symbolic, projeq.scenes) emptied first. "
           "n_ops: sympy.count_ops after sympy.cse of the derived equations (Gauss form: M and rhs; multiplier form: "
-          "its residuals; Hamilton's canonical form: q̇ and ṗ; Barhorst's: p and ṗ; beam: the field equations), "
+          "its residuals; Hamilton's canonical form: q̇ and ṗ; Barhorst's: p and ṗ; beam: every intermediate "
+          "expression of the field equations and the Ritz model, summed over the steps), "
           "parameters replaced by their numbers, functions of time by symbols; numeric evaluators derive nothing.")
 
 

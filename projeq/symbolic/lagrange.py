@@ -202,18 +202,24 @@ class MultiplierSystem:
         from projeq.simulation.integrators import radau_dae
 
         n = len(self.q)
-        q0, q_dot0 = (np.asarray(v, dtype=float).ravel() for v in (q0, q_dot0))
-        if q0.size != n or q_dot0.size != n:
-            raise ValueError(f"q0, q_dot0: expected {n} values each, got {q0.size} and {q_dot0.size}")
-        _, _, _, constraint_force, _ = self._evaluate(t_span[0], q0, q_dot0, 0.0)
-        _, _, _, _, A, _, _ = self._compiled(t_span[0], q0, q_dot0)
-        lam0 = np.linalg.lstsq(np.asarray(A, float).reshape(-1, n).T, constraint_force, rcond=None)[0]
+        y0 = self.dae_start(t_span[0], q0, q_dot0)
         f, mass, index = self.hamilton_dae(phi)
-        y0 = np.concatenate([q0, self.momenta(t_span[0], q0, q_dot0), lam0])
         sol = radau_dae(f, t_span, y0, mass=mass, index=index, rtol=rtol, atol=atol, t_eval=t_eval)
         sol.q, sol.p, sol.lam = sol.y[:n], sol.y[n:2 * n], sol.y[2 * n:]
         sol.q_dot = np.array([self._velocities(ti, qi, pi) for ti, qi, pi in zip(sol.t, sol.q.T, sol.p.T)]).T
         return sol
+
+    def dae_start(self, t0: float, q0, q_dot0) -> np.ndarray:
+        """The consistent initial state y₀ = (q₀, p₀, λ₀) of :meth:`hamilton_dae`: p₀ = ∂L/∂q̇ at (q₀, q̇₀),
+        λ₀ from the constraint differentiated once (Aᵀλ₀ the constraint force of the index-1 form)."""
+        n = len(self.q)
+        q0, q_dot0 = (np.asarray(v, dtype=float).ravel() for v in (q0, q_dot0))
+        if q0.size != n or q_dot0.size != n:
+            raise ValueError(f"q0, q_dot0: expected {n} values each, got {q0.size} and {q_dot0.size}")
+        _, _, _, constraint_force, _ = self._evaluate(t0, q0, q_dot0, 0.0)
+        _, _, _, _, A, _, _ = self._compiled(t0, q0, q_dot0)
+        lam0 = np.linalg.lstsq(np.asarray(A, float).reshape(-1, n).T, constraint_force, rcond=None)[0]
+        return np.concatenate([q0, self.momenta(t0, q0, q_dot0), lam0])
 
     def _velocities(self, t, q, p):
         """q̇ = M⁻¹(p − ∂L/∂q̇|_{q̇=0}) = ∂H/∂p, K(23), numerically (M does not depend on q̇)."""

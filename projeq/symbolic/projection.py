@@ -119,12 +119,15 @@ class SymbolicEvaluator:
         return np.linalg.solve(M, rhs)
 
 
-def projection_equation(bodies, q, s, K=None, parameters=()) -> GaussForm:
+def projection_equation(bodies, q, s, K=None, parameters=(), trace: list | None = None) -> GaussForm:
     """Gauss form of B(10) for ``bodies`` (a mapping name → :class:`Body`).
 
     q, s : sequences of sympy symbols, the coordinates and the minimal velocities ṡ
     K : matrix of q̇ = K(q) ṡ (default: identity, ṡ = q̇, needs len(q) == len(s))
     parameters : the other symbols the inputs may contain
+    trace : a list to which each body's intermediate expressions are appended, by name (its
+        projections J_v = ∂v/∂ṡ, J_ω = ∂ω/∂ṡ and its momentum balances), for
+        counting the effort of the derivation (:mod:`projeq.studies.effort_growth`)
 
     >>> m, c, C0, vx, wz, g = sp.symbols("m c C0 v_x omega_z gamma")
     >>> car = Body(v_c=(vx, c * wz, 0), omega=(0, 0, wz), m=m, I_c=sp.diag(0, 0, C0 - m * c**2),
@@ -154,8 +157,10 @@ def projection_equation(bodies, q, s, K=None, parameters=()) -> GaussForm:
         b = body.vectors(name)
         for key, value in b.items():
             check_symbols(f"{name}.{key}", value, declared)
-        M_i, rhs_i = _body_terms(b, q, s, q_dot)
+        M_i, rhs_i, steps = _body_terms(b, q, s, q_dot)
         M, rhs = M + M_i, rhs + rhs_i
+        if trace is not None:
+            trace.append(steps)
     return GaussForm(M, rhs, q, s, K, t, parameters)
 
 
@@ -165,7 +170,8 @@ def _rest_of_derivative(x, q, q_dot):
 
 
 def _body_terms(b, q, s, q_dot):
-    """One body's share of B(10): M_i = m J_vᵀJ_v + J_ωᵀ I_c J_ω and rhs_i = −Jᵀ(… − fᵉ, … − Mᵉ)."""
+    """One body's share of B(10): M_i = m J_vᵀJ_v + J_ωᵀ I_c J_ω and rhs_i = −Jᵀ(… − fᵉ, … − Mᵉ), and the
+    expressions formed on the way, by name."""
     J_v, J_w = b["v_c"].jacobian(s), b["omega"].jacobian(s)
     m, I_c, w_IR = b["m"], b["I_c"], b["omega_IR"]
     p, L = m * b["v_c"], I_c * b["omega"]
@@ -173,5 +179,7 @@ def _body_terms(b, q, s, q_dot):
     I_c_dot = sum((I_c.diff(q_k) * q_dot_k for q_k, q_dot_k in zip(q, q_dot)), I_c.diff(t))
     L_dot_rest = I_c * _rest_of_derivative(b["omega"], q, q_dot) + I_c_dot * b["omega"]
     M_i = m * J_v.T * J_v + J_w.T * I_c * J_w
-    rhs_i = -J_v.T * (p_dot_rest + w_IR.cross(p) - b["f"]) - J_w.T * (L_dot_rest + w_IR.cross(L) - b["M"])
-    return M_i, rhs_i
+    force, moment = p_dot_rest + w_IR.cross(p) - b["f"], L_dot_rest + w_IR.cross(L) - b["M"]
+    rhs_i = -J_v.T * force - J_w.T * moment
+    steps = {"projections J_v, J_ω": [*J_v, *J_w], "momentum balances": [*force, *moment]}
+    return M_i, rhs_i, steps

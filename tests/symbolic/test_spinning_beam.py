@@ -198,18 +198,67 @@ def test_boundary_operators_are_the_free_end_conditions():
     assert sp.expand(B0_w.subs(sb.rho_I, 0) + sb.EI * sb.w.diff(sb.x, 3)) == 0
 
 
+def _frequency_benchmark():
+    import runpy
+    from pathlib import Path
+
+    return runpy.run_path(str(Path(__file__).parents[2] / "benchmarks" / "spinning_beam_frequencies.py"))
+
+
 def test_zero_rotary_inertia_frequencies_are_the_cantilevers_shifted_by_the_spin():
     """ρI = 0 at constant spin Ω = 1.3 (ρA = EI = L = 1): the PDE's co-rotating frequencies are |ω_k ± Ω|
     with ω_k = (β_k L)² of the cantilever, 1 + cos βL cosh βL = 0 (benchmarks/spinning_beam_frequencies.py,
     which prints n = 2 … 8; this runs its quick mode, n = 2). The Ritz model of the Projection Equation
     splits each ω̃_k into ω̃_k ± Ω exactly (f₂ − f₁ = 2Ω to 1e-12, measured 1e-14) and has the first two
-    frequencies within 1e-2 relative at n = 2 (measured 7.5e-3, 3.5e-3; 1.4e-10 at n = 6)."""
-    import runpy
-    from pathlib import Path
-
-    benchmark = runpy.run_path(str(Path(__file__).parents[2] / "benchmarks" / "spinning_beam_frequencies.py"))
+    frequencies within 1e-2 relative at n = 2 (measured 7.5e-3, 3.5e-3; 1.4e-10 at n = 6). With ρI = 0.01
+    the Ritz model at n = 2 is within 1e-2 of the PDE's first two (measured 7.1e-3, 2.6e-3; 1e-10 at n = 6),
+    and the PDE's spectral frequencies equal the boundary determinant's roots to 1e-13 (measured 2e-15)."""
+    benchmark = _frequency_benchmark()
     report = benchmark["main"](["--quick"])
     (row,) = report["rows"]
     assert abs(row["frequencies"][1] - row["frequencies"][0] - 2 * benchmark["OMEGA"]) < 1e-12
     assert np.all(row["errors"][:2] < 1e-2)
     assert report["exact"][1] - report["exact"][0] == pytest.approx(2 * benchmark["OMEGA"], abs=1e-12)
+    (inertia_row,) = report["inertia_rows"]
+    assert np.all(inertia_row["errors"][:2] < 1e-2)
+    np.testing.assert_allclose(report["pde"], report["determinant"], rtol=1e-13)
+
+
+def test_whirl_equations_are_B23_and_its_boundary_terms_at_constant_spin():
+    """v + i w = U e^{iλt}, α = Ωt in B(23) and B₀, B₁ (B(21)): EI U⁗ + ρI(λ² − Ω²)U″ − ρA(λ + Ω)²U = 0,
+    free end EI U″ = 0, EI U‴ + ρI(λ² − Ω²)U′ = 0 (at Ω = 0 the Rayleigh beam's, Han, Benaroya & Wei 1999);
+    the w plane at λt = π/2 gives the same (exact: symbolic identity)."""
+    E, B0, B1 = sb.whirl_equations()
+    lam, Om, U = sp.Symbol("lambda"), sp.Symbol("Omega"), sp.Function("U")(sb.x)
+    k = sb.rho_I * (lam**2 - Om**2)
+    field = sb.EI * U.diff(sb.x, 4) + k * U.diff(sb.x, 2) - sb.rho_A * (lam + Om) ** 2 * U
+    assert sp.expand(E - field) == 0
+    assert sp.expand(B0 + sb.EI * U.diff(sb.x, 3) + k * U.diff(sb.x)) == 0
+    assert B1 == sb.EI * U.diff(sb.x, 2)
+    whirl = {sb.alpha: Om * sb.t, sb.v: U * sp.cos(lam * sb.t), sb.w: U * sp.sin(lam * sb.t)}
+    E_w = sb.projection_field_equations()[1].subs(whirl).doit().subs(sb.t, sp.pi / (2 * lam))
+    assert sp.simplify(E_w - E) == 0
+
+
+@pytest.mark.parametrize("omega, rho_I", [(1.3, 0.0), (0.0, 0.01), (1.3, 0.01), (2.5, 0.05)])
+def test_whirl_frequencies_are_the_boundary_determinants_roots(omega, rho_I):
+    """The Chebyshev solution of the PDE (whirl_frequencies, degree 18) against the roots of the 4 × 4
+    boundary determinant of the constant-coefficient ODE (cosh, sinh, cos, sin; at Ω = 0 the Rayleigh
+    cantilever's frequency equation, Han, Benaroya & Wei 1999): 1e-13 relative (measured ≤ 5e-15); at
+    ρI = 0 also against |ω_k ± Ω| of the cantilever (1e-13, measured 1e-15)."""
+    benchmark = _frequency_benchmark()
+    found = sb.whirl_frequencies(omega, rho_I)
+    np.testing.assert_allclose(found, benchmark["determinant_frequencies"](omega, rho_I), rtol=1e-13)
+    if rho_I == 0:
+        np.testing.assert_allclose(found, benchmark["closed_form"](omega), rtol=1e-13)
+
+
+def test_whirl_frequencies_bad_input():
+    with pytest.raises(ValueError, match="rho_I"):
+        sb.whirl_frequencies(1.0, -0.1)
+    with pytest.raises(ValueError, match="Omega"):
+        sb.whirl_frequencies(float("nan"), 0.1)
+    with pytest.raises(ValueError, match="degree"):
+        sb.whirl_frequencies(1.0, 0.1, degree=5)
+    with pytest.raises(ValueError, match="count"):
+        sb.whirl_frequencies(1.0, 0.1, count=0)
