@@ -13,7 +13,8 @@ from projeq.subsystems import inertia
 from projeq.assembly import SingularMassError
 from projeq.forces import BodyLoad, Force, ForceLaw, JointForce, JointSpring, SpringDamper, Torque
 from projeq.analysis.linearize import Linearization, NotSteadyError, eigenvalue_sweep, linearize
-from projeq.joints import Fixed, Free, Joint, Planar, Prescribed, Prismatic, Revolute, UserJoint
+from projeq.joints import (Cylindrical, Fixed, Free, Joint, Planar, Prescribed, Prismatic, Revolute, RollingDisk,
+                           RollingSphere, Spherical, Universal, UserJoint)
 from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, RitzBeam, Subsystem
 from projeq.system import GROUND, System, SystemBuilder
 
@@ -21,7 +22,8 @@ __version__ = "0.1.0"
 
 __all__ = [
     "GROUND", "System", "SystemBuilder", "Subsystem", "RigidBody", "PlanarBody", "PointMass", "Frame", "RitzBeam",
-    "Joint", "Revolute", "Prismatic", "Fixed", "Planar", "Free", "Prescribed", "UserJoint",
+    "Joint", "Revolute", "Prismatic", "Fixed", "Planar", "Free", "Prescribed", "Cylindrical", "Universal",
+    "Spherical", "RollingDisk", "RollingSphere", "UserJoint",
     "ForceLaw", "BodyLoad", "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
     "inertia", "simulate", "Result", "SimulationError", "scenes", "linearize", "Linearization", "NotSteadyError",
     "eigenvalue_sweep", "modes", "Modes", "campbell", "CampbellDiagram", "compare", "ComparisonTable", "ConstrainedSystem", "reactions", "joint_reactions", "PinClosure",
