@@ -36,7 +36,7 @@ def _contact_twist(m, R, n):
 class RollingDisk(Joint):
     """A thin disk (a wheel) of radius R rolling without slipping on the joint frame's x–y plane.
 
-    Coordinates as Barhorst (2017), "Non-holonomic Systems" §3.2, eqs. (88)–(97):
+    Coordinates as Barhorst §3.2, eqs. (88)–(97) (the disk of :func:`projeq.scenes.rolling_disk`):
     q = (ψ, φ, θ, x, y): heading ψ about the normal z, tilt φ about the heading frame's x axis,
     roll θ about the disk's axis, and (x, y) the contact point; the child frame is
     A = R_z(ψ) R_x(φ) R_y(θ), its y axis the disk's axis, its origin the disk's centre,
