@@ -27,7 +27,7 @@ __all__ = [
     "ForceLaw", "BodyLoad", "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
     "inertia", "simulate", "Result", "SimulationError", "scenes", "linearize", "Linearization", "NotSteadyError",
     "eigenvalue_sweep", "modes", "Modes", "campbell", "CampbellDiagram", "compare", "ComparisonTable", "ConstrainedSystem", "reactions", "joint_reactions", "PinClosure",
-    "contact_event", "StiffnessWarning", "plots", "sweep", "SweepTable", "symbolic",
+    "contact_event", "StiffnessWarning", "plots", "sweep", "SweepTable", "symbolic", "from_urdf",
 ]
 
 
@@ -43,6 +43,7 @@ _LAZY = {
     "contact_event": "projeq.constraints.reactions",
     "sweep": "projeq.simulation.sweep", "SweepTable": "projeq.simulation.sweep",
     "StiffnessWarning": "projeq.simulation.integrators",
+    "from_urdf": "projeq.scenes.urdf",
 }
 _LAZY_MODULES = {"scenes": "projeq.scenes", "plots": "projeq.simulation.plots", "symbolic": "projeq.symbolic"}
 
