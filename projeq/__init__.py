@@ -13,7 +13,8 @@ from projeq.subsystems import inertia
 from projeq.assembly import SingularMassError
 from projeq.forces import BodyLoad, Force, ForceLaw, JointForce, JointSpring, SpringDamper, Torque
 from projeq.analysis.linearize import Linearization, NotSteadyError, eigenvalue_sweep, linearize
-from projeq.joints import Fixed, Free, Joint, Planar, Prescribed, Prismatic, Revolute, UserJoint
+from projeq.joints import (Cylindrical, Fixed, Free, Joint, Planar, Prescribed, Prismatic, Revolute, RollingDisk,
+                           RollingSphere, Spherical, Universal, UserJoint)
 from projeq.subsystems import Frame, PlanarBody, PointMass, RigidBody, RitzBeam, Subsystem
 from projeq.system import GROUND, System, SystemBuilder
 
@@ -21,11 +22,12 @@ __version__ = "0.1.0"
 
 __all__ = [
     "GROUND", "System", "SystemBuilder", "Subsystem", "RigidBody", "PlanarBody", "PointMass", "Frame", "RitzBeam",
-    "Joint", "Revolute", "Prismatic", "Fixed", "Planar", "Free", "Prescribed", "UserJoint",
+    "Joint", "Revolute", "Prismatic", "Fixed", "Planar", "Free", "Prescribed", "Cylindrical", "Universal",
+    "Spherical", "RollingDisk", "RollingSphere", "UserJoint",
     "ForceLaw", "BodyLoad", "Force", "Torque", "JointForce", "JointSpring", "SpringDamper", "SingularMassError",
     "inertia", "simulate", "Result", "SimulationError", "scenes", "linearize", "Linearization", "NotSteadyError",
     "eigenvalue_sweep", "modes", "Modes", "campbell", "CampbellDiagram", "compare", "ComparisonTable", "ConstrainedSystem", "reactions", "joint_reactions", "PinClosure",
-    "contact_event", "StiffnessWarning", "plots", "sweep", "SweepTable", "symbolic",
+    "contact_event", "StiffnessWarning", "plots", "sweep", "SweepTable", "symbolic", "from_urdf",
 ]
 
 
@@ -41,6 +43,7 @@ _LAZY = {
     "contact_event": "projeq.constraints.reactions",
     "sweep": "projeq.simulation.sweep", "SweepTable": "projeq.simulation.sweep",
     "StiffnessWarning": "projeq.simulation.integrators",
+    "from_urdf": "projeq.scenes.urdf",
 }
 _LAZY_MODULES = {"scenes": "projeq.scenes", "plots": "projeq.simulation.plots", "symbolic": "projeq.symbolic"}
 

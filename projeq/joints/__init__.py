@@ -5,14 +5,20 @@
 - :mod:`.statement`: a joint's one statement (:class:`Stated`: pose, F⁶, f⁶, K, k as scalar code
   over a namespace), run on numpy, traced with sympy and printed for numba;
 - :mod:`.standard`: Revolute, Prismatic, Fixed, Planar, Free, Prescribed, each with its sympy
-  form (written with :mod:`projeq.symbolic.algebra`) and compiled kind next to ``relative``;
+  form (written with :mod:`projeq.symbolic.algebra`) and compiled kind next to ``relative``, and
+  Cylindrical, Universal, Spherical, each stated once;
+- :mod:`.rolling`: RollingDisk and RollingSphere, rolling without slipping on a plane
+  (non-holonomic, stated once);
 - :mod:`.user`: :class:`UserJoint` from sympy or callables, compiled by :mod:`.user_compiler`.
 """
 
 from projeq.joints.base import Joint, Relative, SymbolicRelative, pose_twist_mismatch
 from projeq.joints.statement import Stated
-from projeq.joints.standard import Fixed, Free, Planar, Prescribed, Prismatic, Revolute
+from projeq.joints.standard import (Cylindrical, Fixed, Free, Planar, Prescribed, Prismatic, Revolute, Spherical,
+                                   Universal)
+from projeq.joints.rolling import RollingDisk, RollingSphere
 from projeq.joints.user import UserJoint
 
 __all__ = ["Joint", "Relative", "Stated", "SymbolicRelative", "pose_twist_mismatch", "Revolute", "Prismatic", "Fixed",
-           "Planar", "Free", "Prescribed", "UserJoint"]
+           "Planar", "Free", "Prescribed", "Cylindrical", "Universal", "Spherical", "RollingDisk", "RollingSphere",
+           "UserJoint"]

@@ -1,8 +1,11 @@
-"""The standard joints: Revolute, Prismatic, Fixed, Planar, Free and Prescribed (docs/theory.md §4).
+"""The standard joints: Revolute, Prismatic, Fixed, Planar, Free, Prescribed, Cylindrical, Universal
+and Spherical (docs/theory.md §4).
 
-Each states its relative kinematics (A, r, F⁶, w, ζ) in ``relative``, next to it their
-sympy form in ``symbolic_relative`` and, where the compiled kernel has the same
-kinematics, its ``compiled_kind``; see :mod:`projeq.joints.base` for the contract.
+Revolute, Prismatic, Fixed, Planar, Free and Prescribed state their relative kinematics (A, r, F⁶,
+w, ζ) in ``relative``, next to it their sympy form in ``symbolic_relative`` and, where the compiled
+kernel has the same kinematics, its ``compiled_kind``; Cylindrical, Universal and Spherical state
+them once, in ``statement`` (:mod:`projeq.joints.statement`). See :mod:`projeq.joints.base` for the
+contract.
 """
 
 from __future__ import annotations
@@ -16,7 +19,8 @@ import numpy as np
 from projeq.checks import callable_name
 from projeq.joints import statement
 from projeq.joints.base import Joint, Relative, SymbolicRelative
-from projeq.spatial import axis_spin, norm, numeric, quaternion_matrix, quaternion_rate_matrix, rodrigues, unit_axis
+from projeq.joints.statement import Stated
+from projeq.spatial import axis_spin, cross, norm, numeric, quaternion_matrix, quaternion_rate_matrix, rodrigues, unit_axis
 from projeq.symbolic import lazy_import
 
 sp = lazy_import("sympy")
@@ -204,6 +208,99 @@ class Free(Joint):
         out = numeric(np.array(q_n))
         out[3:] /= norm(out[3:])
         return out
+
+
+class Cylindrical(Joint):
+    """Rotation θ about and translation z along the unit axis e through O_n (joint-frame
+    coordinates): q = (θ, z), ṡ = (θ̇, ż), F⁶ = [[0, e], [e, 0]] (A e = e, so the same in child
+    and joint-frame coordinates); a Revolute and a Prismatic about one axis in one joint."""
+
+    n_q = n_s = 2
+
+    def __init__(self, parent=None, axis="z", r_pn=(0.0, 0.0, 0.0), orientation=None):
+        super().__init__(parent, r_pn, orientation)
+        self.axis = unit_axis(axis, "axis")
+
+    def statement(self, q, t, m):
+        zero = (0.0, 0.0, 0.0)
+        return Stated(A=m.rotation(self.axis, q[0]), r=q[1] * m.vector(self.axis),
+                      F=m.columns(m.vector([*zero, *self.axis]), m.vector([*self.axis, *zero])))
+
+    def coordinates(self):
+        return (("angle", "rad"), ("position", "m"))
+
+    def velocities(self):
+        return (("angle_dot", "rad/s"), ("position_dot", "m/s"))
+
+
+class Universal(Joint):
+    """Two rotations: θ₁ about the unit axis e₁ fixed in the joint frame, then θ₂ about the unit
+    axis e₂ fixed in the child (the cross of a Cardan joint; e₁ ⟂ e₂ for a Cardan joint, any two
+    axes that are not parallel allowed): A = R(e₁, θ₁) R(e₂, θ₂), q = (θ₁, θ₂), ṡ = (θ̇₁, θ̇₂).
+
+    The child's angular velocity is ω = θ̇₁ R(e₂, θ₂)ᵀ e₁ + θ̇₂ e₂ in child coordinates, so
+    F⁶ = [[0, 0], [R(e₂, θ₂)ᵀ e₁, e₂]]: two Revolutes on a massless Frame in one joint.
+    """
+
+    n_q = n_s = 2
+
+    def __init__(self, parent=None, axes=("x", "y"), r_pn=(0.0, 0.0, 0.0), orientation=None):
+        super().__init__(parent, r_pn, orientation)
+        if isinstance(axes, str) or len(axes) != 2:
+            raise ValueError(f"axes: expected two axes (e₁ in the joint frame, e₂ in the child), got {axes!r}")
+        first, second = unit_axis(axes[0], "axes[0]"), unit_axis(axes[1], "axes[1]")
+        if norm(cross(first, second)) < 1e-6:
+            raise ValueError(f"axes: e₁ = {first} and e₂ = {second} are parallel; a universal joint turns about "
+                             "two different axes (one axis: a Revolute)")
+        self.axes = np.array([first, second])
+
+    def statement(self, q, t, m):
+        first, second = self.axes
+        turn = m.rotation(second, q[1])
+        first_in_child = turn.T @ m.vector(first)
+        zero = (0.0, 0.0, 0.0)
+        return Stated(A=m.rotation(first, q[0]) @ turn, r=m.zeros(3),
+                      F=m.columns(m.vector([*zero, *first_in_child]), m.vector([*zero, *second])))
+
+    def coordinates(self):
+        return (("angle_1", "rad"), ("angle_2", "rad"))
+
+    def velocities(self):
+        return (("angle_1_dot", "rad/s"), ("angle_2_dot", "rad/s"))
+
+
+class Spherical(Joint):
+    """Three rotations about O_n (a ball joint): q = the unit quaternion (w, x, y, z) of the child
+    relative to the joint frame, ṡ = ω, the child's angular velocity in child coordinates.
+
+    F⁶ = [[0], [E₃]] and q̇ = ½ q ⊗ (0, ω) = Γ(q) ω, as Free does for its rotation (no Euler-angle
+    singularity). The statement divides the quaternion by its length √(qᵀq) wherever it is read,
+    so a quaternion that drifts off the unit sphere in integration still gives a rotation.
+    """
+
+    n_q, n_s = 4, 3
+
+    def statement(self, q, t, m):
+        length = m.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2 + q[3] ** 2)
+        w, x, y, z = (q[i] / length for i in range(4))
+        rows = [[0.0] * 3] * 3 + [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+        rate = [[-x, -y, -z], [w, -z, y], [z, w, -x], [-y, x, w]]  # 2 Γ(q): quaternion_rate_matrix
+        return Stated(A=m.quaternion_matrix([w, x, y, z]), r=m.zeros(3), F=m.matrix(rows),
+                      K=m.matrix([[entry / 2 for entry in row] for row in rate]))
+
+    def coordinates(self):
+        return tuple((f"quat_{a}", "") for a in "wxyz")
+
+    def velocities(self):  # ω of the child in child coordinates
+        return tuple((f"omega_{a}", "rad/s") for a in "xyz")
+
+    def default_q(self):
+        return np.array([1.0, 0.0, 0.0, 0.0])
+
+    def normalized(self, q_n):
+        """The quaternion divided by its length √(qᵀq) (analytic: a complex step passes)."""
+        out = numeric(np.array(q_n))
+        return out / norm(out)
 
 
 class Prescribed(Joint):

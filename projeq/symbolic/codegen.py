@@ -27,10 +27,21 @@ __all__ = ["numeric_function"]
 
 
 class _Printer(NumPyPrinter):
-    """numpy code with floats to full precision (sympy prints 15 digits)."""
+    """numpy code with floats to full precision (sympy prints 15 digits) and small integer powers
+    as products: numba's complex power goes through exp(n log z), whose round-off leaves an
+    imaginary part of order ε |z|ⁿ at a negative real z — (−0.566 + 10⁻²⁰ i)³ has 7e-17 i instead
+    of 1e-20 i —, which a complex step reads as a derivative of order 10⁴."""
 
     def _print_Float(self, expr):
         return repr(float(expr))
+
+    def _print_Pow(self, expr, rational=False):
+        exponent = expr.exp
+        if exponent.is_number and float(exponent).is_integer() and 1 <= abs(int(exponent)) <= 4:
+            base = self._print(expr.base) if expr.base.is_Symbol else f"({self._print(expr.base)})"
+            product = "*".join([base] * abs(int(exponent)))
+            return f"({product})" if exponent > 0 else f"(1/({product}))"
+        return super()._print_Pow(expr, rational)
 
 
 def numeric_function(name: str, arguments, expressions, constants=()):

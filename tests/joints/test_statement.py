@@ -1,7 +1,7 @@
 """A joint's one statement runs three ways, and they agree (projeq/joints/statement.py).
 
-Four joints projeq does not ship, each stated once as ``statement(q, t, m)``: a screw (pose
-and a constant F⁶), a cylindrical joint (two freedoms), a slider on a turntable turning at a
+Four joints each stated once as ``statement(q, t, m)``: a screw (pose and a constant F⁶),
+projeq's Cylindrical (two freedoms), and, not shipped, a slider on a turntable turning at a
 given rate (rheonomic: f⁶ depends on q, so ζ has ∂f/∂q q̇ + ∂f/∂t), and a knife edge (Bremer's
 non-holonomic minimal velocities, q̇ = K(q) ṡ with K not integrable). The references are
 independent of the statement's derivations: the pose's own time derivative
@@ -42,21 +42,6 @@ class Screw(pq.Joint):
                       F=m.columns(m.vector([*(self.lead * self.e), *self.e])))
 
 
-class Cylindrical(pq.Joint):
-    """Rotation θ about and translation z along the unit axis e: q = ṡ-integral = (θ, z)."""
-
-    n_q = n_s = 2
-
-    def __init__(self, parent=None, axis=(0.0, 0.0, 1.0), r_pn=(0.0, 0.0, 0.0)):
-        super().__init__(parent, r_pn)
-        self.e = np.asarray(axis, float) / np.linalg.norm(axis)
-
-    def statement(self, q, t, m):
-        zero = [0.0, 0.0, 0.0]
-        return Stated(A=m.rotation(self.e, q[0]), r=q[1] * m.vector(self.e),
-                      F=m.columns(m.vector([*zero, *self.e]), m.vector([*self.e, *zero])))
-
-
 class Turntable(pq.Joint):
     """A slider along the x axis of a table turning at the rate Ω about z: A = R_z(Ω t),
     r = A (x, 0, 0); in child coordinates v = (ẋ, Ω x, 0), ω = (0, 0, Ω): f⁶ = (0, Ω x, 0, 0, 0, Ω)."""
@@ -85,7 +70,7 @@ class KnifeEdge(pq.Joint):
 
 JOINTS = {
     "screw": lambda: Screw(axis=(0.3, -0.5, 0.8), lead=0.04),
-    "cylindrical": lambda: Cylindrical(axis=(1.0, 2.0, -0.5)),
+    "cylindrical": lambda: pq.Cylindrical(axis=(1.0, 2.0, -0.5)),
     "turntable": Turntable,
     "knife_edge": KnifeEdge,
 }
@@ -153,7 +138,7 @@ def _tree(kinds, seed):
         axis, offset = rng.standard_normal(3), rng.uniform(-0.5, 0.5, 3)
         joints[name] = {
             "screw": lambda: Screw(parent, axis, float(rng.uniform(0.01, 0.1)), offset),
-            "cylindrical": lambda: Cylindrical(parent, axis, offset),
+            "cylindrical": lambda: pq.Cylindrical(parent, axis, offset),
             "turntable": lambda: Turntable(parent, offset),
             "knife_edge": lambda: KnifeEdge(parent, offset),
             "revolute": lambda: pq.Revolute(parent, axis / np.linalg.norm(axis), offset),
