@@ -74,6 +74,7 @@ tree, M s̈_free + b = 0, so that M s̈_tree + b = M (s̈_tree − s̈_free): al
 from __future__ import annotations
 
 import copy
+import warnings
 from numbers import Real
 
 import numpy as np
@@ -102,6 +103,11 @@ FORMULATIONS = ("auto", "partitioned", "null_space")
 PARTITION_CONDITION = 1e8
 # |Φ| (relative to the largest coordinate, at least 1) accepted as on the manifold: 1e4 × round-off
 POSITION_TOLERANCE = 1e-12
+
+
+class RedundantRowWarning(UserWarning):
+    """A constraint row that is zero at and around q0 (value and gradient): it constrains nothing and
+    is taken as redundant."""
 
 
 class ConstrainedSystem(Model):
@@ -378,7 +384,7 @@ class ConstrainedSystem(Model):
             raise ValueError(f"phi: the constraint derivatives are not finite at q0 = {np.round(q0, 6).tolist()}")
         tol = 1e-9 * max(np.abs(A_s).max(initial=0.0), 1.0)  # far above round-off, far below a real row
         for i in np.flatnonzero(np.abs(A_s).max(axis=1, initial=0.0) <= tol):
-            raise self._vanishing_row(int(i), q0, tol)
+            self._vanishing_row(int(i), q0, tol)
         redundant = _dependent_rows(A_s, tol)
         if not redundant:
             return ()
@@ -404,33 +410,36 @@ class ConstrainedSystem(Model):
                 continue
         return points
 
-    def _vanishing_row(self, i: int, q0, tol: float) -> ValueError:
-        """The error for row i of the constraints whose gradient vanishes at q0: a row of A; a
-        Φ row zero around q0 too (it constrains nothing); a Φ row with a saddle at q0 (its surface
-        branches: a singular position); with an extremum (its solutions are isolated: the mechanism
-        cannot move); or one that is only stationary there (curvature of one sign, some zero)."""
+    def _vanishing_row(self, i: int, q0, tol: float) -> None:
+        """Row i of the constraints, whose gradient vanishes at q0: a Φ row zero around q0 too
+        constrains nothing (a RedundantRowWarning: taken as redundant); ValueError for a row of A,
+        a Φ row with a saddle at q0 (its surface branches: a singular position), with an extremum
+        (its solutions are isolated: the mechanism cannot move), or one only stationary there
+        (curvature of one sign, some zero)."""
         where = f"q0 = {np.round(q0, 6).tolist()}"
         if i >= self.m_h:
-            return ValueError(f"A: row {i - self.m_h} vanishes at {where}: it constrains no velocity there; "
-                              "remove it, or start where it acts")
+            raise ValueError(f"A: row {i - self.m_h} vanishes at {where}: it constrains no velocity there; "
+                             "remove it, or start where it acts")
         hessian = self._phi_hessian(i, q0)
         if np.abs(hessian).max(initial=0.0) <= tol and all(
                 abs(self.phi(q)[i]) <= tol for q in q0 + 1e-2 * np.random.default_rng(2).standard_normal((3, len(q0)))):
-            return ValueError(f"phi: row {i} is zero at and around {where} (value and gradient): it constrains "
-                              "nothing; remove it")
+            warnings.warn(f"phi: row {i} is zero at and around {where} (value and gradient): it constrains nothing "
+                          "and is taken as a redundant row (the z row of a planar mechanism's pin, say); remove it "
+                          "to spare its work", RedundantRowWarning, stacklevel=5)
+            return
         curvature = np.linalg.eigvalsh((hessian + hessian.T) / 2)
         if curvature[0] < -tol and curvature[-1] > tol:
-            return ValueError(
+            raise ValueError(
                 f"q0: a singular position of the constraints: Φ[{i}]'s gradient vanishes at {where}, where "
                 f"the surface Φ[{i}] = 0 branches (like x z = 0 at the origin, two lines crossing), so the motion's "
                 "directions are not determined there; start the mechanism away from it")
         if curvature[0] * curvature[-1] > 0 and min(abs(curvature[0]), abs(curvature[-1])) > tol:
-            return ValueError(
+            raise ValueError(
                 f"phi: row {i} holds only at isolated points around {where}: Φ[{i}] has a "
                 f"{'minimum' if curvature[0] > 0 else 'maximum'} there and its gradient vanishes (like a two-link "
                 "arm stretched to its full reach), so no motion keeps it; it fixes every coordinate, not a "
                 "degree of freedom: write the constraints the mechanism holds, or start where it can move")
-        return ValueError(
+        raise ValueError(
             f"phi: row {i}'s gradient ∂Φ[{i}]/∂q vanishes at {where}: Φ[{i}] is stationary there, so it fixes "
             "coordinates only to second order (like 1 − cos q = 0 at q = 0) and its velocity constraint is "
             "empty; write it with a gradient that does not vanish (q = 0), or start where it does not")

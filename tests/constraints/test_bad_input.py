@@ -277,10 +277,14 @@ def test_an_isolated_solution_is_named(tree):
 
 
 def test_a_row_that_is_identically_zero_is_named(tree):
-    """A row 0 · x constrains nothing: refused (before: taken silently as redundant)."""
-    with pytest.raises(ValueError, match=r"^phi: row 1 is zero at and around q0 = \[0.6, -0.8\] \(value and "
-                                         r"gradient\): it constrains nothing"):
-        ConstrainedSystem(tree, phi=lambda q, t: [np.sqrt(q[0] ** 2 + q[1] ** 2) - 1.0, 0.0 * q[0]])
+    """A row 0 · x constrains nothing: taken as redundant, with a warning naming it (before: taken
+    silently as redundant)."""
+    from projeq.constraints.partitioned import RedundantRowWarning
+
+    with pytest.warns(RedundantRowWarning, match=r"^phi: row 1 is zero at and around q0 = \[0.6, -0.8\] \(value "
+                                                 r"and gradient\): it constrains nothing"):
+        system = ConstrainedSystem(tree, phi=lambda q, t: [np.sqrt(q[0] ** 2 + q[1] ** 2) - 1.0, 0.0 * q[0]])
+    assert (system.redundant, system.formulation, system.n_s) == ((1,), "null space", 1)
 
 
 def test_a_row_stationary_at_q0_is_named(tree):
