@@ -36,15 +36,70 @@ def all_finite(a: NDArray) -> bool:
 def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
     """``value`` as a float array of the given shape with finite entries."""
     try:
-        a = np.array(value, dtype=float)
+        a = np.asarray(value)
+        real = a.dtype.kind != "c"  # numpy would drop an imaginary part with a mere ComplexWarning
+        if real:
+            a = np.array(a, dtype=float)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
+    if not real:
+        raise ValueError(f"{name}: expected real numbers, got complex ones ({_first_complex(a)}); a complex value "
+                         "is refused, not cast")
     if shape is not None and a.shape != shape:
         raise ValueError(f"{name}: expected shape {shape}, got {a.shape}")
     if not all_finite(a):
         bad = np.flatnonzero(~np.isfinite(a.ravel()))
         raise ValueError(f"{name}: non-finite entries (NaN or inf) at flat index {bad.tolist()}")
     return a
+
+
+def _first_complex(a: NDArray) -> str:
+    """The first entry of the complex array ``a`` with an imaginary part, for messages."""
+    flat = a.ravel()
+    imaginary = np.flatnonzero(flat.imag)
+    i = int(imaginary[0]) if imaginary.size else 0
+    return f"entry {i} is {complex(flat[i])}" if flat.size else "empty"
+
+
+def kernel_state(name: str, value, length: int) -> NDArray:
+    """``value`` as an evaluator reads it (a state, q or ṡ, passed straight to compiled code):
+    a one-dimensional array of ``length`` float or complex entries (complex for the complex step
+    of :mod:`projeq.analysis.jacobians`), C-contiguous (a strided view is copied). Type, dtype and
+    shape are checked, not finiteness (an evaluator returns what the state gives): a kernel never
+    reads past the array."""
+    if not (isinstance(value, np.ndarray) and value.dtype.kind in "fc"):
+        value = _numbers(name, value)
+    if value.shape != (length,):
+        raise ValueError(f"{name}: expected {length} entries, got shape {value.shape}")
+    return value if value.flags.c_contiguous else np.ascontiguousarray(value)
+
+
+def _numbers(name: str, value) -> NDArray:
+    """``value`` (a list, or an array of integers, ...) as a float or complex array; ValueError naming
+    ``name`` for anything else (strings, objects, booleans)."""
+    a = np.asarray(value) if not isinstance(value, (str, bytes)) else np.asarray(None)
+    if a.dtype.kind not in "iufc":
+        raise ValueError(f"{name}: expected an array of numbers, got {type(value).__name__} {value!r:.60}")
+    return np.asarray(a, dtype=complex if a.dtype.kind == "c" else float)
+
+
+def finite_result(what: str, value, **state):
+    """``value`` (a result computed at ``state``, its arguments by name; an array or a tuple of them)
+    if every entry is finite; else :func:`not_finite`'s ValueError, raised."""
+    if all(all_finite(np.asarray(part)) for part in (value if isinstance(value, tuple) else (value,))):
+        return value
+    raise not_finite(what, **state)
+
+
+def not_finite(what: str, **state) -> ValueError:
+    """The ValueError for a result ``what`` that is not finite at ``state`` (arguments by name): it names
+    the argument with the largest entry, a finite state whose products overflow (|ṡ| = 1e200 squared
+    in the velocity terms) or a non-finite one."""
+    magnitudes = {name: np.abs(np.asarray(x)).max(initial=0.0) for name, x in state.items()}
+    culprit = max(magnitudes, key=lambda name: np.nan_to_num(magnitudes[name], nan=np.inf))
+    return ValueError(f"{culprit}: {what} is not finite at this state (largest |{culprit}| = "
+                      f"{magnitudes[culprit]:.3g}): an entry overflowed to inf or NaN; the state is outside any "
+                      "range a model describes")
 
 
 def check_rotation(name: str, A, where: str = "", tol: float = 1e-9) -> NDArray:

@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from projeq.assembly.linalg import mass_scale, solve_spd, warn_if_ill_conditioned
 from projeq.assembly.kinematics import forward, gauss_terms
+from projeq.checks import kernel_state
 
 
 class DenseEvaluator:
@@ -32,6 +33,7 @@ class DenseEvaluator:
         """M(q) and b(q, ṡ, t) with M s̈ + b = 0."""
         self.n_calls += 1
         system = self.system
+        q, s_dot = kernel_state("q", q, system.n_q), kernel_state("s_dot", s_dot, system.n_s)
         kin = forward(system, q, s_dot, t)
         M_n, h_n = gauss_terms(system, kin, q, s_dot, t)
         J = [None] * len(system.joints) + [np.zeros((0, system.n_s))]

@@ -75,6 +75,7 @@ from projeq.assembly import given, kernels, loads
 from projeq.assembly.beam_fast import elastic_unsupported, hub_beam_unsupported
 from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
+from projeq.checks import kernel_state
 from projeq.subsystems.rigid import rigid_mass_matrix
 
 
@@ -296,7 +297,10 @@ class FastEvaluator:
         (:meth:`projeq.System.potential_energy`). Each beam's ``check_spin`` at its ω, as the
         reference's terms do (the rows of :func:`projeq.simulate` say where a spin makes an
         unstiffened beam unstable)."""
-        q, s_dot, ws = kernels.kernel_array(q), kernels.kernel_array(s_dot), self._real
+        q, s_dot, ws = self._state(q, s_dot)
+        if ws is not self._real:
+            raise ValueError("q, s_dot: the compiled energy takes a real state; System.energy takes a complex step "
+                             "by the reference")
         self._kinematics(ws, q, s_dot, t)
         y_dot = ws.y_dot
         y_dot[:, :6] = ws.twist[:-1]
@@ -315,8 +319,10 @@ class FastEvaluator:
         return self._assembled(ws)
 
     def _state(self, q, s_dot) -> tuple[NDArray, NDArray, _Workspace]:
-        """q and ṡ as arrays of one dtype, float or complex (a complex step), and its workspace."""
-        q, s_dot = np.asarray(q), np.asarray(s_dot)
+        """q and ṡ as C-contiguous arrays of one dtype, float or complex (a complex step), and its
+        workspace; ValueError naming q or ṡ when either is not an array of n_q (n_s) numbers
+        (:func:`projeq.checks.kernel_state`: the kernels read that many entries, never more)."""
+        q, s_dot = kernel_state("q", q, self.system.n_q), kernel_state("s_dot", s_dot, self.system.n_s)
         dtype = complex if q.dtype.kind == "c" or s_dot.dtype.kind == "c" else float
         ws = self._real if dtype is float else self._workspace(dtype)
         return kernels.kernel_array(q, dtype), kernels.kernel_array(s_dot, dtype), ws

@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 
 from projeq.assembly.linalg import mass_scale, solve_spd
 from projeq.assembly.kinematics import forward, gauss_terms
+from projeq.checks import kernel_state
 
 
 class RecursiveEvaluator:
@@ -54,6 +55,7 @@ class RecursiveEvaluator:
         """s̈ by the backward and forward passes of docs/theory.md §6."""
         self.n_calls += 1
         system, scale = self.system, self.scale
+        q, s_dot = kernel_state("q", q, system.n_q), kernel_state("s_dot", s_dot, system.n_s)
         kin = forward(system, q, s_dot, t)
         M, h = gauss_terms(system, kin, q, s_dot, t)
         dtype = np.result_type(*kin.T_aug, *kin.F, *M, *h)
