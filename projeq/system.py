@@ -579,8 +579,9 @@ class System(Model):
 
     def K(self, q: NDArray, t: float = 0.0) -> NDArray:
         """K(q) of q̇ = K ṡ + k (block-diagonal over the joints), complex for a complex q (a complex step);
-        ValueError naming q when it is not n_q numbers."""
-        q = kernel_state("q", q, self.n_q)
+        q given otherwise than as an array is checked as :meth:`check_q` does, an array's shape and dtype
+        (:func:`projeq.checks.kernel_state`)."""
+        q = kernel_state("q", q, self.n_q) if isinstance(q, np.ndarray) else self.check_q("q", q)
         K = np.zeros((self.n_q, self.n_s), dtype=np.result_type(q, float))
         for n, j in enumerate(self.joints):
             if not j.coupling:
