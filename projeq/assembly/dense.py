@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.assembly.linalg import mass_scale, solve_spd, warn_if_ill_conditioned
+from projeq.assembly.linalg import column_scales, solve_spd, warn_if_ill_conditioned
 from projeq.assembly.kinematics import forward, gauss_terms
 from projeq.checks import kernel_state
 
@@ -26,7 +26,7 @@ class DenseEvaluator:
     def __init__(self, system):
         self.system = system
         self.P = [system.joint_s_columns(n) for n in range(len(system.joints))]
-        self.scale = mass_scale(system)
+        self.scale = column_scales(system)  # each pivot's yardstick, the mass its velocity moves
         self.n_calls, self.conditioned = 0, False
 
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
