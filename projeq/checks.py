@@ -35,16 +35,18 @@ def all_finite(a: NDArray) -> bool:
 
 def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
     """``value`` as a float array of the given shape with finite entries."""
+    a = None
     try:
-        a = np.asarray(value)
-        real = a.dtype.kind != "c"  # numpy would drop an imaginary part with a mere ComplexWarning
-        if real:
-            a = np.array(a, dtype=float)
+        a = np.array(value)  # a copy, of the value's own dtype
+        if a.dtype.kind == "c":  # numpy would drop the imaginary part with a mere ComplexWarning
+            raise TypeError("complex")
+        if a.dtype != np.float64:
+            a = a.astype(float)
     except (TypeError, ValueError) as exc:
+        if a is not None and a.dtype.kind == "c":
+            raise ValueError(f"{name}: expected real numbers, got complex ones ({_first_complex(a)}); a complex "
+                             "value is refused, not cast") from None
         raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
-    if not real:
-        raise ValueError(f"{name}: expected real numbers, got complex ones ({_first_complex(a)}); a complex value "
-                         "is refused, not cast")
     if shape is not None and a.shape != shape:
         raise ValueError(f"{name}: expected shape {shape}, got {a.shape}")
     if not all_finite(a):
@@ -61,14 +63,17 @@ def _first_complex(a: NDArray) -> str:
     return f"entry {i} is {complex(flat[i])}" if flat.size else "empty"
 
 
+_FLOAT, _COMPLEX = np.dtype(float), np.dtype(complex)  # the kernels' dtypes: native float64, complex128
+
+
 def kernel_state(name: str, value, length: int) -> NDArray:
     """``value`` as an evaluator reads it (a state, q or ṡ, passed straight to compiled code):
     a one-dimensional array of ``length`` float or complex entries (complex for the complex step
     of :mod:`projeq.analysis.jacobians`), C-contiguous (a strided view is copied). Type, dtype and
     shape are checked, not finiteness (an evaluator returns what the state gives): a kernel never
     reads past the array."""
-    if not (isinstance(value, np.ndarray) and value.dtype.kind in "fc"):
-        value = _numbers(name, value)
+    if not (isinstance(value, np.ndarray) and (value.dtype is _FLOAT or value.dtype is _COMPLEX)):
+        value = _numbers(name, value)  # float32, a file's big-endian float64, integers, lists: converted
     if value.shape != (length,):
         raise ValueError(f"{name}: expected {length} entries, got shape {value.shape}")
     return value if value.flags.c_contiguous else np.ascontiguousarray(value)
@@ -77,10 +82,13 @@ def kernel_state(name: str, value, length: int) -> NDArray:
 def _numbers(name: str, value) -> NDArray:
     """``value`` (a list, or an array of integers, ...) as a float or complex array; ValueError naming
     ``name`` for anything else (strings, objects, booleans)."""
-    a = np.asarray(value) if not isinstance(value, (str, bytes)) else np.asarray(None)
+    try:
+        a = np.asarray(value)
+    except ValueError as exc:  # a ragged list
+        raise ValueError(f"{name}: expected an array of numbers, got {value!r:.60}") from exc
     if a.dtype.kind not in "iufc":
         raise ValueError(f"{name}: expected an array of numbers, got {type(value).__name__} {value!r:.60}")
-    return np.asarray(a, dtype=complex if a.dtype.kind == "c" else float)
+    return np.asarray(a, dtype=_COMPLEX if a.dtype.kind == "c" else _FLOAT)
 
 
 def finite_result(what: str, value, **state):

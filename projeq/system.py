@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.assembly.kinematics import Plan
-from projeq.checks import finite_array, finite_result, kernel_state, not_finite, state_vector
+from projeq.checks import all_finite, finite_array, finite_result, kernel_state, not_finite, state_vector
 from projeq.constraints.nonholonomic import check_configuration
 from projeq.joints import Joint
 from projeq.spatial import numeric
@@ -214,7 +214,9 @@ class Model(ABC):
             s_ddot = self.evaluator(method).accelerations(q, s_dot, float(t))
         except FloatingPointError as exc:  # a pivot or M_ee that overflowed: the state's doing, named
             raise not_finite("s̈", q=q, s_dot=s_dot) from exc
-        return finite_result("s̈", s_ddot, q=q, s_dot=s_dot)
+        if not all_finite(s_ddot):
+            raise not_finite("s̈", q=q, s_dot=s_dot)
+        return s_ddot
 
     @abstractmethod
     def accelerations_tree(self, q: NDArray, s_dot: NDArray, t: float = 0.0,

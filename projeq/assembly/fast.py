@@ -325,9 +325,9 @@ class FastEvaluator:
         workspace; ValueError naming q or ṡ when either is not an array of n_q (n_s) numbers
         (:func:`projeq.checks.kernel_state`: the kernels read that many entries, never more)."""
         q, s_dot = kernel_state("q", q, self.system.n_q), kernel_state("s_dot", s_dot, self.system.n_s)
-        dtype = complex if q.dtype.kind == "c" or s_dot.dtype.kind == "c" else float
-        ws = self._real if dtype is float else self._workspace(dtype)
-        return kernels.kernel_array(q, dtype), kernels.kernel_array(s_dot, dtype), ws
+        if q.dtype.kind == "f" and s_dot.dtype.kind == "f":
+            return q, s_dot, self._real
+        return q.astype(complex), s_dot.astype(complex), self._workspace(complex)
 
     def _assembled(self, ws: _Workspace) -> tuple[NDArray, NDArray]:
         """M and b of the terms in the workspace: :func:`projeq.assembly.kernels.gauss_form` in
