@@ -197,8 +197,11 @@ class Model(ABC):
     def evaluator(self, method: str | None = None):
         """An object whose ``accelerations(q, s_dot, t)`` gives s̈ by ``method``
         (``"recursive"``, ``"dense"``, ``"fast"``, ``"hub_beam"`` or ``"auto"``; None: the
-        model's default), without checking the state: the right-hand side that
-        :func:`projeq.simulate` calls. One that cannot evaluate the model raises why."""
+        model's default), without checking the state's values: the right-hand side that
+        :func:`projeq.simulate` calls (it checks x and ẋ). Its type, dtype and shape are checked
+        (:func:`projeq.checks.kernel_state`: ValueError naming q or s_dot; a strided array is
+        copied, a complex one is the complex step); a non-finite state gives a non-finite s̈ or
+        an error, never a finite number. One that cannot evaluate the model raises why."""
 
     def accelerations(self, q, s_dot, t: float = 0.0, method: str | None = None) -> NDArray:
         """Minimal accelerations s̈ from the Projection Equation at (q, ṡ, t) by the
