@@ -35,17 +35,16 @@ def all_finite(a: NDArray) -> bool:
 
 def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
     """``value`` as a float array of the given shape with finite entries."""
-    a = None
     try:
-        a = np.array(value)  # a copy, of the value's own dtype
-        if a.dtype.kind == "c":  # numpy would drop the imaginary part with a mere ComplexWarning
-            raise TypeError("complex")
-        if a.dtype != np.float64:
-            a = a.astype(float)
-    except (TypeError, ValueError) as exc:
-        if a is not None and a.dtype.kind == "c":
-            raise ValueError(f"{name}: expected real numbers, got complex ones ({_first_complex(a)}); a complex "
-                             "value is refused, not cast") from None
+        a = value if isinstance(value, np.ndarray) else np.array(value)  # its own dtype: complex stays complex
+    except (TypeError, ValueError) as exc:  # a ragged list
+        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
+    if a.dtype.kind == "c":  # numpy would drop the imaginary part with a mere ComplexWarning
+        raise ValueError(f"{name}: expected real numbers, got complex ones ({_first_complex(a)}); a complex value "
+                         "is refused, not cast")
+    try:
+        a = np.array(a, dtype=float)  # a copy
+    except (TypeError, ValueError) as exc:  # strings, objects
         raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
     if shape is not None and a.shape != shape:
         raise ValueError(f"{name}: expected shape {shape}, got {a.shape}")
