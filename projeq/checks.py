@@ -68,14 +68,17 @@ _FLOAT, _COMPLEX = np.dtype(float), np.dtype(complex)  # the kernels' dtypes: na
 def kernel_state(name: str, value, length: int) -> NDArray:
     """``value`` as an evaluator reads it (a state, q or ṡ, passed straight to compiled code):
     a one-dimensional array of ``length`` float or complex entries (complex for the complex step
-    of :mod:`projeq.analysis.jacobians`), C-contiguous (a strided view is copied). Type, dtype and
+    of :mod:`projeq.analysis.jacobians`), C-contiguous and writeable (a strided or read-only view,
+    such as a row of a frozen Result, is copied: numba would compile the kernels again for its
+    layout, 10–30 s cold). Type, dtype and
     shape are checked, not finiteness (an evaluator returns what the state gives): a kernel never
     reads past the array."""
     if not (isinstance(value, np.ndarray) and (value.dtype is _FLOAT or value.dtype is _COMPLEX)):
         value = _numbers(name, value)  # float32, a file's big-endian float64, integers, lists: converted
     if value.shape != (length,):
         raise ValueError(f"{name}: expected {length} entries, got shape {value.shape}")
-    return value if value.flags.c_contiguous else np.ascontiguousarray(value)
+    flags = value.flags  # numba compiles a kernel again for each layout and mutability: one kind only
+    return value if flags.c_contiguous and flags.writeable else np.array(value, order="C")
 
 
 def _numbers(name: str, value) -> NDArray:
