@@ -39,12 +39,12 @@ def all_finite(a: NDArray) -> bool:
 def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
     """``value`` as a float array of the given shape with finite entries."""
     try:
-        a = value if isinstance(value, np.ndarray) else np.array(value)  # its own dtype: complex stays complex
+        a = value if isinstance(value, np.ndarray) else np.array(value)  # its own dtype: complex stays
     except (TypeError, ValueError) as exc:  # a ragged list
         raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
     if a.dtype.kind == "c":  # numpy would drop the imaginary part with a mere ComplexWarning
-        raise ValueError(f"{name}: expected real numbers, got complex ones ({_first_complex(a)}); a complex value "
-                         "is refused, not cast")
+        raise ValueError(f"{name}: expected real numbers, got complex ones ({_first_complex(a)}); a complex "
+                         "value is refused, not cast")
     try:
         a = np.array(a, dtype=float)  # a copy
     except (TypeError, ValueError) as exc:  # strings, objects
@@ -111,8 +111,8 @@ def not_finite(what: str, **state) -> ValueError:
     magnitudes = {name: np.abs(np.asarray(x)).max(initial=0.0) for name, x in state.items()}
     culprit = max(magnitudes, key=lambda name: np.nan_to_num(magnitudes[name], nan=np.inf))
     return ValueError(f"{culprit}: {what} is not finite at this state (largest |{culprit}| = "
-                      f"{magnitudes[culprit]:.3g}): an entry overflowed to inf or NaN; the state is outside any "
-                      "range a model describes")
+                      f"{magnitudes[culprit]:.3g}): an entry overflowed to inf or NaN; the state is outside "
+                      "any range a model describes")
 
 
 def check_rotation(name: str, A, where: str = "", tol: float = 1e-9) -> NDArray:

@@ -636,8 +636,8 @@ class System(Model):
         """M(q) and b(q, ṡ, t) of the Gauss form M s̈ + b = 0 (docs/theory.md §5); ValueError naming the
         state where they are not finite."""
         q, s_dot = self.check_state(q, s_dot, t)
-        return finite_result("the Gauss form (M, b)", self.evaluator("dense").gauss_form(q, s_dot, float(t)), q=q,
-                             s_dot=s_dot)
+        M_b = self.evaluator("dense").gauss_form(q, s_dot, float(t))
+        return finite_result("the Gauss form (M, b)", M_b, q=q, s_dot=s_dot)
 
     def mass_matrix(self, q, t: float = 0.0) -> NDArray:
         """M(q) = Σ J_nᵀ M_n J_n (docs/theory.md §5)."""
@@ -658,7 +658,8 @@ class System(Model):
                              "or None")
         complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot) or np.iscomplexobj(t)
         if complex_step:
-            return self._energy(kernel_state("q", q, self.n_q), kernel_state("s_dot", s_dot, self.n_s), t, "recursive")
+            q, s_dot = kernel_state("q", q, self.n_q), kernel_state("s_dot", s_dot, self.n_s)
+            return self._energy(q, s_dot, t, "recursive")
         q, s_dot = self.check_state(q, s_dot, t)
         try:
             energies = self._energy(q, s_dot, float(t), method)

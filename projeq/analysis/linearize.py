@@ -152,8 +152,8 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
         _check_steady(x_dot, kept, names, tol)
         _check_invariant(system, x0, x_dot, t, A, dropped, kept, names, derivatives)
     n_u = sum(system.joint(name).n_s for name in inputs)
-    B = finite_result("B = ∂ẋ/∂u", differentiate(lambda u: state_derivative(system, x0, t, u, inputs), np.zeros(n_u),
-                                                  derivatives)[0], q=q, s_dot=s_dot)
+    B = differentiate(lambda u: state_derivative(system, x0, t, u, inputs), np.zeros(n_u), derivatives)[0]
+    finite_result("B = ∂ẋ/∂u", B, q=q, s_dot=s_dot)
     return Linearization(A[np.ix_(kept, kept)], B[kept], [names[i] for i in kept],
                          [names[i] for i in dropped], inputs)
 

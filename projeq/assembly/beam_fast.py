@@ -183,7 +183,8 @@ class HubBeamEvaluator:
         return np.linalg.solve(M_e[:, 6:], h_e - M_e[:, :6] @ hub.zeta)
 
     def _state(self, q, s_dot) -> tuple[NDArray, NDArray]:
-        """q_e and q̇_e checked as the kernel reads them, n_e entries each (:func:`projeq.checks.kernel_state`)."""
+        """q_e and q̇_e checked as the kernel reads them, n_e entries each
+        (:func:`projeq.checks.kernel_state`)."""
         return kernel_state("q", q, self.beam.n_e), kernel_state("s_dot", s_dot, self.beam.n_e)
 
     def state_derivative(self, t: float, x: NDArray) -> NDArray | None:
@@ -253,14 +254,16 @@ class HubBeamEvaluator:
         return x_dot, status
 
     def _check_x(self, x: NDArray) -> None:
-        """ValueError for an x that is not (q_e, q̇_e), 2 n_e entries (the kernel's workspace is sized for them)."""
+        """ValueError for an x that is not (q_e, q̇_e), 2 n_e entries (the kernel's workspace is
+        sized for them)."""
         if x.shape != (2 * self.beam.n_e,):
-            raise ValueError(f"x: expected the state (q_e, q̇_e) of 2 n_e = {2 * self.beam.n_e} entries, got shape "
-                             f"{x.shape}")
+            raise ValueError(f"x: expected the state (q_e, q̇_e) of 2 n_e = {2 * self.beam.n_e} entries, "
+                             f"got shape {x.shape}")
 
     def _evaluate(self, x: NDArray, t: float) -> tuple[NDArray, int]:
         """(ẋ, status) of one call of :func:`projeq.assembly.kernels.hub_beam` at (x, t), the hub's
-        motion first (:meth:`_hub`); its terms stay in the workspace of x's dtype (x checked, :meth:`_check_x`)."""
+        motion first (:meth:`_hub`); its terms stay in the workspace of x's dtype (x checked,
+        :meth:`_check_x`)."""
         self._check_x(x)
         self._hub(t)
         x_dot = np.empty(x.shape[0], x.dtype)

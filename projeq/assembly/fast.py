@@ -191,7 +191,8 @@ class FastEvaluator:
         self._gravity = np.asarray(system.gravity, dtype=float)
         # each joint's pivot against the mass it carries (linalg.mass_scales); the coupled joints' one M
         # against the system's
-        self._pivot_min, self._pivot_min_all = SINGULAR_PIVOT * mass_scales(system), SINGULAR_PIVOT * mass_scale(system)
+        self._pivot_min = SINGULAR_PIVOT * mass_scales(system)
+        self._pivot_min_all = SINGULAR_PIVOT * mass_scale(system)
         self._given_plan = [
             (n, joints[n], slice(q_index[n], q_index[n] + joints[n].n_q),
              slice(s_index[n], s_index[n] + joints[n].n_s), kernels.GIVEN_F + 6 * joints[n].n_s)
@@ -301,8 +302,8 @@ class FastEvaluator:
         unstiffened beam unstable)."""
         q, s_dot, ws = self._state(q, s_dot)
         if ws is not self._real:
-            raise ValueError("q, s_dot: the compiled energy takes a real state; System.energy takes a complex step "
-                             "by the reference")
+            raise ValueError("q, s_dot: the compiled energy takes a real state; System.energy takes a "
+                             "complex step by the reference")
         self._kinematics(ws, q, s_dot, t)
         y_dot = ws.y_dot
         y_dot[:, :6] = ws.twist[:-1]
@@ -349,8 +350,8 @@ class FastEvaluator:
         s_ddot = np.empty(self.system.n_s, dtype=q.dtype)
         if self._expansion is not None:
             self._assembled(ws)
-            failed = self._projected_accelerations(ws.M_all, ws.b_all, self._expansion[1], self._pivot_min_all, ws.M,
-                                                   s_ddot)
+            failed = self._projected_accelerations(ws.M_all, ws.b_all, self._expansion[1], self._pivot_min_all,
+                                                   ws.M, s_ddot)
         else:
             failed = self._passes(self._index, ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat, self._pivot_min,
                                   s_ddot)

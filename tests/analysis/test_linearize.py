@@ -33,7 +33,8 @@ def test_pendulum_matches_closed_form_beyond_central_differences():
     m, l = 2.0, 0.7
     lin = linearize(pendulum(m, l), inputs=["bob"])
     A, B = lin
-    errors = np.abs(A - [[0.0, 1.0], [-G / l, 0.0]]).max() / (G / l), np.abs(B.ravel() - [0.0, 1 / (m * l * l)]).max() * m * l * l
+    errors = (np.abs(A - [[0.0, 1.0], [-G / l, 0.0]]).max() / (G / l),
+              np.abs(B.ravel() - [0.0, 1 / (m * l * l)]).max() * m * l * l)
     assert max(errors) < 100 * np.finfo(float).eps, errors
     assert lin.states == ("bob.q[0]", "bob.s_dot[0]") and lin.dropped == ()
     x0 = np.zeros(2)

@@ -33,9 +33,9 @@ def _double_pendulum(m1: float, m2: float):
     vertical) and φ2 (relative to the upper rod)."""
     import projeq as pq
 
-    return pq.System({"upper": pq.PointMass(m1, (0, 0, -L1)), "lower": pq.PointMass(m2, (0, 0, -L2))},
-                     {"upper": pq.Revolute(axis="y"), "lower": pq.Revolute(parent="upper", axis="y", r_pn=(0, 0, -L1))},
-                     gravity=(0, 0, -G))
+    bodies = {"upper": pq.PointMass(m1, (0, 0, -L1)), "lower": pq.PointMass(m2, (0, 0, -L2))}
+    joints = {"upper": pq.Revolute(axis="y"), "lower": pq.Revolute(parent="upper", axis="y", r_pn=(0, 0, -L1))}
+    return pq.System(bodies, joints, gravity=(0, 0, -G))
 
 
 def _closed_form(m1: float, m2: float, q, s_dot):
