@@ -93,16 +93,19 @@ def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
     """Without rotary inertia the spinning beam is the non-rotating cantilever seen from the
     co-rotating frame: forward whirl |ω_k − Ω|, backward whirl ω_k + Ω (ω_k = (β_k L)² for
     EI = ρA = L = 1, Blevins (1979), Table 8-1). The four clamped–free eigenfunctions per plane
-    are exact, so the branches are to 1e-10 relative (measured 6e-12; the issue asks 1e-8),
+    are exact, so the branches are to round-off over the Ritz model's eigensolution (bounds 10× the
+    relative errors measured: forward 5.7e-12, backward 3.5e-13, |ζ| 7.7e-14; were all 1e-10),
     over Ω = 0 … 30 where the forward whirls pass through zero (at Ω = ω₁, ω₂) and cross the
     backward ones: a diagram sorted by frequency would mix the branches."""
     speeds = np.linspace(0.0, 30.0, 16)
     diagram = campbell(lambda omega: pq.scenes.spinning_beam(omega=omega, n_shapes=4), speeds, orders=[0, 1])
     omega_k = clamped_free_roots(4) ** 2
-    for k in range(4):
-        assert np.abs(diagram.branch(f"forward whirl {k + 1}") / np.abs(omega_k[k] - speeds) - 1).max() < 1e-10
-        assert np.abs(diagram.branch(f"backward whirl {k + 1}") / (omega_k[k] + speeds) - 1).max() < 1e-10
-    assert np.abs(diagram.damping).max() < 1e-10
+    forward = max(np.abs(diagram.branch(f"forward whirl {k + 1}") / np.abs(omega_k[k] - speeds) - 1).max()
+                  for k in range(4))
+    backward = max(np.abs(diagram.branch(f"backward whirl {k + 1}") / (omega_k[k] + speeds) - 1).max()
+                   for k in range(4))
+    assert forward < 5.7e-11 and backward < 3.5e-12, (forward, backward)
+    assert np.abs(diagram.damping).max() < 7.7e-13, np.abs(diagram.damping).max()
     first = [c for c in diagram.critical_speeds if c.mode == "forward whirl 1" and c.order == 1]
     # an unbalance (fixed in the rotor, order 0) resonates where a forward whirl's co-rotating
     # frequency passes through zero: Ω = ω₁, ω₂ (Brent on the signed branch, down to the
@@ -111,8 +114,8 @@ def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
     unbalance = [c for c in diagram.critical_speeds if c.order == 0]
     assert [c.mode for c in unbalance] == ["forward whirl 1", "forward whirl 2"]
     assert np.allclose([c.speed for c in unbalance], omega_k[:2], rtol=3e-7, atol=0)
-    # |ω₁ − Ω| = Ω at Ω = ω₁/2 (Brent's method on the branch: 1e-10, measured 2e-16)
-    assert len(first) == 1 and first[0].speed == pytest.approx(omega_k[0] / 2, rel=1e-10)
+    # |ω₁ − Ω| = Ω at Ω = ω₁/2 (Brent's method on the branch: 100 ε, measured 1.1e-15; was 1e-10)
+    assert len(first) == 1 and first[0].speed == pytest.approx(omega_k[0] / 2, rel=100 * EPS)
 
 
 def _oscillators(stiffness: float, coupling: float) -> pq.System:
