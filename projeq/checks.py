@@ -13,6 +13,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 
+_FLOAT, _COMPLEX = np.dtype(float), np.dtype(complex)  # the kernels' dtypes: native float64, complex128
+
+
 def closest(name: str, known) -> str:
     """`` (did you mean 'x'?)`` for the closest known name, or an empty string."""
     match = difflib.get_close_matches(name, list(known), n=1)
@@ -37,18 +40,9 @@ def all_finite(a: NDArray) -> bool:
 
 
 def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
-    """``value`` as a float array of the given shape with finite entries."""
-    try:
-        a = value if isinstance(value, np.ndarray) else np.array(value)  # its own dtype: complex stays
-    except (TypeError, ValueError) as exc:  # a ragged list
-        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
-    if a.dtype.kind == "c":  # numpy would drop the imaginary part with a mere ComplexWarning
-        raise ValueError(f"{name}: expected real numbers, got complex ones ({_first_complex(a)}); a complex "
-                         "value is refused, not cast")
-    try:
-        a = np.array(a, dtype=float)  # a copy
-    except (TypeError, ValueError) as exc:  # strings, objects
-        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
+    """``value`` as a float array (a copy) of the given shape with finite entries."""
+    # a float64 array, as the integrators hold a state, copied; anything else converted
+    a = value.copy() if type(value) is np.ndarray and value.dtype is _FLOAT else _float_array(name, value)
     if shape is not None and a.shape != shape:
         raise ValueError(f"{name}: expected shape {shape}, got {a.shape}")
     if not all_finite(a):
@@ -57,15 +51,28 @@ def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
     return a
 
 
+def _float_array(name: str, value) -> NDArray:
+    """``value`` (numbers, a list of them, an array of another dtype) as a new float array; a complex
+    one refused by name, not cast (numpy would drop its imaginary part with a mere ComplexWarning)."""
+    try:
+        a = value if isinstance(value, np.ndarray) else np.array(value)  # its own dtype: complex stays
+    except (TypeError, ValueError) as exc:  # a ragged list
+        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
+    if a.dtype.kind == "c":
+        raise ValueError(f"{name}: expected real numbers, got complex ones ({_first_complex(a)}); a complex "
+                         "value is refused, not cast")
+    try:
+        return np.array(a, dtype=float)
+    except (TypeError, ValueError) as exc:  # strings, objects
+        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
+
+
 def _first_complex(a: NDArray) -> str:
     """The first entry of the complex array ``a`` with an imaginary part, for messages."""
     flat = a.ravel()
     imaginary = np.flatnonzero(flat.imag)
     i = int(imaginary[0]) if imaginary.size else 0
     return f"entry {i} is {complex(flat[i])}" if flat.size else "empty"
-
-
-_FLOAT, _COMPLEX = np.dtype(float), np.dtype(complex)  # the kernels' dtypes: native float64, complex128
 
 
 def kernel_state(name: str, value, length: int) -> NDArray:
