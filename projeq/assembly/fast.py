@@ -74,7 +74,7 @@ from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import given, kernels, loads
 from projeq.assembly.beam_fast import elastic_unsupported, hub_beam_unsupported
 from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
-from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale, mass_scales
+from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, column_scales, mass_scales
 from projeq.checks import kernel_state
 from projeq.subsystems.rigid import rigid_mass_matrix
 
@@ -190,9 +190,12 @@ class FastEvaluator:
         self._rigid_M = [rigid_mass_matrix(*inertia) for inertia in rigid]
         self._gravity = np.asarray(system.gravity, dtype=float)
         # each joint's pivot against the mass it carries (linalg.mass_scales); the coupled joints' one M
-        # against the system's
+        # factored as D M D = (P D)ᵀ M_all (P D), D = diag(c_j^(−1/2)) with c_j the mass its velocity moves
+        # (linalg.column_scales): each pivot of D M D is that of M over c_j, compared with SINGULAR_PIVOT,
+        # and s̈ = D (D M D)⁻¹ (−D b)
         self._pivot_min = SINGULAR_PIVOT * mass_scales(system)
-        self._pivot_min_all = SINGULAR_PIVOT * mass_scale(system)
+        self._D = 1.0 / np.sqrt(column_scales(system)) if system.coupled else None
+        self._P_D = self._expansion[1] * self._D if system.coupled else None
         self._given_plan = [
             (n, joints[n], slice(q_index[n], q_index[n] + joints[n].n_q),
              slice(s_index[n], s_index[n] + joints[n].n_s), kernels.GIVEN_F + 6 * joints[n].n_s)
@@ -350,8 +353,8 @@ class FastEvaluator:
         s_ddot = np.empty(self.system.n_s, dtype=q.dtype)
         if self._expansion is not None:
             self._assembled(ws)
-            failed = self._projected_accelerations(ws.M_all, ws.b_all, self._expansion[1], self._pivot_min_all,
-                                                   ws.M, s_ddot)
+            failed = self._projected_accelerations(ws.M_all, ws.b_all, self._P_D, SINGULAR_PIVOT, ws.M, s_ddot)
+            s_ddot *= self._D
         else:
             failed = self._passes(self._index, ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat, self._pivot_min,
                                   s_ddot)
