@@ -13,6 +13,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 
+_FLOAT, _COMPLEX = np.dtype(float), np.dtype(complex)  # the kernels' dtypes: native float64, complex128
+
+
 def closest(name: str, known) -> str:
     """`` (did you mean 'x'?)`` for the closest known name, or an empty string."""
     match = difflib.get_close_matches(name, list(known), n=1)
@@ -29,22 +32,94 @@ def all_finite(a: NDArray) -> bool:
     an infinity makes it NaN or infinite), found in one pass — Python's sum of a short state vector
     (≤ 32 entries, 13× faster than ``np.all(np.isfinite(a))`` at 7), numpy's reduction of a longer
     one (3×); only a sum that overflows from finite entries takes the entry-wise test."""
-    total = sum(a.ravel().tolist()) if a.size <= 32 else np.add.reduce(a, axis=None)
+    if a.size > 32:
+        total = np.add.reduce(a, axis=None)
+    else:  # a state vector's own list (no ravel: half the cost of this check at 10 entries)
+        total = sum(a.tolist() if a.ndim == 1 else a.ravel().tolist())
     return math.isfinite(total) or bool(np.isfinite(a).all())
 
 
 def finite_array(name: str, value, shape: tuple | None = None) -> NDArray:
-    """``value`` as a float array of the given shape with finite entries."""
-    try:
-        a = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
+    """``value`` as a float array (a copy) of the given shape with finite entries."""
+    # a float64 array, as the integrators hold a state, copied; anything else converted
+    a = value.copy() if type(value) is np.ndarray and value.dtype is _FLOAT else _float_array(name, value)
     if shape is not None and a.shape != shape:
         raise ValueError(f"{name}: expected shape {shape}, got {a.shape}")
     if not all_finite(a):
         bad = np.flatnonzero(~np.isfinite(a.ravel()))
         raise ValueError(f"{name}: non-finite entries (NaN or inf) at flat index {bad.tolist()}")
     return a
+
+
+def _float_array(name: str, value) -> NDArray:
+    """``value`` (numbers, a list of them, an array of another dtype) as a new float array; a complex
+    one refused by name, not cast (numpy would drop its imaginary part with a mere ComplexWarning)."""
+    try:
+        a = value if isinstance(value, np.ndarray) else np.array(value)  # its own dtype: complex stays
+    except (TypeError, ValueError) as exc:  # a ragged list
+        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
+    if a.dtype.kind == "c":
+        raise ValueError(f"{name}: expected real numbers, got complex ones ({_first_complex(a)}); a complex "
+                         "value is refused, not cast")
+    try:
+        return np.array(a, dtype=float)
+    except (TypeError, ValueError) as exc:  # strings, objects
+        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
+
+
+def _first_complex(a: NDArray) -> str:
+    """The first entry of the complex array ``a`` with an imaginary part, for messages."""
+    flat = a.ravel()
+    imaginary = np.flatnonzero(flat.imag)
+    i = int(imaginary[0]) if imaginary.size else 0
+    return f"entry {i} is {complex(flat[i])}" if flat.size else "empty"
+
+
+def kernel_state(name: str, value, length: int) -> NDArray:
+    """``value`` as an evaluator reads it (a state, q or ṡ, passed straight to compiled code):
+    a one-dimensional array of ``length`` float or complex entries (complex for the complex step
+    of :mod:`projeq.analysis.jacobians`), C-contiguous and writeable (a strided or read-only view,
+    such as a row of a frozen Result, is copied: numba would compile the kernels again for its
+    layout, 10–30 s cold). Type, dtype and
+    shape are checked, not finiteness (an evaluator returns what the state gives): a kernel never
+    reads past the array."""
+    if not (isinstance(value, np.ndarray) and (value.dtype is _FLOAT or value.dtype is _COMPLEX)):
+        value = _numbers(name, value)  # float32, a file's big-endian float64, integers, lists: converted
+    if value.shape != (length,):
+        raise ValueError(f"{name}: expected {length} entries, got shape {value.shape}")
+    flags = value.flags  # numba compiles a kernel again for each layout and mutability: one kind only
+    return value if flags.c_contiguous and flags.writeable else np.array(value, order="C")
+
+
+def _numbers(name: str, value) -> NDArray:
+    """``value`` (a list, or an array of integers, ...) as a float or complex array; ValueError naming
+    ``name`` for anything else (strings, objects, booleans)."""
+    try:
+        a = np.asarray(value)
+    except ValueError as exc:  # a ragged list
+        raise ValueError(f"{name}: expected an array of numbers, got {value!r:.60}") from exc
+    if a.dtype.kind not in "iufc":
+        raise ValueError(f"{name}: expected an array of numbers, got {type(value).__name__} {value!r:.60}")
+    return np.asarray(a, dtype=_COMPLEX if a.dtype.kind == "c" else _FLOAT)
+
+
+def finite_result(what: str, value, **state):
+    """``value`` (a result computed at ``state``, its arguments by name; an array or a tuple of them)
+    if every entry is finite; else :func:`not_finite`'s ValueError, raised."""
+    if all(all_finite(np.asarray(part)) for part in (value if isinstance(value, tuple) else (value,))):
+        return value
+    raise not_finite(what, **state)
+
+
+def not_finite(what: str, **state) -> ValueError:
+    """The ValueError for a result ``what`` that is not finite at ``state`` (arguments by name): it names
+    the argument with the largest entry, a finite state whose products overflow (|ṡ| = 1e200 squared
+    in the velocity terms) or a non-finite one."""
+    magnitudes = {name: np.abs(np.asarray(x)).max(initial=0.0) for name, x in state.items()}
+    culprit = max(magnitudes, key=lambda name: np.nan_to_num(magnitudes[name], nan=np.inf))
+    return ValueError(f"{culprit}: {what} is not finite at this state (largest |{culprit}| = "
+                      f"{magnitudes[culprit]:.3g}): an entry overflowed to inf or NaN; the state is outside "
+                      "any range a model describes")
 
 
 def check_rotation(name: str, A, where: str = "", tol: float = 1e-9) -> NDArray:

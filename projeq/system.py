@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.assembly.kinematics import Plan
-from projeq.checks import finite_array, state_vector
+from projeq.checks import all_finite, finite_array, finite_result, kernel_state, not_finite, state_vector
 from projeq.constraints.nonholonomic import check_configuration
 from projeq.joints import Joint
 from projeq.spatial import numeric
@@ -197,8 +197,11 @@ class Model(ABC):
     def evaluator(self, method: str | None = None):
         """An object whose ``accelerations(q, s_dot, t)`` gives s̈ by ``method``
         (``"recursive"``, ``"dense"``, ``"fast"``, ``"hub_beam"`` or ``"auto"``; None: the
-        model's default), without checking the state: the right-hand side that
-        :func:`projeq.simulate` calls. One that cannot evaluate the model raises why."""
+        model's default), without checking the state's values: the right-hand side that
+        :func:`projeq.simulate` calls (it checks x and ẋ). Its type, dtype and shape are checked
+        (:func:`projeq.checks.kernel_state`: ValueError naming q or s_dot; a strided array is
+        copied, a complex one is the complex step); a non-finite state gives a non-finite s̈ or
+        an error, never a finite number. One that cannot evaluate the model raises why."""
 
     def accelerations(self, q, s_dot, t: float = 0.0, method: str | None = None) -> NDArray:
         """Minimal accelerations s̈ from the Projection Equation at (q, ṡ, t) by the
@@ -207,9 +210,16 @@ class Model(ABC):
         ``"fast"`` (the recursive pass compiled, :mod:`projeq.assembly.fast`), ``"hub_beam"``
         (a beam on a prescribed hub, :mod:`projeq.assembly.beam_fast`) or ``"auto"`` (the
         fastest of them that can, :mod:`projeq.assembly.auto`); for a ConstrainedSystem the
-        evaluator of its tree, projected (see its :meth:`evaluator`)."""
+        evaluator of its tree, projected (see its :meth:`evaluator`). ValueError naming the state
+        where s̈ is not finite (an entry such as ṡ = 1e200 whose products overflow)."""
         q, s_dot = self.check_state(q, s_dot, t)
-        return self.evaluator(method).accelerations(q, s_dot, float(t))
+        try:
+            s_ddot = self.evaluator(method).accelerations(q, s_dot, float(t))
+        except FloatingPointError as exc:  # a pivot or M_ee that overflowed: the state's doing, named
+            raise not_finite("s̈", q=q, s_dot=s_dot) from exc
+        if not all_finite(s_ddot):
+            raise not_finite("s̈", q=q, s_dot=s_dot)
+        return s_ddot
 
     @abstractmethod
     def accelerations_tree(self, q: NDArray, s_dot: NDArray, t: float = 0.0,
@@ -542,9 +552,13 @@ class System(Model):
         """q̇ = K(q) ṡ + k(q, t): q̇ = ṡ in one step where K = E (revolute and prismatic
         joints, elastic coordinates), joint by joint elsewhere. q and ṡ given otherwise than as
         arrays (lists, tuples) are checked as :meth:`check_state` does; arrays, as the
-        integrators pass them, go straight on."""
+        integrators pass them (complex under a complex step), go straight on once their shapes are
+        right."""
         if not (isinstance(q, np.ndarray) and isinstance(s_dot, np.ndarray)):
             q, s_dot = self.check_state(q, s_dot, t)
+        elif q.shape != (self.n_q,) or s_dot.shape != (self.n_s,) or q.dtype.kind not in "fc" or \
+                s_dot.dtype.kind not in "fc":
+            q, s_dot = kernel_state("q", q, self.n_q), kernel_state("s_dot", s_dot, self.n_s)
         if self._q_dot_is_s_dot:  # K = E throughout (one copy: the right-hand side of every step calls it)
             return np.array(s_dot, dtype=np.result_type(q, s_dot, float))
         q_dot = np.empty(self.n_q, dtype=np.result_type(q, s_dot, float))  # complex for a complex step
@@ -569,8 +583,10 @@ class System(Model):
         return np.concatenate(parts) if parts else np.zeros(0)
 
     def K(self, q: NDArray, t: float = 0.0) -> NDArray:
-        """K(q) of q̇ = K ṡ + k (block-diagonal over the joints)."""
-        q = np.asarray(q)  # a list's result_type would be read as a structured dtype
+        """K(q) of q̇ = K ṡ + k (block-diagonal over the joints), complex for a complex q (a complex step);
+        q given otherwise than as an array is checked as :meth:`check_q` does, an array's shape and dtype
+        (:func:`projeq.checks.kernel_state`)."""
+        q = kernel_state("q", q, self.n_q) if isinstance(q, np.ndarray) else self.check_q("q", q)
         K = np.zeros((self.n_q, self.n_s), dtype=np.result_type(q, float))
         for n, j in enumerate(self.joints):
             if not j.coupling:
@@ -617,9 +633,11 @@ class System(Model):
         return Q
 
     def gauss_form(self, q, s_dot, t: float = 0.0) -> tuple[NDArray, NDArray]:
-        """M(q) and b(q, ṡ, t) of the Gauss form M s̈ + b = 0 (docs/theory.md §5)."""
+        """M(q) and b(q, ṡ, t) of the Gauss form M s̈ + b = 0 (docs/theory.md §5); ValueError naming the
+        state where they are not finite."""
         q, s_dot = self.check_state(q, s_dot, t)
-        return self.evaluator("dense").gauss_form(q, s_dot, float(t))
+        M_b = self.evaluator("dense").gauss_form(q, s_dot, float(t))
+        return finite_result("the Gauss form (M, b)", M_b, q=q, s_dot=s_dot)
 
     def mass_matrix(self, q, t: float = 0.0) -> NDArray:
         """M(q) = Σ J_nᵀ M_n J_n (docs/theory.md §5)."""
@@ -640,9 +658,14 @@ class System(Model):
                              "or None")
         complex_step = np.iscomplexobj(q) or np.iscomplexobj(s_dot) or np.iscomplexobj(t)
         if complex_step:
-            return self._energy(np.asarray(q), np.asarray(s_dot), t, "recursive")
+            q, s_dot = kernel_state("q", q, self.n_q), kernel_state("s_dot", s_dot, self.n_s)
+            return self._energy(q, s_dot, t, "recursive")
         q, s_dot = self.check_state(q, s_dot, t)
-        return self._energy(q, s_dot, float(t), method)
+        try:
+            energies = self._energy(q, s_dot, float(t), method)
+        except FloatingPointError as exc:
+            raise not_finite("the energy", q=q, s_dot=s_dot) from exc
+        return finite_result("the energy", energies, q=q, s_dot=s_dot)
 
     def _energy(self, q: NDArray, s_dot: NDArray, t, method: str | None = None) -> tuple:
         """:meth:`energy` at a checked (q, ṡ, t), or by the reference at a complex one."""

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.jacobians import check_point, differentiate, state_derivative, state_jacobian
-from projeq.checks import callable_name, flag, positive
+from projeq.checks import callable_name, finite_result, flag, positive
 from projeq.system import check_model
 
 _TOL = 1e-8  # relative threshold: zero columns of A, and the steady-motion residual
@@ -143,6 +143,7 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
     require_steady = flag("require_steady", require_steady)
     x0 = np.concatenate((q, s_dot))
     A, derivatives = state_jacobian(system, x0, t, derivatives)
+    finite_result("A = ∂ẋ/∂x", A, q=q, s_dot=s_dot)  # a state whose products overflow gives NaN columns
     names = system.state_names()
     dropped = _dropped(system, names, A, ignore, tol)
     kept = [i for i in range(len(x0)) if i not in dropped]
@@ -152,6 +153,7 @@ def linearize(system, q=None, s_dot=None, t: float = 0.0, inputs=None, ignore="a
         _check_invariant(system, x0, x_dot, t, A, dropped, kept, names, derivatives)
     n_u = sum(system.joint(name).n_s for name in inputs)
     B = differentiate(lambda u: state_derivative(system, x0, t, u, inputs), np.zeros(n_u), derivatives)[0]
+    finite_result("B = ∂ẋ/∂u", B, q=q, s_dot=s_dot)
     return Linearization(A[np.ix_(kept, kept)], B[kept], [names[i] for i in kept],
                          [names[i] for i in dropped], inputs)
 

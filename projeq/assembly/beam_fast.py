@@ -47,6 +47,7 @@ from numpy.typing import NDArray
 from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import given, kernels
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
+from projeq.checks import kernel_state
 from projeq.joints import Prescribed
 
 
@@ -164,6 +165,7 @@ class HubBeamEvaluator:
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """q̈_e = M_ee⁻¹ (h_e − M_eR ζ) at (q, ṡ, t) = (q_e, q̇_e, t)."""
+        q, s_dot = self._state(q, s_dot)
         if self.compiled:
             x = np.concatenate((q, s_dot))
             x = x.astype(complex if x.dtype.kind == "c" else float)
@@ -179,6 +181,11 @@ class HubBeamEvaluator:
         y_dot = np.concatenate((hub.w, s_dot))
         M_e, h_e = self.beam.elastic_terms(y_dot, R, self.system.gravity, q)
         return np.linalg.solve(M_e[:, 6:], h_e - M_e[:, :6] @ hub.zeta)
+
+    def _state(self, q, s_dot) -> tuple[NDArray, NDArray]:
+        """q_e and q̇_e checked as the kernel reads them, n_e entries each
+        (:func:`projeq.checks.kernel_state`)."""
+        return kernel_state("q", q, self.beam.n_e), kernel_state("s_dot", s_dot, self.beam.n_e)
 
     def state_derivative(self, t: float, x: NDArray) -> NDArray | None:
         """ẋ = (q̇_e, q̈_e) at the state x = (q_e, q̇_e) in one compiled call (q̇ = ṡ: the
@@ -197,6 +204,7 @@ class HubBeamEvaluator:
         x or ẋ not finite: the caller's evaluation then raises, naming it)."""
         if not self.compiled:
             return None
+        self._check_x(x)
         self._hub(t)
         self.n_calls += len(x)
         J = np.empty((len(x), len(x)))
@@ -215,7 +223,7 @@ class HubBeamEvaluator:
         if not self.compiled:
             raise ValueError(f"method: the 'hub_beam' energy is compiled only; this system's path is interpreted: "
                              f"{self.interpreted_reason}")
-        x = kernels.kernel_array(np.concatenate((q, s_dot)))
+        x = kernels.kernel_array(np.concatenate(self._state(q, s_dot)))
         if self._evaluate(x, t)[1] == 1 and not np.all(np.isfinite(x)):
             raise FloatingPointError(f"the state is not finite at t = {t:.6g} (NaN or overflowed): no energy")
         M, frame = self._tail[x.dtype][1], self._tail[x.dtype][4]
@@ -245,9 +253,18 @@ class HubBeamEvaluator:
                                     f"t = {t:.6g}: the state has left the range the model describes")
         return x_dot, status
 
+    def _check_x(self, x: NDArray) -> None:
+        """ValueError for an x that is not (q_e, q̇_e), 2 n_e entries (the kernel's workspace is
+        sized for them)."""
+        if x.shape != (2 * self.beam.n_e,):
+            raise ValueError(f"x: expected the state (q_e, q̇_e) of 2 n_e = {2 * self.beam.n_e} entries, "
+                             f"got shape {x.shape}")
+
     def _evaluate(self, x: NDArray, t: float) -> tuple[NDArray, int]:
         """(ẋ, status) of one call of :func:`projeq.assembly.kernels.hub_beam` at (x, t), the hub's
-        motion first (:meth:`_hub`); its terms stay in the workspace of x's dtype."""
+        motion first (:meth:`_hub`); its terms stay in the workspace of x's dtype (x checked,
+        :meth:`_check_x`)."""
+        self._check_x(x)
         self._hub(t)
         x_dot = np.empty(x.shape[0], x.dtype)
         return x_dot, self._kernel(*self._head, x, *self._tail[x.dtype], x_dot)

@@ -14,8 +14,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.assembly.linalg import mass_scale, solve_spd, warn_if_ill_conditioned
+from projeq.assembly.linalg import column_scales, solve_spd, warn_if_ill_conditioned
 from projeq.assembly.kinematics import forward, gauss_terms
+from projeq.checks import kernel_state
 
 
 class DenseEvaluator:
@@ -25,13 +26,14 @@ class DenseEvaluator:
     def __init__(self, system):
         self.system = system
         self.P = [system.joint_s_columns(n) for n in range(len(system.joints))]
-        self.scale = mass_scale(system)
+        self.scale = column_scales(system)  # each pivot's yardstick, the mass its velocity moves
         self.n_calls, self.conditioned = 0, False
 
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
         """M(q) and b(q, ṡ, t) with M s̈ + b = 0."""
         self.n_calls += 1
         system = self.system
+        q, s_dot = kernel_state("q", q, system.n_q), kernel_state("s_dot", s_dot, system.n_s)
         kin = forward(system, q, s_dot, t)
         M_n, h_n = gauss_terms(system, kin, q, s_dot, t)
         J = [None] * len(system.joints) + [np.zeros((0, system.n_s))]

@@ -74,7 +74,8 @@ from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import given, kernels, loads
 from projeq.assembly.beam_fast import elastic_unsupported, hub_beam_unsupported
 from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
-from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
+from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, column_scales, mass_scales
+from projeq.checks import kernel_state
 from projeq.subsystems.rigid import rigid_mass_matrix
 
 
@@ -188,7 +189,13 @@ class FastEvaluator:
         self._width, self._depth = 6 + max(b.n_e for b in bodies), max(6, max(n_cols))
         self._rigid_M = [rigid_mass_matrix(*inertia) for inertia in rigid]
         self._gravity = np.asarray(system.gravity, dtype=float)
-        self._pivot_min = SINGULAR_PIVOT * mass_scale(system)
+        # each joint's pivot against the mass it carries (linalg.mass_scales); the coupled joints' one M
+        # factored as D M D = (P D)ᵀ M_all (P D), D = diag(c_j^(−1/2)) with c_j the mass its velocity moves
+        # (linalg.column_scales): each pivot of D M D is that of M over c_j, compared with SINGULAR_PIVOT,
+        # and s̈ = D (D M D)⁻¹ (−D b)
+        self._pivot_min = SINGULAR_PIVOT * mass_scales(system)
+        self._D = 1.0 / np.sqrt(column_scales(system)) if system.coupled else None
+        self._P_D = self._expansion[1] * self._D if system.coupled else None
         self._given_plan = [
             (n, joints[n], slice(q_index[n], q_index[n] + joints[n].n_q),
              slice(s_index[n], s_index[n] + joints[n].n_s), kernels.GIVEN_F + 6 * joints[n].n_s)
@@ -296,7 +303,10 @@ class FastEvaluator:
         (:meth:`projeq.System.potential_energy`). Each beam's ``check_spin`` at its ω, as the
         reference's terms do (the rows of :func:`projeq.simulate` say where a spin makes an
         unstiffened beam unstable)."""
-        q, s_dot, ws = kernels.kernel_array(q), kernels.kernel_array(s_dot), self._real
+        q, s_dot, ws = self._state(q, s_dot)
+        if ws is not self._real:
+            raise ValueError("q, s_dot: the compiled energy takes a real state; System.energy takes a "
+                             "complex step by the reference")
         self._kinematics(ws, q, s_dot, t)
         y_dot = ws.y_dot
         y_dot[:, :6] = ws.twist[:-1]
@@ -315,11 +325,13 @@ class FastEvaluator:
         return self._assembled(ws)
 
     def _state(self, q, s_dot) -> tuple[NDArray, NDArray, _Workspace]:
-        """q and ṡ as arrays of one dtype, float or complex (a complex step), and its workspace."""
-        q, s_dot = np.asarray(q), np.asarray(s_dot)
-        dtype = complex if q.dtype.kind == "c" or s_dot.dtype.kind == "c" else float
-        ws = self._real if dtype is float else self._workspace(dtype)
-        return kernels.kernel_array(q, dtype), kernels.kernel_array(s_dot, dtype), ws
+        """q and ṡ as C-contiguous arrays of one dtype, float or complex (a complex step), and its
+        workspace; ValueError naming q or ṡ when either is not an array of n_q (n_s) numbers
+        (:func:`projeq.checks.kernel_state`: the kernels read that many entries, never more)."""
+        q, s_dot = kernel_state("q", q, self.system.n_q), kernel_state("s_dot", s_dot, self.system.n_s)
+        if q.dtype.kind == "f" and s_dot.dtype.kind == "f":
+            return q, s_dot, self._real
+        return q.astype(complex), s_dot.astype(complex), self._workspace(complex)
 
     def _assembled(self, ws: _Workspace) -> tuple[NDArray, NDArray]:
         """M and b of the terms in the workspace: :func:`projeq.assembly.kernels.gauss_form` in
@@ -341,8 +353,8 @@ class FastEvaluator:
         s_ddot = np.empty(self.system.n_s, dtype=q.dtype)
         if self._expansion is not None:
             self._assembled(ws)
-            failed = self._projected_accelerations(ws.M_all, ws.b_all, self._expansion[1], self._pivot_min, ws.M,
-                                                   s_ddot)
+            failed = self._projected_accelerations(ws.M_all, ws.b_all, self._P_D, SINGULAR_PIVOT, ws.M, s_ddot)
+            s_ddot *= self._D
         else:
             failed = self._passes(self._index, ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat, self._pivot_min,
                                   s_ddot)

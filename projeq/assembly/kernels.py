@@ -576,7 +576,8 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
     Forward: a = T_np ÿ_p + ζ_n, s̈_n = D_n⁻¹ (F_nᵀ ĥ_n − Uᵀ a), ÿ_n = a + F_n s̈_n.
     ``M_hat`` (a workspace) starts as a copy of M_n, ``h_hat`` enters as h_n; both are
     overwritten (``h_hat`` may have a ground row N that collects, never read). Returns −1, or the index of the first body
-    with a pivot of D_n (a squared diagonal entry of L) not above ``pivot_min``.
+    with a pivot of D_n (a squared diagonal entry of L) not above ``pivot_min[n]`` (one bound per joint, relative
+    to the mass it carries: :func:`projeq.assembly.linalg.mass_scales`).
     """
     N, width, depth = index.shape[0], M_hat.shape[1], F.shape[2]
     n_cols, n_y, parent, s_index = index[:, N_COLS], index[:, N_Y], index[:, PARENT], index[:, S_INDEX]
@@ -598,7 +599,7 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
                     L[n, i, j] = dot_first(F[n, :, i], U[n, :, j], m)  # D_n, factored in place
                 f_h[n, i] = dot_first(F[n, :, i], h_hat[n], m)
                 g[i] = dot_first(F[n, :, i], c, m)
-            if not cholesky(L[n], k, pivot_min):
+            if not cholesky(L[n], k, pivot_min[n]):
                 return n
             cholesky_solve(L[n], k, g)  # D_n⁻¹ F_nᵀ c
             for a in range(m):

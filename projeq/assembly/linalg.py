@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 from numpy.typing import NDArray
 
-SINGULAR_PIVOT = 1e-13  # pivots below this fraction of the system's mass scale count as zero
+SINGULAR_PIVOT = 1e-13  # pivots below this fraction of the mass scale they carry count as zero
 ACCURACY = 1e-5  # relative error bound ε κ(M) of a solve above which an evaluator warns
 
 
@@ -20,13 +20,38 @@ class SingularMassError(ValueError):
 
 
 def mass_scale(system) -> float:
-    """The largest diagonal entry of the subsystems' M_n at rest in q0: the yardstick for
-    calling a pivot zero."""
-    diagonals = [
+    """The largest diagonal entry of the subsystems' M_n at rest: the yardstick for calling a pivot
+    zero where one number serves the whole system (one body, or the mass matrix of coupled joints)."""
+    return float(mass_scales(system).max(initial=1e-300))
+
+
+def mass_scales(system) -> NDArray:
+    """For each joint n, the largest diagonal entry of M_k at rest over the bodies k it carries (its
+    own subsystem and every descendant): the yardstick for calling its pivot D_n = F_nᵀ M̂_n F_n zero.
+    Relative to the mass it moves, not to the system's heaviest body: a bob 1e-16 times lighter than
+    the one it hangs from has a pivot of its own scale, exact to round-off, while a pivot that
+    cancels to round-off (a massless link between two joints on one axis) is at ε times the
+    scale of the bodies it carries, and one of a truly massless leaf is 0 (floor 1e-300)."""
+    own = [
         np.abs(np.diagonal(sub.gauss_terms(np.zeros(sub.n_y), np.eye(3), system.gravity, np.zeros(sub.n_e))[0])).max()
         for sub in system.subsystems
     ]
-    return max(diagonals + [1e-300])
+    scales = np.maximum(np.array(own, dtype=float).reshape(len(own)), 1e-300)
+    for n in range(len(scales) - 1, -1, -1):  # leaves → root (parent[n] < n)
+        if system.parent[n] >= 0:
+            scales[system.parent[n]] = max(scales[system.parent[n]], scales[n])
+    return scales
+
+
+def column_scales(system) -> NDArray:
+    """For each minimal velocity, the largest :func:`mass_scales` entry of the joints that move with it
+    (one joint's, or those of the coupled joints sharing it): the pivots of M's Cholesky factor, in
+    the order of the velocities, compared with these."""
+    joint_scales, scales = mass_scales(system), np.full(system.n_s, 1e-300)
+    for n in range(len(system.joints)):
+        columns = system.joint_s_columns(n)[0]
+        scales[columns] = np.maximum(scales[columns], joint_scales[n])
+    return scales
 
 
 def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
@@ -34,7 +59,8 @@ def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
 
     A 1×1 D (every one-dof joint in the recursive pass) is a division; 0×0 (fixed and
     prescribed joints) returns B unchanged. Raises :class:`SingularMassError` naming
-    ``what`` when a pivot is below ``1e-13 · scale``.
+    ``what`` when a pivot is below ``1e-13 · scale``, ``scale`` one number or one per pivot
+    (:func:`column_scales`).
     """
     k = D.shape[0]
     if not np.all(np.isfinite(D)):
@@ -44,6 +70,7 @@ def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
         _check_pivots(np.real(D), what, scale)
         return np.linalg.solve(D, B) if k else B
     if k == 1:
+        scale = np.max(scale)
         if D[0, 0] > SINGULAR_PIVOT * scale:
             return B / D[0, 0]
         raise SingularMassError(_negative(D, what) if D[0, 0] < -SINGULAR_PIVOT * scale else
@@ -54,7 +81,7 @@ def solve_spd(D: NDArray, B: NDArray, what: str, scale: float) -> NDArray:
         L = np.linalg.cholesky(D)
     except np.linalg.LinAlgError as exc:
         raise SingularMassError(_massless(D, what)) from exc
-    if np.diagonal(L).min() ** 2 <= SINGULAR_PIVOT * scale:
+    if np.any(np.diagonal(L) ** 2 <= SINGULAR_PIVOT * scale):
         raise SingularMassError(_massless(D, what))
     return np.linalg.solve(L.T, np.linalg.solve(L, B))
 

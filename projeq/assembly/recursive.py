@@ -28,8 +28,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from projeq.assembly.linalg import mass_scale, solve_spd
+from projeq.assembly.linalg import mass_scales, solve_spd
 from projeq.assembly.kinematics import forward, gauss_terms
+from projeq.checks import kernel_state
 
 
 class RecursiveEvaluator:
@@ -46,7 +47,7 @@ class RecursiveEvaluator:
                 "this system has coupled joints (shared ṡ): use method='dense'"
             )
         self.system = system
-        self.scale = mass_scale(system)
+        self.scale = mass_scales(system)  # each pivot's yardstick, the mass its joint carries
         self._workspaces = {np.dtype(float): _workspace(system, float)}  # and complex, for a complex step
         self.n_calls = 0
 
@@ -54,6 +55,7 @@ class RecursiveEvaluator:
         """s̈ by the backward and forward passes of docs/theory.md §6."""
         self.n_calls += 1
         system, scale = self.system, self.scale
+        q, s_dot = kernel_state("q", q, system.n_q), kernel_state("s_dot", s_dot, system.n_s)
         kin = forward(system, q, s_dot, t)
         M, h = gauss_terms(system, kin, q, s_dot, t)
         dtype = np.result_type(*kin.T_aug, *kin.F, *M, *h)
@@ -76,7 +78,7 @@ class RecursiveEvaluator:
         for n in range(N - 1, -1, -1):  # backward: leaves → root
             A = A_hat[n]
             AF = A[:, :-1] @ F[n]  # Ã_n F̃_n
-            gain[n] = solve_spd(F[n].T @ AF[:-1], AF.T, names[n], scale)  # D_n⁻¹ F̃_nᵀ Ã_n
+            gain[n] = solve_spd(F[n].T @ AF[:-1], AF.T, names[n], scale[n])  # D_n⁻¹ F̃_nᵀ Ã_n
             A -= AF @ gain[n]  # Ā_n
             A_hat[parent[n]] += T_aug[n].T @ A @ T_aug[n]  # Ã_p += T̃ᵀ Ā T̃
         minus_s_ddot = [None] * N

@@ -337,9 +337,10 @@ def test_compiled_flexible_arm_with_force_laws():
 @pytest.mark.parametrize("family", ["default", "clamped_free"])
 def test_compiled_hub_beam(family):
     """The spin-up beam (a RitzBeam on a prescribed hub): one call of
-    kernels.hub_beam_jacobian = its source interpreted to 1e-13 of max(1, |J|), and, with the
-    clamped–free functions, = the complex step through the interpreted path (the beam's own
-    elastic_terms, a second formulation) to 1e-13 (measured 2e-16). The default functions'
+    kernels.hub_beam_jacobian = its source interpreted to 100 ε of max(1, |J|) (measured 2.0e-15
+    with the default functions, 2.6e-17 clamped–free), and, with the clamped–free functions, = the
+    complex step through the interpreted path (the beam's own elastic_terms, a second formulation)
+    to 100 ε (measured 2.0e-16; both bounds were 1e-13). The default functions'
     M_ee is ill-conditioned: the two paths' s̈ differ by 1.8e-11 of |s̈| already, so no
     cross-formulation bound below that is meaningful there."""
     system = pq.scenes.spin_up_beam() if family == "default" else pq.scenes.spin_up_beam(family=family, n_shapes=3)
@@ -352,7 +353,9 @@ def test_compiled_hub_beam(family):
     interpreted = np.empty_like(J)
     assert kernels.hub_beam_jacobian_kernel(False)(*ev._head, x, COMPLEX_STEP, *ev._tail[np.dtype(complex)],
                                                    interpreted) < 0
-    assert _relative(J, interpreted) <= 1e-13
+    eps = np.finfo(float).eps
+    assert _relative(J, interpreted) <= 100 * eps, _relative(J, interpreted)
     if family != "default":
         reference = HubBeamEvaluator(system, compiled=False)
-        assert _relative(J, _reference_jacobian(system, x, t, reference)) <= 1e-13
+        error = _relative(J, _reference_jacobian(system, x, t, reference))
+        assert error <= 100 * eps, error

@@ -187,8 +187,9 @@ def test_a_torque_free_body_keeps_its_momenta_and_a_unit_quaternion():
     origin) in zero gravity, spinning near its unstable middle axis while drifting: the
     inertial angular momentum R I_c ω, the inertial momentum R m v and the kinetic energy
     stay constant (Euler's equations), the mass centre moves uniformly, and the output
-    quaternion has unit norm (normalised output; 1e-15). DOP853 at rtol 1e-10 for 10 s:
-    measured 1e-11 relative for all; the bound 1e-9 is ten times rtol."""
+    quaternion has unit norm (normalised output; 1e-15, measured 1.1e-16). DOP853 at rtol 1e-10
+    for 10 s, relative errors measured (each bound 10× that, rounded): angular momentum 4.1e-11,
+    momentum 2.4e-10, kinetic energy 2.5e-11, the centre's uniform motion 2.3e-11."""
     body = pq.RigidBody(2.0, (0, 0, 0), np.diag([1.0, 2.0, 3.0]))
     system = pq.System({"body": body}, {"body": pq.Free()})
     s_dot0 = np.array([0.1, 0.0, 0.0, 0.01, 2.0, 0.01])
@@ -198,11 +199,11 @@ def test_a_torque_free_body_keeps_its_momenta_and_a_unit_quaternion():
     R = np.array([quaternion_matrix(quat) for quat in quats])
     L = np.einsum("nij,nj->ni", R, result.s_dot[:, 3:] @ body.I_c.T)
     p = np.einsum("nij,nj->ni", R, body.m * result.s_dot[:, :3])
-    assert np.abs(L - L[0]).max() < 1e-9 * np.linalg.norm(L[0])
-    assert np.abs(p - p[0]).max() < 1e-9 * np.linalg.norm(p[0])
-    assert np.abs(result.kinetic - result.kinetic[0]).max() < 1e-9 * result.kinetic[0]
-    distance = 10.0 * 0.1  # t_end |v|
-    assert np.abs(result.q[:, :3] - np.outer(result.t, p[0] / body.m)).max() < 1e-9 * distance
+    error = {"L": np.abs(L - L[0]).max() / np.linalg.norm(L[0]), "p": np.abs(p - p[0]).max() / np.linalg.norm(p[0]),
+             "T": np.abs(result.kinetic - result.kinetic[0]).max() / result.kinetic[0],
+             "x": np.abs(result.q[:, :3] - np.outer(result.t, p[0] / body.m)).max() / (10.0 * 0.1)}  # / t_end |v|
+    bound = {"L": 4e-10, "p": 2.4e-9, "T": 2.5e-10, "x": 2.3e-10}
+    assert all(error[k] < bound[k] for k in bound), f"relative errors {error}"
     assert np.ptp(result.s_dot[:, 4]) > 3.0  # ω_y turns over: the body really tumbles
 
 

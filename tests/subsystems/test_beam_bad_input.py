@@ -94,17 +94,18 @@ def test_unstiffened_critical_speed_is_the_first_bending_frequency():
     """Without stiffening the in-plane equations are M q̈ + (K_e − Ω² M) q = 0 (zero hub
     radius): stable up to Ω = ω₁ of the same Ritz model, divergent beyond (a real
     eigenvalue √(Ω² − ω₁²) > 0). The warning's critical speed is this ω₁: checked 1 %
-    below and above it (growth rate above: √(1.01² − 1) ω₁ = 0.14 ω₁, measured to 3e-11,
-    asserted 1e-6; below, the real parts are round-off of the linearisation's central
-    differences: measured 1e-13 ω₁, asserted < 1e-6 ω₁)."""
+    below and above it (growth rate above: √(1.01² − 1) ω₁ = 0.14 ω₁, measured to 1.44e-10
+    relative, asserted 1.4e-9; below, the real parts are round-off of the linearisation:
+    measured 9.1e-14 ω₁, asserted < 9e-13 ω₁; each bound 10× the error measured on the
+    branch of issue 37, which found them 10⁴ and 10⁷ times looser)."""
     beam, _ = _steady_spin_eigenvalues(1.0)
     critical = beam.first_frequency
     exact = 3.51601527 * np.sqrt(1.4e4 / (1.2 * 1e4))  # (β₁L)² √(EI/(ρAL⁴)), Blevins (1979), Table 8-1
     assert critical == pytest.approx(exact, rel=1e-5)  # Ritz with n = 4 polynomials: 1.5e-6
     _, below = _steady_spin_eigenvalues(0.99 * critical)
     _, above = _steady_spin_eigenvalues(1.01 * critical)
-    assert np.abs(below.real).max() < 1e-6 * critical
-    assert above.real.max() == pytest.approx(np.sqrt(1.01**2 - 1.0) * critical, rel=1e-6)
+    assert np.abs(below.real).max() < 9e-13 * critical, f"max |Re λ| = {np.abs(below.real).max() / critical:.3g} ω₁"
+    assert above.real.max() == pytest.approx(np.sqrt(1.01**2 - 1.0) * critical, rel=1.4e-9)
 
 
 def test_unstiffened_spin_up_warns_once_with_the_critical_speed():

@@ -114,7 +114,8 @@ def test_tapered_cantilever_frequencies(kind):
     """Per-length properties as functions of x: a wedge and a cone (L = 2, EI₀ = 3,
     ρA₀ = 1.5). The Bessel roots agree with the published 5-digit values (rounding: half
     a unit of the last digit), and nine polynomial Ritz functions reproduce the first
-    three to 1e-7 (Kirchhoff's modes are power series in ξ; measured ≤ 9e-10)."""
+    three to 10× the relative error measured (Kirchhoff's modes are power series in ξ; measured
+    8.8e-10 for the cone, 1.1e-10 for the wedge; the bound was rtol 1e-7 with numpy's atol 1e-8)."""
     p_mass, p_stiffness, published = TAPERED[kind]
     exact = _tapered_exact(kind)
     assert np.all(np.abs(exact - published) <= 0.5 * 10.0 ** (np.floor(np.log10(published)) - 4) + 1e-12)
@@ -123,7 +124,8 @@ def test_tapered_cantilever_frequencies(kind):
     beam = RitzBeam(L, rho_A, EI, n_v=9, n_w=0)
     M, _ = beam.gauss_terms(np.zeros(beam.n_y), np.eye(3), np.zeros(3), np.zeros(beam.n_e))
     omega = np.sqrt(eigh(beam.K_e, M[6:, 6:], eigvals_only=True))[:3] / np.sqrt(EI_0 / (rho_A_0 * L**4))
-    assert np.allclose(omega, exact, rtol=1e-7)
+    error = np.abs(omega / exact - 1).max()
+    assert error < {"cone": 8.8e-9, "wedge": 1.1e-9}[kind], error
 
 
 # -- section forces with x-dependent stiffness ---------------------------------------------

@@ -46,23 +46,26 @@ def test_disc_hamiltonian_and_canonical_equations_match_the_lecture():
     assert sp.simplify(p_dot[2] - (l3 + m * g)) == 0
 
 
+#: (q, z = −r cos ϕ, velocity constraints) errors of the disc's multiplier forms against the PE, measured
+MEASURED = {"lagrange": (1.2e-12, 4.4e-14, 9.4e-14), "hamilton": (1.1e-11, 3.9e-13, 5.6e-13)}
+
+
 @pytest.mark.parametrize("form", ["lagrange", "hamilton"])
 def test_disc_multiplier_forms_follow_the_projection_equation(form):
     """Lagrange K(7) and Hamilton K(23)–(24) with multipliers, index-reduced (constraint differentiated once,
     no Baumgarte), from the same state as projeq's PE simulation: (x, y, ψ, ϕ, θ) agree to integration
-    accuracy (1000 × rtol over 1 time unit, half a turn of θ, both runs at rtol = 1e-11), and the dropped
-    position-level constraint
-    z = −r cos ϕ and the velocity constraints drift by less than 1000 × rtol (measured ~1e-13)."""
+    accuracy over 1 time unit, half a turn of θ, both runs at rtol = 1e-11, and the dropped
+    position-level constraint z = −r cos ϕ and the velocity constraints drift little: each bound
+    10× the error measured (MEASURED; the bound was 1000 × rtol = 1e-8 for all before issue 37)."""
     reference, q0, q_dot0 = disc_reference()
     disc = lecture_disc()
     sol = disc.simulate(q0, q_dot0, (0, reference.t[-1]), form=form, t_eval=reference.t,
                         rtol=RTOL, atol=ATOL)
     assert sol.success
-    assert np.abs(sol.q[[0, 1, 3, 4, 5]].T - reference.q).max() < 1000 * RTOL
-    assert np.abs(sol.q[2] + np.cos(sol.q[4])).max() < 1000 * RTOL
     drift = max(np.abs(disc.velocity_residual(ti, qi, ui)).max()
                 for ti, qi, ui in zip(sol.t, sol.q.T, sol.q_dot.T))
-    assert drift < 1000 * RTOL
+    errors = (np.abs(sol.q[[0, 1, 3, 4, 5]].T - reference.q).max(), np.abs(sol.q[2] + np.cos(sol.q[4])).max(), drift)
+    assert all(e < 10 * m for e, m in zip(errors, MEASURED[form])), f"(q, z, drift) off by {errors}"
 
 
 @pytest.mark.parametrize("form, alpha", [("lagrange", 0.0), ("hamilton", 0.0), ("lagrange", 10.0)])
