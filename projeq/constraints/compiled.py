@@ -721,24 +721,26 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
     _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
     U, sigma, Vt = _svd(A)
-    near = 0  # the singular values below separation σ_max, at least k
+    count = 0  # the singular values above acting σ_max, at most rank
     for value in sigma:
-        near += value < separation * sigma[0]
+        count += value > acting * sigma[0]
+    b_s = _constraint_rates(pins, joints, fields, tree, q, m_h, m)  # from the workspace at q, before q*
+    sigma_star, Vt_star = _on_manifold(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, U, sigma, Vt,
+                                       min(count, rank))
+    near = 0  # the singular values below separation σ_max, at least k
+    for value in sigma_star:
+        near += value < separation * sigma_star[0]
     near = max(k, near)
     if near == k or np.isnan(kept[0, 0]):
-        N = Vt[n - k:].T.copy()
+        N = Vt_star[n - k:].T.copy()
         kept[:, :] = N
     else:
-        V_near = Vt[n - near:]  # the near-null space (rows)
+        V_near = Vt_star[n - near:]  # the near-null space (rows)
         N = np.linalg.qr(_matmul(V_near.T, _matmul(V_near, kept)))[0]
     F = _scaled(N, independent)
     if F.shape[0] == 0:
         return DEGENERATE
-    count = 0  # the singular values above acting σ_max, at most rank
-    for value in sigma:
-        count += value > acting * sigma[0]
     s_dot_tree = _matvec(F, s_dot)
-    b_s = _constraint_rates(pins, joints, fields, tree, q, m_h, m)
     if b_s.shape[0]:  # ṡ_tree = F ṡ + f, A_s f = b_s with f[independent] = 0
         f = _particular(U, sigma, Vt, -b_s, min(count, rank), F, independent)
         for i in range(n):
@@ -748,6 +750,50 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     f_bar = _particular(U, sigma, Vt, gamma, min(count, rank), F, independent)
     given_motions(joints, q, s_dot_tree, t, tree[4])
     return _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree)
+
+
+def _on_manifold(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, U, sigma, Vt, count):
+    """(σ, Vᵀ) of A_s at q* = q − A_s⁺ [Φ(q); 0], the point q moved onto the constraint manifold by one
+    Gauss–Newton step (A_s = U Σ Vᵀ at q, its ``count`` largest singular values), whose null space is
+    the motion's tangent (:meth:`projeq.constraints.tangent.NullSpaceForm._motion_tangent`); (σ, Vᵀ)
+    of q itself where it lies on the manifold (Φ(q) = 0, or no Φ rows)."""
+    n, m = Vt.shape[0], U.shape[0]
+    values = np.zeros(m)
+    _constraint_values(phi, pins, fields, tree, q, t, values[:m_h])
+    moved = False
+    for r in range(m_h):
+        moved = moved or values[r] != 0.0
+    if not moved:
+        return sigma, Vt
+    q_star = q.copy()
+    for j in range(count):
+        weight = 0.0
+        for r in range(m):
+            weight += U[r, j] * values[r]
+        weight /= sigma[j]
+        for i in range(n):
+            q_star[i] -= Vt[j, i] * weight
+    A_star = np.empty((m, n))
+    _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q_star, t, m_h, A_star)
+    _, sigma_star, Vt_star = _svd(A_star)
+    return sigma_star, Vt_star
+
+
+def _constraint_values(phi, pins, fields, tree, q, t, values):
+    """values ← Φ(q, t) of the closure callback. The kernels' variant for cut joints calls
+    :func:`_pin_constraint_values` under this name instead."""
+    x, value = np.empty(q.shape[0], np.complex128), np.empty(values.shape[0], np.complex128)
+    for i in range(q.shape[0]):
+        x[i] = q[i]
+    phi_into(phi, x, t, value)
+    for r in range(values.shape[0]):
+        values[r] = value[r].real
+
+
+def _pin_constraint_values(phi, pins, fields, tree, q, t, values):
+    """:func:`_constraint_values` of cut joints, from the chain at q that :func:`_pin_constraint_rows`
+    leaves in the workspace (:func:`_pin_values`)."""
+    _pin_values(pins, fields, tree, q, values)
 
 
 def _scaled(N: NDArray, independent: NDArray) -> NDArray:
@@ -976,7 +1022,8 @@ def _inverse(A: NDArray) -> NDArray:
     return inv
 
 
-_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _constraint_rates, _pin_constraint_rows,
+_HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _constraint_rates, _constraint_values,
+            _pin_constraint_values, _on_manifold, _pin_constraint_rows,
             _pin_constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame, _port_chain, _pin_values, _pin_rates,
             _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, given_motions, _matvec, _matmul, _svd,
             _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms, _projected,
@@ -1200,7 +1247,7 @@ class CutJointRows:
 
 #: the kernels' helpers for a Φ made of cut joints, under the names of the general ones
 _PINNED = {"_constraint_rows": _pin_constraint_rows, "_constraint_gamma": _pin_constraint_gamma,
-           "_constraint_rates": _pin_constraint_rates}
+           "_constraint_rates": _pin_constraint_rates, "_constraint_values": _pin_constraint_values}
 
 
 @functools.cache

@@ -41,7 +41,13 @@ singular vectors would be off by O(1) there (tests/constraints/test_iftomm.py). 
 double four-bar of IFToMM A02 to 10 s (``benchmarks/iftomm.py``): point B0 within 7.6e-6 of
 the parallelogram motion at rtol 1e-9 and 4.2e-7 at rtol 1e-10, against 4.3e-5 and 1.3e-5 without
 the continuation (``separation=0``, which has also met step failures and energy jumps at later
-crossings, depending on tolerance). On the constraint manifold the rank of A_s can only drop below its value at a
+crossings, depending on tolerance). The null space is taken at the state moved onto the manifold
+by one Gauss–Newton step (:meth:`NullSpaceForm._motion_tangent`), not at the integrator's stage,
+which lies off it by δ (~1e-11 at rtol 1e-11): the stage's own null vector turns by ~δ/σ_next,
+which near a singular position and through f̄ = A_s⁺(−γ) put errors of up to 5e-5 into s̈, so that
+the double four-bar's error over 10 s stopped falling with rtol (2.8e-7 at 1e-10, 8.6e-7 at
+1e-11); from the manifold it falls 5–12× per decade from rtol 1e-6 to 1e-11 (1.2e-3 … 2.2e-8,
+``benchmarks/iftomm.py``, the tolerances table). On the constraint manifold the rank of A_s can only drop below its value at a
 regular q0 (at singular positions), never rise, so the n_s directions always exist (q0 must be a
 regular configuration: its rank fixes n_s). Where the independent velocities stop describing the
 motion (a crank at a dead centre, N_ind singular) the independent set is re-chosen as in :mod:`.partitioned`.
@@ -210,19 +216,44 @@ class NullSpaceForm(Model):
         return compiled_tangent(self, ACTING)
 
     def F(self, q: NDArray, t: float = 0.0, constraint_matrix=None) -> tuple[NDArray, NDArray]:
-        """(F, f) of ṡ_tree = F ṡ + f: F = N N_ind⁻¹, f the particular solution of A_s f = b_s
-        with f[independent] = 0 (module docstring)."""
+        """(F, f) of ṡ_tree = F ṡ + f: F = N N_ind⁻¹ with N the motion's tangent at q
+        (:meth:`_motion_tangent`), f the particular solution of A_s f = b_s with f[independent] = 0
+        (module docstring)."""
         A_s, b_s = self.constraint_matrix(q, t) if constraint_matrix is None else constraint_matrix
-        return self._scaled(self._null_space(A_s)), self.particular(A_s, b_s)
+        self._tangent_of = (A_s, self._motion_tangent(q, t, A_s))
+        return self._scaled(self._tangent_of[1]), self.particular(A_s, b_s)
+
+    _tangent_of = (None, None)  # (A_s, N) of the latest F: particular's f̄ at the same state takes its N
+
+    def _motion_tangent(self, q: NDArray, t: float, A_s: NDArray) -> NDArray:
+        """N (:meth:`_null_space`) of the constraint matrix at q* = q − A_s⁺ [Φ(q); 0], the state moved
+        onto the constraint manifold by one Gauss–Newton step (K = E; else along Φ_q⁺ and normalised),
+        not of A_s at q itself: an integrator's stage lies off the manifold by δ (~1e-11 at rtol 1e-11),
+        and the null vector of A_s there turns by ~δ/σ_next from the motion's, which near a singular
+        position (σ_next small) and through f̄ = A_s⁺(−γ) gave accelerations off by up to 5e-5 on the
+        double four-bar and an error that stopped falling with rtol (module docstring). At q itself
+        for A_s carrying a complex step, or where q is on the manifold."""
+        if not self.m_h or np.iscomplexobj(A_s) or np.iscomplexobj(q):
+            return self._null_space(A_s)
+        values = self.phi(q, t)
+        if not np.any(values):
+            return self._null_space(A_s)
+        rank = self.tree.n_s - self.n_s
+        if self._identity:
+            q_star = q - minimum_norm_solution(A_s, np.concatenate((values, np.zeros(self.m_p))), ACTING, rank)
+        else:
+            q_star = self.tree.normalized(q - minimum_norm_solution(self.phi_q(q, t), values, ACTING))
+        return self._null_space(self.constraint_matrix(q_star, t)[0])
 
     def particular(self, A_s: NDArray, c: NDArray) -> NDArray:
         """x₀ − F x₀[independent] with x₀ = A_s⁺ c, the pseudo-inverse over the largest
-        n_s,tree − n_s singular values (the rank at q0) above ACTING σ_max, F from the same
-        decomposition: A_s x = c with x[independent] = 0, where A_s x = c can hold."""
+        n_s,tree − n_s singular values (the rank at q0) above ACTING σ_max, F that of :meth:`F` at the
+        same A_s (else from its null space): A_s x = c with x[independent] = 0, where A_s x = c can hold."""
         if not A_s.size:
             return np.zeros(self.tree.n_s)
         x0 = minimum_norm_solution(A_s, c, ACTING, rank=self.tree.n_s - self.n_s)
-        return x0 - self._scaled(self._null_space(A_s)) @ x0[self.independent]
+        kept, N = self._tangent_of  # one read: another thread may replace it
+        return x0 - self._scaled(N if kept is A_s else self._null_space(A_s)) @ x0[self.independent]
 
     def __repr__(self) -> str:
         return (f"ConstrainedSystem(n_q={self.n_q}, n_s={self.n_s}, {self.m_h} holonomic, {self.m_p} Pfaffian, "
