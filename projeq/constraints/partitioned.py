@@ -88,7 +88,7 @@ from projeq.constraints.matrices import (
     RANK_TOLERANCE, REPIVOT_CONDITION, independent_indices, minimum_norm_solution, numerical_rank, pivoted_columns,
 )
 from projeq.constraints.tangent import SEPARATION, NullSpaceForm
-from projeq.checks import depends_on_t, positive, state_vector
+from projeq.checks import depends_on_t, finite_result, kernel_state, positive, state_vector
 from projeq.analysis.differentiation import (MIXED_STEP, complex_failure, derivative_along,
                                              derivative_along_differences, second_derivative_along,
                                              second_derivative_along_differences, warn_differences)
@@ -341,7 +341,12 @@ class ConstrainedSystem(Model):
         return self._in_tree_velocities(q, t, *self.velocity_constraints(q, t))
 
     def _in_tree_velocities(self, q: NDArray, t: float, C: NDArray, c: NDArray) -> tuple[NDArray, NDArray]:
-        """(A_s, b_s) = (C K, c − C k) from (C, c) at (q, t)."""
+        """(A_s, b_s) = (C K, c − C k) from (C, c) at (q, t); ValueError naming q where they are not
+        finite (a non-finite state, or one whose constraint rows overflow), before any factorisation."""
+        if not np.isfinite(C).all():
+            raise ValueError(f"q: the constraint matrix is not finite at q = {np.round(np.real(q), 6).tolist()}, "
+                             f"t = {np.real(t):.6g} (a non-finite state, or one outside any range the constraints "
+                             "describe)")
         if self._identity:
             return C, c
         return C @ self.tree.K(q, t), c - C @ self.tree.q_dot(q, np.zeros(self.tree.n_s), t)
@@ -653,7 +658,9 @@ class ConstrainedSystem(Model):
         return x
 
     def tree_velocities(self, q: NDArray, s_dot: NDArray, t: float = 0.0, constraint_matrix=None) -> NDArray:
-        """ṡ_tree = F ṡ + f (``constraint_matrix``: (A_s, b_s) at (q, t) if known)."""
+        """ṡ_tree = F ṡ + f (``constraint_matrix``: (A_s, b_s) at (q, t) if known); ValueError naming q or
+        s_dot for one of the wrong type or shape."""
+        q, s_dot = kernel_state("q", q, self.n_q), kernel_state("s_dot", s_dot, self.n_s)
         F, f = self.F(q, t, constraint_matrix)
         return F @ s_dot + f
 
@@ -668,6 +675,7 @@ class ConstrainedSystem(Model):
 
     def K(self, q: NDArray, t: float = 0.0) -> NDArray:
         """K of q̇ = K ṡ + k in the minimal velocities: K_tree F."""
+        q = kernel_state("q", q, self.n_q)
         return self.tree.K(q, t) @ self.F(q, t)[0]
 
     def q_dot(self, q: NDArray, s_dot: NDArray, t: float = 0.0) -> NDArray:
@@ -823,8 +831,11 @@ class ConstrainedSystem(Model):
                            method: str | None = None) -> tuple[NDArray, NDArray]:
         """(s̈_tree, λ): s̈_tree = F s̈ + f̄ from Fᵀ(M (F s̈ + f̄) + b) = 0, and the
         multipliers λ of M s̈_tree + b = A_sᵀ λ (the constraint forces); ``method`` picks
-        the tree's evaluator (module docstring; None: compiled where the tree is)."""
+        the tree's evaluator (module docstring; None: compiled where the tree is). ValueError
+        naming q or s_dot for a state of the wrong type or shape, or one where s̈_tree is not finite."""
+        q, s_dot = kernel_state("q", q, self.n_q), kernel_state("s_dot", s_dot, self.n_s)
         s_ddot_tree, A_s, M, b = self._tree_accelerations(q, s_dot, t, method)
+        finite_result("s̈_tree", s_ddot_tree, q=q, s_dot=s_dot)
         lam = np.zeros(0)
         if self.n_c:  # the minimum-norm λ where rows are redundant
             lam = np.linalg.lstsq(A_s.T, M @ s_ddot_tree + b, rcond=RANK_TOLERANCE)[0]
@@ -950,12 +961,15 @@ class PartitionedEvaluator:
         self._tree = system._tree_accelerations if partitioned else system.accelerations_tree
 
     def accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
-        return self._tree(q, s_dot, t, self.method)[0][self.system.independent]
+        system = self.system
+        q, s_dot = kernel_state("q", q, system.n_q), kernel_state("s_dot", s_dot, system.n_s)
+        return self._tree(q, s_dot, t, self.method)[0][system.independent]
 
     def _compiled_accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """s̈ by the system's compiled kernel at real arguments; by the numpy path at complex ones (a
         complex step) and where the kernel flags (which raises the error naming the cause)."""
-        system, q, s_dot = self.system, np.asarray(q), np.asarray(s_dot)
+        system = self.system
+        q, s_dot = kernel_state("q", q, system.n_q), kernel_state("s_dot", s_dot, system.n_s)  # before the kernel reads
         if q.dtype.kind != "c" and s_dot.dtype.kind != "c":  # (np.iscomplexobj costs more than the check)
             s_ddot = system.compiled_kernel().minimal_accelerations(system, q, s_dot, t)
             if s_ddot is not None:
@@ -964,8 +978,10 @@ class PartitionedEvaluator:
 
     def _state_derivative(self, t: float, x: NDArray):
         """ẋ = (q̇, s̈) by the system's compiled kernel, or None
-        (:meth:`projeq.constraints.compiled.CompiledClosure.state_derivative`)."""
-        return self.system.compiled_kernel().state_derivative(self.system, x, t)
+        (:meth:`projeq.constraints.compiled.CompiledClosure.state_derivative`); ValueError naming x
+        for one of the wrong type or shape."""
+        system = self.system
+        return system.compiled_kernel().state_derivative(system, kernel_state("x", x, system.n_q + system.n_s), t)
 
 
 def _minimal(F: NDArray, f_bar: NDArray, M: NDArray, b: NDArray) -> tuple[NDArray, NDArray]:
