@@ -33,7 +33,18 @@ def _contact_twist(m, R, n):
                      [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
 
 
-class RollingDisk(Joint):
+class _Rolling(Joint):
+    """A body of radius R rolling without slip on the parent's x–y plane (the two contact-point
+    velocity rows in F, q̇ = K(q) ṡ): what the rolling joints share."""
+
+    n_c = 2
+
+    def __init__(self, parent=None, radius=1.0, r_pn=(0.0, 0.0, 0.0), orientation=None):
+        super().__init__(parent, r_pn, orientation)
+        self.radius = positive("radius", radius)
+
+
+class RollingDisk(_Rolling):
     """A thin disk (a wheel) of radius R rolling without slipping on the joint frame's x–y plane.
 
     Coordinates as Barhorst §3.2, eqs. (88)–(97) (the disk of :func:`projeq.scenes.rolling_disk`):
@@ -53,11 +64,7 @@ class RollingDisk(Joint):
         R, the disk's radius (m), positive.
     """
 
-    n_q, n_s, n_c = 5, 3, 2
-
-    def __init__(self, parent=None, radius=1.0, r_pn=(0.0, 0.0, 0.0), orientation=None):
-        super().__init__(parent, r_pn, orientation)
-        self.radius = positive("radius", radius)
+    n_q, n_s = 5, 3
 
     def statement(self, q, t, m):
         R = self.radius
@@ -84,7 +91,7 @@ class RollingDisk(Joint):
         return tuple((f"omega_{a}", "rad/s") for a in "xyz")
 
 
-class RollingSphere(Joint):
+class RollingSphere(_Rolling):
     """A sphere (a ball) of radius R rolling without slipping on the joint frame's x–y plane.
 
     q = (x, y, w, q_x, q_y, q_z): the centre's (x, y), at the height R, and the unit quaternion of
@@ -99,11 +106,7 @@ class RollingSphere(Joint):
         R, the sphere's radius (m), positive.
     """
 
-    n_q, n_s, n_c = 6, 3, 2
-
-    def __init__(self, parent=None, radius=1.0, r_pn=(0.0, 0.0, 0.0), orientation=None):
-        super().__init__(parent, r_pn, orientation)
-        self.radius = positive("radius", radius)
+    n_q, n_s = 6, 3
 
     def statement(self, q, t, m):
         R = self.radius
