@@ -89,7 +89,9 @@ def test_tangent_continues_the_branch_off_the_manifold_near_a_singular_position(
     separated from the directions that come free there: the n_s smallest singular vectors
     (separation=0) give a motion off the parallelogram branch by up to tens of rad/s per rad/s,
     the continued tangent (the default) the branch's own, ṡ_tree ∝ (1, 1, 1, −1, −1) for
-    (cranks, couplers), to 1e-6."""
+    (cranks, couplers): measured 3.4e-6 (bound 10×), the stage moved back toward the manifold by one
+    Gauss–Newton step first (NullSpaceForm._motion_tangent; 1e-6 with the stage's own A_s, which is
+    worse by orders at the stages' real distances, ~1e-11: test_the_double_four_bars_error_falls_...)."""
     rng = np.random.default_rng(0)
     errors = {}
     for separation in (1e-2, 0.0):
@@ -106,7 +108,7 @@ def test_tangent_continues_the_branch_off_the_manifold_near_a_singular_position(
                 q[crank], q[coupler] = np.pi - d, d - np.pi
                 F = system.F(q + 1e-4 * rng.standard_normal(5))[0][:, 0]
                 errors[separation] = max(errors[separation], np.abs(F - branch).max())
-    assert errors[1e-2] < 1e-6 and errors[0.0] > 1.0, errors
+    assert errors[1e-2] < 3.4e-5 and errors[0.0] > 1.0, errors
 
 
 def test_separation_is_checked():
