@@ -354,14 +354,20 @@ class ConstrainedSystem(Model):
     redundant = ()  # rows that depend on the others along the motion (found at construction, _rows_on_surface)
 
     def _choose_form(self, q0, formulation: str, independent) -> None:
-        """The form of the minimal velocities (the ``formulation`` parameter): this class's
-        partition where the rows are independent on the constraint surface and well conditioned
-        at q0, else the null-space form (:class:`TangentSystem`, into which this object turns)."""
+        """The form of the minimal velocities (the ``formulation`` parameter): a ConstrainedSystem
+        partitions where the rows are independent on the constraint surface and well conditioned at
+        q0, else takes the null-space form (:class:`TangentSystem`, into which it turns); a subclass
+        keeps its own (AugmentedSystem's tree velocities; a user's), partitioned ones refusing
+        redundant rows."""
         self.redundant = self._rows_on_surface(q0)
         self.automatic = formulation == "auto"  # goes on in the null-space form from a singular position
         if isinstance(self, NullSpaceForm):
             return
-        if formulation == "partitioned" or (formulation == "auto" and independent is not None and not self.redundant):
+        if type(self) is ConstrainedSystem and formulation != "partitioned" and (
+                formulation == "null_space" or self.redundant
+                or (independent is None and not self._well_conditioned(q0))):
+            self.__class__ = TangentSystem
+        elif type(self)._choose_velocities is ConstrainedSystem._choose_velocities:
             if self.redundant:
                 raise ValueError(
                     f"phi: rows {list(self.redundant)} depend on the others along the motion (the rank of the "
@@ -370,9 +376,6 @@ class ConstrainedSystem(Model):
                     "formulation at its default, which takes redundant rows as they are")
             if self.n_c > self.tree.n_s:
                 raise ValueError(f"phi: {self.n_c} constraints on only {self.tree.n_s} tree velocities")
-            return
-        if formulation == "null_space" or self.redundant or not self._well_conditioned(q0):
-            self.__class__ = TangentSystem
 
     def _well_conditioned(self, q0) -> bool:
         """Whether the rows are far from a singular position at q0: σ_min ≥ σ_max / REPIVOT_CONDITION
