@@ -232,8 +232,10 @@ class NullSpaceForm(Model):
         and the null vector of A_s there turns by ~δ/σ_next from the motion's, which near a singular
         position (σ_next small) and through f̄ = A_s⁺(−γ) gave accelerations off by up to 5e-5 on the
         double four-bar and an error that stopped falling with rtol (module docstring). At q itself
-        for A_s carrying a complex step, or where q is on the manifold."""
-        if not self.m_h or np.iscomplexobj(A_s) or np.iscomplexobj(q):
+        where q is on the manifold. Complex-safe (the step's pseudo-inverse is differentiated exactly,
+        :func:`~projeq.constraints.matrices.minimum_norm_solution`): the exact Jacobian is that of this
+        rule, as differences see it."""
+        if not self.m_h:
             return self._null_space(A_s)
         values = self.phi(q, t)
         if not np.any(values):

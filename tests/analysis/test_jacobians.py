@@ -156,17 +156,23 @@ def _pendulum_on_sliders(rows: int):
 def test_tangent_system_jacobians_are_the_partitioned_ones():
     """A second formulation: the pendulum on sliders as a TangentSystem with its closure written
     twice (a redundant row) and as a ConstrainedSystem with it once, both with ẋ independent,
-    have the same F, f̄ and s̈, so their exact Jacobians agree to round-off (measured 1.6e-15 of the
-    largest entry; 1e-12 allowed)."""
+    have the same F, f̄ and s̈ on the constraint manifold, so their exact Jacobians agree there
+    along the manifold's tangent in q and every ṡ: measured 5.0e-12 of the largest entry (bound
+    10×; 1.6e-15 before the null-space form took its tangent at the state moved onto the manifold,
+    whose Gauss–Newton step the complex step differentiates too). Off the manifold the partition
+    takes F at the state itself: the columns across it differ."""
     from projeq.constraints.partitioned import TangentSystem
 
-    q0, s_dot = [0.6, -0.8], [0.7]
+    q0, s_dot = np.array([0.6, -0.8]), [0.7]
     tangent = TangentSystem(*_pendulum_on_sliders(2), q0=q0, independent=[0])
     partitioned = pq.ConstrainedSystem(*_pendulum_on_sliders(1), q0=q0, independent=[0])
     J, K = state_jacobians(tangent, q0, s_dot, 0.2), state_jacobians(partitioned, q0, s_dot, 0.2)
     assert J.derivatives == K.derivatives == "exact"
+    along = np.zeros((3, 2))  # x = (q, ṡ) moving along the circle in q, and in ṡ
+    along[:2, 0], along[2, 1] = (0.8, 0.6), 1.0
     for a, b in zip(J[:5], K[:5]):
-        assert np.abs(a - b).max(initial=0.0) <= 1e-12 * np.abs(b).max(initial=1.0)
+        a, b = (m @ along if np.ndim(m) == 2 and np.shape(m)[1] == 3 else m for m in (a, b))
+        assert np.abs(a - b).max(initial=0.0) <= 5e-11 * np.abs(b).max(initial=1.0)
 
 
 # -- the complex step through the compiled kernels (issue 16) ------------------------------------

@@ -12,6 +12,6 @@ def test_the_quick_mode_prints_every_table(capsys):
     module.main(["--quick"])
     out = capsys.readouterr().out
     for heading in ("IFToMM problems", "against the published reference files", "the formulations",
-                    "B0 error by rtol", "partitioned against null space", "A05 stiff flyball governor"):
+                    "B0 position error by rtol", "partitioned against null space", "A05 stiff flyball governor"):
         assert heading in out, heading
     assert "stopped" not in out.split("the formulations")[1].split("auto")[1].splitlines()[0]
