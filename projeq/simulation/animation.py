@@ -1,17 +1,17 @@
 """The motion of a Result to look at: one self-contained HTML page (three.js), a GIF or an MP4.
 
 :func:`animate` writes by the file's suffix. The page (:func:`write_html`) plays the run in any
-browser, offline: three.js (a pinned release, ``THREE_VERSION``, MIT licence, shipped with projeq
-in ``projeq/simulation/viewer/``) and the motion's numbers are inlined. A subsystem with
-``visuals`` (:class:`projeq.subsystems.Visual`: boxes, cylinders, spheres, as
-:func:`projeq.from_urdf` reads them from a URDF link) is drawn by them; other rigid bodies as the
-homogeneous box or cylinder of the same mass and central inertia (:func:`equivalent_shape`; a
-planar body as a plate in its plane, :func:`planar_shape`; a point mass as a small sphere), beams as tubes along their deformed centre lines (the shape
-functions' field, :meth:`~projeq.subsystems.beam.RitzBeam.centre_line`), the mechanism as thin
-rods from each joint to its children's joints and to its centre of mass, and each subsystem's
-frame (at its joint) as axes that a checkbox shows. The poses are the ParaView export's
-(:class:`projeq.simulation.export.Drawing`, :func:`~projeq.simulation.export.system_of`): a
-Result loaded from a file is drawn with the scene its run record names.
+browser, offline: three.js (a pinned release, ``THREE_VERSION``, MIT licence, shipped with projeq in
+``projeq/simulation/viewer/``) and the motion's numbers are inlined. A subsystem with ``visuals``
+(:class:`projeq.subsystems.Visual`: boxes, cylinders, spheres, as :func:`projeq.from_urdf` reads
+them from a URDF link) is drawn by them; other rigid bodies as the homogeneous box or cylinder of
+the same mass and central inertia (:func:`equivalent_shape`; a planar body as a plate in its plane,
+:func:`planar_shape`; a point mass as a small sphere), beams as tubes along their deformed centre
+lines (the shape functions' field, :meth:`~projeq.subsystems.beam.RitzBeam.centre_line`), the
+mechanism as thin rods from each joint to its children's joints and to its centre of mass, and each
+subsystem's frame (at its joint) as axes that a checkbox shows. The poses are the ParaView export's
+(:class:`projeq.simulation.export.Drawing`, :func:`~projeq.simulation.export.system_of`): a Result
+loaded from a file is drawn with the scene its run record names.
 
 A GIF (matplotlib's ``PillowWriter``) or MP4 (``FFMpegWriter``, where ffmpeg is found) shows the
 same geometry projected on the viewing plane, for papers and slides.
@@ -113,7 +113,8 @@ def planar_shape(body: PlanarBody) -> Shape:
         along, edge = np.roll(normal, 1), np.sqrt(6.0 * I_n / m)
         size = (edge, edge, 0.1 * edge)
     along = along / np.linalg.norm(along)
-    return Shape("box", tuple(float(e) for e in size), np.column_stack((along, np.cross(normal, along), normal)))
+    rotation = np.column_stack((along, np.cross(normal, along), normal))
+    return Shape("box", tuple(float(e) for e in size), rotation)
 
 
 def _visual_shape(visual) -> tuple[Shape, NDArray]:

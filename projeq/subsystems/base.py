@@ -173,12 +173,14 @@ class Visual:
             raise ValueError(f"kind: expected one of {sorted(VISUAL_SIZES)}, got {self.kind!r}")
         size = np.asarray(self.size, dtype=float)
         if size.shape != (VISUAL_SIZES[self.kind],) or not np.all(np.isfinite(size) & (size > 0)):
-            raise ValueError(f"size: a {self.kind} takes {VISUAL_SIZES[self.kind]} positive sizes, got {self.size!r}")
+            raise ValueError(f"size: a {self.kind} takes {VISUAL_SIZES[self.kind]} positive sizes, "
+                             f"got {self.size!r}")
         origin = np.asarray(self.origin, dtype=float)
         rotation = origin[:3, :3] if origin.shape == (4, 4) else None
         if rotation is None or not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-9) \
                 or not np.all(np.isfinite(origin)) or np.linalg.det(rotation) <= 0:
-            raise ValueError(f"origin: expected a 4 x 4 homogeneous transform with a rotation, got {self.origin!r}")
+            raise ValueError(f"origin: expected a 4 x 4 homogeneous transform with a rotation, "
+                             f"got {self.origin!r}")
         object.__setattr__(self, "size", tuple(float(x) for x in size))
         object.__setattr__(self, "origin", origin)
 
