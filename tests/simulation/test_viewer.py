@@ -297,11 +297,12 @@ def chromium(page: Path, at: float, profile: str, screenshot: Path) -> subproces
 @pytest.mark.skipif(not CHROMIUM.exists(), reason="no /usr/bin/chromium (Debian's package chromium): "
                     "the pages are not loaded in a browser here")
 def test_pages_play_in_headless_chromium_offline(tmp_path):
-    """Each page (double pendulum, flexible arm, bicycle, bodies drawn by visuals and plates) loads
-    from a file in headless Chromium with no network, plays to t = 0.5 s and stops there with no error (the page's collector of
-    errors, uncaught exceptions and console.error stays empty), and its picture then differs from
-    its first one (the page compares its canvas, data-changed); the double pendulum's screenshot
-    after the play differs from that of its first frame (#t=0) in many pixels (measured 1.4 %)."""
+    """Each page (double pendulum, flexible arm, bicycle, bodies drawn by visuals and plates)
+    loads from a file in headless Chromium with no network, plays to t = 0.5 s and stops there with
+    no error (the page's collector of errors, uncaught exceptions and console.error stays empty),
+    and its picture then differs from its first one (the page compares its canvas, data-changed);
+    the double pendulum's screenshot after the play differs from that of its first frame (#t=0) in
+    many pixels (measured 1.4 %)."""
     from matplotlib.image import imread
 
     arm, bike = scenes.flexible_arm(), bicycle()
