@@ -98,8 +98,8 @@ def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
     over Ω = 0 … 30 where the forward whirls pass through zero (at Ω = ω₁, ω₂) and cross the
     backward ones: a diagram sorted by frequency would mix the branches. Seen from the inertial
     frame (``stationary``, w + Ω with the co-rotating whirl w signed) both whirls are the
-    non-rotating cantilever's ω_k at every speed (Genta (2005), "Dynamics of Rotating Systems",
-    §4.4; measured 3.5e-13 relative, bound 3.5e-12), on both sides of the forward whirl's zero."""
+    non-rotating cantilever's ω_k at every speed (G. Genta, "Dynamics of Rotating Systems",
+    Springer, 2005; measured 3.5e-13 relative, bound 3.5e-12), on both sides of the forward whirl's zero."""
     speeds = np.linspace(0.0, 30.0, 16)
     diagram = campbell(lambda omega: pq.scenes.spinning_beam(omega=omega, n_shapes=4), speeds, orders=[0, 1])
     omega_k = clamped_free_roots(4) ** 2
@@ -126,8 +126,8 @@ def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
 
 def test_stationary_whirls_split_by_rotary_inertia_and_in_the_csv(tmp_path):
     """With rotary inertia (ρI = 0.01) the shaft is gyroscopic: seen from the inertial frame the
-    forward whirls rise and the backward ones fall from their common value at rest (Genta (2005),
-    §4.4; second whirls at Ω = 10: 21.75 and 16.86 rad/s from 19.14); the CSV carries a whirl's
+    forward whirls rise and the backward ones fall from their common value at rest (Genta,
+    2005; second whirls at Ω = 10: 21.75 and 16.86 rad/s from 19.14); the CSV carries a whirl's
     stationary frequency beside its co-rotating one, which is ω_rot + Ω (forward, its co-rotating
     whirl not through zero here) and ω_rot − Ω (backward) to round-off (bound 1e-12 relative); a
     blade has no stationary frequency and asking for one is named."""
