@@ -27,12 +27,12 @@ motion at the lowest nonzero speed, relative to the beam frame's angular velocit
 - *axial* or *torsion* where those coordinates dominate the shape; numbered by frequency
   within each kind. Other systems: ``mode 1, 2, …`` by frequency at the first speed.
 
-A whirl seen from the inertial (stationary) frame turns at |w + Ω_b| (Ω_b = ω_b·e the spin,
-e the beam's axis at the labelling speed): the co-rotating whirl w = σ Im λ signed along the
+A whirl seen from the inertial (stationary) frame turns at |w + Ω_b| (Ω_b = ω_b·e the spin, e
+the beam's axis at the labelling speed): the co-rotating whirl w = σ Im λ signed along the
 branch (through zero), so a forward whirl is seen at ω_k and a backward one at ω_k again where
 the co-rotating frame shows |ω_k ∓ Ω| (a shaft without rotary inertia: G. Genta, *Dynamics of
-Rotating Systems*, Springer, New York, 2005, on the fixed and the rotating frame). :attr:`CampbellDiagram.stationary`
-holds these, NaN for branches that are no whirl.
+Rotating Systems*, Springer, New York, 2005, on the fixed and the rotating frame).
+:attr:`CampbellDiagram.stationary` holds these, NaN for branches that are no whirl.
 
 Critical speeds are where a branch's frequency equals an engine order k Ω (k = 1, 2, …: an
 excitation k times per revolution; k = 0: a frequency through zero), bracketed by neighbouring speeds of the sweep and found

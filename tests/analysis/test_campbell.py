@@ -99,7 +99,8 @@ def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
     backward ones: a diagram sorted by frequency would mix the branches. Seen from the inertial
     frame (``stationary``, w + Ω with the co-rotating whirl w signed) both whirls are the
     non-rotating cantilever's ω_k at every speed (G. Genta, "Dynamics of Rotating Systems",
-    Springer, 2005; measured 3.5e-13 relative, bound 3.5e-12), on both sides of the forward whirl's zero."""
+    Springer, 2005; measured 3.5e-13 relative, bound 3.5e-12), on both sides of the forward
+    whirl's zero."""
     speeds = np.linspace(0.0, 30.0, 16)
     diagram = campbell(lambda omega: pq.scenes.spinning_beam(omega=omega, n_shapes=4), speeds, orders=[0, 1])
     omega_k = clamped_free_roots(4) ** 2
