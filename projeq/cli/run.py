@@ -230,20 +230,28 @@ def _exit_code(status: int) -> int:
             ends.NON_FINITE: commands.NON_FINITE}.get(status, commands.FAILED)
 
 
+NOT_CONSERVED = "not conserved: a prescribed motion or non-conservative forces"
+
+
 def _outcome(system, result, code: int, notes: list) -> dict:
     """How the run ended, for run.json: status, exit code, message, time reached, evaluations,
-    the final state by name and the energies."""
+    the final state by name and the energies: initial, final, their change (J) and, where the
+    system conserves energy, the drift (:attr:`projeq.Result.energy_drift`); a driven or damped
+    system's drift is no check of the integration (``NOT_CONSERVED`` in its place)."""
     from projeq.simulation.result import STATUSES
 
     outcome = {"status": STATUSES.get(result.status, str(result.status)), "exit_code": code,
                "message": "; ".join(notes) or result.message, "nfev": result.nfev}
     if len(result.t):
         q_names, s_names = result.column_names()
+        conserved = _conserves_energy(system)
         outcome |= {"t_reached": float(result.t[-1]),
                     "final_q": dict(zip(q_names, result.q[-1].tolist())),
                     "final_s_dot": dict(zip(s_names, result.s_dot[-1].tolist())),
                     "energy": {"initial": float(result.energy[0]), "final": float(result.energy[-1]),
-                               "drift": result.energy_drift, "conserved": _conserves_energy(system)}}
+                               "change": float(result.energy[-1] - result.energy[0]),
+                               "drift": result.energy_drift if conserved else NOT_CONSERVED,
+                               "conserved": conserved}}
         if system.n_c:
             outcome["constraint_drift"] = float(np.abs(result.constraint_residual).max())
     return outcome
