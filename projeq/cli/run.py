@@ -159,7 +159,7 @@ def _run_scene(args, raised: list) -> int:
         files = _write_all(result, system, scene, out, label, args.plots)
         record.update(_outcome(system, result, code, notes), warnings=list(raised),
                       files=[str(f.relative_to(out)) for f in files])
-        files.append(_write_json(out / "run.json", record))
+        files.append(write_json(out / "run.json", record))
     except OSError:  # nothing half-written: the folder goes too if no file in it is complete
         if not any(out.rglob("*")):
             out.rmdir()
@@ -263,7 +263,8 @@ def _conserves_energy(system) -> bool:
     return conserves_energy(system, system.q0, system.s_dot0)
 
 
-def _write_json(path: Path, document: dict) -> Path:
+def write_json(path: Path, document: dict) -> Path:
+    """``document`` as indented JSON at ``path`` (complete or not at all), its folder made."""
     from projeq.simulation.export import written_atomically
 
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -89,6 +89,14 @@ def test_json_documents_of_list_run_sweep_and_compare(tmp_path, capsys, monkeypa
                  "--atol", "1e-9", "--out", str(tmp_path / "sweep"), "--json"]) == 0
     document = json.loads(capsys.readouterr().out)
     assert document["points"] == 2 and document["options"]["atol"] == 1e-9 and document["table"]["m1"] == [1.5, 2.0]
+    record = json.loads((tmp_path / "sweep" / "sweep_atwood.json").read_text())  # the sweep's run.json
+    assert record["grid"] == {"m1": [1.5, 2.0]}
+    assert "m1" not in record["parameters"] and "m2" in record["parameters"]
+    assert record["tolerances"]["atol"] == 1e-9 and record["outputs"] == ["q0"] and record["points"] == 2
+    assert record["t_end"] == 0.1 and record["options"]["atol"] == 1e-9  # what --resume compares, kept
+    assert record["failed"] == 0 and record["files"] == ["sweep_atwood.csv", "sweep_atwood.npz"]
+    assert record["command_line"][:3] == ["projeq", "sweep", "atwood"]
+    assert record["projeq_version"] == pq.__version__
     monkeypatch.setattr(projeq.cli.studies, "compare", lambda *a, **k: pq.ComparisonTable("car", rows=[{"x": 1.0}]))
     assert main(["compare", "car", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["rows"] == [{"x": 1.0}]
