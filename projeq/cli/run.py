@@ -33,7 +33,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from projeq.cli.options import json_option, jsonable, output_directory, scene_label, simulate_options, simulation_options
+from projeq.cli.options import (json_option, jsonable, output_directory, plain, scene_label, simulate_options,
+                                simulation_options)
 
 WIDTH = 100  # columns of the text output
 
@@ -97,8 +98,16 @@ def list_scenes(args) -> int:
         return 0
     print(f"{args.scene}: {scene.description} (default t_end = {scene.t_end:g} s)")
     width = max((len(p.name) for p in parameters), default=0)
-    for parameter in parameters:
-        print(f"  {parameter.name:{width}s}  {parameter.default!r:24s} {parameter.unit}")
+    lines = [f"  {p.name:{width}s}  {p.default!r:24s} {p.unit}" for p in parameters]
+    column = max(map(len, lines), default=0) + 2  # the descriptions' column, or below each line (6)
+    column = column if WIDTH - column >= 30 else 6
+    for line, parameter in zip(lines, parameters):
+        if not parameter.description:
+            print(line)
+            continue
+        first = f"{line:{column}s}" if len(line) < column else line + "\n" + " " * column
+        print(textwrap.fill(plain(parameter.description), WIDTH, initial_indent=first,
+                            subsequent_indent=" " * column))
     return 0
 
 

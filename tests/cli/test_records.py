@@ -76,6 +76,21 @@ def test_the_summary_names_the_state_and_says_why_energy_changes(tmp_path, capsy
     assert energy["conserved"] is True and 0.0 <= energy["drift"] < 6e-13, energy
 
 
+def test_list_describes_a_scenes_parameters(capsys):
+    """``projeq list car``: each parameter with its description from the build function's
+    numpydoc Parameters section (plain text, within 100 columns; in --json too); a parameter
+    common to scenes (g) described where the docstring does not."""
+    assert main(["list", "car"]) == 0
+    out = capsys.readouterr().out
+    assert "C°, the moment of inertia about the" in out and "``" not in out
+    assert max(map(len, out.splitlines()[1:])) <= 100
+    assert main(["list", "car", "--json"]) == 0
+    described = {p["name"]: p["description"] for p in json.loads(capsys.readouterr().out)["parameters"]}
+    assert all(described.values()) and described["m"] == "Mass of the car (kg)."
+    assert main(["list", "double_pendulum"]) == 0
+    assert "gravitational acceleration" in capsys.readouterr().out
+
+
 def test_json_documents_of_list_run_sweep_and_compare(tmp_path, capsys, monkeypatch):
     assert main(["list", "--json"]) == 0
     assert set(json.loads(capsys.readouterr().out)) == set(pq.scenes.SCENES)
