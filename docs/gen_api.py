@@ -65,8 +65,9 @@ INTERNAL = {
     "System": ("joint_q_getter", "joint_s_dot_getter", "joint_s_columns", "evaluator", "accelerations_tree",
                "tree_velocities", "gauss_form", "output_row"),
     "ConstrainedSystem": ("row_models", "F", "particular", "tree_velocities", "project", "gamma",
-                          "tree_gauss_form", "compiled_tree", "gauss_form", "accelerations_tree", "compiled_kernel",
-                          "evaluator", "output_row", "after_event", "with_independent", "check_closed"),
+                          "tree_gauss_form", "compiled_tree", "gauss_form", "accelerations_tree",
+                          "compiled_kernel", "evaluator", "output_row", "after_event", "with_independent",
+                          "check_closed"),
 }
 #: Plug-in contracts documented besides projeq.__all__ (module, name); name None: the module.
 CONTRACTS = (("projeq.system", "Model"), ("projeq.joints.base", "Relative"),
