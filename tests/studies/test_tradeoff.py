@@ -191,7 +191,8 @@ def test_plot_returns_a_figure_with_one_line_per_method_and_knob():
     table = _constructed_table()
     fig = tr.plot(table)
     assert len(fig.axes[0].lines) == 6  # A, B, C, D, G, H succeeded; E, F failed and are not drawn
-    assert fig.axes[0].get_xlabel() == "error\nnot drawn: 1 timeout, 1 diverged (of 9 settings; see the table)"
+    label = "error\nnot drawn: 1 timeout, 1 diverged (of 9 settings; see the table)"
+    assert fig.axes[0].get_xlabel() == label
     assert len(fig.axes[0].texts) == 0
 
 

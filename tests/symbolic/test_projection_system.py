@@ -140,7 +140,8 @@ def test_coordinates_are_named_by_the_system():
     from projeq.symbolic.system import named_symbols
 
     gauss = gauss_form(pq.scenes.double_pendulum())
-    assert [str(x) for x in (*gauss.q, *gauss.s)] == ["bob1_angle", "bob2_angle", "bob1_angle_dot", "bob2_angle_dot"]
+    names = ["bob1_angle", "bob2_angle", "bob1_angle_dot", "bob2_angle_dot"]
+    assert [str(x) for x in (*gauss.q, *gauss.s)] == names
     assert "bob2_angle" in str(gauss.M) and "q_" not in str(gauss.M)
     assert named_symbols(["a.b_c", "a_b.c"], "q") == sp.symbols("q_1 q_2")
     assert named_symbols(["1st.x"], "s") == (sp.Symbol("s_1"),)
