@@ -24,8 +24,8 @@ from projeq.studies.tradeoff_studies import STUDIES
 
 def compare_arguments(parser) -> None:
     parser.add_argument("name", help=f"one of: {', '.join(sorted(COMPARISONS))}; or a scene or "
-                                     "FILE.py:FUNCTION returning a System (its numeric and symbolic Projection "
-                                     "Equation)")
+                                     "FILE.py:FUNCTION returning a System (its numeric and symbolic "
+                                     "Projection Equation)")
     parser.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
     parser.add_argument("--no-simulate", action="store_true", help="derive and check only")
     parser.add_argument("--t-end", type=float, default=None, help="simulated time (s)")

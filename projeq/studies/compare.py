@@ -557,8 +557,9 @@ def compare(name, formulations=None, simulate: bool = True, t_end: float | None 
 
     system = name if isinstance(name, Model) else None
     if system is not None and system is not system.tree:
-        raise ValueError(f"name: compare takes a System (a tree of joints) or one of {sorted(COMPARISONS)}; got "
-                         f"a {type(system).__name__}, whose constraint forms only the built-in comparisons have")
+        raise ValueError(f"name: compare takes a System (a tree of joints) or one of {sorted(COMPARISONS)}; "
+                         f"got a {type(system).__name__}, whose constraint forms only the built-in "
+                         "comparisons have")
     if system is None and (not isinstance(name, str) or name not in COMPARISONS):
         raise ValueError(f"name: unknown comparison {name!r}; choose one of {sorted(COMPARISONS)} or pass a "
                          "System")
