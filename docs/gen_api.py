@@ -3,7 +3,9 @@
 Every name of ``projeq.__all__`` gets a heading, its signature and its docstring rendered as
 plain Markdown (numpydoc sections as bold titles and lists, doctest examples as code, Sphinx
 roles and double backticks as code spans), so that the page reads the same on any Markdown
-viewer. Classes list their own public methods and properties; modules their public names.
+viewer. Classes list their own public methods and properties (a method that implements a base
+class's, documented there, and the evaluators' methods of :data:`INTERNAL` are named in one line,
+not documented again); modules their public names; :data:`MODULES` adds functions of submodules.
 tests/test_api_doc.py checks that docs/api.md is what this script writes now.
 """
 
@@ -53,6 +55,19 @@ result = pq.simulate(system, 1.0, q0=q0, s_dot0=s_dot0)
 i = system.q_index("link2.angle")   # 1: for functions of q such as constraints Φ(q)
 ```
 """,
+}
+#: Names of submodules documented in a group besides projeq.__all__'s: {group: ((module, name), ...)}.
+MODULES = {"Subsystems": (("projeq.subsystems", "Visual"),),
+           "Simulation": (("projeq.simulation.export", "write_vtu_series"),)}
+#: Public methods that the evaluators, the integrators and the command line call, not a user building
+#: or running a model: named in one line under their class.
+INTERNAL = {
+    "System": ("joint_q_getter", "joint_s_dot_getter", "joint_s_columns", "evaluator", "accelerations_tree",
+               "tree_velocities", "gauss_form", "output_row"),
+    "ConstrainedSystem": ("row_models", "F", "particular", "tree_velocities", "project", "gamma",
+                          "tree_gauss_form", "compiled_tree", "gauss_form", "accelerations_tree",
+                          "compiled_kernel", "evaluator", "output_row", "after_event", "with_independent",
+                          "check_closed"),
 }
 #: Plug-in contracts documented besides projeq.__all__ (module, name); name None: the module.
 CONTRACTS = (("projeq.system", "Model"), ("projeq.joints.base", "Relative"),
@@ -203,15 +218,40 @@ def own_members(cls) -> list[tuple[str, object]]:
     return members
 
 
+def documented_classes() -> set:
+    """The classes this page documents: those of projeq.__all__ and of :data:`CONTRACTS`."""
+    named = [getattr(projeq, name) for name in projeq.__all__]
+    named += [getattr(__import__(module, fromlist=["_"]), name) for module, name in CONTRACTS if name]
+    return {value for value in named if inspect.isclass(value)}
+
+
+def implemented(cls, name: str) -> str | None:
+    """The name of the nearest documented base class of ``cls`` that defines ``name`` (where the
+    method is documented), or None."""
+    return next((base.__name__ for base in cls.__mro__[1:-1] if name in vars(base)
+                 and base in documented_classes()), None)
+
+
 def document_class(qualified: str, cls, level: int = 3) -> str:
     bases = [b.__name__ for b in cls.__bases__ if b is not object]
     text = [f"{'#' * level} {qualified}\n", code(signature(qualified, cls))]
     if bases:
         text.append(f"Bases: {', '.join(f'`{b}`' for b in bases)}\n")
     text.append(markdown(inspect.getdoc(cls) or "(no docstring)"))
-    for name, member in own_members(cls):
+    members = own_members(cls)
+    overrides: dict[str, list[str]] = {}
+    for name, _ in members:
+        if implemented(cls, name) and name not in INTERNAL.get(cls.__name__, ()):
+            overrides.setdefault(implemented(cls, name), []).append(f"`{name}`")
+    for base, names in overrides.items():
+        text.append(f"Implements {', '.join(names)} of `{base}` (documented there).\n")
+    internal = [f"`{name}`" for name, _ in members if name in INTERNAL.get(cls.__name__, ())]
+    if internal:
+        text.append(f"For the evaluators and integrators (not needed to build or run a model): "
+                    f"{', '.join(internal)}.\n")
+    for name, member in members:
         doc = inspect.getdoc(member)
-        if not doc:
+        if not doc or implemented(cls, name) or name in INTERNAL.get(cls.__name__, ()):
             continue
         if isinstance(member, property):
             text.append(f"{'#' * (level + 1)} {cls.__name__}.{name} (property)\n\n" + markdown(doc))
@@ -282,6 +322,9 @@ def page() -> str:
             if title in INTROS:
                 text.append(INTROS[title])
             text += [document(f"projeq.{name}", getattr(projeq, name)) for name in present]
+            for module_name, name in MODULES.get(title, ()):
+                module = __import__(module_name, fromlist=["_"])
+                text.append(document(f"{module_name}.{name}", getattr(module, name)))
     text.append("## Plug-in contracts\n\nSee [the architecture](architecture.md) for how to add a joint, "
                 "a subsystem or a force law.\n")
     for module_name, name in CONTRACTS:

@@ -37,6 +37,23 @@ def test_every_public_name_has_a_heading_and_a_signature():
         assert section.lstrip().startswith(f"```python\nprojeq.{name}("), name
 
 
+def test_user_methods_are_documented_once_and_internal_ones_named_only():
+    """A class documents its own user methods; a method implementing a documented base class's
+    (Revolute.relative: Joint's) and the evaluators' methods (System.evaluator) are named in a
+    line, without a heading; write_vtu_series and Visual (submodules) have their headings."""
+    text = API.read_text(encoding="utf-8")
+    assert re.search(r"^#### System\.mass_matrix$", text, re.M)
+    assert re.search(r"^#### Joint\.relative$", text, re.M)
+    internal = ("System.evaluator", "System.joint_q_getter", "ConstrainedSystem.compiled_kernel")
+    for heading in ("Revolute.relative",) + internal:
+        assert not re.search(rf"^#### {re.escape(heading)}\b", text, re.M), heading
+    revolute = text.split("### projeq.Revolute\n")[1].split("###")[0]
+    assert "Implements `coordinates`, `velocities`, `relative`" in revolute
+    assert "`evaluator`" in text.split("### projeq.System\n")[1].split("\n### ")[0]
+    assert re.search(r"^### projeq\.simulation\.export\.write_vtu_series$", text, re.M)
+    assert re.search(r"^### projeq\.subsystems\.Visual$", text, re.M)
+
+
 def test_docstrings_are_rendered_as_plain_markdown():
     text = prose(API.read_text(encoding="utf-8"))
     assert not re.search(r":(mod|class|func|meth|attr|data|obj|exc):`", text)

@@ -27,6 +27,13 @@ motion at the lowest nonzero speed, relative to the beam frame's angular velocit
 - *axial* or *torsion* where those coordinates dominate the shape; numbered by frequency
   within each kind. Other systems: ``mode 1, 2, …`` by frequency at the first speed.
 
+A whirl seen from the inertial (stationary) frame turns at |w + Ω_b| (Ω_b = ω_b·e the spin, e
+the beam's axis at the labelling speed): the co-rotating whirl w = σ Im λ signed along the
+branch (through zero), so a forward whirl is seen at ω_k and a backward one at ω_k again where
+the co-rotating frame shows |ω_k ∓ Ω| (a shaft without rotary inertia: G. Genta, *Dynamics of
+Rotating Systems*, Springer, New York, 2005, on the fixed and the rotating frame).
+:attr:`CampbellDiagram.stationary` holds these, NaN for branches that are no whirl.
+
 Critical speeds are where a branch's frequency equals an engine order k Ω (k = 1, 2, …: an
 excitation k times per revolution; k = 0: a frequency through zero), bracketed by neighbouring speeds of the sweep and found
 by Brent's method on the branch (or by linear interpolation, ``refine=False``).
@@ -146,28 +153,46 @@ class CampbellDiagram:
     orders : tuple of int
         The engine orders k of :attr:`critical_speeds`.
     critical_speeds : list of CriticalSpeed
-        Where a branch crosses k Ω, by speed.
+        Where a branch crosses k Ω, by speed (in the frame of the coordinates).
+    stationary : ndarray (n_speeds, n_branches)
+        Each whirl branch's frequency seen from the inertial frame, |w + Ω_b| in rad/s (module
+        docstring); NaN in the columns of branches that are no whirl.
     """
 
-    def __init__(self, speeds, frequencies, damping, eigenvalues, labels, orders, critical):
+    def __init__(self, speeds, frequencies, damping, eigenvalues, labels, orders, critical, stationary=None):
         self.speeds, self.frequencies, self.damping, self.eigenvalues = speeds, frequencies, damping, eigenvalues
         self.labels, self.orders, self.critical_speeds = tuple(labels), tuple(orders), list(critical)
+        self.stationary = np.full_like(frequencies, np.nan) if stationary is None else stationary
 
-    def branch(self, label: str) -> NDArray:
-        """The frequencies (rad/s) of the branch ``label`` at every speed."""
+    def branch(self, label: str, frame: str = "rotating") -> NDArray:
+        """The frequencies (rad/s) of the branch ``label`` at every speed, in the frame of the
+        coordinates (``frame="rotating"``) or, for a whirl, the inertial one (``"stationary"``)."""
         if label not in self.labels:
             raise ValueError(f"label: no branch {label!r}; the branches are {', '.join(self.labels)}")
-        return self.frequencies[:, self.labels.index(label)]
+        column = self.labels.index(label)
+        if _frame(frame) == "rotating":
+            return self.frequencies[:, column]
+        if np.isnan(self.stationary[:, column]).all():
+            raise ValueError(f"label: {label!r} is no whirl; only a whirl (forward/backward) has a "
+                             "stationary frequency")
+        return self.stationary[:, column]
 
     def write_csv(self, path) -> None:
-        """One row per speed: Ω, then each branch's frequency (rad/s) and damping ratio."""
+        """One row per speed: Ω, then each branch's frequency (rad/s) and damping ratio, and a
+        whirl's frequency seen from the inertial frame (``stationary frequency (rad/s)``)."""
+        whirls = [int(not np.isnan(column).all()) for column in self.stationary.T]
+        kinds = ("frequency (rad/s)", "damping ratio")
+        header = [f"{label} {kind}" for label, whirl in zip(self.labels, whirls)
+                  for kind in kinds + ("stationary frequency (rad/s)",) * whirl]
         with open(path, "w", newline="", encoding="utf-8") as stream:
             writer = csv.writer(stream)
-            writer.writerow(["speed (rad/s)"] + [f"{label} {kind}" for label in self.labels
-                                                 for kind in ("frequency (rad/s)", "damping ratio")])
+            writer.writerow(["speed (rad/s)"] + header)
             for k, speed in enumerate(self.speeds):
-                pairs = np.column_stack((self.frequencies[k], self.damping[k])).ravel()
-                writer.writerow([repr(float(speed))] + [repr(float(x)) for x in pairs])
+                row = [repr(float(speed))]
+                for j in range(len(self.labels)):
+                    row += [repr(float(x)) for x in (self.frequencies[k, j], self.damping[k, j])]
+                    row += [repr(float(self.stationary[k, j]))] * whirls[j]
+                writer.writerow(row)
 
     def write_critical_speeds(self, path) -> None:
         """The critical speeds as CSV: mode, engine order, speed (rad/s), frequency (rad/s)."""
@@ -177,28 +202,32 @@ class CampbellDiagram:
             for c in self.critical_speeds:
                 writer.writerow([c.mode, c.order, repr(c.speed), repr(c.frequency)])
 
-    def plot(self):
+    def plot(self, frame: str = "rotating"):
         """The Campbell diagram as a :class:`matplotlib.figure.Figure` (not shown; save it with
         ``fig.savefig(path)``): each branch's frequency against Ω, the engine orders k Ω dashed,
-        the critical speeds marked."""
+        the critical speeds marked; ``frame="stationary"``: the whirls seen from the inertial
+        frame (no critical speeds: they are the co-rotating frame's)."""
         from matplotlib.figure import Figure  # no pyplot: no GUI backend, no global state
 
+        stationary = _frame(frame) == "stationary"
+        shown = self.stationary if stationary else self.frequencies
         fig = Figure(figsize=(8.0, 5.0), layout="constrained")
         ax = fig.subplots()
-        for label, column in zip(self.labels, self.frequencies.T):
-            ax.plot(self.speeds, column, marker=".", markersize=3, label=label)
-        top = 1.05 * self.frequencies.max(initial=0.0)
+        for label, column in zip(self.labels, shown.T):
+            if not np.isnan(column).all():
+                ax.plot(self.speeds, column, marker=".", markersize=3, label=label)
+        top = 1.05 * np.nanmax(shown, initial=0.0)
         for k in self.orders:
             ax.plot(self.speeds, k * np.abs(self.speeds), color="0.6", linestyle="--", linewidth=0.8)
             end = min(abs(self.speeds[-1]), top / k)
             ax.annotate(f"{k}Ω", (end, k * end), fontsize="small", color="0.4", xytext=(2, 0),
                         textcoords="offset points")
-        if self.critical_speeds:
+        if self.critical_speeds and not stationary:
             ax.plot([c.speed for c in self.critical_speeds], [c.frequency for c in self.critical_speeds], "o",
                     color="k", markerfacecolor="none", label="critical speeds")
         ax.set_ylim(0.0, top)
         ax.set_xlabel("rotation speed Ω (rad/s)")
-        ax.set_ylabel("frequency ω (rad/s)")
+        ax.set_ylabel("frequency ω (rad/s)" + (", seen from the inertial frame" if stationary else ""))
         ax.grid(alpha=0.3)
         ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
         return fig
@@ -276,10 +305,10 @@ def campbell(system, speeds, joint: str | None = None, orders=(1, 2, 3), n_modes
     lam = lam[:, keep]
     reference = _labelling_speed(speeds)
     model, q, s_dot, _ = found[reference]
-    labels = branch_labels(model, q, s_dot, t, lam[reference], shapes[reference][:, keep],
-                           found[reference][3].coordinates)
+    labels, senses = branch_labels(model, q, s_dot, t, lam[reference], shapes[reference][:, keep],
+                                   found[reference][3].coordinates)
     by_frequency = np.argsort(np.abs(lam[reference].imag), kind="stable")  # the order of the labels' numbers
-    lam, labels = lam[:, by_frequency], [labels[j] for j in by_frequency]
+    lam, labels, senses = lam[:, by_frequency], [labels[j] for j in by_frequency], senses[by_frequency]
     shapes = shapes[:, :, keep][:, :, by_frequency]
 
     def branch_at(j: int, i: int, speed: float) -> float:
@@ -294,7 +323,8 @@ def campbell(system, speeds, joint: str | None = None, orders=(1, 2, 3), n_modes
 
     frequencies = np.abs(lam.imag)
     critical = critical_speeds(speeds, lam.imag, labels, orders, branch_at if refine else None)
-    return CampbellDiagram(speeds, frequencies, -lam.real / np.abs(lam), lam, labels, orders, critical)
+    return CampbellDiagram(speeds, frequencies, -lam.real / np.abs(lam), lam, labels, orders, critical,
+                           _stationary(found, lam.imag, senses, reference, t))
 
 
 def track(found: list, speeds: NDArray) -> tuple[NDArray, NDArray]:
@@ -366,25 +396,43 @@ def critical_speeds(speeds: NDArray, signed: NDArray, labels, orders, branch_at=
     return sorted(found, key=lambda c: (c.speed, c.order))
 
 
-def branch_labels(system, q, s_dot, t: float, lam: NDArray, shapes: NDArray, coordinates) -> list[str]:
-    """The labels of the module docstring, from the modes (λ, φ) of ``system`` at (q, ṡ, t)."""
-    from projeq.subsystems.beam.beam import RitzBeam
-
+def branch_labels(system, q, s_dot, t: float, lam: NDArray, shapes: NDArray,
+                  coordinates) -> tuple[list, NDArray]:
+    """The labels of the module docstring, from the modes (λ, φ) of ``system`` at (q, ṡ, t), and
+    each mode's whirl sense σ (±1: its co-rotating whirl is w = σ Im λ about ω_b; 0: no whirl)."""
     tree = system.tree
-    beams = [n for n, sub in enumerate(tree.subsystems) if isinstance(sub, RitzBeam)]
+    n = _beam(tree)
     order = np.argsort(np.abs(lam.imag))
-    if len(beams) != 1:
-        return _numbered(["mode"] * len(lam), order)
-    n = beams[0]
-    kinds = []
+    if n is None:
+        return _numbered(["mode"] * len(lam), order), np.zeros(len(lam))
     omega_b = _beam_angular_velocity(system, n, q, s_dot, t)
     names = system.state_names()[: system.n_q]
     full = np.zeros((system.n_q, shapes.shape[1]), dtype=complex)
     full[[names.index(c) for c in coordinates]] = shapes
-    for j in range(shapes.shape[1]):
-        elastic = full[tree.e_q_slice[n], j]
-        kinds.append(_kind(tree.subsystems[n], elastic, np.linalg.norm(full[:, j]), lam[j], omega_b))
-    return _numbered(kinds, order)
+    kinds, senses = zip(*(_kind(tree.subsystems[n], full[tree.e_q_slice[n], j], np.linalg.norm(full[:, j]),
+                                lam[j], omega_b) for j in range(shapes.shape[1])))
+    return _numbered(list(kinds), order), np.array(senses, dtype=float)
+
+
+def _beam(tree) -> int | None:
+    """The index of the tree's one RitzBeam (None: none or several)."""
+    from projeq.subsystems.beam.beam import RitzBeam
+
+    beams = [n for n, sub in enumerate(tree.subsystems) if isinstance(sub, RitzBeam)]
+    return beams[0] if len(beams) == 1 else None
+
+
+def _stationary(found: list, signed: NDArray, senses: NDArray, reference: int, t: float) -> NDArray:
+    """|σ_j Im λ_j + Ω_b| of each whirl branch j at each speed (module docstring: Ω_b = ω_b·e,
+    e the beam's axis of rotation at the labelling speed ``reference``); NaN for the others."""
+    stationary = np.full(signed.shape, np.nan)
+    whirls = senses != 0.0
+    if whirls.any():
+        n = _beam(found[reference][0].tree)
+        omega_b = np.array([_beam_angular_velocity(model, n, q, s_dot, t) for model, q, s_dot, _ in found])
+        spin = omega_b @ (omega_b[reference] / np.linalg.norm(omega_b[reference]))
+        stationary[:, whirls] = np.abs(senses[whirls] * signed[:, whirls] + spin[:, None])
+    return stationary
 
 
 def _beam_angular_velocity(system, n: int, q, s_dot, t: float) -> NDArray:
@@ -395,8 +443,9 @@ def _beam_angular_velocity(system, n: int, q, s_dot, t: float) -> NDArray:
     return np.real(forward(tree, np.asarray(q, dtype=float), system.tree_velocities(q, s_dot, t), t).twist[n][3:])
 
 
-def _kind(beam, a: NDArray, total: float, lam: complex, omega_b: NDArray) -> str:
-    """flapwise, lead-lag, forward/backward whirl, axial, torsion or mode (module docstring)."""
+def _kind(beam, a: NDArray, total: float, lam: complex, omega_b: NDArray) -> tuple[str, float]:
+    """flapwise, lead-lag, forward/backward whirl, axial, torsion or mode (module docstring), and
+    the whirl's sense σ (0 for the other kinds)."""
     offset = 6  # the beam's columns of ẏ after (v_O, ω)
     part = {key: a[cols.start - offset: cols.stop - offset]
             for key, cols in (("u", beam.u_cols), ("v", beam.v_cols), ("w", beam.w_cols), ("beta", beam.beta_cols))}
@@ -404,21 +453,21 @@ def _kind(beam, a: NDArray, total: float, lam: complex, omega_b: NDArray) -> str
              "torsion": np.linalg.norm(part["beta"])}
     kind = max(norms, key=norms.get)
     if sum(norms.values()) < 0.5 * total:
-        return "mode"  # mostly outside the beam (a hub, other bodies)
+        return "mode", 0.0  # mostly outside the beam (a hub, other bodies)
     spin = np.linalg.norm(omega_b)
     if kind != "bending":
-        return kind
+        return kind, 0.0
     if spin == 0.0:
-        return "bending"
+        return "bending", 0.0
     Phi = beam.station_data(np.array([beam.length]))[0]
     d = np.array([0.0, Phi["v"][0][:, 0] @ part["v"], Phi["w"][0][:, 0] @ part["w"]])
     e = omega_b / spin
     across = np.cross(e, (1.0, 0.0, 0.0))
     if np.linalg.norm(across) < 1.0 / np.sqrt(2.0):  # ω_b within 45° of the beam's axis: whirl
-        sense = np.sign(np.imag(e @ np.cross(d, d.conj())))
-        return "forward whirl" if sense * lam.imag + spin > 0.0 else "backward whirl"
+        sense = float(np.sign(np.imag(e @ np.cross(d, d.conj()))))
+        return ("forward whirl" if sense * lam.imag + spin > 0.0 else "backward whirl"), sense
     lag = abs(d @ across) / np.linalg.norm(across)
-    return "flapwise" if abs(d @ e) >= lag else "lead-lag"
+    return ("flapwise" if abs(d @ e) >= lag else "lead-lag"), 0.0
 
 
 def _numbered(kinds: list[str], order: NDArray) -> list[str]:
@@ -467,6 +516,13 @@ def _builder(system, joint):
         return system, system.q0, s_dot
 
     return at_speed
+
+
+def _frame(frame: str) -> str:
+    if frame not in ("rotating", "stationary"):
+        raise ValueError(f"frame: expected 'rotating' (the coordinates' frame) or 'stationary' (inertial), "
+                         f"got {frame!r}")
+    return frame
 
 
 def _speeds(speeds) -> NDArray:

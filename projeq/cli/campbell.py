@@ -4,8 +4,9 @@ veering and labelled (flapwise / lead-lag for a blade on a hub, forward / backwa
 shaft spinning about its own axis), with the critical speeds where a branch crosses an engine
 order k Ω (:func:`projeq.analysis.campbell.campbell`). The scene is built at each speed with
 its speed parameter (``--parameter``, default ``omega``) set and linearised about its steady
-rotation. Writes SCENE_campbell.csv (Ω, each branch's frequency and damping ratio),
-SCENE_critical_speeds.csv and SCENE_campbell.png into --out; prints the table.
+rotation. Writes SCENE_campbell.csv (Ω, each branch's frequency and damping ratio, and a
+whirl's frequency seen from the inertial frame), SCENE_critical_speeds.csv and
+SCENE_campbell.png into --out; prints the table.
 
 Frequencies are in rad/s in the frame of the scene's coordinates (co-rotating for
 rotating_blade and spinning_beam). Example: ``projeq campbell rotating_blade --set

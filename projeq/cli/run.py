@@ -33,7 +33,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from projeq.cli.options import json_option, jsonable, output_directory, scene_label, simulate_options, simulation_options
+from projeq.cli.options import (json_option, jsonable, output_directory, plain, scene_label, simulate_options,
+                                simulation_options)
 
 WIDTH = 100  # columns of the text output
 
@@ -97,8 +98,16 @@ def list_scenes(args) -> int:
         return 0
     print(f"{args.scene}: {scene.description} (default t_end = {scene.t_end:g} s)")
     width = max((len(p.name) for p in parameters), default=0)
-    for parameter in parameters:
-        print(f"  {parameter.name:{width}s}  {parameter.default!r:24s} {parameter.unit}")
+    lines = [f"  {p.name:{width}s}  {p.default!r:24s} {p.unit}" for p in parameters]
+    column = max(map(len, lines), default=0) + 2  # the descriptions' column, or below each line (6)
+    column = column if WIDTH - column >= 30 else 6
+    for line, parameter in zip(lines, parameters):
+        if not parameter.description:
+            print(line)
+            continue
+        first = f"{line:{column}s}" if len(line) < column else line + "\n" + " " * column
+        print(textwrap.fill(plain(parameter.description), WIDTH, initial_indent=first,
+                            subsequent_indent=" " * column))
     return 0
 
 
@@ -159,7 +168,7 @@ def _run_scene(args, raised: list) -> int:
         files = _write_all(result, system, scene, out, label, args.plots)
         record.update(_outcome(system, result, code, notes), warnings=list(raised),
                       files=[str(f.relative_to(out)) for f in files])
-        files.append(_write_json(out / "run.json", record))
+        files.append(write_json(out / "run.json", record))
     except OSError:  # nothing half-written: the folder goes too if no file in it is complete
         if not any(out.rglob("*")):
             out.rmdir()
@@ -230,20 +239,28 @@ def _exit_code(status: int) -> int:
             ends.NON_FINITE: commands.NON_FINITE}.get(status, commands.FAILED)
 
 
+NOT_CONSERVED = "not conserved: a prescribed motion or non-conservative forces"
+
+
 def _outcome(system, result, code: int, notes: list) -> dict:
     """How the run ended, for run.json: status, exit code, message, time reached, evaluations,
-    the final state by name and the energies."""
+    the final state by name and the energies: initial, final, their change (J) and, where the
+    system conserves energy, the drift (:attr:`projeq.Result.energy_drift`); a driven or damped
+    system's drift is no check of the integration (``NOT_CONSERVED`` in its place)."""
     from projeq.simulation.result import STATUSES
 
     outcome = {"status": STATUSES.get(result.status, str(result.status)), "exit_code": code,
                "message": "; ".join(notes) or result.message, "nfev": result.nfev}
     if len(result.t):
         q_names, s_names = result.column_names()
+        conserved = _conserves_energy(system)
         outcome |= {"t_reached": float(result.t[-1]),
                     "final_q": dict(zip(q_names, result.q[-1].tolist())),
                     "final_s_dot": dict(zip(s_names, result.s_dot[-1].tolist())),
                     "energy": {"initial": float(result.energy[0]), "final": float(result.energy[-1]),
-                               "drift": result.energy_drift, "conserved": _conserves_energy(system)}}
+                               "change": float(result.energy[-1] - result.energy[0]),
+                               "drift": result.energy_drift if conserved else NOT_CONSERVED,
+                               "conserved": conserved}}
         if system.n_c:
             outcome["constraint_drift"] = float(np.abs(result.constraint_residual).max())
     return outcome
@@ -255,7 +272,8 @@ def _conserves_energy(system) -> bool:
     return conserves_energy(system, system.q0, system.s_dot0)
 
 
-def _write_json(path: Path, document: dict) -> Path:
+def write_json(path: Path, document: dict) -> Path:
+    """``document`` as indented JSON at ``path`` (complete or not at all), its folder made."""
     from projeq.simulation.export import written_atomically
 
     path.parent.mkdir(parents=True, exist_ok=True)

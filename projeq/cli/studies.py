@@ -1,8 +1,9 @@
 """``projeq compare NAME`` and ``projeq tradeoff SCENE``: the studies of
 :mod:`projeq.studies.compare` and :mod:`projeq.studies.tradeoff` from the command line.
 
-``projeq compare`` prints the table of formulations of one system (and writes it as CSV
-with ``--csv``); ``projeq tradeoff`` runs a work-precision study and writes its CSV and PNG
+``projeq compare`` prints the table of formulations of one system, built in or the System of a
+scene or of a user's ``FILE.py:FUNCTION`` (its numeric and symbolic Projection Equation), and
+writes it as CSV with ``--csv``; ``projeq tradeoff`` runs a work-precision study and writes its CSV and PNG
 plot, exit code 1 when its reference run failed or Ctrl-C stopped it (the rows finished so
 far are written).
 """
@@ -22,7 +23,9 @@ from projeq.studies.tradeoff_studies import STUDIES
 
 
 def compare_arguments(parser) -> None:
-    parser.add_argument("name", choices=sorted(COMPARISONS))
+    parser.add_argument("name", help=f"one of: {', '.join(sorted(COMPARISONS))}; or a scene or "
+                                     "FILE.py:FUNCTION returning a System (its numeric and symbolic "
+                                     "Projection Equation)")
     parser.add_argument("--csv", metavar="PATH", help="also write the table as CSV")
     parser.add_argument("--no-simulate", action="store_true", help="derive and check only")
     parser.add_argument("--t-end", type=float, default=None, help="simulated time (s)")
@@ -36,7 +39,12 @@ def compare_arguments(parser) -> None:
 def compare_formulations(args) -> int:
     if args.csv:
         output_file(args.csv, "--csv")
-    table = compare(args.name, args.formulation, simulate=not args.no_simulate, t_end=args.t_end,
+    system = args.name
+    if args.name not in COMPARISONS:  # a scene's System: its numeric and symbolic Projection Equation
+        from projeq.scenes import resolve_scene
+
+        system = resolve_scene(args.name).build()
+    table = compare(system, args.formulation, simulate=not args.no_simulate, t_end=args.t_end,
                     repeats=args.repeats)
     if args.json:
         print(json.dumps({"name": table.name, "rows": table.rows, "effort": table.effort, "claims": table.claims},

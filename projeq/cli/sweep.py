@@ -1,5 +1,10 @@
 """``projeq sweep SCENE --grid NAME=A:B:N ...``: a scene on a parameter grid, in parallel
-local processes or on a Dask cluster; writes ``sweep_SCENE.csv`` and ``.npz``.
+local processes or on a Dask cluster; writes ``sweep_SCENE.csv`` and ``.npz``, and the sweep's
+record ``sweep_SCENE.json``: what ``run.json`` is to a run (the scene's build function, end time
+and options, by which ``--resume`` knows its table, and the fields of :func:`projeq.cli.run.run_record`
+but the scene's name: fixed parameters, method, tolerances, evaluator, projeq version, command
+line, start time) with the grid, the outputs and how many points failed, were interrupted or left
+their model's range.
 
 Each finished point is appended to ``sweep_SCENE.csv`` at once, so a crash loses only the
 points in flight, and ``--resume`` runs only the points not finished there. Ctrl-C or
@@ -49,6 +54,7 @@ def sweep_arguments(parser) -> None:
 
 
 def sweep_scene(args) -> int:
+    from projeq.cli.run import run_record, write_json
     from projeq.scenes import parse_settings, resolve_scene
     from projeq.simulation.sweep import sweep
 
@@ -63,6 +69,11 @@ def sweep_scene(args) -> int:
     options = simulate_options(args, scene)
     t_end = None if args.t_end is None else positive("t_end", args.t_end)  # before anything is printed or made
     quiet = args.quiet or args.json
+    asked = run_record(args, scene, fixed, t_end, options)
+    asked = {k: v for k, v in asked.items() if k not in ("scene", "t_end")}  # the sweep's own are kept
+    asked["parameters"] = {k: v for k, v in asked["parameters"].items() if k not in grid or k in fixed}
+    asked |= {"grid": {k: np.asarray(v).tolist() for k, v in grid.items() if k not in fixed},
+              "outputs": args.outputs.split(",")}
     with _closed(client):  # a Dask client is closed also when --out is refused
         out = output_directory(args.out)
         if not quiet:
@@ -75,6 +86,10 @@ def sweep_scene(args) -> int:
     files = [out / f"sweep_{label}.csv", out / f"sweep_{label}.npz"]
     failed, partial = int(np.isin(table["status"], (-1, 4)).sum()), int((table["status"] == 2).sum())
     beyond = int((table["status"] == 3).sum())  # stopped where the model left its range
+    record = out / f"sweep_{label}.json"  # the sweep's own (scene, t_end, options: --resume reads them)
+    files.append(write_json(record, json.loads(record.read_text()) | asked | {
+        "points": len(table["status"]), "failed": failed, "interrupted": partial, "out_of_range": beyond,
+        "files": [f.name for f in files]}))
     if args.json:
         print(json.dumps({"scene": args.scene, "options": options, "points": len(table["status"]), "failed": failed,
                           "interrupted": partial, "out_of_range": beyond, "files": [str(f) for f in files],

@@ -59,12 +59,26 @@ def car(m: float = 1200.0, C0: float = 3228.0, c: float = 1.2, f_x=0.0, M_z=0.0,
     non-holonomic constraint −sin γ ẋ + cos γ ẏ = 0 is inserted up front by leaving v_y
     out of F (B(11)); q̇ = K ṡ with K = [[cos γ, 0], [sin γ, 0], [0, 1]] (B(6)).
 
-    Parameters: mass ``m`` (kg); ``C0`` = C° the moment of inertia about O (kg m²); ``c``
-    the distance O → mass centre along the body x-axis (m); ``f_x`` a driving force along
-    the body x-axis at O (N); ``M_z`` a torque about z (N m); ``f_y`` a lateral force at the
-    mass centre (N, default 0; B(12) projects it to c f_y on ω_z). Loads are constants or
-    callables ``(t, q, s_dot)``. Expected (B(9)):
-    m v̇_x − m c ω_z² = f_x,  C° ω̇_z + m c v_x ω_z = M_z + c f_y.
+    Expected (B(9)): m v̇_x − m c ω_z² = f_x,  C° ω̇_z + m c v_x ω_z = M_z + c f_y.
+
+    Parameters
+    ----------
+    m : float
+        Mass of the car (kg).
+    C0 : float
+        C°, the moment of inertia about the rear-axle point O (kg m²).
+    c : float
+        Distance O → mass centre along the body x-axis (m).
+    f_x : float or callable
+        Driving force along the body x-axis at O (N): a constant or ``(t, q, s_dot)``.
+    M_z : float or callable
+        Torque about z (N m): a constant or ``(t, q, s_dot)``.
+    f_y : float or callable
+        Lateral force at the mass centre (N; B(12) projects it to c f_y on ω_z).
+    q0 : 3-tuple
+        Initial (x, y, γ): position of O (m) and heading (rad).
+    s_dot0 : 2-tuple
+        Initial (v_x, ω_z): forward speed of O (m/s) and yaw rate (rad/s).
     """
     x, y, g = sp.symbols("x y gamma")
     vx, wz = sp.symbols("v_x omega_z")

@@ -1,7 +1,8 @@
 """Scene parameters as data: names, defaults and units, overridable by name.
 
 A scene's parameters are its build function's keyword arguments; their defaults come from
-the signature and their units from :data:`UNITS` (SI; a scene may override entries).
+the signature, their units from :data:`UNITS` (SI; a scene may override entries) and their
+descriptions from the numpydoc ``Parameters`` section of its docstring (else :data:`DESCRIPTIONS`).
 ``--set name=value`` strings are parsed against the type of the default.
 
 >>> from projeq.scenes import SCENES
@@ -39,12 +40,21 @@ UNITS = {
 }
 
 
+#: What a parameter common to many scenes is, where the scene's docstring does not say.
+DESCRIPTIONS = {
+    "g": "gravitational acceleration", "gravity": "gravitational acceleration",
+    "q0": "initial coordinates q", "s_dot0": "initial minimal velocities ṡ",
+    "q_dot0": "initial coordinate rates q̇", "n_shapes": "shape functions per bending plane",
+}
+
+
 class Parameter(NamedTuple):
-    """One keyword parameter of a scene: its name, default value and SI unit."""
+    """One keyword parameter of a scene: its name, default value, SI unit and what it is."""
 
     name: str
     default: object
     unit: str
+    description: str = ""
 
     def __str__(self) -> str:
         unit = "" if self.unit == "-" else f" {self.unit}"
@@ -52,13 +62,33 @@ class Parameter(NamedTuple):
 
 
 def scene_parameters(scene) -> list[Parameter]:
-    """The keyword parameters of ``scene.build`` with defaults and units."""
+    """The keyword parameters of ``scene.build`` with defaults, units and descriptions."""
     units = {**UNITS, **(scene.units or {})}
+    described = DESCRIPTIONS | documented(scene.build)
     return [
-        Parameter(p.name, p.default, units.get(p.name, "-"))
+        Parameter(p.name, p.default, units.get(p.name, "-"), described.get(p.name, ""))
         for p in inspect.signature(scene.build).parameters.values()
         if p.default is not inspect.Parameter.empty
     ]
+
+
+def documented(function) -> dict[str, str]:
+    """{name: description} from the numpydoc ``Parameters`` section of ``function``'s docstring
+    (an entry ``a, b : type`` describes each name; its indented lines joined)."""
+    lines = (inspect.getdoc(function) or "").splitlines()
+    if "Parameters" not in lines or lines.index("Parameters") + 1 >= len(lines):
+        return {}
+    found, names = {}, []
+    body = lines[lines.index("Parameters") + 2:]
+    for k, line in enumerate(body):
+        if line and not line.startswith(" "):
+            if body[k + 1: k + 2] and body[k + 1].strip() and not body[k + 1].strip("-"):
+                break  # the next section's title, underlined
+            names = [name.strip() for name in line.split(" : ")[0].split(",")]
+            found.update(dict.fromkeys(names, ""))
+        elif line.strip():
+            found.update({name: (found[name] + " " + line.strip()).strip() for name in names})
+    return found
 
 
 def check_names(scene, overrides: dict) -> None:

@@ -8,9 +8,13 @@ mass, or the subsystem the user puts in its place (``flexible``). Each joint bec
 its child link: its ``<origin>`` (xyz, rpy: R = R_z(yaw) R_y(pitch) R_x(roll)) is the joint
 frame's placement on the parent link (``r_pn``, ``orientation``), its ``<axis>`` the axis in that
 frame; revolute and continuous joints are Revolutes, prismatic ones Prismatics, fixed ones Fixed,
-floating ones Free. The root link is fixed to the ground. What the equations of motion do not
-use — joint limits, dynamics (damping, friction), mimic tags, safety controllers, collision and
-visual geometry — is reported in one warning listing it.
+floating ones Free. The root link is fixed to the ground. A link's visual boxes, cylinders and
+spheres (with their origins) become its subsystem's ``visuals`` (:class:`projeq.subsystems.Visual`),
+which the viewer draws (``Result.animate``, ``projeq view``) instead of the solid of its inertia;
+visual meshes are not read (a link drawn by meshes alone is drawn as the solid of its inertia).
+What the equations of motion and the viewer do not use — joint limits, dynamics (damping,
+friction), mimic tags, safety controllers, collision geometry, visual meshes — is reported in one
+warning listing it.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ from xml.etree import ElementTree
 import numpy as np
 
 from projeq.joints import Fixed, Free, Prismatic, Revolute
-from projeq.subsystems import Frame, RigidBody
+from projeq.subsystems import Frame, RigidBody, Visual
 from projeq.system import System
 
 #: URDF joint types and the projeq joint that moves the same way (given its frame and axis)
@@ -103,14 +107,36 @@ def _walk(root: str, urdf_joints) -> list[str]:
 
 
 def _body(link):
-    """A RigidBody of the link's inertial element (a Frame where it has none, or no mass)."""
+    """A RigidBody of the link's inertial element (a Frame where it has none, or no mass), drawn
+    by the link's visual primitives."""
     inertial = link.inertial
     if inertial is None or not inertial.mass:
-        return Frame()
-    pose = np.eye(4) if inertial.origin is None else np.asarray(inertial.origin, float)
-    R = pose[:3, :3]
-    inertia = np.zeros((3, 3)) if inertial.inertia is None else np.asarray(inertial.inertia, float)
-    return RigidBody(float(inertial.mass), r_c=pose[:3, 3], I_c=R @ inertia @ R.T)
+        body = Frame()
+    else:
+        pose = np.eye(4) if inertial.origin is None else np.asarray(inertial.origin, float)
+        R = pose[:3, :3]
+        inertia = np.zeros((3, 3)) if inertial.inertia is None else np.asarray(inertial.inertia, float)
+        body = RigidBody(float(inertial.mass), r_c=pose[:3, 3], I_c=R @ inertia @ R.T)
+    body.visuals = _visuals(link)
+    return body
+
+
+def _visuals(link) -> tuple:
+    """The link's visual primitives (box, cylinder, sphere) placed by their origins; meshes are
+    left out (reported by :func:`_report_ignored`)."""
+    visuals = []
+    for visual in link.visuals:
+        geometry = visual.geometry
+        origin = np.eye(4) if visual.origin is None else np.asarray(visual.origin, float)
+        if geometry is None:
+            continue
+        if geometry.box is not None:
+            visuals.append(Visual("box", tuple(geometry.box.size), origin))
+        elif geometry.cylinder is not None:
+            visuals.append(Visual("cylinder", (geometry.cylinder.radius, geometry.cylinder.length), origin))
+        elif geometry.sphere is not None:
+            visuals.append(Visual("sphere", (geometry.sphere.radius,), origin))
+    return tuple(visuals)
 
 
 def _joint(joint):
@@ -129,14 +155,17 @@ def _joint(joint):
 
 
 def _report_ignored(robot, path) -> None:
-    """One IgnoredWarning listing what the file states and the equations of motion do not use."""
+    """One IgnoredWarning listing what the file states and neither the equations of motion nor
+    the viewer use."""
     parts = {
         "joint limits": [j.name for j in robot.joints if j.limit is not None],
         "joint dynamics (damping, friction)": [j.name for j in robot.joints if j.dynamics is not None],
         "mimic joints": [j.name for j in robot.joints if j.mimic is not None],
         "safety controllers": [j.name for j in robot.joints if j.safety_controller is not None],
         "collision geometry": [link.name for link in robot.links if link.collisions],
-        "visual geometry": [link.name for link in robot.links if link.visuals],
+        "visual meshes (drawn as the solid of the inertia)": [
+            link.name for link in robot.links
+            if any(v.geometry is not None and v.geometry.mesh is not None for v in link.visuals)],
         "transmissions": [t.name for t in robot.transmission],
     }
     found = [f"{what} ({len(names)}: {', '.join(names[:4])}{', …' if len(names) > 4 else ''})"

@@ -1,15 +1,17 @@
 """The motion of a Result to look at: one self-contained HTML page (three.js), a GIF or an MP4.
 
 :func:`animate` writes by the file's suffix. The page (:func:`write_html`) plays the run in any
-browser, offline: three.js (a pinned release, ``THREE_VERSION``, MIT licence, shipped with projeq
-in ``projeq/simulation/viewer/``) and the motion's numbers are inlined. Rigid bodies are drawn as
-the homogeneous box or cylinder of the same mass and central inertia (:func:`equivalent_shape`;
-a point mass as a small sphere), beams as tubes along their deformed centre lines (the shape
-functions' field, :meth:`~projeq.subsystems.beam.RitzBeam.centre_line`), the mechanism as thin
-rods from each joint to its children's joints and to its centre of mass, and each subsystem's
-frame (at its joint) as axes that a checkbox shows. The poses are the ParaView export's
-(:class:`projeq.simulation.export.Drawing`, :func:`~projeq.simulation.export.system_of`): a
-Result loaded from a file is drawn with the scene its run record names.
+browser, offline: three.js (a pinned release, ``THREE_VERSION``, MIT licence, shipped with projeq in
+``projeq/simulation/viewer/``) and the motion's numbers are inlined. A subsystem with ``visuals``
+(:class:`projeq.subsystems.Visual`: boxes, cylinders, spheres, as :func:`projeq.from_urdf` reads
+them from a URDF link) is drawn by them; other rigid bodies as the homogeneous box or cylinder of
+the same mass and central inertia (:func:`equivalent_shape`; a planar body as a plate in its plane,
+:func:`planar_shape`; a point mass as a small sphere), beams as tubes along their deformed centre
+lines (the shape functions' field, :meth:`~projeq.subsystems.beam.RitzBeam.centre_line`), the
+mechanism as thin rods from each joint to its children's joints and to its centre of mass, and each
+subsystem's frame (at its joint) as axes that a checkbox shows. The poses are the ParaView export's
+(:class:`projeq.simulation.export.Drawing`, :func:`~projeq.simulation.export.system_of`): a Result
+loaded from a file is drawn with the scene its run record names.
 
 A GIF (matplotlib's ``PillowWriter``) or MP4 (``FFMpegWriter``, where ffmpeg is found) shows the
 same geometry projected on the viewing plane, for papers and slides.
@@ -27,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.simulation.export import Drawing, system_of, tree_poses, written_atomically
+from projeq.subsystems import PlanarBody
 
 THREE_VERSION = "0.170.0"  # npm's three@0.170.0, build/three.module.min.js: the last single-file module build
 COLORS = ("#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7", "#9c755f")
@@ -93,22 +96,65 @@ def _quaternions(R: NDArray) -> NDArray:
     return quat
 
 
+def planar_shape(body: PlanarBody) -> Shape:
+    """A plate in the plane of a :class:`projeq.PlanarBody` whose moment about the plane's normal
+    is the body's, I_n (the only moment of inertia its motion knows): a bar along the in-plane
+    part of r_c (joint → mass centre), as wide and thick as a tenth of its length ℓ, where r_c
+    has one, m (ℓ² + (ℓ/10)²)/12 = I_n; else a square plate of edge a, a tenth as thick,
+    m (a² + a²)/12 = I_n (:func:`projeq.subsystems.inertia.box`)."""
+    m, r_c = body.m, body.r_c
+    normal = np.eye(3)[{"xy": 2, "yz": 0, "zx": 1, "xz": 1}[body.plane]]
+    I_n = normal @ body.I_c @ normal
+    along = r_c - (r_c @ normal) * normal
+    if np.linalg.norm(along) > 1e-9 * np.sqrt(I_n / m):
+        length = np.sqrt(12.0 * I_n / (1.01 * m))
+        size = (length, 0.1 * length, 0.1 * length)
+    else:
+        along, edge = np.roll(normal, 1), np.sqrt(6.0 * I_n / m)
+        size = (edge, edge, 0.1 * edge)
+    along = along / np.linalg.norm(along)
+    rotation = np.column_stack((along, np.cross(normal, along), normal))
+    return Shape("box", tuple(float(e) for e in size), rotation)
+
+
+def _visual_shape(visual) -> tuple[Shape, NDArray]:
+    """(Shape, centre) of a :class:`projeq.subsystems.Visual`: URDF's cylinder along its z is
+    three.js's along y (the axes turned cyclically, a rotation)."""
+    rotation = visual.origin[:3, :3]
+    if visual.kind == "cylinder":
+        rotation = rotation[:, [1, 2, 0]]
+    return Shape(visual.kind, visual.size, rotation), visual.origin[:3, 3]
+
+
+def _inertia_shape(sub, scale: float, heaviest: float) -> tuple[Shape, NDArray] | None:
+    """(Shape, centre) of a rigid subsystem's inertia (a PlanarBody's plate, :func:`planar_shape`;
+    a point mass as a sphere of 4 % of ``scale`` by the cube root of its share of the largest
+    mass; else :func:`equivalent_shape`), None for a massless one."""
+    m, r_c, I_c = sub.rigid_inertia
+    if not m > 0:
+        return None
+    if np.abs(I_c).max() <= 1e-12 * m * scale**2:
+        return Shape("sphere", (0.04 * scale * (m / heaviest) ** (1 / 3),), np.eye(3)), r_c
+    if isinstance(sub, PlanarBody):
+        return planar_shape(sub), r_c
+    return equivalent_shape(m, I_c), r_c
+
+
 def _shapes(tree, scale: float) -> list[dict]:
-    """The solids of the tree's rigid subsystems in their frames (:func:`equivalent_shape`; a
-    point mass as a sphere of 4 % of ``scale`` by the cube root of its share of the largest
-    mass); massless frames and deforming subsystems have none."""
-    inertias = [(n, sub.rigid_inertia) for n, sub in enumerate(tree.subsystems)
-                if sub.rigid_inertia is not None and not sub.deforms and sub.rigid_inertia[0] > 0]
-    heaviest = max((m for _, (m, _, _) in inertias), default=1.0)
+    """The solids of the tree's rigid subsystems in their frames: a subsystem's ``visuals``
+    (:class:`projeq.subsystems.Visual`, URDF's primitives) where it has them, else the solid of
+    its inertia (:func:`_inertia_shape`); massless frames without visuals and deforming
+    subsystems have none."""
+    rigid = [(n, sub) for n, sub in enumerate(tree.subsystems) if not sub.deforms
+             and (sub.visuals or sub.rigid_inertia is not None)]
+    heaviest = max((sub.rigid_inertia[0] for _, sub in rigid if sub.rigid_inertia is not None), default=1.0)
     shapes = []
-    for n, (m, r_c, I_c) in inertias:
-        if np.abs(I_c).max() <= 1e-12 * m * scale**2:
-            shape = Shape("sphere", (0.04 * scale * (m / heaviest) ** (1 / 3),), np.eye(3))
-        else:
-            shape = equivalent_shape(m, I_c)
-        shapes.append({"frame": n, "kind": shape.kind, "size": list(shape.size),
-                       "position": np.asarray(r_c, dtype=float).tolist(),
-                       "quaternion": _quaternions(shape.rotation).tolist(), "color": COLORS[n % len(COLORS)]})
+    for n, sub in rigid:
+        solids = [_visual_shape(v) for v in sub.visuals] or [_inertia_shape(sub, scale, heaviest)]
+        shapes += [{"frame": n, "kind": shape.kind, "size": list(shape.size),
+                    "position": np.asarray(centre, dtype=float).tolist(),
+                    "quaternion": _quaternions(shape.rotation).tolist(), "color": COLORS[n % len(COLORS)]}
+                   for shape, centre in filter(None, solids)]
     return shapes
 
 

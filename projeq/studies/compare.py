@@ -171,7 +171,12 @@ def _gauss_form_rows(system, formulations, values, simulate: bool, t_end: float)
             continue
         gauss = None
         if f.derive is not None:
-            gauss, row["derivation_s"] = derivation_timed(f.derive)
+            try:
+                gauss, row["derivation_s"] = derivation_timed(f.derive)
+            except ValueError as exc:  # refused (gauss_form of callable loads): a row saying why
+                row.update(identical="not available", note=f"{f.note}; not derived: {exc}".lstrip("; "))
+                rows.append(row)
+                continue
             row["n_ops"] = cse_ops([*gauss.M, *gauss.rhs], values)
             evaluator = gauss.evaluator({k: v for k, v in values.items() if k in gauss.parameters})
         else:
@@ -229,7 +234,8 @@ def _pendulum(formulations, simulate, t_end):
         Formulation("projection (symbolic)", lambda: projection_equation(bodies, q, s, parameters=parameters)),
         Formulation("projection (numeric, dense)", evaluator="dense"),
         Formulation("projection (numeric, recursive)", evaluator="recursive"),
-        Formulation("projection (symbolic, recursive chain)", lambda: gauss_form(chain(n), chain_parameters(n)),
+        Formulation("projection (symbolic, recursive chain)",
+                    lambda: _in_symbols(gauss_form(chain(n), chain_parameters(n)), q, s),
                     note="gauss_form(scenes.chain(2)): body frames, composite inertias"),
         Formulation("lagrange (2nd kind)", lambda: _lagrange(bodies, q, s, parameters),
                     note="d/dt ∂T/∂q̇ − ∂T/∂q = Q from the same bodies"),
@@ -256,6 +262,29 @@ def _plain(q_t, u_t, M, forcing, q, s, parameters):
     symbols = dict(zip(q_t, q)) | dict(zip(u_t, s))
     return GaussForm(M.xreplace(symbols), forcing.xreplace(symbols), tuple(q), tuple(s), sp.eye(len(q)),
                      parameters=parameters)
+
+
+def _in_symbols(gauss, q, s):
+    """``gauss`` with its coordinates and velocities renamed (in order) to the symbols ``q``, ``s``
+    of another formulation of the same coordinates: their residuals can then be subtracted."""
+    from projeq.symbolic.projection import GaussForm
+
+    names = dict(zip((*gauss.q, *gauss.s), (*q, *s)))
+    return GaussForm(gauss.M.xreplace(names), gauss.rhs.xreplace(names), tuple(q), tuple(s),
+                     gauss.K.xreplace(names), gauss.t, gauss.parameters)
+
+
+def _user_system(system, formulations, simulate: bool, t_end: float) -> list[dict]:
+    """A user's System: its Projection Equation evaluated numerically, recursive (the reference)
+    and dense, and derived in sympy (:func:`projeq.symbolic.gauss_form`; "not available", with the
+    reason, where gauss_form refuses the System)."""
+    from projeq.symbolic import gauss_form
+
+    available = [Formulation("projection (numeric, recursive)", evaluator="recursive"),
+                 Formulation("projection (numeric, dense)", evaluator="dense"),
+                 Formulation("projection (symbolic)", lambda: gauss_form(system),
+                             note="gauss_form(system): the System's own joints and bodies in sympy")]
+    return _gauss_form_rows(system, _select(available, formulations), {}, simulate, t_end)
 
 
 def _select(available, wanted):
@@ -504,13 +533,18 @@ def _effort_claims(name: str, rows: list) -> list[str]:
             + "; ".join(measured) + "."]
 
 
-def compare(name: str, formulations=None, simulate: bool = True, t_end: float | None = None,
+def compare(name, formulations=None, simulate: bool = True, t_end: float | None = None,
             repeats: int = DERIVATION_REPEATS) -> ComparisonTable:
-    """Compare the formulations of the system ``name`` (a key of ``COMPARISONS``).
+    """Compare the formulations of the system ``name`` (a key of ``COMPARISONS``), or of a user's
+    :class:`projeq.System` given as ``name``: its Projection Equation evaluated numerically,
+    recursive (the reference) and dense, and derived in sympy (``projection (symbolic)``,
+    :func:`projeq.symbolic.gauss_form`: "not available" with the reason where it refuses the
+    System, e.g. callable loads). A ConstrainedSystem is refused (ValueError): its formulations
+    (multipliers, partitions) are the built-in comparisons'.
 
     formulations : names of the rows to compute (default all); the first is the reference
     simulate : also integrate each formulation's equations (rtol 1e-9, atol 1e-12)
-    t_end : simulated time in s (default ``DEFAULT_T_END[name]``)
+    t_end : simulated time in s (default ``DEFAULT_T_END[name]``; a user's System: 1 s)
     repeats : derivations per row; derivation_s is their median (``EFFORT``)
 
     Each row: derivation time (s), operation count after CSE (``sympy.count_ops``),
@@ -519,9 +553,17 @@ def compare(name: str, formulations=None, simulate: bool = True, t_end: float | 
     do not, integration time (s), relative energy drift, max constraint residual, and how the
     formulation follows from the Central Equation B(2) (``derivation``).
     """
-    if name not in COMPARISONS:
-        raise ValueError(f"name: unknown comparison {name!r}; choose one of {sorted(COMPARISONS)}")
-    t_end = DEFAULT_T_END[name] if t_end is None else t_end
+    from projeq.system import Model
+
+    system = name if isinstance(name, Model) else None
+    if system is not None and system is not system.tree:
+        raise ValueError(f"name: compare takes a System (a tree of joints) or one of {sorted(COMPARISONS)}; "
+                         f"got a {type(system).__name__}, whose constraint forms only the built-in "
+                         "comparisons have")
+    if system is None and (not isinstance(name, str) or name not in COMPARISONS):
+        raise ValueError(f"name: unknown comparison {name!r}; choose one of {sorted(COMPARISONS)} or pass a "
+                         "System")
+    t_end = (1.0 if system is not None else DEFAULT_T_END[name]) if t_end is None else t_end
     if not (isinstance(t_end, (int, float)) and 0 < t_end < np.inf):
         raise ValueError(f"t_end: must be a positive, finite number of seconds, got {t_end!r}")
     if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
@@ -533,9 +575,11 @@ def compare(name: str, formulations=None, simulate: bool = True, t_end: float | 
                              "pass None for all")
     token = derivation_repeats.set(repeats)
     try:
-        rows = COMPARISONS[name](formulations, simulate, float(t_end))
+        rows = (_user_system(system, formulations, simulate, float(t_end)) if system is not None
+                else COMPARISONS[name](formulations, simulate, float(t_end)))
     finally:
         derivation_repeats.reset(token)
     for row in rows:
         row.setdefault("derivation", derivation_of(row["formulation"]))
-    return ComparisonTable(name, rows, EFFORT.format(repeats=repeats), _effort_claims(name, rows))
+    label = name if system is None else f"System({', '.join(system.names)})"
+    return ComparisonTable(label, rows, EFFORT.format(repeats=repeats), _effort_claims(label, rows))

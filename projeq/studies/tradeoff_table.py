@@ -97,7 +97,8 @@ def plot(table: dict):
     """Work-precision figure of the successful rows: CPU time over error, one line per
     (integrator, knob). An error of exactly 0 is drawn at a floor and circled
     (:func:`projeq.simulation.plots.work_precision`); the settings left out (failed, or no
-    finite error) are counted in a note on the figure."""
+    finite error) are counted by reason under the axis label (the table names each), not over
+    the lines."""
     from projeq.simulation import plots
 
     drawn = (table["failure"] == "") & np.isfinite(table["error"])
@@ -106,10 +107,10 @@ def plot(table: dict):
     fig = plots.work_precision(rows, legend=False)
     ax = fig.axes[0]
     if not drawn.all():
-        left_out = ", ".join(f"{_setting(table, i)} ({table['failure'][i] or 'no finite error'})"
-                             for i in np.flatnonzero(~drawn))
-        ax.text(0.01, 0.98, f"not drawn: {left_out}", transform=ax.transAxes, fontsize="x-small", va="top",
-                wrap=True)
+        reasons = [(table["failure"][i] or "no finite error").split(":")[0] for i in np.flatnonzero(~drawn)]
+        counted = ", ".join(f"{reasons.count(r)} {r}" for r in dict.fromkeys(reasons))
+        ax.set_xlabel(f"{ax.get_xlabel()}\nnot drawn: {counted} (of {len(drawn)} settings; see the table)",
+                      fontsize="small")
     methods, knobs = (list(dict.fromkeys(table[name][ok])) for name in ("method", "knob"))
     color = {method: f"C{i % 10}" for i, method in enumerate(methods)}
     style = {knob: dict(linestyle=("-", "--", ":", "-.")[k % 4], marker="os^vDP"[k % 6]) for k, knob in enumerate(knobs)}

@@ -14,6 +14,7 @@ h_n = Q_n − G_n ẏ_n.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from types import MethodType
 
 import numpy as np
@@ -58,6 +59,11 @@ class Subsystem:
         centre line of length ``length`` (export, command line; set when the class is defined).
     length : float
         (``deforms``) Length of the centre line, in m.
+    visuals : tuple of Visual (default empty)
+        Solids that draw the subsystem in the viewer (``Result.animate``, ``projeq view``), in
+        its reference frame; :func:`projeq.from_urdf` sets a link's URDF primitives here. Empty:
+        a rigid body is drawn as the solid of its inertia. Drawing only: the equations of
+        motion never read it.
 
     Overrides are never bypassed: the members derived from :meth:`gauss_terms`
     (``rigid_inertia``, :meth:`elastic_terms`) are stated for the class that defines them;
@@ -72,6 +78,7 @@ class Subsystem:
     has_ports: bool = False
     deforms: bool = False
     length: float
+    visuals: tuple = ()
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -136,6 +143,46 @@ class Subsystem:
         """(``deforms``) Displacement (u, v, w) of the centre line at station x, one row per
         time point of a simulated ``result``."""
         raise NotImplementedError(f"{type(self).__name__} does not deform (deforms is False)")
+
+
+VISUAL_SIZES = {"box": 3, "cylinder": 2, "sphere": 1}  # kind: number of sizes
+
+
+@dataclass(frozen=True)
+class Visual:
+    """A solid that draws a subsystem (:attr:`Subsystem.visuals`), URDF's primitives (ROS, "URDF
+    XML specification: link/visual/geometry").
+
+    Attributes
+    ----------
+    kind : str
+        ``"box"`` (``size``: edges along the solid's x, y, z), ``"cylinder"`` (radius, length
+        along the solid's z) or ``"sphere"`` (radius); sizes in m, positive.
+    size : tuple of float
+    origin : (4, 4) array
+        Pose of the solid's frame (its centre and axes) in the subsystem's reference frame, a
+        homogeneous transform; default identity.
+    """
+
+    kind: str
+    size: tuple
+    origin: NDArray = field(default_factory=lambda: np.eye(4))
+
+    def __post_init__(self):
+        if self.kind not in VISUAL_SIZES:
+            raise ValueError(f"kind: expected one of {sorted(VISUAL_SIZES)}, got {self.kind!r}")
+        size = np.asarray(self.size, dtype=float)
+        if size.shape != (VISUAL_SIZES[self.kind],) or not np.all(np.isfinite(size) & (size > 0)):
+            raise ValueError(f"size: a {self.kind} takes {VISUAL_SIZES[self.kind]} positive sizes, "
+                             f"got {self.size!r}")
+        origin = np.asarray(self.origin, dtype=float)
+        rotation = origin[:3, :3] if origin.shape == (4, 4) else None
+        if rotation is None or not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-9) \
+                or not np.all(np.isfinite(origin)) or np.linalg.det(rotation) <= 0:
+            raise ValueError(f"origin: expected a 4 x 4 homogeneous transform with a rotation, "
+                             f"got {self.origin!r}")
+        object.__setattr__(self, "size", tuple(float(x) for x in size))
+        object.__setattr__(self, "origin", origin)
 
 
 class Port:

@@ -30,6 +30,7 @@ the number the system was built with; every free symbol of these values other th
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -86,18 +87,21 @@ class _Inertia:
 def gauss_form(system, parameters=None) -> GaussForm:
     """M(q) s̈ = rhs(q, ṡ, t) of ``system`` in sympy (B(10), docs/theory.md §2–4, §6), nothing inverted.
 
-    ``.q`` = (q_1, …), ``.s`` = (s_1, …) in the system's order of coordinates and minimal
-    velocities; time is ``.t``; ``.K`` is K(q) of q̇ = K ṡ (+ k). See the module docstring
-    for ``parameters``.
+    ``.q``, ``.s``: the coordinates and minimal velocities in the system's order, named by them
+    (``bob1.angle`` is the symbol ``bob1_angle``, ``bob1.angle_dot`` ``bob1_angle_dot``:
+    :func:`named_symbols`); time is ``.t``; ``.K`` is K(q) of q̇ = K ṡ (+ k). See the module
+    docstring for ``parameters``.
 
     >>> import projeq as pq
     >>> gf = gauss_form(pq.scenes.double_pendulum(), {"bob1.m": sp.Symbol("m_1")})
     >>> gf.parameters
     (m_1,)
+    >>> gf.q
+    (bob1_angle, bob2_angle)
     """
     parameters = _check_parameters(system, dict(parameters or {}))
-    q = sp.symbols(f"q_1:{system.n_q + 1}")
-    s = sp.symbols(f"s_1:{system.n_s + 1}")
+    q = named_symbols([name for name, _ in system.coordinates()], "q")
+    s = named_symbols([name for name, _ in system.velocities()], "s")
     q_all, s_all = np.array(q, dtype=object), np.array(s, dtype=object)
     q_joint = [list(system.joint_q_getter(n)(q_all)) for n in range(len(system.names))]
     s_joint = [list(system.joint_s_dot_getter(n)(s_all)) for n in range(len(system.names))]
@@ -113,6 +117,16 @@ def gauss_form(system, parameters=None) -> GaussForm:
     M, rhs = _to_minimal(system, M_joint, rhs_joint)
     symbols = set().union(*(sp.sympify(v).free_symbols for v in parameters.values())) - {t}
     return GaussForm(M, rhs, q, s, K, t, tuple(sorted(symbols, key=str)))
+
+
+def named_symbols(names: list[str], letter: str) -> tuple:
+    """Symbols for the coordinates ``names`` (``"bob1.angle"`` → ``bob1_angle``: each character
+    that cannot be in a Python name as ``_``, so that the compiled functions take them); where
+    two names would coincide, or one begins with a digit, ``letter_1``, ``letter_2``, … instead."""
+    identifiers = [re.sub(r"\W", "_", name) for name in names]
+    if len(set(identifiers)) == len(identifiers) and all(i.isidentifier() for i in identifiers):
+        return tuple(sp.Symbol(i) for i in identifiers)
+    return tuple(sp.Symbol(f"{letter}_{i}") for i in range(1, len(names) + 1))
 
 
 def _kinematics(system, rels) -> tuple[sp.Matrix, sp.Matrix]:

@@ -8,7 +8,7 @@
   one against their Table 1;
 - the beam spinning about its own axis (``scenes.spinning_beam``, ρI = 0): forward and
   backward whirl |ω_k ∓ Ω| in the co-rotating frame, through the zero of the forward whirl
-  and the crossings of branches;
+  and the crossings of branches, and both at ω_k seen from the inertial frame (Genta 2005);
 - two coupled oscillators: tracking by shape crosses uncoupled branches and follows a
   veering pair.
 """
@@ -96,7 +96,11 @@ def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
     are exact, so the branches are to round-off over the Ritz model's eigensolution (bounds 10× the
     relative errors measured: forward 5.7e-12, backward 3.5e-13, |ζ| 7.7e-14; were all 1e-10),
     over Ω = 0 … 30 where the forward whirls pass through zero (at Ω = ω₁, ω₂) and cross the
-    backward ones: a diagram sorted by frequency would mix the branches."""
+    backward ones: a diagram sorted by frequency would mix the branches. Seen from the inertial
+    frame (``stationary``, w + Ω with the co-rotating whirl w signed) both whirls are the
+    non-rotating cantilever's ω_k at every speed (G. Genta, "Dynamics of Rotating Systems",
+    Springer, 2005; measured 3.5e-13 relative, bound 3.5e-12), on both sides of the forward
+    whirl's zero."""
     speeds = np.linspace(0.0, 30.0, 16)
     diagram = campbell(lambda omega: pq.scenes.spinning_beam(omega=omega, n_shapes=4), speeds, orders=[0, 1])
     omega_k = clamped_free_roots(4) ** 2
@@ -105,6 +109,9 @@ def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
     backward = max(np.abs(diagram.branch(f"backward whirl {k + 1}") / (omega_k[k] + speeds) - 1).max()
                    for k in range(4))
     assert forward < 5.7e-11 and backward < 3.5e-12, (forward, backward)
+    stationary = max(np.abs(diagram.branch(f"{kind} whirl {k + 1}", "stationary") / omega_k[k] - 1).max()
+                     for k in range(4) for kind in ("forward", "backward"))
+    assert stationary < 3.5e-12, stationary
     assert np.abs(diagram.damping).max() < 7.7e-13, np.abs(diagram.damping).max()
     first = [c for c in diagram.critical_speeds if c.mode == "forward whirl 1" and c.order == 1]
     # an unbalance (fixed in the rotor, order 0) resonates where a forward whirl's co-rotating
@@ -116,6 +123,32 @@ def test_spinning_beam_whirls_at_omega_k_plus_minus_spin():
     assert np.allclose([c.speed for c in unbalance], omega_k[:2], rtol=3e-7, atol=0)
     # |ω₁ − Ω| = Ω at Ω = ω₁/2 (Brent's method on the branch: 100 ε, measured 1.1e-15; was 1e-10)
     assert len(first) == 1 and first[0].speed == pytest.approx(omega_k[0] / 2, rel=100 * EPS)
+
+
+def test_stationary_whirls_split_by_rotary_inertia_and_in_the_csv(tmp_path):
+    """With rotary inertia (ρI = 0.01) the shaft is gyroscopic: seen from the inertial frame the
+    forward whirls rise and the backward ones fall from their common value at rest (Genta,
+    2005; second whirls at Ω = 10: 21.75 and 16.86 rad/s from 19.14); the CSV carries a whirl's
+    stationary frequency beside its co-rotating one, which is ω_rot + Ω (forward, its co-rotating
+    whirl not through zero here) and ω_rot − Ω (backward) to round-off (bound 1e-12 relative); a
+    blade has no stationary frequency and asking for one is named."""
+    speeds = np.array([0.0, 5.0, 10.0])
+    diagram = campbell(lambda omega: pq.scenes.spinning_beam(omega=omega, n_shapes=2, rho_I=0.01), speeds,
+                       n_modes=4, refine=False)
+    forward, backward = (diagram.branch(f"{kind} whirl 2", "stationary") for kind in ("forward", "backward"))
+    assert forward[0] == pytest.approx(backward[0], rel=1e-12)
+    assert np.all(np.diff(forward) > 0.5) and np.all(np.diff(backward) < -0.5), (forward, backward)
+    assert np.abs(forward - (diagram.branch("forward whirl 2") + speeds)).max() < 1e-12 * forward.max()
+    assert np.abs(backward - (diagram.branch("backward whirl 2") - speeds)).max() < 1e-12 * backward.max()
+    diagram.write_csv(tmp_path / "spinning.csv")
+    rows = list(csv.reader(open(tmp_path / "spinning.csv", encoding="utf-8")))
+    column = rows[0].index("forward whirl 2 stationary frequency (rad/s)")
+    assert np.array(rows[1:], dtype=float)[:, column].tolist() == forward.tolist()
+    blade = campbell(lambda w: pq.scenes.rotating_blade(omega=w, n_shapes=1), [0.0, 1.0], refine=False)
+    with pytest.raises(ValueError, match="label: 'flapwise 1' is no whirl"):
+        blade.branch("flapwise 1", frame="stationary")
+    with pytest.raises(ValueError, match="frame: expected 'rotating'"):
+        blade.branch("flapwise 1", frame="inertial")
 
 
 def _oscillators(stiffness: float, coupling: float) -> pq.System:

@@ -18,17 +18,21 @@ from projeq.scenes.urdf import IgnoredWarning  # noqa: E402
 
 ARM = """<?xml version="1.0"?>
 <robot name="arm">
-  <link name="base"/>
+  <link name="base"><visual><geometry><box size="0.2 0.3 0.1"/></geometry></visual></link>
   <link name="upper">
     <inertial><origin xyz="0.1 0.02 -0.3" rpy="0.2 -0.4 0.7"/><mass value="2.5"/>
       <inertia ixx="0.08" ixy="0.004" ixz="-0.002" iyy="0.07" iyz="0.001" izz="0.02"/></inertial>
     <collision><geometry><cylinder radius="0.05" length="0.6"/></geometry></collision>
+    <visual><origin xyz="0 0 -0.3" rpy="1.5707963267948966 0 0"/>
+      <geometry><cylinder radius="0.05" length="0.6"/></geometry></visual>
+    <visual><origin xyz="0 0 -0.6" rpy="0 0 0"/><geometry><sphere radius="0.07"/></geometry></visual>
   </link>
   <link name="slider">
     <inertial><origin xyz="0 0 0.05" rpy="0 0 0"/><mass value="0.8"/>
       <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.003" iyz="0" izz="0.004"/></inertial>
   </link>
   <link name="hand">
+    <visual><geometry><mesh filename="package://arm/hand.stl"/></geometry></visual>
     <inertial><origin xyz="0.03 0 0" rpy="0 0.3 0"/><mass value="0.5"/>
       <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.0015"/></inertial>
   </link>
@@ -82,6 +86,7 @@ def test_a_small_arm_equals_the_same_arm_by_hand(arm_file):
     assert len(said) == 1
     assert "joint limits (2: shoulder, slide)" in str(said[0].message)
     assert "collision geometry (1: upper)" in str(said[0].message)
+    assert "visual meshes (drawn as the solid of the inertia) (1: hand)" in str(said[0].message)
     reference = by_hand()
     assert system.coordinates() == reference.coordinates()
     rng = np.random.default_rng(3)
@@ -101,6 +106,38 @@ def test_a_flexible_link_replaces_the_rigid_one(arm_file):
         warnings.simplefilter("ignore", IgnoredWarning)
         system = pq.from_urdf(arm_file, flexible={"hand": beam})
     assert system.subsystem("hand") is beam and system.n_s == 3 + 2
+
+
+def test_visual_primitives_are_drawn(arm_file):
+    """The links' visual box, cylinder and sphere are their subsystems' Visuals with their origins
+    and the viewer's solids (the massless base's box too); the hand, drawn by a mesh (not read),
+    is the box of its inertia; the page carries them (its data equal motion()'s, test_viewer.py)."""
+    from scipy.spatial.transform import Rotation
+
+    from projeq.simulation.animation import motion
+    from tests.simulation.test_viewer import prescribed
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", IgnoredWarning)
+        system = pq.from_urdf(arm_file)
+    cylinder, sphere = system.subsystem("upper").visuals
+    assert (cylinder.kind, cylinder.size) == ("cylinder", (0.05, 0.6))
+    assert (sphere.kind, sphere.size) == ("sphere", (0.07,))
+    assert np.abs(cylinder.origin[:3, :3] - rotation_x(np.pi / 2)).max() < 1e-15
+    assert cylinder.origin[:3, 3].tolist() == [0.0, 0.0, -0.3]
+    assert sphere.origin[:3, 3].tolist() == [0.0, 0.0, -0.6]
+    doc = motion(prescribed(system, np.zeros((2, system.n_q))))
+    shapes = {(doc["frames"][s["frame"]], s["kind"]): s for s in doc["shapes"]}
+    assert shapes["base", "box"]["size"] == [0.2, 0.3, 0.1]
+    drawn = shapes["upper", "cylinder"]
+    assert drawn["size"] == [0.05, 0.6] and drawn["position"] == [0.0, 0.0, -0.3]
+    axis = Rotation.from_quat(drawn["quaternion"]).apply([0.0, 1.0, 0.0])  # three.js's y: URDF's z turned
+    assert np.abs(axis - rotation_x(np.pi / 2)[:, 2]).max() < 1e-15
+    assert shapes["upper", "sphere"]["position"] == [0.0, 0.0, -0.6]
+    moments = np.array([0.001, 0.002, 0.0015])  # the hand's: a box of edges² 6 (Σλ − 2λ_i)/m
+    edges = np.sqrt(6 * (moments.sum() - 2 * moments) / 0.5)
+    assert sorted(shapes["hand", "box"]["size"]) == pytest.approx(sorted(edges), rel=1e-12)
+    assert ("slider", "box") in shapes and ("tool", "sphere") in shapes  # no visuals: their inertias' solids
 
 
 def test_bad_input_is_named(arm_file, tmp_path):

@@ -134,6 +134,19 @@ def test_double_pendulum_with_symbolic_parameters_is_the_closed_form():
     assert sp.simplify(rest - gravity) == sp.zeros(2, 1)
 
 
+def test_coordinates_are_named_by_the_system():
+    """The symbols of q and ṡ carry the coordinates' names (bob1.angle → bob1_angle), so that
+    printed equations read as the model; names that would coincide fall back to q_1, q_2."""
+    from projeq.symbolic.system import named_symbols
+
+    gauss = gauss_form(pq.scenes.double_pendulum())
+    names = ["bob1_angle", "bob2_angle", "bob1_angle_dot", "bob2_angle_dot"]
+    assert [str(x) for x in (*gauss.q, *gauss.s)] == names
+    assert "bob2_angle" in str(gauss.M) and "q_" not in str(gauss.M)
+    assert named_symbols(["a.b_c", "a_b.c"], "q") == sp.symbols("q_1 q_2")
+    assert named_symbols(["1st.x"], "s") == (sp.Symbol("s_1"),)
+
+
 def test_callable_loads_and_functions_are_refused():
     """Loads and joints given as numeric callables have no expressions: refused by name."""
     body = {"b": pq.RigidBody(1.0, I_c=np.eye(3))}
