@@ -21,7 +21,10 @@ def test_campbell_writes_the_diagram_and_its_csv(tmp_path, capsys):
     rows = list(csv.reader(open(tmp_path / "spinning_beam_campbell.csv", encoding="utf-8")))
     expected = campbell(lambda w: pq.scenes.spinning_beam(omega=w, n_shapes=2), [0.0, 2.0, 4.0], n_modes=2)
     assert rows[0][1] == f"{expected.labels[0]} frequency (rad/s)"
-    assert np.array_equal(np.array(rows[1:], dtype=float)[:, 1::2], expected.frequencies)
+    columns = [i for i, name in enumerate(rows[0]) if name.endswith(" frequency (rad/s)") and "stationary" not in name]
+    assert np.array_equal(np.array(rows[1:], dtype=float)[:, columns], expected.frequencies)
+    stationary = [i for i, name in enumerate(rows[0]) if name.endswith("stationary frequency (rad/s)")]
+    assert len(stationary) == 2  # a whirl's frequency seen from the inertial frame, per whirl branch
     assert (tmp_path / "spinning_beam_campbell.png").stat().st_size > 0
     critical = list(csv.reader(open(tmp_path / "spinning_beam_critical_speeds.csv", encoding="utf-8")))
     assert critical[0] == ["mode", "engine order", "speed (rad/s)", "frequency (rad/s)"] and len(critical) > 1
