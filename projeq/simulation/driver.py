@@ -319,15 +319,17 @@ class _Run:
         system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
         self.ev.accelerations(q0, s_dot0, t_start)  # a singular model or a failing force law raises here, by name
         self.chosen = method is None  # simulate's choice: it may go on with Radau (go_implicit)
+        self.step_size = None  # the integrator's next step size where the last segment ended (_counted)
         if self.chosen:
-            method = default_method(self.ev, system, q0, s_dot0, t_start, t_end, self.rtol)
+            mode = measured_mode(self.ev, system, q0, s_dot0, t_start)
+            method = default_method(self.ev, system, q0, s_dot0, t_start, t_end, self.rtol, mode=mode)
             _check_options(method, options)
+            self.step_size = stable_first_step(method, mode, t_start, t_end)
         self.method, self.progress, self.options = method, progress, options
         self.solver = projected_solver(method, system, q0, s_dot0, t_start) if method in PROJECTED else method
         self.x, self.reached = np.concatenate((q0, s_dot0)), t_start  # reached: the latest right-hand side's t
         self.jac, self.switched, self.note = _jac_option(method, jac, self.x.size), "", ""  # go_implicit's record
         self.pieces, self.nfev, self.njev, self.cause, self.steps, self.calls = [], 0, 0, None, 0, 0
-        self.step_size = None  # the integrator's next step size where the last segment ended (_counted)
         self.dense_output, self.x_end = flag("dense_output", dense_output), None  # x_end: the state at the end of the last segment
         self.out_of_range = False  # warned that a subsystem left the range of its model
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
@@ -508,8 +510,32 @@ STIFF_STEPS = 100_000  # DOP853 steps forced by stability alone beyond which Rad
 HIGH_ORDER_RTOL = 1e-7  # at rtol this tight or tighter the eighth order of DOP853 pays on every model measured
 
 
+def measured_mode(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float) -> tuple[float, bool]:
+    """(ρ, decays) of the model's fastest mode at the initial state
+    (:func:`~projeq.simulation.integrators.fastest_mode` of ẋ = (q̇, s̈) by ``evaluator``)."""
+
+    def rhs(t, x):
+        q, s_dot = x[: model.n_q], x[model.n_q :]
+        return np.concatenate((model.q_dot(q, s_dot, t), evaluator.accelerations(q, s_dot, t)))
+
+    return fastest_mode(rhs, t0, np.concatenate((q0, s_dot0)), jacobian=getattr(evaluator, "state_jacobian", None))
+
+
+def stable_first_step(method: str, mode: tuple[float, bool], t0: float, t_end: float) -> float | None:
+    """The first step of simulate's own explicit choice where fast modes chose it (more than
+    FAST_MODE_STEPS RK45 steps for stability alone): the stability limit of ``method`` over ρ.
+    scipy's first-step guess reads ẋ and not the modes (Hairer, Nørsett & Wanner, *Solving ODEs I*,
+    §II.4): on a UR5 robot whose last link is a RitzBeam (ρ ≈ 2e3 1/s) it was far beyond the stable
+    step and DOP853's error estimate let it pass, the beam's modes growing until D_n was indefinite at
+    t = 5.6 ms (benchmarks/urdf_pinocchio.py). None (scipy's guess) for the other models."""
+    rho = mode[0]
+    if method not in ("RK45", "DOP853") or not rho * (t_end - t0) > FAST_MODE_STEPS * stability_limit("RK45"):
+        return None
+    return 0.5 * stability_limit(method) / rho  # half the limit: the error estimate then sees the modes
+
+
 def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_end: float,
-                   rtol: float = 1e-8) -> str:
+                   rtol: float = 1e-8, mode: tuple[float, bool] | None = None) -> str:
     """simulate's integrator when none is given, from the tolerance and the model's fastest
     mode measured at the initial state: ρ = the spectral radius of ∂ẋ/∂x (exact:
     :func:`projeq.simulation.integrators.fastest_mode`, the eigenvalues of the evaluator's
@@ -517,7 +543,7 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
     power iteration on complex-step products)
     gives the steps an explicit method needs for stability alone, n = ρ (t_end − t0) / |x_s|
     with |x_s| its stability interval (:func:`~projeq.simulation.integrators.stability_limit`:
-    RK45 3.31, DOP853 6.39).
+    RK45 3.31, DOP853 6.39). ``mode``: (ρ, decays) measured already (:func:`measured_mode`).
 
     * "Radau" (exact Jacobian) when even DOP853 would need more than ``STIFF_STEPS`` steps
       for stability alone, or when the fastest mode decays without oscillating (a real
@@ -563,12 +589,7 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
     benchmarks/default_integrator.py).
     """
 
-    def rhs(t, x):
-        q, s_dot = x[: model.n_q], x[model.n_q :]
-        return np.concatenate((model.q_dot(q, s_dot, t), evaluator.accelerations(q, s_dot, t)))
-
-    rho, decays = fastest_mode(rhs, t0, np.concatenate((q0, s_dot0)),
-                               jacobian=getattr(evaluator, "state_jacobian", None))
+    rho, decays = measured_mode(evaluator, model, q0, s_dot0, t0) if mode is None else mode
     rho_T = rho * (t_end - t0)
     explicit_steps = rho_T / stability_limit("RK45")
     if rho_T > STIFF_STEPS * stability_limit("DOP853") or (decays and explicit_steps > FAST_MODE_STEPS):

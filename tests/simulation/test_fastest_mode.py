@@ -238,3 +238,17 @@ def test_the_default_run_goes_on_from_where_its_explicit_steps_crawled():
     assert chosen.method == "DOP853, Radau from t = 0.1 s"
     for mine, theirs in ((chosen.q[-1], implicit.q[-1]), (chosen.s_dot[-1], implicit.s_dot[-1])):
         assert np.all(np.abs(mine - theirs) < 50 * (1e-8 * np.abs(theirs) + 1e-10))
+
+
+def test_simulates_own_explicit_choice_starts_at_a_stable_step_where_fast_modes_chose_it():
+    """Where simulate chose DOP853 for fast modes (more than FAST_MODE_STEPS RK45 steps for stability
+    alone), its first step is half DOP853's stability limit over ρ; scipy's guess reads ẋ, not the modes
+    (a UR5 with a flexible last link, ρ ≈ 2e3 1/s: the guess was accepted beyond the stable step and the
+    beam's modes grew until D_n was indefinite at 5.6 ms, benchmarks/urdf_pinocchio.py). Rigid models
+    and implicit methods keep scipy's guess."""
+    from projeq.simulation.integrators import stability_limit
+
+    step = driver.stable_first_step("DOP853", (2e3, False), 0.0, 1.0)
+    assert step == pytest.approx(0.5 * stability_limit("DOP853") / 2e3, rel=1e-15)
+    assert driver.stable_first_step("DOP853", (10.0, False), 0.0, 1.0) is None  # 3 RK45 steps: accuracy rules
+    assert driver.stable_first_step("Radau", (2e3, False), 0.0, 1.0) is None
