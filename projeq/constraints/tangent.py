@@ -245,7 +245,9 @@ class NullSpaceForm(Model):
             q_star = q - minimum_norm_solution(A_s, np.concatenate((values, np.zeros(self.m_p))), ACTING, rank)
         else:
             q_star = self.tree.normalized(q - minimum_norm_solution(self.phi_q(q, t), values, ACTING))
-        return self._null_space(self.constraint_matrix(q_star, t)[0])
+        # past velocity_constraints' cache, which keeps (C, c) at q for q̇ and s̈ of the same state
+        C, c = super(NullSpaceForm, self).velocity_constraints(q_star, t)
+        return self._null_space(self._in_tree_velocities(q_star, t, C, c)[0])
 
     def particular(self, A_s: NDArray, c: NDArray) -> NDArray:
         """x₀ − F x₀[independent] with x₀ = A_s⁺ c, the pseudo-inverse over the largest
