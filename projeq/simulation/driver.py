@@ -239,8 +239,7 @@ def simulate(
             else:
                 if stiff is None and run.steps >= 2 * checked:  # ρ at most log₂(steps) times per run
                     checked = run.steps
-                    stiff = stiff_steps(run.exact_rhs, run.steps, run.t_start, b, run.x_end, run.method, rtol,
-                                        getattr(run.ev, "state_jacobian", None))
+                    stiff = stiff_steps(run.model_rhs, run.steps, run.t_start, b, run.x_end, run.method, rtol)
                     if stiff is not None and run.chosen:
                         run.go_implicit(b, stiff)
                     elif stiff is not None:
@@ -367,10 +366,9 @@ class _Run:
             raise NonFiniteState(f"non-finite state derivative at t = {t:.6g} (q = {q}, s_dot = {s_dot})")
         return x_dot
 
-    def exact_rhs(self, t: float, x: NDArray) -> NDArray:
-        """ẋ of the current model for real or complex x (:func:`projeq.analysis.jacobians.state_derivative`,
-        complex-safe, unlike the fused compiled :meth:`rhs`): its complex step makes the stiffness
-        check's ρ exact (issue 16)."""
+    def model_rhs(self, t: float, x: NDArray) -> NDArray:
+        """ẋ of the current model (:func:`projeq.analysis.jacobians.state_derivative`) without the
+        run's counters and monitor of :meth:`rhs`: the stiffness check differentiates it."""
         return state_derivative(self.model, x, t)
 
     def jacobian(self, t: float, x: NDArray) -> NDArray:
@@ -518,7 +516,7 @@ def measured_mode(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float) -> 
         q, s_dot = x[: model.n_q], x[model.n_q :]
         return np.concatenate((model.q_dot(q, s_dot, t), evaluator.accelerations(q, s_dot, t)))
 
-    return fastest_mode(rhs, t0, np.concatenate((q0, s_dot0)), jacobian=getattr(evaluator, "state_jacobian", None))
+    return fastest_mode(rhs, t0, np.concatenate((q0, s_dot0)), derivatives="differences")
 
 
 def stable_first_step(method: str, mode: tuple[float, bool], t0: float, t_end: float) -> float | None:
@@ -537,10 +535,10 @@ def stable_first_step(method: str, mode: tuple[float, bool], t0: float, t_end: f
 def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_end: float,
                    rtol: float = 1e-8, mode: tuple[float, bool] | None = None) -> str:
     """simulate's integrator when none is given, from the tolerance and the model's fastest
-    mode measured at the initial state: ρ = the spectral radius of ∂ẋ/∂x (exact:
-    :func:`projeq.simulation.integrators.fastest_mode`, the eigenvalues of the evaluator's
-    ``state_jacobian`` where it has one, else of the complex-step Jacobian for n_x ≤ 32, else
-    power iteration on complex-step products)
+    mode measured at the initial state: ρ = the spectral radius of ∂ẋ/∂x
+    (:func:`projeq.simulation.integrators.fastest_mode` by differences at real states: the
+    eigenvalues of Richardson's Jacobian for n_x ≤ 64, else power iteration; a compiled model
+    is not compiled for complex states for it)
     gives the steps an explicit method needs for stability alone, n = ρ (t_end − t0) / |x_s|
     with |x_s| its stability interval (:func:`~projeq.simulation.integrators.stability_limit`:
     RK45 3.31, DOP853 6.39). ``mode``: (ρ, decays) measured already (:func:`measured_mode`).

@@ -33,9 +33,10 @@ from numpy.typing import NDArray
 from scipy.integrate import BDF, DOP853, RK23, RK45, DenseOutput, OdeSolver, Radau
 from scipy.linalg import LinAlgWarning, get_lapack_funcs
 
-from projeq.analysis.differentiation import (attempt_complex, complex_step, exact_jacobian, forward,
+from projeq.analysis.differentiation import (attempt_complex, central, complex_step, exact_jacobian, forward,
                                              is_complex_safe)
-from projeq.analysis.jacobians import differentiate
+from projeq.analysis.differentiation import jacobian as richardson_jacobian
+from projeq.analysis.jacobians import DERIVATIVES, differentiate
 
 PROJECTED = {"RK45-projected": RK45, "DOP853-projected": DOP853}
 EXPLICIT = ("RK45", "RK23", "DOP853", *PROJECTED)
@@ -210,15 +211,17 @@ class _ProjectedDenseOutput(DenseOutput):
         return np.column_stack([self._project(ti, yi) for ti, yi in zip(np.atleast_1d(t), y.T)])
 
 
-def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None) -> float:
+def spectral_radius(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None,
+                    derivatives: str = "exact") -> float:
     """ρ(∂f/∂x) at (t, x) (:func:`fastest_mode`, which says how and at what cost)."""
-    return fastest_mode(fun, t, x, iterations, jacobian)[0]
+    return fastest_mode(fun, t, x, iterations, jacobian, derivatives)[0]
 
 
 DECAYING = 0.1  # a fastest eigenvalue λ with |Im λ| ≤ DECAYING ρ and Re λ < 0 decays without oscillating
 
 
-def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None) -> tuple[float, bool]:
+def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None,
+                 derivatives: str = "exact") -> tuple[float, bool]:
     """(ρ, decays) of J = ∂f/∂x at (t, x): ρ the spectral radius, ``decays`` whether the fastest
     mode is a real eigenvalue λ ≈ −ρ (a stiff damper, not an oscillation: Re λ < 0 and
     |Im λ| ≤ 0.1 ρ, a damping ratio ≥ 0.995).
@@ -239,8 +242,7 @@ def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None)
       :func:`projeq.analysis.differentiation.complex_step`), for a complex-safe f;
     * power iteration on forward-difference products (f(x + εv) − f(x))/ε, ε = √ε_m (1 + |x|),
       only for an f that cannot take complex states (a user's callable that casts to float, a
-      compiled right-hand side for real states such as simulate's fused ``state_derivative``;
-      simulate hands :func:`stiff_steps` the model's complex-safe ẋ instead).
+      compiled right-hand side for real states such as simulate's fused ``state_derivative``).
 
     The power iteration: ρ is the geometric mean growth ‖J v_k‖ over an even number of the last
     iterations (for an undamped mode, a pair ±iω, the growth alternates between ω²|a|/|b| and
@@ -250,8 +252,21 @@ def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None)
     Rayleigh quotient λ = vᵀJv ≤ −0.5 ρ (the iterates of a complex pair rotate in its plane and
     fail the test).
     It costs ``iterations`` + 1 evaluations of f (complex ones with the complex step).
+
+    ``derivatives="differences"``: f at real states only, for a guess that needs ρ to a few digits
+    (simulate's choice of method and its stiffness check): for n_x ≤ 2 ``iterations`` the
+    eigenvalues of Richardson's differences column by column
+    (:func:`projeq.analysis.differentiation.jacobian`, 4 n_x evaluations; ρ within 1e-9 of the
+    exact one on the models of tests/simulation/test_fastest_mode.py), beyond, power iteration on
+    central-difference products (f(x + εv) − f(x − εv)) / 2ε, ε = ε_m^(1/3) (1 + |x|). A compiled
+    model then never needs its complex128 specialization for the guess, which is about half of
+    the first compilation of an explicit run (README's pendulum: the one-call ∂ẋ/∂x kernel).
     """
+    if derivatives not in DERIVATIVES:
+        raise ValueError(f"derivatives: expected one of {list(DERIVATIVES)}, got {derivatives!r}")
     x = np.asarray(x, dtype=float)
+    if derivatives == "differences":
+        return _mode_by_differences(fun, t, x, iterations)
     J = None if jacobian is None or len(x) > 2 * iterations else jacobian(t, x)
     if J is None and len(x) <= iterations:
         J = _by_complex_step(fun, t, x, lambda: exact_jacobian(lambda z: fun(t, z), x))
@@ -264,6 +279,16 @@ def fastest_mode(fun, t: float, x: NDArray, iterations: int = 32, jacobian=None)
     f0 = fun(t, x)
     eps = np.sqrt(np.finfo(float).eps) * (1.0 + np.linalg.norm(x))
     return _power_iteration(lambda v: forward(lambda e: fun(t, x + e * v), eps, f0), len(x), iterations)
+
+
+def _mode_by_differences(fun, t: float, x: NDArray, iterations: int) -> tuple[float, bool]:
+    """(ρ, decays) of :func:`fastest_mode` with ``derivatives="differences"``."""
+    if len(x) <= 2 * iterations:
+        J = richardson_jacobian(lambda z: fun(t, z), x)
+        if np.all(np.isfinite(J)):
+            return _eigen_mode(np.linalg.eigvals(J))
+    eps = np.finfo(float).eps ** (1 / 3) * (1.0 + np.linalg.norm(x))
+    return _power_iteration(lambda v: central(lambda e: fun(t, x + e * v), eps), len(x), iterations)
 
 
 def _by_complex_step(fun, t: float, x: NDArray, run):
@@ -325,15 +350,14 @@ def _stability_interval(name: str) -> float:
     return -float(brentq(amplification, grid[first - 1], grid[first], xtol=1e-12))
 
 
-def stiff_steps(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rtol: float,
-                jacobian=None) -> str | None:
+def stiff_steps(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rtol: float) -> str | None:
     """Whether an explicit ``method``'s ``n_steps`` steps from t0 to t (all of a run's segments
     so far, whatever the segmenting) sit at its stability limit: the evidence (mean step, ρ,
     ρh) as text, or None; ``x`` is the state at t.
 
     The criterion: mean step h with ρ h at least half the method's :func:`stability_limit`
-    (ρ = :func:`spectral_radius` at (t, x), exact for a complex-safe ``fun`` or with the
-    model's one-call ``jacobian``), over at least 50 steps, at rtol ≤ 1e-5. At such
+    (ρ = :func:`spectral_radius` at (t, x) by differences of ``fun`` at real states, to a few
+    digits at least: the test is a factor of 2), over at least 50 steps, at rtol ≤ 1e-5. At such
     tolerances a mode with ρ h that large would be integrated with a local error ≫ rtol, so
     the error control can only accept these steps because the fast mode is hardly excited:
     the step is set by stability, the definition of stiffness, and an implicit method could
@@ -344,7 +368,7 @@ def stiff_steps(fun, n_steps: int, t0: float, t: float, x: NDArray, method, rtol
     if method not in EXPLICIT or rtol > 1e-5 or n_steps < 50:
         return None
     h = (t - t0) / n_steps
-    rho = spectral_radius(fun, t, x, jacobian=jacobian)
+    rho = spectral_radius(fun, t, x, derivatives="differences")
     if rho * h < 0.5 * stability_limit(method):
         return None
     return f"mean step {h:.3g} s, fastest mode {rho:.3g} 1/s, ρh = {rho * h:.2g}"
