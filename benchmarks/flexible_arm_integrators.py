@@ -78,7 +78,7 @@ def jacobian(jac, model, complex_ws, x, J):
     J[:] = 0.0
     for i in range(n_q):
         J[i, n_q + i] = 1.0
-    jac(index, geometry, inertia, gravity, x, n_q, COMPLEX_STEP, given, elastic, ports, T, zeta, F, M_n, M_hat,
+    jac(0.0, index, geometry, inertia, gravity, x, n_q, COMPLEX_STEP, given, elastic, ports, T, zeta, F, M_n, M_hat,
         h_hat, R, r, twist, pivot_min, J[n_q:])
 
 

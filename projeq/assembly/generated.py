@@ -3,7 +3,8 @@
 A plug-in's statement, traced with sympy and printed as scalar code (:mod:`projeq.symbolic.codegen`),
 is compiled by numba into a C callback — a joint's relative motion (:mod:`projeq.assembly.given`), a
 force law's body wrench (:func:`law_callback`), a constraint Φ (:mod:`projeq.constraints.compiled`) —
-in a module written once per printed source (:func:`generated_module`) and cached on disk; the
+in a module written once per printed source (:func:`generated_module`) and cached on disk; a load
+given as a callable of (t, q, ṡ) is compiled by ``numba.njit`` in memory (:func:`load_callbacks`); the
 numbers of the plug-in (its parameters) are data, passed by the address of an array
 (:func:`parameters`); the compiled kernels call the callbacks through their addresses by the
 intrinsics of :func:`intrinsics`.
@@ -14,6 +15,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+import re
 import sys
 import tempfile
 import warnings
@@ -138,10 +140,78 @@ def law_callback(values, dtype=float):
                     UncompiledLawWarning)
 
 
+_LOADS: dict = {}  # (load_key(function), size, n_q, n_s) -> (its float64 and complex128 C callbacks, why not)
+
+
+def load_key(function):
+    """A hashable key of a callable's code and captured values (its closure's cells, arrays by their
+    bytes, and its defaults): one compiled callback for closures of the same source and numbers (a
+    scene built twice); the callable itself where they do not hash."""
+    try:
+        cells = tuple(_frozen(c.cell_contents) for c in (function.__closure__ or ()))
+        key = (function.__code__, cells, function.__defaults__)
+        hash(key)
+    except (AttributeError, TypeError, ValueError):
+        return function
+    return key
+
+
+def _frozen(value):
+    """An array as (dtype, shape, bytes), hashable; anything else as it is."""
+    return (value.dtype.str, value.shape, value.tobytes()) if isinstance(value, np.ndarray) else value
+
+
+def load_callbacks(function, size: int, n_q: int, n_s: int) -> tuple[tuple | None, str]:
+    """((float64, complex128) C callbacks ``into(t, q, n_q, s_dot, n_s, load)``, "") of a load given as a
+    callable ``function(t, q, s_dot)`` of ``size`` entries (a scalar where ``size`` is 1), compiled by
+    ``numba.njit`` — once per source and captured numbers in a process (:func:`load_key`), in memory:
+    a user's function has no file for numba's disk cache — and checked against the callable's own
+    values, real and imaginary parts (a complex step) each to 1e-13 relative, at three states of
+    n_q coordinates and n_s velocities; (None, why) where numba cannot compile it or its values
+    differ. A returned load of another size writes NaN (the loop of laws then names the law,
+    :func:`projeq.assembly.loads.add_loads`). numba takes the numbers a callable reads from its
+    module's globals as constants when it compiles them, as ``numba.njit`` does."""
+    key = (load_key(function), size, n_q, n_s)
+    if key not in _LOADS:
+        try:
+            _LOADS[key] = _compiled_load(function, size, n_q, n_s), ""
+        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+            lines = [line.strip() for line in re.sub(r"\x1b\[[0-9;]*m", "", str(exc)).splitlines() if line.strip()]
+            _LOADS[key] = None, f"{type(exc).__name__}: {' '.join(lines[:2])[:200]}"
+    return _LOADS[key]
+
+
+def _compiled_load(function, size: int, n_q: int, n_s: int) -> tuple:
+    """:func:`load_callbacks`' callbacks; raises where numba refuses the callable or its values differ."""
+    numba = kernels.numba_module()
+    from numba import types as nb
+
+    jitted = function if isinstance(function, numba.core.dispatcher.Dispatcher) else numba.njit(function)
+    rng = np.random.default_rng(7)
+    for t in (0.0, 0.37, 1.9):
+        q, s_dot = (rng.uniform(-1, 1, n) + 1j * 1e-30 * rng.standard_normal(n) for n in (n_q, n_s))
+        want = np.ravel(np.asarray(function(t, q, s_dot), dtype=complex))
+        got = np.ravel(np.asarray(jitted(t, q, s_dot), dtype=complex))
+        scale, rate = max(1.0, np.abs(want.real).max(initial=0.0)), max(1.0, np.abs(want.imag / 1e-30).max(initial=0.0))
+        if not (got.shape == want.shape == (size,) and np.all(np.abs(got.real - want.real) <= 1e-13 * scale)
+                and np.all(np.abs(got.imag - want.imag) / 1e-30 <= 1e-13 * rate)):
+            raise ValueError(f"its compiled values {got} differ from its own {want} at t = {t}")
+
+    def into(t, q_pointer, n_q, s_pointer, n_s, load_pointer):
+        q, s_dot = numba.carray(q_pointer, (n_q,)), numba.carray(s_pointer, (n_s,))
+        found, load = np.asarray(jitted(t, q, s_dot)).ravel(), numba.carray(load_pointer, (size,))
+        for i in range(size):
+            load[i] = found[i] if found.shape[0] == size else np.nan
+
+    return tuple(numba.cfunc(nb.void(nb.float64, nb.CPointer(kind), nb.int64, nb.CPointer(kind), nb.int64,
+                                     nb.CPointer(kind)))(into) for kind in (nb.float64, nb.complex128))
+
+
 @functools.cache
 def intrinsics() -> dict:
     """The compiled :func:`projeq.assembly.given.given_into`, ``phi_into`` (Φ's values of
-    :mod:`projeq.constraints.compiled`) and :func:`projeq.assembly.loads.wrench_into`:
+    :mod:`projeq.constraints.compiled`), :func:`projeq.assembly.loads.wrench_into` and
+    :func:`projeq.assembly.loads.load_into`:
     each calls the C function at the address its first argument holds with the data pointers of its
     arrays (numba's own layout of complex128 and float64, that of the C callbacks) and its scalars
     as they are."""
@@ -190,4 +260,17 @@ def intrinsics() -> dict:
 
         return numba.types.void(address, complex_address, R, r, w, t, p, wrench), call
 
-    return {"phi_into": phi_into, "given_into": given_into, "wrench_into": wrench_into}
+    @intrinsic
+    def load_into(typingctx, address, complex_address, t, q, n_q, s_dot, n_s, load):
+        # the callback of the arrays' dtype (:func:`load_callbacks`): complex128 under the complex step
+        if not q.dtype == s_dot.dtype == load.dtype:
+            return None
+
+        def call(context, builder, signature, args):
+            kinds = signature.args
+            chosen = 1 if isinstance(kinds[3].dtype, numba.types.Complex) else 0
+            return caller(numba.types.void(kinds[chosen], *kinds[2:]), (args[chosen], *args[2:]), context, builder)
+
+        return numba.types.void(address, complex_address, t, q, n_q, s_dot, n_s, load), call
+
+    return {"phi_into": phi_into, "given_into": given_into, "wrench_into": wrench_into, "load_into": load_into}

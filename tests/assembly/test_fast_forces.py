@@ -170,7 +170,8 @@ def test_the_compiled_loop_takes_a_complex_step():
     def loads_at(step, kernel):
         args = [getattr(ws, name) + step * direction[name] for name in ("R", "r", "twist", "F", "T")]
         h = np.zeros(ws.h_hat.shape, dtype=np.result_type(step, float))
-        kernel(ev._laws, ev._law_constants, ev._index, q + step * 0.3, s_dot - step * 0.2, *args, h)
+        state = (q + step * 0.3, s_dot - step * 0.2)
+        kernel(ev._laws, ev._law_constants, ev._index, 0.0, *state, *state, *args, h)
         return h
 
     h_complex = loads_at(1e-30j, loads.kernel(True))
