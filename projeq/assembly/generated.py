@@ -4,7 +4,8 @@ A plug-in's statement, traced with sympy and printed as scalar code (:mod:`proje
 is compiled by numba into a C callback — a joint's relative motion (:mod:`projeq.assembly.given`), a
 force law's body wrench (:func:`law_callback`), a constraint Φ (:mod:`projeq.constraints.compiled`) —
 in a module written once per printed source (:func:`generated_module`) and cached on disk; a load
-given as a callable of (t, q, ṡ) is compiled by ``numba.njit`` in memory (:func:`load_callbacks`); the
+given as a callable of (t, q, ṡ) is printed from its source with the numbers it reads as data, or
+compiled by ``numba.njit`` in memory with them frozen (:func:`load_callbacks`); the
 numbers of the plug-in (its parameters) are data, passed by the address of an array
 (:func:`parameters`); the compiled kernels call the callbacks through their addresses by the
 intrinsics of :func:`intrinsics`.
@@ -50,9 +51,6 @@ def generated_module(f, into: str, parameters: bool = False):
     writable: compiled anew each process). ``f``'s constants (``f.constants``) are, with
     ``parameters``, the entries of a last argument p of ``function`` (one module for all their
     values), else module globals holding their values (``f.values``)."""
-    import importlib.util
-
-    numba = kernels.numba_module()
     header = f.source.split("\n", 1)
     if parameters:
         signature = header[0].replace(f"def {f.__name__}(", "def function(", 1).replace("):", ", p):", 1)
@@ -61,8 +59,16 @@ def generated_module(f, into: str, parameters: bool = False):
     else:
         constants = [f"{name} = {float(value)!r}" for name, value in sorted(zip(f.constants, f.values))]
         body = f.source.replace(f"def {f.__name__}(", "def function(", 1)
-    source = "\n".join(["import numba", "import numpy", "from numba import types as nb", "", *constants, "",
-                        "@numba.njit(cache=True)", body, into])
+    return source_module("\n".join(["import numba", "import numpy", "from numba import types as nb", "", *constants,
+                                     "", "@numba.njit(cache=True)", body, into]))
+
+
+def source_module(source: str):
+    """The module of ``source`` (:func:`generated_module`), written once to a file named by its digest
+    and imported, once per process."""
+    import importlib.util
+
+    numba = kernels.numba_module()
     digest = hashlib.sha1((source + numba.__version__).encode()).hexdigest()[:20]
     module_name = f"projeq_generated_{digest}"
     if module_name not in sys.modules:
@@ -140,13 +146,13 @@ def law_callback(values, dtype=float):
                     UncompiledLawWarning)
 
 
-_LOADS: dict = {}  # (load_key(function), size, n_q, n_s) -> (its float64 and complex128 C callbacks, why not)
+_LOADS: dict = {}  # (load_key(function), size, n_q, n_s) -> (callbacks, parameters), or (None, why not)
 
 
 def load_key(function):
     """A hashable key of a callable's code and captured values (its closure's cells, arrays by their
-    bytes, and its defaults): one compiled callback for closures of the same source and numbers (a
-    scene built twice); the callable itself where they do not hash."""
+    bytes, and its defaults): one check of closures of the same source and numbers (a scene built
+    twice); the callable itself where they do not hash."""
     try:
         cells = tuple(_frozen(c.cell_contents) for c in (function.__closure__ or ()))
         key = (function.__code__, cells, function.__defaults__)
@@ -161,32 +167,60 @@ def _frozen(value):
     return (value.dtype.str, value.shape, value.tobytes()) if isinstance(value, np.ndarray) else value
 
 
-def load_callbacks(function, size: int, n_q: int, n_s: int) -> tuple[tuple | None, str]:
-    """((float64, complex128) C callbacks ``into(t, q, n_q, s_dot, n_s, load)``, "") of a load given as a
-    callable ``function(t, q, s_dot)`` of ``size`` entries (a scalar where ``size`` is 1), compiled by
-    ``numba.njit`` — once per source and captured numbers in a process (:func:`load_key`), in memory:
-    a user's function has no file for numba's disk cache — and checked against the callable's own
-    values, real and imaginary parts (a complex step) each to 1e-13 relative, at three states of
-    n_q coordinates and n_s velocities; (None, why) where numba cannot compile it or its values
-    differ. A returned load of another size writes NaN (the loop of laws then names the law,
-    :func:`projeq.assembly.loads.add_loads`). numba takes the numbers a callable reads from its
-    module's globals as constants when it compiles them, as ``numba.njit`` does."""
+def load_callbacks(function, size: int, n_q: int, n_s: int) -> tuple:
+    """((float64, complex128) C callbacks ``into(t, q, n_q, s_dot, n_s, p, load)``, parameters p) of a
+    load given as a callable ``function(t, q, s_dot)`` of ``size`` entries (a scalar where ``size``
+    is 1), or (None, why) where numba cannot compile it or its compiled values differ from its own
+    (real and imaginary parts, a complex step, each to 1e-13 relative at three states of n_q
+    coordinates and n_s velocities). A lambda or function whose source reads numbers (scalars,
+    real arrays) from its closure or module is printed with those numbers as the data p
+    (:func:`stated_load`): one compiled module per source, cached on disk, for every value of its
+    numbers; any other is compiled by ``numba.njit`` in memory with its captured values frozen
+    (p empty). A load of another size is written as NaN (the loop then names the law,
+    :func:`projeq.assembly.loads.add_loads`)."""
     key = (load_key(function), size, n_q, n_s)
     if key not in _LOADS:
         try:
-            _LOADS[key] = _compiled_load(function, size, n_q, n_s), ""
+            _LOADS[key] = _compiled_load(function, size, n_q, n_s)
         except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
             lines = [line.strip() for line in re.sub(r"\x1b\[[0-9;]*m", "", str(exc)).splitlines() if line.strip()]
             _LOADS[key] = None, f"{type(exc).__name__}: {' '.join(lines[:2])[:200]}"
     return _LOADS[key]
 
 
-def _compiled_load(function, size: int, n_q: int, n_s: int) -> tuple:
-    """:func:`load_callbacks`' callbacks; raises where numba refuses the callable or its values differ."""
-    numba = kernels.numba_module()
-    from numba import types as nb
+#: a C callback of a stated load (:func:`stated_load`) of one dtype
+LOAD_INTO = """
+@numba.cfunc(nb.void(nb.float64, nb.CPointer(nb.{dtype}), nb.int64, nb.CPointer(nb.{dtype}), nb.int64,
+                     nb.CPointer(nb.float64), nb.CPointer(nb.{dtype})), cache=True)
+def {name}(t, q_pointer, n_q, s_pointer, n_s, p_pointer, load_pointer):
+    q, s_dot, p = numba.carray(q_pointer, (n_q,)), numba.carray(s_pointer, (n_s,)), numba.carray(p_pointer, ({n_p},))
+    found, load = numpy.asarray(function(t, q, s_dot, p)).ravel(), numba.carray(load_pointer, ({size},))
+    for i in range({size}):
+        load[i] = found[i] if found.shape[0] == {size} else numpy.nan
+"""
 
+
+def _compiled_load(function, size: int, n_q: int, n_s: int) -> tuple:
+    """:func:`load_callbacks`' (callbacks, parameters); raises where numba refuses the callable or its
+    values differ."""
+    stated = stated_load(function)
+    if stated is not None:
+        try:
+            source, parameters = stated
+            module = source_module(source + "".join(LOAD_INTO.format(n_p=len(parameters), size=size, dtype=dtype, name=name)
+                                                    for dtype, name in (("float64", "into"), ("complex128", "complex_into"))))
+            _check_load(function, lambda t, q, s_dot: module.function(t, q, s_dot, parameters), size, n_q, n_s)
+            return (module.into, module.complex_into), parameters
+        except Exception:  # noqa: BLE001 — compiled with its numbers frozen instead
+            pass
+    numba = kernels.numba_module()
     jitted = function if isinstance(function, numba.core.dispatcher.Dispatcher) else numba.njit(function)
+    _check_load(function, jitted, size, n_q, n_s)
+    return _frozen_callbacks(jitted, size), np.zeros(0)
+
+
+def _check_load(function, jitted, size: int, n_q: int, n_s: int) -> None:
+    """ValueError unless the compiled ``jitted`` gives ``function``'s values (:func:`load_callbacks`)."""
     rng = np.random.default_rng(7)
     for t in (0.0, 0.37, 1.9):
         q, s_dot = (rng.uniform(-1, 1, n) + 1j * 1e-30 * rng.standard_normal(n) for n in (n_q, n_s))
@@ -197,14 +231,77 @@ def _compiled_load(function, size: int, n_q: int, n_s: int) -> tuple:
                 and np.all(np.abs(got.imag - want.imag) / 1e-30 <= 1e-13 * rate)):
             raise ValueError(f"its compiled values {got} differ from its own {want} at t = {t}")
 
-    def into(t, q_pointer, n_q, s_pointer, n_s, load_pointer):
+
+def _frozen_callbacks(jitted, size: int) -> tuple:
+    """The C callbacks of :func:`load_callbacks` around a compiled callable (its numbers frozen, p unread)."""
+    numba = kernels.numba_module()
+    from numba import types as nb
+
+    def into(t, q_pointer, n_q, s_pointer, n_s, p_pointer, load_pointer):
         q, s_dot = numba.carray(q_pointer, (n_q,)), numba.carray(s_pointer, (n_s,))
         found, load = np.asarray(jitted(t, q, s_dot)).ravel(), numba.carray(load_pointer, (size,))
         for i in range(size):
             load[i] = found[i] if found.shape[0] == size else np.nan
 
     return tuple(numba.cfunc(nb.void(nb.float64, nb.CPointer(kind), nb.int64, nb.CPointer(kind), nb.int64,
-                                     nb.CPointer(kind)))(into) for kind in (nb.float64, nb.complex128))
+                                     nb.CPointer(nb.float64), nb.CPointer(kind)))(into)
+                 for kind in (nb.float64, nb.complex128))
+
+
+def stated_load(function) -> tuple[str, np.ndarray] | None:
+    """(source, p): a lambda or function of (t, q, s_dot) printed as ``function(t, q, s_dot, p)``, the
+    numbers it reads from its closure and its module (scalars and real arrays) unpacked from p at
+    its start and the modules it reads imported by their names; None where its source cannot be
+    found (one lambda or def of its arguments on its first line) or it reads anything else."""
+    import ast
+    import inspect
+    import linecache
+    import types
+
+    code = getattr(function, "__code__", None)
+    if code is None or code.co_argcount != 3 or function.__defaults__ or code.co_kwonlyargcount:
+        return None
+    try:
+        tree = ast.parse("".join(linecache.getlines(inspect.getsourcefile(function))))
+    except (OSError, TypeError, SyntaxError):
+        return None
+    arguments = list(code.co_varnames[:3])
+    found = [node for node in ast.walk(tree) if isinstance(node, (ast.Lambda, ast.FunctionDef))
+             and min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])]) == code.co_firstlineno
+             and [a.arg for a in node.args.args] == arguments and not node.args.vararg and not node.args.kwarg]
+    if len(found) != 1:
+        return None
+    values = dict(zip(code.co_freevars, (cell.cell_contents for cell in function.__closure__ or ())))
+    names, codes = set(), [code]
+    while codes:  # the names the code and its nested codes (comprehensions) read
+        c = codes.pop()
+        names.update(c.co_names)
+        codes.extend(k for k in c.co_consts if isinstance(k, types.CodeType))
+    imports = []
+    for name in sorted(names):
+        value = function.__globals__.get(name)
+        if isinstance(value, types.ModuleType):
+            imports.append(f"import {value.__name__} as {name}")
+        elif name in function.__globals__:
+            values[name] = value
+    lines, p = [], []
+    for name, value in values.items():
+        if isinstance(value, bool) or not (isinstance(value, (int, float, np.integer, np.floating)) or
+                                           isinstance(value, np.ndarray) and value.dtype.kind == "f"):
+            return None  # anything else (a function, an object): compiled with it frozen
+        value = np.asarray(value, dtype=float)
+        at = sum(len(v) for v in p)
+        p.append(value.ravel())
+        entries = f"projeq_p[{at}:{at + value.size}]"
+        lines.append(f"    {name} = projeq_p[{at}]" if value.ndim == 0 else f"    {name} = {entries}" if value.ndim == 1
+                     else f"    {name} = {entries}.reshape({value.shape})")
+    node = found[0]
+    body = [f"    return {ast.unparse(node.body)}"] if isinstance(node, ast.Lambda) else \
+        [f"    {line}" for statement in node.body for line in ast.unparse(statement).splitlines()]
+    source = "\n".join([*imports, "", "", "@numba.njit(cache=True)", f"def function({', '.join(arguments)}, projeq_p):",
+                        *lines, *body, ""])
+    return "\n".join(["import numba", "import numpy", "from numba import types as nb", source]), \
+        np.concatenate(p) if p else np.zeros(0)
 
 
 @functools.cache
@@ -261,9 +358,9 @@ def intrinsics() -> dict:
         return numba.types.void(address, complex_address, R, r, w, t, p, wrench), call
 
     @intrinsic
-    def load_into(typingctx, address, complex_address, t, q, n_q, s_dot, n_s, load):
+    def load_into(typingctx, address, complex_address, t, q, n_q, s_dot, n_s, p, load):
         # the callback of the arrays' dtype (:func:`load_callbacks`): complex128 under the complex step
-        if not q.dtype == s_dot.dtype == load.dtype:
+        if not q.dtype == s_dot.dtype == load.dtype or p.dtype != numba.types.float64:
             return None
 
         def call(context, builder, signature, args):
@@ -271,6 +368,6 @@ def intrinsics() -> dict:
             chosen = 1 if isinstance(kinds[3].dtype, numba.types.Complex) else 0
             return caller(numba.types.void(kinds[chosen], *kinds[2:]), (args[chosen], *args[2:]), context, builder)
 
-        return numba.types.void(address, complex_address, t, q, n_q, s_dot, n_s, load), call
+        return numba.types.void(address, complex_address, t, q, n_q, s_dot, n_s, p, load), call
 
     return {"phi_into": phi_into, "given_into": given_into, "wrench_into": wrench_into, "load_into": load_into}

@@ -54,8 +54,9 @@ WRENCH, SPRING_DAMPER, JOINT_FORCE, JOINT_SPRING, STATED = range(5)
 KINDS = {"wrench": WRENCH, "spring_damper": SPRING_DAMPER, "joint_force": JOINT_FORCE, "joint_spring": JOINT_SPRING,
          "stated": STATED}
 #: the columns of ``laws``: the kind, its two indices, the addresses of a stated law's callbacks or of a
-#: load's callable (0: none), and where that load goes in the row's constants
-KIND, FIRST, SECOND, CALLBACK, COMPLEX_CALLBACK, AT = range(6)
+#: load's callable (0: none), where that load goes in the row's constants and where the callable's
+#: numbers (its data p) start there
+KIND, FIRST, SECOND, CALLBACK, COMPLEX_CALLBACK, AT, PARAMETERS = range(7)
 _INTERPRETED: dict = {}  # an "address" in the interpreted loop -> a stated law's printed wrench, or (callable, size)
 
 
@@ -66,13 +67,15 @@ def compiled_rows(system, compiled: bool) -> tuple[np.ndarray, np.ndarray, list]
     (law, why) of those that run their own ``add_to``: no row, or a piece numba cannot compile."""
     rows, python = [], []
     for law in system.forces:
-        row, addresses, at, why = law.compiled_terms(), None, 0, "its own add_to"
+        row, addresses, at, why = law.compiled_terms(), None, (0, 0), "its own add_to"
         if row is not None and row[0] == "stated":
             addresses = stated_addresses(law.compiled_wrench(), compiled)
             why = "" if addresses else "numba cannot compile its wrench"
         elif row is not None and law.compiled_load() is not None:
-            function, at, size = law.compiled_load()
-            addresses, why = load_addresses(function, size, system.n_q, system.n_s, compiled)
+            function, load_at, size = law.compiled_load()
+            addresses, p, why = load_addresses(function, size, system.n_q, system.n_s, compiled)
+            at = load_at, len(row[2])  # the load's place, and the callable's numbers after the row's own
+            row = (*row[:2], np.concatenate((row[2], p)))
         elif row is not None:
             why = ""
         if why:
@@ -84,15 +87,15 @@ def compiled_rows(system, compiled: bool) -> tuple[np.ndarray, np.ndarray, list]
 
 def table(rows) -> tuple[np.ndarray, np.ndarray]:
     """(laws, constants): the ``compiled_terms`` rows (kind, indices, constants), each with the two
-    addresses of its callbacks (None: none) and where a load's callable writes in its constants, as
-    an int array (L × 6: the columns KIND ... AT) and a float array (L × the most constants,
-    zero-padded)."""
-    laws = np.zeros((len(rows), 6), dtype=np.int64)
+    addresses of its callbacks (None: none) and where a load's callable writes in its constants and
+    where its numbers start there, as an int array (L × 7: the columns KIND ... PARAMETERS) and a
+    float array (L × the most constants, zero-padded)."""
+    laws = np.zeros((len(rows), 7), dtype=np.int64)
     for i, ((kind, indices, _), addresses, at) in enumerate(rows):
         laws[i, :1 + len(indices)] = (KINDS[kind], *indices)
         if addresses is not None:
             laws[i, CALLBACK:COMPLEX_CALLBACK + 1] = addresses
-        laws[i, AT] = at
+        laws[i, AT:] = at
     constants = np.zeros((len(rows), max((len(c) for (_, _, c), _, _ in rows), default=0)))
     for i, ((_, _, c), _, _) in enumerate(rows):
         constants[i, :len(c)] = c
@@ -110,19 +113,19 @@ def stated_addresses(values, compiled: bool) -> tuple[int, int] | None:
     return None if None in callbacks else tuple(back.address for back in callbacks)
 
 
-def load_addresses(function, size: int, n_q: int, n_s: int, compiled: bool) -> tuple[tuple | None, str]:
-    """((float64, complex128) addresses, "") of the C callbacks of a load given as a callable
-    ``function(t, q, s_dot)`` of ``size`` entries (:func:`projeq.assembly.generated.load_callbacks`),
-    or (None, why numba cannot compile it); interpreted, a key of the callable itself
-    (:func:`load_into` looks it up)."""
+def load_addresses(function, size: int, n_q: int, n_s: int, compiled: bool) -> tuple:
+    """((float64, complex128) addresses, p, "") of the C callbacks of a load given as a callable
+    ``function(t, q, s_dot)`` of ``size`` entries and the numbers p they read
+    (:func:`projeq.assembly.generated.load_callbacks`), or (None, p, why numba cannot compile it);
+    interpreted, a key of the callable itself (:func:`load_into` looks it up)."""
     if not compiled:
         _INTERPRETED[id(function)] = function, size
-        return (id(function), id(function)), ""
-    callbacks, why = load_callbacks(function, size, n_q, n_s)
+        return (id(function), id(function)), np.zeros(0), ""
+    callbacks, p = load_callbacks(function, size, n_q, n_s)
     if callbacks is None:
         name = getattr(function, "__qualname__", type(function).__name__)
-        return None, f"numba cannot compile its callable {name} ({why})"
-    return tuple(back.address for back in callbacks), ""
+        return None, np.zeros(0), f"numba cannot compile its callable {name} ({p})"
+    return tuple(back.address for back in callbacks), p, ""
 
 
 def wrench_into(address, complex_address, R, r, w, t, p, wrench):
@@ -133,11 +136,12 @@ def wrench_into(address, complex_address, R, r, w, t, p, wrench):
     wrench[:] = _INTERPRETED[address](R.ravel(), r, w, t)
 
 
-def load_into(address, complex_address, t, q, n_q, s_dot, n_s, load):
+def load_into(address, complex_address, t, q, n_q, s_dot, n_s, p, load):
     """load ← a law's load given as a callable at (t, q, ṡ) (NaN where it returns another number of
     entries than the law's): in the compiled loop, by the C callback at ``address``
     (``complex_address`` under the complex step; an intrinsic,
-    :func:`projeq.assembly.generated.intrinsics`); interpreted, by the callable itself."""
+    :func:`projeq.assembly.generated.intrinsics`) with the callable's numbers p; interpreted, by the
+    callable itself."""
     function, size = _INTERPRETED[address]
     found = np.ravel(function(t, q[:n_q], s_dot[:n_s]))
     load[:size] = found if found.size == size else np.nan
@@ -151,7 +155,7 @@ def loaded(laws, i, c, t, q, s_dot, row) -> bool:
     if laws[i, CALLBACK] == 0:
         return True
     load_into(laws[i, CALLBACK], laws[i, COMPLEX_CALLBACK], t, q, q.shape[0], s_dot, s_dot.shape[0],
-              row[laws[i, AT]:])
+              c[laws[i, PARAMETERS]:], row[laws[i, AT]:])
     for j in range(row.shape[0]):
         if not (np.isfinite(row[j].real) and np.isfinite(row[j].imag)):
             return False
