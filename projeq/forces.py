@@ -22,9 +22,9 @@ numba compiles (:func:`body_wrench`, :func:`spring_end`, :func:`spring_damper`,
 :func:`spring_force`, :func:`joint_wrench`): a law's ``add_to`` calls them (the reference
 evaluators), and the compiled evaluator calls the same source from its loop over the laws'
 rows (:mod:`projeq.assembly.loads`), which each law of this module gives by ``compiled_terms``
-(a load given as a callable by ``compiled_load`` too). They index matrices as ``R[i][j]``, so ``add_to`` hands them
-nested lists of Python numbers (several times faster interpreted than numpy scalars) and
-the compiled loop arrays; they take complex numbers too (a complex step), so they compare
+(a load given as a callable by ``compiled_load`` too). They index matrices as ``R[i][j]``, so
+``add_to`` hands them nested lists of Python numbers (several times faster interpreted than
+numpy scalars) and the compiled loop arrays; they take complex numbers too (a complex step), so they compare
 real parts only.
 """
 
@@ -199,8 +199,8 @@ class ForceLaw:
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         drop_inherited_twins(cls, ForceLaw, ("add_to", "wrench", "generalized_force"),
-                             ("symbolic_unsupported", "symbolic_wrenches", "symbolic_joint_forces", "compiled_terms",
-                              "compiled_load"))
+                             ("symbolic_unsupported", "symbolic_wrenches", "symbolic_joint_forces",
+                              "compiled_terms", "compiled_load"))
 
     def bind(self, system) -> "ForceLaw":
         """Resolve the names the law was given in ``system`` (indices, selections) and return
@@ -280,7 +280,7 @@ class Force(_BodyLoad):
         return np.array(wrench)
 
     def compiled_terms(self) -> tuple | None:
-        force = _ZERO if self.force.constant is None else self.force.constant  # a callable's: compiled_load
+        force = _ZERO if self.force.function is not None else self.force.constant  # compiled_load's
         return "wrench", (self.index, self.frame == "world"), np.concatenate((force, self.point, _ZERO))
 
     def compiled_load(self) -> tuple | None:
@@ -308,7 +308,7 @@ class Torque(_BodyLoad):
         return np.array(wrench)
 
     def compiled_terms(self) -> tuple | None:
-        torque = _ZERO if self.torque.constant is None else self.torque.constant  # a callable's: compiled_load
+        torque = _ZERO if self.torque.function is not None else self.torque.constant  # compiled_load's
         return "wrench", (self.index, self.frame == "world"), np.concatenate((_ZERO, _ZERO, torque))
 
     def compiled_load(self) -> tuple | None:
@@ -435,7 +435,7 @@ class JointForce(ForceLaw):
         h[self.parent] += w_p  # the reaction −T_npᵀ w
 
     def compiled_terms(self) -> tuple | None:
-        tau = np.zeros(self.n_s) if self._tau.constant is None else self._tau.constant  # a callable's: compiled_load
+        tau = self._tau.constant if self._tau.function is None else np.zeros(self.n_s)  # compiled_load's
         return "joint_force", (self.index, self.parent), tau
 
     def compiled_load(self) -> tuple | None:

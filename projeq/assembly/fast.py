@@ -93,9 +93,9 @@ class PythonPieceWarning(UserWarning):
 HOW_TO_COMPILE = {
     "joint": "state a joint's motion once as statement(q_n, t, m) (docs/architecture.md, 'Adding a joint') or in "
              "sympy (UserJoint.from_sympy; a Prescribed motion as an expression in t)",
-    "force law": "build the loads from the laws of projeq.forces, a load that varies as a callable (t, q, s_dot) "
-                 "written with numpy and math on numbers and arrays (numba compiles it), or state a load on a body "
-                 "once as a projeq.BodyLoad (docs/architecture.md, 'Adding a force law')",
+    "force law": "build the loads from the laws of projeq.forces, a load that varies as a callable "
+                 "(t, q, s_dot) written with numpy and math on numbers and arrays (numba compiles it), or "
+                 "state a load on a body once as a projeq.BodyLoad (docs/architecture.md, 'Adding a force law')",
 }
 
 
@@ -142,7 +142,8 @@ class FastEvaluator:
         self._given_motions = given.motions_kernel() if self._given and not self._python_joints and self.compiled \
             else None
         self.interpreted = [f"joint {system.names[n]!r} ({type(system.joints[n]).__name__})" for n in self._python_joints] \
-            + [f"force law {type(law).__name__} ({why})" for law, why in zip(self._python_laws, self._python_why)]
+            + [f"force law {type(law).__name__} ({why})"
+               for law, why in zip(self._python_laws, self._python_why)]
         if self.interpreted and self.compiled:
             how = "; ".join(hint for piece, hint in HOW_TO_COMPILE.items()
                             if any(name.startswith(piece) for name in self.interpreted))
@@ -285,8 +286,8 @@ class FastEvaluator:
         if self._add_loads is not None:
             if isinstance(t, complex) and t.imag and np.any(self._laws[:, loads.CALLBACK]):
                 raise ValueError(f"t: the compiled loop of force laws takes a real time, got {t}")
-            failed = self._add_loads(self._laws, self._law_constants, self._index, float(np.real(t)), q, s_dot, q_all,
-                                     s_all, ws.R, ws.r, ws.twist, ws.F, ws.T, ws.h_hat)
+            failed = self._add_loads(self._laws, self._law_constants, self._index, float(np.real(t)), q, s_dot,
+                                     q_all, s_all, ws.R, ws.r, ws.twist, ws.F, ws.T, ws.h_hat)
             if failed >= 0:
                 self.system.evaluator("recursive").accelerations(q, s_dot, t)  # the law's add_to says why
                 raise ValueError(f"forces: law {failed} of the compiled ones cannot be evaluated at t = {t:.6g}")

@@ -19,6 +19,7 @@ import os
 import re
 import sys
 import tempfile
+import types
 import warnings
 from pathlib import Path
 
@@ -150,16 +151,28 @@ _LOADS: dict = {}  # (load_key(function), size, n_q, n_s) -> (callbacks, paramet
 
 
 def load_key(function):
-    """A hashable key of a callable's code and captured values (its closure's cells, arrays by their
-    bytes, and its defaults): one check of closures of the same source and numbers (a scene built
-    twice); the callable itself where they do not hash."""
+    """A hashable key of a callable's code and the values it reads (its closure's cells, the numbers
+    of its module it names, arrays by their bytes, and its defaults): one check of closures of the
+    same source and numbers (a scene built twice); the callable itself where they do not hash."""
     try:
         cells = tuple(_frozen(c.cell_contents) for c in (function.__closure__ or ()))
-        key = (function.__code__, cells, function.__defaults__)
+        numbers = tuple((name, _frozen(function.__globals__[name])) for name in sorted(_names(function.__code__))
+                        if isinstance(function.__globals__.get(name), (int, float, np.number, np.ndarray)))
+        key = (function.__code__, cells, numbers, function.__defaults__)
         hash(key)
     except (AttributeError, TypeError, ValueError):
         return function
     return key
+
+
+def _names(code) -> set:
+    """The names a code object and its nested ones (comprehensions, inner functions) read."""
+    names, codes = set(), [code]
+    while codes:
+        c = codes.pop()
+        names.update(c.co_names)
+        codes.extend(k for k in c.co_consts if isinstance(k, types.CodeType))
+    return names
 
 
 def _frozen(value):
@@ -183,8 +196,8 @@ def load_callbacks(function, size: int, n_q: int, n_s: int) -> tuple:
         try:
             _LOADS[key] = _compiled_load(function, size, n_q, n_s)
         except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
-            lines = [line.strip() for line in re.sub(r"\x1b\[[0-9;]*m", "", str(exc)).splitlines() if line.strip()]
-            _LOADS[key] = None, f"{type(exc).__name__}: {' '.join(lines[:2])[:200]}"
+            lines = [line.strip() for line in re.sub(r"\x1b\[[0-9;]*m", "", str(exc)).splitlines()]
+            _LOADS[key] = None, f"{type(exc).__name__}: {' '.join(filter(None, lines))[:200]}"
     return _LOADS[key]
 
 
@@ -193,7 +206,8 @@ LOAD_INTO = """
 @numba.cfunc(nb.void(nb.float64, nb.CPointer(nb.{dtype}), nb.int64, nb.CPointer(nb.{dtype}), nb.int64,
                      nb.CPointer(nb.float64), nb.CPointer(nb.{dtype})), cache=True)
 def {name}(t, q_pointer, n_q, s_pointer, n_s, p_pointer, load_pointer):
-    q, s_dot, p = numba.carray(q_pointer, (n_q,)), numba.carray(s_pointer, (n_s,)), numba.carray(p_pointer, ({n_p},))
+    q, s_dot = numba.carray(q_pointer, (n_q,)), numba.carray(s_pointer, (n_s,))
+    p = numba.carray(p_pointer, ({n_p},))
     found, load = numpy.asarray(function(t, q, s_dot, p)).ravel(), numba.carray(load_pointer, ({size},))
     for i in range({size}):
         load[i] = found[i] if found.shape[0] == {size} else numpy.nan
@@ -206,11 +220,12 @@ def _compiled_load(function, size: int, n_q: int, n_s: int) -> tuple:
     stated = stated_load(function)
     if stated is not None:
         try:
-            source, parameters = stated
-            module = source_module(source + "".join(LOAD_INTO.format(n_p=len(parameters), size=size, dtype=dtype, name=name)
-                                                    for dtype, name in (("float64", "into"), ("complex128", "complex_into"))))
-            _check_load(function, lambda t, q, s_dot: module.function(t, q, s_dot, parameters), size, n_q, n_s)
-            return (module.into, module.complex_into), parameters
+            source, p = stated
+            module = source_module(source + "".join(
+                LOAD_INTO.format(n_p=len(p), size=size, dtype=dtype, name=name)
+                for dtype, name in (("float64", "into"), ("complex128", "complex_into"))))
+            _check_load(function, lambda t, q, s_dot: module.function(t, q, s_dot, p), size, n_q, n_s)
+            return (module.into, module.complex_into), p
         except Exception:  # noqa: BLE001 — compiled with its numbers frozen instead
             pass
     numba = kernels.numba_module()
@@ -226,7 +241,8 @@ def _check_load(function, jitted, size: int, n_q: int, n_s: int) -> None:
         q, s_dot = (rng.uniform(-1, 1, n) + 1j * 1e-30 * rng.standard_normal(n) for n in (n_q, n_s))
         want = np.ravel(np.asarray(function(t, q, s_dot), dtype=complex))
         got = np.ravel(np.asarray(jitted(t, q, s_dot), dtype=complex))
-        scale, rate = max(1.0, np.abs(want.real).max(initial=0.0)), max(1.0, np.abs(want.imag / 1e-30).max(initial=0.0))
+        scale = max(1.0, np.abs(want.real).max(initial=0.0))
+        rate = max(1.0, np.abs(want.imag / 1e-30).max(initial=0.0))
         if not (got.shape == want.shape == (size,) and np.all(np.abs(got.real - want.real) <= 1e-13 * scale)
                 and np.all(np.abs(got.imag - want.imag) / 1e-30 <= 1e-13 * rate)):
             raise ValueError(f"its compiled values {got} differ from its own {want} at t = {t}")
@@ -256,7 +272,6 @@ def stated_load(function) -> tuple[str, np.ndarray] | None:
     import ast
     import inspect
     import linecache
-    import types
 
     code = getattr(function, "__code__", None)
     if code is None or code.co_argcount != 3 or function.__defaults__ or code.co_kwonlyargcount:
@@ -268,17 +283,13 @@ def stated_load(function) -> tuple[str, np.ndarray] | None:
     arguments = list(code.co_varnames[:3])
     found = [node for node in ast.walk(tree) if isinstance(node, (ast.Lambda, ast.FunctionDef))
              and min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])]) == code.co_firstlineno
-             and [a.arg for a in node.args.args] == arguments and not node.args.vararg and not node.args.kwarg]
+             and [a.arg for a in node.args.args] == arguments
+             and not (node.args.vararg or node.args.kwarg)]
     if len(found) != 1:
         return None
     values = dict(zip(code.co_freevars, (cell.cell_contents for cell in function.__closure__ or ())))
-    names, codes = set(), [code]
-    while codes:  # the names the code and its nested codes (comprehensions) read
-        c = codes.pop()
-        names.update(c.co_names)
-        codes.extend(k for k in c.co_consts if isinstance(k, types.CodeType))
     imports = []
-    for name in sorted(names):
+    for name in sorted(_names(code)):
         value = function.__globals__.get(name)
         if isinstance(value, types.ModuleType):
             imports.append(f"import {value.__name__} as {name}")
@@ -293,13 +304,14 @@ def stated_load(function) -> tuple[str, np.ndarray] | None:
         at = sum(len(v) for v in p)
         p.append(value.ravel())
         entries = f"projeq_p[{at}:{at + value.size}]"
-        lines.append(f"    {name} = projeq_p[{at}]" if value.ndim == 0 else f"    {name} = {entries}" if value.ndim == 1
-                     else f"    {name} = {entries}.reshape({value.shape})")
+        unpacked = f"projeq_p[{at}]" if value.ndim == 0 else entries if value.ndim == 1 else \
+            f"{entries}.reshape({value.shape})"
+        lines.append(f"    {name} = {unpacked}")
     node = found[0]
     body = [f"    return {ast.unparse(node.body)}"] if isinstance(node, ast.Lambda) else \
         [f"    {line}" for statement in node.body for line in ast.unparse(statement).splitlines()]
-    source = "\n".join([*imports, "", "", "@numba.njit(cache=True)", f"def function({', '.join(arguments)}, projeq_p):",
-                        *lines, *body, ""])
+    signature = f"def function({', '.join(arguments)}, projeq_p):"
+    source = "\n".join([*imports, "", "", "@numba.njit(cache=True)", signature, *lines, *body, ""])
     return "\n".join(["import numba", "import numpy", "from numba import types as nb", source]), \
         np.concatenate(p) if p else np.zeros(0)
 
@@ -366,8 +378,10 @@ def intrinsics() -> dict:
         def call(context, builder, signature, args):
             kinds = signature.args
             chosen = 1 if isinstance(kinds[3].dtype, numba.types.Complex) else 0
-            return caller(numba.types.void(kinds[chosen], *kinds[2:]), (args[chosen], *args[2:]), context, builder)
+            chosen_kinds = numba.types.void(kinds[chosen], *kinds[2:])
+            return caller(chosen_kinds, (args[chosen], *args[2:]), context, builder)
 
         return numba.types.void(address, complex_address, t, q, n_q, s_dot, n_s, p, load), call
 
-    return {"phi_into": phi_into, "given_into": given_into, "wrench_into": wrench_into, "load_into": load_into}
+    return {"phi_into": phi_into, "given_into": given_into, "wrench_into": wrench_into,
+            "load_into": load_into}

@@ -57,7 +57,8 @@ KINDS = {"wrench": WRENCH, "spring_damper": SPRING_DAMPER, "joint_force": JOINT_
 #: load's callable (0: none), where that load goes in the row's constants and where the callable's
 #: numbers (its data p) start there
 KIND, FIRST, SECOND, CALLBACK, COMPLEX_CALLBACK, AT, PARAMETERS = range(7)
-_INTERPRETED: dict = {}  # an "address" in the interpreted loop -> a stated law's printed wrench, or (callable, size)
+#: an "address" in the interpreted loop -> a stated law's printed wrench, or (callable, size) of a load
+_INTERPRETED: dict = {}
 
 
 def compiled_rows(system, compiled: bool) -> tuple[np.ndarray, np.ndarray, list]:
@@ -220,5 +221,6 @@ CALLEES = (body_wrench, spring_end, spring_damper, spring_force, joint_wrench, l
 
 @functools.cache
 def _compiled():
-    return kernels.jit(add_loads, callees=CALLEES, kernels={name: intrinsics()[name] for name in ("wrench_into",
-                                                                                                 "load_into")})
+    intrinsic = intrinsics()
+    return kernels.jit(add_loads, callees=CALLEES,
+                       kernels={"wrench_into": intrinsic["wrench_into"], "load_into": intrinsic["load_into"]})
