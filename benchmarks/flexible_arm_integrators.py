@@ -78,8 +78,9 @@ def jacobian(jac, model, complex_ws, x, J):
     J[:] = 0.0
     for i in range(n_q):
         J[i, n_q + i] = 1.0
-    jac(index, geometry, inertia, gravity, x, n_q, COMPLEX_STEP, given, elastic, ports, T, zeta, F, M_n, M_hat,
-        h_hat, R, r, twist, pivot_min, J[n_q:])
+    no_laws, no_constants = np.zeros((0, 7), np.int64), np.zeros((0, 0))  # the arm has gravity only
+    jac(0.0, index, geometry, inertia, gravity, no_laws, no_constants, x, n_q, COMPLEX_STEP, given, elastic, ports,
+        T, zeta, F, M_n, M_hat, h_hat, R, r, twist, pivot_min, J[n_q:])
 
 
 @numba.njit(cache=True)

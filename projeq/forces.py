@@ -8,7 +8,9 @@ joint's minimal velocities enters as an equal and opposite pair: h_n += w, h_p �
 with F_nᵀ w = τ (w = F_n (F_nᵀF_n)⁻¹ τ), whose projection Σ J_nᵀ h_n is exactly τ on ṡ_n
 (B(14)); so the assemblers never special-case joint forces.
 
-Callables receive ``(t, q, s_dot)`` and return the load.
+Callables receive ``(t, q, s_dot)`` and return the load; the compiled evaluator compiles them
+with numba (``compiled_load``; numbers they read from their closure or module are frozen then,
+as ``numba.njit`` does), and runs one numba cannot compile in Python, saying so once.
 
 Each law states its symbolic form next to its numeric one (:class:`ForceLaw`):
 ``symbolic_wrenches`` (body wrenches) or ``symbolic_joint_forces`` (τ on minimal
@@ -19,10 +21,10 @@ The numeric terms are stated once, as plain functions on arrays and scalars in t
 numba compiles (:func:`body_wrench`, :func:`spring_end`, :func:`spring_damper`,
 :func:`spring_force`, :func:`joint_wrench`): a law's ``add_to`` calls them (the reference
 evaluators), and the compiled evaluator calls the same source from its loop over the laws'
-rows (:mod:`projeq.assembly.loads`), which each law with constant loads or stated terms
-gives by ``compiled_terms``. They index matrices as ``R[i][j]``, so ``add_to`` hands them
-nested lists of Python numbers (several times faster interpreted than numpy scalars) and
-the compiled loop arrays; they take complex numbers too (a complex step), so they compare
+rows (:mod:`projeq.assembly.loads`), which each law of this module gives by ``compiled_terms``
+(a load given as a callable by ``compiled_load`` too). They index matrices as ``R[i][j]``, so
+``add_to`` hands them nested lists of Python numbers (several times faster interpreted than
+numpy scalars) and the compiled loop arrays; they take complex numbers too (a complex step), so they compare
 real parts only.
 """
 
@@ -145,14 +147,14 @@ def _load(name: str, value, shape: tuple) -> Callable:
             out = _one_number(numeric(value(t, q, s_dot)), shape)  # complex in a complex step
             finite_array(name, np.real(out), shape)
             return out
-        load.constant = None
+        load.constant, load.function = None, value  # the callable, for the compiled loop (compiled_load)
         return load
     constant = finite_array(name, _one_number(value, shape), shape)
 
     def load(t, q, s_dot):
         return constant
 
-    load.constant = constant  # the value, for the symbolic forms
+    load.constant, load.function = constant, None  # the value, for the symbolic forms
     return load
 
 
@@ -189,7 +191,7 @@ class ForceLaw:
 
     Its symbolic form: :meth:`symbolic_wrenches` and :meth:`symbolic_joint_forces`, and
     :meth:`symbolic_unsupported` (None when it has one); its row of the compiled evaluator:
-    :meth:`compiled_terms`. A subclass that restates ``add_to``, ``wrench`` or
+    :meth:`compiled_terms` (and :meth:`compiled_load`). A subclass that restates ``add_to``, ``wrench`` or
     ``generalized_force`` loses the symbolic form and the compiled row it inherits unless
     it restates them too, so an override is never bypassed.
     """
@@ -197,7 +199,8 @@ class ForceLaw:
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         drop_inherited_twins(cls, ForceLaw, ("add_to", "wrench", "generalized_force"),
-                             ("symbolic_unsupported", "symbolic_wrenches", "symbolic_joint_forces", "compiled_terms"))
+                             ("symbolic_unsupported", "symbolic_wrenches", "symbolic_joint_forces",
+                              "compiled_terms", "compiled_load"))
 
     def bind(self, system) -> "ForceLaw":
         """Resolve the names the law was given in ``system`` (indices, selections) and return
@@ -215,8 +218,14 @@ class ForceLaw:
     def compiled_terms(self) -> tuple | None:
         """(kind, indices, constants) of the bound law for the compiled evaluator's loop
         (:mod:`projeq.assembly.loads`, which names the kinds and their layouts), the same
-        statement its ``add_to`` calls; None (the default, and a law with a callable load):
-        the compiled evaluator calls ``add_to``."""
+        statement its ``add_to`` calls; None (the default): the compiled evaluator calls ``add_to``."""
+        return None
+
+    def compiled_load(self) -> tuple | None:
+        """(function, at, size) where the law's load is a callable ``function(t, q, s_dot)`` of ``size``
+        entries: the compiled loop writes its value into the row's constants from entry ``at`` on at
+        each evaluation (numba compiles it, :func:`projeq.assembly.generated.load_callbacks`; one it
+        cannot compile keeps the law on ``add_to``); None (the default): the constants are the load."""
         return None
 
     def symbolic_unsupported(self) -> str | None:
@@ -271,9 +280,11 @@ class Force(_BodyLoad):
         return np.array(wrench)
 
     def compiled_terms(self) -> tuple | None:
-        if self.force.constant is None:
-            return None
-        return "wrench", (self.index, self.frame == "world"), np.concatenate((self.force.constant, self.point, _ZERO))
+        force = _ZERO if self.force.function is not None else self.force.constant  # compiled_load's
+        return "wrench", (self.index, self.frame == "world"), np.concatenate((force, self.point, _ZERO))
+
+    def compiled_load(self) -> tuple | None:
+        return None if self.force.function is None else (self.force.function, 0, 3)
 
     def symbolic_unsupported(self) -> str | None:
         return _callable("force", self.force)
@@ -297,9 +308,11 @@ class Torque(_BodyLoad):
         return np.array(wrench)
 
     def compiled_terms(self) -> tuple | None:
-        if self.torque.constant is None:
-            return None
-        return "wrench", (self.index, self.frame == "world"), np.concatenate((_ZERO, _ZERO, self.torque.constant))
+        torque = _ZERO if self.torque.function is not None else self.torque.constant  # compiled_load's
+        return "wrench", (self.index, self.frame == "world"), np.concatenate((_ZERO, _ZERO, torque))
+
+    def compiled_load(self) -> tuple | None:
+        return None if self.torque.function is None else (self.torque.function, 6, 3)
 
     def symbolic_unsupported(self) -> str | None:
         return _callable("torque", self.torque)
@@ -318,9 +331,8 @@ class BodyLoad(ForceLaw):
     :meth:`add_to` (numpy, the reference evaluators; complex under a complex step),
     :meth:`symbolic_wrenches` (traced with sympy, for :func:`projeq.symbolic.gauss_form`) and the
     compiled loop's row (:meth:`compiled_terms`, :meth:`compiled_wrench`: the traced wrench printed
-    for numba, its numbers passed as data; :mod:`projeq.assembly.loads`). A wrench that depends on t
-    runs in Python in the compiled kernel (named once by its PythonPieceWarning). The potential is
-    0 unless the subclass states :meth:`potential`.
+    for numba, its numbers passed as data, t an argument; :mod:`projeq.assembly.loads`), a wrench that
+    depends on t too. The potential is 0 unless the subclass states :meth:`potential`.
 
     >>> import numpy as np
     >>> class Drag(BodyLoad):  # −c |v| v at the body's origin
@@ -364,21 +376,18 @@ class BodyLoad(ForceLaw):
     def compiled_wrench(self):
         """``wrench(R, r, w, t)``, the statement traced with sympy at symbols of R (row by row), r and the
         twist w = (v, ω), the law's numbers as constants (:func:`projeq.joints.statement.parameterized`),
-        printed as scalar code that numba compiles (:func:`projeq.symbolic.codegen.numeric_function`);
-        None where the wrench depends on t. Built once per law."""
+        printed as scalar code that numba compiles (:func:`projeq.symbolic.codegen.numeric_function`).
+        Built once per law."""
         if "_printed" not in self.__dict__:
             self._printed = _printed_wrench(self)
         return self._printed
 
     def compiled_terms(self) -> tuple | None:
-        values = self.compiled_wrench()
-        if values is None:
-            return None
-        return "stated", (self.index,), np.array(values.values, dtype=float)
+        return "stated", (self.index,), np.array(self.compiled_wrench().values, dtype=float)
 
 
 def _printed_wrench(law):
-    """:meth:`BodyLoad.compiled_wrench` of ``law`` (None where its traced wrench depends on t)."""
+    """:meth:`BodyLoad.compiled_wrench` of ``law``."""
     R, r, w, t = sp.symbols("R0:9"), sp.symbols("r0:3"), sp.symbols("w0:6"), sp.Symbol("t")
 
     def trace(tracer):
@@ -386,8 +395,6 @@ def _printed_wrench(law):
                                           statement.SYMBOLIC)).reshape(6, 1)
 
     wrench, symbols, values = statement.parameterized(law, trace, ("S",))
-    if t in wrench.free_symbols:
-        return None
     return _print_wrench(R, r, w, t, sp.ImmutableMatrix(wrench), symbols)(*values)
 
 
@@ -401,7 +408,8 @@ def _print_wrench(R, r, w, t, wrench, symbols):
 
 class JointForce(ForceLaw):
     """A generalized force τ on the minimal velocities ṡ_n of ``joint`` (a motor torque,
-    a drive force): a constant or a callable ``(t, q, s_dot) -> τ``."""
+    a drive force): a constant or a callable ``(t, q, s_dot) -> τ`` (compiled by numba where it
+    can be, :meth:`ForceLaw.compiled_load`: written with numpy and math on t, q and ṡ)."""
 
     def __init__(self, joint: str, tau):
         self.joint = joint
@@ -427,9 +435,11 @@ class JointForce(ForceLaw):
         h[self.parent] += w_p  # the reaction −T_npᵀ w
 
     def compiled_terms(self) -> tuple | None:
-        if self._tau.constant is None:
-            return None
-        return "joint_force", (self.index, self.parent), self._tau.constant
+        tau = self._tau.constant if self._tau.function is None else np.zeros(self.n_s)  # compiled_load's
+        return "joint_force", (self.index, self.parent), tau
+
+    def compiled_load(self) -> tuple | None:
+        return None if self._tau.function is None else (self._tau.function, 0, self.n_s)
 
     def symbolic_unsupported(self) -> str | None:
         return _callable("tau", self._tau)

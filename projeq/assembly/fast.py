@@ -93,8 +93,9 @@ class PythonPieceWarning(UserWarning):
 HOW_TO_COMPILE = {
     "joint": "state a joint's motion once as statement(q_n, t, m) (docs/architecture.md, 'Adding a joint') or in "
              "sympy (UserJoint.from_sympy; a Prescribed motion as an expression in t)",
-    "force law": "build the loads from the laws of projeq.forces (constant loads) or state a load on a body once as a "
-                 "projeq.BodyLoad (docs/architecture.md, 'Adding a force law')",
+    "force law": "build the loads from the laws of projeq.forces, a load that varies as a callable "
+                 "(t, q, s_dot) written with numpy and math on numbers and arrays (numba compiles it), or "
+                 "state a load on a body once as a projeq.BodyLoad (docs/architecture.md, 'Adding a force law')",
 }
 
 
@@ -141,7 +142,8 @@ class FastEvaluator:
         self._given_motions = given.motions_kernel() if self._given and not self._python_joints and self.compiled \
             else None
         self.interpreted = [f"joint {system.names[n]!r} ({type(system.joints[n]).__name__})" for n in self._python_joints] \
-            + [f"force law {type(law).__name__}" for law in self._python_laws]
+            + [f"force law {type(law).__name__} ({why})"
+               for law, why in zip(self._python_laws, self._python_why)]
         if self.interpreted and self.compiled:
             how = "; ".join(hint for piece, hint in HOW_TO_COMPILE.items()
                             if any(name.startswith(piece) for name in self.interpreted))
@@ -204,14 +206,9 @@ class FastEvaluator:
         self._n_cols = n_cols
         self._x_shape = (system.n_q + system.n_s,)
         self._internal = [(n, system.e_s_slice[n]) for n, b in enumerate(bodies) if b.n_e]  # ṡ_e of ẏ_n
-        terms = [law.compiled_terms() for law in system.forces]
-        addresses = [loads.stated_addresses(law.compiled_wrench(), self.compiled) if row and row[0] == "stated"
-                     else None for law, row in zip(system.forces, terms)]
-        terms = [None if row and row[0] == "stated" and address is None else row  # numba refused it (it warned)
-                 for row, address in zip(terms, addresses)]
-        kept = [(row, address) for row, address in zip(terms, addresses) if row is not None]
-        self._laws, self._law_constants = loads.table([row for row, _ in kept], [address for _, address in kept])
-        self._python_laws = [law for law, row in zip(system.forces, terms) if row is None]  # their own add_to
+        self._laws, self._law_constants, python = loads.compiled_rows(system, self.compiled)
+        self._python_laws = [law for law, _ in python]  # their own add_to
+        self._python_why = [why for _, why in python]
         # the h_n the force laws load in the reference evaluators' coordinates: rows of n_y for
         # the bodies with a selection S (zeroed before each evaluation), the workspace's rows for
         # the others, none for the ground
@@ -287,8 +284,10 @@ class FastEvaluator:
         """T_np, ζ_n, F_n, h_n (forces included) of every body into the workspace ``ws``."""
         q_all, s_all = self._kinematics(ws, q, s_dot, t)
         if self._add_loads is not None:
-            failed = self._add_loads(self._laws, self._law_constants, self._index, q_all, s_all, ws.R, ws.r,
-                                     ws.twist, ws.F, ws.T, ws.h_hat)
+            if isinstance(t, complex) and t.imag and np.any(self._laws[:, loads.CALLBACK]):
+                raise ValueError(f"t: the compiled loop of force laws takes a real time, got {t}")
+            failed = self._add_loads(self._laws, self._law_constants, self._index, float(np.real(t)), q, s_dot,
+                                     q_all, s_all, ws.R, ws.r, ws.twist, ws.F, ws.T, ws.h_hat)
             if failed >= 0:
                 self.system.evaluator("recursive").accelerations(q, s_dot, t)  # the law's add_to says why
                 raise ValueError(f"forces: law {failed} of the compiled ones cannot be evaluated at t = {t:.6g}")
@@ -384,7 +383,7 @@ class FastEvaluator:
             return None
         if x.shape != self._x_shape:
             self._refuse(x)
-        head = self._head(float, t) if self._given else ()
+        head = self._head(float, t)
         if head is None:
             return None
         self.n_calls += 1
@@ -399,9 +398,11 @@ class FastEvaluator:
                          f"{x.shape}")
 
     def _head(self, dtype, t: float) -> tuple | None:
-        """The one-call kernels' arguments before the tree's where it has joints of kind GIVEN: their
-        table of C callbacks of ``dtype`` and the time t (:func:`projeq.assembly.given.given_state_derivative`),
-        None where numba cannot compile one."""
+        """The one-call kernels' arguments before the tree's: the time t, after the table of C callbacks
+        of ``dtype`` of the joints of kind GIVEN where the tree has them
+        (:func:`projeq.assembly.given.given_state_derivative`; None where numba cannot compile one)."""
+        if not self._given:
+            return (float(t),)
         table = self._joint_table(dtype)
         return None if table is None else (table, float(t))
 
@@ -418,7 +419,7 @@ class FastEvaluator:
             return None
         if x.shape != self._x_shape:
             self._refuse(x)
-        head = self._head(complex, t) if self._given else ()
+        head = self._head(complex, t)
         if head is None:
             return None
         self.n_calls += len(x)
@@ -476,10 +477,10 @@ def unsupported(system) -> str | None:
             reason = elastic_unsupported(body)
             if reason:
                 return f"subsystem {name!r} is a {type(body).__name__} {reason}"
-            python = [type(law).__name__ for law in system.forces if law.compiled_terms() is None]
+            python = loads.compiled_rows(system, kernels.has_numba())[2]
             if python:
                 return (f"subsystem {name!r} is elastic in a system with force laws the kernel cannot compile "
-                        f"({', '.join(python)}: a callable load or a user's law)")
+                        f"({'; '.join(f'{type(law).__name__}: {why}' for law, why in python)})")
         elif body.rigid_inertia is None:
             return (f"subsystem {name!r} is a {type(body).__name__} (the kernel knows the terms of rigid bodies, "
                     "rigid_inertia, spatial or selected by S, and of RitzBeams)")

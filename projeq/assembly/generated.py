@@ -3,7 +3,9 @@
 A plug-in's statement, traced with sympy and printed as scalar code (:mod:`projeq.symbolic.codegen`),
 is compiled by numba into a C callback — a joint's relative motion (:mod:`projeq.assembly.given`), a
 force law's body wrench (:func:`law_callback`), a constraint Φ (:mod:`projeq.constraints.compiled`) —
-in a module written once per printed source (:func:`generated_module`) and cached on disk; the
+in a module written once per printed source (:func:`generated_module`) and cached on disk; a load
+given as a callable of (t, q, ṡ) is printed from its source with the numbers it reads as data, or
+compiled by ``numba.njit`` in memory with them frozen (:func:`load_callbacks`); the
 numbers of the plug-in (its parameters) are data, passed by the address of an array
 (:func:`parameters`); the compiled kernels call the callbacks through their addresses by the
 intrinsics of :func:`intrinsics`.
@@ -14,8 +16,10 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+import re
 import sys
 import tempfile
+import types
 import warnings
 from pathlib import Path
 
@@ -48,9 +52,6 @@ def generated_module(f, into: str, parameters: bool = False):
     writable: compiled anew each process). ``f``'s constants (``f.constants``) are, with
     ``parameters``, the entries of a last argument p of ``function`` (one module for all their
     values), else module globals holding their values (``f.values``)."""
-    import importlib.util
-
-    numba = kernels.numba_module()
     header = f.source.split("\n", 1)
     if parameters:
         signature = header[0].replace(f"def {f.__name__}(", "def function(", 1).replace("):", ", p):", 1)
@@ -59,8 +60,16 @@ def generated_module(f, into: str, parameters: bool = False):
     else:
         constants = [f"{name} = {float(value)!r}" for name, value in sorted(zip(f.constants, f.values))]
         body = f.source.replace(f"def {f.__name__}(", "def function(", 1)
-    source = "\n".join(["import numba", "import numpy", "from numba import types as nb", "", *constants, "",
-                        "@numba.njit(cache=True)", body, into])
+    return source_module("\n".join(["import numba", "import numpy", "from numba import types as nb", "", *constants,
+                                     "", "@numba.njit(cache=True)", body, into]))
+
+
+def source_module(source: str):
+    """The module of ``source`` (:func:`generated_module`), written once to a file named by its digest
+    and imported, once per process."""
+    import importlib.util
+
+    numba = kernels.numba_module()
     digest = hashlib.sha1((source + numba.__version__).encode()).hexdigest()[:20]
     module_name = f"projeq_generated_{digest}"
     if module_name not in sys.modules:
@@ -138,10 +147,186 @@ def law_callback(values, dtype=float):
                     UncompiledLawWarning)
 
 
+_LOADS: dict = {}  # (load_key(function), size, n_q, n_s) -> (callbacks, parameters), or (None, why not)
+
+
+def load_key(function):
+    """A hashable key of a callable's code and the values it reads (its closure's cells, the numbers
+    of its module it names, arrays by their bytes, and its defaults): one check of closures of the
+    same source and numbers (a scene built twice); the callable itself where they do not hash."""
+    try:
+        cells = tuple(_frozen(c.cell_contents) for c in (function.__closure__ or ()))
+        numbers = tuple((name, _frozen(function.__globals__[name])) for name in sorted(_names(function.__code__))
+                        if isinstance(function.__globals__.get(name), (int, float, np.number, np.ndarray)))
+        key = (function.__code__, cells, numbers, function.__defaults__)
+        hash(key)
+    except (AttributeError, TypeError, ValueError):
+        return function
+    return key
+
+
+def _names(code) -> set:
+    """The names a code object and its nested ones (comprehensions, inner functions) read."""
+    names, codes = set(), [code]
+    while codes:
+        c = codes.pop()
+        names.update(c.co_names)
+        codes.extend(k for k in c.co_consts if isinstance(k, types.CodeType))
+    return names
+
+
+def _frozen(value):
+    """An array as (dtype, shape, bytes), hashable; anything else as it is."""
+    return (value.dtype.str, value.shape, value.tobytes()) if isinstance(value, np.ndarray) else value
+
+
+def load_callbacks(function, size: int, n_q: int, n_s: int) -> tuple:
+    """((float64, complex128) C callbacks ``into(t, q, n_q, s_dot, n_s, p, load)``, parameters p) of a
+    load given as a callable ``function(t, q, s_dot)`` of ``size`` entries (a scalar where ``size``
+    is 1), or (None, why) where numba cannot compile it or its compiled values differ from its own
+    (real and imaginary parts, a complex step, each to 1e-13 relative at three states of n_q
+    coordinates and n_s velocities). A lambda or function whose source reads numbers (scalars,
+    real arrays) from its closure or module is printed with those numbers as the data p
+    (:func:`stated_load`): one compiled module per source, cached on disk, for every value of its
+    numbers; any other is compiled by ``numba.njit`` in memory with its captured values frozen
+    (p empty). A load of another size is written as NaN (the loop then names the law,
+    :func:`projeq.assembly.loads.add_loads`)."""
+    key = (load_key(function), size, n_q, n_s)
+    if key not in _LOADS:
+        try:
+            _LOADS[key] = _compiled_load(function, size, n_q, n_s)
+        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+            lines = [line.strip() for line in re.sub(r"\x1b\[[0-9;]*m", "", str(exc)).splitlines()]
+            _LOADS[key] = None, f"{type(exc).__name__}: {' '.join(filter(None, lines))[:200]}"
+    return _LOADS[key]
+
+
+#: a C callback of a stated load (:func:`stated_load`) of one dtype
+LOAD_INTO = """
+@numba.cfunc(nb.void(nb.float64, nb.CPointer(nb.{dtype}), nb.int64, nb.CPointer(nb.{dtype}), nb.int64,
+                     nb.CPointer(nb.float64), nb.CPointer(nb.{dtype})), cache=True)
+def {name}(t, q_pointer, n_q, s_pointer, n_s, p_pointer, load_pointer):
+    q, s_dot = numba.carray(q_pointer, (n_q,)), numba.carray(s_pointer, (n_s,))
+    p = numba.carray(p_pointer, ({n_p},))
+    found, load = numpy.asarray(function(t, q, s_dot, p)).ravel(), numba.carray(load_pointer, ({size},))
+    for i in range({size}):
+        load[i] = found[i] if found.shape[0] == {size} else numpy.nan
+"""
+
+
+def _compiled_load(function, size: int, n_q: int, n_s: int) -> tuple:
+    """:func:`load_callbacks`' (callbacks, parameters); raises where numba refuses the callable or its
+    values differ."""
+    stated = stated_load(function)
+    if stated is not None:
+        try:
+            source, p = stated
+            module = source_module(source + "".join(
+                LOAD_INTO.format(n_p=len(p), size=size, dtype=dtype, name=name)
+                for dtype, name in (("float64", "into"), ("complex128", "complex_into"))))
+            _check_load(function, lambda t, q, s_dot: module.function(t, q, s_dot, p), size, n_q, n_s)
+            return (module.into, module.complex_into), p
+        except Exception:  # noqa: BLE001 — compiled with its numbers frozen instead
+            pass
+    numba = kernels.numba_module()
+    jitted = function if isinstance(function, numba.core.dispatcher.Dispatcher) else numba.njit(function)
+    _check_load(function, jitted, size, n_q, n_s)
+    return _frozen_callbacks(jitted, size), np.zeros(0)
+
+
+def _check_load(function, jitted, size: int, n_q: int, n_s: int) -> None:
+    """ValueError unless the compiled ``jitted`` gives ``function``'s values (:func:`load_callbacks`)."""
+    rng = np.random.default_rng(7)
+    for t in (0.0, 0.37, 1.9):
+        q, s_dot = (rng.uniform(-1, 1, n) + 1j * 1e-30 * rng.standard_normal(n) for n in (n_q, n_s))
+        try:
+            want = np.ravel(np.asarray(function(t, q, s_dot), dtype=complex))
+        except Exception as exc:  # noqa: BLE001 — a user's callable raises what it raises
+            raise ValueError(f"calling it at t = {t} raised {type(exc).__name__}: {exc}") from exc
+        got = np.ravel(np.asarray(jitted(t, q, s_dot), dtype=complex))
+        if got.shape != want.shape or not np.array_equal(np.isnan(got), np.isnan(want)):
+            raise ValueError(f"its compiled values {got} differ from its own {want} at t = {t}")
+        got, want = np.nan_to_num(got), np.nan_to_num(want)  # a NaN where its own is NaN: the loop names it
+        scale = max(1.0, np.abs(want.real).max(initial=0.0))
+        rate = max(1.0, np.abs(want.imag / 1e-30).max(initial=0.0))
+        if not (want.shape == (size,) and np.all(np.abs(got.real - want.real) <= 1e-13 * scale)
+                and np.all(np.abs(got.imag - want.imag) / 1e-30 <= 1e-13 * rate)):
+            raise ValueError(f"its compiled values {got} differ from its own {want} at t = {t}")
+
+
+def _frozen_callbacks(jitted, size: int) -> tuple:
+    """The C callbacks of :func:`load_callbacks` around a compiled callable (its numbers frozen, p unread)."""
+    numba = kernels.numba_module()
+    from numba import types as nb
+
+    def into(t, q_pointer, n_q, s_pointer, n_s, p_pointer, load_pointer):
+        q, s_dot = numba.carray(q_pointer, (n_q,)), numba.carray(s_pointer, (n_s,))
+        found, load = np.asarray(jitted(t, q, s_dot)).ravel(), numba.carray(load_pointer, (size,))
+        for i in range(size):
+            load[i] = found[i] if found.shape[0] == size else np.nan
+
+    return tuple(numba.cfunc(nb.void(nb.float64, nb.CPointer(kind), nb.int64, nb.CPointer(kind), nb.int64,
+                                     nb.CPointer(nb.float64), nb.CPointer(kind)))(into)
+                 for kind in (nb.float64, nb.complex128))
+
+
+def stated_load(function) -> tuple[str, np.ndarray] | None:
+    """(source, p): a lambda or function of (t, q, s_dot) printed as ``function(t, q, s_dot, p)``, the
+    numbers it reads from its closure and its module (scalars and real arrays) unpacked from p at
+    its start and the modules it reads imported by their names; None where its source cannot be
+    found (one lambda or def of its arguments on its first line) or it reads anything else."""
+    import ast
+    import inspect
+    import linecache
+
+    code = getattr(function, "__code__", None)
+    if code is None or code.co_argcount != 3 or function.__defaults__ or code.co_kwonlyargcount:
+        return None
+    try:
+        tree = ast.parse("".join(linecache.getlines(inspect.getsourcefile(function))))
+    except (OSError, TypeError, SyntaxError):
+        return None
+    arguments = list(code.co_varnames[:3])
+    found = [node for node in ast.walk(tree) if isinstance(node, (ast.Lambda, ast.FunctionDef))
+             and min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])]) == code.co_firstlineno
+             and [a.arg for a in node.args.args] == arguments
+             and not (node.args.vararg or node.args.kwarg)]
+    if len(found) != 1:
+        return None
+    values = dict(zip(code.co_freevars, (cell.cell_contents for cell in function.__closure__ or ())))
+    imports = []
+    for name in sorted(_names(code)):
+        value = function.__globals__.get(name)
+        if isinstance(value, types.ModuleType):
+            imports.append(f"import {value.__name__} as {name}")
+        elif name in function.__globals__:
+            values[name] = value
+    lines, p = [], []
+    for name, value in values.items():
+        if isinstance(value, bool) or not (isinstance(value, (int, float, np.integer, np.floating)) or
+                                           isinstance(value, np.ndarray) and value.dtype.kind == "f"):
+            return None  # anything else (a function, an object): compiled with it frozen
+        value = np.asarray(value, dtype=float)
+        at = sum(len(v) for v in p)
+        p.append(value.ravel())
+        entries = f"projeq_p[{at}:{at + value.size}]"
+        unpacked = f"projeq_p[{at}]" if value.ndim == 0 else entries if value.ndim == 1 else \
+            f"{entries}.reshape({value.shape})"
+        lines.append(f"    {name} = {unpacked}")
+    node = found[0]
+    body = [f"    return {ast.unparse(node.body)}"] if isinstance(node, ast.Lambda) else \
+        [f"    {line}" for statement in node.body for line in ast.unparse(statement).splitlines()]
+    signature = f"def function({', '.join(arguments)}, projeq_p):"
+    source = "\n".join([*imports, "", "", "@numba.njit(cache=True)", signature, *lines, *body, ""])
+    return "\n".join(["import numba", "import numpy", "from numba import types as nb", source]), \
+        np.concatenate(p) if p else np.zeros(0)
+
+
 @functools.cache
 def intrinsics() -> dict:
     """The compiled :func:`projeq.assembly.given.given_into`, ``phi_into`` (Φ's values of
-    :mod:`projeq.constraints.compiled`) and :func:`projeq.assembly.loads.wrench_into`:
+    :mod:`projeq.constraints.compiled`), :func:`projeq.assembly.loads.wrench_into` and
+    :func:`projeq.assembly.loads.load_into`:
     each calls the C function at the address its first argument holds with the data pointers of its
     arrays (numba's own layout of complex128 and float64, that of the C callbacks) and its scalars
     as they are."""
@@ -190,4 +375,19 @@ def intrinsics() -> dict:
 
         return numba.types.void(address, complex_address, R, r, w, t, p, wrench), call
 
-    return {"phi_into": phi_into, "given_into": given_into, "wrench_into": wrench_into}
+    @intrinsic
+    def load_into(typingctx, address, complex_address, t, q, n_q, s_dot, n_s, p, load):
+        # the callback of the arrays' dtype (:func:`load_callbacks`): complex128 under the complex step
+        if not q.dtype == s_dot.dtype == load.dtype or p.dtype != numba.types.float64:
+            return None
+
+        def call(context, builder, signature, args):
+            kinds = signature.args
+            chosen = 1 if isinstance(kinds[3].dtype, numba.types.Complex) else 0
+            chosen_kinds = numba.types.void(kinds[chosen], *kinds[2:])
+            return caller(chosen_kinds, (args[chosen], *args[2:]), context, builder)
+
+        return numba.types.void(address, complex_address, t, q, n_q, s_dot, n_s, p, load), call
+
+    return {"phi_into": phi_into, "given_into": given_into, "wrench_into": wrench_into,
+            "load_into": load_into}

@@ -133,8 +133,8 @@ def given_state_derivative(joints, t, index, geometry, inertia, gravity, laws, c
     time t), then :func:`projeq.assembly.kernels.tree_state_derivative` with q̇ by :func:`given_rates`.
     Returns its status (−1: done)."""
     given_motions(joints, x[:n_q], x[n_q:], t, given)
-    return tree_state_derivative(index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port, T,
-                                 zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, x_dot)
+    return tree_state_derivative(t, index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port,
+                                 T, zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, x_dot)
 
 
 def given_jacobian(joints, t, index, geometry, inertia, gravity, laws, constants, x, n_q, step, given, elastic, port,

@@ -639,10 +639,10 @@ def passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot):
     return -1
 
 
-def tree_accelerations(index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port, T, zeta,
+def tree_accelerations(t, index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port, T, zeta,
                        F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, s_ddot):
-    """s̈ of the order-n kernel at the state x = (q, ṡ) (real, or complex for a complex step) into
-    s_ddot: :func:`chain_terms`, the loads of the force laws' rows ``laws``, ``constants``
+    """s̈ of the order-n kernel at the time t and the state x = (q, ṡ) (real, or complex for a complex
+    step) into s_ddot: :func:`chain_terms`, the loads of the force laws' rows ``laws``, ``constants``
     (:func:`projeq.assembly.loads.add_loads`, bound by :func:`state_kernels`) and :func:`passes`
     on a workspace of x's dtype (T ... twist). For trees whose kinematics the kernel computes
     itself (no joint of kind GIVEN) and whose laws all have compiled rows. Returns −1, or where
@@ -651,21 +651,22 @@ def tree_accelerations(index, geometry, inertia, gravity, laws, constants, x, n_
     chain_terms(index, geometry, inertia, gravity, x[:n_q], x[n_q:], given, elastic, port, T, zeta, F, M_n, h_hat,
                 R, r_O, twist)
     if laws.shape[0]:
-        failed = add_loads(laws, constants, index, x[:n_q], x[n_q:], R, r_O, twist, F, T, h_hat)  # noqa: F821
+        q, s_dot = x[:n_q], x[n_q:]
+        failed = add_loads(laws, constants, index, t, q, s_dot, q, s_dot, R, r_O, twist, F, T, h_hat)  # noqa: F821
         if failed >= 0:
             return x.shape[0] + failed
     return passes(index, T, zeta, F, M_n, M_hat, h_hat, pivot_min, s_ddot)
 
 
-def tree_state_derivative(index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port, T,
+def tree_state_derivative(t, index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port, T,
                           zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, x_dot):
-    """ẋ = (q̇, s̈) = (ṡ, s̈) at the real state x = (q, ṡ) into x_dot in one call
+    """ẋ = (q̇, s̈) = (ṡ, s̈) at the time t and the real state x = (q, ṡ) into x_dot in one call
     (:func:`tree_accelerations`; q̇ = ṡ by :func:`_rates`: K = E for the trees it takes; with joints of
     kind GIVEN, :func:`projeq.assembly.given.given_state_derivative`), the right-hand side of
     :func:`projeq.simulate` without Python between the kernels. Returns −1, or where the
     evaluation failed (:func:`tree_accelerations`' index) or x or ẋ is not finite: a
     non-negative number (the caller's checked evaluation then raises, naming the cause)."""
-    failed = tree_accelerations(index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port,
+    failed = tree_accelerations(t, index, geometry, inertia, gravity, laws, constants, x, n_q, given, elastic, port,
                                 T, zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, x_dot[n_q:])
     if failed >= 0:
         return failed
@@ -683,9 +684,9 @@ def _rates(index, elastic, given, x, n_q, x_dot):
         x_dot[i] = x[n_q + i]
 
 
-def tree_jacobian(index, geometry, inertia, gravity, laws, constants, x, n_q, step, given, elastic, port, T,
+def tree_jacobian(t, index, geometry, inertia, gravity, laws, constants, x, n_q, step, given, elastic, port, T,
                   zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, J):
-    """∂s̈/∂x of the order-n kernel at the real state x = (q, ṡ) by the complex step, column
+    """∂s̈/∂x of the order-n kernel at the time t and the real state x = (q, ṡ) by the complex step, column
     k = Im s̈(x + i step e_k) / step (Squire & Trapp, SIAM Review 40, 1998):
     :func:`tree_accelerations` n_x times in one call on a complex workspace (T ... twist:
     complex128); written into J (n_s × n_x). Returns −1, or the first failed evaluation's
@@ -695,7 +696,7 @@ def tree_jacobian(index, geometry, inertia, gravity, laws, constants, x, n_q, st
     for k in range(n_x):
         z[:] = x
         z[k] += 1j * step
-        failed = tree_accelerations(index, geometry, inertia, gravity, laws, constants, z, n_q, given, elastic,
+        failed = tree_accelerations(t, index, geometry, inertia, gravity, laws, constants, z, n_q, given, elastic,
                                     port, T, zeta, F, M_n, M_hat, h_hat, R, r_O, twist, pivot_min, s_ddot)
         if failed >= 0:
             return failed

@@ -7,7 +7,7 @@ indices, constants) — which :func:`table` packs into two arrays (as the joints
 kernel's h_n, reading the poses, twists, F_n and T_np of its workspace, by the functions the
 laws' ``add_to`` call for the reference evaluators (plain Python in the style numba
 compiles; :func:`kernel` compiles it, ``compiled=False`` runs the same source interpreted).
-The kinds and their rows (``laws``: kind, first, second; ``constants``):
+The kinds and their rows (``laws``: kind, first, second, …; ``constants``):
 
 - ``"wrench"`` (:class:`~projeq.Force`, :class:`~projeq.Torque`): body n, world frame (1) or
   body frame (0); (f, p, τ) — :func:`projeq.forces.body_wrench`;
@@ -20,7 +20,14 @@ The kinds and their rows (``laws``: kind, first, second; ``constants``):
 - ``"stated"`` (a :class:`~projeq.forces.BodyLoad`: a law that states its body wrench once as
   scalar code): body n; its parameters' values — the wrench by the C callback of its printed
   statement (:func:`projeq.assembly.generated.law_callback`, float64 and complex128: the
-  callbacks' addresses in the row's last two columns), :func:`wrench_into`.
+  callbacks' addresses in the columns CALLBACK, COMPLEX_CALLBACK), :func:`wrench_into`, at time t.
+
+A load given as a callable (t, q, ṡ) (a :class:`~projeq.Force`, :class:`~projeq.Torque` or
+:class:`~projeq.JointForce` whose ``compiled_load`` names it) runs in the loop too: compiled by
+numba (:func:`projeq.assembly.generated.load_callbacks`), its callbacks' addresses in those
+columns, it writes the load into the row's constants from column ``AT`` on at each evaluation
+(:func:`loaded`); one numba refuses leaves its law on its own ``add_to`` (:func:`compiled_rows`
+says why). The loop takes t as a number, so time-dependent loads stay compiled.
 
 On an elastic body (a RitzBeam) the loads act on its reference frame (the first six rows of
 h_n, as its S = [E; 0] selects them in the reference); a joint's pair takes the n_y rows of
@@ -39,30 +46,59 @@ import functools
 import numpy as np
 
 from projeq.assembly import kernels
-from projeq.assembly.generated import intrinsics, law_callback
+from projeq.assembly.generated import intrinsics, law_callback, load_callbacks
 from projeq.assembly.kernels import N_COLS, N_Y, Q_INDEX, S_INDEX
 from projeq.forces import body_wrench, joint_wrench, spring_damper, spring_end, spring_force
 
 WRENCH, SPRING_DAMPER, JOINT_FORCE, JOINT_SPRING, STATED = range(5)
 KINDS = {"wrench": WRENCH, "spring_damper": SPRING_DAMPER, "joint_force": JOINT_FORCE, "joint_spring": JOINT_SPRING,
          "stated": STATED}
-#: the columns of ``laws``: the kind, its two indices, the addresses of a stated law's callbacks
-KIND, FIRST, SECOND, CALLBACK, COMPLEX_CALLBACK = range(5)
-_INTERPRETED: dict = {}  # a stated law's "address" in the interpreted loop -> its printed wrench
+#: the columns of ``laws``: the kind, its two indices, the addresses of a stated law's callbacks or of a
+#: load's callable (0: none), where that load goes in the row's constants and where the callable's
+#: numbers (its data p) start there
+KIND, FIRST, SECOND, CALLBACK, COMPLEX_CALLBACK, AT, PARAMETERS = range(7)
+#: an "address" in the interpreted loop -> a stated law's printed wrench, or (callable, size) of a load
+_INTERPRETED: dict = {}
 
 
-def table(rows, addresses=()) -> tuple[np.ndarray, np.ndarray]:
-    """(laws, constants): the ``compiled_terms`` rows (kind, indices, constants) as an int array
-    (L × 5: kind code, the two indices, and a stated law's two callbacks' ``addresses``, one entry
-    per row, None for the others: :func:`stated_addresses`) and a float array (L × the most
-    constants, zero-padded)."""
-    laws = np.zeros((len(rows), 5), dtype=np.int64)
-    for i, ((kind, indices, _), address) in enumerate(zip(rows, list(addresses) + [None] * len(rows))):
+def compiled_rows(system, compiled: bool) -> tuple[np.ndarray, np.ndarray, list]:
+    """(laws, constants, python): the rows of ``system``'s force laws that run in the loop
+    (:func:`table`; a stated law with its printed wrench's callbacks, :func:`stated_addresses`; a law
+    with a load given as a callable with the callable's, :func:`load_addresses`) and the
+    (law, why) of those that run their own ``add_to``: no row, or a piece numba cannot compile."""
+    rows, python = [], []
+    for law in system.forces:
+        row, addresses, at, why = law.compiled_terms(), None, (0, 0), "its own add_to"
+        if row is not None and row[0] == "stated":
+            addresses = stated_addresses(law.compiled_wrench(), compiled)
+            why = "" if addresses else "numba cannot compile its wrench"
+        elif row is not None and law.compiled_load() is not None:
+            function, load_at, size = law.compiled_load()
+            addresses, p, why = load_addresses(function, size, system.n_q, system.n_s, compiled)
+            at = load_at, len(row[2])  # the load's place, and the callable's numbers after the row's own
+            row = (*row[:2], np.concatenate((row[2], p)))
+        elif row is not None:
+            why = ""
+        if why:
+            python.append((law, why))
+        else:
+            rows.append((row, addresses, at))
+    return (*table(rows), python)
+
+
+def table(rows) -> tuple[np.ndarray, np.ndarray]:
+    """(laws, constants): the ``compiled_terms`` rows (kind, indices, constants), each with the two
+    addresses of its callbacks (None: none) and where a load's callable writes in its constants and
+    where its numbers start there, as an int array (L × 7: the columns KIND ... PARAMETERS) and a
+    float array (L × the most constants, zero-padded)."""
+    laws = np.zeros((len(rows), 7), dtype=np.int64)
+    for i, ((kind, indices, _), addresses, at) in enumerate(rows):
         laws[i, :1 + len(indices)] = (KINDS[kind], *indices)
-        if address is not None:
-            laws[i, CALLBACK:] = address
-    constants = np.zeros((len(rows), max((len(c) for _, _, c in rows), default=0)))
-    for i, (_, _, c) in enumerate(rows):
+        if addresses is not None:
+            laws[i, CALLBACK:COMPLEX_CALLBACK + 1] = addresses
+        laws[i, AT:] = at
+    constants = np.zeros((len(rows), max((len(c) for (_, _, c), _, _ in rows), default=0)))
+    for i, ((_, _, c), _, _) in enumerate(rows):
         constants[i, :len(c)] = c
     return laws, constants
 
@@ -78,6 +114,21 @@ def stated_addresses(values, compiled: bool) -> tuple[int, int] | None:
     return None if None in callbacks else tuple(back.address for back in callbacks)
 
 
+def load_addresses(function, size: int, n_q: int, n_s: int, compiled: bool) -> tuple:
+    """((float64, complex128) addresses, p, "") of the C callbacks of a load given as a callable
+    ``function(t, q, s_dot)`` of ``size`` entries and the numbers p they read
+    (:func:`projeq.assembly.generated.load_callbacks`), or (None, p, why numba cannot compile it);
+    interpreted, a key of the callable itself (:func:`load_into` looks it up)."""
+    if not compiled:
+        _INTERPRETED[id(function)] = function, size
+        return (id(function), id(function)), np.zeros(0), ""
+    callbacks, p = load_callbacks(function, size, n_q, n_s)
+    if callbacks is None:
+        name = getattr(function, "__qualname__", type(function).__name__)
+        return None, np.zeros(0), f"numba cannot compile its callable {name} ({p})"
+    return tuple(back.address for back in callbacks), p, ""
+
+
 def wrench_into(address, complex_address, R, r, w, t, p, wrench):
     """wrench ← the body wrench (f; M_O) of a stated law at the body's pose R, r and twist w: in the
     compiled loop, by the C callback at ``address`` (``complex_address`` under the complex step;
@@ -86,21 +137,52 @@ def wrench_into(address, complex_address, R, r, w, t, p, wrench):
     wrench[:] = _INTERPRETED[address](R.ravel(), r, w, t)
 
 
-def add_loads(laws, constants, index, q, s_dot, R, r, twist, F, T, h):
-    """h_n += the loads of every row of ``laws`` at the kernel's kinematics (poses R, r,
+def load_into(address, complex_address, t, q, n_q, s_dot, n_s, p, load):
+    """load ← a law's load given as a callable at (t, q, ṡ) (NaN where it returns another number of
+    entries than the law's): in the compiled loop, by the C callback at ``address``
+    (``complex_address`` under the complex step; an intrinsic,
+    :func:`projeq.assembly.generated.intrinsics`) with the callable's numbers p; interpreted, by the
+    callable itself."""
+    function, size = _INTERPRETED[address]
+    found = np.ravel(function(t, q[:n_q], s_dot[:n_s]))
+    load[:size] = found if found.size == size else np.nan
+
+
+def loaded(laws, i, c, t, q, s_dot, row) -> bool:
+    """row ← the constants c of the law in row i of ``laws``, its load given as a callable (if any,
+    :func:`load_into`) written from column ``AT`` on at (t, q, ṡ); False where that load is not finite."""
+    for j in range(c.shape[0]):
+        row[j] = c[j]
+    if laws[i, CALLBACK] == 0:
+        return True
+    load_into(laws[i, CALLBACK], laws[i, COMPLEX_CALLBACK], t, q, q.shape[0], s_dot, s_dot.shape[0],
+              c[laws[i, PARAMETERS]:], row[laws[i, AT]:])
+    for j in range(row.shape[0]):
+        if not (np.isfinite(row[j].real) and np.isfinite(row[j].imag)):
+            return False
+    return True
+
+
+def add_loads(laws, constants, index, t, q, s_dot, q_all, s_all, R, r, twist, F, T, h):
+    """h_n += the loads of every row of ``laws`` at time t and the kernel's kinematics (poses R, r,
     twists, F_n of ``index[n, N_COLS]`` columns, T_np: :func:`projeq.assembly.kernels.chain_terms`;
-    q and ṡ: every joint's own coordinates and velocities). Returns −1, or the row of a
-    spring-damper whose two points coincide (no direction: its ``add_to`` says so)."""
+    q_all and ṡ_all: every joint's own coordinates and velocities; q and ṡ: the System's, which
+    a load given as a callable reads — the same unless joints are coupled). Returns −1, or the row of
+    a spring-damper whose two points coincide (no direction) or of a load that is not finite (its
+    ``add_to`` says so)."""
     work, L = np.empty((4, 6), dtype=h.dtype), np.empty((6, 6), dtype=F.dtype)
+    row = np.empty(constants.shape[1], dtype=h.dtype)
     wrench_a, wrench_b, tau, y = work[0], work[1], work[2], work[3]
     for i in range(laws.shape[0]):
         kind, a, b, c = laws[i, KIND], laws[i, FIRST], laws[i, SECOND], constants[i]
         if kind == WRENCH:
-            body_wrench(R[a], c[0:3], c[3:6], c[6:9], b == 1, wrench_a)
+            if not loaded(laws, i, c, t, q, s_dot, row):
+                return i
+            body_wrench(R[a], row[0:3], row[3:6], row[6:9], b == 1, wrench_a)
             for j in range(6):
                 h[a, j] += wrench_a[j]
         elif kind == STATED:
-            wrench_into(laws[i, CALLBACK], laws[i, COMPLEX_CALLBACK], R[a], r[a], twist[a], 0.0, c, wrench_a)
+            wrench_into(laws[i, CALLBACK], laws[i, COMPLEX_CALLBACK], R[a], r[a], twist[a], t, c, wrench_a)
             for j in range(6):
                 h[a, j] += wrench_a[j]
         elif kind == SPRING_DAMPER:
@@ -115,9 +197,11 @@ def add_loads(laws, constants, index, q, s_dot, R, r, twist, F, T, h):
             k = index[a, N_COLS] - n_y + 6
             if kind == JOINT_SPRING:
                 q0, s0 = index[a, Q_INDEX], index[a, S_INDEX]
-                spring_force(c[0], c[1], q[q0 : q0 + k], c[2 : 2 + k], s_dot[s0 : s0 + k], tau[:k])
+                spring_force(c[0], c[1], q_all[q0 : q0 + k], c[2 : 2 + k], s_all[s0 : s0 + k], tau[:k])
+            elif loaded(laws, i, c, t, q, s_dot, row):
+                tau[:k] = row[:k]
             else:
-                tau[:k] = c[:k]
+                return i
             joint_wrench(F[a, :n_y, :k], T[a, :n_y, :n_y_p], tau[:k], L, y, h[a, :n_y], h[b, :n_y_p])
     return -1
 
@@ -132,9 +216,11 @@ def kernel(compiled: bool = True):
 
 
 #: the statements the loop calls (compiled with it)
-CALLEES = (body_wrench, spring_end, spring_damper, spring_force, joint_wrench)
+CALLEES = (body_wrench, spring_end, spring_damper, spring_force, joint_wrench, loaded)
 
 
 @functools.cache
 def _compiled():
-    return kernels.jit(add_loads, callees=CALLEES, kernels={"wrench_into": intrinsics()["wrench_into"]})
+    intrinsic = intrinsics()
+    return kernels.jit(add_loads, callees=CALLEES,
+                       kernels={"wrench_into": intrinsic["wrench_into"], "load_into": intrinsic["load_into"]})

@@ -135,10 +135,8 @@ def _tree_piece(tree) -> str | None:
                 "Python (no compiled values: a UserJoint from callables, a Prescribed motion that is a callable)")
     if ev._expansion is not None:
         return "coupled joints (shared minimal velocities)"
-    for i, law in enumerate(tree.forces):
-        if law.compiled_terms() is None:
-            return (f"force law {i} ({type(law).__name__}) has no compiled row (a callable load, or a law "
-                    "that states its own add_to)")
+    for law, why in zip(ev._python_laws, ev._python_why):
+        return f"force law {tree.forces.index(law)} ({type(law).__name__}) runs in Python: {why}"
     return None
 
 
@@ -623,7 +621,7 @@ def _chain_terms(tree, q, s_dot_tree):
                 twist)
 
 
-def _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree):
+def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
     """The tree's M, b at (q, ṡ_tree) by the compiled kernels (its joints of kind GIVEN stated
     there), the loads of its force laws added to h_n by their compiled rows
     (:func:`projeq.assembly.loads.add_loads`, the loop of the fast evaluator), then s̈ from
@@ -632,7 +630,8 @@ def _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree):
     _chain_terms(tree, q, s_dot_tree)
     index, T, zeta, F_n, M_n, h = tree[0], tree[7], tree[8], tree[9], tree[10], tree[11]
     R, r_O, twist, laws, constants = tree[12], tree[13], tree[14], tree[15], tree[16]
-    if laws.shape[0] and add_loads(laws, constants, index, q, s_dot_tree, R, r_O, twist, F_n, T, h) >= 0:
+    if laws.shape[0] and add_loads(laws, constants, index, t, q, s_dot_tree, q, s_dot_tree, R, r_O, twist, F_n, T,
+                                   h) >= 0:
         return UNLOADED
     gauss_form(index, T, zeta, F_n, M_n, h, M, b)
     n, k = F.shape
@@ -707,7 +706,7 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
     for r in range(m):
         f_bar[dependent[r]] = minus_gamma[r]
     given_motions(joints, q, s_dot_tree, t, tree[4])
-    return _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree)
+    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
 def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept,
@@ -749,7 +748,7 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
     f_bar = _particular(U, sigma, Vt, gamma, min(count, rank), F, independent)
     given_motions(joints, q, s_dot_tree, t, tree[4])
-    return _projected(tree, q, s_dot_tree, F, f_bar, pivot, M, b, s_ddot_tree)
+    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
 def _on_manifold(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, U, sigma, Vt, count):

@@ -5,7 +5,7 @@ independent references: the dense Gauss form and the recursive evaluator on rand
 carrying every law kind (spatial and planar bodies), the closed form B(9) of Bremer's car
 (H. Bremer, *Elastic Multibody Dynamics: A Direct Ritz Approach*, Springer 2008/2009, §2.2:
 m v̇_x − m c ω_z² = f_x, C° ω̇_z + m c v_x ω_z = M_z + c f_y), and, for the laws that stay in
-Python (a callable load, a user's subclass), the reference evaluators' numbers. Tolerances
+Python (a user's subclass), the reference evaluators' numbers. Tolerances
 are those of tests/assembly/test_recursive_vs_dense.py (``_agree``).
 """
 
@@ -116,11 +116,12 @@ def _pendulum(*forces) -> pq.System:
                      gravity=(0, 0, -9.81), forces=list(forces))
 
 
-def test_a_user_law_and_a_callable_load_keep_their_python_on_the_fast_evaluator():
+def test_a_user_law_keeps_its_python_and_a_callable_load_runs_compiled_on_the_fast_evaluator():
     """A subclass that restates ``wrench`` or ``generalized_force`` loses the compiled row it
-    inherits (its override is never bypassed) and a callable load has none: the fast evaluator
-    calls their ``add_to`` and gives the reference's numbers — which differ from the plain
-    law's (the override counts). A subclass that restates nothing keeps its row."""
+    inherits (its override is never bypassed): the fast evaluator calls its ``add_to`` and gives
+    the reference's numbers — which differ from the plain law's (the override counts). A load given
+    as a callable of (t, q, ṡ) has a row whose load numba compiles (``compiled_load``), with the
+    reference's numbers. A subclass that restates nothing keeps its row."""
     doubled = Doubled("b", (1.0, -2.0, 0.5), (0.2, 0.1, 0.0))
     callable_load = pq.Force("a", lambda t, q, s: (t, q[1], s[0]))
     assert Doubled.compiled_terms is pq.ForceLaw.compiled_terms
@@ -129,7 +130,9 @@ def test_a_user_law_and_a_callable_load_keep_their_python_on_the_fast_evaluator(
     plain = _pendulum(pq.Force("b", (1.0, -2.0, 0.5), (0.2, 0.1, 0.0)), callable_load)
     system = _pendulum(doubled, callable_load)
     bound = system.forces
-    assert bound[0].compiled_terms() is None and bound[1].compiled_terms() is None
+    assert bound[0].compiled_terms() is None and bound[1].compiled_terms() is not None
+    assert bound[1].compiled_load()[1:] == (0, 3)
+    assert [law for law in system.evaluator("fast")._python_laws] == [bound[0]]
     fast = system.accelerations(q, s_dot, t, method="fast")
     assert np.allclose(fast, system.accelerations(q, s_dot, t, method="recursive"), rtol=1e-12, atol=1e-12)
     assert not np.allclose(fast, plain.accelerations(q, s_dot, t, method="fast"), rtol=1e-3)
@@ -170,7 +173,8 @@ def test_the_compiled_loop_takes_a_complex_step():
     def loads_at(step, kernel):
         args = [getattr(ws, name) + step * direction[name] for name in ("R", "r", "twist", "F", "T")]
         h = np.zeros(ws.h_hat.shape, dtype=np.result_type(step, float))
-        kernel(ev._laws, ev._law_constants, ev._index, q + step * 0.3, s_dot - step * 0.2, *args, h)
+        state = (q + step * 0.3, s_dot - step * 0.2)
+        kernel(ev._laws, ev._law_constants, ev._index, 0.0, *state, *state, *args, h)
         return h
 
     h_complex = loads_at(1e-30j, loads.kernel(True))

@@ -32,10 +32,14 @@ class Drag(pq.BodyLoad):
 
 
 class Gust(Drag):
-    """Drag in a wind that grows with time: the wrench depends on t (not on the compiled path)."""
+    """Drag in a wind that grows with time, w = a t along z: −c (v_z − a t); the wrench depends on t."""
+
+    def __init__(self, body, c, a):
+        super().__init__(body, c)
+        self.a = float(a)
 
     def statement(self, R, r, v, omega, t, m):
-        return m.vector([-self.c * (v[0] - t), -self.c * v[1], -self.c * v[2], 0.0, 0.0, 0.0])
+        return m.vector([0.0, 0.0, -self.c * (v[2] - self.a * t), 0.0, 0.0, 0.0])
 
 
 def _ball(law):
@@ -114,14 +118,19 @@ def test_the_gauss_form_and_the_exact_jacobian_come_from_the_statement():
     assert how == "exact" and error <= 2.8e-11, (how, error)
 
 
-def test_a_wrench_of_t_runs_in_python_and_says_so():
-    """The compiled loop has no time: a wrench that depends on t stays on its add_to, named once;
-    its s̈ is the reference's (m s̈ = −m g − c (ṡ − 0) at t = 0.5 along z: the gust blows along x)."""
-    system = _ball(Gust("ball", 0.2))
-    with warnings.catch_warnings(record=True) as said:
-        warnings.simplefilter("always")
+def test_a_wrench_of_t_runs_compiled_and_reaches_the_closed_form():
+    """The compiled loop takes t: a wrench that depends on t runs compiled by default with no warning,
+    and the ball in the growing wind, v̇ = −g − k (v − a t) with k = c/m, reaches
+    v(t) = α (1 − e^(−kt)) + a t, α = −(g + a)/k, from rest: measured 8.0e-15 m/s over 3 s at rtol 1e-10
+    (the linear ODE is integrated nearly exactly), bound 8e-14."""
+    m, c, a, g = 0.5, 0.2, 1.5, 9.81
+    system = _ball(Gust("ball", c, a))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
         evaluator = system.evaluator()
-    assert [type(w.message) for w in said] == [PythonPieceWarning]
-    assert "force law Gust" in str(said[0].message)
-    assert evaluator.accelerations(np.array([0.0]), np.array([-1.0]), 0.5)[0] == pytest.approx(-9.81 + 0.2 / 0.5,
-                                                                                               rel=1e-14)
+    assert evaluator.name == "fast" and evaluator.evaluator.interpreted == []
+    result = pq.simulate(system, 3.0, rtol=1e-10, atol=1e-12)
+    k = c / m
+    v = -(g + a) / k * (1 - np.exp(-k * result.t)) + a * result.t
+    error = np.abs(result.s_dot[:, 0] - v).max()
+    assert error <= 8e-14, error
