@@ -14,8 +14,8 @@ from projeq.studies.barhorst_compiled import compiled_study
 
 
 def test_quick_mode_the_four_generated_formulations_give_one_motion():
-    """End positions within 3e-10 of Hamilton's DAE (both at rtol 1e-8; measured 2.9e-11 over 1 s, was 1e-7); every
-    ODE form also run by DOP853, the DAE not; Barhorst's ratio beside each row."""
+    """End positions within 3e-10 of Hamilton's DAE (both at rtol 1e-8; measured 2.9e-11 over 1 s, was
+    1e-7); every ODE form also run by DOP853, the DAE not; Barhorst's ratio beside each row."""
     benchmark = runpy.run_path(str(Path(__file__).parents[2] / "benchmarks" / "barhorst_compiled.py"))
     (rows,) = benchmark["main"](["--quick"]).values()
     assert [r["formulation"] for r in rows] == list(benchmark["PAPER"]["barhorst_particle"])

@@ -12,8 +12,8 @@ def _rows(table):
 def test_compare_barhorst_particle_four_formulations_agree():
     """compare("barhorst_particle"): his four formulations, the Hamilton row a DAE; over 2 s all follow the
     projective (Kane) reference to 2e-8 (measured ≤ 1.9e-9; was 1e-6), conserve E to 1e-7 (measured
-    ≤ 1.06e-8), and his reported numbers stand beside projeq's. Bounds about 10× the measured values (integration
-    results: DOP853/Radau at compare's tolerances)."""
+    ≤ 1.06e-8), and his reported numbers stand beside projeq's. Bounds about 10× the measured values
+    (integration results: DOP853/Radau at compare's tolerances)."""
     rows = _rows(compare("barhorst_particle", t_end=2.0, repeats=1))
     assert len(rows) == 4
     reference = rows["kane (projective), u = ẏ"]
