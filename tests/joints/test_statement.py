@@ -159,7 +159,9 @@ KINDS = ("screw", "cylindrical", "turntable", "knife_edge", "revolute", "prismat
 def test_random_trees_of_stated_joints_run_compiled_and_agree(kinds, seed):
     """Whole trees of stated and built-in joints: the default evaluator is the compiled kernel
     with no piece in Python and no warning, and its s̈ equals the recursive (order-n, the
-    statement on numpy) and dense Gauss forms: measured ≤ 3e-13 relative, bound 1e-10."""
+    statement on numpy) and dense Gauss forms, relative to 1 + |s̈|: compiled 100 ε (measured ≤ 2.1e-15),
+    dense 7.3e-14 (measured ≤ 7.3e-15, κ(M) = 143; the largest over 1150 random trees drawn as here; both
+    were 1e-10)."""
     system = _tree(kinds, seed)
     rng = np.random.default_rng(seed)
     q, s_dot, t = rng.uniform(-1, 1, system.n_q), rng.uniform(-1, 1, system.n_s), float(rng.uniform(0, 1))
@@ -172,8 +174,9 @@ def test_random_trees_of_stated_joints_run_compiled_and_agree(kinds, seed):
     recursive = system.accelerations(q, s_dot, t, method="recursive")
     dense = system.accelerations(q, s_dot, t, method="dense")
     scale = 1.0 + np.abs(recursive).max()
-    assert np.abs(compiled - recursive).max() <= 1e-10 * scale
-    assert np.abs(dense - recursive).max() <= 1e-10 * scale
+    eps = np.finfo(float).eps
+    assert np.abs(compiled - recursive).max() <= 100 * eps * scale, (compiled - recursive) / scale
+    assert np.abs(dense - recursive).max() <= 7.3e-14 * scale, (dense - recursive) / scale
 
 
 def test_the_gauss_form_is_traced_from_the_statements():
