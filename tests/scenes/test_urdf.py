@@ -79,8 +79,8 @@ def arm_file(tmp_path_factory):
 
 def test_a_small_arm_equals_the_same_arm_by_hand(arm_file):
     """Mass matrix and s̈ (order-n) of the imported arm = the hand-built one's at random states
-    (measured 0 here, 4e-16 before; bound 100 ε relative, was 1e-13); the limits and the collision geometry are reported
-    in one warning."""
+    (measured 0 here, 4e-16 before; bound 100 ε relative, was 1e-13); the limits and the collision
+    geometry are reported in one warning."""
     with pytest.warns(IgnoredWarning) as said:
         system = pq.from_urdf(arm_file)
     assert len(said) == 1
