@@ -233,7 +233,8 @@ def test_a_free_hub_at_a_steady_speed():
 
 def test_the_benchmark_quick_mode():
     """benchmarks/campbell.py --quick (≤ 3 s): the spinning beam's whirls against |ω_k ∓ Ω|
-    and the blade's ω_lag² = ω_flap² − Ω² to 1e-10 (measured 1.5e-14, 2.3e-15); exit code 0."""
+    to 1.5e-13 and the blade's ω_lag² = ω_flap² − Ω² to 2.3e-14 (relative; measured ≤ 1.5e-14 and 2.3e-15,
+    were 1e-10: the script's QUICK_BOUNDS); exit code 0."""
     import importlib.util
     from pathlib import Path
 

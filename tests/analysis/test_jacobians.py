@@ -4,8 +4,9 @@ through the model's own evaluation (``projeq.analysis.jacobians``).
 References: Richardson-extrapolated central differences (``differentiation.jacobian``,
 truncation O(h⁴)) on hypothesis trees with every joint, force law and subsystem kind of
 ``tests/strategies.py`` and on the constrained, non-holonomic and elastic scenes (measured
-≤ 2e-9 of max(1, |J|) over 120 trees at h = 1e-3: the differences' own error, so 1e-7
-bounds it and still catches any lost term, which is O(1)); closed forms where the
+at h = 1e-3, of max(1, |J|): ≤ 3.3e-9 over 120 trees, ∂s̈/∂τ 4.5e-9, the flexible arm 6.9e-9 —
+the differences' own error —, so DIFFERENCES_TOL = 7e-8, 10× the largest (was 1e-7), bounds it
+and still catches any lost term, which is O(1)); closed forms where the
 derivative is known exactly (the compound pendulum: to round-off)."""
 
 import math
@@ -22,7 +23,7 @@ from projeq.assembly.beam_fast import HubBeamEvaluator
 from projeq.assembly.fast import FastEvaluator
 from strategies import random_state, trees, with_couplings, with_every_law
 
-DIFFERENCES_TOL = 1e-7  # of max(1, |J|): the O(h⁴) differences' error at h = 1e-3 (module docstring)
+DIFFERENCES_TOL = 7e-8  # of max(1, |J|): the O(h⁴) differences' error at h = 1e-3 (module docstring)
 
 
 def _check_against_differences(system, q, s_dot, t, inputs=()):

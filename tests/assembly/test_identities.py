@@ -49,18 +49,20 @@ def _chain_J(system, kin):
 def test_kinetic_energy_from_M_equals_the_sum_over_subsystems(tree):
     """½ ṡᵀ M(q) ṡ = Σ ½ ẏ_nᵀ M_n ẏ_n (``System.energy``) for scleronomic systems.
     Both sides add the same positive terms (ṡᵀ J_nᵀ M_n J_n ṡ = ẏ_nᵀ M_n ẏ_n), so there is
-    no cancellation: round-off is ~N ε relative, and 1e-10 is a margin of > 1e4."""
+    no cancellation: round-off is ~N ε relative; bound 3.2e-14, 10× the largest measured over 1000
+    trees (3.2e-15; was 1e-10)."""
     system = tree.system
     kinetic, _ = system.energy(tree.q, tree.s_dot, tree.t)
     from_M = 0.5 * tree.s_dot @ system.mass_matrix(tree.q, tree.t) @ tree.s_dot
-    assert abs(from_M - kinetic) <= 1e-10 * abs(kinetic)
+    assert abs(from_M - kinetic) <= 3.2e-14 * abs(kinetic), (from_M - kinetic) / kinetic
 
 
 @given(any_plane.flatmap(lambda planar: trees(max_n=10, planar=planar, forces=False)))
 def test_functional_matrix_is_the_coefficient_matrix_of_the_velocities(tree):
     """Column k of J_n (from the chain recurrence) equals ẏ_n(ṡ = e_k) − ẏ_n(ṡ = 0), computed
     by ``kinematics.forward`` with unit vectors (the subtraction removes the rheonomic part
-    f). ẏ is exactly linear in ṡ, so the only error is round-off: 1e-12 relative. Also
+    f). ẏ is exactly linear in ṡ, so the only error is round-off: 100 ε relative (measured ≤ 9.8e-16 over
+    1000 trees; was 1e-12). Also
     M = Σ J_nᵀ M_n J_n with these J_n equals ``System.mass_matrix`` (1e-10, sums of
     positive-definite terms)."""
     system, q, t = tree.system, tree.q, tree.t
@@ -74,7 +76,8 @@ def test_functional_matrix_is_the_coefficient_matrix_of_the_velocities(tree):
         for k, kin in enumerate(columns):
             coefficients[:, k] = kin.y_dot[n] - rest.y_dot[n]
         scale = max(1.0, np.abs(J[n]).max(initial=0.0))
-        assert np.abs(coefficients - J[n]).max(initial=0.0) <= 1e-12 * scale, system.names[n]
+        error = np.abs(coefficients - J[n]).max(initial=0.0) / scale
+        assert error <= 100 * np.finfo(float).eps, (system.names[n], error)
         M += coefficients.T @ M_n[n] @ coefficients
     if system.n_s:
         M_sys = system.mass_matrix(q, t)

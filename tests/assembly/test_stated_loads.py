@@ -80,7 +80,8 @@ def _tree(n, seed):
 @given(n=st.integers(1, 6), seed=st.integers(0, 2**32 - 1))
 def test_compiled_interpreted_and_reference_agree_on_random_trees(n, seed):
     """s̈ by the compiled loop of laws = the same kernels interpreted = the order-n elimination and
-    the dense Gauss form with the law's add_to: measured ≤ 2e-15 relative, bound 1e-11."""
+    the dense Gauss form with the law's add_to: relative to 1 + |s̈|, bound 2.9e-14 (measured ≤ 2.9e-15,
+    the largest over 1200 random trees drawn as here; was 1e-11)."""
     system = _tree(n, seed)
     rng = np.random.default_rng(seed)
     q, s_dot = rng.uniform(-1, 1, system.n_q), rng.uniform(-1, 1, system.n_s)
@@ -89,7 +90,7 @@ def test_compiled_interpreted_and_reference_agree_on_random_trees(n, seed):
     for s_ddot in (FastEvaluator(system).accelerations(q, s_dot, 0.3),
                    FastEvaluator(system, compiled=False).accelerations(q, s_dot, 0.3),
                    system.accelerations(q, s_dot, 0.3, method="dense")):
-        assert np.abs(s_ddot - reference).max() <= 1e-11 * scale
+        assert np.abs(s_ddot - reference).max() <= 2.9e-14 * scale, (s_ddot - reference) / scale
 
 
 def test_the_gauss_form_and_the_exact_jacobian_come_from_the_statement():

@@ -7,7 +7,8 @@ projeq linearises its nonlinear model (a tree with the rolling constraints inser
 coordinate partitioning, ``projeq.scenes.whipple_eigenvalues``) with Jacobians by the complex
 step (``projeq.analysis.jacobians``), the constraints' second time derivative by the complex
 step inside a fourth-order stencil: the eigenvalues agree with the table to its last digit
-(measured ≤ 3.2e-14 of max(1, |λ|); issue 16 asks for 1e-12; central differences gave ~1e-7).
+(measured ≤ 2.9e-14 of max(1, |λ|), bound 3e-13; issue 16 asks for 1e-12; central differences gave
+~1e-7).
 """
 
 import numpy as np
@@ -39,7 +40,8 @@ TABLE_2 = {  # v (m/s): weave pair, capsize, castering (the upright-standing pai
     10: [-3.72016840437287 + 10.9068113947629j, -3.72016840437287 - 10.9068113947629j,
          0.161053386531720, -24.6245963501740],
 }
-TOL = 1e-12  # of max(1, |λ|): the table's 15 digits leave ≤ 5e-15 of rounding
+#: of max(1, |λ|), 10× the measured 2.9e-14 (at 7 m/s; was 1e-12): the table's 15 digits leave ≤ 5e-15
+TOL = 3e-13
 
 
 @pytest.mark.parametrize("speed", sorted(TABLE_2), ids=lambda v: f"{v}m/s")
@@ -48,4 +50,4 @@ def test_eigenvalues_match_table_2(speed):
     lam = whipple_eigenvalues(float(speed))
     rows, cols = linear_sum_assignment(np.abs(lam[:, None] - reference[None, :]))
     error = np.abs(lam[rows] - reference[cols]) / np.maximum(1.0, np.abs(reference[cols]))
-    assert error.max() < TOL, (lam, reference)
+    assert error.max() < TOL, (error.max(), lam, reference)

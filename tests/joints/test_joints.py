@@ -170,17 +170,19 @@ def joint_pair(request):
 def test_from_sympy_equals_from_functions(joint_pair, seed):
     """The same joint written as sympy expressions and as numpy callables gives the same
     (A, r, F, w, ζ), K and q̇ at random states: both are exact formulas (ζ symbolic vs
-    complex step, exact to round-off), so they agree to 1e-12 relative."""
+    complex step, exact to round-off), so they agree to 100 ε relative (measured ≤ 1.7e-16, K and q̇
+    exactly; was 1e-12)."""
     _, (symbolic, numeric) = joint_pair
+    eps = np.finfo(float).eps
     rng = np.random.default_rng(seed)
     q, s_dot, t = _state(symbolic, rng)
     a, b = symbolic.relative(q, s_dot, t), numeric.relative(q, s_dot, t)
     for field in ("A", "r", "F", "w", "zeta"):
         x, y = getattr(a, field), getattr(b, field)
         assert np.shape(x) == np.shape(y), field
-        assert np.abs(x - y).max(initial=0.0) <= 1e-12 * max(1.0, np.abs(y).max(initial=0.0)), field
-    assert np.abs(symbolic.K(q, t) - numeric.K(q, t)).max() <= 1e-12
-    assert np.abs(symbolic.q_dot(q, s_dot, t) - numeric.q_dot(q, s_dot, t)).max() <= 1e-12 * max(
+        assert np.abs(x - y).max(initial=0.0) <= 100 * eps * max(1.0, np.abs(y).max(initial=0.0)), field
+    assert np.abs(symbolic.K(q, t) - numeric.K(q, t)).max() <= 100 * eps
+    assert np.abs(symbolic.q_dot(q, s_dot, t) - numeric.q_dot(q, s_dot, t)).max() <= 100 * eps * max(
         1.0, np.abs(s_dot).max()
     )
 

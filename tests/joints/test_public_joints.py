@@ -219,11 +219,12 @@ def test_ball_on_a_turntable_circles_at_two_sevenths_of_its_rate():
                                    pq.RollingDisk(radius=0.3), pq.RollingSphere(radius=0.2)], ids=type)
 def test_the_statement_is_the_derivative_of_its_pose(joint):
     """F⁶ ṡ + f⁶ = the pose's time derivative along q̇ = K ṡ (central differences, step 1e-7:
-    measured 3e-10 to 1.3e-9, bound 1e-7), on unit quaternions."""
+    measured 1.0e-10 to 2.9e-9, the Spherical's the largest; bound 2.9e-8, was 1e-7), on unit quaternions."""
     rng = np.random.default_rng(2)
     for _ in range(3):
         q = joint.normalized(rng.uniform(-1, 1, joint.n_q) + joint.default_q())
-        assert pose_twist_mismatch(joint, q, rng.uniform(-2, 2, joint.n_s), 0.3) < 1e-7
+        mismatch = pose_twist_mismatch(joint, q, rng.uniform(-2, 2, joint.n_s), 0.3)
+        assert mismatch < 2.9e-8, mismatch
 
 
 def test_bad_input_is_named():

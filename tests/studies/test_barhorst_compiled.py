@@ -14,12 +14,12 @@ from projeq.studies.barhorst_compiled import compiled_study
 
 
 def test_quick_mode_the_four_generated_formulations_give_one_motion():
-    """End positions within 1e-7 of Hamilton's DAE (both at rtol 1e-8; measured 1e-10 over 1 s); every
-    ODE form also run by DOP853, the DAE not; Barhorst's ratio beside each row."""
+    """End positions within 3e-10 of Hamilton's DAE (both at rtol 1e-8; measured 2.9e-11 over 1 s, was
+    1e-7); every ODE form also run by DOP853, the DAE not; Barhorst's ratio beside each row."""
     benchmark = runpy.run_path(str(Path(__file__).parents[2] / "benchmarks" / "barhorst_compiled.py"))
     (rows,) = benchmark["main"](["--quick"]).values()
     assert [r["formulation"] for r in rows] == list(benchmark["PAPER"]["barhorst_particle"])
-    assert all(r["gap"] < 1e-7 for r in rows)
+    assert all(r["gap"] < 3e-10 for r in rows), [r["gap"] for r in rows]
     assert rows[0]["dop853_s"] is None and all(r["dop853_s"] > 0 for r in rows[1:])
     assert rows[0]["radau_ratio"] == 1.0 and all(r["paper"] for r in rows)
 

@@ -23,20 +23,23 @@ def test_quick_chain_part_is_one_json_report_whose_evaluators_agree(capsys):
     """The chain part of ``projeq bench`` without peers, timed once (budget 0 s): its JSON
     report holds every evaluator at every size and their s̈ agree with the dense Gauss form
     (a second formulation of the same Projection Equation, docs/theory.md §5 vs §6). Tolerance
-    1e-11 relative: the two solutions differ by about cond(M)·ε (docs/theory.md, "Accuracy
-    of the two evaluators"), measured 6e-13 at n = 10. Each row also holds every evaluator's
+    6e-12 relative (was 1e-11): the two solutions differ by about cond(M)·ε (docs/theory.md, "Accuracy
+    of the two evaluators"), measured 3.5e-13 at n = 10 (6e-13 on another machine: 10× the larger).
+    Each row also holds every evaluator's
     deviation from the exact s̈ (projeq.studies.bench_exact); the order-n ones are within 10 n ε of
-    it (the bound of tests/studies/test_chain_exact.py), the dense one within its 1e-11 above."""
+    it (the bound of tests/studies/test_chain_exact.py), the dense one within its 6e-12 above (measured
+    3.4e-13)."""
     assert projeq(["bench", "--chain-only", "--no-peers", "--json", "--budget", "0", "--sizes", "2,10"]) == 0
     report = json.loads(capsys.readouterr().out)
     rows = report["chain_scaling"]["rows"]
     assert [r["n"] for r in rows] == [2, 10]
     for row in rows:
         assert set(row["seconds"]) == OURS and min(row["seconds"].values()) > 0
-        assert max(row["deviation"].values()) < 1e-11
+        assert max(row["deviation"].values()) < 6e-12, row["deviation"]
         exact = row["exact_deviation"]
         assert set(exact) == set(row["seconds"]) and row["exact_seconds"] > 0
-        assert max(exact[k] for k in OURS - {"dense"}) < 10 * row["n"] * np.finfo(float).eps and exact["dense"] < 1e-11
+        assert max(exact[k] for k in OURS - {"dense"}) < 10 * row["n"] * np.finfo(float).eps
+        assert exact["dense"] < 6e-12, exact
     assert set(report["chain_scaling"]["slopes"]) == OURS
     assert [p["benchmark"] for p in report["parts"]] == ["chain_scaling"]
     assert report["total_seconds"] < report["budget_seconds"]

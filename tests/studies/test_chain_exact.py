@@ -150,16 +150,16 @@ def test_order_n_evaluators_are_exact_to_a_few_n_eps(references, accelerations):
 
 def test_dense_error_is_its_forward_error_bound_and_explains_fast_vs_dense(references):
     """chain(30): the dense Gauss form (docs/theory.md §5, one LU of M) is backward stable, so its
-    s̈ is within κ∞(M) ε of the reference (measured ≤ 0.06 κ∞(M) ε over 20 states,
-    κ∞(M) ≈ 2e6 here); and its error is over ten times the fast evaluator's (measured
-    ≥ 60×), i.e. the fast − dense difference is the dense evaluator's error."""
+    s̈ is within 0.12 κ∞(M) ε of the reference (measured ≤ 0.0115 κ∞(M) ε at these states, was
+    κ∞(M) ε; κ∞(M) ≈ 2e6 here); and its error is over ten times the fast evaluator's (measured
+    ≥ 280×), i.e. the fast − dense difference is the dense evaluator's error."""
     system = pq.scenes.chain(N_LINKS)
     for seed, reference in references.items():
         q, s_dot = _state(seed)
         kappa = np.linalg.cond(system.mass_matrix(q), np.inf)
         dense = _deviation(system.accelerations(q, s_dot, method="dense"), reference)
         fast = _deviation(system.accelerations(q, s_dot, method="auto"), reference)
-        assert dense < kappa * EPS
+        assert dense < 0.12 * kappa * EPS, dense / (kappa * EPS)
         assert fast < dense / 10
 
 

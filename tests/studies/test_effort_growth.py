@@ -32,7 +32,7 @@ def test_quick_mode_counts_every_step_and_states_a_verdict():
 
 def test_pendulum_lagrange_and_projection_steps_end_in_the_same_equations():
     """Two links: M and rhs of Lagrange's steps equal the Projection Equation's at 3 random points (angles,
-    rates and parameters), to 1e-12 relative (measured 1e-16)."""
+    rates and parameters), to 100 ε relative (round-off: measured ≤ 4.1e-16; was 1e-12)."""
     lagrange, projection = pendulum_steps(2, "lagrange"), pendulum_steps(2, "projection")
     assert "projections J_v, J_ω" in projection and "∂T/∂q̇" in lagrange
     rng = np.random.default_rng(5)
@@ -41,7 +41,8 @@ def test_pendulum_lagrange_and_projection_steps_end_in_the_same_equations():
         difference = sp.lambdify(symbols, lagrange[key] - projection[key])
         scale = sp.lambdify(symbols, lagrange[key])
         for point in rng.uniform(0.5, 2.0, (3, len(symbols))):
-            assert np.abs(difference(*point)).max() <= 1e-12 * np.abs(scale(*point)).max()
+            error = np.abs(difference(*point)).max() / np.abs(scale(*point)).max()
+            assert error <= 100 * np.finfo(float).eps, (key, error)
 
 
 def test_bad_sizes():
