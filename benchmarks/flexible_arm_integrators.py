@@ -26,6 +26,7 @@ fastest mode (ρ = 3144 1/s, 0.37 of ṡ_e) needs ρ h ≲ 1.6 to end within 1e-
 
     PYTHONPATH=. python benchmarks/flexible_arm_integrators.py            # 5 s, as in the issue
     PYTHONPATH=. python benchmarks/flexible_arm_integrators.py --t-end 1  # shorter
+    PYTHONPATH=. python benchmarks/flexible_arm_integrators.py --quick    # 10 ms (a test runs it)
 """
 
 from __future__ import annotations
@@ -348,8 +349,9 @@ COEFFICIENTS = (DOP853.A, DOP853.B, DOP853.C, DOP853.E3, DOP853.E5)
 def main(argv=None) -> tuple[Table, Table]:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--t-end", type=float, default=5.0, help="simulated seconds (default 5)")
+    parser.add_argument("--quick", action="store_true", help="10 ms (--t-end 0.01)")
     args = parser.parse_args(argv)
-    T = args.t_end
+    T = 0.01 if args.quick else args.t_end
     arms = {}
     for label, system, flexible in (("rigid twin", pq.scenes.flexible_arm(rigid_last_link=True), False),
                                     ("flexible", pq.scenes.flexible_arm(), True)):

@@ -100,11 +100,11 @@ def _q_dot(canonical, sol):
     return np.array([np.asarray(K(qi), float) @ ui for qi, ui in zip(sol.q.T, sol.u.T)]).T
 
 
-def main():
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--barhorst", action="store_true", help="only Barhorst's three examples")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     cases = [] if args.barhorst else [(10.0, 1e-8)] if args.quick else [(100.0, 1e-6), (100.0, 1e-10)]
     for t_end, rtol in cases:
         print(f"\nknife-edge disc, t_end = {t_end}, rtol = {rtol:g}, atol = {rtol / 100:g}")

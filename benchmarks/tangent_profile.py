@@ -11,6 +11,7 @@ and the compiled chain(k)'s, all timed alternately in one run
 
     python benchmarks/tangent_profile.py                       # Andrews' squeezer, Bricard
     python benchmarks/tangent_profile.py n_four_bar            # another TangentSystem scene
+    python benchmarks/tangent_profile.py --quick               # Andrews' squeezer, 0.05 s (a test runs it)
 """
 
 from __future__ import annotations
@@ -142,7 +143,10 @@ def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scenes", nargs="*", default=["andrews_squeezer", "bricard"])
     parser.add_argument("--budget", type=float, default=2.0, help="seconds of timing per scene (default 2)")
+    parser.add_argument("--quick", action="store_true", help="Andrews' squeezer, 0.05 s of timing")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.scenes, args.budget = ["andrews_squeezer"], 0.05
     report = {}
     for name in args.scenes:
         report[name] = rows = profile(name, args.budget)
