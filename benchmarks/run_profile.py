@@ -121,7 +121,7 @@ for name, label in (("differentiate", "  Jacobians ∂ẋ/∂x (implicit methods
         patch(projeq.simulation.driver, name, label)
 patch(projeq.cli.run, "_write", "write NPZ + CSV")
 patch(projeq.simulation.export, "write_vtu_series", "write ParaView series")
-patch(projeq.cli.run, "_write_json", "write run.json")
+patch(projeq.cli.run, "write_json", "write run.json")
 patch(projeq.cli.run, "_plots", "write PNG plots (--plots; matplotlib's import)")
 before_main = clock()
 code = commands.command() if hasattr(commands, "command") else commands.main(sys.argv[1:])  # as the installed command

@@ -102,8 +102,9 @@ def profile(name: str, budget: float) -> dict:
     s_ddot_tree = closure._s_ddot_tree.copy()
     f_bar = s_ddot_tree - F @ s_ddot_tree[system.independent]
     gamma = -As[-1] @ s_ddot_tree  # A_s s̈_tree = −γ: its size
+    callees = compiled._compiled_callees(elastic=False)  # the TangentSystem scenes are rigid trees
     loops = dict(zip((f.__name__ for f in LOOPS), kernels.jit(*_in_compiled_module(LOOPS), callees=compiled._HELPERS,
-                                                                kernels=compiled._compiled_callees())))
+                                                                kernels=callees)))
     jitted_call_only = kernels._numba().njit(call_only)
     ws, m_h, phi, pfaffian, r = closure._workspace, closure.m_h, closure.phi, closure.pfaffian, REPEATS
     kept = np.array(system._tangent, dtype=float)

@@ -34,7 +34,7 @@ PRINTS = {
     "beam_convergence.py": ("n_shapes",),
     "bicycle_compiled.py": ("us_per_call", "ratio_to_chain3", "final_state_max_difference (roll_rate=0.5)"),
     "bicycle_effort.py": ('"projeq"', '"s_ddot_s"', '"eigenvalues_s"'),
-    "chain_scaling.py": ("chain",),
+    "chain_scaling.py": ("recursive µs", "fast µs", "log-log slope"),
     "closure_runs.py": ("numpy/compiled", "andrews_squeezer"),
     "closures.py": ("default/chain", "four_bar", "andrews_squeezer"),
     "code_size.py": ("compiled path:", "interpreted path:", "ratio compiled / interpreted"),
