@@ -10,7 +10,7 @@ difference of their final states, for the default (upright, straight) bicycle an
 roll-rate kick of 0.5 rad/s (a weave). Ratios hold across machines, not the absolute times.
 
     PYTHONPATH=. python benchmarks/bicycle_compiled.py [--budget 2] [--json]
-    PYTHONPATH=. python benchmarks/bicycle_compiled.py --quick   # 0.05 s of timing, 0.02 s runs (a test runs it)
+    PYTHONPATH=. python benchmarks/bicycle_compiled.py --quick   # 0.05 s of timing, 0.02 s runs (a test)
 """
 
 from __future__ import annotations

@@ -96,8 +96,8 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     p = projeq_effort(0.02 if args.quick else args.budget)
     if args.quick:
-        print("Whipple bicycle, quick: projeq's part alone (KanesMethod's derivation, ~16 s CPU, and the stability "
-              "limits are the full run's)\n" + json.dumps({"projeq": p}))
+        print("Whipple bicycle, quick: projeq's part alone (KanesMethod's derivation, ~16 s CPU, and the "
+              "stability limits are the full run's)\n" + json.dumps({"projeq": p}))
         return 0
     k, model = kane_effort(args.budget)
     limits = stability_limits(model)

@@ -143,7 +143,7 @@ def table(systems: dict, repeat: int) -> None:
 
 
 def flyball(runs: int, t_end: float = 10.0) -> None:
-    """The flyball governor's default run (module docstring) up to ``t_end``, one-call vs per-column Jacobians:
+    """The flyball governor's default run (module docstring) to ``t_end``, one-call vs per-column Jacobians:
     the CPU time of the whole run and of its Jacobians (simulate's ``_Run.jacobian``, timed)."""
     from projeq.simulation import driver
 

@@ -22,7 +22,8 @@ def main(argv=None) -> list:
     parser.add_argument("--quick", action="store_true", help="N = 1 only")
     args = parser.parse_args(argv)
     sizes = (1,) if args.quick else tuple(args.sizes) or tuple(range(1, 11))
-    rows = derivation_effort(sizes, not args.no_lagrange, show=None if args.json else lambda line: print(line, flush=True))
+    show = None if args.json else lambda line: print(line, flush=True)
+    rows = derivation_effort(sizes, not args.no_lagrange, show=show)
     if args.json:
         print(json.dumps(rows, indent=1))
     return rows

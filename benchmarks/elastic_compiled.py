@@ -89,8 +89,8 @@ def main(argv=None) -> Table:
                    "run ratio", "|Δq(t_end)|"), rows,
                   formats={"s̈ µs": ".1f", "ref s̈ µs": ".1f", "s̈ ratio": ".1f", "run s": ".2f", "ref run s": ".2f",
                            "run ratio": ".1f", "|Δq(t_end)|": ".1e"},
-                  title=f"elastic models on the compiled paths vs the reference evaluators (one run; simulate defaults, "
-                        f"{t_end:g} s)")
+                  title=f"elastic models on the compiled paths vs the reference evaluators (one run; "
+                        f"simulate defaults, {t_end:g} s)")
     print(table.to_text())
     return table
 

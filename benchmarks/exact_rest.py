@@ -11,7 +11,7 @@ measured in one run:
    power iteration on forward differences of the fused real-only right-hand side it used
    against ρ now (the model's complex-safe ẋ) and the eigenvalues of the exact Jacobian.
 
-    PYTHONPATH=. python benchmarks/exact_rest.py [--quick]   # --quick: A02 runs of 1 s, 5 event calls (a test)
+    PYTHONPATH=. python benchmarks/exact_rest.py [--quick]   # --quick: A02 over 1 s, 5 event calls
 """
 
 from __future__ import annotations
@@ -69,10 +69,12 @@ def events(t_end: float = 10.0, calls: int = 200) -> None:
             event(t, q, s_dot)
         per_call = (time.process_time() - start) / calls * 1e6
         start = time.process_time()
-        run = pq.simulate(system, t_end, n_points=201, rtol=1e-9, atol=1e-11, events=[event] if event else None)
+        run = pq.simulate(system, t_end, n_points=201, rtol=1e-9, atol=1e-11,
+                          events=[event] if event else None)
         runs[name] = time.process_time() - start
         if event is not None and not len(run.t_events[0]):
-            print(f"{name:5s}: no event in {t_end:g} s, {per_call:.0f} µs per event call, run {runs[name]:.2f} s CPU")
+            print(f"{name:5s}: no event in {t_end:g} s, {per_call:.0f} µs per event call, "
+                  f"run {runs[name]:.2f} s CPU")
         elif event:
             found = run.t_events[0]
             horizontal = [brentq(lambda s: parallelogram_motion([0.0, s], 2)[-1, 1], a - 0.05, a + 0.05, xtol=1e-14)

@@ -82,7 +82,8 @@ def spin_up(omegas=(2.0, 6.0, 10.0, 20.0), t_end: float = 20.0) -> list[dict]:
             beam = system.subsystem("beam")
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)  # the beam's own unstiffened warning
-                r, error, cpu, _ = timed_simulate(system, t_end, method="RK45", rtol=1e-7, atol=1e-9, n_points=801,
+                r, error, cpu, _ = timed_simulate(system, t_end, method="RK45", rtol=1e-7, atol=1e-9,
+                                                  n_points=801,
                                                   events=[_beyond_length(system, beam)])
             v = np.abs(beam.deflection(r, beam.length)[:, 1])
             diverged = float(r.t_events[0][0]) if len(r.t_events[0]) else (float(r.t[-1]) if error else None)
@@ -247,7 +248,8 @@ def mass_ratios(scale: float = 1.0) -> list[dict]:
     rows = []
     print(f"{'masses kg':<20}{'max κ(M)':>10}{'max |Δ|/|s̈|':>14}{'ρ 1/s':>9}{'method':>8}{'energy':>10}"
           f"{'bound':>9}{'CPU s':>7}  verdict")
-    for masses, method, t_end in (((1e6, 1.0, 1e-6), "DOP853", 2.0 * scale), ((1e-6, 1.0, 1e6), "Radau", 0.2 * scale)):
+    for masses, method, t_end in (((1e6, 1.0, 1e-6), "DOP853", 2.0 * scale),
+                                  ((1e-6, 1.0, 1e6), "Radau", 0.2 * scale)):
         system = mass_ratio_chain(masses)
         kappas, diffs = [], []
         for seed in range(5):

@@ -55,7 +55,7 @@ def main(argv=None) -> None:
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--quick", action="store_true", help="the double pendulum and the four-bar, once")
     args = parser.parse_args(argv)
-    names, repeat = (("double_pendulum", "four_bar"), 1) if args.quick else (scenes.SCENES.keys(), args.repeat)
+    names, repeat = (("double_pendulum", "four_bar"), 1) if args.quick else (list(scenes.SCENES), args.repeat)
     print(f"{'scene':22} {'n_x':>4} {'t_end':>6} | {'ρ fd':>11} {'ρ exact':>11} {'way':>8} | {'fd':>6} "
           f"{'default':>7} | {'fd ms':>7} {'exact ms':>8} | {'ẋ µs':>7} {'fd/ẋ':>5} {'exact/ẋ':>7} {'ratio':>5}")
     for name in names:

@@ -48,16 +48,17 @@ SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0  # scipy.integrate's Runge–Kut
 
 
 def compiled_model(system):
-    """(chain_terms, passes, tree_jacobian, model tuple, complex workspace with the force laws) of the system's fast evaluator, for the
-    compiled loops: ẋ = (ṡ, s̈) (q̇ = ṡ: revolute joints only) and ∂ẋ/∂x by the kernels."""
+    """(chain_terms, passes, tree_jacobian, model tuple, complex workspace with the (empty) force laws) of
+    the system's fast evaluator, for the compiled loops: ẋ = (ṡ, s̈) (q̇ = ṡ: revolute joints only) and
+    ∂ẋ/∂x by the kernels."""
     ev = system.evaluator().evaluator
     if ev._given or system.forces or system.coupled or system.n_q != system.n_s:
         raise ValueError("system: the compiled loops take trees of revolute/prismatic joints without force laws")
     ws, wc = ev._real, ev._workspace(complex)
     model = (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
              ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat, ws.R, ws.r, ws.twist, ev._pivot_min, system.n_q)
-    complex_ws = (ev._laws, ev._law_constants, wc.given_values, wc.T, wc.zeta, wc.F, wc.M_n, wc.M_hat, wc.h_hat, wc.R,
-                  wc.r, wc.twist)
+    complex_ws = (ev._laws, ev._law_constants, wc.given_values, wc.T, wc.zeta, wc.F, wc.M_n, wc.M_hat,
+                  wc.h_hat, wc.R, wc.r, wc.twist)
     return ev._chain_terms, ev._passes, ev._jacobian, model, complex_ws
 
 
@@ -80,8 +81,8 @@ def jacobian(jac, model, complex_ws, x, J):
     J[:] = 0.0
     for i in range(n_q):
         J[i, n_q + i] = 1.0
-    jac(index, geometry, inertia, gravity, laws, constants, x, n_q, COMPLEX_STEP, given, elastic, ports, T, zeta, F,
-        M_n, M_hat, h_hat, R, r, twist, pivot_min, J[n_q:])
+    jac(index, geometry, inertia, gravity, laws, constants, x, n_q, COMPLEX_STEP, given, elastic, ports, T,
+        zeta, F, M_n, M_hat, h_hat, R, r, twist, pivot_min, J[n_q:])
 
 
 @numba.njit(cache=True)

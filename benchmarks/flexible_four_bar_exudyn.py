@@ -37,7 +37,7 @@ difference and each code's own error; then every run's CPU time and largest diff
 both finest runs; then Exudyn's difference by its axial stiffness. Measured (one run, 2 shared cores):
 
     python benchmarks/flexible_four_bar_exudyn.py --n-v 2 4 6 8   # 5 min; default --n-v 2 4 6: 2.5 min
-    python benchmarks/flexible_four_bar_exudyn.py --quick         # 20 ms (a test runs it; no Exudyn: projeq's runs)
+    python benchmarks/flexible_four_bar_exudyn.py --quick         # 20 ms (no Exudyn: projeq's runs alone)
 
     crank angle, rad: projeq n_v=8 tight vs exudyn 32 el h=0.000125
     t (s)     projeq     exudyn  difference  projeq error  exudyn error
@@ -372,8 +372,8 @@ def tables(times, results: dict, exudyn=EXUDYN_RUNS) -> list[Table]:
         columns = [f"{k} vs projeq" for k in quantities]
         return [Table(("run", "method", "cpu", *columns), rows, units={"cpu": "s"},
                       formats={"cpu": ".2f", **{c: ".1e" for c in columns}},
-                      title=f"projeq's runs: CPU (time.process_time) and max |difference| over the {len(times)} "
-                            f"times from {pq_names[-1]} (rad, m)")]
+                      title=f"projeq's runs: CPU (time.process_time) and max |difference| over the "
+                            f"{len(times)} times from {pq_names[-1]} (rad, m)")]
     n, h = exudyn[-1]
     ex_name = _exudyn_name(n, h)
     ex_best = results[ex_name]
@@ -405,7 +405,7 @@ def main(argv=None) -> list[Table]:
     parser.add_argument("--n-v", type=int, nargs="+", default=[2, 4, 6],
                         help="projeq's numbers of bending functions at tight rtol (default 2 4 6; the last two give its error)")
     parser.add_argument("--quick", action="store_true",
-                        help="20 ms, 2 times, n_v = 2, 4, Exudyn 4 and 8 elements at h = 1e-3 (a test runs it)")
+                        help="20 ms, 2 times, n_v = 2, 4, Exudyn 4 and 8 elements at h = 1e-3")
     args = parser.parse_args(argv)
     if args.quick:
         args.t_end, args.points, args.n_v = 0.02, 2, [2, 4]
@@ -419,7 +419,8 @@ def main(argv=None) -> list[Table]:
         results = runs(times, n_vs=args.n_v, exudyn=exudyn, axial_stiffness=args.axial_stiffness)
         out = tables(times, results, exudyn)
         if exudyn:
-            out.append(axial_table(times, results, (1e7,), *exudyn[-1]) if args.quick else axial_table(times, results))
+            out.append(axial_table(times, results, (1e7,), *exudyn[-1]) if args.quick
+                       else axial_table(times, results))
     for table in out:
         print(table.to_text())
         print()

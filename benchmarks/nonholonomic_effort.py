@@ -8,7 +8,7 @@ long run at two tolerances, the relative energy drift (``Result.energy_drift``),
 largest constraint residual, the number of right-hand-side evaluations and wall time.
 
     python benchmarks/nonholonomic_effort.py            # the full table (~2 min)
-    python benchmarks/nonholonomic_effort.py --quick    # runs 1000× shorter, 0.02 s of timing (a test runs it)
+    python benchmarks/nonholonomic_effort.py --quick    # runs 1000× shorter, 0.02 s of timing
     python benchmarks/nonholonomic_effort.py --json
 
 Runs: the car without loads (v_x = 10 m/s, ω_z = 0.2 rad/s) for 200 s; the knife-edge

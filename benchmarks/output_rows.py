@@ -70,7 +70,7 @@ def main(argv=None) -> None:
     parser.add_argument("scenes", nargs="*", default=list(SCENES), help="scene names, optionally name:t_end")
     parser.add_argument("--repeat", type=int, default=3, help="processes of each tree per scene (median CPU)")
     parser.add_argument("--quick", action="store_true",
-                        help="simple_pendulum:0.1, one process each (the other checkout: this tree if not given)")
+                        help="simple_pendulum:0.1, one process each (the other checkout: this tree if none)")
     args = parser.parse_intermixed_args(argv)
     from projeq import scenes
 

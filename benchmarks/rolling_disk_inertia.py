@@ -23,7 +23,8 @@ G_CM2_S2 = 1e7  # 1 kg m²/s² in g cm²/s²
 
 def study(inertia: str, t_end: float = 10.0) -> dict:
     system = pq.scenes.rolling_disk(inertia=inertia)
-    result = pq.simulate(system, t_end, method="DOP853", rtol=1e-10, atol=1e-12, n_points=int(200 * t_end) + 1)
+    result = pq.simulate(system, t_end, method="DOP853", rtol=1e-10, atol=1e-12,
+                         n_points=int(200 * t_end) + 1)
     dense = system.evaluator("dense")
     p2 = np.array([(dense.gauss_form(q, u, 0.0)[0] @ u)[1] for q, u in zip(result.q, result.s_dot)]) * G_CM2_S2
     q1, q3, q4, q5 = result.q[:, 0], result.q[:, 2], 100 * result.q[:, 3], 100 * result.q[:, 4]

@@ -19,7 +19,7 @@ the first s̈ (the loads of projeq's kernels from the cache), the second s̈, an
 specialisation a compilation of its own when the cache is empty).
 
     python benchmarks/run_default.py            # ~1 min: the reference costs ~25 s
-    python benchmarks/run_default.py --quick    # the default run over 1 s alone, no reference (a test runs it)
+    python benchmarks/run_default.py --quick    # the default run over 1 s alone, no reference
 """
 
 from __future__ import annotations
@@ -95,7 +95,8 @@ def projeq_run(out: Path, *options: str) -> dict:
 
 
 def first_call(fill: bool = True) -> dict:
-    """:data:`FIRST_CALL` in a fresh process (with ``fill``, run once before, so that numba's cache is filled)."""
+    """:data:`FIRST_CALL` in a fresh process (with ``fill`` run once before, so that numba's cache is
+    filled)."""
     if fill:
         child(["-c", FIRST_CALL])
     return json.loads(child(["-c", FIRST_CALL])[2])
@@ -111,9 +112,9 @@ def main(argv=None) -> dict:
         if args.quick:
             runs = {"default, 1 s": projeq_run(Path(out), "--t-end", "1")}
         else:
+            former = ("--method", "DOP853", "--rtol", "1e-9", "--atol", "1e-11")
             runs = {"default": projeq_run(Path(out)), "--plots": projeq_run(Path(out), "--plots"),
-                    "former DOP853 1e-9": projeq_run(Path(out), "--method", "DOP853", "--rtol", "1e-9", "--atol",
-                                                     "1e-11")}
+                    "former DOP853 1e-9": projeq_run(Path(out), *former)}
     python_cpu, python_wall, _ = child(["-c", "pass"])
     import_cpu, import_wall, _ = child(["-c", IMPORT])
     latency = first_call(fill=not args.quick)
@@ -139,10 +140,11 @@ def main(argv=None) -> dict:
               f"{run['process_wall_s']:>6.1f} {run['simulation_cpu_s']:>9.2f} {rest:>9.2f} {run['files']:>6} "
               f"{run['nfev']:>6} {error:>18.1e}")
     if not args.quick:
-        print(f"default / --plots: {runs['default']['process_cpu_s'] / runs['--plots']['process_cpu_s']:.2f} of the CPU "
-              f"time; default / former: {runs['default']['process_cpu_s'] / runs['former DOP853 1e-9']['process_cpu_s']:.2f}"
-              " ('rest': the process's CPU time less the imports of projeq run and the simulation: NPZ, CSV, ParaView "
-              "files, plots with matplotlib's import when asked, the build, the record, and Python's start)")
+        cpu = {name: run["process_cpu_s"] for name, run in runs.items()}
+        print(f"default / --plots: {cpu['default'] / cpu['--plots']:.2f} of the CPU time; default / former: "
+              f"{cpu['default'] / cpu['former DOP853 1e-9']:.2f} ('rest': the process's CPU time less the "
+              "imports of projeq run and the simulation: NPZ, CSV, ParaView files, plots with matplotlib's "
+              "import when asked, the build, the record, and Python's start)")
     print(f"\nfirst compiled s̈ in a fresh process, numba's cache filled (chain(5), evaluator {latency['evaluator']}): "
           "CPU s (wall s)")
     for phase, (cpu, wall) in latency["phases"].items():

@@ -25,7 +25,7 @@ scipy.linalg instead of scipy.integrate); ``--compare TREE`` times the phases of
 
     PYTHONPATH=. python benchmarks/run_profile.py [--repeat 5] [--cprofile] [--alternatives] [SCENE ...]
     PYTHONPATH=. python benchmarks/run_profile.py --compare /path/to/other/checkout [--repeat 5]
-    PYTHONPATH=. python benchmarks/run_profile.py --quick   # one process of projeq run --t-end 1 per view (a test)
+    PYTHONPATH=. python benchmarks/run_profile.py --quick   # a process of projeq run --t-end 1 per view
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ processes, and the ratios before/after of the first and of the repeated build:
     PYTHONPATH=. python benchmarks/scene_builds.py [--repeat 5] [SCENE ...]
     git -C /work/main archive HEAD | tar -x -C /tmp/builds_old
     PYTHONPATH=. python benchmarks/scene_builds.py --base /tmp/builds_old
-    PYTHONPATH=. python benchmarks/scene_builds.py --quick   # the Barhorst particle, one build after the first
+    PYTHONPATH=. python benchmarks/scene_builds.py --quick   # Barhorst's particle, one build after the first
 """
 
 from __future__ import annotations

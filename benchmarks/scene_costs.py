@@ -23,9 +23,10 @@ def main(argv=None) -> dict:
     parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per scene (default 0.5)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--quick", action="store_true",
-                        help="chain and four_bar, 0.01 s each; no latency (its cold compile takes about a minute)")
+                        help="chain and four_bar, 0.01 s each; no latency (its cold compile takes a minute)")
     args = parser.parse_args(argv)
-    rows = [scene_row(name, 0.01) for name in ("chain", "four_bar")] if args.quick else scene_costs(args.budget)[0]
+    rows = [scene_row(name, 0.01) for name in ("chain", "four_bar")] if args.quick else \
+        scene_costs(args.budget)[0]
     report = {"scenes": rows, "latency": {} if args.quick else first_call_latency()}
     if args.json:
         print(json.dumps(report, indent=2))

@@ -75,11 +75,12 @@ def motions_table(sizes=(10, 20, 40), t_end: float = T_END) -> None:
     times = np.linspace(0.0, t_end, 201)
     runs = {name: ritz_motion(model, times=times, t_end=t_end) for name, model in models.items()}
     for n_slices in sizes:
-        runs[f"chain {n_slices}/{2 * n_slices}"] = ritz_motion(extrapolated_model(n_slices, rho_I=RHO_I), times=times,
-                                                               t_end=t_end)
+        chain = extrapolated_model(n_slices, rho_I=RHO_I)
+        runs[f"chain {n_slices}/{2 * n_slices}"] = ritz_motion(chain, times=times, t_end=t_end)
     runs["RitzBeam"] = ritzbeam_motion(2, times)
     names = list(runs)
-    print(f"\n2. spin-up: max |Δa| over {t_end:g} s (a0 = 0.01); chain N/2N = extrapolated from N and 2N slices")
+    print(f"\n2. spin-up: max |Δa| over {t_end:g} s (a0 = 0.01); chain N/2N = extrapolated from N and 2N "
+          "slices")
     print(" " * 16 + " ".join(f"{name:>14}" for name in names))
     for row in names:
         print(f"{row:>16}" + " ".join(f"{np.max(np.abs(runs[row] - runs[col])):14.2e}" for col in names))

@@ -107,7 +107,7 @@ def profile(name: str, budget: float) -> dict:
                                                                 kernels=callees)))
     jitted_call_only = kernels._numba().njit(call_only)
     ws, m_h, r = closure._workspace, closure.m_h, REPEATS
-    head = (closure.phi, closure.pins, closure.fields, closure.pfaffian, closure.joints, closure.tree)  # Φ and the tree
+    head = (closure.phi, closure.pins, closure.fields, closure.pfaffian, closure.joints, closure.tree)
     kept = np.array(system._tangent, dtype=float)
     args = (*head, q, s_dot, t, m_h, system.independent, n - k, system.separation, closure.constants[0], kept,
             SINGULAR_PIVOT, closure._q_dot, closure._s_ddot_tree, closure._A, ws.M_all, ws.b_all)

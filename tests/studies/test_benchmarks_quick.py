@@ -53,12 +53,13 @@ PRINTS = {
     "formulations.py": ("knife-edge disc", "formulation"),
     "given_joints.py": ("ẋ one-call µs", "free_chain", "simulate rolling_disk"),
     "jacobians.py": ("elastic_arm (3 shapes)", "Radau", "BDF", "differences", "exact"),
-    "loop_drift.py": ("quick-return", "baumgarte beta=10.0", "projection n_segments=100", "four-bar (crank-rocker)",
-                      "rocker, repivot"),
+    "loop_drift.py": ("quick-return", "baumgarte beta=10.0", "projection n_segments=100",
+                      "four-bar (crank-rocker)", "rocker, repivot"),
     "nonholonomic_effort.py": ("| car |", "| knife_edge_disc |", "| rolling_disk |"),
     "output_rows.py": ("before/after", "simple_pendulum"),
     "peers.py": ("chain",),
-    "pin_closures.py": ("PinClosure, compiled kernel", "PinClosure, numpy path", "hand-written Φ", "driven, sympy motion"),
+    "pin_closures.py": ("PinClosure, compiled kernel", "PinClosure, numpy path", "hand-written Φ",
+                        "driven, sympy motion"),
     "rolling_disk_inertia.py": ("E0 (g cm²/s²)", "hoop"),
     "row_costs.py": ("chain ", "four_bar ", "µs/row"),
     "run_default.py": ("projeq run (spin_up_beam", "default, 1 s", "first compiled s̈ in a fresh process",
@@ -78,7 +79,7 @@ def scripts() -> list[str]:
 def test_every_script_has_a_quick_test():
     """Each script is run below or by its own test, which exists and runs its quick mode."""
     missing = set(scripts()) - set(PRINTS) - set(OWN_TESTS)
-    assert not missing, f"benchmarks without a quick test (add a --quick mode and a line to PRINTS): {missing}"
+    assert not missing, f"benchmarks without a quick test (give them a --quick mode, PRINTS): {missing}"
     assert set(PRINTS) <= set(scripts()) and set(OWN_TESTS) <= set(scripts())
     for script, test in OWN_TESTS.items():
         text = (ROOT / test).read_text()
