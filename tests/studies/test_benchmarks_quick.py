@@ -10,6 +10,7 @@ scripts with one line saying so.
 """
 
 import importlib.util
+import sys
 from pathlib import Path
 
 import pytest
@@ -87,9 +88,10 @@ def test_every_script_has_a_quick_test():
 
 
 def load(script: str):
-    """The script as a module (not run as __main__)."""
+    """The script as a module (not run as __main__), in sys.modules as an imported one is (numba's
+    object mode finds a compiled function's globals there)."""
     spec = importlib.util.spec_from_file_location(f"benchmark_{Path(script).stem}", BENCHMARKS / script)
-    module = importlib.util.module_from_spec(spec)
+    module = sys.modules[spec.name] = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
