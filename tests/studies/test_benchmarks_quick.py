@@ -31,10 +31,10 @@ OWN_TESTS = {
     "urdf_pinocchio.py": "tests/scenes/test_urdf.py",
 }
 
-#: scripts whose quick mode compiles numba code at every run, with PROJEQ_ALL_BENCHMARKS=1 only: script → why
+#: scripts whose quick mode compiles numba code at every run, run with PROJEQ_ALL_BENCHMARKS=1 only
 COMPILES_EVERY_RUN = {
-    "flexible_arm_integrators.py": "its compiled loops take the kernels as first-class arguments, whose types "
-                                   "numba's disk cache does not keep across processes (~1 CPU minute each run)",
+    "flexible_arm_integrators.py": "its compiled loops take the kernels as first-class arguments, whose "
+                                   "types numba's cache does not keep across processes (~1 CPU minute a run)",
 }
 
 #: script → texts its quick run prints (table heads and row labels, no numbers)
