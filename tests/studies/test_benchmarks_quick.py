@@ -6,8 +6,9 @@ here: a new benchmark gets a quick mode (the same code paths as its full run on 
 models and horizons, ≤ 3 s warm) and its line below. The quick runs measure nothing worth
 comparing (their timings are of a few calls); their numbers are checked by the full runs and by
 the tests of the library. Peers that are not installed (Exudyn, MuJoCo) are left out by the
-scripts with one line saying so. A script whose quick mode compiles numba code at every run
-(:data:`COMPILES_EVERY_RUN`) runs here only with ``PROJEQ_ALL_BENCHMARKS=1``: the suite's CI budget.
+scripts with one line saying so. The quick modes that cost more than the suite's CI budget allows
+(:data:`OPT_IN`: fresh processes, sympy derivations, numba compilations at every run) run here only
+with ``PROJEQ_ALL_BENCHMARKS=1``.
 """
 
 import importlib.util
@@ -31,10 +32,19 @@ OWN_TESTS = {
     "urdf_pinocchio.py": "tests/scenes/test_urdf.py",
 }
 
-#: scripts whose quick mode compiles numba code at every run, run with PROJEQ_ALL_BENCHMARKS=1 only
-COMPILES_EVERY_RUN = {
+#: scripts whose quick mode costs more than the suite's budget allows (warm, this module ≤ 45 s), run with
+#: PROJEQ_ALL_BENCHMARKS=1 only: script → why (wall seconds warm, measured on 2 loaded cores)
+OPT_IN = {
     "flexible_arm_integrators.py": "its compiled loops take the kernels as first-class arguments, whose "
                                    "types numba's cache does not keep across processes (~1 CPU minute a run)",
+    "spinning_beam_chain.py": "the three Ritz models derived by sympy and the slice chains (17 s)",
+    "pin_closures.py": "the numpy path's runs and the driven crank's sympy motion (14 s)",
+    "output_rows.py": "two fresh processes (13 s)",
+    "run_default.py": "four fresh processes (10 s)",
+    "extremes.py": "six studies, a 1000-body chain among them (10 s)",
+    "closure_runs.py": "Andrews' squeezer on the numpy path, 501 output rows (9 s)",
+    "run_profile.py": "two fresh processes (8 s)",
+    "beam_convergence.py": "projeq bench's quick study: seven 20 s spin-ups (8 s)",
 }
 
 #: script → texts its quick run prints (table heads and row labels, no numbers)
@@ -89,7 +99,7 @@ def test_every_script_has_a_quick_test():
     """Each script is run below or by its own test, which exists and runs its quick mode."""
     missing = set(scripts()) - set(PRINTS) - set(OWN_TESTS)
     assert not missing, f"benchmarks without a quick test (give them a --quick mode, PRINTS): {missing}"
-    assert set(PRINTS) | set(COMPILES_EVERY_RUN) <= set(scripts()) and set(OWN_TESTS) <= set(scripts())
+    assert set(OPT_IN) <= set(PRINTS) <= set(scripts()) and set(OWN_TESTS) <= set(scripts())
     for script, test in OWN_TESTS.items():
         text = (ROOT / test).read_text()
         assert script in text and '"--quick"' in text, (script, test)
@@ -108,8 +118,8 @@ def load(script: str):
 def test_quick_mode_prints_its_tables(script, capsys):
     if script not in PRINTS:
         pytest.fail(f"benchmarks/{script} has no quick test: give it a --quick mode and a line in PRINTS")
-    if script in COMPILES_EVERY_RUN and os.environ.get("PROJEQ_ALL_BENCHMARKS") != "1":
-        pytest.skip(f"{script}: {COMPILES_EVERY_RUN[script]}; PROJEQ_ALL_BENCHMARKS=1 runs it")
+    if script in OPT_IN and os.environ.get("PROJEQ_ALL_BENCHMARKS") != "1":
+        pytest.skip(f"{script}: {OPT_IN[script]}; PROJEQ_ALL_BENCHMARKS=1 runs it")
     load(script).main(["--quick"])
     out = capsys.readouterr().out
     for text in PRINTS[script]:
