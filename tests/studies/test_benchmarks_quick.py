@@ -45,6 +45,7 @@ OPT_IN = {
     "closure_runs.py": "Andrews' squeezer on the numpy path, 501 output rows (9 s)",
     "run_profile.py": "two fresh processes (8 s)",
     "beam_convergence.py": "projeq bench's quick study: seven 20 s spin-ups (8 s)",
+    "scene_builds.py": "a fresh process (4 s)",
 }
 
 #: script → texts its quick run prints (table heads and row labels, no numbers)
