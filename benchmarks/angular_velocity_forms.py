@@ -4,11 +4,12 @@ code) and the sin² + cos² = 1 normal form :func:`projeq.symbolic.algebra.trig_
 seconds of each, their ratio, and whether the two give identical expressions — for one, two and
 three Euler angles (the last is the rolling disk's C = R_z(q1) R_x(q2) R_y(q3), Barhorst §3.2).
 
-    PYTHONPATH=. python benchmarks/angular_velocity_forms.py
+    PYTHONPATH=. python benchmarks/angular_velocity_forms.py [--quick]   # --quick: R_z alone
 """
 
 from __future__ import annotations
 
+import argparse
 import time
 
 import sympy as sp
@@ -16,11 +17,16 @@ import sympy as sp
 from projeq.symbolic.algebra import rotation_x, rotation_y, rotation_z, trig_normal
 
 
-def main() -> None:
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="one Euler angle only (what a test runs)")
+    args = parser.parse_args(argv)
     q = sp.symbols("q1:4")
     q_dot = sp.symbols("q1_dot q2_dot q3_dot")
     cases = {"R_z": rotation_z(q[0]), "R_z R_x": rotation_z(q[0]) * rotation_x(q[1]),
              "R_z R_x R_y": rotation_z(q[0]) * rotation_x(q[1]) * rotation_y(q[2])}
+    if args.quick:
+        cases = {"R_z": cases["R_z"]}
     print(f"{'R':12s} {'trigsimp s':>10s} {'trig_normal s':>13s} {'ratio':>6s} identical")
     for name, R in cases.items():
         W = R.T * sum((R.diff(qi) * rate for qi, rate in zip(q, q_dot)), sp.zeros(3, 3))

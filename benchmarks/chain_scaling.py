@@ -16,7 +16,7 @@ absolute times are this machine's only. Targets of issue 7: fast ≤ 5× Pinocch
 n = 100, faster than MuJoCo for n ≥ 200, slope ≤ 1.1.
 
     python benchmarks/chain_scaling.py            # n = 10, 30, 100, 200, 300, 1000
-    python benchmarks/chain_scaling.py --quick    # n = 10, 30, 100
+    python benchmarks/chain_scaling.py --quick    # n = 10, 30, 100, 0.05 s each, exact s̈ to n = 30
 """
 
 from __future__ import annotations
@@ -31,12 +31,14 @@ SIZES = (10, 30, 100, 200, 300, 1000)
 
 def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="n = 10, 30, 100 only")
+    parser.add_argument("--quick", action="store_true", help="n = 10, 30, 100, 0.05 s each, exact to n = 30")
     parser.add_argument("--budget", type=float, default=1.0, help="seconds of timing per size (default 1)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--no-peers", action="store_true", help="skip Pinocchio and MuJoCo")
     exact_option(parser)
     args = parser.parse_args(argv)
+    if args.quick:
+        args.budget, args.exact_up_to = 0.05, min(args.exact_up_to, 30)
     return chain_scaling(QUICK_SIZES if args.quick else SIZES, args.budget, args.json, not args.no_peers, args.exact_up_to)
 
 

@@ -8,6 +8,7 @@ and the projection by numpy on the compiled tree's Gauss form (the default befor
 
     python benchmarks/closures.py                 # every constrained scene
     python benchmarks/closures.py four_bar        # some of them
+    python benchmarks/closures.py --quick         # four-bar and Andrews' squeezer, 0.02 s each (a test)
 """
 
 from __future__ import annotations
@@ -50,8 +51,10 @@ def main(argv=None) -> list:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scenes", nargs="*", default=CONSTRAINED, help="scene names (default: the constrained ones)")
     parser.add_argument("--budget", type=float, default=0.5, help="seconds of timing per scene (default 0.5)")
+    parser.add_argument("--quick", action="store_true", help="four-bar and Andrews' squeezer, 0.02 s each")
     args = parser.parse_args(argv)
-    rows = [row(name, args.budget) for name in args.scenes]
+    names, budget = (("four_bar", "andrews_squeezer"), 0.02) if args.quick else (args.scenes, args.budget)
+    rows = [row(name, budget) for name in names]
     print(Table(("scene", "k", "chain_us", "numpy_us", "default_us", "numpy/chain", "default/chain", "one compiled call"),
                 [(r["scene"], r["k"], r["chain_us"], r["numpy_us"], r["default_us"], r["numpy_us"] / r["chain_us"],
                   r["default_us"] / r["chain_us"], "yes" if r["compiled"] else "no") for r in rows],

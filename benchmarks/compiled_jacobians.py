@@ -22,6 +22,7 @@ by column (the evaluator's one-call Jacobian switched off: what projeq did befor
 loop ran inside the Jacobian kernel), each the best CPU time of ``--runs`` alternating runs.
 
     python benchmarks/compiled_jacobians.py [--repeat 7] [--flyball [--runs 2]]
+    python benchmarks/compiled_jacobians.py --quick   # chain(10) and the spin-up beam, then A05 over 0.1 s
 """
 
 from __future__ import annotations
@@ -93,26 +94,36 @@ def best(f, repeat):
     return min(times)
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
     parser.add_argument("--flyball", action="store_true", help="A05 over 10 s: one-call vs per-column Jacobians")
     parser.add_argument("--runs", type=int, default=2)
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true",
+                        help="the table for chain(10) and the spin-up beam, then A05 over 0.1 s, once each")
+    args = parser.parse_args(argv)
+    if args.quick:
+        table({k: v for k, v in models().items() if k in ("chain(10)", "spin-up beam")}, 1)
+        return flyball(1, 0.1)
     if args.flyball:
         return flyball(args.runs)
+    table(models(), args.repeat)
+
+
+def table(systems: dict, repeat: int) -> None:
+    """The Jacobians' costs of each model (module docstring), ``repeat`` batches each."""
     t = 0.3
     print(f"{'model':18} {'n_x':>4} {'ẋ µs':>7} {'ẋ(z) µs':>7} | {'interpreted':>17} | {'compiled':>17} | {'per column':>17} | "
           f"{'forward diff.':>17} | {'agree':>8}")
-    for name, system in models().items():
+    for name, system in systems.items():
         x = state(system)
         compiled = system.evaluator()
         reference = HubBeamEvaluator(system, compiled=False) if compiled.name == "hub_beam" \
             else system.evaluator("dense" if system.coupled else "recursive")
         f, f_reference = rhs(system, compiled, t), rhs(system, reference, t)
-        unit = best(lambda: f(x), args.repeat)
+        unit = best(lambda: f(x), repeat)
         z = x + 1j * COMPLEX_STEP * np.eye(len(x))[0]
-        complex_call = best(lambda: f(z), args.repeat)
+        complex_call = best(lambda: f(z), repeat)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             J_reference = exact_jacobian(f_reference, x)
@@ -123,16 +134,16 @@ def main() -> None:
             "per column": lambda: exact_jacobian(f, x),
             "forward diff.": lambda: forward(f, x),
         }
-        costs = {label: best(run, args.repeat) for label, run in rows.items()}
-        unit = min(unit, best(lambda: f(x), args.repeat))  # measured again: the least of both, as each row
+        costs = {label: best(run, repeat) for label, run in rows.items()}
+        unit = min(unit, best(lambda: f(x), repeat))  # measured again: the least of both, as each row
         cells = [f"{cost * 1e3:8.3f} ms {cost / unit:5.0f}×" for cost in costs.values()]
         agree = np.abs(J - J_reference).max() / np.abs(J_reference).max()
         print(f"{name:18} {len(x):4d} {unit * 1e6:7.1f} {complex_call * 1e6:7.1f} | " + " | ".join(cells)
               + f" | {agree:8.1e}")
 
 
-def flyball(runs: int) -> None:
-    """The flyball governor's default run (module docstring), one-call vs per-column Jacobians:
+def flyball(runs: int, t_end: float = 10.0) -> None:
+    """The flyball governor's default run (module docstring) to ``t_end``, one-call vs per-column Jacobians:
     the CPU time of the whole run and of its Jacobians (simulate's ``_Run.jacobian``, timed)."""
     from projeq.simulation import driver
 
@@ -153,7 +164,7 @@ def flyball(runs: int) -> None:
         for label, way in (("one call", one_call), ("per column", lambda t, x: None)):
             evaluator.state_jacobian, spent[0] = way, 0.0
             start = time.process_time()
-            r = pq.simulate(system, 10.0)
+            r = pq.simulate(system, t_end)
             cpu = time.process_time() - start
             if label not in results or cpu < results[label][0]:
                 results[label] = (cpu, spent[0], r)

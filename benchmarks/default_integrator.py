@@ -7,6 +7,7 @@ each method's kernels are compiled, or loaded from disk, by a short run first).
 
     python benchmarks/default_integrator.py               # 5 s of the spin-up, a table of tolerances
     python benchmarks/default_integrator.py --t-end 20    # the scene's full 20 s (minutes)
+    python benchmarks/default_integrator.py --quick       # 10 ms of the spin-up (a test runs it)
     python benchmarks/default_integrator.py --scene chain5 --runs default RK45 DOP853   # another model,
                                                           # at simulate's default tolerances
     python benchmarks/default_integrator.py --scene spinning_beam spinning_beam_1cm axial_beam \\
@@ -88,7 +89,10 @@ def main(argv=None) -> Table:
     parser.add_argument("--scene", nargs="+", choices=sorted(SCENES), default=["spin_up_beam"],
                         help="the models (default spin_up_beam)")
     parser.add_argument("--runs", nargs="*", help="methods at the default tolerances ('default': simulate's choice)")
+    parser.add_argument("--quick", action="store_true", help="10 ms of each scene (--t-end 0.01)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.t_end = 0.01
     runs = [(None if m == "default" else m, 1e-8, 1e-10) for m in args.runs] if args.runs else RUNS
     rows = [row for name in args.scene for row in scene_rows(name, args.t_end, runs)]
     table = Table(("scene", "t_end", "method", "rtol", "cpu", "nfev", "njev", "error", "StiffnessWarning"), rows,

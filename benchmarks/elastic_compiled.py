@@ -6,11 +6,12 @@ rotary inertia (a RitzBeam on a prescribed hub: `method="hub_beam"`), a link car
 with rotary inertia (the order-n kernel's elastic block with `kernels.rotary_body`), and a beam
 beside a coupled joint (the compiled Gauss form with each body's n_y, projected).
 
-    PYTHONPATH=. python benchmarks/elastic_compiled.py
+    PYTHONPATH=. python benchmarks/elastic_compiled.py [--quick]   # --quick: 0.05 s runs, few calls (a test)
 """
 
 from __future__ import annotations
 
+import argparse
 import time
 import warnings
 
@@ -53,8 +54,9 @@ def per_call(f, calls: int) -> float:
     return (time.perf_counter() - started) / calls * 1e6
 
 
-def row(name: str, build) -> tuple:
-    """The model's row of the table (module docstring)."""
+def row(name: str, build, t_end: float = 2.0, calls: int = 2000) -> tuple:
+    """The model's row of the table (module docstring): runs of ``t_end`` s, s̈ timed over ``calls`` calls
+    (a tenth of them by the reference)."""
     system = build()
     reference = "dense" if system.coupled else "recursive"
     rng = np.random.default_rng(0)
@@ -62,28 +64,33 @@ def row(name: str, build) -> tuple:
     default = system.evaluator().name
     with warnings.catch_warnings():
         warnings.simplefilter("error", pq.assembly.InterpretedWarning)  # the default must be compiled
-        fast = per_call(lambda: system.accelerations(q, s_dot, 0.3), 2000)
+        fast = per_call(lambda: system.accelerations(q, s_dot, 0.3), calls)
         pq.simulate(system, 0.01)  # the kernels from numba's cache, outside the timings
         started = time.process_time()
-        compiled_run = pq.simulate(system, 2.0)
+        compiled_run = pq.simulate(system, t_end)
         compiled_cpu = time.process_time() - started
-    slow = per_call(lambda: system.accelerations(q, s_dot, 0.3, method=reference), 200)
+    slow = per_call(lambda: system.accelerations(q, s_dot, 0.3, method=reference), calls // 10)
     started = time.process_time()
-    reference_run = pq.simulate(system, 2.0, evaluator=reference)
+    reference_run = pq.simulate(system, t_end, evaluator=reference)
     reference_cpu = time.process_time() - started
     difference = float(np.abs(compiled_run.q[-1] - reference_run.q[-1]).max())
     return (name, default, fast, reference, slow, slow / fast, compiled_cpu, reference_cpu,
             reference_cpu / compiled_cpu, difference)
 
 
-def main() -> Table:
+def main(argv=None) -> Table:
     """Print and return the table."""
-    rows = [row(name, build) for name, build in MODELS.items()]
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="runs of 0.05 s, 50 calls timed")
+    args = parser.parse_args(argv)
+    t_end, calls = (0.05, 50) if args.quick else (2.0, 2000)
+    rows = [row(name, build, t_end, calls) for name, build in MODELS.items()]
     table = Table(("model", "default", "s̈ µs", "reference", "ref s̈ µs", "s̈ ratio", "run s", "ref run s",
-                   "run ratio", "|Δq(2 s)|"), rows,
+                   "run ratio", "|Δq(t_end)|"), rows,
                   formats={"s̈ µs": ".1f", "ref s̈ µs": ".1f", "s̈ ratio": ".1f", "run s": ".2f", "ref run s": ".2f",
-                           "run ratio": ".1f", "|Δq(2 s)|": ".1e"},
-                  title="elastic models on the compiled paths vs the reference evaluators (one run; simulate defaults, 2 s)")
+                           "run ratio": ".1f", "|Δq(t_end)|": ".1e"},
+                  title=f"elastic models on the compiled paths vs the reference evaluators (one run; "
+                        f"simulate defaults, {t_end:g} s)")
     print(table.to_text())
     return table
 

@@ -11,11 +11,12 @@ measured in one run:
    power iteration on forward differences of the fused real-only right-hand side it used
    against ρ now (the model's complex-safe ẋ) and the eigenvalues of the exact Jacobian.
 
-    PYTHONPATH=. python benchmarks/exact_rest.py
+    PYTHONPATH=. python benchmarks/exact_rest.py [--quick]   # --quick: A02 over 1 s, 5 event calls
 """
 
 from __future__ import annotations
 
+import argparse
 import time
 import warnings
 
@@ -46,7 +47,8 @@ def central_event(system):
     return singular_position, ratio
 
 
-def events() -> None:
+def events(t_end: float = 10.0, calls: int = 200) -> None:
+    """Table 1 of the module docstring: the runs over ``t_end`` s, ``calls`` event calls timed."""
     system = n_four_bar(2)
     fd, ratio = central_event(system)
     exact = system.singular_positions()
@@ -62,15 +64,18 @@ def events() -> None:
     q, s_dot, t = r.q[4], r.s_dot[4], r.t[4]
     runs = {}
     for name, event in (("none", None), ("fd", fd), ("exact", exact)):
-        calls = 200
         start = time.process_time()
         for _ in range(calls if event else 0):
             event(t, q, s_dot)
         per_call = (time.process_time() - start) / calls * 1e6
         start = time.process_time()
-        run = pq.simulate(system, 10.0, n_points=201, rtol=1e-9, atol=1e-11, events=[event] if event else None)
+        run = pq.simulate(system, t_end, n_points=201, rtol=1e-9, atol=1e-11,
+                          events=[event] if event else None)
         runs[name] = time.process_time() - start
-        if event:
+        if event is not None and not len(run.t_events[0]):
+            print(f"{name:5s}: no event in {t_end:g} s, {per_call:.0f} µs per event call, "
+                  f"run {runs[name]:.2f} s CPU")
+        elif event:
             found = run.t_events[0]
             horizontal = [brentq(lambda s: parallelogram_motion([0.0, s], 2)[-1, 1], a - 0.05, a + 0.05, xtol=1e-14)
                           for a in found]
@@ -94,7 +99,15 @@ def stiffness() -> None:
               f"before (forward differences) {before:.12g} (rel {abs(before / eig - 1):.1e})")
 
 
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="A02 runs of 1 s and 5 event calls")
+    args = parser.parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        events(*((1.0, 5) if args.quick else ()))
+        stiffness()
+
+
 if __name__ == "__main__":
-    warnings.simplefilter("ignore")
-    events()
-    stiffness()
+    main()

@@ -14,6 +14,7 @@ default_method picks before and now; then the cost of each check in ms (CPU, the
 ``--repeat``) and in real evaluations of ẋ, and after/before.
 
     python benchmarks/fastest_mode.py [--repeat 5]
+    python benchmarks/fastest_mode.py --quick   # the double pendulum and the four-bar, once (a test runs it)
 """
 
 from __future__ import annotations
@@ -49,13 +50,15 @@ def real_only(fun):
     return f
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true", help="the double pendulum and the four-bar, once")
+    args = parser.parse_args(argv)
+    names, repeat = (("double_pendulum", "four_bar"), 1) if args.quick else (list(scenes.SCENES), args.repeat)
     print(f"{'scene':22} {'n_x':>4} {'t_end':>6} | {'ρ fd':>11} {'ρ exact':>11} {'way':>8} | {'fd':>6} "
           f"{'default':>7} | {'fd ms':>7} {'exact ms':>8} | {'ẋ µs':>7} {'fd/ẋ':>5} {'exact/ẋ':>7} {'ratio':>5}")
-    for name in scenes.SCENES.keys():
+    for name in names:
         scene = scenes.get_scene(name)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -74,7 +77,7 @@ def main() -> None:
             before, after = (lambda: fastest_mode(real_only(rhs), 0.0, x0)), \
                 (lambda: fastest_mode(rhs, 0.0, x0, jacobian=one_call))
             (rho_fd, decays_fd), (rho, decays) = before(), after()
-            cost_fd, cost = best(before, args.repeat), best(after, args.repeat)
+            cost_fd, cost = best(before, repeat), best(after, repeat)
             unit = best(lambda: rhs(0.0, x0), 50)
             chosen = driver.default_method(evaluator, system, q0, s_dot0, 0.0, t_end)
             chosen_fd = driver.default_method(_Real(evaluator), system, q0, s_dot0, 0.0, t_end)

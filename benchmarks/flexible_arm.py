@@ -8,6 +8,7 @@ is checked by the difference to a run at rtol 1e-10).
 
     python benchmarks/flexible_arm.py             # 5 s, as in the issue
     python benchmarks/flexible_arm.py --t-end 1   # shorter
+    python benchmarks/flexible_arm.py --quick     # 10 ms, and Radau besides (a test runs it)
     python benchmarks/flexible_arm.py --methods RK45 Radau BDF   # and the flexible arm by these
                                                                   # methods (implicit: exact Jacobian)
 """
@@ -37,7 +38,10 @@ def main(argv=None) -> Table:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--t-end", type=float, default=5.0, help="simulated seconds (default 5)")
     parser.add_argument("--methods", nargs="*", default=(), help="further methods for the flexible arm, same tolerances")
+    parser.add_argument("--quick", action="store_true", help="10 ms (--t-end 0.01 --methods Radau)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.t_end, args.methods = 0.01, ("Radau",)
     rigid, flexible = pq.scenes.flexible_arm(rigid_last_link=True), pq.scenes.flexible_arm()
     for system in (rigid, flexible):  # compile (or load) the kernels simulate calls outside the timings
         run(system, 1e-3)

@@ -26,6 +26,7 @@ fastest mode (ρ = 3144 1/s, 0.37 of ṡ_e) needs ρ h ≲ 1.6 to end within 1e-
 
     PYTHONPATH=. python benchmarks/flexible_arm_integrators.py            # 5 s, as in the issue
     PYTHONPATH=. python benchmarks/flexible_arm_integrators.py --t-end 1  # shorter
+    PYTHONPATH=. python benchmarks/flexible_arm_integrators.py --quick    # 10 ms (a test runs it)
 """
 
 from __future__ import annotations
@@ -47,15 +48,17 @@ SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0  # scipy.integrate's Runge–Kut
 
 
 def compiled_model(system):
-    """(chain_terms, passes, tree_jacobian, model tuple) of the system's fast evaluator, for the
-    compiled loops: ẋ = (ṡ, s̈) (q̇ = ṡ: revolute joints only) and ∂ẋ/∂x by the kernels."""
+    """(chain_terms, passes, tree_jacobian, model tuple, complex workspace with the (empty) force laws) of
+    the system's fast evaluator, for the compiled loops: ẋ = (ṡ, s̈) (q̇ = ṡ: revolute joints only) and
+    ∂ẋ/∂x by the kernels."""
     ev = system.evaluator().evaluator
     if ev._given or system.forces or system.coupled or system.n_q != system.n_s:
         raise ValueError("system: the compiled loops take trees of revolute/prismatic joints without force laws")
     ws, wc = ev._real, ev._workspace(complex)
     model = (ev._index, ev._geometry, ev._inertia, ev._gravity, ws.given_values, ev._elastic, ev._ports,
              ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat, ws.R, ws.r, ws.twist, ev._pivot_min, system.n_q)
-    complex_ws = (wc.given_values, wc.T, wc.zeta, wc.F, wc.M_n, wc.M_hat, wc.h_hat, wc.R, wc.r, wc.twist)
+    complex_ws = (ev._laws, ev._law_constants, wc.given_values, wc.T, wc.zeta, wc.F, wc.M_n, wc.M_hat,
+                  wc.h_hat, wc.R, wc.r, wc.twist)
     return ev._chain_terms, ev._passes, ev._jacobian, model, complex_ws
 
 
@@ -74,13 +77,12 @@ def x_dot(chain, passes, model, x, out):
 def jacobian(jac, model, complex_ws, x, J):
     """∂ẋ/∂x at x into J by the complex step through the kernels (kernels.tree_jacobian)."""
     (index, geometry, inertia, gravity, _, elastic, ports, _, _, _, _, _, _, _, _, _, pivot_min, n_q) = model
-    given, T, zeta, F, M_n, M_hat, h_hat, R, r, twist = complex_ws
+    laws, constants, given, T, zeta, F, M_n, M_hat, h_hat, R, r, twist = complex_ws
     J[:] = 0.0
     for i in range(n_q):
         J[i, n_q + i] = 1.0
-    no_laws, no_constants = np.zeros((0, 7), np.int64), np.zeros((0, 0))  # the arm has gravity only
-    jac(0.0, index, geometry, inertia, gravity, no_laws, no_constants, x, n_q, COMPLEX_STEP, given, elastic, ports,
-        T, zeta, F, M_n, M_hat, h_hat, R, r, twist, pivot_min, J[n_q:])
+    jac(0.0, index, geometry, inertia, gravity, laws, constants, x, n_q, COMPLEX_STEP, given, elastic, ports,
+        T, zeta, F, M_n, M_hat, h_hat, R, r, twist, pivot_min, J[n_q:])  # the arm has gravity only: no laws
 
 
 @numba.njit(cache=True)
@@ -349,8 +351,9 @@ COEFFICIENTS = (DOP853.A, DOP853.B, DOP853.C, DOP853.E3, DOP853.E5)
 def main(argv=None) -> tuple[Table, Table]:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--t-end", type=float, default=5.0, help="simulated seconds (default 5)")
+    parser.add_argument("--quick", action="store_true", help="10 ms (--t-end 0.01)")
     args = parser.parse_args(argv)
-    T = args.t_end
+    T = 0.01 if args.quick else args.t_end
     arms = {}
     for label, system, flexible in (("rigid twin", pq.scenes.flexible_arm(rigid_last_link=True), False),
                                     ("flexible", pq.scenes.flexible_arm(), True)):

@@ -37,6 +37,7 @@ difference and each code's own error; then every run's CPU time and largest diff
 both finest runs; then Exudyn's difference by its axial stiffness. Measured (one run, 2 shared cores):
 
     python benchmarks/flexible_four_bar_exudyn.py --n-v 2 4 6 8   # 5 min; default --n-v 2 4 6: 2.5 min
+    python benchmarks/flexible_four_bar_exudyn.py --quick         # 20 ms (no Exudyn: projeq's runs alone)
 
     crank angle, rad: projeq n_v=8 tight vs exudyn 32 el h=0.000125
     t (s)     projeq     exudyn  difference  projeq error  exudyn error
@@ -158,6 +159,7 @@ import os
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # single-threaded CPU times, as benchmarks/exudyn_spin_up.py
 import argparse
+import importlib.util
 import time
 import warnings
 
@@ -328,7 +330,8 @@ def _exudyn_name(n, h):
 
 
 def runs(times, n_vs=(2, 4, 6), exudyn=EXUDYN_RUNS, axial_stiffness=1e7) -> dict:
-    """Name → run (:func:`projeq_run`, :func:`exudyn_run`), all in this process."""
+    """Name → run (:func:`projeq_run`, :func:`exudyn_run`; ``exudyn=()``: projeq's alone), all in this
+    process."""
     out = {"projeq n_v=2 defaults": projeq_run(times, 2)}
     for n_v in n_vs:
         out[f"projeq n_v={n_v} tight"] = projeq_run(times, n_v, **PROJEQ_TIGHT)
@@ -359,9 +362,18 @@ def tables(times, results: dict, exudyn=EXUDYN_RUNS) -> list[Table]:
     discretisation error (its finest run's change from the next coarser: projeq's last n_v
     against the one before; Exudyn's last run against half its elements and against twice
     its step, the larger) at ``times``; then per run its CPU time and largest differences
-    from both codes' finest runs."""
+    from both codes' finest runs (``exudyn=()``: projeq's runs alone, from its finest)."""
     pq_names = [k for k in results if k.startswith("projeq") and k.endswith("tight")]
     pq_best, pq_next = results[pq_names[-1]], results[pq_names[-2]]
+    quantities = ("crank", "rocker", "tip", "sag")
+    if not exudyn:
+        rows = [(name, r["method"], r["cpu"], *[float(np.abs(r[k] - pq_best[k]).max()) for k in quantities])
+                for name, r in results.items()]
+        columns = [f"{k} vs projeq" for k in quantities]
+        return [Table(("run", "method", "cpu", *columns), rows, units={"cpu": "s"},
+                      formats={"cpu": ".2f", **{c: ".1e" for c in columns}},
+                      title=f"projeq's runs: CPU (time.process_time) and max |difference| over the "
+                            f"{len(times)} times from {pq_names[-1]} (rad, m)")]
     n, h = exudyn[-1]
     ex_name = _exudyn_name(n, h)
     ex_best = results[ex_name]
@@ -375,7 +387,6 @@ def tables(times, results: dict, exudyn=EXUDYN_RUNS) -> list[Table]:
                          units={"t": "s"}, formats={"t": ".2f", "projeq": ".6f", "exudyn": ".6f", "difference": ".1e",
                                                     "projeq error": ".1e", "exudyn error": ".1e"},
                          title=f"{what}: {pq_names[-1]} vs {ex_name}"))
-    quantities = ("crank", "rocker", "tip", "sag")
     rows = [(name, r["method"], r["cpu"], *[float(np.abs(r[k] - pq_best[k]).max()) for k in quantities],
              *[float(np.abs(r[k] - ex_best[k]).max()) for k in quantities]) for name, r in results.items()]
     columns = [f"{k} vs {code}" for code in ("projeq", "exudyn") for k in quantities]
@@ -393,12 +404,23 @@ def main(argv=None) -> list[Table]:
     parser.add_argument("--axial-stiffness", type=float, default=1e7, help="Exudyn's EA in N (default 1e7)")
     parser.add_argument("--n-v", type=int, nargs="+", default=[2, 4, 6],
                         help="projeq's numbers of bending functions at tight rtol (default 2 4 6; the last two give its error)")
+    parser.add_argument("--quick", action="store_true",
+                        help="20 ms, 2 times, n_v = 2, 4, Exudyn 4 and 8 elements at h = 1e-3")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.t_end, args.points, args.n_v = 0.02, 2, [2, 4]
+    exudyn = ((4, 1e-3), (8, 1e-3)) if args.quick else EXUDYN_RUNS
+    if importlib.util.find_spec("exudyn") is None:
+        print("exudyn is not installed (pip install 'projeq[bench]'): its runs and the comparison left out")
+        exudyn = ()
     times = np.linspace(args.t_end / args.points, args.t_end, args.points)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
-        results = runs(times, n_vs=args.n_v, axial_stiffness=args.axial_stiffness)
-        out = [*tables(times, results), axial_table(times, results)]
+        results = runs(times, n_vs=args.n_v, exudyn=exudyn, axial_stiffness=args.axial_stiffness)
+        out = tables(times, results, exudyn)
+        if exudyn:
+            out.append(axial_table(times, results, (1e7,), *exudyn[-1]) if args.quick
+                       else axial_table(times, results))
     for table in out:
         print(table.to_text())
         print()

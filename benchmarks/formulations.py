@@ -24,7 +24,8 @@ speeds u = Y q̇ of eq. 93), all by the same Radau IIA code at rtol 1e-8; integr
 baseline row, energy and constraint drift, and his reported numbers beside.
 
     python benchmarks/formulations.py            # disc: t_end = 100, rtol 1e-6 and 1e-10; Barhorst: 10 s
-    python benchmarks/formulations.py --quick    # disc: t_end = 10, rtol 1e-8; Barhorst: 2 s
+    python benchmarks/formulations.py --quick    # disc: t_end = 0.1, PE, Lagrange+λ, Barhorst projective;
+                                                 # Barhorst: his particle over 0.1 s (a test runs it)
     python benchmarks/formulations.py --barhorst # Barhorst's three examples only (10 s)
 """
 
@@ -53,7 +54,8 @@ def _row(name, setup, wall, nfev, q, q_dot, disc):
             residual, np.abs(q[2] + np.cos(q[4])).max())
 
 
-def run(t_end: float, rtol: float):
+def run(t_end: float, rtol: float, quick: bool = False):
+    """The rows of the disc's table (module docstring); ``quick``: PE, Lagrange+λ and Barhorst projective."""
     system = knife_edge_disc(s_dot0=(0.4, 0.0, -3.0))
     q0, q_dot0 = lecture_disc_state(system)
     t_eval, rows = np.linspace(0, t_end, 201), []
@@ -69,7 +71,7 @@ def run(t_end: float, rtol: float):
 
     multiplier_runs = (("Lagrange+λ", 0.0, "lagrange"), ("Lagrange+λ, Baumgarte α=1", 1.0, "lagrange"),
                        ("Lagrange+λ, Baumgarte α=10", 10.0, "lagrange"), ("Hamilton+λ", 0.0, "hamilton"))
-    for name, alpha, form in multiplier_runs:
+    for name, alpha, form in multiplier_runs[:1] if quick else multiplier_runs:
         sp.core.cache.clear_cache()
         start = time.perf_counter()
         candidate = build_lecture_disc()
@@ -80,8 +82,9 @@ def run(t_end: float, rtol: float):
                                  atol=rtol / 100)
         rows.append(_row(name, setup, time.perf_counter() - start, sol.nfev, sol.q, sol.q_dot, disc))
 
-    for name, build in (("Barhorst Lagrangian", lambda: lagrangian_canonical(build_lecture_disc())),
-                        ("Barhorst projective", build_projective_disc)):
+    canonical_runs = (("Barhorst Lagrangian", lambda: lagrangian_canonical(build_lecture_disc())),
+                      ("Barhorst projective", build_projective_disc))
+    for name, build in canonical_runs[1:] if quick else canonical_runs:
         sp.core.cache.clear_cache()
         start = time.perf_counter()
         canonical = build()
@@ -100,27 +103,27 @@ def _q_dot(canonical, sol):
     return np.array([np.asarray(K(qi), float) @ ui for qi, ui in zip(sol.q.T, sol.u.T)]).T
 
 
-def main():
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--barhorst", action="store_true", help="only Barhorst's three examples")
-    args = parser.parse_args()
-    cases = [] if args.barhorst else [(10.0, 1e-8)] if args.quick else [(100.0, 1e-6), (100.0, 1e-10)]
+    args = parser.parse_args(argv)
+    cases = [] if args.barhorst else [(0.1, 1e-8)] if args.quick else [(100.0, 1e-6), (100.0, 1e-10)]
     for t_end, rtol in cases:
         print(f"\nknife-edge disc, t_end = {t_end}, rtol = {rtol:g}, atol = {rtol / 100:g}")
         print(f"{'formulation':28s} {'setup s':>8s} {'run s':>7s} {'nfev':>6s} {'|ΔE|':>9s} {'|Aq̇|':>9s} "
               f"{'|z+rcϕ|':>9s} {'run/PE':>7s}")
-        rows = run(t_end, rtol)
+        rows = run(t_end, rtol, args.quick)
         for name, setup, wall, nfev, dE, dA, dz in rows:
             print(f"{name:28s} {setup:8.2f} {wall:7.2f} {nfev:6d} {dE:9.2e} {dA:9.2e} {dz:9.2e} "
                   f"{wall / rows[0][2]:7.2f}")
-    barhorst(2.0 if args.quick else 10.0)
+    barhorst(*((0.1, ("barhorst_particle",)) if args.quick else (10.0,)))
 
 
-def barhorst(t_end: float):
-    """Barhorst's three examples over ``t_end`` seconds (his runs: 10 s), each formulation's row with his
+def barhorst(t_end: float, names=("barhorst_particle", "rolling_disk", "quick_return")):
+    """Barhorst's examples over ``t_end`` seconds (his runs: 10 s), each formulation's row with his
     reported numbers beside."""
-    for name in ("barhorst_particle", "rolling_disk", "quick_return"):
+    for name in names:
         table = pq.compare(name, t_end=t_end, repeats=1)
         print()
         print(table.format())

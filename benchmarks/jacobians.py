@@ -9,6 +9,7 @@ Jacobians (n_x per Jacobian), and the wall time, all in one run. The end states 
 runs are compared (they must agree to the tolerance).
 
     python benchmarks/jacobians.py [--t-end 0.2] [--rtol 1e-6]
+    python benchmarks/jacobians.py --quick     # the elastic arm with 3 shapes over 10 ms (a test runs it)
 """
 
 from __future__ import annotations
@@ -46,14 +47,18 @@ def run(system, method, jac, t_end, rtol):
     return evaluator.n_calls - before - complex_calls, complex_calls, wall, result
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--t-end", type=float, default=0.2)
     parser.add_argument("--rtol", type=float, default=1e-6)
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true", help="the elastic arm with 3 shapes over 10 ms")
+    args = parser.parse_args(argv)
+    systems = models()
+    if args.quick:
+        args.t_end, systems = 0.01, {"elastic_arm (3 shapes)": systems["elastic_arm (3 shapes)"]}
     print(f"t_end = {args.t_end} s, rtol = {args.rtol}; real / complex evaluations of s̈, wall time")
     print(f"{'model':24} {'method':6} {'jac':12} {'real':>8} {'complex':>8} {'wall s':>8} {'Δq_end':>9}  reached")
-    for name, system in models().items():
+    for name, system in systems.items():
         for method in ("Radau", "BDF"):
             ends = []
             for jac in ("differences", "exact"):

@@ -19,6 +19,7 @@ prints the partitions' switch times, the largest crank-angle difference to the c
 the energy drift, evaluations and wall time.
 
     python benchmarks/loop_drift.py [--t-end 10] [--rtol 1e-8] [--four-bar-t-end 2]
+    python benchmarks/loop_drift.py --quick    # 0.2 s each (a test runs it)
 """
 
 from __future__ import annotations
@@ -74,12 +75,15 @@ def repivoting(t_end: float, rtol: float) -> None:
               f"{r.energy_drift:>10.2e}{r.nfev:>7d}{time.perf_counter() - started:>7.1f}")
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--t-end", type=float, default=10.0)
     parser.add_argument("--rtol", type=float, default=1e-8)
     parser.add_argument("--four-bar-t-end", type=float, default=2.0)
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true", help="--t-end 0.2 --four-bar-t-end 0.2")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.t_end = args.four_bar_t_end = 0.2
     cases = [("none", {}), ("baumgarte", {"beta": 1.0}), ("baumgarte", {"beta": 10.0}),
              ("projection", {"n_segments": 20}), ("projection", {"n_segments": 100})]
     print(f"quick-return, {args.t_end} s, rtol {args.rtol:g}")

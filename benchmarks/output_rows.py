@@ -7,6 +7,7 @@ difference of each array that is not, relative to its largest entry.
 
     git -C /work/main archive HEAD | tar -x -C /tmp/out_old
     PYTHONPATH=. python benchmarks/output_rows.py /tmp/out_old [--repeat 3] [SCENE[:t_end] ...]
+    PYTHONPATH=. python benchmarks/output_rows.py --quick   # this tree against itself, one 0.1 s run each
 """
 
 from __future__ import annotations
@@ -63,15 +64,21 @@ def differences(a: str, b: str) -> str:
         return "identical" if not differ else "; ".join(differ)
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("other", type=Path, help="the other checkout (before the change)")
+    parser.add_argument("other", type=Path, nargs="?", help="the other checkout (before the change)")
     parser.add_argument("scenes", nargs="*", default=list(SCENES), help="scene names, optionally name:t_end")
     parser.add_argument("--repeat", type=int, default=3, help="processes of each tree per scene (median CPU)")
-    args = parser.parse_intermixed_args()
+    parser.add_argument("--quick", action="store_true",
+                        help="simple_pendulum:0.1, one process each (the other checkout: this tree if none)")
+    args = parser.parse_intermixed_args(argv)
     from projeq import scenes
 
     here = Path(__file__).resolve().parent.parent
+    if args.quick:
+        args.other, args.scenes, args.repeat = args.other or here, ["simple_pendulum:0.1"], 1
+    if args.other is None:
+        parser.error("the other checkout is required (except with --quick)")
     print(f"{'scene':18s} {'t_end':>6s} {'rows':>5s} {'nfev':>6s} {'before s':>9s} {'after s':>8s} "
           f"{'before/after':>12s} arrays (identical, or max |difference| / max |entry|)")
     with tempfile.TemporaryDirectory() as tmp:

@@ -13,7 +13,7 @@
 
     pip install 'projeq[bench]'                  # pin, mujoco, exudyn
     python benchmarks/peers.py                   # lines as measured, then the JSON file
-    python benchmarks/peers.py --quick           # n = 10, 100; no spin-up
+    python benchmarks/peers.py --quick           # n = 10, 100, 0.05 s each; no spin-up, no latency (a test)
     python benchmarks/peers.py --save benchmarks/results/2026-11-27/peers.json
 """
 
@@ -31,11 +31,13 @@ from projeq.studies.bench_peers import CHAIN_SIZES, peers_report
 
 def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--quick", action="store_true", help="chain n = 10, 100 only and no spin-up")
+    parser.add_argument("--quick", action="store_true",
+                        help="chain n = 10, 100 only, 0.05 s each; no spin-up, no cold-cache latency")
     parser.add_argument("--budget", type=float, default=1.0, help="seconds of timing per comparison (default 1)")
     parser.add_argument("--save", type=Path, default=None, help="write the report as JSON to this file")
     args = parser.parse_args(argv)
-    report = peers_report((10, 100) if args.quick else CHAIN_SIZES, args.budget, spin_up=not args.quick,
+    report = peers_report((10, 100) if args.quick else CHAIN_SIZES, 0.05 if args.quick else args.budget,
+                          spin_up=not args.quick, latency=not args.quick,
                           show=lambda line: print(line, flush=True))
     if args.save is not None:
         args.save.parent.mkdir(parents=True, exist_ok=True)

@@ -8,8 +8,11 @@ contact point (q4, q5) and p₂, in his units (g, cm, s). His figures: E ≈ 751
 (Fig. 8), p₂ axes from about 2850 g cm²/s (Figs. 6, 8); heading axes to about −60 rad, roll to
 about 250 rad, q4 within about ±6 cm, q5 down to about −12 cm.
 
-    python benchmarks/rolling_disk_inertia.py      # ~1 min
+    python benchmarks/rolling_disk_inertia.py           # ~1 min
+    python benchmarks/rolling_disk_inertia.py --quick   # his first 0.1 s (a test runs it)
 """
+
+import argparse
 
 import numpy as np
 
@@ -18,9 +21,10 @@ import projeq as pq
 G_CM2_S2 = 1e7  # 1 kg m²/s² in g cm²/s²
 
 
-def study(inertia: str) -> dict:
+def study(inertia: str, t_end: float = 10.0) -> dict:
     system = pq.scenes.rolling_disk(inertia=inertia)
-    result = pq.simulate(system, 10.0, method="DOP853", rtol=1e-10, atol=1e-12, n_points=2001)
+    result = pq.simulate(system, t_end, method="DOP853", rtol=1e-10, atol=1e-12,
+                         n_points=int(200 * t_end) + 1)
     dense = system.evaluator("dense")
     p2 = np.array([(dense.gauss_form(q, u, 0.0)[0] @ u)[1] for q, u in zip(result.q, result.s_dot)]) * G_CM2_S2
     q1, q3, q4, q5 = result.q[:, 0], result.q[:, 2], 100 * result.q[:, 3], 100 * result.q[:, 4]
@@ -30,9 +34,12 @@ def study(inertia: str) -> dict:
             "energy drift": result.energy_drift}
 
 
-def main():
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="the first 0.1 s only")
+    args = parser.parse_args(argv)
     for inertia in ("disk", "hoop"):
-        for key, value in study(inertia).items():
+        for key, value in study(inertia, 0.1 if args.quick else 10.0).items():
             text = f"[{value[0]:.4g}, {value[1]:.4g}]" if isinstance(value, tuple) else (
                 f"{value:.6g}" if isinstance(value, float) else value)
             print(f"{key:>18}: {text}")

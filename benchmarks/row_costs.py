@@ -6,11 +6,12 @@ energy and the residual for a System; and the whole row (normalisation and ``out
 Run it with either checkout on PYTHONPATH to compare them.
 
     PYTHONPATH=. python benchmarks/row_costs.py [SCENE[:t_end] ...]
+    PYTHONPATH=. python benchmarks/row_costs.py --quick   # chain:0.1 and four_bar:0.1 (a test runs it)
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 import time
 
 import projeq as pq
@@ -79,8 +80,12 @@ def parts(model, X, T) -> dict:
     return cost
 
 
-def main() -> None:
-    for spec in sys.argv[1:] or SCENES:
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scenes", nargs="*", default=SCENES, help="scene names, optionally name:t_end")
+    parser.add_argument("--quick", action="store_true", help="chain:0.1 and four_bar:0.1")
+    args = parser.parse_args(argv)
+    for spec in ("chain:0.1", "four_bar:0.1") if args.quick else args.scenes:
         name, _, t = spec.partition(":")
         cost = parts(*row_states(name, float(t) if t else None))
         print(f"{name:17s} " + " ".join(f"{k} {v:6.0f}" for k, v in cost.items()) + "  µs/row", flush=True)

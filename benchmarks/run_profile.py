@@ -25,6 +25,7 @@ scipy.linalg instead of scipy.integrate); ``--compare TREE`` times the phases of
 
     PYTHONPATH=. python benchmarks/run_profile.py [--repeat 5] [--cprofile] [--alternatives] [SCENE ...]
     PYTHONPATH=. python benchmarks/run_profile.py --compare /path/to/other/checkout [--repeat 5]
+    PYTHONPATH=. python benchmarks/run_profile.py --quick   # a process of projeq run --t-end 1 per view
 """
 
 from __future__ import annotations
@@ -120,7 +121,7 @@ for name, label in (("differentiate", "  Jacobians ∂ẋ/∂x (implicit methods
         patch(projeq.simulation.driver, name, label)
 patch(projeq.cli.run, "_write", "write NPZ + CSV")
 patch(projeq.simulation.export, "write_vtu_series", "write ParaView series")
-patch(projeq.cli.run, "_write_json", "write run.json")
+patch(projeq.cli.run, "write_json", "write run.json")
 patch(projeq.cli.run, "_plots", "write PNG plots (--plots; matplotlib's import)")
 before_main = clock()
 code = commands.command() if hasattr(commands, "command") else commands.main(sys.argv[1:])  # as the installed command
@@ -297,7 +298,7 @@ def compare(other: str, scene: list, repeat: int) -> None:
     print(f"  {'process wall':<45} {walls[0]:10.3f} {walls[1]:10.3f} {walls[0] / walls[1]:7.2f}")
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scene", nargs="*", help="scene and options of projeq run (default: none, the spin-up beam)")
     parser.add_argument("--repeat", type=int, default=5, help="fresh processes for the phases (median)")
@@ -306,11 +307,16 @@ def main() -> None:
                         help="also time the alternatives for the fixed costs (numba in a thread, numba's cache load "
                              "without its target refresh, scipy.linalg instead of scipy.integrate)")
     parser.add_argument("--compare", metavar="TREE", help="only: this tree's projeq run against another checkout's")
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true",
+                        help="spin_up_beam --t-end 1, one process for the phases and one for the imports")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.scene, args.repeat = ["spin_up_beam", "--t-end", "1"], 1
     if args.compare:
         return compare(args.compare, args.scene, args.repeat)
     with tempfile.TemporaryDirectory() as out:
-        child(["-m", "projeq", "run", *args.scene, "--quiet", "--out", out])  # numba's cache filled
+        if not args.quick:
+            child(["-m", "projeq", "run", *args.scene, "--quiet", "--out", out])  # numba's cache filled
         runs = [phases(args.scene, out) for _ in range(args.repeat)]
         packages, slowest = import_times(args.scene, out)
         profile = cprofile(args.scene, out) if args.cprofile else ""

@@ -13,6 +13,7 @@ processes, and the ratios before/after of the first and of the repeated build:
     PYTHONPATH=. python benchmarks/scene_builds.py [--repeat 5] [SCENE ...]
     git -C /work/main archive HEAD | tar -x -C /tmp/builds_old
     PYTHONPATH=. python benchmarks/scene_builds.py --base /tmp/builds_old
+    PYTHONPATH=. python benchmarks/scene_builds.py --quick   # Barhorst's particle, one build after the first
 """
 
 from __future__ import annotations
@@ -123,13 +124,16 @@ def compare(here: Path, base: Path, names, repeat: int) -> None:
               f"{ratio(rb['total'], ra['total']):>6s} | {ob:18.4f} {oa:7.4f} {ratio(ob, oa):>6s}")
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scenes", nargs="*", default=list(SCENES),
                         help="scene names (rigid_slice_chain:N: the Cardan-jointed slice chain of N slices)")
     parser.add_argument("--base", type=Path, help="another checkout (before the change) to compare against")
     parser.add_argument("--repeat", type=int, default=5, help="builds after the first (median)")
-    args = parser.parse_intermixed_args()
+    parser.add_argument("--quick", action="store_true", help="barhorst_particle, --repeat 1 (a test runs it)")
+    args = parser.parse_intermixed_args(argv)
+    if args.quick:
+        args.scenes, args.repeat = ["barhorst_particle"], 1
     here = Path(__file__).resolve().parent.parent
     if args.base is None:
         table(here, args.scenes, args.repeat)

@@ -19,6 +19,7 @@ per plane, a0 = (0.01, 0, 0, 0), 3 s. Prints
    functions, is 1.8e-4), 6.7e-4 from B(18) and 7.5e-4 from B(23).
 
     python benchmarks/spinning_beam_chain.py [--free]
+    python benchmarks/spinning_beam_chain.py --quick   # N = 10 only, 0.3 s of motion (a test runs it)
 """
 
 from __future__ import annotations
@@ -40,11 +41,11 @@ L, RHO_A, EI, RHO_I, T_END = 1.0, 1.0, 1.0, 0.05, 3.0
 MOTION = spin_up_motion(3.0, 2.0)
 
 
-def ritz_motion(model, n: int = 2, times=None):
+def ritz_motion(model, n: int = 2, times=None, t_end: float = T_END):
     """a(t) of a RitzModel under the spin-up from a0 = (0.01, 0, …)."""
     a0 = np.zeros(2 * n)
     a0[0] = 0.01
-    t, a = sb.simulate_ritz(model, MOTION, a0, np.zeros(2 * n), T_END)[:2]
+    t, a = sb.simulate_ritz(model, MOTION, a0, np.zeros(2 * n), t_end)[:2]
     return a if times is None else np.array([np.interp(times, t, column) for column in a.T]).T
 
 
@@ -53,15 +54,15 @@ def ritzbeam_motion(n: int, times):
     system = System({"beam": beam}, {"beam": Prescribed(Revolute(axis="x"), MOTION)})
     a0 = np.zeros(2 * n)
     a0[0] = 0.01
-    return simulate(system, T_END, q0=a0, t_eval=times, rtol=1e-9, atol=1e-12).q
+    return simulate(system, times[-1], q0=a0, t_eval=times, rtol=1e-9, atol=1e-12).q
 
 
-def matrices_table() -> None:
+def matrices_table(sizes=(10, 20, 40, 80)) -> None:
     reference = sb.ritz_models(2, rho_I_value=RHO_I, kinds=("torsion_free",))["torsion_free"]
     print("1. Ritz-constrained chain − torsion-free Ritz model, max |entry| (2 functions per plane)")
     print(f"{'joint':>9} {'N':>4} {'time_s':>7} " + " ".join(f"{name:>9}" for name in reference._fields))
     for joint in JOINTS:
-        for n_slices in (10, 20, 40, 80):
+        for n_slices in sizes:
             start = time.process_time()
             model = SliceChain(n_slices, rho_I=RHO_I, joint=joint).linear_model()
             seconds = time.process_time() - start
@@ -69,15 +70,17 @@ def matrices_table() -> None:
             print(f"{joint:>9} {n_slices:4d} {seconds:7.2f} {errors}")
 
 
-def motions_table() -> None:
+def motions_table(sizes=(10, 20, 40), t_end: float = T_END) -> None:
     models = sb.ritz_models(2, rho_I_value=RHO_I)
-    times = np.linspace(0.0, T_END, 201)
-    runs = {name: ritz_motion(model, times=times) for name, model in models.items()}
-    for n_slices in (10, 20, 40):
-        runs[f"chain {n_slices}/{2 * n_slices}"] = ritz_motion(extrapolated_model(n_slices, rho_I=RHO_I), times=times)
+    times = np.linspace(0.0, t_end, 201)
+    runs = {name: ritz_motion(model, times=times, t_end=t_end) for name, model in models.items()}
+    for n_slices in sizes:
+        chain = extrapolated_model(n_slices, rho_I=RHO_I)
+        runs[f"chain {n_slices}/{2 * n_slices}"] = ritz_motion(chain, times=times, t_end=t_end)
     runs["RitzBeam"] = ritzbeam_motion(2, times)
     names = list(runs)
-    print("\n2. spin-up: max |Δa| over 3 s (a0 = 0.01); chain N/2N = extrapolated from N and 2N slices")
+    print(f"\n2. spin-up: max |Δa| over {t_end:g} s (a0 = 0.01); chain N/2N = extrapolated from N and 2N "
+          "slices")
     print(" " * 16 + " ".join(f"{name:>14}" for name in names))
     for row in names:
         print(f"{row:>16}" + " ".join(f"{np.max(np.abs(runs[row] - runs[col])):14.2e}" for col in names))
@@ -108,12 +111,17 @@ def free_table(slices=(8, 16, 32)) -> None:
         print(f"{row:>14}" + " ".join(f"{np.max(np.abs(tips[row] - tips[col])):13.2e}" for col in names))
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--free", action="store_true", help="add the free rigid-slice chain (slow)")
-    args = parser.parse_args()
-    matrices_table()
-    motions_table()
+    parser.add_argument("--quick", action="store_true", help="N = 10 only and 0.3 s of motion")
+    args = parser.parse_args(argv)
+    if args.quick:
+        matrices_table((10,))
+        motions_table((10,), 0.3)
+    else:
+        matrices_table()
+        motions_table()
     if args.free:
         free_table()
 

@@ -11,6 +11,7 @@ and the compiled chain(k)'s, all timed alternately in one run
 
     python benchmarks/tangent_profile.py                       # Andrews' squeezer, Bricard
     python benchmarks/tangent_profile.py n_four_bar            # another TangentSystem scene
+    python benchmarks/tangent_profile.py --quick               # Andrews' squeezer, 0.05 s (a test runs it)
 """
 
 from __future__ import annotations
@@ -34,10 +35,10 @@ from projeq.studies.timing import time_per_call
 REPEATS = 50  # passes over the states per compiled loop
 
 
-def jacobian_loop(phi, pfaffian, Q, t, m_h, A, repeats):
+def jacobian_loop(phi, pins, fields, pfaffian, joints, tree, Q, t, m_h, A, repeats):
     for _ in range(repeats):
         for j in range(Q.shape[0]):
-            _constraint_rows(phi, pfaffian, Q[j], t, m_h, A)
+            _constraint_rows(phi, pins, fields, pfaffian, joints, tree, Q[j], t, m_h, A)
 
 
 def svd_loop(As, repeats):
@@ -54,10 +55,10 @@ def scaled_loop(Vts, independent, repeats):
             _scaled(Vt[Vt.shape[0] - k:].T.copy(), independent)
 
 
-def gamma_loop(phi, pfaffian, Q, Q_dot, t, m_h, m, repeats):
+def gamma_loop(phi, pins, fields, pfaffian, joints, tree, Q, Q_dot, t, m_h, m, repeats):
     for _ in range(repeats):
         for j in range(Q.shape[0]):
-            _constraint_gamma(phi, pfaffian, Q[j], Q_dot[j], t, m_h, m)
+            _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, Q[j], Q_dot[j], t, m_h, m)
 
 
 def particular_loop(U, sigma, Vt, gamma, F, independent, count, repeats):
@@ -65,10 +66,10 @@ def particular_loop(U, sigma, Vt, gamma, F, independent, count, repeats):
         _particular(U, sigma, Vt, gamma, count, F, independent)
 
 
-def projected_loop(tree, Q, Q_dot, t, F, f_bar, pivot, M, b, s_ddot_tree, repeats):
+def projected_loop(tree, Q, Q_dot, F, f_bar, pivot, M, b, s_ddot_tree, repeats):
     for _ in range(repeats):
         for j in range(Q.shape[0]):
-            _projected(tree, Q[j], Q_dot[j], t, F, f_bar, pivot, M, b, s_ddot_tree)
+            _projected(tree, Q[j], Q_dot[j], F, f_bar, pivot, M, b, s_ddot_tree)
 
 
 def call_only(*args):
@@ -101,27 +102,28 @@ def profile(name: str, budget: float) -> dict:
     s_ddot_tree = closure._s_ddot_tree.copy()
     f_bar = s_ddot_tree - F @ s_ddot_tree[system.independent]
     gamma = -As[-1] @ s_ddot_tree  # A_s s̈_tree = −γ: its size
+    callees = compiled._compiled_callees(elastic=False)  # the TangentSystem scenes are rigid trees
     loops = dict(zip((f.__name__ for f in LOOPS), kernels.jit(*_in_compiled_module(LOOPS), callees=compiled._HELPERS,
-                                                                kernels=compiled._compiled_callees())))
+                                                                kernels=callees)))
     jitted_call_only = kernels._numba().njit(call_only)
-    ws, m_h, phi, pfaffian, r = closure._workspace, closure.m_h, closure.phi, closure.pfaffian, REPEATS
+    ws, m_h, r = closure._workspace, closure.m_h, REPEATS
+    head = (closure.phi, closure.pins, closure.fields, closure.pfaffian, closure.joints, closure.tree)
     kept = np.array(system._tangent, dtype=float)
-    args = (closure.joints, closure.tree, q, s_dot, t, m_h, system.independent, n - k, system.separation,
-            closure.constants[0], kept, SINGULAR_PIVOT, closure._q_dot, closure._s_ddot_tree, closure._A, ws.M_all,
-            ws.b_all)
+    args = (*head, q, s_dot, t, m_h, system.independent, n - k, system.separation, closure.constants[0], kept,
+            SINGULAR_PIVOT, closure._q_dot, closure._s_ddot_tree, closure._A, ws.M_all, ws.b_all)
     cycled = itertools.cycle(states)
     pieces = {  # name: (a call, how many s̈ pieces it times)
-        "Φ_q (complex step)": (lambda: loops["jacobian_loop"](phi, pfaffian, Q, t, m_h, As[0].copy(), r), r * STATES),
+        "Φ_q (complex step)": (lambda: loops["jacobian_loop"](*head, Q, t, m_h, As[0].copy(), r), r * STATES),
         "SVD of A_s": (lambda: loops["svd_loop"](As, r), r * STATES),
         "N, F = N N_ind⁻¹": (lambda: loops["scaled_loop"](Vts, system.independent, r), r * STATES),
-        "γ (complex step)": (lambda: loops["gamma_loop"](phi, pfaffian, Q, Q_dot, t, m_h, m, r), r * STATES),
+        "γ (complex step)": (lambda: loops["gamma_loop"](*head, Q, Q_dot, t, m_h, m, r), r * STATES),
         "x₀ = A_s⁺(−γ), f̄": (lambda: loops["particular_loop"](U, sigma, Vt, gamma, F, system.independent, n - k,
                                                                r * STATES), r * STATES),
         "tree terms, FᵀMF (_projected)": (lambda: loops["projected_loop"](
-            closure.tree, Q, Q_dot, t, F, f_bar, SINGULAR_PIVOT, ws.M_all.copy(), ws.b_all.copy(),
+            closure.tree, Q, Q_dot, F, f_bar, SINGULAR_PIVOT, ws.M_all.copy(), ws.b_all.copy(),
             s_ddot_tree.copy(), r), r * STATES),
-        "a compiled call of the kernel's arguments": (lambda: jitted_call_only(phi, pfaffian, *args), 1),
-        "kernel called from Python": (lambda: closure.kernel(phi, pfaffian, *args), 1),
+        "a compiled call of the kernel's arguments": (lambda: jitted_call_only(*args), 1),
+        "kernel called from Python": (lambda: closure.kernel(*args), 1),
         "CompiledClosure.minimal_accelerations": (lambda: closure.minimal_accelerations(system, *next(cycled), t), 1),
         "evaluator.accelerations": (lambda: ev.accelerations(*next(cycled), t), 1),
         f"chain({k}) evaluator.accelerations": (lambda: chain.accelerations(*next(chain_states), t), 1),
@@ -142,7 +144,10 @@ def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scenes", nargs="*", default=["andrews_squeezer", "bricard"])
     parser.add_argument("--budget", type=float, default=2.0, help="seconds of timing per scene (default 2)")
+    parser.add_argument("--quick", action="store_true", help="Andrews' squeezer, 0.05 s of timing")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.scenes, args.budget = ["andrews_squeezer"], 0.05
     report = {}
     for name in args.scenes:
         report[name] = rows = profile(name, args.budget)
