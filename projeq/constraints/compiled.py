@@ -727,7 +727,7 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     b_s = _constraint_rates(pins, joints, fields, tree, q, m_h, m)  # from the workspace at q, before q*
     sigma_star, Vt_star = _on_manifold(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, U, sigma, Vt,
                                        min(count, rank))
-    if not np.isfinite(sigma_star[0]):  # A_s not finite (:func:`_svd`): the numpy path names the cause
+    if not np.all(np.isfinite(Vt_star)):  # A_s not finite (:func:`_svd`): the numpy path names the cause
         return DEGENERATE
     near = 0  # the singular values below separation σ_max, at least k
     for value in sigma_star:
@@ -843,7 +843,19 @@ def _particular(U: NDArray, sigma: NDArray, Vt: NDArray, gamma: NDArray, count: 
     return f_bar
 
 
+#: the order up to which the hand-written routines beat LAPACK's in the kernels (min(m, n) of an
+#: SVD, m of an inverse; benchmarks/closure_linalg.py: even at about 16 for both)
+SMALL = 15
+
+
 def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """(U, σ, Vᵀ) of A (m × n), σ with all n singular values, descending, those beyond m zero, Vᵀ n × n:
+    by :func:`_jacobi_svd` where min(m, n) ≤ SMALL (the loops' A_s: faster there), else LAPACK's
+    (:func:`_lapack_svd`)."""
+    return _jacobi_svd(A) if min(A.shape[0], A.shape[1]) <= SMALL else _lapack_svd(A)
+
+
+def _lapack_svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     """(U, σ, Vᵀ) of A (m × n) by LAPACK (numba's ``np.linalg.svd``: gesdd, as the numpy path's
     :meth:`~projeq.constraints.tangent.NullSpaceForm._decomposition`): U m × m, Vᵀ n × n, and σ
     with all n singular values, descending, those beyond the m rows zero (as
@@ -859,11 +871,173 @@ def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     return U, sigma, Vt
 
 
+def _jacobi_svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """(U, σ, Vᵀ) of A (m × n) with all n singular values, descending (those beyond m zero to
+    round-off), V n × n and U m × n (column j = A v_j / σ_j, zero where σ_j = 0), for the few rows
+    and columns of a loop's A_s, without LAPACK's calls and workspace: the QR decomposition with
+    column pivoting of Aᵀ (:func:`_transposed_qr`, A[order] Q = [L 0]) as the preconditioner of
+    Drmač & Veselić ("New fast and accurate Jacobi SVD algorithm I", SIAM J. Matrix Anal. Appl. 29,
+    2008, §3: the one-sided Jacobi method on Rᵀ = L converges in fewer sweeps than on A), then
+    one-sided Jacobi rotations of the columns of L (:func:`_jacobi` of [L; E]ᵀ): L W = Ũ Σ, so that
+    V = Q diag(W, E) and U[order] = Ũ. Faster than LAPACK's (:func:`_lapack_svd`) for the few rows of a
+    loop's A_s, which :func:`_svd` gives it (benchmarks/closure_linalg.py, single-threaded BLAS: the SVD
+    alone 1.9× at 6 × 7, 1.2× at 12 × 13, 1.09× at 14 × 15, 0.97× at 16 × 17; the tangent kernel's s̈
+    1.27× at A_s 1 × 2, 1.36× at 4 × 5, 1.37× at 5 × 5, 1.42× at 6 × 7; LAPACK's 3.3× faster at 80 × 81)."""
+    m, n = A.shape
+    X, Qt, order = _transposed_qr(A)  # X = [L; E]ᵀ
+    p = X.shape[0]
+    _jacobi(X, m)  # X = [Ũ Σ; W]ᵀ
+    norms = np.zeros(p)
+    for j in range(p):
+        norms[j] = _row_square(X, m, j)
+    ranked = np.argsort(-norms)
+    sigma, U, Vt = np.zeros(n), np.zeros((m, n)), np.zeros((n, n))
+    for c in range(p):
+        j = ranked[c]
+        for l in range(p):  # v_c = Q₁ w_j: Vt[c] = Σ_l W[l, j] Qᵀ[l]
+            for i in range(n):
+                Vt[c, i] += X[j, m + l] * Qt[l, i]
+        if norms[j] > 0.0:
+            sigma[c] = np.sqrt(norms[j])
+            for i in range(m):
+                U[order[i], c] = X[j, i] / sigma[c]
+    for c in range(p, n):  # the columns of Q beyond the rows of A: in its null space
+        for i in range(n):
+            Vt[c, i] = Qt[c, i]
+    return U, sigma, Vt
+
+
+def _transposed_qr(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """([L; E]ᵀ, Qᵀ, order): Householder QR with column pivoting of Aᵀ (m × n A), Aᵀ[:, order] = Q R
+    (Golub & Van Loan, "Matrix Computations", 4th ed., 2013, Algorithm 5.4.1; Q n × n orthogonal,
+    the product H_0 ⋯ H_{p−1} of p = min(m, n) reflectors accumulated backwards, §5.1.6), so that
+    A[order] Q = Rᵀ = [L 0] with L = R[:p]ᵀ, m × p lower trapezoidal, above the p × p identity.
+    The columns of Aᵀ are the rows of A: the reflectors act on rows (:func:`_reflect`)."""
+    m, n = A.shape
+    p = min(m, n)
+    C, order = A.copy(), np.arange(m)  # C = Aᵀᵀ: row j is column j of Aᵀ, reflected in place
+    reflectors, scales = np.zeros((p, n)), np.zeros(p)  # H_c = E − scales[c] v_c v_cᵀ, v_c zero before entry c
+    for c in range(p):
+        size, chosen = -1.0, c  # the column of largest norm below row c first
+        for j in range(c, m):
+            column = 0.0
+            for i in range(c, n):
+                column += C[j, i] * C[j, i]
+            if column > size:
+                size, chosen = column, j
+        for i in range(n):
+            C[c, i], C[chosen, i] = C[chosen, i], C[c, i]
+        order[c], order[chosen] = order[chosen], order[c]
+        if size == 0.0:  # the rest is zero: H_c = E
+            continue
+        head = -np.sqrt(size) if C[c, c] >= 0.0 else np.sqrt(size)  # R[c, c], of the sign that avoids cancellation
+        for i in range(c, n):
+            reflectors[c, i] = C[c, i]
+        reflectors[c, c] -= head
+        scales[c] = 2.0 / (size - C[c, c] * C[c, c] + reflectors[c, c] * reflectors[c, c])  # 2 / v_cᵀ v_c
+        _reflect(reflectors, scales[c], c, C, c + 1, m)
+        C[c, c] = head
+    Qt = np.eye(n)
+    for c in range(p - 1, -1, -1):  # Q = H_0 (H_1 (⋯ H_{p−1})): H_c touches rows and columns c… only
+        _reflect(reflectors, scales[c], c, Qt, c, n)
+    X = np.zeros((p, m + p))  # [L; E]ᵀ = [R[:p] E]
+    for c in range(p):
+        for i in range(c, m):
+            X[c, i] = C[i, c]
+        X[c, m + c] = 1.0
+    return X, Qt, order
+
+
+def _reflect(reflectors: NDArray, scale: float, c: int, X: NDArray, first: int, last: int) -> None:
+    """Rows first … last − 1 of X ← X H_c (each the transpose of H_c times a column), H_c = E − scale v vᵀ,
+    v = reflectors[c] (zero before entry c)."""
+    if scale == 0.0:
+        return
+    for j in range(first, last):
+        dot = 0.0
+        for i in range(c, X.shape[1]):
+            dot += reflectors[c, i] * X[j, i]
+        dot *= scale
+        for i in range(c, X.shape[1]):
+            X[j, i] -= dot * reflectors[c, i]
+
+
+#: an updated squared column norm that has dropped below this fraction of its value before the
+#: rotation is computed anew (its update lost digits to cancellation)
+DRIFT = 0.1
+
+
+def _jacobi(X: NDArray, m: int) -> None:
+    """Rotate the rows of X = [W; V]ᵀ (the columns of W their first ``m`` entries, those of V the
+    others, rotated alike; rows, so that the loops run over contiguous entries) until the columns
+    of W are orthogonal to round-off (one-sided Jacobi, Demmel & Veselić, "Jacobi's method is more
+    accurate than QR", SIAM J. Matrix Anal. Appl. 13, 1992, Algorithm 4.1): a pair (a, r) whose
+    cosine |γ| / √(α β) (α, β the squared norms of the columns of W, γ their dot product) is above
+    1e-15 is rotated by the angle that makes it zero. The squared norms are taken at each sweep's
+    start and updated by each rotation, α' = α − t γ, β' = β + t γ with t = tan of the angle (de
+    Rijk, "A one-sided Jacobi algorithm for computing the singular value decomposition on a vector
+    computer", SIAM J. Sci. Stat. Comput. 10, 1989), computed anew where one drops below DRIFT of
+    its value; the last sweep rotates none, so that every pair's cosine is tested on norms taken
+    afresh. A column below 1e-15 of ‖W‖_F is W v = 0 to round-off (in the null space): not rotated."""
+    p = X.shape[0]
+    squares, floor = np.zeros(p), 0.0
+    for j in range(p):
+        floor += 1e-30 * _row_square(X, m, j)
+    for _ in range(100):  # sweeps; quadratic convergence takes a handful
+        for j in range(p):
+            squares[j] = 0.0
+            for i in range(m):
+                squares[j] += X[j, i] * X[j, i]
+        rotated = False
+        for a in range(p - 1):
+            for r in range(a + 1, p):
+                alpha, beta = squares[a], squares[r]
+                if alpha <= floor or beta <= floor:
+                    continue
+                gamma = 0.0
+                for i in range(m):
+                    gamma += X[a, i] * X[r, i]
+                if abs(gamma) <= 1e-15 * np.sqrt(alpha * beta):
+                    continue  # orthogonal to round-off
+                rotated = True
+                if abs(beta - alpha) > 1e100 * abs(gamma):  # a tiny angle: tan = 1/(2ζ) to round-off
+                    tan = gamma / (beta - alpha)
+                else:
+                    zeta = (beta - alpha) / (2.0 * gamma)
+                    tan = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
+                cos = 1.0 / np.sqrt(1.0 + tan * tan)
+                sin = cos * tan
+                for i in range(X.shape[1]):
+                    x_a, x_r = X[a, i], X[r, i]
+                    X[a, i], X[r, i] = cos * x_a - sin * x_r, sin * x_a + cos * x_r
+                squares[a], squares[r] = alpha - tan * gamma, beta + tan * gamma
+                if squares[a] < DRIFT * alpha:
+                    squares[a] = _row_square(X, m, a)
+                if squares[r] < DRIFT * beta:
+                    squares[r] = _row_square(X, m, r)
+        if not rotated:
+            break
+
+
+def _row_square(X: NDArray, m: int, j: int) -> float:
+    """|X[j, :m]|²."""
+    total = 0.0
+    for i in range(m):
+        total += X[j, i] * X[j, i]
+    return total
+
+
 # interpreted; _compiled holds the compiled ones
 chain_terms, gauss_form, add_loads = kernels.chain_terms, kernels.gauss_form, loads.add_loads
 
 
 def _inverse(A: NDArray) -> NDArray:
+    """A⁻¹, ∞ entries where A is singular or not finite: by :func:`_gauss_jordan` where A has at most
+    SMALL rows (a loop's A_dep, N_ind: faster there), else LAPACK's (:func:`_lapack_inverse`)."""
+    return _gauss_jordan(A) if A.shape[0] <= SMALL else _lapack_inverse(A)
+
+
+def _lapack_inverse(A: NDArray) -> NDArray:
     """A⁻¹ by LAPACK (numba's ``np.linalg.inv``: getrf, getri); ∞ entries where A is singular or not
     finite (LinAlgError), as on the numpy path
     (:meth:`~projeq.constraints.partitioned.ConstrainedSystem._dependent_inverse`): the kernel flags it."""
@@ -873,11 +1047,40 @@ def _inverse(A: NDArray) -> NDArray:
         return np.full(A.shape, np.inf)
 
 
+def _gauss_jordan(A: NDArray) -> NDArray:
+    """A⁻¹ by Gauss–Jordan elimination with partial pivoting (∞ entries for a singular A): faster than
+    LAPACK's (:func:`_lapack_inverse`) for the small A_dep and N_ind that :func:`_inverse` gives it
+    (benchmarks/closure_linalg.py: the inverse alone 3.2× at 2 × 2, 2.1× at 5 × 5, 1.2× at 12 × 12,
+    0.96× at 16 × 16; the partitioned kernel's s̈ 1.08× with the four-bar's A_dep 2 × 2, 1.04× with
+    the Whipple bicycle's 5 × 5)."""
+    m = A.shape[0]
+    work, inv = A.copy(), np.eye(m)
+    for c in range(m):
+        p = c + np.argmax(np.abs(work[c:, c]))
+        if work[p, c] == 0.0:
+            return np.full((m, m), np.inf)
+        for row in (work, inv):
+            for j in range(m):
+                row[c, j], row[p, j] = row[p, j], row[c, j]
+        d = work[c, c]
+        for j in range(m):
+            work[c, j] /= d
+            inv[c, j] /= d
+        for r in range(m):
+            if r != c and work[r, c] != 0.0:
+                e = work[r, c]
+                for j in range(m):
+                    work[r, j] -= e * work[c, j]
+                    inv[r, j] -= e * inv[c, j]
+    return inv
+
+
 _HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _constraint_rates, _constraint_values,
             _pin_constraint_values, _on_manifold, _pin_constraint_rows,
             _pin_constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame, _port_chain, _pin_values, _pin_rates,
             _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, given_motions, _matvec, _matmul, _svd,
-            _scaled, _particular, _chain_terms, _projected, _inverse)
+            _lapack_svd, _jacobi_svd, _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular,
+            _chain_terms, _projected, _inverse, _lapack_inverse, _gauss_jordan)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":

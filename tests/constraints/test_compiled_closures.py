@@ -110,14 +110,16 @@ def test_the_kernels_linear_algebra_equals_numpys():
     rng = np.random.default_rng(3)
     for m in (1, 2, 4):
         A = rng.standard_normal((m, m))
-        assert np.allclose(compiled._inverse(A), np.linalg.inv(A), rtol=1e-12, atol=1e-12)
+        assert np.allclose(compiled._gauss_jordan(A), np.linalg.inv(A), rtol=1e-12, atol=1e-12)
+        assert np.array_equal(compiled._lapack_inverse(A), np.linalg.inv(A))
         D, x = A @ A.T + m * np.eye(m), rng.standard_normal(m)
         expected = np.linalg.solve(D, x)
         L = D.copy()
         assert kernels.cholesky(L, m, 1e-13)
         kernels.cholesky_solve(L, m, x)
         assert np.allclose(x, expected, rtol=1e-12, atol=1e-14)
-    assert np.all(np.isinf(compiled._inverse(np.array([[1.0, 2.0], [2.0, 4.0]]))))
+    for inverse in (compiled._gauss_jordan, compiled._lapack_inverse):
+        assert np.all(np.isinf(inverse(np.array([[1.0, 2.0], [2.0, 4.0]]))))
     assert not kernels.cholesky(np.array([[1.0, 1.0], [1.0, 1.0]]), 2, 1e-13)
 
 
@@ -277,28 +279,114 @@ def test_a_force_law_without_a_value_in_the_compiled_call_raises_the_numpy_paths
 
 
 @pytest.mark.parametrize("shape", [(1, 2), (2, 3), (5, 5), (7, 3)])
-def test_the_kernels_svd_is_lapacks_with_every_singular_value_and_nan_where_lapack_refuses(shape):
-    """The kernels' SVD is numpy's (LAPACK gesdd, as the numpy path's) with σ padded to the n columns
-    by zeros (the null space of a wide A_s counts them, as NullSpaceForm._branch does), U m × m and
-    Vᵀ n × n; NaN where A is not finite (LAPACK refuses it: the kernel flags, the numpy path names q)."""
+def test_the_kernels_lapack_svd_is_numpys_with_every_singular_value_and_nan_where_lapack_refuses(shape):
+    """The kernels' SVD of larger A_s is numpy's (LAPACK gesdd, as the numpy path's) with σ padded to
+    the n columns by zeros (the null space of a wide A_s counts them, as NullSpaceForm._branch does),
+    U m × m and Vᵀ n × n; NaN where A is not finite (LAPACK refuses it: the kernel flags, the numpy
+    path names q)."""
     m, n = shape
     A = np.random.default_rng(m * n).standard_normal(shape)
-    U, sigma, Vt = compiled._svd(A)
+    U, sigma, Vt = compiled._lapack_svd(A)
     expected = np.linalg.svd(A)
     assert U.shape == (m, m) and sigma.shape == (n,) and Vt.shape == (n, n)
     assert np.array_equal(U, expected[0]) and np.array_equal(Vt, expected[2])
     assert np.array_equal(sigma[:min(m, n)], expected[1]) and not np.any(sigma[min(m, n):])
     A[0, 0] = np.nan
-    assert all(np.isnan(part).all() for part in compiled._svd(A))
+    assert all(np.isnan(part).all() for part in compiled._lapack_svd(A))
 
 
-def test_the_closure_linalg_benchmark_runs_and_the_hand_written_routines_give_lapacks_accelerations(capsys):
-    """benchmarks/closure_linalg.py --quick runs (both variants of the kernels interpreted: nothing to
+@pytest.mark.parametrize("shape", [(1, 2), (2, 3), (4, 5), (5, 5), (6, 7)])
+def test_the_kernels_jacobi_svd_equals_lapacks(shape):
+    """One-sided Jacobi (Demmel & Veselić 1992) against numpy's LAPACK SVD: the same singular
+    values to round-off (a redundant row: a zero one), U Σ Vᵀ = A, V orthogonal, and the rows of
+    Vᵀ beyond the rank in the null space."""
+    m, n = shape
+    A = np.random.default_rng(m * n).standard_normal(shape)
+    if m == n:
+        A[-1] = A[0] + A[1]  # a redundant row, as Bricard's
+    U, sigma, Vt = compiled._jacobi_svd(A)
+    expected = np.linalg.svd(A, compute_uv=False)
+    r = len(expected)
+    assert np.abs(sigma[:r] - expected).max() <= 1e-14 * expected[0]
+    assert np.abs(sigma[r:]).max(initial=0.0) <= 1e-14 * expected[0]
+    assert np.abs((U[:, :r] * sigma[:r]) @ Vt[:r] - A).max() <= 1e-14 * expected[0]
+    assert np.abs(Vt @ Vt.T - np.eye(n)).max() <= 1e-14
+    rank = int(np.sum(expected > 1e-12 * expected[0]))
+    assert np.abs(A @ Vt[rank:].T).max(initial=0.0) <= 1e-14 * expected[0]
+
+
+def _with_singular_values(rng, m: int, n: int, sigma) -> np.ndarray:
+    """U diag(σ) Vᵀ, m × n, with random orthogonal U, V (QR of Gaussian matrices)."""
+    U = np.linalg.qr(rng.standard_normal((m, m)))[0]
+    V = np.linalg.qr(rng.standard_normal((n, n)))[0]
+    S = np.zeros((m, n))
+    S[np.arange(len(sigma)), np.arange(len(sigma))] = sigma
+    return U @ S @ V.T
+
+
+def _svd_cases():
+    """(name, A): m ≤ 8, n ≤ 9 — full rank, rank-deficient (some σ exactly 0 in exact arithmetic),
+    repeated singular values, zero rows, more rows than columns, rank 0."""
+    rng = np.random.default_rng(2026)
+    for m, n in ((1, 1), (1, 4), (3, 5), (6, 7), (8, 9), (5, 5), (7, 3), (8, 8)):
+        p = min(m, n)
+        yield f"{m}x{n} full rank", _with_singular_values(rng, m, n, rng.uniform(0.1, 1.0, p))
+        if p > 1:
+            yield f"{m}x{n} rank {p - 1}", _with_singular_values(rng, m, n, [*rng.uniform(0.1, 1.0, p - 1), 0.0])
+            yield f"{m}x{n} repeated", _with_singular_values(rng, m, n, [0.7] * (p // 2) + [0.3] * (p - p // 2))
+            A = _with_singular_values(rng, m, n, rng.uniform(0.1, 1.0, p))
+            A[rng.choice(m, size=max(1, m // 3), replace=False)] = 0.0
+            yield f"{m}x{n} zero rows", A
+        yield f"{m}x{n} rank 0", np.zeros((m, n))
+
+
+def test_the_kernels_svd_gives_lapacks_singular_values_null_space_and_pseudo_inverse():
+    """The kernel's SVD (QR-preconditioned one-sided Jacobi, Drmač & Veselić 2008; norms updated
+    by the rotations, de Rijk 1989) against numpy's LAPACK SVD on matrices of the sizes of a loop's
+    A_s: the same singular values, the same null space (its orthogonal projector: the basis of a
+    null space of dimension > 1 is not unique) and the same pseudo-inverse V Σ⁺ Uᵀ over the
+    nonzero singular values (unique, also where singular values repeat), each to 1e-13 of its
+    size; U Σ Vᵀ = A and V orthogonal."""
+    for name, A in _svd_cases():
+        m, n = A.shape
+        U, sigma, Vt = compiled._jacobi_svd(A)
+        expected = np.linalg.svd(A, compute_uv=False)
+        scale = max(expected.max(initial=0.0), 1e-300)
+        rank = int(np.sum(expected > 1e-10 * scale))
+        assert np.abs(sigma[:len(expected)] - expected).max() <= 1e-13 * scale, name
+        assert np.abs(sigma[len(expected):]).max(initial=0.0) <= 1e-13 * scale, name
+        assert np.all(np.diff(sigma) <= 0.0), name
+        assert np.abs((U * sigma) @ Vt - A).max() <= 1e-13 * scale, name
+        assert np.abs(Vt @ Vt.T - np.eye(n)).max() <= 1e-13, name
+        null = Vt[rank:].T @ Vt[rank:]
+        expected_null = np.eye(n) - np.linalg.pinv(A, rcond=1e-10) @ A
+        assert np.abs(null - expected_null).max() <= 1e-13, name
+        pseudo_inverse = (Vt[:rank].T / sigma[:rank]) @ U[:, :rank].T
+        expected_inverse = np.linalg.pinv(A, rcond=1e-10)
+        assert np.abs(pseudo_inverse - expected_inverse).max() <= 1e-13 * max(1.0, np.abs(expected_inverse).max()), name
+
+
+def test_the_kernels_take_the_hand_written_routines_up_to_order_small_and_lapacks_above():
+    """_svd and _inverse: the hand-written SVD and Gauss–Jordan (faster for a loop's few rows) up to
+    min(m, n) = SMALL, LAPACK's above (faster there: benchmarks/closure_linalg.py)."""
+    rng = np.random.default_rng(8)
+    for m, n in ((2, 3), (compiled.SMALL, compiled.SMALL + 1), (compiled.SMALL + 1, compiled.SMALL + 2)):
+        A = rng.standard_normal((m, n))
+        small = min(m, n) <= compiled.SMALL
+        expected = (compiled._jacobi_svd if small else compiled._lapack_svd)(A)
+        assert all(np.array_equal(a, b) for a, b in zip(compiled._svd(A), expected))
+        square = A[:, :m]
+        expected = (compiled._gauss_jordan if small else compiled._lapack_inverse)(square)
+        assert np.array_equal(compiled._inverse(square), expected)
+
+
+def test_the_closure_linalg_benchmark_runs_and_both_variants_give_the_same_accelerations(capsys):
+    """benchmarks/closure_linalg.py --quick runs (the kernels of both variants interpreted: nothing to
     compile), and the kernels with the hand-written SVD (QR-preconditioned one-sided Jacobi) and
-    Gauss–Jordan inverse that LAPACK replaced, which the script keeps to measure against, give the
-    s̈_tree of the kernels by LAPACK: another algorithm for the same null space, pseudo-inverse and
-    A_dep⁻¹, agreeing to round-off (measured 3.7e-16 four-bar, 1.1e-17 simple pendulum, 2.9e-15 double
-    four-bar, relative to max(1, |s̈_tree|); bound 100 ε)."""
+    Gauss–Jordan inverse at every size give the s̈_tree of the kernels with LAPACK's at every size:
+    another algorithm for the same null space, pseudo-inverse and A_dep⁻¹, agreeing to round-off
+    (measured 3.7e-16 four-bar, 1.1e-17 simple pendulum, 2.9e-15 double four-bar, relative to
+    max(1, |s̈_tree|); bound 100 ε)."""
     spec = importlib.util.spec_from_file_location("closure_linalg", BENCHMARKS / "closure_linalg.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
