@@ -99,9 +99,10 @@ def variant_kernels(variant: str) -> dict:
     models here) compiled as :func:`projeq.constraints.compiled._compiled` compiles them, with the SVD and
     the inverse of ``variant`` at every size (cached on disk under names of their own)."""
     rules = ("partitioned", "tangent")
-    return dict(zip(rules, kernels.jit(*(getattr(compiled, rule) for rule in rules), callees=compiled._HELPERS,
-                                       kernels=compiled._compiled_callees(False),
-                                       names=tuple(f"{variant}_{rule}" for rule in rules), **VARIANTS[variant])))
+    functions = [getattr(compiled, rule) for rule in rules]
+    names = tuple(f"{variant}_{rule}" for rule in rules)
+    return dict(zip(rules, kernels.jit(*functions, callees=compiled._HELPERS, names=names,
+                                       kernels=compiled._compiled_callees(False), **VARIANTS[variant])))
 
 
 def interpreted_kernel(rule: str, variant: str):
@@ -127,8 +128,9 @@ def closures(build, interpreted: bool) -> tuple:
         if interpreted:
             rule, constant = ("tangent", ACTING) if isinstance(model, TangentSystem) else \
                 ("partitioned", PARTITION_CONDITION)
-            closure = compiled.CompiledClosure(model.tree, model.n_c, model._phi, rule, (constant,), compiled=False,
-                                               m_h=model.m_h, pfaffian=model._A if model.m_p else None)
+            pfaffian = model._A if model.m_p else None
+            closure = compiled.CompiledClosure(model.tree, model.n_c, model._phi, rule, (constant,),
+                                               compiled=False, m_h=model.m_h, pfaffian=pfaffian)
             closure.kernel = interpreted_kernel(rule, variant)
         else:
             with warnings.catch_warnings():
@@ -200,7 +202,8 @@ def cold_compile(variant: str, rule: str) -> dict:
 
 
 def main(argv=None) -> dict:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seconds", type=float, default=2.0, help="timing budget per model (default 2)")
     parser.add_argument("--models", nargs="+", choices=[name for name, _ in MODELS], metavar="MODEL",
                         help=f"these models only (default: all; {', '.join(name for name, _ in MODELS)})")
@@ -216,7 +219,8 @@ def main(argv=None) -> dict:
         return found
     models, budget = (MODELS[:QUICK], 0.05) if args.quick else (MODELS, args.seconds)
     models = [(name, build) for name, build in models if args.models is None or name in args.models]
-    print("constrained s̈ per call, µs, LAPACK (numba's np.linalg) and the hand-written SVD / inverse alternately"
+    print("constrained s̈ per call, µs, LAPACK (numba's np.linalg) and the hand-written SVD / inverse "
+          "alternately"
           f"{' — interpreted: the script checked, not the speeds' if args.quick else ''}")
     print(f"{'model':18} {'kernel':12} {'factorised':13} {'LAPACK':>10} {'hand':>10} {'LAPACK/hand':>12} "
           f"{'|Δs̈_tree|':>10}")

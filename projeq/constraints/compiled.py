@@ -849,9 +849,9 @@ SMALL = 15
 
 
 def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-    """(U, σ, Vᵀ) of A (m × n), σ with all n singular values, descending, those beyond m zero, Vᵀ n × n:
-    by :func:`_jacobi_svd` where min(m, n) ≤ SMALL (the loops' A_s: faster there), else LAPACK's
-    (:func:`_lapack_svd`)."""
+    """(U, σ, Vᵀ) of A (m × n), σ with all n singular values, descending, those beyond m zero, Vᵀ n × n
+    (U m × n or m × m: the kernels read its first columns only): by :func:`_jacobi_svd` where
+    min(m, n) ≤ SMALL (the loops' A_s: faster there), else LAPACK's (:func:`_lapack_svd`)."""
     return _jacobi_svd(A) if min(A.shape[0], A.shape[1]) <= SMALL else _lapack_svd(A)
 
 
@@ -880,9 +880,10 @@ def _jacobi_svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     2008, §3: the one-sided Jacobi method on Rᵀ = L converges in fewer sweeps than on A), then
     one-sided Jacobi rotations of the columns of L (:func:`_jacobi` of [L; E]ᵀ): L W = Ũ Σ, so that
     V = Q diag(W, E) and U[order] = Ũ. Faster than LAPACK's (:func:`_lapack_svd`) for the few rows of a
-    loop's A_s, which :func:`_svd` gives it (benchmarks/closure_linalg.py, single-threaded BLAS: the SVD
-    alone 1.9× at 6 × 7, 1.2× at 12 × 13, 1.09× at 14 × 15, 0.97× at 16 × 17; the tangent kernel's s̈
-    1.27× at A_s 1 × 2, 1.36× at 4 × 5, 1.37× at 5 × 5, 1.42× at 6 × 7; LAPACK's 3.3× faster at 80 × 81)."""
+    loop's A_s, which :func:`_svd` gives it — LAPACK's time over this one's (benchmarks/closure_linalg.py,
+    single-threaded BLAS): the SVD alone 1.9 at 6 × 7, 1.2 at 12 × 13, 1.09 at 14 × 15, 0.97 at 16 × 17;
+    the tangent kernel's s̈ 1.27 with A_s 1 × 2, 1.36 at 4 × 5, 1.37 at 5 × 5, 1.42 at 6 × 7, 0.95 at
+    20 × 21 and 0.31 at 80 × 81 (the IFToMM A02 N-four-bar, N = 10 and 40)."""
     m, n = A.shape
     X, Qt, order = _transposed_qr(A)  # X = [L; E]ᵀ
     p = X.shape[0]
@@ -1049,10 +1050,10 @@ def _lapack_inverse(A: NDArray) -> NDArray:
 
 def _gauss_jordan(A: NDArray) -> NDArray:
     """A⁻¹ by Gauss–Jordan elimination with partial pivoting (∞ entries for a singular A): faster than
-    LAPACK's (:func:`_lapack_inverse`) for the small A_dep and N_ind that :func:`_inverse` gives it
-    (benchmarks/closure_linalg.py: the inverse alone 3.2× at 2 × 2, 2.1× at 5 × 5, 1.2× at 12 × 12,
-    0.96× at 16 × 16; the partitioned kernel's s̈ 1.08× with the four-bar's A_dep 2 × 2, 1.04× with
-    the Whipple bicycle's 5 × 5)."""
+    LAPACK's (:func:`_lapack_inverse`) for the small A_dep and N_ind that :func:`_inverse` gives it —
+    LAPACK's time over this one's (benchmarks/closure_linalg.py): the inverse alone 3.2 at 2 × 2, 2.1
+    at 5 × 5, 1.2 at 12 × 12, 0.96 at 16 × 16; the partitioned kernel's s̈ 1.08 with the four-bar's
+    A_dep 2 × 2, 1.04 with the Whipple bicycle's 5 × 5."""
     m = A.shape[0]
     work, inv = A.copy(), np.eye(m)
     for c in range(m):
