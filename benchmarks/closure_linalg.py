@@ -4,16 +4,14 @@ the sizes used).
 
 :func:`projeq.constraints.compiled.tangent` takes the SVD of A_s (at q and at q moved onto the
 constraint manifold, :func:`~projeq.constraints.compiled._on_manifold`) and N_ind⁻¹,
-:func:`~projeq.constraints.compiled.partitioned` A_dep⁻¹, each through
-:func:`~projeq.constraints.compiled._svd` and :func:`~projeq.constraints.compiled._inverse`, which take
-the hand-written routines up to the order SMALL and LAPACK's above it: one-sided Jacobi rotations
-preconditioned by a QR with column pivoting (:func:`~projeq.constraints.compiled._jacobi_svd`; Drmač &
-Veselić, "New fast and accurate Jacobi SVD algorithm I", SIAM J. Matrix Anal. Appl. 29, 2008) or gesdd
-(:func:`~projeq.constraints.compiled._lapack_svd`, as the numpy path), Gauss–Jordan elimination
-(:func:`~projeq.constraints.compiled._gauss_jordan`) or getrf/getri
-(:func:`~projeq.constraints.compiled._lapack_inverse`). Here the kernels are compiled twice more, with
-each variant at every size (:data:`VARIANTS`, under the names the kernels call:
-:func:`projeq.assembly.kernels.jit`'s replacements), both in one process.
+:func:`~projeq.constraints.compiled.partitioned` A_dep⁻¹, by the library's hand-written routines:
+one-sided Jacobi rotations preconditioned by a QR with column pivoting
+(:func:`~projeq.constraints.compiled._svd`; Drmač & Veselić, "New fast and accurate Jacobi SVD
+algorithm I", SIAM J. Matrix Anal. Appl. 29, 2008) and Gauss–Jordan elimination
+(:func:`~projeq.constraints.compiled._inverse`). Here the same kernels are compiled a second time with
+LAPACK's in their place (:func:`lapack_svd`: gesdd, as the numpy path; :func:`lapack_inverse`:
+getrf/getri; numba's ``np.linalg``, under the names the kernels call: the replacements of
+:func:`projeq.assembly.kernels.jit`), and both run in one process.
 
 Printed per model — the closed-loop scenes: the four-bar and the Whipple bicycle partitioned (A_dep
 2 × 2 and 5 × 5); the simple pendulum, the double four-bar (IFToMM A02, N = 2), Bricard's mechanism,
@@ -24,8 +22,8 @@ Python wrapper), timed alternately at moving states near q0
 (:func:`projeq.studies.bench_scenes.moving_states`: off the manifold by round-off, so that the
 tangent kernel takes both SVDs) by :func:`projeq.studies.timing.time_per_call` (the fastest batch,
 CPU time), their ratio, and the largest difference of their s̈_tree (relative to max(1, |s̈_tree|)).
-Then (``--compile``, the default outside ``--quick``) the cold compilation of each kernel, the
-library's (both routines) and each variant's: a fresh process per kernel with an empty
+Then (``--compile``, the default outside ``--quick``) the cold compilation of each kernel of each
+variant: a fresh process per kernel with an empty
 ``NUMBA_CACHE_DIR`` compiles the tree's kernels through its fast evaluator, then the closure kernel at
 its first call (CPU seconds of each step).
 
@@ -33,8 +31,9 @@ its first call (CPU seconds of each step).
     python benchmarks/closure_linalg.py --no-compile    # the s̈ table only
     python benchmarks/closure_linalg.py --quick         # both variants interpreted, small models (the test)
 
-OPENBLAS_NUM_THREADS=1 unless set (single-threaded CPU times: on a shared machine the 80 × 81 SVDs
-slow down up to 100-fold when BLAS threads compete, as benchmarks/iftomm.py says). ``--quick`` runs
+OPENBLAS_NUM_THREADS=1 unless set (single-threaded CPU times): with BLAS threads on a loaded machine
+(``OPENBLAS_NUM_THREADS=2 … --models "A02 N=40"``) the 80 × 81 SVDs slow down up to 100-fold, as
+benchmarks/iftomm.py says — the reason the kernels keep the hand-written SVD there too. ``--quick`` runs
 both variants' kernels interpreted (plain Python on numpy: nothing to compile) on the three smallest
 models: it checks that the script runs and that both give the same s̈, not their speed.
 """
@@ -87,21 +86,47 @@ STATES = 4  # moving states per model, taken in turn
 COMPILED_FIRST = {"partitioned": pq.scenes.four_bar, "tangent": n_four_bar}
 
 
+def lapack_svd(A):
+    """(U, σ, Vᵀ) of A (m × n) by LAPACK (numba's ``np.linalg.svd``: gesdd, as the numpy path's
+    NullSpaceForm._decomposition) in the form the kernels read (:func:`~projeq.constraints.compiled._svd`):
+    U m × m, Vᵀ n × n, σ with all n singular values, those beyond the m rows zero (as
+    NullSpaceForm._branch pads them); NaN where LAPACK refuses A (not finite: the kernel flags it)."""
+    m, n = A.shape
+    try:
+        U, values, Vt = np.linalg.svd(A)
+    except Exception:  # noqa: BLE001 — numba raises LinAlgError, catchable only as Exception
+        return np.full((m, m), np.nan), np.full(n, np.nan), np.full((n, n), np.nan)
+    sigma = np.zeros(n)
+    sigma[:values.shape[0]] = values
+    return U, sigma, Vt
+
+
+def lapack_inverse(A):
+    """A⁻¹ by LAPACK (numba's ``np.linalg.inv``: getrf, getri), ∞ entries where A is singular or not
+    finite, as :func:`~projeq.constraints.compiled._inverse` gives them (the kernel flags them)."""
+    try:
+        return np.linalg.inv(A)
+    except Exception:  # noqa: BLE001 — numba raises LinAlgError, catchable only as Exception
+        return np.full(A.shape, np.inf)
+
+
 #: the two variants of the kernels' linear algebra: the routines under the names the kernels call
-VARIANTS = {
-    "lapack": {"_svd": compiled._lapack_svd, "_inverse": compiled._lapack_inverse},
-    "hand": {"_svd": compiled._jacobi_svd, "_inverse": compiled._gauss_jordan},
-}
+#: (the hand-written ones are the library's)
+VARIANTS = {"lapack": {"_svd": lapack_svd, "_inverse": lapack_inverse}, "hand": {}}
 
 
 def variant_kernels(variant: str) -> dict:
     """{"partitioned": …, "tangent": …}: the closure kernels of rigid trees with a Φ of their own (the
-    models here) compiled as :func:`projeq.constraints.compiled._compiled` compiles them, with the SVD and
-    the inverse of ``variant`` at every size (cached on disk under names of their own)."""
+    models here) with the routines of ``variant``: the library's own
+    (:func:`projeq.constraints.compiled._compiled`), or compiled as it compiles them with LAPACK's in
+    their place (cached on disk under names of their own)."""
+    if not VARIANTS[variant]:
+        return compiled._compiled(False, False)
     rules = ("partitioned", "tangent")
     functions = [getattr(compiled, rule) for rule in rules]
     names = tuple(f"{variant}_{rule}" for rule in rules)
-    return dict(zip(rules, kernels.jit(*functions, callees=compiled._HELPERS, names=names,
+    callees = compiled._HELPERS + (lapack_svd, lapack_inverse)  # in the digest of the names
+    return dict(zip(rules, kernels.jit(*functions, callees=callees, names=names,
                                        kernels=compiled._compiled_callees(False), **VARIANTS[variant])))
 
 
@@ -112,7 +137,8 @@ def interpreted_kernel(rule: str, variant: str):
     for f in compiled._HELPERS:
         if f.__module__ == compiled.__name__:
             namespace[f.__name__] = types.FunctionType(f.__code__, namespace, f.__name__, f.__defaults__)
-    namespace.update({name: namespace[f.__name__] for name, f in VARIANTS[variant].items()})
+    for name, f in VARIANTS[variant].items():
+        namespace[name] = types.FunctionType(f.__code__, namespace, name)
     return types.FunctionType(getattr(compiled, rule).__code__, namespace, rule)
 
 
@@ -179,8 +205,7 @@ def first_call(variant: str, rule: str) -> dict:
     model = COMPILED_FIRST[rule]()
     model.tree.evaluator("fast").accelerations(model.q0, np.zeros(model.tree.n_s), 0.0)
     closure = copy.copy(model.compiled_kernel())
-    if variant in VARIANTS:
-        closure.kernel = variant_kernels(variant)[rule]
+    closure.kernel = variant_kernels(variant)[rule]
     tree = time.process_time()
     assert closure.minimal_accelerations(model, model.q0, model.s_dot0, 0.0) is not None
     return {"variant": variant, "rule": rule, "tree_s": tree - start, "kernel_s": time.process_time() - tree}
@@ -235,7 +260,7 @@ def main(argv=None) -> dict:
         print("\ncold compilation (fresh process, empty NUMBA_CACHE_DIR), CPU s: the tree's kernels, then "
               "the closure kernel at its first call; CPU and wall s of the whole process")
         for rule in COMPILED_FIRST:
-            for variant in ("library", *VARIANTS):
+            for variant in VARIANTS:
                 row = cold_compile(variant, rule)
                 found["compile"].append(row)
                 print(f"{rule:12} {variant:7} tree {row['tree_s']:6.1f}  kernel {row['kernel_s']:6.1f}  "

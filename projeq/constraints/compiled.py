@@ -727,7 +727,7 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     b_s = _constraint_rates(pins, joints, fields, tree, q, m_h, m)  # from the workspace at q, before q*
     sigma_star, Vt_star = _on_manifold(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, U, sigma, Vt,
                                        min(count, rank))
-    if not np.all(np.isfinite(Vt_star)):  # A_s not finite (:func:`_svd`): the numpy path names the cause
+    if not np.all(np.isfinite(Vt_star)):  # A_s not finite: the numpy path names the cause
         return DEGENERATE
     near = 0  # the singular values below separation σ_max, at least k
     for value in sigma_star:
@@ -843,35 +843,7 @@ def _particular(U: NDArray, sigma: NDArray, Vt: NDArray, gamma: NDArray, count: 
     return f_bar
 
 
-#: the order up to which the hand-written routines beat LAPACK's in the kernels (min(m, n) of an
-#: SVD, m of an inverse; benchmarks/closure_linalg.py: even at about 16 for both)
-SMALL = 15
-
-
 def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-    """(U, σ, Vᵀ) of A (m × n), σ with all n singular values, descending, those beyond m zero, Vᵀ n × n
-    (U m × n or m × m: the kernels read its first columns only): by :func:`_jacobi_svd` where
-    min(m, n) ≤ SMALL (the loops' A_s: faster there), else LAPACK's (:func:`_lapack_svd`)."""
-    return _jacobi_svd(A) if min(A.shape[0], A.shape[1]) <= SMALL else _lapack_svd(A)
-
-
-def _lapack_svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-    """(U, σ, Vᵀ) of A (m × n) by LAPACK (numba's ``np.linalg.svd``: gesdd, as the numpy path's
-    :meth:`~projeq.constraints.tangent.NullSpaceForm._decomposition`): U m × m, Vᵀ n × n, and σ
-    with all n singular values, descending, those beyond the m rows zero (as
-    :meth:`~projeq.constraints.tangent.NullSpaceForm._branch` pads them); NaN where LAPACK refuses A
-    (not finite) or does not converge, which the kernel flags (the numpy path then names the cause)."""
-    m, n = A.shape
-    try:
-        U, values, Vt = np.linalg.svd(A)
-    except Exception:  # noqa: BLE001 — numba raises LinAlgError, catchable only as Exception
-        return np.full((m, m), np.nan), np.full(n, np.nan), np.full((n, n), np.nan)
-    sigma = np.zeros(n)
-    sigma[:values.shape[0]] = values
-    return U, sigma, Vt
-
-
-def _jacobi_svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     """(U, σ, Vᵀ) of A (m × n) with all n singular values, descending (those beyond m zero to
     round-off), V n × n and U m × n (column j = A v_j / σ_j, zero where σ_j = 0), for the few rows
     and columns of a loop's A_s, without LAPACK's calls and workspace: the QR decomposition with
@@ -879,11 +851,12 @@ def _jacobi_svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     Drmač & Veselić ("New fast and accurate Jacobi SVD algorithm I", SIAM J. Matrix Anal. Appl. 29,
     2008, §3: the one-sided Jacobi method on Rᵀ = L converges in fewer sweeps than on A), then
     one-sided Jacobi rotations of the columns of L (:func:`_jacobi` of [L; E]ᵀ): L W = Ũ Σ, so that
-    V = Q diag(W, E) and U[order] = Ũ. Faster than LAPACK's (:func:`_lapack_svd`) for the few rows of a
-    loop's A_s, which :func:`_svd` gives it — LAPACK's time over this one's (benchmarks/closure_linalg.py,
-    single-threaded BLAS): the SVD alone 1.9 at 6 × 7, 1.2 at 12 × 13, 1.09 at 14 × 15, 0.97 at 16 × 17;
-    the tangent kernel's s̈ 1.27 with A_s 1 × 2, 1.36 at 4 × 5, 1.37 at 5 × 5, 1.42 at 6 × 7, 0.95 at
-    20 × 21 and 0.31 at 80 × 81 (the IFToMM A02 N-four-bar, N = 10 and 40)."""
+    V = Q diag(W, E) and U[order] = Ũ. Not LAPACK's gesdd (numba's ``np.linalg.svd``, as the numpy path),
+    which benchmarks/closure_linalg.py times against it in the same kernels — LAPACK's time over this
+    one's per tangent s̈: 1.28 with A_s 1 × 2, 1.31 at 4 × 5, 1.34 at 5 × 5 and 6 × 7, 0.99 at 20 × 21,
+    0.31 at 80 × 81 (the IFToMM A02 N-four-bar, N = 10 and 40) with single-threaded BLAS; but with
+    BLAS threads on a loaded machine (tests in two processes on two cores) one 80 × 81 SVD takes
+    430 ms against 7 ms single-threaded, and the A02 N = 40 reference test ran 162 s against 35 s."""
     m, n = A.shape
     X, Qt, order = _transposed_qr(A)  # X = [L; E]ᵀ
     p = X.shape[0]
@@ -1033,27 +1006,11 @@ chain_terms, gauss_form, add_loads = kernels.chain_terms, kernels.gauss_form, lo
 
 
 def _inverse(A: NDArray) -> NDArray:
-    """A⁻¹, ∞ entries where A is singular or not finite: by :func:`_gauss_jordan` where A has at most
-    SMALL rows (a loop's A_dep, N_ind: faster there), else LAPACK's (:func:`_lapack_inverse`)."""
-    return _gauss_jordan(A) if A.shape[0] <= SMALL else _lapack_inverse(A)
-
-
-def _lapack_inverse(A: NDArray) -> NDArray:
-    """A⁻¹ by LAPACK (numba's ``np.linalg.inv``: getrf, getri); ∞ entries where A is singular or not
-    finite (LinAlgError), as on the numpy path
-    (:meth:`~projeq.constraints.partitioned.ConstrainedSystem._dependent_inverse`): the kernel flags it."""
-    try:
-        return np.linalg.inv(A)
-    except Exception:  # noqa: BLE001 — numba raises LinAlgError, catchable only as Exception
-        return np.full(A.shape, np.inf)
-
-
-def _gauss_jordan(A: NDArray) -> NDArray:
     """A⁻¹ by Gauss–Jordan elimination with partial pivoting (∞ entries for a singular A): faster than
-    LAPACK's (:func:`_lapack_inverse`) for the small A_dep and N_ind that :func:`_inverse` gives it —
-    LAPACK's time over this one's (benchmarks/closure_linalg.py): the inverse alone 3.2 at 2 × 2, 2.1
-    at 5 × 5, 1.2 at 12 × 12, 0.96 at 16 × 16; the partitioned kernel's s̈ 1.08 with the four-bar's
-    A_dep 2 × 2, 1.04 with the Whipple bicycle's 5 × 5."""
+    LAPACK's getrf/getri (numba's ``np.linalg.inv``) for a loop's A_dep and N_ind — LAPACK's time over
+    this one's (benchmarks/closure_linalg.py): the partitioned kernel's s̈ 1.05 with the four-bar's
+    A_dep 2 × 2, 1.14 with the Whipple bicycle's 5 × 5; the inverse alone 3.2 at 2 × 2, 2.1 at 5 × 5,
+    1.2 at 12 × 12, 0.96 at 16 × 16."""
     m = A.shape[0]
     work, inv = A.copy(), np.eye(m)
     for c in range(m):
@@ -1080,8 +1037,8 @@ _HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _constraint_
             _pin_constraint_values, _on_manifold, _pin_constraint_rows,
             _pin_constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame, _port_chain, _pin_values, _pin_rates,
             _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, given_motions, _matvec, _matmul, _svd,
-            _lapack_svd, _jacobi_svd, _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular,
-            _chain_terms, _projected, _inverse, _lapack_inverse, _gauss_jordan)
+            _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms, _projected,
+            _inverse)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":

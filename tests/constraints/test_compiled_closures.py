@@ -110,16 +110,14 @@ def test_the_kernels_linear_algebra_equals_numpys():
     rng = np.random.default_rng(3)
     for m in (1, 2, 4):
         A = rng.standard_normal((m, m))
-        assert np.allclose(compiled._gauss_jordan(A), np.linalg.inv(A), rtol=1e-12, atol=1e-12)
-        assert np.array_equal(compiled._lapack_inverse(A), np.linalg.inv(A))
+        assert np.allclose(compiled._inverse(A), np.linalg.inv(A), rtol=1e-12, atol=1e-12)
         D, x = A @ A.T + m * np.eye(m), rng.standard_normal(m)
         expected = np.linalg.solve(D, x)
         L = D.copy()
         assert kernels.cholesky(L, m, 1e-13)
         kernels.cholesky_solve(L, m, x)
         assert np.allclose(x, expected, rtol=1e-12, atol=1e-14)
-    for inverse in (compiled._gauss_jordan, compiled._lapack_inverse):
-        assert np.all(np.isinf(inverse(np.array([[1.0, 2.0], [2.0, 4.0]]))))
+    assert np.all(np.isinf(compiled._inverse(np.array([[1.0, 2.0], [2.0, 4.0]]))))
     assert not kernels.cholesky(np.array([[1.0, 1.0], [1.0, 1.0]]), 2, 1e-13)
 
 
@@ -278,23 +276,6 @@ def test_a_force_law_without_a_value_in_the_compiled_call_raises_the_numpy_paths
         model.accelerations_tree(model.q0, model.s_dot0, 0.0)
 
 
-@pytest.mark.parametrize("shape", [(1, 2), (2, 3), (5, 5), (7, 3)])
-def test_the_kernels_lapack_svd_is_numpys_with_every_singular_value_and_nan_where_lapack_refuses(shape):
-    """The kernels' SVD of larger A_s is numpy's (LAPACK gesdd, as the numpy path's) with σ padded to
-    the n columns by zeros (the null space of a wide A_s counts them, as NullSpaceForm._branch does),
-    U m × m and Vᵀ n × n; NaN where A is not finite (LAPACK refuses it: the kernel flags, the numpy
-    path names q)."""
-    m, n = shape
-    A = np.random.default_rng(m * n).standard_normal(shape)
-    U, sigma, Vt = compiled._lapack_svd(A)
-    expected = np.linalg.svd(A)
-    assert U.shape == (m, m) and sigma.shape == (n,) and Vt.shape == (n, n)
-    assert np.array_equal(U, expected[0]) and np.array_equal(Vt, expected[2])
-    assert np.array_equal(sigma[:min(m, n)], expected[1]) and not np.any(sigma[min(m, n):])
-    A[0, 0] = np.nan
-    assert all(np.isnan(part).all() for part in compiled._lapack_svd(A))
-
-
 @pytest.mark.parametrize("shape", [(1, 2), (2, 3), (4, 5), (5, 5), (6, 7)])
 def test_the_kernels_jacobi_svd_equals_lapacks(shape):
     """One-sided Jacobi (Demmel & Veselić 1992) against numpy's LAPACK SVD: the same singular
@@ -304,7 +285,7 @@ def test_the_kernels_jacobi_svd_equals_lapacks(shape):
     A = np.random.default_rng(m * n).standard_normal(shape)
     if m == n:
         A[-1] = A[0] + A[1]  # a redundant row, as Bricard's
-    U, sigma, Vt = compiled._jacobi_svd(A)
+    U, sigma, Vt = compiled._svd(A)
     expected = np.linalg.svd(A, compute_uv=False)
     r = len(expected)
     assert np.abs(sigma[:r] - expected).max() <= 1e-14 * expected[0]
@@ -349,7 +330,7 @@ def test_the_kernels_svd_gives_lapacks_singular_values_null_space_and_pseudo_inv
     size; U Σ Vᵀ = A and V orthogonal."""
     for name, A in _svd_cases():
         m, n = A.shape
-        U, sigma, Vt = compiled._jacobi_svd(A)
+        U, sigma, Vt = compiled._svd(A)
         expected = np.linalg.svd(A, compute_uv=False)
         scale = max(expected.max(initial=0.0), 1e-300)
         rank = int(np.sum(expected > 1e-10 * scale))
@@ -366,27 +347,13 @@ def test_the_kernels_svd_gives_lapacks_singular_values_null_space_and_pseudo_inv
         assert np.abs(pseudo_inverse - expected_inverse).max() <= 1e-13 * max(1.0, np.abs(expected_inverse).max()), name
 
 
-def test_the_kernels_take_the_hand_written_routines_up_to_order_small_and_lapacks_above():
-    """_svd and _inverse: the hand-written SVD and Gauss–Jordan (faster for a loop's few rows) up to
-    min(m, n) = SMALL, LAPACK's above (faster there: benchmarks/closure_linalg.py)."""
-    rng = np.random.default_rng(8)
-    for m, n in ((2, 3), (compiled.SMALL, compiled.SMALL + 1), (compiled.SMALL + 1, compiled.SMALL + 2)):
-        A = rng.standard_normal((m, n))
-        small = min(m, n) <= compiled.SMALL
-        expected = (compiled._jacobi_svd if small else compiled._lapack_svd)(A)
-        assert all(np.array_equal(a, b) for a, b in zip(compiled._svd(A), expected))
-        square = A[:, :m]
-        expected = (compiled._gauss_jordan if small else compiled._lapack_inverse)(square)
-        assert np.array_equal(compiled._inverse(square), expected)
-
-
 def test_the_closure_linalg_benchmark_runs_and_both_variants_give_the_same_accelerations(capsys):
     """benchmarks/closure_linalg.py --quick runs (the kernels of both variants interpreted: nothing to
-    compile), and the kernels with the hand-written SVD (QR-preconditioned one-sided Jacobi) and
-    Gauss–Jordan inverse at every size give the s̈_tree of the kernels with LAPACK's at every size:
-    another algorithm for the same null space, pseudo-inverse and A_dep⁻¹, agreeing to round-off
-    (measured 3.7e-16 four-bar, 1.1e-17 simple pendulum, 2.9e-15 double four-bar, relative to
-    max(1, |s̈_tree|); bound 100 ε)."""
+    compile), and the kernels with their hand-written SVD (QR-preconditioned one-sided Jacobi) and
+    Gauss–Jordan inverse give the s̈_tree of the same kernels with LAPACK's (numba's np.linalg, as the
+    numpy path): another algorithm for the same null space, pseudo-inverse and A_dep⁻¹, agreeing to
+    round-off (measured 3.7e-16 four-bar, 1.1e-17 simple pendulum, 2.9e-15 double four-bar, relative
+    to max(1, |s̈_tree|); bound 100 ε)."""
     spec = importlib.util.spec_from_file_location("closure_linalg", BENCHMARKS / "closure_linalg.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
