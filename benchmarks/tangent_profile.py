@@ -66,10 +66,10 @@ def particular_loop(U, sigma, Vt, gamma, F, independent, count, repeats):
         _particular(U, sigma, Vt, gamma, count, F, independent)
 
 
-def projected_loop(tree, Q, Q_dot, F, f_bar, pivot, M, b, s_ddot_tree, repeats):
+def projected_loop(tree, Q, Q_dot, t, F, f_bar, pivot, M, b, s_ddot_tree, repeats):
     for _ in range(repeats):
         for j in range(Q.shape[0]):
-            _projected(tree, Q[j], Q_dot[j], F, f_bar, pivot, M, b, s_ddot_tree)
+            _projected(tree, Q[j], Q_dot[j], t, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
 def call_only(*args):
@@ -120,7 +120,7 @@ def profile(name: str, budget: float) -> dict:
         "x₀ = A_s⁺(−γ), f̄": (lambda: loops["particular_loop"](U, sigma, Vt, gamma, F, system.independent, n - k,
                                                                r * STATES), r * STATES),
         "tree terms, FᵀMF (_projected)": (lambda: loops["projected_loop"](
-            closure.tree, Q, Q_dot, F, f_bar, SINGULAR_PIVOT, ws.M_all.copy(), ws.b_all.copy(),
+            closure.tree, Q, Q_dot, t, F, f_bar, SINGULAR_PIVOT, ws.M_all.copy(), ws.b_all.copy(),
             s_ddot_tree.copy(), r), r * STATES),
         "a compiled call of the kernel's arguments": (lambda: jitted_call_only(*args), 1),
         "kernel called from Python": (lambda: closure.kernel(*args), 1),

@@ -25,10 +25,12 @@ BENCHMARKS = ROOT / "benchmarks"
 OWN_TESTS = {
     "barhorst_compiled.py": "tests/studies/test_barhorst_compiled.py",
     "campbell.py": "tests/analysis/test_campbell.py",
+    "closure_linalg.py": "tests/constraints/test_compiled_closures.py",
     "effort_growth.py": "tests/studies/test_effort_growth.py",
     "iftomm.py": "tests/studies/test_iftomm_benchmark.py",
     "spinning_beam_frequencies.py": "tests/symbolic/test_spinning_beam.py",
     "statements.py": "tests/studies/test_statements_benchmark.py",
+    "time_loads.py": "tests/assembly/test_time_loads.py",
     "urdf_pinocchio.py": "tests/scenes/test_urdf.py",
 }
 
