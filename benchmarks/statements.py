@@ -20,13 +20,13 @@ from __future__ import annotations
 
 import argparse
 import time
-import timeit
 import warnings
 
 import numpy as np
 
 import projeq as pq
 from projeq.joints import Stated
+from projeq.studies.timing import per_call
 
 
 class Helical(pq.Joint):
@@ -108,12 +108,6 @@ def checks(system: pq.System, q: np.ndarray, s_dot: np.ndarray) -> dict:
     return {"evaluator": default.name, "in Python": default.evaluator.interpreted, "compiled vs recursive": error,
             "gauss_form vs recursive (N = 2)": symbolic_error, "Jacobian": how}
 
-
-def per_call(f, seconds: float) -> float:
-    """µs per call over about ``seconds``."""
-    f()
-    number = max(1, int(seconds / max(timeit.timeit(f, number=20) / 20, 1e-7)))
-    return timeit.timeit(f, number=number) / number * 1e6
 
 
 def main(argv=None) -> dict:

@@ -23,12 +23,12 @@ compiled with no warning and that its ẋ equals the recursive evaluator's.
 from __future__ import annotations
 
 import argparse
-import timeit
 import warnings
 
 import numpy as np
 
 import projeq as pq
+from projeq.studies.timing import per_call
 
 A, OMEGA = 1.5, 3.0  # τ(t) = A sin(OMEGA t)
 
@@ -79,12 +79,6 @@ def right_hand_side(system: pq.System):
 
     return x_dot
 
-
-def per_call(f, seconds: float) -> float:
-    """µs per call over about ``seconds``."""
-    f()
-    number = max(1, int(seconds / max(timeit.timeit(f, number=20) / 20, 1e-7)))
-    return timeit.timeit(f, number=number) / number * 1e6
 
 
 def main(argv=None) -> dict:

@@ -5,8 +5,17 @@ ratios hold on a loaded machine (:func:`time_per_call`, used by every benchmark 
 from __future__ import annotations
 
 import time
+import timeit
 
 import numpy as np
+
+
+def per_call(f, seconds: float) -> float:
+    """µs per call of ``f()`` over about ``seconds`` (after one call that compiles or warms it),
+    by :func:`timeit.timeit`: wall time, for the alternating rounds of a benchmark."""
+    f()
+    number = max(1, int(seconds / max(timeit.timeit(f, number=20) / 20, 1e-7)))
+    return timeit.timeit(f, number=number) / number * 1e6
 
 
 def time_per_call(funcs: dict, q, s_dot, budget: float, clock=time.process_time, batch: float = 2e-3) -> dict:
