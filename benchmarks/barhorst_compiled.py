@@ -70,5 +70,8 @@ def main(argv=None) -> dict:
             for study in ("barhorst_particle", "quick_return")}
 
 
+os.environ.setdefault("PROJEQ_COMPILE", "now")  # compiled from the first call: this measures the compiled path
+
+
 if __name__ == "__main__":
     main()

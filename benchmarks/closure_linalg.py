@@ -268,5 +268,8 @@ def main(argv=None) -> dict:
     return found
 
 
+os.environ.setdefault("PROJEQ_COMPILE", "now")  # compiled from the first call: this measures the compiled path
+
+
 if __name__ == "__main__":
     main()

@@ -19,6 +19,7 @@ default_method picks before and now; then the cost of each check in ms (CPU, the
 
 from __future__ import annotations
 
+import os
 import argparse
 import time
 import warnings
@@ -97,6 +98,9 @@ class _Real:
         if np.iscomplexobj(q) or np.iscomplexobj(s_dot):
             raise TypeError("real states only")
         return self._evaluator.accelerations(q, s_dot, t)
+
+
+os.environ.setdefault("PROJEQ_COMPILE", "now")  # compiled from the first call: this measures the compiled path
 
 
 if __name__ == "__main__":

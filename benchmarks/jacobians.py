@@ -14,6 +14,7 @@ runs are compared (they must agree to the tolerance).
 
 from __future__ import annotations
 
+import os
 import argparse
 import time
 
@@ -68,6 +69,9 @@ def main(argv=None) -> None:
                 t_reached = result.t[-1] if len(result.t) else 0.0
                 reached = "t_end" if result.status == 0 else f"failed at t = {t_reached:.3g} s: {result.message[:40]}"
                 print(f"{name:24} {method:6} {jac:12} {real:8d} {cplx:8d} {wall:8.2f} {diff:9.1e}  {reached}")
+
+
+os.environ.setdefault("PROJEQ_COMPILE", "now")  # compiled from the first call: this measures the compiled path
 
 
 if __name__ == "__main__":

@@ -96,5 +96,8 @@ def main(argv=None) -> None:
                   f"{same}", flush=True)
 
 
+os.environ.setdefault("PROJEQ_COMPILE", "now")  # compiled from the first call: this measures the compiled path
+
+
 if __name__ == "__main__":
     main()

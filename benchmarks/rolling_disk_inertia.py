@@ -12,6 +12,7 @@ about 250 rad, q4 within about ±6 cm, q5 down to about −12 cm.
     python benchmarks/rolling_disk_inertia.py --quick   # his first 0.1 s (a test runs it)
 """
 
+import os
 import argparse
 
 import numpy as np
@@ -44,6 +45,9 @@ def main(argv=None):
                 f"{value:.6g}" if isinstance(value, float) else value)
             print(f"{key:>18}: {text}")
         print()
+
+
+os.environ.setdefault("PROJEQ_COMPILE", "now")  # compiled from the first call: this measures the compiled path
 
 
 if __name__ == "__main__":

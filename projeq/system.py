@@ -448,8 +448,15 @@ class System(Model):
                                 and np.array_equal(self._identity_s, np.arange(n_s)))
         self._normalizing = tuple(  # joints whose coordinates live on a manifold (quaternions)
             n for n, j in enumerate(self.joints)
-            if type(j).normalized is not Joint.normalized and not j.coupling
+            if type(j).normalized is not Joint.normalized and not j.coupling and self.e_q_slice[n].start > self.q_slice[n].start
         )
+        self._constrained = tuple(n for n, j in enumerate(self.joints) if j.n_c)  # joints with velocity constraints
+        from projeq.subsystems.rigid import RigidBody
+
+        rigid = [n for n, sub in enumerate(self.subsystems) if type(sub).potential_energy is RigidBody.potential_energy]
+        self._rigid_potential = (np.array(rigid, dtype=int), np.array([self.subsystems[n].m for n in rigid]),
+                                 np.array([self.subsystems[n].r_c for n in rigid]).reshape(-1, 3))
+        self._own_potential = tuple(n for n in range(len(self.subsystems)) if n not in set(rigid))
 
     def _coupling_rows(self, n: int, slices) -> tuple[NDArray, NDArray]:
         """Indices into the global vector and weights for coupled joint n."""
@@ -508,10 +515,9 @@ class System(Model):
         """q with every joint's coordinates projected onto their manifold (unit quaternions, the
         same at any time t)."""
         q = numeric(np.array(q))  # complex under a complex step (the energy projection's exact gradient)
-        for n, joint in enumerate(self.joints):
+        for n in self._normalizing:  # the others' normalized is the identity
             sl = slice(self.q_slice[n].start, self.e_q_slice[n].start)
-            if sl.stop > sl.start:
-                q[sl] = joint.normalized(q[sl])
+            q[sl] = self.joints[n].normalized(q[sl])
         return q
 
     def check_q(self, name: str, q) -> NDArray:
@@ -576,9 +582,8 @@ class System(Model):
     def constraint_residual(self, q: NDArray, q_dot: NDArray, t: float = 0.0) -> NDArray:
         """Residuals of the joints' original velocity constraints at (q, q̇, t)."""
         parts = [
-            j.constraint_residual(self._q_get[n](q), self._q_get[n](q_dot), t)
-            for n, j in enumerate(self.joints)
-            if j.n_c
+            self.joints[n].constraint_residual(self._q_get[n](q), self._q_get[n](q_dot), t)
+            for n in self._constrained
         ]
         return np.concatenate(parts) if parts else np.zeros(0)
 
@@ -669,10 +674,10 @@ class System(Model):
 
     def _energy(self, q: NDArray, s_dot: NDArray, t, method: str | None = None) -> tuple:
         """:meth:`energy` at a checked (q, ṡ, t), or by the reference at a complex one."""
-        if method is None:  # the default evaluator's own where it is a compiled one
-            picked = self.evaluator(None).evaluator
-            if getattr(picked, "compiled", False):
-                return picked.energy(q, s_dot, t)
+        if method is None:  # the default evaluator's own where it is a compiled one (tiered: projeq.assembly.auto)
+            default = self.evaluator(None)
+            if getattr(default.evaluator, "compiled", False):
+                return default.energy(q, s_dot, t)
         elif method != "recursive":
             return self.evaluator(method).energy(q, s_dot, t)
         from projeq.assembly.kinematics import poses
@@ -690,10 +695,17 @@ class System(Model):
 
     def potential_energy(self, kin, q: NDArray):
         """V at the poses ``kin`` (R_n, r_n, twists, ẏ_n; the ground's last) and q: each
-        subsystem's ``potential_energy`` (gravity, strain) and each force law's ``potential``."""
-        return sum(
-            sub.potential_energy(kin.R[n], kin.r[n], self.gravity, q[self.e_q_slice[n]])
-            for n, sub in enumerate(self.subsystems)
+        subsystem's ``potential_energy`` (gravity, strain) and each force law's ``potential``;
+        the rigid bodies' −m g·(r_n + R_n r_c,n) (:meth:`RigidBody.potential_energy
+        <projeq.subsystems.rigid.RigidBody.potential_energy>`) summed in one array expression."""
+        rigid, m, r_c = self._rigid_potential
+        V = 0.0
+        if len(rigid):
+            R, r = np.asarray(kin.R), np.asarray(kin.r)
+            V = -(m * ((r[rigid] + np.einsum("nij,nj->ni", R[rigid], r_c)) @ self.gravity)).sum()
+        return V + sum(
+            self.subsystems[n].potential_energy(kin.R[n], kin.r[n], self.gravity, q[self.e_q_slice[n]])
+            for n in self._own_potential
         ) + sum(f.potential(kin, q) for f in self.forces)
 
     def _check_planar(self) -> None:

@@ -14,6 +14,16 @@ says what it chose (``name``, ``reason``). The compiled kernel is compiled on it
 use and cached on disk (numba's ``cache=True``): a fresh environment pays the compilation
 once (``projeq bench`` reports the first-call latency), later processes load it.
 
+Compiling costs 10–40 s of CPU, more than a short run costs interpreted (README's pendulum
+example: 17 s to compile ẋ against about 6 s for the whole example interpreted). So the picked
+compiled evaluator's methods run where numba has their kernels (in this process or in its
+disk cache) and otherwise by the reference evaluators, until
+:data:`projeq.assembly.compilation.BUDGET` seconds of CPU are spent so (counted over the runs
+of the same numba cache; one line on standard error says so; ``PROJEQ_COMPILE=now`` compiles
+at first use instead); past that they compile. The
+two agree to round-off (the evaluators' property tests), so a run's result does not depend
+on which one ran, beyond round-off.
+
 >>> import warnings, numpy as np, projeq as pq
 >>> AutoEvaluator(pq.scenes.atwood()).name  # coupled joints: compiled
 'fast'
@@ -34,9 +44,12 @@ RitzBeams)"]
 
 from __future__ import annotations
 
+import time
 import warnings
 
-from projeq.assembly import kernels
+import numpy as np
+
+from projeq.assembly import compilation, kernels
 from projeq.assembly.beam_fast import hub_beam_unsupported
 from projeq.assembly.fast import InterpretedWarning, PythonPieceWarning, unsupported
 
@@ -78,6 +91,8 @@ class AutoEvaluator:
             self.state_derivative = self.evaluator.state_derivative
         if hasattr(self.evaluator, "state_jacobian"):  # ∂ẋ/∂x in one call (projeq.analysis.jacobians)
             self.state_jacobian = self.evaluator.state_jacobian
+        if getattr(self.evaluator, "compiled", False):
+            self._tiered(system)
         if self.name in ("dense", "recursive"):
             warnings.warn(
                 f"system: evaluated by the interpreted {self.name!r} evaluator, not the compiled one: "
@@ -88,3 +103,68 @@ class AutoEvaluator:
                 f"system: evaluated by the interpreted 'hub_beam' path, not the compiled one: "
                 f"{self.evaluator.interpreted_reason}", InterpretedWarning, stacklevel=3,
             )
+
+    def _tiered(self, system) -> None:
+        """The compiled evaluator's methods, each by the reference evaluator while its kernels are
+        not compiled and the budget lasts (module docstring, :class:`Tier`)."""
+        from projeq.assembly.beam_fast import HubBeamEvaluator
+
+        reference = HubBeamEvaluator(system, compiled=False) if self.name == "hub_beam" else \
+            system.evaluator("dense" if system.coupled else "recursive")
+        picked, model = self.evaluator, f"the {self.name!r} evaluator"
+        self.accelerations = Tier(picked.accelerations, reference.accelerations, model, 0)
+        self.state_derivative = Tier(picked.state_derivative, _none, model, 1)  # None: ẋ by q̇ and s̈
+        if hasattr(picked, "state_jacobian"):  # None: the caller's complex step through s̈
+            self.state_jacobian = Tier(picked.state_jacobian, _none, model, 1)
+        self.energy = Tier(picked.energy, lambda q, s_dot, t: system._energy(q, s_dot, t, "recursive"), model, 0)
+
+    @property
+    def interpreting(self) -> bool:
+        """Whether a method of the compiled evaluator last ran interpreted (its kernels not compiled yet)."""
+        return any(getattr(getattr(self, name, None), "deferred", None) for name in Tier.METHODS)
+
+
+def _none(*args) -> None:
+    """No one-call result: the caller evaluates otherwise."""
+    return None
+
+
+class Tier:
+    """One method of a compiled evaluator, ``compiled``, run by ``interpreted`` (same arguments, same
+    result to round-off) while numba has not compiled its kernels for the dtype of argument
+    ``state`` (real or complex) and the budget of interpreted CPU lasts
+    (:func:`projeq.assembly.compilation.compile_now`); past it, compiled (numba compiles then,
+    announced). Once compiled (or loaded from the cache) for a dtype, the compiled method is
+    called directly."""
+
+    METHODS = ("accelerations", "state_derivative", "state_jacobian", "energy")
+
+    def __init__(self, compiled, interpreted, what: str, state: int):
+        self.compiled, self.interpreted, self.what, self.state = compiled, interpreted, what, state
+        self.ready, self.deferred = set(), set()  # dtype kinds ("f", "c") compiled, and found not compiled
+
+    def __call__(self, *args):
+        kind = "c" if getattr(args[self.state], "dtype", np.dtype(float)).kind == "c" else "f"
+        if kind in self.ready:
+            return self.compiled(*args)
+        if compilation.compile_now():
+            value = self.compiled(*args)  # compiles where numba has not (announced)
+        elif kind in self.deferred:
+            return self._interpreted(args)
+        else:
+            try:
+                with compilation.cached_only():
+                    value = self.compiled(*args)
+            except compilation.NotCompiled:
+                self.deferred.add(kind)
+                return self._interpreted(args)
+        self.ready.add(kind)
+        self.deferred.discard(kind)
+        return value
+
+    def _interpreted(self, args):
+        started = time.process_time()
+        try:
+            return self.interpreted(*args)
+        finally:
+            compilation.spend(time.process_time() - started, self.what)

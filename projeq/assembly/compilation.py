@@ -11,21 +11,45 @@ numba compiles projeq's kernels on their first use and keeps them in its disk ca
   time (numba's ``numba:compile`` event fires on a cache miss only, before compiling);
 - a cache entry numba cannot read back (a truncated or corrupted index or data file: an
   ``EOFError`` or ``UnpicklingError`` from its loader) is discarded with one
-  :class:`CacheWarning` naming it, and the kernel is compiled and cached anew.
+  :class:`CacheWarning` naming it, and the kernel is compiled and cached anew;
+- under :func:`cached_only` a kernel numba would compile raises :class:`NotCompiled` before
+  its compilation starts (a kernel in memory or in the disk cache runs): the default evaluator
+  (:mod:`projeq.assembly.auto`) evaluates interpreted instead, until :data:`BUDGET` seconds of
+  CPU are spent so over the runs of the same numba cache, then compiles (:func:`spend`,
+  :func:`compile_now`).
 
-Both apply to projeq's own functions only (their module's name starts with ``projeq``: the
+All three apply to projeq's own functions only (their module's name starts with ``projeq``: the
 package and the modules it generates, :func:`projeq.assembly.given.generated_module`).
 """
 
 from __future__ import annotations
 
+import atexit
+import contextlib
 import functools
+import os
 import sys
+import threading
 import time
 import warnings
+from pathlib import Path
 
 #: seconds after which a top-level kernel's compilation is reported by name
 SLOW = 5.0
+
+#: CPU seconds of interpreted evaluation, while the compiled kernels needed are not in numba's cache,
+#: after which they are compiled (counted over the processes of one numba cache). Compiling a model's kernels costs 10–40 s of CPU (README's pendulum:
+#: 17 s for ẋ alone); renting the interpreted evaluator until its cost reaches the price of compiling,
+#: then buying, costs at most twice the better of the two choices made knowing the run's length in
+#: advance (the ski-rental bound), and a short run (README's example, ``projeq run``) compiles nothing.
+BUDGET = 10.0
+
+#: ``PROJEQ_COMPILE=now``: compile on first use, as before the budget (benchmarks of the compiled path)
+COMPILE_NOW = "now"
+
+
+class NotCompiled(Exception):
+    """Under :func:`cached_only`, numba was about to compile a projeq kernel (it was not cached)."""
 
 
 class CacheWarning(UserWarning):
@@ -37,16 +61,21 @@ def _ours(function) -> bool:
 
 
 class _Announcer:
-    """numba's ``numba:compile`` listener: the first line, then the slow top-level kernels."""
+    """numba's ``numba:compile`` listener: the first line, then the slow top-level kernels; under
+    :func:`cached_only`, :class:`NotCompiled` before a top-level kernel compiles."""
 
     def __init__(self):
-        self.announced, self.depth, self.started = False, 0, 0.0
+        self.announced, self.depth, self.started = False, 0, None
+        self.deferring = threading.local()
 
     def on_start(self, event):
         function = getattr(event.data.get("dispatcher"), "py_func", None)
-        self.depth += 1
+        self.depth += 1  # the end event follows even where this raises
         if self.depth > 1 or not _ours(function):
             return
+        self.started = None
+        if getattr(self.deferring, "on", False):
+            raise NotCompiled(function.__qualname__)  # before numba compiles anything
         self.started = time.perf_counter()
         if not self.announced:
             self.announced = True
@@ -56,7 +85,7 @@ class _Announcer:
     def on_end(self, event):
         self.depth -= 1
         function = getattr(event.data.get("dispatcher"), "py_func", None)
-        if self.depth == 0 and _ours(function) and time.perf_counter() - self.started > SLOW:
+        if self.depth == 0 and _ours(function) and self.started is not None and time.perf_counter() - self.started > SLOW:
             print(f"projeq:   compiled {function.__qualname__} "
                   f"({time.perf_counter() - self.started:.0f} s)", file=sys.stderr, flush=True)
 
@@ -79,6 +108,76 @@ def _safe_load(load):
 
     load_overload.projeq_safe = True
     return load_overload
+
+
+@contextlib.contextmanager
+def cached_only():
+    """Within: projeq's kernels run where numba has them compiled (in this process or in its disk
+    cache); one it would compile raises :class:`NotCompiled` instead (the calling thread only)."""
+    prepare()
+    _ANNOUNCER.deferring.on = True
+    try:
+        yield
+    finally:
+        _ANNOUNCER.deferring.on = False
+
+
+class _Budget:
+    """The CPU seconds spent interpreted while kernels were not cached, by this process and the
+    earlier ones of the same numba cache: kept in a file beside the cache's entries of projeq's
+    kernels (:func:`_ledger`), so that the budget is spent once per cache, not once per process (an
+    emptied cache starts a new one)."""
+
+    def __init__(self):
+        self.spent, self.told, self.before = 0.0, False, None
+
+    def total(self) -> float:
+        if self.before is None:
+            self.before = _read_ledger()
+            atexit.register(self.save)
+        return self.before + self.spent
+
+    def exhausted(self) -> bool:
+        return os.environ.get("PROJEQ_COMPILE", "").strip().lower() == COMPILE_NOW or self.total() >= BUDGET
+
+    def save(self) -> None:
+        if self.spent:
+            with contextlib.suppress(OSError):
+                _ledger().write_text(f"{self.total():.3f}\n")
+
+
+def _ledger() -> Path:
+    """The file of the interpreted seconds: in numba's cache folder of projeq's kernels
+    (``NUMBA_CACHE_DIR``, or the ``__pycache__`` beside this module)."""
+    from numba.core import config
+
+    return Path(config.CACHE_DIR or Path(__file__).parent / "__pycache__") / "projeq-interpreted-seconds"
+
+
+def _read_ledger() -> float:
+    try:
+        return max(0.0, float(_ledger().read_text()))
+    except (OSError, ValueError):  # none yet, unreadable or damaged: a new budget
+        return 0.0
+
+
+_BUDGET = _Budget()
+
+
+def compile_now() -> bool:
+    """Whether kernels compile at their next use: :data:`BUDGET` is spent, or ``PROJEQ_COMPILE=now``."""
+    return _BUDGET.exhausted()
+
+
+def spend(seconds: float, what: str) -> None:
+    """Add ``seconds`` of interpreted evaluation to the budget; the first time, one line on standard
+    error says so, naming ``what`` runs interpreted and how to compile at once."""
+    _BUDGET.spent += seconds
+    if not _BUDGET.told:
+        _BUDGET.told = True
+        print(f"projeq: {what}'s compiled kernels are not in numba's cache: evaluating it interpreted until "
+              f"{BUDGET:.0f} s of CPU are spent so (now {_BUDGET.total():.1f} s, counted over the runs of this cache), "
+              "then compiling them, once (PROJEQ_COMPILE=now compiles at first use)", file=sys.stderr, flush=True)
 
 
 @functools.cache

@@ -312,7 +312,7 @@ class FastEvaluator:
         for n, e_s in self._internal:
             y_dot[n, 6 : 6 + e_s.stop - e_s.start] = s_dot[e_s]
             self.system.subsystems[n].check_spin(ws.twist[n, 3:6])
-        kinetic = 0.5 * np.einsum("ni,nij,nj->", y_dot, ws.M_n, y_dot)
+        kinetic = 0.5 * np.vdot(y_dot, np.einsum("nij,nj->ni", ws.M_n, y_dot))
         potential = self.system.potential_energy(_SelectedKinematics(self.system, ws, s_dot), q)
         return float(kinetic), float(potential)
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 
 from projeq.cli.options import plain
 from projeq.studies import bench, bench_peers
@@ -41,6 +42,7 @@ def exact_option(parser: argparse.ArgumentParser) -> None:
 
 
 def run_benchmarks(args) -> int:
+    os.environ.setdefault("PROJEQ_COMPILE", "now")  # compiled from the first call: they measure the compiled path
     if args.peers:
         report = bench_peers.peers_report(args.sizes, args.budget, show=None if args.json else _show)
         if args.json:

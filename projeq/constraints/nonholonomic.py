@@ -63,6 +63,12 @@ def initial_speeds(system, q, q_dot, t: float = 0.0, tol: float = CONSTRAINT_TOL
     return s_dot
 
 
+def may_lose_rank(joint) -> bool:
+    """Whether ``joint`` has minimal velocities of its own whose K(q) or F(q) can lose rank: not a
+    revolute or prismatic joint, whose K = E and F = its unit axis have condition number 1 at every q."""
+    return bool(joint.n_s) and not joint.coupling and joint.compiled_kind not in ("revolute", "prismatic")
+
+
 def near_singularity(system, q, t: float) -> None:
     """During a run: ValueError when the state at t has come near a coordinate singularity
     (a condition number of K or F above :data:`NEAR_SINGULAR_CONDITION`), naming the joint."""
@@ -79,6 +85,8 @@ def check_configuration(system, q, t: float = 0.0, max_condition: float = SINGUL
     from projeq.assembly.kinematics import forward
 
     q = state_vector("q", q, system.n_q)
+    if not any(may_lose_rank(joint) for joint in system.joints):
+        return
     with np.errstate(all="ignore"):
         K = system.K(q, t)
         try:
@@ -87,7 +95,7 @@ def check_configuration(system, q, t: float = 0.0, max_condition: float = SINGUL
         except (FloatingPointError, ZeroDivisionError, ValueError):
             F_all = [None] * len(system.joints)
     for n, joint in enumerate(system.joints):
-        if joint.coupling or joint.n_s == 0:
+        if not may_lose_rank(joint):
             continue
         rows, cols = _joint_rows(system, n)
         where = f"joint of {system.names[n]!r} at q = {np.round(q[rows], 6).tolist()}"

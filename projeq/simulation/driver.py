@@ -37,7 +37,7 @@ from projeq.simulation.integrators import (
     EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, stiff_steps, warn_stiff, with_direct_lu,
 )
 from projeq.simulation.result import FAILED, NON_FINITE, OUT_OF_RANGE, Result, SimulationError
-from projeq.constraints.nonholonomic import near_singularity
+from projeq.constraints.nonholonomic import may_lose_rank, near_singularity
 from projeq.system import CLOSED, Model, check_model
 
 __all__ = ["INTEGRATORS", "Result", "SimulationError", "ValidityWarning", "default_method", "simulate"]
@@ -313,6 +313,7 @@ class _Run:
             raise ValueError(f"progress: expected a callable progress(t), got {progress!r}")
         self.events = _checked_events(events, t_start, q0, s_dot0)
         self.model = self.user_model = system
+        self.may_be_singular = _may_be_singular(system.tree)  # one tree for every model of the run
         self.choice, self.ev = evaluator, _evaluator(system, evaluator)
         self.fused = getattr(self.ev, "state_derivative", None)
         system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
@@ -349,7 +350,7 @@ class _Run:
         """Count a right-hand side; every ``MONITOR_EVERY`` calls the distance of q to a
         coordinate singularity (where a joint has minimal velocities of its own)."""
         self.calls += 1
-        if self.calls % MONITOR_EVERY == 0 and _may_be_singular(self.model.tree):
+        if self.calls % MONITOR_EVERY == 0 and self.may_be_singular:
             near_singularity(self.model.tree, q, t)
 
     def checked_rhs(self, t: float, x: NDArray) -> NDArray:
@@ -470,7 +471,8 @@ class _Run:
         self.x = self.x_end.copy()
         n_q = self.model.n_q
         self.x[:n_q] = self.model.normalized(self.x[:n_q], b)
-        near_singularity(self.model.tree, self.x[:n_q], b)
+        if self.may_be_singular:
+            near_singularity(self.model.tree, self.x[:n_q], b)
         if self.progress is not None:
             self.progress(b)
 
@@ -598,12 +600,10 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
 
 def _may_be_singular(tree) -> bool:
     """Whether a joint of ``tree`` has minimal velocities of its own whose K(q) or F(q) can lose
-    rank, which :func:`~projeq.constraints.nonholonomic.near_singularity` checks (a forward
-    pass and condition numbers: 0.5 ms on the spin-up beam, whose prescribed hub has none; ~2 ms
-    on chain(5)): not a revolute or prismatic joint, whose K = E and F = its unit axis have
-    condition number 1 at every q."""
-    return any(joint.n_s and not joint.coupling and joint.compiled_kind not in ("revolute", "prismatic")
-               for joint in tree.joints)
+    rank (:func:`~projeq.constraints.nonholonomic.may_lose_rank`), which
+    :func:`~projeq.constraints.nonholonomic.near_singularity` checks (a forward pass and condition
+    numbers: 0.5 ms on the spin-up beam, whose prescribed hub has none; ~2 ms on chain(5))."""
+    return any(may_lose_rank(joint) for joint in tree.joints)
 
 
 def _counted(solver, run: _Run) -> type:

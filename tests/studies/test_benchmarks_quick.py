@@ -59,6 +59,7 @@ PRINTS = {
     "chain_scaling.py": ("recursive µs", "fast µs", "log-log slope"),
     "closure_runs.py": ("numpy/compiled", "andrews_squeezer"),
     "closures.py": ("default/chain", "four_bar", "andrews_squeezer"),
+    "cold_start.py": ("projeq run --t-end 1", "default", "exit codes"),
     "code_size.py": ("compiled path:", "interpreted path:", "ratio compiled / interpreted"),
     "compiled_jacobians.py": ("forward diff.", "chain(10)", "spin-up beam", "per column / one call"),
     "default_integrator.py": ("StiffnessWarning", "spin_up_beam", "Radau", "BDF"),
@@ -89,6 +90,7 @@ PRINTS = {
     "run_profile.py": ("simulate", "import self-time by package", "slowest cumulative imports"),
     "scene_builds.py": ("barhorst_particle", "first/repeat"),
     "scene_costs.py": ("chain", "four_bar", "ratio"),
+    "simulate_share.py": ("ẋ share", "rows share", "DOP853"),
     "spinning_beam_chain.py": ("1. Ritz-constrained chain", "2. spin-up", "RitzBeam"),
     "tangent_profile.py": ("andrews_squeezer: µs per call", "SVD of A_s", "evaluator.accelerations"),
 }
