@@ -143,15 +143,18 @@ class _Budget:
     def save(self) -> None:
         if self.spent:
             with contextlib.suppress(OSError):
-                _ledger().write_text(f"{self.total():.3f}\n")
+                ledger = _ledger()
+                ledger.parent.mkdir(parents=True, exist_ok=True)
+                ledger.write_text(f"{self.total():.3f}\n")
 
 
 def _ledger() -> Path:
-    """The file of the interpreted seconds: in numba's cache folder of projeq's kernels
-    (``NUMBA_CACHE_DIR``, or the ``__pycache__`` beside this module)."""
-    from numba.core import config
+    """The file of the interpreted seconds: in the folder where numba caches this module's kernels
+    (``NUMBA_CACHE_DIR``, the ``__pycache__`` beside it, or numba's user-wide folder where that is
+    not writable), as numba's own locator finds it."""
+    from numba.core.caching import FunctionCache
 
-    return Path(config.CACHE_DIR or Path(__file__).parent / "__pycache__") / "projeq-interpreted-seconds"
+    return Path(FunctionCache(_ledger)._cache_path) / "projeq-interpreted-seconds"
 
 
 def _read_ledger() -> float:
