@@ -608,6 +608,9 @@ class System(Model):
         :mod:`projeq.assembly.auto`; also ``None``, the default: the compiled evaluator where it
         knows every piece, else the reference one with one warning naming the piece). One
         that cannot evaluate this system raises why."""
+        evaluator = self._evaluators.get("auto" if method is None else method)
+        if evaluator is not None:  # made before: the public calls' common case, first
+            return evaluator
         from projeq.assembly import EVALUATORS
 
         if method is None:

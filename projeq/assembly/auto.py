@@ -76,16 +76,18 @@ class AutoEvaluator:
     warns once (:class:`InterpretedWarning`) when that is an interpreted reference evaluator.
 
     Attributes: ``name`` (of the picked evaluator: "fast", "hub_beam", "dense" or
-    "recursive"), ``reason`` (why), ``evaluator`` (the picked evaluator, which counts the calls);
-    ``accelerations`` and, where the picked one has them, ``state_derivative`` and ``state_jacobian`` are the picked
-    evaluator's own (called without a layer between).
+    "recursive"), ``reason`` (why; and whether it runs interpreted until compiled), ``interpreting``,
+    ``evaluator`` (the picked evaluator, which counts the calls);
+    ``accelerations`` and, where the picked one has them, ``state_derivative``, ``state_jacobian`` and
+    ``energy``: the picked evaluator's own, through a :class:`Tier` where it is compiled (module
+    docstring), else called without a layer between.
     """
 
     def __init__(self, system):
-        self.name, self.reason = pick(system)
+        self.name, self._reason = pick(system)
         self.evaluator = system.evaluator(self.name)
         if getattr(self.evaluator, "interpreted", None):  # the compiled kernel with pieces in Python (it warned)
-            self.reason = f"the compiled order-n kernel, with {', '.join(self.evaluator.interpreted)} in Python"
+            self._reason = f"the compiled order-n kernel, with {', '.join(self.evaluator.interpreted)} in Python"
         self.accelerations = self.evaluator.accelerations  # the picked one's, called directly (one layer less per s̈)
         if hasattr(self.evaluator, "state_derivative"):  # ẋ in one call (projeq.simulate's right-hand side)
             self.state_derivative = self.evaluator.state_derivative
@@ -119,9 +121,20 @@ class AutoEvaluator:
         self.energy = Tier(picked.energy, lambda q, s_dot, t: system._energy(q, s_dot, t, "recursive"), model, 0)
 
     @property
+    def reason(self) -> str:
+        """Why this evaluator (:func:`pick`), and, while its kernels are not compiled yet, that the
+        reference evaluator runs in their place."""
+        if self.interpreting:
+            return f"{self._reason}; interpreted by the reference evaluator until its kernels are compiled"
+        return self._reason
+
+    @property
     def interpreting(self) -> bool:
         """Whether a method of the compiled evaluator last ran interpreted (its kernels not compiled yet)."""
         return any(getattr(getattr(self, name, None), "deferred", None) for name in Tier.METHODS)
+
+
+_FLOAT = np.dtype(float)
 
 
 def _none(*args) -> None:
@@ -142,9 +155,15 @@ class Tier:
     def __init__(self, compiled, interpreted, what: str, state: int):
         self.compiled, self.interpreted, self.what, self.state = compiled, interpreted, what, state
         self.ready, self.deferred = set(), set()  # dtype kinds ("f", "c") compiled, and found not compiled
+        self.real_ready = False
 
     def __call__(self, *args):
-        kind = "c" if getattr(args[self.state], "dtype", np.dtype(float)).kind == "c" else "f"
+        if self.real_ready and getattr(args[self.state], "dtype", None) is _FLOAT:  # the common case, first
+            return self.compiled(*args)
+        return self._tiered(args)
+
+    def _tiered(self, args):
+        kind = "c" if getattr(args[self.state], "dtype", _FLOAT).kind == "c" else "f"
         if kind in self.ready:
             return self.compiled(*args)
         if compilation.compile_now():
@@ -160,6 +179,7 @@ class Tier:
                 return self._interpreted(args)
         self.ready.add(kind)
         self.deferred.discard(kind)
+        self.real_ready = "f" in self.ready
         return value
 
     def _interpreted(self, args):

@@ -11,6 +11,7 @@ far are written).
 from __future__ import annotations
 
 import json
+import os
 import sys
 
 import numpy as np
@@ -73,6 +74,7 @@ def tradeoff_arguments(parser) -> None:
 
 
 def tradeoff_study(args) -> int:
+    os.environ.setdefault("PROJEQ_COMPILE", "now")  # compiled from the first call: the study times the compiled path
     options = _tradeoff_options(args)
     out = options["out"]
     table = tradeoff(**options)

@@ -111,7 +111,7 @@ RUN = textwrap.dedent("""
     system = pq.scenes.double_pendulum()
     result = pq.simulate(system, t_end=2.0, method="DOP853", rtol=1e-10, atol=1e-12)
     print(json.dumps({"q": list(result.q[-1]), "s_dot": list(result.s_dot[-1]),
-                      "interpreting": system.evaluator(None).interpreting}))
+                      "interpreting": system.evaluator(None).interpreting, "reason": system.evaluator(None).reason}))
 """)
 
 
@@ -128,7 +128,8 @@ def test_a_new_cache_runs_the_default_evaluator_interpreted(tmp_path):
     spent = float(ledger.read_text())
     assert 0.0 < spent < compilation.BUDGET
     child = json.loads(run.stdout)
-    assert child["interpreting"]
+    assert child["interpreting"] and child["reason"].endswith("interpreted by the reference evaluator until its "
+                                                              "kernels are compiled")
     system = pq.scenes.double_pendulum()
     compiled = pq.simulate(system, t_end=2.0, method="DOP853", rtol=1e-10, atol=1e-12, evaluator="fast")
     assert np.abs(np.array(child["q"]) - compiled.q[-1]).max() < 1e-13
