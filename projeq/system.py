@@ -18,6 +18,7 @@ import copy
 import math
 import warnings
 from abc import ABC, abstractmethod
+from collections import Counter
 
 import numpy as np
 from numpy.typing import NDArray
@@ -318,7 +319,7 @@ def _named_coordinates(system) -> tuple[tuple, tuple]:
         s_named += [(f"{name}.{c}", u) for c, u in own_s]
         s_named += [(f"{name}.{c}_dot", f"{u}/s" if u else "") for c, u in elastic]
     for named in (q_named, s_named):
-        repeated = sorted({n for n, _ in named if [m for m, _ in named].count(n) > 1})
+        repeated = sorted(n for n, count in Counter(m for m, _ in named).items() if count > 1)
         if repeated:
             raise ValueError(f"joints: the coordinate names {repeated} are declared twice within one subsystem")
     return tuple(q_named), tuple(s_named)
@@ -456,7 +457,7 @@ class System(Model):
         rigid = [n for n, sub in enumerate(self.subsystems) if type(sub).potential_energy is RigidBody.potential_energy]
         self._rigid_potential = (np.array(rigid, dtype=int), np.array([self.subsystems[n].m for n in rigid]),
                                  np.array([self.subsystems[n].r_c for n in rigid]).reshape(-1, 3))
-        self._own_potential = tuple(n for n in range(len(self.subsystems)) if n not in set(rigid))
+        self._own_potential = tuple(sorted(set(range(len(self.subsystems))) - set(rigid)))
 
     def _coupling_rows(self, n: int, slices) -> tuple[NDArray, NDArray]:
         """Indices into the global vector and weights for coupled joint n."""
