@@ -62,7 +62,7 @@ def test_a_tier_is_interpreted_until_the_budget_is_spent_then_compiled(budget, c
     assert kernel.calls == 0 and tier.deferred == {"f"} and compilation._BUDGET.spent >= 0.04
     while kernel.calls == 0:  # the call after the budget is spent compiles
         values.append(tier(np.array([1.5])))
-    assert 6 <= len(values) <= 8 and all(v[0] == 3.0 for v in values)
+    assert 5 <= len(values) <= 8 and all(v[0] == 3.0 for v in values)  # 5 or 6 at 10 ms a call
     assert tier.ready == {"f"} and not tier.deferred
     tier(np.array([1.5]))
     assert kernel.calls == 2  # called directly from now on
