@@ -21,7 +21,7 @@ projeq's kernels compiled or loaded before, the minimum of ``--repeat`` alternat
 
     pip install 'projeq[bench]'                    # mujoco
     python benchmarks/four_bar_mujoco.py           # 5 s; the settings default, rtol 1e-6 and 1e-10
-    python benchmarks/four_bar_mujoco.py --quick   # 0.5 s, the default only, one repeat (a test)
+    python benchmarks/four_bar_mujoco.py --quick   # 0.5 s, rtol 1e-6 only, one repeat (a test)
 """
 
 from __future__ import annotations
@@ -45,7 +45,8 @@ MASSES = (1.0, 2.0, 1.5)  # kg: crank, coupler, rocker
 G = 9.81  # m/s²
 OUTPUT_STEP = 0.05  # s between output times
 #: projeq settings compared: name → simulate's keyword arguments
-SETTINGS = {"default": {}, "rtol=1e-6": {"rtol": 1e-6, "atol": 1e-8}, "rtol=1e-10": {"rtol": 1e-10, "atol": 1e-12}}
+SETTINGS = {"default": {}, "rtol=1e-6": {"rtol": 1e-6, "atol": 1e-8},
+            "rtol=1e-10": {"rtol": 1e-10, "atol": 1e-12}}
 REFERENCE = {"method": "RK45", "rtol": 1e-11, "atol": 1e-13}
 
 
@@ -57,7 +58,8 @@ def mujoco_xml(dt: float) -> str:
     """The four-bar as MJCF at step ``dt``: rods along each body's x from its hinge."""
 
     def rod(name: str, m: float, L: float, pos: str, child: str = "", site: str = "") -> str:
-        inertial = f'<inertial pos="{L / 2} 0 0" mass="{m}" diaginertia="1e-10 {m * L * L / 12} {m * L * L / 12}"/>'
+        I_c = m * L * L / 12  # about the rod's centre, across it (about its axis: nearly 0)
+        inertial = f'<inertial pos="{L / 2} 0 0" mass="{m}" diaginertia="1e-10 {I_c} {I_c}"/>'
         tip = f'<site name="{site}" pos="{L} 0 0"/>' if site else ""
         return f'<body name="{name}" pos="{pos}"><joint name="{name}" type="hinge" axis="0 0 1"/>' \
                f"{inertial}{tip}{child}</body>"
@@ -77,7 +79,8 @@ def mujoco_crank(k: int, times: np.ndarray) -> tuple[np.ndarray, float]:
     system = scene()
     model = mujoco.MjModel.from_xml_string(mujoco_xml(OUTPUT_STEP / k))
     data = mujoco.MjData(model)
-    # projeq's tree orders q = (crank, rocker, coupler), the coupler's angle relative to the crank's (as MuJoCo's)
+    # projeq's tree orders q = (crank, rocker, coupler), the coupler's angle relative to the crank's
+    # (as MuJoCo's hinge in the crank's body)
     tree_rates = system.tree_velocities(system.q0, system.s_dot0)
     for i, name in enumerate(system.tree.names):
         joint = model.joint(name)
@@ -131,7 +134,8 @@ class MujocoSteps:
 
 
 def one_evaluation(budget: float) -> tuple[float, float]:
-    """µs of CPU of one projeq ẋ (the evaluator's s̈ with its closure) and of one ``mj_forward``, alternately."""
+    """µs of CPU of one projeq ẋ (the evaluator's s̈ with its closure) and of one ``mj_forward``,
+    timed alternately."""
     import mujoco
 
     system = scene()
@@ -145,14 +149,16 @@ def one_evaluation(budget: float) -> tuple[float, float]:
 
 
 def main(argv=None) -> Table:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--t-end", type=float, default=5.0, help="simulated seconds (default 5)")
-    parser.add_argument("--repeat", type=int, default=3, help="timed runs of each, alternating; the minimum counts")
-    parser.add_argument("--quick", action="store_true", help="0.5 s, the default setting, one repeat")
+    parser.add_argument("--repeat", type=int, default=3,
+                        help="timed runs of each, alternating; the minimum counts")
+    parser.add_argument("--quick", action="store_true", help="0.5 s, rtol 1e-6 only, one repeat")
     args = parser.parse_args(argv)
     settings = SETTINGS
     if args.quick:
-        args.t_end, args.repeat, settings = 0.5, 1, {"default": {}}
+        args.t_end, args.repeat, settings = 0.5, 1, {"rtol=1e-6": SETTINGS["rtol=1e-6"]}
     times = np.linspace(0.0, args.t_end, round(args.t_end / OUTPUT_STEP) + 1)
     projeq_crank({}, times[:2])  # compile or load the kernels outside the timings
     reference, reference_cpu, _ = projeq_crank(REFERENCE, times)
@@ -167,7 +173,7 @@ def main(argv=None) -> Table:
         cpu = min(run[1] for run in runs)
         k = steps.fewest(error) if steps else None
         if k is None:
-            rows.append((name, str(result.method), int(result.nfev), error, cpu, None, None, None, None, float("nan")))
+            rows.append((name, str(result.method), int(result.nfev), error, cpu, *(None,) * 4, float("nan")))
             continue
         mujoco_cpu = min([steps.runs[k][1]] + [mujoco_crank(k, times)[1] for _ in range(args.repeat - 1)])
         rows.append((name, str(result.method), int(result.nfev), error, cpu, OUTPUT_STEP / k,
@@ -178,8 +184,9 @@ def main(argv=None) -> Table:
                          "MuJoCo CPU": "s"},
                   formats={"crank error": ".2e", "CPU": ".3f", "MuJoCo RK4 dt": ".3e", "MuJoCo error": ".2e",
                            "MuJoCo CPU": ".3f", "projeq/MuJoCo": ".2f"},
-                  title=(f"four-bar over {args.t_end:g} s: projeq's CPU / MuJoCo RK4's at the largest step reaching "
-                         f"projeq's crank error (against RK45 rtol 1e-11, {reference_cpu:.2f} s CPU)"))
+                  title=(f"four-bar over {args.t_end:g} s: projeq's CPU / MuJoCo RK4's at the largest step "
+                         f"reaching projeq's crank error (against RK45 rtol 1e-11, "
+                         f"{reference_cpu:.2f} s CPU)"))
     print(table.to_text())
     if have_mujoco:
         projeq_us, mujoco_us = one_evaluation(0.05 if args.quick else 1.0)
@@ -188,7 +195,8 @@ def main(argv=None) -> Table:
     return table
 
 
-os.environ.setdefault("PROJEQ_COMPILE", "now")  # compiled from the first call: this measures the compiled path
+# compiled from the first call: this measures the compiled path
+os.environ.setdefault("PROJEQ_COMPILE", "now")
 
 
 if __name__ == "__main__":
