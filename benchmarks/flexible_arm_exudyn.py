@@ -249,9 +249,10 @@ def main(argv=None) -> dict:
         compared = [(best, "cheapest")] + [(run, "the issue's") for run in exudyn
                                            if run[0] == ISSUE_EXUDYN[level] and run is not best]
         for theirs, which in compared:
-            if mine and theirs:
+            if mine:  # without Exudyn, projeq's run alone, the ratio nan
                 targets.append((f"simulate(rtol={rtol:.0e})", mine[0][1], level, mine[0][2],
-                                f"{theirs[0]} ({which})", theirs[1], theirs[2], mine[0][2] / theirs[2]))
+                                f"{theirs[0]} ({which})" if theirs else "—", *(theirs[1:3] if theirs else (None, None)),
+                                mine[0][2] / theirs[2] if theirs else float("nan")))
     print()
     print(Table(("projeq", "tip error", "level", "CPU", "Exudyn at the level", "Exudyn error", "Exudyn CPU",
                  "projeq/Exudyn"),
