@@ -50,7 +50,8 @@ def test_planar_particle_motion_energy_constraint():
     assert np.abs(res.constraint_residual).max() < 1e-12
     assert np.all(np.diff(x) < 0) and np.all(y > 0) and y[-1] < 0.1
     speed = np.hypot(*system_rates(system, res).T)
-    assert speed[-1] == pytest.approx(np.sqrt(2 * 10.0 * (2.0 - y[-1])), rel=1e-10)  # energy: ½v² = g(2 − y)
+    # energy: ½v² = g(2 − y)
+    assert speed[-1] == pytest.approx(np.sqrt(2 * 10.0 * (2.0 - y[-1])), rel=1e-10, abs=0)
 
 
 def system_rates(system, res):
@@ -61,9 +62,9 @@ def test_spatial_particle_closed_form():
     """Footnote 6, ẏ + z ẋ = 0 under gravity −g n̂3 with ṡ = (ẋ, ż): Kane's equations give
     z̈ = −g and (1 + z²) ẍ + z ż ẋ = 0, i.e. ẋ √(1 + z²) = const; then
     y(t) = y₀ − ∫ z ẋ dt. The simulation follows these closed forms, conserves energy and
-    keeps the constraint residual at round-off. Measured (largest over this run and three others: ṡ₀ = (0.5, 3),
-    (2, 1), 2.5 s): z 1.8e-14 (exact up to round-off: ż is linear), x 3.1e-12, y 5.1e-12, ẋ √(1 + z²)
-    3.7e-12 relative, energy drift 6.2e-14; the bounds are 10 times those (were 1e-8 and 1e-9)."""
+    keeps the constraint residual at round-off. Measured (largest over this run and three others:
+    ṡ₀ = (0.5, 3), (2, 1), 2.5 s): z 1.8e-14 (exact up to round-off: ż is linear), x 3.1e-12,
+    y 5.1e-12, ẋ √(1 + z²) 3.7e-12 relative, energy drift 6.2e-14; the bounds are 10 times those (were 1e-8 and 1e-9)."""
     g, q0, s0 = 10.0, np.array([0.0, 0.0, 1.0]), np.array([1.0, 2.0])
     system = nonholonomic_particle(g=g, q0=q0, s_dot0=s0)
     res = pq.simulate(system, 2.0, rtol=1e-11, atol=1e-13, n_points=21)
@@ -97,4 +98,4 @@ def test_spatial_particle_is_truly_non_holonomic():
         res = pq.simulate(system, 1.0, q0=q, s_dot0=s, rtol=1e-12, atol=1e-14, n_points=2)
         q = res.q[-1]
     assert np.allclose(q[[0, 2]], 0.0, rtol=0.0, atol=100 * np.finfo(float).eps)
-    assert q[1] == pytest.approx(1.0, rel=100 * np.finfo(float).eps)  # −∮ z dx = +1 for this orientation
+    assert q[1] == pytest.approx(1.0, rel=100 * np.finfo(float).eps, abs=0)  # −∮ z dx = +1 here
