@@ -77,11 +77,12 @@ def test_run_writes_results_that_load_back(tmp_path, capsys):
 
 def test_set_overrides_a_parameter(tmp_path, capsys):
     """--set m1=3 reaches the model: the final pulley angle is the closed form's for m1 = 3 kg
-    (constant acceleration; rtol 1e-10 gives ~1e-10, checked to 1e-8 relative)."""
+    (constant acceleration, a quadratic in t that the integrator follows exactly: measured 9.2e-16
+    relative, bound 100 ε; was 1e-8)."""
     assert main(["run", "atwood", "--set", "m1=3", "--t-end", "0.5", "--rtol", "1e-10", "--out", str(tmp_path)]) == 0
     assert "energy" in capsys.readouterr().out
     result = pq.Result.load(next(tmp_path.rglob("atwood.npz")))
-    assert result.q[-1, 0] == pytest.approx(atwood_angle(3.0, 0.5), rel=1e-8)
+    assert result.q[-1, 0] == pytest.approx(atwood_angle(3.0, 0.5), rel=100 * np.finfo(float).eps, abs=0)
 
 
 def test_failed_run_exits_1_with_partial_results(tmp_path, capsys, monkeypatch):
