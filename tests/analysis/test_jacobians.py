@@ -255,9 +255,9 @@ def test_compiled_one_call_with_every_compiled_force_law(tree):
     max(1, |J|) (the same arithmetic), = the same kernel source interpreted to max(1e-13, κ(M) ε/2)
     (two orders of the same arithmetic: s̈ solves M s̈ = b, forward error ∝ κ ε, Higham (2002) §7.1;
     hypothesis found a planar chain with κ = 3.4·10³ at 1.09e-13 = 0.15 κ ε), = the
-    complex step through the recursive evaluator (the laws' own add_to) to 1e-11 (as
-    test_compiled_column_by_column_with_every_joint_and_force_law) and = Richardson's central
-    differences to DIFFERENCES_TOL."""
+    complex step through the recursive evaluator (the laws' own add_to) to 2e-13 (measured at most
+    1.2e-14 over 300 spatial and 1.9e-14 over 300 planar drawn trees, κ(M) up to 3.7e4; was 1e-11)
+    and = Richardson's central differences to DIFFERENCES_TOL."""
     _check_one_call_with_laws(tree)
 
 
@@ -279,7 +279,7 @@ def _check_one_call_with_laws(tree):
     kappa = np.linalg.cond(system.mass_matrix(tree.q, t)) if system.n_s else 1.0
     interpreted = FastEvaluator(system, compiled=False).state_jacobian(t, x)
     assert _relative(one_call, interpreted) <= max(1e-13, kappa * EPS / 2)
-    assert _relative(one_call, _reference_jacobian(system, x, t, system.evaluator("recursive"))) <= 1e-11
+    assert _relative(one_call, _reference_jacobian(system, x, t, system.evaluator("recursive"))) <= 2e-13
     _check_against_differences(system, tree.q, tree.s_dot, t)
 
 

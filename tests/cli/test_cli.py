@@ -77,11 +77,12 @@ def test_run_writes_results_that_load_back(tmp_path, capsys):
 
 def test_set_overrides_a_parameter(tmp_path, capsys):
     """--set m1=3 reaches the model: the final pulley angle is the closed form's for m1 = 3 kg
-    (constant acceleration; rtol 1e-10 gives ~1e-10, checked to 1e-8 relative)."""
+    (constant acceleration, a quadratic in t that the integrator follows exactly: measured 9.2e-16
+    relative, bound 100 ε; was 1e-8)."""
     assert main(["run", "atwood", "--set", "m1=3", "--t-end", "0.5", "--rtol", "1e-10", "--out", str(tmp_path)]) == 0
     assert "energy" in capsys.readouterr().out
     result = pq.Result.load(next(tmp_path.rglob("atwood.npz")))
-    assert result.q[-1, 0] == pytest.approx(atwood_angle(3.0, 0.5), rel=1e-8)
+    assert result.q[-1, 0] == pytest.approx(atwood_angle(3.0, 0.5), rel=100 * np.finfo(float).eps, abs=0)
 
 
 def test_failed_run_exits_1_with_partial_results(tmp_path, capsys, monkeypatch):
@@ -294,12 +295,14 @@ def test_bench_exact_up_to_must_be_a_chain_length(value, capsys):
 
 
 def test_sweep_writes_one_table(tmp_path, capsys):
-    """projeq sweep: a 3-point grid of the Atwood machine, final angles = closed form."""
+    """projeq sweep: a 3-point grid of the Atwood machine, final angles = closed form (a quadratic in t,
+    exact for the integrator: 100 ε, measured 9.2e-16 relative; was 1e-8)."""
     argv = ["sweep", "atwood", "--grid", "m1=1:3:3", "--t-end", "0.5", "--rtol", "1e-10", "--outputs", "q0",
             "--workers", "2", "--out", str(tmp_path), "--quiet"]
     assert main(argv) == 0
     table = np.genfromtxt(tmp_path / "sweep_atwood.csv", delimiter=",", names=True, usecols=(0, 1, 2))
-    assert np.allclose(table["q0"], [atwood_angle(m, 0.5) for m in (1.0, 2.0, 3.0)], rtol=1e-8, atol=1e-12)
+    assert np.allclose(table["q0"], [atwood_angle(m, 0.5) for m in (1.0, 2.0, 3.0)],
+                       rtol=100 * np.finfo(float).eps, atol=0)
 
 
 def test_unreachable_scheduler_writes_nothing(tmp_path, capsys):
@@ -436,5 +439,5 @@ def test_the_cli_pages_bicycle_falls_over_with_a_physical_message(tmp_path, caps
                  "--out", str(out)]) == 0
     assert "fell over" in capsys.readouterr().out
     result = pq.Result.load(next(out.rglob("whipple_bicycle.npz")))
-    assert abs(abs(result.q[-1, 3]) - np.pi / 3) < 1e-8
+    assert abs(abs(result.q[-1, 3]) - np.pi / 3) < 4e-9  # the event's root: measured 3.2e-10 (was 1e-8)
     assert len(result.partitions) >= 2

@@ -30,16 +30,19 @@ def _relative(a, b) -> float:
 
 
 def test_the_stencil_is_the_sixth_order_rule():
-    """Nodes and weights read off sixth_order reproduce it on a function it does not know."""
+    """Nodes and weights read off sixth_order reproduce it on a function it does not know, to
+    round-off: measured 4.5e-15 relative, bound 4.5e-14. (The bound was rel=1e-15, which the sum does not
+    meet: pytest's default abs 1e-12 let it pass.)"""
     f = lambda e: np.exp(0.7 + 3 * e)  # noqa: E731
-    assert np.dot(WEIGHTS, f(NODES)) == pytest.approx(sixth_order(f, MIXED_STEP), rel=1e-15)
+    assert np.dot(WEIGHTS, f(NODES)) == pytest.approx(sixth_order(f, MIXED_STEP), rel=4.5e-14, abs=0)
     assert sorted(NODES / MIXED_STEP) == [-3, -2, -1, 1, 2, 3]
 
 
 @pytest.mark.parametrize("name", sorted(CONSTRAINED))
 def test_batched_derivatives_equal_the_pointwise_ones(name):
     """(C, c), γ at random tree velocities, and s̈ with the compiled tree: the batched closure equals
-    one call per stencil point with the dense tree (the reference path) to round-off."""
+    one call per stencil point with the dense tree (the reference path) to round-off (s̈: measured
+    2.6e-14 relative over the scenes' three states, bound 3e-13; was 1e-12)."""
     system = CONSTRAINED[name]
     reference = copy.copy(system)
     reference._closure = None
@@ -52,7 +55,7 @@ def test_batched_derivatives_equal_the_pointwise_ones(name):
             assert _relative(ours, theirs) <= 1e-15
         assert _relative(system.gamma(q, s_dot_tree, 0.2), reference.gamma(q, s_dot_tree, 0.2)) < 1e-13
         assert _relative(system.accelerations(q, s_dot, 0.2),
-                         reference.accelerations(q, s_dot, 0.2, method="dense")) < 1e-12
+                         reference.accelerations(q, s_dot, 0.2, method="dense")) < 3e-13
 
 
 def test_every_scene_closure_takes_batches():

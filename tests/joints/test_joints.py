@@ -89,13 +89,14 @@ def test_zeta_is_the_derivative_of_the_twist_at_fixed_velocities(kind, seed):
 @pytest.mark.parametrize("kind", KINDS)
 @given(seed=seeds)
 def test_relative_kinematics_have_consistent_shapes_and_rotation(kind, seed):
-    """A is a proper rotation, F is 6 × n_s, w = F ṡ + f has 6 entries, K is n_q × n_s."""
+    """A is a proper rotation (to 100 ε: measured 8.9e-16 and 1.1e-15 over 650 draws; were 1e-12), F is
+    6 × n_s, w = F ṡ + f has 6 entries, K is n_q × n_s."""
     rng = np.random.default_rng(seed)
     joint = _joint(kind, rng)
     q, s_dot, t = _state(joint, rng)
     rel = joint.relative(q, s_dot, t)
-    assert np.abs(rel.A.T @ rel.A - np.eye(3)).max() <= 1e-12
-    assert abs(np.linalg.det(rel.A) - 1.0) <= 1e-12
+    assert np.abs(rel.A.T @ rel.A - np.eye(3)).max() <= 100 * np.finfo(float).eps
+    assert abs(np.linalg.det(rel.A) - 1.0) <= 100 * np.finfo(float).eps
     assert rel.F.shape == (6, joint.n_s) and rel.w.shape == (6,) and rel.zeta.shape == (6,)
     assert rel.r.shape == (3,)
     assert joint.K(q, t).shape == (joint.n_q, joint.n_s)

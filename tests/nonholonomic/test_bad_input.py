@@ -118,10 +118,12 @@ def test_initial_rates_violating_the_constraints():
     system = pq.scenes.knife_edge_disc()
     s_dot = np.array([0.3, -0.2, 1.1])
     q_dot = system.q_dot(system.q0, s_dot)
-    assert np.allclose(initial_speeds(system, system.q0, q_dot), s_dot, rtol=1e-14)
+    # the speeds from q̇ to round-off (measured 4.4e-16; allclose's default atol 1e-8 applied before)
+    assert np.allclose(initial_speeds(system, system.q0, q_dot), s_dot, rtol=1e-14, atol=0)
     built = pq.scenes.knife_edge_disc(q_dot0=q_dot)
-    assert np.allclose(built.s_dot0, s_dot, rtol=1e-14)
-    assert np.allclose(pq.scenes.barhorst_particle(q_dot0=(1.0, 4.0)).s_dot0, [1.0])
+    assert np.allclose(built.s_dot0, s_dot, rtol=1e-14, atol=0)
+    particle = pq.scenes.barhorst_particle(q_dot0=(1.0, 4.0))
+    assert np.allclose(particle.s_dot0, [1.0], rtol=0, atol=100 * np.finfo(float).eps)
 
 
 @pytest.mark.parametrize("kwargs, message", [

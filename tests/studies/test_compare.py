@@ -62,14 +62,17 @@ def test_car_hamel_equals_projection_symbolically(car_table):
 
 
 def test_car_simulations_conserve_energy_and_constraint(car_table):
-    """No loads: kinetic energy constant; v_y = 0 exactly since it is built into K (B(6))."""
+    """No loads: kinetic energy constant; v_y = 0 exactly since it is built into K (B(6)). Measured
+    over the table's eight runs (rtol 1e-9, 0.2 s): energy drift at most 5.8e-13 (the multiplier forms;
+    7.3e-16 with the constraint in K), constraint drift 7.2e-13 with multipliers, 5.6e-17 in K; bounds 10
+    times the largest or 100 ε (were 1e-7, 1e-9, 1e-12)."""
     for row in car_table.rows:
-        assert row["energy_drift"] < 1e-7  # rtol 1e-9 per step over 0.2 s: ≪ 1e-7
+        assert row["energy_drift"] < 6e-12, row
         if "multipliers" in row["formulation"]:
             # constraint differentiated once (index 1): its drift is integration error, rtol 1e-9
-            assert row["constraint_drift"] < 1e-9
+            assert row["constraint_drift"] < 8e-12, row
         else:
-            assert row["constraint_drift"] < 1e-12  # constraint in K: round-off only
+            assert row["constraint_drift"] < 100 * np.finfo(float).eps, row  # constraint in K: round-off
 
 
 def test_car_constraint_inserted_too_early_loses_both_terms(car_table):
@@ -168,14 +171,15 @@ def test_car_multiplier_forms_give_the_same_motion(car_table):
 
 def test_pendulum_lagrange_equals_projection():
     """Lagrange's equations of the 2nd kind (an independent formulation) = the symbolic
-    Projection Equation = projeq's numeric evaluators; energy conserved in the simulation."""
+    Projection Equation = projeq's numeric evaluators; energy conserved in the simulation (to 100 ε:
+    measured 2.0e-16 in each of the six runs over 0.1 s at rtol 1e-9; was 1e-7)."""
     table = compare("n_link_pendulum", t_end=0.1, repeats=1)
     for row in table.rows[1:]:
         assert row["identical"] == "yes", row
     chain = next(row for row in table.rows if row["formulation"] == "projection (symbolic, recursive chain)")
     assert chain["check"].startswith("symbolic")  # its named coordinates renamed to the reference's q_1, q_2
     for row in table.rows:
-        assert row["energy_drift"] < 1e-7  # rtol 1e-9 over 0.1 s
+        assert row["energy_drift"] < 100 * np.finfo(float).eps, row
 
 
 @pytest.fixture(scope="module")
@@ -194,16 +198,18 @@ def test_knife_edge_disc_formulations_agree(disc_table, tmp_path):
     equal each other (symbolically where they share symbols, else at random states) and the
     numeric evaluator; the lecture's Lagrange equations with multipliers (K(7)), in
     (x, y, z, ψ, ϕ, θ), move the disc as the Projection Equation does; energy is conserved and
-    the constraints hold."""
+    the constraints hold (measured over the six runs of 0.1 s at rtol 1e-9: energy drift 1.6e-15,
+    constraint drift 2.7e-15 with multipliers, 4.4e-16 in K; bounds 100 ε and 3e-14, were 1e-7, 1e-9
+    and 1e-12)."""
     right = [r for r in disc_table.rows if r["formulation"] != TOO_EARLY]
     assert all(r["n_ops"] > 0 for r in right if r["formulation"] != "projection (numeric, dense)")
     for row in right[1:]:
         assert row["identical"] == "yes", row
     assert _row(disc_table, "hamel")["difference"] == (0, 0, 0)
     for row in disc_table.rows:
-        assert row["energy_drift"] < 1e-7  # rtol 1e-9 per step over 0.1 s: ≪ 1e-7
+        assert row["energy_drift"] < 100 * np.finfo(float).eps, row
         # rolling constraints in K: round-off; differentiated once (index 1): integration error at rtol 1e-9
-        assert row["constraint_drift"] < (1e-9 if "multipliers" in row["formulation"] else 1e-12)
+        assert row["constraint_drift"] < (3e-14 if "multipliers" in row["formulation"] else 100 * np.finfo(float).eps)
     path = tmp_path / "disc.csv"
     disc_table.to_csv(path)
     with open(path) as handle:

@@ -26,15 +26,16 @@ def _reference(k):
 
 
 def test_clamped_free_roots_match_the_catalogue():
-    """β_k L of Blevins (1979), Table 8-1 to its 8 digits."""
-    assert np.allclose(clamped_free_roots(4), [1.8751041, 4.6940911, 7.8547574, 10.9955407], atol=5e-8)
+    """β_k L of Blevins (1979), Table 8-1 to its 8 digits: the table's rounding, 5e-8 (measured 3.8e-8;
+    allclose's default rtol 1e-5 made the bound 1.1e-4 before)."""
+    assert np.allclose(clamped_free_roots(4), [1.8751041, 4.6940911, 7.8547574, 10.9955407], rtol=0.0, atol=5e-8)
 
 
 def test_eigenfunction_family_reproduces_clamped_free_frequencies():
     """With the beam's own eigenfunctions as Ritz functions the first four frequencies are
-    exact (up to quadrature round-off: 1e-10)."""
+    exact (up to quadrature round-off: measured 3.5e-13 relative, bound 3.5e-12; was 1e-10)."""
     beam = RitzBeam(L, RHO_A, EI, n_v=4, n_w=0, family="clamped_free")
-    assert np.allclose(_frequencies_at_rest(beam), _reference(4), rtol=1e-10)
+    assert np.allclose(_frequencies_at_rest(beam), _reference(4), rtol=3.5e-12, atol=0.0)
 
 
 def test_polynomial_ritz_converges_from_above():
@@ -73,10 +74,11 @@ def test_rotating_cantilever_flapwise_frequency(eta):
 def test_rotating_cantilever_lead_lag_frequency(eta):
     """In the plane of rotation the centrifugal load also softens: ω_lag² = ω_flap² − Ω²
     for the inextensible Euler–Bernoulli beam with zero hub radius (same equations plus
-    −ρA Ω² v). Both sides come from the same discretisation: 1e-8."""
+    −ρA Ω² v). Both sides come from the same discretisation: round-off (measured 2.3e-14 relative,
+    bound 2.4e-13; was 1e-8)."""
     flap = _spinning(eta, n_v=0, n_w=10)[0]
     lag = _spinning(eta, n_v=10, n_w=0)[0]
-    assert lag == pytest.approx(np.sqrt(flap**2 - eta**2), rel=1e-8)
+    assert lag == pytest.approx(np.sqrt(flap**2 - eta**2), rel=2.4e-13, abs=0)
 
 
 @pytest.mark.parametrize("eta", [1, 3, 5], ids=["eta=1", "eta=3", "eta=5"])
@@ -224,7 +226,8 @@ def test_body_on_a_beam_station_recursive_equals_dense():
 def test_port_pose_and_twist_agree(torsion):
     """The port's relative twist F q̇_e is the time derivative of its pose (A, r) — with
     torsion A = R_z(v′)R_y(−w′)R_x(β) — and its ζ = Ḟ q̇_e the derivative of F (central
-    differences of step 1e-6: 1e-8)."""
+    differences of step 1e-6: round-off ε/h ≈ 2e-10; measured 1.1e-10 and 7.9e-11, bounds 1.1e-9 and
+    8e-10; were 1e-8)."""
     from projeq.spatial import vee
 
     beam = RitzBeam(2.0, 1.0, 1.0, n_v=3, n_w=2, n_u=1, EA=10.0, **torsion)
@@ -234,8 +237,8 @@ def test_port_pose_and_twist_agree(torsion):
     h = 1e-6
     ahead, behind = beam.port(point, q + h * q_dot, q_dot), beam.port(point, q - h * q_dot, q_dot)
     twist = np.concatenate((now.A.T @ (ahead.r - behind.r), vee(now.A.T @ (ahead.A - behind.A)))) / (2 * h)
-    assert np.abs(twist - now.w).max() < 1e-8
-    assert np.abs((ahead.F - behind.F) / (2 * h) @ q_dot - now.zeta).max() < 1e-8
+    assert np.abs(twist - now.w).max() < 1.1e-9
+    assert np.abs((ahead.F - behind.F) / (2 * h) @ q_dot - now.zeta).max() < 8e-10
 
 
 def test_elastic_arm_conserves_energy():
@@ -253,7 +256,8 @@ def test_spinning_shaft_frequencies_split_by_the_spin(omega):
     the co-rotating frame at ω_k ± Ω (the isotropic spinning shaft without rotary inertia; with z = v + i w the
     equations ρA(z̈ + 2iΩż − Ω²z) + EI z'''' = 0 of B(23) give λ = i(−Ω ± ω_k)). ω_k from
     the same discretisation at rest, so only round-off and the linearisation's central
-    differences remain: 1e-7 relative."""
+    differences remain: measured 1.3e-15 relative (the three spins), bound 1.3e-14 (was 1e-7, and
+    allclose's default atol 1e-8)."""
     from projeq.scenes.elastic import spinning_beam
 
     A, _ = linearize(spinning_beam(omega=omega, n_shapes=3))
@@ -261,7 +265,7 @@ def test_spinning_shaft_frequencies_split_by_the_spin(omega):
     found = np.sort(np.abs(eigenvalues.imag[eigenvalues.imag > 1e-9]))
     at_rest = _frequencies_at_rest(RitzBeam(1.0, 1.0, 1.0, n_v=3, n_w=0, family="clamped_free"))
     expected = np.sort(np.abs(np.concatenate((at_rest + omega, at_rest - omega))))
-    assert np.allclose(found, expected, rtol=1e-7)
+    assert np.allclose(found, expected, rtol=1.3e-14, atol=0.0)
 
 
 def test_probes_along_a_trajectory():

@@ -89,10 +89,11 @@ def test_recursive_equals_dense(seed):
 
 def test_energy_is_conserved():
     """No damping, no drive: kinetic + potential (gravity, spring) is constant; DOP853 at
-    rtol 1e-11 keeps it to well below 1e-8 of the energy scale over 5 s."""
+    rtol 1e-11 keeps it to 4.1e-13 of the energy scale over 5 s (4.0e-13 over 3 s, 5.0e-13 over 8 s); the
+    bound is 10 times the largest (was 1e-8)."""
     system = _pendulum_with_absorber()
     result = pq.simulate(system, 5.0, method="DOP853", rtol=1e-11, atol=1e-12)
-    assert result.energy_drift < 1e-8
+    assert result.energy_drift < 5e-12, result.energy_drift
     assert np.ptp(result.q[:, 1]) > 0.01  # the absorber does move
 
 
