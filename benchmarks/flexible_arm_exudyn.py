@@ -48,6 +48,7 @@ import numpy as np
 
 import projeq as pq
 from projeq.assembly.kinematics import poses
+from projeq.studies.bench_peers import exudyn_generalized_alpha
 from projeq.studies.table import Table
 
 L1, M1, L2, M2, R_LINK = 0.6, 2.0, 0.5, 1.5, 0.02  # m, kg: the rigid links (solid cylinders of radius R_LINK)
@@ -102,7 +103,6 @@ def exudyn_tip(n_elements: int, h: float, times: np.ndarray, rho_inf: float = 0.
         RevoluteJoint2D,
         SensorNode,
     )
-    from exudyn.solver import SolveDynamic
 
     mbs = exu.SystemContainer().AddSystem()
     gravity = [0.0, -G, 0.0]
@@ -140,17 +140,7 @@ def exudyn_tip(n_elements: int, h: float, times: np.ndarray, rho_inf: float = 0.
     sensor = mbs.AddSensor(SensorNode(nodeNumber=tip_node, storeInternal=True,
                                       outputVariableType=exu.OutputVariableType.Position))
     mbs.Assemble()
-    settings = exu.SimulationSettings()
-    settings.timeIntegration.endTime = float(times[-1])
-    settings.timeIntegration.numberOfSteps = round(float(times[-1]) / h)
-    settings.timeIntegration.verboseMode = 0
-    settings.timeIntegration.newton.absoluteTolerance = 1e-6
-    settings.timeIntegration.generalizedAlpha.spectralRadius = rho_inf
-    settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = h
-    started = time.process_time()
-    SolveDynamic(mbs, settings, exu.DynamicSolverType.GeneralizedAlpha)
-    cpu = time.process_time() - started
+    cpu = exudyn_generalized_alpha(mbs, float(times[-1]), h, 1e-6, rho_inf)
     data = mbs.GetSensorStoredData(sensor)  # rows (t, x, y, z) at every step
     rows = [int(np.argmin(np.abs(data[:, 0] - t))) for t in times]
     if not np.allclose(data[rows, 0], times, atol=h / 4):

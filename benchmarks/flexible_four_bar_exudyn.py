@@ -167,6 +167,7 @@ import numpy as np
 
 import projeq as pq
 from projeq.scenes.mechanisms import four_bar_angles, slender_rod
+from projeq.studies.bench_peers import exudyn_generalized_alpha
 from projeq.studies.table import Table
 
 A, B, C, D = 0.3, 1.0, 0.8, 1.0  # crank, coupler (the beam), rocker, ground link, m
@@ -238,7 +239,6 @@ def exudyn_run(times, n_elements: int = 16, h: float = 1e-3, axial_stiffness: fl
         RevoluteJoint2D,
         SensorNode,
     )
-    from exudyn.solver import SolveDynamic
 
     times = np.asarray(times, float)
     system, _ = projeq_model(2)
@@ -293,18 +293,7 @@ def exudyn_run(times, n_elements: int = 16, h: float = 1e-3, axial_stiffness: fl
     sensors = {name: mbs.AddSensor(SensorNode(nodeNumber=node, storeInternal=True, writeToFile=False,
                                               outputVariableType=coordinates)) for name, node in watched.items()}
     mbs.Assemble()
-    settings = exu.SimulationSettings()
-    settings.timeIntegration.numberOfSteps = round(float(times[-1]) / h)
-    settings.timeIntegration.endTime = float(times[-1])
-    settings.timeIntegration.verboseMode = 0
-    settings.timeIntegration.newton.absoluteTolerance = newton_atol
-    if spectral_radius is not None:
-        settings.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
-    settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = h
-    started = time.process_time()
-    SolveDynamic(mbs, settings, exu.DynamicSolverType.GeneralizedAlpha)
-    cpu = time.process_time() - started
+    cpu = exudyn_generalized_alpha(mbs, float(times[-1]), h, newton_atol, spectral_radius)
     values = {}
     for name, sensor in sensors.items():
         data = mbs.GetSensorStoredData(sensor)

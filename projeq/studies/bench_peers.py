@@ -156,6 +156,28 @@ def rolling_disk_row(budget: float = 1.0, q=(0.3, 0.15, 0.2, 0.0, 0.0), s_dot=(0
             "deviation": deviation, "ratio": seconds["projeq"] / seconds["sympy"]}
 
 
+def exudyn_generalized_alpha(mbs, t_end: float, h: float, newton_atol: float,
+                             spectral_radius: float | None = None) -> float:
+    """CPU seconds of Exudyn's generalized-α integration (``SolveDynamic``) of the assembled ``mbs``
+    over [0, t_end] at the fixed step h, its sensors stored at every step, no files written; Newton's
+    absolute tolerance ``newton_atol``, the spectral radius ρ∞ Exudyn's default unless given."""
+    import exudyn as exu
+    from exudyn.solver import SolveDynamic
+
+    settings = exu.SimulationSettings()
+    settings.timeIntegration.numberOfSteps = round(t_end / h)
+    settings.timeIntegration.endTime = t_end
+    settings.timeIntegration.verboseMode = 0
+    settings.timeIntegration.newton.absoluteTolerance = newton_atol
+    if spectral_radius is not None:
+        settings.timeIntegration.generalizedAlpha.spectralRadius = spectral_radius
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = h
+    started = time.process_time()
+    SolveDynamic(mbs, settings, exu.DynamicSolverType.GeneralizedAlpha)
+    return time.process_time() - started
+
+
 def exudyn_tip_deflection(omega_s: float = 4.0, times=SPIN_UP_TIMES, n_elements: int = 16, h: float = 1e-3,
                           axial_stiffness: float = 2.8e7, newton_atol: float = 1e-6) -> tuple[np.ndarray, float]:
     """The in-plane tip deflection v(L, t) of ``scenes.spin_up_beam`` at ``times`` by Exudyn's
@@ -175,7 +197,6 @@ def exudyn_tip_deflection(omega_s: float = 4.0, times=SPIN_UP_TIMES, n_elements:
     import exudyn as exu
     from exudyn.beams import GenerateStraightLineANCFCable2D
     from exudyn.itemInterface import CoordinateConstraint, MarkerNodeCoordinate, NodePointGround, ObjectANCFCable2D, SensorNode
-    from exudyn.solver import SolveDynamic
 
     from projeq.scenes.elastic import spin_up_motion
 
@@ -204,16 +225,7 @@ def exudyn_tip_deflection(omega_s: float = 4.0, times=SPIN_UP_TIMES, n_elements:
     mbs.SetPreStepUserFunction(follow_hub)
     tip = mbs.AddSensor(SensorNode(nodeNumber=nodes[-1], storeInternal=True, outputVariableType=exu.OutputVariableType.Position))
     mbs.Assemble()
-    settings = exu.SimulationSettings()
-    settings.timeIntegration.numberOfSteps = round(float(times[-1]) / h)
-    settings.timeIntegration.endTime = float(times[-1])
-    settings.timeIntegration.verboseMode = 0
-    settings.timeIntegration.newton.absoluteTolerance = newton_atol
-    settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = h
-    started = time.process_time()
-    SolveDynamic(mbs, settings, exu.DynamicSolverType.GeneralizedAlpha)
-    cpu = time.process_time() - started
+    cpu = exudyn_generalized_alpha(mbs, float(times[-1]), h, newton_atol)
     data = mbs.GetSensorStoredData(tip)  # rows (t, x, y, z)
     rows = [np.argmin(np.abs(data[:, 0] - t)) for t in times]
     theta = np.array([motion(t)[0] for t in times])
