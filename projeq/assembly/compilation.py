@@ -38,10 +38,11 @@ from pathlib import Path
 SLOW = 5.0
 
 #: CPU seconds of interpreted evaluation, while the compiled kernels needed are not in numba's cache,
-#: after which they are compiled (counted over the processes of one numba cache). Compiling a model's kernels costs 10–40 s of CPU (README's pendulum:
-#: 17 s for ẋ alone); renting the interpreted evaluator until its cost reaches the price of compiling,
-#: then buying, costs at most twice the better of the two choices made knowing the run's length in
-#: advance (the ski-rental bound), and a short run (README's example, ``projeq run``) compiles nothing.
+#: after which they are compiled (counted over the processes of one numba cache). Compiling a model's
+#: kernels costs 10–40 s of CPU (README's pendulum: 17 s for ẋ alone, 47 s for the whole example);
+#: renting the interpreted evaluator until its cost reaches the price of compiling, then buying, costs
+#: at most twice the better of the two choices made knowing the run's length in advance (the
+#: ski-rental bound), and a short run (README's example, ``projeq run``) compiles nothing.
 BUDGET = 10.0
 
 #: ``PROJEQ_COMPILE=now``: compile on first use, as before the budget (benchmarks of the compiled path)
@@ -85,7 +86,8 @@ class _Announcer:
     def on_end(self, event):
         self.depth -= 1
         function = getattr(event.data.get("dispatcher"), "py_func", None)
-        if self.depth == 0 and _ours(function) and self.started is not None and time.perf_counter() - self.started > SLOW:
+        compiled = self.started is not None  # not the kernel cached_only stopped
+        if self.depth == 0 and _ours(function) and compiled and time.perf_counter() - self.started > SLOW:
             print(f"projeq:   compiled {function.__qualname__} "
                   f"({time.perf_counter() - self.started:.0f} s)", file=sys.stderr, flush=True)
 
@@ -179,8 +181,9 @@ def spend(seconds: float, what: str) -> None:
     if not _BUDGET.told:
         _BUDGET.told = True
         print(f"projeq: {what}'s compiled kernels are not in numba's cache: evaluating it interpreted until "
-              f"{BUDGET:.0f} s of CPU are spent so (now {_BUDGET.total():.1f} s, counted over the runs of this cache), "
-              "then compiling them, once (PROJEQ_COMPILE=now compiles at first use)", file=sys.stderr, flush=True)
+              f"{BUDGET:.0f} s of CPU are spent so (now {_BUDGET.total():.1f} s, counted over the runs of this "
+              "cache), then compiling them, once (PROJEQ_COMPILE=now compiles at first use)",
+              file=sys.stderr, flush=True)
 
 
 @functools.cache
