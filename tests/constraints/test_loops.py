@@ -75,7 +75,8 @@ def test_four_bar_agrees_with_the_explicitly_solved_loop():
     # both integrated to rtol 1e-9: 10 rtol·|θ1| (achieved 7e-10 rad)
     assert err.max() < 10 * RTOL * np.abs(ref.y[0]).max(), err.max()
     theta2 = np.array([four_bar_angles(x, 0.3, 1.0, 0.8, 1.0)[0] for x in r.q[:, 0]])
-    assert np.abs(r.q[:, 0] + r.q[:, 2] - theta2).max() < 1e-9  # dependent coordinates on the closed loop
+    # the dependent coordinates on the closed loop (measured 2.7e-12: the projection's tolerance)
+    assert np.abs(r.q[:, 0] + r.q[:, 2] - theta2).max() < 3e-11
 
 
 def test_pendulum_rod_tension_from_the_multiplier():
