@@ -50,7 +50,7 @@ def test_the_double_four_bar_drops_to_rank_2_only_at_its_singular_position(throu
     assert np.all(r.rank[~at] == 4) and np.all(r.mobility[~at] == 1)
     assert r.rank[at][0] == 2 and r.mobility[at][0] == 3
     horizontal = brentq(lambda t: parallelogram_motion([0.0, t], 2)[-1, 1], 0.1, 1.0, xtol=1e-12)
-    assert abs(t_singular - horizontal) < 1e-6
+    assert abs(t_singular - horizontal) < 3e-9  # measured 2.4e-10 (the event's root against brentq's)
 
 
 def test_the_rank_history_is_saved_and_files_without_it_still_load(through_the_first_singular_position):
@@ -94,7 +94,7 @@ def test_ratio_rate_of_a_rotated_diagonal_matrix():
         return R(omega * t, 2) @ np.diag([3.0, 2.0 - t, 1.0 + t * t]) @ R(-2 * omega * t, 0).T
 
     A_dot = np.imag(A(t + 1e-30j)) / 1e-30  # the complex step: Ȧ exact
-    assert ratio_rate(A(t).real, A_dot, 3) == pytest.approx(2 * t / 3, rel=1e-14)
+    assert ratio_rate(A(t).real, A_dot, 3) == pytest.approx(2 * t / 3, rel=1e-14, abs=0)  # measured 7e-16
 
 
 def test_the_singular_position_event_is_the_exact_rate_of_the_ratio():
