@@ -32,7 +32,7 @@ def test_default_run_reaches_the_issue_accuracy():
         x, result = _final(arm)
     reference, _ = _final(arm, method="DOP853", rtol=1e-11, atol=1e-13)
     coarser, _ = _final(arm, method="DOP853", rtol=1e-10, atol=1e-12)
-    assert np.abs(coarser - reference).max() < 1e-7  # the reference has converged
+    assert np.abs(coarser - reference).max() < 1.4e-8  # the reference has converged (measured 1.3e-9)
     assert result.method == "DOP853" and arm.evaluator().name == "fast"
-    assert np.abs(x - reference).max() < 1e-5
+    assert np.abs(x - reference).max() < 4e-7  # simulate's defaults (rtol 1e-8): measured 3.6e-8
     assert np.abs(x[3:7]).max() > 1e-3  # the beam has bent: the elastic coordinates take part
