@@ -27,7 +27,8 @@ def test_sphere_rolling_off_a_sphere_leaves_at_cos_theta_10_17():
     r, q, s_dot = _lift_off(system, 0, 5.0)
     cos_theta = q[1] / np.hypot(q[0], q[1])
     # the event root sits on the integrated trajectory: error of the order of rtol
-    assert abs(cos_theta - 10 / 17 * np.cos(theta0)) < 2e-9  # measured 1.5e-10 (4e-10 before); 10× the larger of the two contacts
+    # measured 1.5e-10 (4e-10 before): 10× the larger of the two contacts' errors
+    assert abs(cos_theta - 10 / 17 * np.cos(theta0)) < 2e-9
     lam = reactions(system, r)[:, 0]
     assert np.all(lam[:-1] > 0)  # the sphere pushes on the support until it lifts off
 
