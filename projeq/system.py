@@ -29,6 +29,7 @@ from projeq.constraints.nonholonomic import check_configuration
 from projeq.joints import Joint
 from projeq.spatial import numeric
 from projeq.subsystems.base import conform
+from projeq.subsystems.rigid import RigidBody, gravity_potential
 
 GROUND = -1
 _GROUND_S = np.zeros((0, 6))
@@ -452,8 +453,6 @@ class System(Model):
             if type(j).normalized is not Joint.normalized and not j.coupling and self.e_q_slice[n].start > self.q_slice[n].start
         )
         self._constrained = tuple(n for n, j in enumerate(self.joints) if j.n_c)  # joints with velocity constraints
-        from projeq.subsystems.rigid import RigidBody
-
         rigid = [n for n, sub in enumerate(self.subsystems) if type(sub).potential_energy is RigidBody.potential_energy]
         self._rigid_potential = (np.array(rigid, dtype=int), np.array([self.subsystems[n].m for n in rigid]),
                                  np.array([self.subsystems[n].r_c for n in rigid]).reshape(-1, 3))
@@ -700,13 +699,12 @@ class System(Model):
     def potential_energy(self, kin, q: NDArray):
         """V at the poses ``kin`` (R_n, r_n, twists, ẏ_n; the ground's last) and q: each
         subsystem's ``potential_energy`` (gravity, strain) and each force law's ``potential``;
-        the rigid bodies' −m g·(r_n + R_n r_c,n) (:meth:`RigidBody.potential_energy
-        <projeq.subsystems.rigid.RigidBody.potential_energy>`) summed in one array expression."""
+        the rigid bodies' (:meth:`RigidBody.potential_energy
+        <projeq.subsystems.rigid.RigidBody.potential_energy>`) stacked in one call of
+        :func:`~projeq.subsystems.rigid.gravity_potential`."""
         rigid, m, r_c = self._rigid_potential
-        V = 0.0
-        if len(rigid):
-            R, r = np.asarray(kin.R), np.asarray(kin.r)
-            V = -(m * ((r[rigid] + np.einsum("nij,nj->ni", R[rigid], r_c)) @ self.gravity)).sum()
+        V = gravity_potential(m, r_c, np.asarray(kin.R)[rigid], np.asarray(kin.r)[rigid], self.gravity) \
+            if len(rigid) else 0.0
         return V + sum(
             self.subsystems[n].potential_energy(kin.R[n], kin.r[n], self.gravity, q[self.e_q_slice[n]])
             for n in self._own_potential

@@ -37,7 +37,7 @@ from projeq.simulation.integrators import (
     EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, stiff_steps, warn_stiff, with_direct_lu,
 )
 from projeq.simulation.result import FAILED, NON_FINITE, OUT_OF_RANGE, Result, SimulationError
-from projeq.constraints.nonholonomic import may_lose_rank, near_singularity
+from projeq.constraints.nonholonomic import may_be_singular, near_singularity
 from projeq.system import CLOSED, Model, check_model
 
 __all__ = ["INTEGRATORS", "Result", "SimulationError", "ValidityWarning", "default_method", "simulate"]
@@ -313,7 +313,7 @@ class _Run:
             raise ValueError(f"progress: expected a callable progress(t), got {progress!r}")
         self.events = _checked_events(events, t_start, q0, s_dot0)
         self.model = self.user_model = system
-        self.may_be_singular = _may_be_singular(system.tree)  # one tree for every model of the run
+        self.may_be_singular = may_be_singular(system.tree)  # one tree for every model of the run
         self.choice, self.ev = evaluator, _evaluator(system, evaluator)
         self.fused = getattr(self.ev, "state_derivative", None)
         system.check_configuration(q0, t_start)  # a coordinate singularity (or a degenerate partition) by name
@@ -596,14 +596,6 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
         return "Radau"
     high_order = rtol <= HIGH_ORDER_RTOL and not hasattr(model, "mobility")  # no constraint equations
     return "DOP853" if explicit_steps > FAST_MODE_STEPS or high_order else "RK45"
-
-
-def _may_be_singular(tree) -> bool:
-    """Whether a joint of ``tree`` has minimal velocities of its own whose K(q) or F(q) can lose
-    rank (:func:`~projeq.constraints.nonholonomic.may_lose_rank`), which
-    :func:`~projeq.constraints.nonholonomic.near_singularity` checks (a forward pass and condition
-    numbers: 0.5 ms on the spin-up beam, whose prescribed hub has none; ~2 ms on chain(5))."""
-    return any(may_lose_rank(joint) for joint in tree.joints)
 
 
 def _counted(solver, run: _Run) -> type:

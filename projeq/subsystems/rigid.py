@@ -36,6 +36,12 @@ def rigid_mass_matrix(m: float, r_c: NDArray, I_c: NDArray) -> NDArray:
     return M
 
 
+def gravity_potential(m, r_c: NDArray, R: NDArray, r: NDArray, gravity: NDArray):
+    """V = −Σ m g · (r + R r_c): the gravity potential of one rigid body (m, r_c in its frame, at the
+    pose R, r) or of bodies stacked along the first axis (m (n,), r_c (n, 3), R (n, 3, 3), r (n, 3))."""
+    return -np.sum(m * ((r + (R @ r_c[..., None])[..., 0]) @ gravity))
+
+
 def rigid_h(m, r_c: NDArray, I_c: NDArray, twist: NDArray, g_body: NDArray) -> NDArray:
     """h = Q − G ẏ of a rigid body with gravity g (body coordinates), docs/theory.md §3.
 
@@ -135,8 +141,8 @@ class RigidBody(Subsystem):
         return 0.5 * (y_dot @ self.M6 @ y_dot)
 
     def potential_energy(self, R: NDArray, r: NDArray, gravity: NDArray, q_e=None) -> float:
-        """−m g · r_c(inertial)."""
-        return -self.m * (gravity @ (r + R @ self.r_c))
+        """−m g · r_c(inertial) (:func:`gravity_potential`)."""
+        return gravity_potential(self.m, self.r_c, R, r, gravity)
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(m={self.m}, r_c={self.r_c.tolist()})"
