@@ -696,6 +696,17 @@ class System(Model):
         """:meth:`Model.output_row`, the energy unchecked (the row's state is the integrator's)."""
         return self._energy(q, s_dot, float(t)), self.constraint_residual(q, self.q_dot(q, s_dot, t), t), None
 
+    def output_rows(self, q_rows: NDArray, s_rows: NDArray, times: NDArray) -> tuple | None:
+        """:meth:`output_row` of many rows (q normalised) at once, (energies (k, 2), residuals (k, n_c)),
+        where the default evaluator computes the energies together (compiled: :meth:`projeq.assembly.fast.
+        FastEvaluator.energies`); None where it does not (then row by row)."""
+        energies = getattr(self.evaluator(None), "energies", lambda *rows: None)(q_rows, s_rows, times)
+        if energies is None:
+            return None
+        residuals = [self.constraint_residual(q, self.q_dot(q, s_dot, t), t) for q, s_dot, t in
+                     zip(q_rows, s_rows, times)] if self._constrained else np.zeros((len(times), 0))
+        return energies, np.reshape(residuals, (len(times), self.n_c))
+
     def potential_energy(self, kin, q: NDArray):
         """V at the poses ``kin`` (R_n, r_n, twists, ẏ_n; the ground's last) and q: each
         subsystem's ``potential_energy`` (gravity, strain) and each force law's ``potential``;

@@ -120,6 +120,25 @@ class AutoEvaluator:
             self.state_jacobian = Tier(picked.state_jacobian, _none, model, 1)
         self.energy = Tier(picked.energy, lambda q, s_dot, t: system._energy(q, s_dot, t, "recursive"), model, 0)
 
+    def loop_model(self) -> "LoopModel | None":
+        """The picked evaluator's model for the compiled integration loop
+        (:meth:`projeq.assembly.fast.FastEvaluator.loop_model`) once its ẋ runs compiled; None while
+        it runs interpreted, or where the picked evaluator has none."""
+        tier = getattr(self, "state_derivative", None)
+        if isinstance(tier, Tier) and not tier.real_ready:
+            return None
+        provider = getattr(self.evaluator, "loop_model", None)
+        return None if provider is None else provider()
+
+    def energies(self, q_rows, s_rows, times):
+        """The picked evaluator's (T, V) of many rows at once
+        (:meth:`projeq.assembly.fast.FastEvaluator.energies`) once its energy runs compiled; None while it
+        runs interpreted, or where the picked evaluator cannot (then row by row)."""
+        tier = getattr(self, "energy", None)
+        if not (isinstance(tier, Tier) and tier.real_ready) or not hasattr(self.evaluator, "energies"):
+            return None
+        return self.evaluator.energies(q_rows, s_rows, times)
+
     @property
     def reason(self) -> str:
         """Why this evaluator (:func:`pick`), and, while its kernels are not compiled yet, that the

@@ -76,7 +76,8 @@ from projeq.assembly.beam_fast import elastic_unsupported, hub_beam_unsupported
 from projeq.assembly.kinematics import Kinematics, describing_velocities, selected_chain_terms
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, column_scales, mass_scales
 from projeq.checks import kernel_state
-from projeq.subsystems.rigid import rigid_mass_matrix
+from projeq.forces import ForceLaw
+from projeq.subsystems.rigid import gravity_potential, rigid_mass_matrix
 
 
 class InterpretedWarning(UserWarning):
@@ -167,7 +168,7 @@ class FastEvaluator:
         # none, their C callbacks' tables of each dtype are built on first use (None where numba cannot
         # compile one)
         self._python_joints = [n for n in self._given if joints[n].compiled_values() is None]
-        self._tables = {}
+        self._tables, self._loop_model = {}, None
         n_cols = [j.n_s + b.n_e for j, b in zip(joints, bodies)]
         # every joint's own coordinates and velocities (and a body's internal ones after them), in
         # the order of the joints (q and ṡ themselves unless joints are coupled: then q_all = P_q q,
@@ -316,6 +317,26 @@ class FastEvaluator:
         potential = self.system.potential_energy(_SelectedKinematics(self.system, ws, s_dot), q)
         return float(kinetic), float(potential)
 
+    def energies(self, q_rows: NDArray, s_rows: NDArray, times: NDArray) -> NDArray | None:
+        """(T, V) of each row (q, ṡ, t) of a run's output, as :meth:`energy` gives them, with one compiled
+        kinematics pass per row and T = ½ Σ ẏ_nᵀ M_n ẏ_n and the rigid bodies' gravity potential
+        (:func:`projeq.subsystems.rigid.gravity_potential`) for all rows at once; None where a body has
+        coordinates of its own or a subsystem or force law a potential of its own (elastic bodies,
+        springs: :meth:`energy` row by row)."""
+        system = self.system
+        if self._internal or system._own_potential or any(type(f).potential is not ForceLaw.potential
+                                                          for f in system.forces):
+            return None
+        ws, k = self._real, len(times)
+        twists, R, r = np.empty((k, *ws.twist[:-1].shape)), np.empty((k, *ws.R.shape)), np.empty((k, *ws.r.shape))
+        for i in range(k):
+            self._kinematics(ws, kernels.kernel_array(q_rows[i]), kernels.kernel_array(s_rows[i]), float(times[i]))
+            twists[i], R[i], r[i] = ws.twist[:-1], ws.R, ws.r
+        kinetic = 0.5 * np.einsum("kni,nij,knj->k", twists, ws.M_n[:, :6, :6], twists)  # rigid M_n: the same per row
+        rigid, m, r_c = system._rigid_potential
+        potential = gravity_potential(m, r_c, R[:, rigid], r[:, rigid], system.gravity) if len(rigid) else np.zeros(k)
+        return np.column_stack((kinetic, potential))
+
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
         """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels."""
         self.n_calls += 1
@@ -432,6 +453,19 @@ class FastEvaluator:
         failed = self._jacobian(*head, *tree, kernels.kernel_array(x), n_q, COMPLEX_STEP, *workspace, rows)
         return J if failed < 0 else None
 
+    def loop_model(self) -> LoopModel | None:
+        """The model as the compiled integration loop takes it (:class:`LoopModel`, made once), or None
+        where ẋ has no one-call compiled kernel (Python runs between the kernels, or interpreted)."""
+        if self._x_dot is None or not self.compiled:
+            return None
+        if self._loop_model is None:
+            head = self._head(float, 0.0)
+            if head is None:
+                return None
+            tree, workspace = self._one_call_arguments(self._real)
+            self._loop_model = LoopModel(self._x_dot, head[:-1], tree, workspace)
+        return self._loop_model
+
     def _one_call_arguments(self, ws: _Workspace) -> tuple[tuple, tuple]:
         """The arguments of the one-call kernels (:func:`~projeq.assembly.kernels.tree_state_derivative`,
         :func:`~projeq.assembly.kernels.tree_jacobian`) before the state and after it: the tree and
@@ -439,6 +473,16 @@ class FastEvaluator:
         return ((self._index, self._geometry, self._inertia, self._gravity, self._laws, self._law_constants),
                 (ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.M_hat, ws.h_hat,
                  ws.R, ws.r, ws.twist, self._pivot_min))
+
+
+class LoopModel:
+    """A model as the compiled integration loop (:mod:`projeq.simulation.loop`) takes it: its ẋ kernel
+    ``kernel(*pre, t, *tree, x, n_q, *post, x_dot)`` (as :meth:`FastEvaluator.state_derivative` calls
+    it) with the arrays before t, the tree's and the workspace's; ``loops``, the loops compiled for it,
+    by method."""
+
+    def __init__(self, kernel, pre: tuple, tree: tuple, post: tuple):
+        self.kernel, self.pre, self.tree, self.post, self.loops = kernel, pre, tree, post, {}
 
 
 class _Workspace:

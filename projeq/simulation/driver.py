@@ -1,11 +1,14 @@
-"""Simulation: integrate q̇ = K(q) ṡ + k, s̈ from the Projection Equation, with solve_ivp.
+"""Simulation: integrate q̇ = K(q) ṡ + k, s̈ from the Projection Equation.
 
 The state is x = (q, ṡ) of a model (:class:`projeq.system.Model`: a System or a
 ConstrainedSystem). The run is split into segments (``n_segments``) so that a failure, a
 non-finite state or Ctrl-C keeps everything computed up to the last finished segment;
 each segment is one ``scipy.integrate.solve_ivp`` call with the user's method, tolerances
 and events, plus the model's own events (a ConstrainedSystem's degenerating partition),
-after which the run goes on with the model's :meth:`~projeq.system.Model.after_event`.
+after which the run goes on with the model's :meth:`~projeq.system.Model.after_event` — or,
+for RK23, RK45 and DOP853 on a model whose evaluator has a compiled one-call ẋ and no events,
+one call of the compiled loop (:mod:`projeq.simulation.loop`: scipy's algorithm, the same steps
+to round-off, without Python between the steps).
 Quaternions are normalised where the pose is evaluated and in the output.
 
 The steps: :class:`_Run` checks the arguments and holds the run's state, ``_Run.solve``
@@ -31,8 +34,9 @@ from numpy.typing import NDArray
 from scipy.integrate import OdeSolution, OdeSolver, solve_ivp
 
 from projeq.analysis.jacobians import state_derivative, state_jacobian
-from projeq.assembly import EVALUATORS
+from projeq.assembly import EVALUATORS, compilation
 from projeq.checks import callable_name, closest, count, finite_array, flag, non_negative, positive, state_vector
+from projeq.simulation import loop
 from projeq.simulation.integrators import (
     EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, stiff_steps, warn_stiff, with_direct_lu,
 )
@@ -162,7 +166,10 @@ def simulate(
         the exact Jacobian for very stiff models); a default run whose explicit steps are found
         to crawl at their stability limit goes on with Radau (``Result.method`` "DOP853, Radau
         from t = …", the evidence in ``Result.message``); ``Result.method`` names the choice. Or any method of
-        ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...),
+        ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...): by name, RK23, RK45
+        and DOP853 step in the compiled loop where the model has a compiled ẋ and no events
+        (:mod:`projeq.simulation.loop`; scipy's steps to round-off), and ``method=`` the scipy class
+        (``scipy.integrate.DOP853``) keeps solve_ivp stepping;
         or ``"RK45-projected"`` / ``"DOP853-projected"``: that method with each step projected
         onto the initial energy, so that a conservative scleronomic system's energy error
         stays at round-off over long runs (:mod:`projeq.simulation.integrators`; ValueError for a
@@ -334,6 +341,7 @@ class _Run:
         self.out_of_range = False  # warned that a subsystem left the range of its model
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
+        self.loops, self.renting = {}, False  # the compiled loop (or None) per evaluator and method: compiled_loop
 
     def rhs(self, t: float, x: NDArray) -> NDArray:
         """ẋ = (q̇, s̈) of the current model: by the evaluator's ``state_derivative`` where it
@@ -395,10 +403,18 @@ class _Run:
         labels += [f"the model's event {callable_name(e)}" for e in self.model.events()]
         events = [_event_wrapper(e, n_q, label) for e, label in zip(self.events + list(self.model.events()), labels)]
         dense = self.dense_output or bool(events)
+        compiled = None if dense else self.compiled_loop()
+        if compiled is not None:
+            segment = self._compiled_segment(compiled, a, b, inside)
+            if segment is not None:
+                return segment
         extra = not dense and not (len(inside) and inside[-1] == b)  # b as an output time
+        started = _time.process_time()
         segment = solve_ivp(self.rhs, (a, b), self.x, method=_counted(self.solver, self),
                             t_eval=np.append(inside, b) if extra else inside, rtol=self.rtol, atol=self.atol,
                             events=events or None, dense_output=dense, **jac, **self._continued(b - a))
+        if self.renting:
+            compilation.spend(_time.process_time() - started, "the integration loop")
         self.nfev += segment.nfev
         if segment.status == 0:
             self.x_end = segment.sol(b) if dense else segment.y[:, -1].copy()
@@ -408,6 +424,53 @@ class _Run:
             segment.sol = SimpleNamespace(ts=np.array([a, self.reached if segment.status else b]))
         self._keep(segment)
         return segment
+
+    def compiled_loop(self):
+        """The compiled integration loop of the run's method on the current model
+        (:func:`projeq.simulation.loop.loop`), or None where solve_ivp steps: a method the loop does not
+        step (implicit, projected, an OdeSolver class: ``method=scipy.integrate.DOP853`` keeps scipy's),
+        events, options besides max_step, or an evaluator without a compiled one-call ẋ."""
+        key = (id(self.ev), self.method)
+        if key not in self.loops:
+            ready = not (self.events or self.model.events() or set(self.options) - {"max_step"})
+            provider = getattr(self.ev, "loop_model", None) if ready else None
+            if provider is not None and self.fused is not None:
+                self.fused(self.reached, self.x)  # ẋ's kernel compiled or found (the default evaluator's tier)
+            try:
+                self.loops[key] = None if provider is None else loop.loop(provider(), self.method)
+            except compilation.NotCompiled:  # rented: solve_ivp steps, its CPU spent from the budget
+                self.loops[key], self.renting = None, True
+        return self.loops[key]
+
+    def _compiled_segment(self, compiled, a: float, b: float, inside: NDArray):
+        """One segment from the current state at a to b by the compiled loop, as solve_ivp's result
+        (its output rows, status and message); None where an evaluation failed for a reason the
+        checked evaluation does not raise (the segment then runs again by solve_ivp)."""
+        first = self._continued(b - a).get("first_step") or 0.0
+        self.reached = a
+        status, reached, rows, x_end, x_failed, nfev, steps, h_next = compiled.run(
+            self.model.n_q, a, self.x, b, first, float(self.options.get("max_step", np.inf)), self.rtol, self.atol,
+            np.ascontiguousarray(inside, dtype=float), self._paused, MONITOR_EVERY if self.may_be_singular else 0)
+        self.nfev, self.steps, self.calls, self.step_size, self.reached = (
+            self.nfev + nfev, self.steps + steps, self.calls + nfev, h_next, reached)
+        if status == loop.EVALUATION_FAILED:
+            self.checked_rhs(reached, x_failed)  # raises, naming why
+            return None
+        segment = SimpleNamespace(t=inside[:len(rows)], y=rows.T, status=0, t_events=None, y_events=None,
+                                  sol=SimpleNamespace(ts=np.array([a, b if status == loop.FINISHED else reached])),
+                                  message="The solver successfully reached the end of the integration interval.")
+        if status == loop.TOO_SMALL_STEP:
+            segment.status, segment.message = -1, "Required step size is less than spacing between numbers."
+        else:
+            self.x_end = x_end
+        self._keep(segment)
+        return segment
+
+    def _paused(self, t: float, x: NDArray) -> None:
+        """The check of :meth:`_monitor` where a compiled segment pauses (every ``MONITOR_EVERY``
+        evaluations, on a tree whose joints may lose rank): the distance of q to a coordinate singularity."""
+        self.reached = t
+        near_singularity(self.model.tree, x[:self.model.n_q], t)
 
     def _continued(self, span: float) -> dict:
         """The integrator's options for the next segment: the user's, and where they set no first
@@ -771,6 +834,9 @@ def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, ND
     row): the run is then a failure at that row's time (status, message naming the
     function, cause) and keeps the rows before it."""
     system, n_q = run.user_model, run.user_model.n_q
+    together = _rows_together(rows, x, n_q)
+    if together is not None:
+        return together
     q, energies, residual, ranks = [], [], [], []
     for (model, t), xi in zip(rows, x):
         try:
@@ -790,6 +856,24 @@ def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, ND
         ranks.append(values[2])
     n = len(q)
     return (np.reshape(q, (n, n_q)), np.reshape(energies, (n, 2)), np.reshape(residual, (n, system.n_c)), ranks)
+
+
+def _rows_together(rows: list, x: NDArray, n_q: int) -> tuple | None:
+    """:func:`_row_values` of rows all in one model that computes them together
+    (:meth:`projeq.System.output_rows`) where every energy is finite; None where they are in several
+    models, the model does not, or a row fails (then row by row, which names the row)."""
+    model = rows[0][0] if rows else None
+    if model is None or not hasattr(model, "output_rows") or any(m is not model for m, _ in rows):
+        return None
+    times = np.array([t for _, t in rows])
+    try:
+        q = np.array([model.normalized(xi[:n_q], t) for t, xi in zip(times, x)]).reshape(len(rows), n_q)
+        values = model.output_rows(q, x[:len(rows), n_q:], times)
+    except Exception:  # noqa: BLE001 - a user's function: row by row names it with its time
+        return None
+    if values is None or not np.isfinite(values[0]).all():
+        return None
+    return q, values[0], values[1], [None] * len(rows)
 
 
 def _failure(run: _Run, result: Result) -> SimulationError:

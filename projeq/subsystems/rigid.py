@@ -38,8 +38,10 @@ def rigid_mass_matrix(m: float, r_c: NDArray, I_c: NDArray) -> NDArray:
 
 def gravity_potential(m, r_c: NDArray, R: NDArray, r: NDArray, gravity: NDArray):
     """V = −Σ m g · (r + R r_c): the gravity potential of one rigid body (m, r_c in its frame, at the
-    pose R, r) or of bodies stacked along the first axis (m (n,), r_c (n, 3), R (n, 3, 3), r (n, 3))."""
-    return -np.sum(m * ((r + (R @ r_c[..., None])[..., 0]) @ gravity))
+    pose R, r), of bodies stacked along the first axis (m (n,), r_c (n, 3), R (n, 3, 3), r (n, 3)),
+    or one V per row of such stacks (R (k, n, 3, 3), r (k, n, 3): V (k,))."""
+    heights = (r + (R @ r_c[..., None])[..., 0]) @ gravity
+    return -np.sum(m * heights, axis=-1) if np.ndim(heights) else -m * heights
 
 
 def rigid_h(m, r_c: NDArray, I_c: NDArray, twist: NDArray, g_body: NDArray) -> NDArray:

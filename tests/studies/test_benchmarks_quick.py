@@ -81,6 +81,7 @@ PRINTS = {
     "jacobians.py": ("elastic_arm (3 shapes)", "Radau", "BDF", "differences", "exact"),
     "loop_drift.py": ("quick-return", "baumgarte beta=10.0", "projection n_segments=100",
                       "four-bar (crank-rocker)", "rocker, repivot"),
+    "loop_overhead.py": ("per evaluation", "scipy's loop", "rolling_disk"),
     "nonholonomic_effort.py": ("| car |", "| knife_edge_disc |", "| rolling_disk |"),
     "output_rows.py": ("before/after", "simple_pendulum"),
     "peers.py": ("chain",),
