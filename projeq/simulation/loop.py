@@ -27,7 +27,10 @@ takes effect, keeping every finished segment.
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import signal
+import threading
 import types
 
 import numpy as np
@@ -317,13 +320,29 @@ class CompiledLoop:
         status, n_rows, nfev, steps, known = PAUSED, 0, 0, 0, False
         model = self.model
         while status == PAUSED:
-            status, n_rows, more, taken, t, h_abs = self.compiled(
-                self.kernel, model.pre, model.tree, model.post, n_q, self.method, t, t_bound, known, h_abs, max_step,
-                rtol, atol, every, t_eval, n_rows, rows, state, rate, x_failed)
+            with _signals_held():
+                status, n_rows, more, taken, t, h_abs = self.compiled(
+                    self.kernel, model.pre, model.tree, model.post, n_q, self.method, t, t_bound, known, h_abs,
+                    max_step, rtol, atol, every, t_eval, n_rows, rows, state, rate, x_failed)
             nfev, steps, known = nfev + more, steps + taken, True
             if status == PAUSED:
                 monitor(t, state)
         return status, t, rows[:n_rows], state, x_failed, nfev, steps, h_abs
+
+
+@contextlib.contextmanager
+def _signals_held():
+    """SIGINT and SIGTERM held back during a compiled call (on the main thread, where POSIX allows it) and
+    delivered when it returns: numba runs Python while it unboxes a first-class function, and a signal's
+    exception raised there surfaces as numba's TypeError; compiled code does not see signals anyway."""
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
 
 
 def _address(dispatcher, signature):
