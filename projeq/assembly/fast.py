@@ -80,6 +80,10 @@ from projeq.forces import ForceLaw
 from projeq.subsystems.rigid import gravity_potential, rigid_mass_matrix
 
 
+#: bytes of the output rows' poses and twists that :meth:`FastEvaluator.energies` stacks at once
+ROWS_BYTES = 8 * 2**20
+
+
 class InterpretedWarning(UserWarning):
     """The default evaluator fell back to an interpreted reference evaluator (the message names the
     joint, subsystem or force law the compiled kernel does not know)."""
@@ -327,15 +331,20 @@ class FastEvaluator:
         if self._internal or system._own_potential or any(type(f).potential is not ForceLaw.potential
                                                           for f in system.forces):
             return None
-        ws, k = self._real, len(times)
-        twists, R, r = np.empty((k, *ws.twist[:-1].shape)), np.empty((k, *ws.R.shape)), np.empty((k, *ws.r.shape))
-        for i in range(k):
-            self._kinematics(ws, kernels.kernel_array(q_rows[i]), kernels.kernel_array(s_rows[i]), float(times[i]))
-            twists[i], R[i], r[i] = ws.twist[:-1], ws.R, ws.r
-        kinetic = 0.5 * np.einsum("kni,nij,knj->k", twists, ws.M_n[:, :6, :6], twists)  # rigid M_n: the same per row
-        rigid, m, r_c = system._rigid_potential
-        potential = gravity_potential(m, r_c, R[:, rigid], r[:, rigid], system.gravity) if len(rigid) else np.zeros(k)
-        return np.column_stack((kinetic, potential))
+        ws, rigid, (m, r_c) = self._real, system._rigid_potential[0], system._rigid_potential[1:]
+        chunk = max(1, ROWS_BYTES // (8 * 6 * ws.twist.size))  # rows stacked at once: R, r and the twists
+        energies = np.zeros((len(times), 2))
+        for start in range(0, len(times), chunk):
+            rows = range(start, min(start + chunk, len(times)))
+            twists, R, r = (np.empty((len(rows), *a.shape)) for a in (ws.twist[:-1], ws.R[rigid], ws.r[rigid]))
+            for i, row in enumerate(rows):
+                self._kinematics(ws, kernels.kernel_array(q_rows[row]), kernels.kernel_array(s_rows[row]),
+                                 float(times[row]))
+                twists[i], R[i], r[i] = ws.twist[:-1], ws.R[rigid], ws.r[rigid]
+            energies[rows, 0] = 0.5 * np.einsum("kni,nij,knj->k", twists, ws.M_n[:, :6, :6], twists)  # rigid M_n
+            if len(rigid):
+                energies[rows, 1] = gravity_potential(m, r_c, R, r, system.gravity)
+        return energies
 
     def gauss_form(self, q: NDArray, s_dot: NDArray, t: float) -> tuple[NDArray, NDArray]:
         """M(q) and b(q, ṡ, t) of M s̈ + b = 0 (docs/theory.md §5), by the compiled kernels."""

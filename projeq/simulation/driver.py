@@ -448,22 +448,26 @@ class _Run:
         checked evaluation does not raise (the segment then runs again by solve_ivp)."""
         first = self._continued(b - a).get("first_step") or 0.0
         self.reached = a
-        status, reached, rows, x_end, x_failed, nfev, steps, h_next = compiled.run(
+        stepped = compiled.run(
             self.model.n_q, a, self.x, b, first, float(self.options.get("max_step", np.inf)), self.rtol, self.atol,
             np.ascontiguousarray(inside, dtype=float), self._paused, MONITOR_EVERY if self.may_be_singular else 0)
         self.nfev, self.steps, self.calls, self.step_size, self.reached = (
-            self.nfev + nfev, self.steps + steps, self.calls + nfev, h_next, reached)
-        if status == loop.EVALUATION_FAILED:
-            self.checked_rhs(reached, x_failed)  # raises, naming why
+            self.nfev + stepped.nfev, self.steps + stepped.steps, self.calls + stepped.nfev, stepped.h_abs, stepped.t)
+        if stepped.status == loop.EVALUATION_FAILED:
+            self.checked_rhs(stepped.t, stepped.x_failed)  # raises, naming why
             return None
+        rows = stepped.rows
         segment = SimpleNamespace(t=inside[:len(rows)], y=rows.T, status=0, t_events=None, y_events=None,
-                                  sol=SimpleNamespace(ts=np.array([a, b if status == loop.FINISHED else reached])),
+                                  sol=SimpleNamespace(ts=np.array([a, b if stepped.status == loop.FINISHED
+                                                                   else stepped.t])),
                                   message="The solver successfully reached the end of the integration interval.")
-        if status == loop.TOO_SMALL_STEP:
+        if stepped.status == loop.TOO_SMALL_STEP:
             segment.status, segment.message = -1, "Required step size is less than spacing between numbers."
-        else:
-            self.x_end = x_end
+        elif stepped.status == loop.FINISHED:
+            self.x_end = stepped.state
         self._keep(segment)
+        if stepped.stopped_by is not None:  # the monitor's verdict, the rows before it kept
+            raise stepped.stopped_by
         return segment
 
     def _paused(self, t: float, x: NDArray) -> None:

@@ -32,6 +32,7 @@ import functools
 import signal
 import threading
 import types
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -44,8 +45,24 @@ METHODS = ("RK23", "RK45", "DOP853")
 #: scipy's step-size control constants (``scipy.integrate._ivp.rk``)
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 
-#: what a compiled segment ended with
-FINISHED, TOO_SMALL_STEP, EVALUATION_FAILED, PAUSED = 0, 1, 2, 3
+#: what a compiled segment ended with (STOPPED: the monitor raised where the segment paused)
+FINISHED, TOO_SMALL_STEP, EVALUATION_FAILED, PAUSED, STOPPED = 0, 1, 2, 3, 4
+
+
+class Stepped(NamedTuple):
+    """What :meth:`CompiledLoop.run` did: how it ended (``status``), the time ``t`` and ``state`` reached, the
+    ``rows`` at the output times passed, the state where an evaluation failed (``x_failed``), the
+    evaluations and steps taken, the next step size and the monitor's exception (status STOPPED)."""
+
+    status: int
+    t: float
+    rows: NDArray
+    state: NDArray
+    x_failed: NDArray
+    nfev: int
+    steps: int
+    h_abs: float
+    stopped_by: Exception | None
 
 
 @functools.cache
@@ -311,13 +328,13 @@ class CompiledLoop:
             np.zeros(1), 0, np.zeros((1, 1)), np.zeros(1), np.zeros(1), np.zeros(1))))
 
     def run(self, n_q: int, t: float, x: NDArray, t_bound: float, h_abs: float, max_step: float, rtol: float,
-            atol: float, t_eval: NDArray, monitor=None, every: int = 0) -> tuple:
-        """One segment from (t, x) to t_bound: (status, time reached, rows at t_eval, state reached,
-        failed state, evaluations, steps, next step size); ``monitor(t, x)`` called after the first step
-        past each ``every`` evaluations (``every`` > 0), as :func:`segment` pauses."""
+            atol: float, t_eval: NDArray, monitor=None, every: int = 0) -> Stepped:
+        """One segment from (t, x) to t_bound; ``monitor(t, x)`` called after the first step past each
+        ``every`` evaluations (``every`` > 0), as :func:`segment` pauses: where it raises, the segment
+        ends there (status STOPPED) with the rows computed so far."""
         rows, state, rate, x_failed = np.empty((len(t_eval), len(x))), np.array(x, dtype=float), np.empty(len(x)), \
             np.empty(len(x))
-        status, n_rows, nfev, steps, known = PAUSED, 0, 0, 0, False
+        status, n_rows, nfev, steps, known, stopped_by = PAUSED, 0, 0, 0, False, None
         model = self.model
         while status == PAUSED:
             with _signals_held():
@@ -326,8 +343,11 @@ class CompiledLoop:
                     max_step, rtol, atol, every, t_eval, n_rows, rows, state, rate, x_failed)
             nfev, steps, known = nfev + more, steps + taken, True
             if status == PAUSED:
-                monitor(t, state)
-        return status, t, rows[:n_rows], state, x_failed, nfev, steps, h_abs
+                try:
+                    monitor(t, state)
+                except Exception as exc:  # noqa: BLE001 - the caller raises it, keeping the rows
+                    status, stopped_by = STOPPED, exc
+        return Stepped(status, t, rows[:n_rows], state, x_failed, nfev, steps, h_abs, stopped_by)
 
 
 @contextlib.contextmanager

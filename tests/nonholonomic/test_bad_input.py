@@ -94,18 +94,22 @@ def test_knife_edge_disc_near_flat_tilt_is_singular(distance):
         pq.scenes.knife_edge_disc(q0=(0.0, 0.0, 0.0, np.pi / 2 - distance, 0.0))
 
 
-def test_knife_edge_disc_started_near_flat_stops_within_seconds():
+def test_knife_edge_disc_started_near_flat_stops_within_few_evaluations():
     """Passes if the disc started 1e-4 rad from flat (issue 20: 460k evaluations, never finished
-    its first segment) stops with a SimulationError naming the coordinate singularity, within
-    5 s, the trajectory kept: its spin rates grow like 1/(π/2 − ϕ) as ϕ → π/2 (slide 29) and the
-    run is stopped once cond F passes 1e5, i.e. about 3e-5 rad from flat."""
-    import time
-
+    its first segment) stops with a SimulationError naming the coordinate singularity within a few
+    thousand evaluations (measured: 2405 by the compiled loop; bound 5000), the rows computed
+    before the stop kept: its spin rates grow like 1/(π/2 − ϕ) as ϕ → π/2 (slide 29) and the run
+    is stopped once cond F passes 1e5 (checked every MONITOR_EVERY = 200 evaluations), about 3e-5
+    rad from flat, at t = 0.0134 s. Counted in evaluations, not seconds: a cold numba cache
+    compiles the loop inside a timed call."""
     system = pq.scenes.knife_edge_disc(q0=(0.0, 0.0, 0.0, np.pi / 2 - 1e-4, 0.0))
-    started = time.perf_counter()
-    with pytest.raises(pq.SimulationError, match=r"approaches a coordinate singularity at t = .*condition number 1"):
-        pq.simulate(system, 10.0)
-    assert time.perf_counter() - started < 5.0
+    with pytest.raises(pq.SimulationError, match=r"approaches a coordinate singularity at t = .*condition number 1") \
+            as stopped:
+        pq.simulate(system, 10.0, n_points=2001)
+    result = stopped.value.result
+    assert 0 < result.nfev < 5000
+    assert np.array_equal(result.t, [0.0, 0.005, 0.01])  # the output times before t = 0.0134 s
+    assert np.isfinite(result.q).all() and abs(result.q[-1, 3] - np.pi / 2) < 1e-4
 
 
 def test_initial_rates_violating_the_constraints():
