@@ -12,6 +12,7 @@ each method's kernels are compiled, or loaded from disk, by a short run first).
                                                           # at simulate's default tolerances
     python benchmarks/default_integrator.py --scene spinning_beam spinning_beam_1cm axial_beam \\
         elastic_arm flexible_arm rigid_arm --runs default DOP853 Radau BDF RK45      # the default's choice
+    python benchmarks/default_integrator.py --scene two_masses --runs default Radau BDF   # stiffness ratio 1e10
 
 ``--runs default RK45 ...`` runs each named method at simulate's default tolerances (rtol 1e-8,
 atol 1e-10; "default": no method given, the row names the one simulate chose, "DOP853, Radau
@@ -48,11 +49,23 @@ def axial_beam() -> pq.System:
                                   n_shapes=1, n_axial=1)
 
 
+def two_masses(k_fast: float = 1e10) -> pq.System:
+    """Two unit masses on a line (issue 34's stiff oscillator): the first on a spring k = 1 to the ground
+    (its prismatic joint's q₁), the second on a spring k_fast to the first (q₂ relative to it); at rest,
+    q₁ = 0.1 with q₂ the slow mode's own ratio k₁ q₁ / (2 k_fast), which leaves the fast mode unexcited."""
+    x = (1.0, 0.0, 0.0)
+    return pq.System({"first": pq.PointMass(1.0), "second": pq.PointMass(1.0)},
+                     {"first": pq.Prismatic(axis=x), "second": pq.Prismatic(parent="first", axis=x)},
+                     forces=[pq.JointSpring("first", 1.0), pq.JointSpring("second", k_fast)],
+                     q0=[0.1, 0.1 / (2 * k_fast)])
+
+
 SCENES = {  # name: (model, its span in s)
     "spin_up_beam": (pq.scenes.spin_up_beam, 5.0), "chain5": (lambda: pq.scenes.chain(5), 5.0),
     "elastic_arm": (pq.scenes.elastic_arm, 5.0), "spinning_beam": (pq.scenes.spinning_beam, 10.0),
     "spinning_beam_1cm": (spinning_beam_1cm, 10.0), "axial_beam": (axial_beam, 1.0),
     "rigid_arm": (lambda: pq.scenes.flexible_arm(rigid_last_link=True), 1.0), "flexible_arm": (pq.scenes.flexible_arm, 1.0),
+    "two_masses": (two_masses, 10.0),
 }
 RUNS = (("RK45", 1e-6, 1e-9), ("DOP853", 1e-6, 1e-9), ("Radau", 1e-6, 1e-9), ("BDF", 1e-6, 1e-9),
         ("RK45", 1e-8, 1e-10), ("DOP853", 1e-9, 1e-11), ("Radau", 1e-8, 1e-10))

@@ -255,3 +255,23 @@ def test_simulates_own_explicit_choice_starts_at_a_stable_step_where_fast_modes_
     assert step == pytest.approx(0.5 * stability_limit("DOP853") / 2e3, rel=1e-15)
     assert driver.stable_first_step("DOP853", (10.0, False), 0.0, 1.0) is None  # 3 RK45 steps: accuracy rules
     assert driver.stable_first_step("Radau", (2e3, False), 0.0, 1.0) is None
+
+
+def test_the_stiff_two_mass_oscillator_answers_with_the_default_method():
+    """Stiffness ratio 1e10, the fast mode (ω ≈ 1.4e5 rad/s) unexcited (benchmarks/default_integrator.py's two_masses), rtol 1e-8 over 10 s (issue 34:
+    no answer after 51 s of CPU): simulate's default is Radau (the ρ of its fastest mode would
+    take DOP853 ~1e6 steps for stability alone) and answers in 1548 evaluations (bound 2000; 0.13 s
+    warm); q follows the modal solution q(t) = Σ φᵢ φᵢᵀ M q₀ cos ωᵢt of M q̈ + K q = 0 (M = [[2, 1],
+    [1, 1]] in these relative coordinates, K = diag(1, 1e10), φᵢ M-normalised by scipy.linalg.eigh)
+    within 1e-9 (measured 2.5e-10, at rtol 1e-8 · 0.1 m = 1e-9 per step)."""
+    import scipy.linalg
+
+    from tests.studies.test_benchmarks_quick import load
+
+    system = load("default_integrator.py").two_masses(1e10)
+    run = pq.simulate(system, 10.0, rtol=1e-8)
+    M, K = np.array([[2.0, 1.0], [1.0, 1.0]]), np.diag([1.0, 1e10])
+    omega2, phi = scipy.linalg.eigh(K, M)
+    exact = np.cos(np.outer(run.t, np.sqrt(omega2))) * (phi.T @ M @ system.q0) @ phi.T
+    assert run.method == "Radau" and run.nfev <= 2000
+    assert np.abs(run.q - exact).max() < 1e-9
