@@ -520,6 +520,14 @@ class System(Model):
             q[sl] = self.joints[n].normalized(q[sl])
         return q
 
+    def normalized_rows(self, q_rows: NDArray) -> NDArray:
+        """:meth:`normalized` of each row of ``q_rows`` (k, n_q): only the joints that project touched."""
+        q = np.array(q_rows, dtype=float).reshape(-1, self.n_q)
+        for n in self._normalizing:
+            sl = slice(self.q_slice[n].start, self.e_q_slice[n].start)
+            q[:, sl] = [self.joints[n].normalized(row) for row in q[:, sl]]
+        return q
+
     def check_q(self, name: str, q) -> NDArray:
         """q as a float array of the right length with finite entries that every joint can
         normalise (no zero quaternion)."""

@@ -133,8 +133,11 @@ class AutoEvaluator:
     def energies(self, q_rows, s_rows, times):
         """The picked evaluator's (T, V) of many rows at once
         (:meth:`projeq.assembly.fast.FastEvaluator.energies`) once its energy runs compiled; None while it
-        runs interpreted, or where the picked evaluator cannot (then row by row)."""
+        runs interpreted, or where the picked evaluator cannot (then row by row). The first row's energy
+        by the tier first: it compiles (or finds) the kernels where the compile policy lets it."""
         tier = getattr(self, "energy", None)
+        if isinstance(tier, Tier) and not tier.real_ready and len(times):
+            tier(q_rows[0], s_rows[0], times[0])
         if not (isinstance(tier, Tier) and tier.real_ready) or not hasattr(self.evaluator, "energies"):
             return None
         return self.evaluator.energies(q_rows, s_rows, times)

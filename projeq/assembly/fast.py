@@ -332,15 +332,22 @@ class FastEvaluator:
                                                           for f in system.forces):
             return None
         ws, rigid, (m, r_c) = self._real, system._rigid_potential[0], system._rigid_potential[1:]
+        q_rows, s_rows = np.asarray(q_rows, dtype=float), np.asarray(s_rows, dtype=float)
+        if self._expansion is not None:  # every joint's own coordinates and velocities
+            q_rows, s_rows = q_rows @ self._expansion[0].T, s_rows @ self._expansion[1].T
+        rows_kinematics = kernels.rows_kernel(self.compiled)
         chunk = max(1, ROWS_BYTES // (8 * 6 * ws.twist.size))  # rows stacked at once: R, r and the twists
         energies = np.zeros((len(times), 2))
         for start in range(0, len(times), chunk):
             rows = range(start, min(start + chunk, len(times)))
             twists, R, r = (np.empty((len(rows), *a.shape)) for a in (ws.twist[:-1], ws.R[rigid], ws.r[rigid]))
-            for i, row in enumerate(rows):
-                self._kinematics(ws, kernels.kernel_array(q_rows[row]), kernels.kernel_array(s_rows[row]),
-                                 float(times[row]))
-                twists[i], R[i], r[i] = ws.twist[:-1], ws.R[rigid], ws.r[rigid]
+            for block in ([slice(k, k + 1) for k in range(len(rows))] if self._given else [slice(0, len(rows))]):
+                q_all, s_all = (np.ascontiguousarray(a[start:][block]) for a in (q_rows, s_rows))
+                if self._given:  # the relative motions of joints of kind GIVEN at the row's time
+                    self._relative_motions(ws, q_all[0], s_all[0], float(times[start + block.start]))
+                rows_kinematics(self._index, self._geometry, self._inertia, self._gravity, q_all, s_all,
+                                ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat,
+                                ws.R, ws.r, ws.twist, rigid, twists[block], R[block], r[block])
             energies[rows, 0] = 0.5 * np.einsum("kni,nij,knj->k", twists, ws.M_n[:, :6, :6], twists)  # rigid M_n
             if len(rigid):
                 energies[rows, 1] = gravity_potential(m, r_c, R, r, system.gravity)

@@ -896,6 +896,38 @@ def kernel(compiled: bool = True, rigid: bool = False):
     return compiled_kernels["chain_terms"], compiled_kernels["rigid_passes" if rigid else "passes"]
 
 
+def rows_kinematics(index, geometry, inertia, gravity, q_rows, s_rows, given, elastic, port, T, zeta, F, M, h, R,
+                    r_O, twist, bodies, twists, R_rows, r_rows):
+    """:func:`chain_terms` at each row (q_rows[k], s_rows[k]) of a run's output, keeping what the rows'
+    energies need: every body's twist (twists[k]) and the poses R_n, r_n of ``bodies`` (R_rows[k],
+    r_rows[k]); the other arguments are chain_terms' workspace."""
+    for k in range(q_rows.shape[0]):
+        chain_terms(index, geometry, inertia, gravity, q_rows[k], s_rows[k], given, elastic, port, T, zeta, F, M, h,
+                    R, r_O, twist)
+        for n in range(twists.shape[1]):
+            for i in range(6):
+                twists[k, n, i] = twist[n, i]
+        for j in range(bodies.shape[0]):
+            for i in range(3):
+                r_rows[k, j, i] = r_O[bodies[j], i]
+                for c in range(3):
+                    R_rows[k, j, i, c] = R[bodies[j], i, c]
+
+
+def rows_kernel(compiled: bool = True):
+    """:func:`rows_kinematics`, compiled by numba (as :func:`kernel`, calling its compiled chain_terms)
+    or with ``compiled=False`` the interpreted function."""
+    if not compiled:
+        return rows_kinematics
+    kernel(True)  # the same refusal without numba
+    return _compiled_rows_kernel()
+
+
+@functools.cache
+def _compiled_rows_kernel():
+    return jit(rows_kinematics, kernels={"chain_terms": _compiled()["chain_terms"]})[0]
+
+
 def state_kernels(loads, compiled: bool = True, rigid: bool = False):
     """(:func:`tree_state_derivative`, :func:`tree_jacobian`), compiled by numba (as :func:`kernel`,
     with the same ``rigid`` passes) or with ``compiled=False`` interpreted, calling the force laws'

@@ -871,7 +871,7 @@ def _rows_together(rows: list, x: NDArray, n_q: int) -> tuple | None:
         return None
     times = np.array([t for _, t in rows])
     try:
-        q = np.array([model.normalized(xi[:n_q], t) for t, xi in zip(times, x)]).reshape(len(rows), n_q)
+        q = model.normalized_rows(x[:len(rows), :n_q])
         values = model.output_rows(q, x[:len(rows), n_q:], times)
     except Exception:  # noqa: BLE001 - a user's function: row by row names it with its time
         return None

@@ -319,28 +319,23 @@ class CompiledLoop:
 
     def __init__(self, model, method: str):
         self.model, self.method = model, tableau(method)
-        numba = kernels.numba_module()
-        arguments = (*model.pre, 0.0, *model.tree, np.zeros(1), 0, *model.post, np.zeros(1))
-        self.kernel = _address(model.kernel, model.kernel.overloads[tuple(numba.typeof(a) for a in arguments)]
-                               .signature)
-        self.compiled = _compiled(tuple(numba.typeof(a) for a in (
-            self.kernel, model.pre, model.tree, model.post, 0, self.method, 0.0, 0.0, True, 0.0, 0.0, 0.0, 0.0, 0,
-            np.zeros(1), 0, np.zeros((1, 1)), np.zeros(1), np.zeros(1), np.zeros(1))))
+        self.kernel, self.compiled = _specialised(model, method)
 
     def run(self, n_q: int, t: float, x: NDArray, t_bound: float, h_abs: float, max_step: float, rtol: float,
             atol: float, t_eval: NDArray, monitor=None, every: int = 0) -> Stepped:
         """One segment from (t, x) to t_bound; ``monitor(t, x)`` called after the first step past each
         ``every`` evaluations (``every`` > 0), as :func:`segment` pauses: where it raises, the segment
         ends there (status STOPPED) with the rows computed so far."""
-        rows, state, rate, x_failed = np.empty((len(t_eval), len(x))), np.array(x, dtype=float), np.empty(len(x)), \
-            np.empty(len(x))
+        t_eval, state = np.ascontiguousarray(t_eval, dtype=float).ravel(), np.array(x, dtype=float).ravel()
+        rows, rate, x_failed = np.empty((len(t_eval), len(state))), np.empty(len(state)), np.empty(len(state))
         status, n_rows, nfev, steps, known, stopped_by = PAUSED, 0, 0, 0, False, None
         model = self.model
         while status == PAUSED:
-            with _signals_held():
+            with _signals_held():  # the arguments of the types compiled for (the entry point checks none)
                 status, n_rows, more, taken, t, h_abs = self.compiled(
-                    self.kernel, model.pre, model.tree, model.post, n_q, self.method, t, t_bound, known, h_abs,
-                    max_step, rtol, atol, every, t_eval, n_rows, rows, state, rate, x_failed)
+                    self.kernel, model.pre, model.tree, model.post, int(n_q), self.method, float(t), float(t_bound),
+                    known, float(h_abs), float(max_step), float(rtol), float(atol), int(every), t_eval, n_rows, rows,
+                    state, rate, x_failed)
             nfev, steps, known = nfev + more, steps + taken, True
             if status == PAUSED:
                 try:
@@ -348,6 +343,37 @@ class CompiledLoop:
                 except Exception as exc:  # noqa: BLE001 - the caller raises it, keeping the rows
                     status, stopped_by = STOPPED, exc
         return Stepped(status, t, rows[:n_rows], state, x_failed, nfev, steps, h_abs, stopped_by)
+
+
+def _layout(value):
+    """What numba's type of ``value`` depends on, found cheaply: an array's dtype, dimensions, contiguity
+    and writability, a tuple's element by element, another value's Python type."""
+    if isinstance(value, tuple):
+        return tuple(map(_layout, value))
+    if isinstance(value, np.ndarray):
+        flags = value.flags
+        return value.dtype.str, value.ndim, flags.c_contiguous, flags.f_contiguous, flags.writeable, flags.aligned
+    return type(value)
+
+
+_SPECIALISED = {}
+
+
+def _specialised(model, method: str) -> tuple:
+    """(the ẋ kernel as a first-class function, the compiled :func:`segment`'s entry point) for the types
+    of ``model``'s arrays, found by numba's typeof once per kernel, layout of those arrays and method (a
+    new model of the same layout finds them by :func:`_layout`); the entry point skips numba's dispatch by
+    type at each call, so :meth:`CompiledLoop.run` passes it exactly the types compiled for."""
+    key = (model.kernel, _layout((model.pre, model.tree, model.post)), method)
+    if key not in _SPECIALISED:
+        numba = kernels.numba_module()
+        arguments = (*model.pre, 0.0, *model.tree, np.zeros(1), 0, *model.post, np.zeros(1))
+        kernel = _address(model.kernel, model.kernel.overloads[tuple(numba.typeof(a) for a in arguments)].signature)
+        compiled = _compiled(tuple(numba.typeof(a) for a in (
+            kernel, model.pre, model.tree, model.post, 0, tableau(method), 0.0, 0.0, True, 0.0, 0.0, 0.0, 0.0, 0,
+            np.zeros(1), 0, np.zeros((1, 1)), np.zeros(1), np.zeros(1), np.zeros(1))))
+        _SPECIALISED[key] = kernel, compiled.overloads[compiled.signatures[0]].entry_point
+    return _SPECIALISED[key]
 
 
 @contextlib.contextmanager

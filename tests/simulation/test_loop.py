@@ -81,8 +81,10 @@ def test_one_compiled_loop_for_every_tree():
     lengths, another scene and a force law's other ẋ kernel use the loop compiled once per signature
     of the ẋ kernel (the trees without joints of kind GIVEN share one)."""
     pq.simulate(pq.scenes.chain(2), 0.01, method="RK45")
-    before = loop._compiled.cache_info().currsize
-    for system in (pq.scenes.chain(7), pq.scenes.double_pendulum(), pq.scenes.flyball_governor()):
+    before, specialised = loop._compiled.cache_info().currsize, len(loop._SPECIALISED)
+    pq.simulate(pq.scenes.chain(7), 0.01, method="RK45")
+    assert len(loop._SPECIALISED) == specialised  # found by the arrays' layout, without numba's typeof
+    for system in (pq.scenes.double_pendulum(), pq.scenes.flyball_governor()):
         pq.simulate(system, 0.01, method="RK45")
     assert loop._compiled.cache_info().currsize == before
 
