@@ -495,10 +495,12 @@ class LoopModel:
     """A model as the compiled integration loop (:mod:`projeq.simulation.loop`) takes it: its ẋ kernel
     ``kernel(*pre, t, *tree, x, n_q, *post, x_dot)`` (as :meth:`FastEvaluator.state_derivative` calls
     it) with the arrays before t, the tree's and the workspace's; ``loops``, the loops compiled for it,
-    by method."""
+    by method; ``checks_events``: the kernel fails where the model's own events would fire (a
+    ConstrainedSystem's partition degenerating), so that simulate steps that segment by solve_ivp."""
 
-    def __init__(self, kernel, pre: tuple, tree: tuple, post: tuple):
+    def __init__(self, kernel, pre: tuple, tree: tuple, post: tuple, checks_events: bool = False):
         self.kernel, self.pre, self.tree, self.post, self.loops = kernel, pre, tree, post, {}
+        self.checks_events = checks_events
 
 
 class _Workspace:

@@ -84,6 +84,10 @@ from projeq.constraints.cut_joints import point_rows
 #: (a spring-damper whose two points coincide) — the numpy path then raises the error naming it
 DONE, DEGENERATE, SINGULAR, UNLOADED = 0, 1, 2, 3
 
+#: the share of a partition's event limit at which the compiled loop's ẋ (:func:`partitioned_state_derivative`)
+#: gives the segment back to solve_ivp: below 1, so that round-off between two SVDs of A_s cannot miss it
+EVENT_MARGIN = 0.999
+
 
 class UncompiledClosureWarning(UserWarning):
     """The constrained s̈ of a model is not one compiled call and takes the numpy path (about ten
@@ -753,6 +757,38 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
 
 
+def partitioned_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, independent, dependent, x, n_q, m_h,
+                                 bound, pivot, limit, q, s_dot, q_dot, s_ddot_tree, A, M, b, x_dot):
+    """ẋ = (q̇, s̈_tree[independent]) of :func:`partitioned` at x = (q, ṡ) into ``x_dot``, as the compiled
+    integration loop calls a model's ẋ (:mod:`projeq.simulation.loop`; ``q``, ``s_dot``: buffers of the
+    state's parts): −1, or 0 where the kernel flags, ẋ is not finite or the partition's condition
+    κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ reaches :data:`EVENT_MARGIN` · ``limit`` — the ConstrainedSystem's own event
+    κ − limit, which solve_ivp then locates, stepping that segment again, and re-partitions there
+    (solve_ivp looks for a sign change at the steps' ends, where this call is made: none is missed)."""
+    for i in range(n_q):
+        q[i] = x[i]
+    for i in range(s_dot.shape[0]):
+        s_dot[i] = x[n_q + i]
+    if partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
+                   q_dot, s_ddot_tree, A, M, b) != DONE:
+        return 0
+    A_dep = np.empty((dependent.shape[0], dependent.shape[0]))
+    for r in range(dependent.shape[0]):
+        for c in range(dependent.shape[0]):
+            A_dep[r, c] = A[r, dependent[c]]
+    sigma = np.linalg.svd(A_dep)[1]
+    if not sigma[-1] * EVENT_MARGIN * limit > np.linalg.svd(A)[1][0]:
+        return 0
+    for i in range(n_q):
+        x_dot[i] = q_dot[i]
+    for i in range(independent.shape[0]):
+        x_dot[n_q + i] = s_ddot_tree[independent[i]]
+    for i in range(x_dot.shape[0]):
+        if not np.isfinite(x_dot[i]):
+            return 0
+    return -1
+
+
 def _on_manifold(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, U, sigma, Vt, count):
     """(σ, Vᵀ) of A_s at q* = q − A_s⁺ [Φ(q); 0], the point q moved onto the constraint manifold by one
     Gauss–Newton step (A_s = U Σ Vᵀ at q, its ``count`` largest singular values), whose null space is
@@ -1199,6 +1235,22 @@ class CompiledClosure:
         A_s, M and b), or None (flagged)."""
         return self._s_ddot_tree[system.independent] if self._call(system, q, s_dot, t) else None
 
+    def loop_model(self, system):
+        """``system`` (a ConstrainedSystem of this closure, partitioned) as the compiled integration loop
+        takes it (:class:`~projeq.assembly.fast.LoopModel`: ẋ by :func:`partitioned_state_derivative`,
+        which checks the system's event itself); None for the tangent rule or an interpreted kernel."""
+        from projeq.assembly.fast import LoopModel  # (fast imports the package that imports this module)
+
+        if self.rule != "partitioned" or not isinstance(self.phi, int):
+            return None
+        n_s = system.tree.n_s
+        pre = (self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree)
+        post = (self.m_h, float(self.constants[0]), float(SINGULAR_PIVOT), float(system.limit), np.zeros(system.n_q),
+                np.zeros(system.n_s), self._q_dot, self._s_ddot_tree, self._A, self._workspace.M_all,
+                self._workspace.b_all)
+        return LoopModel(_compiled_adapter(self.kernel), pre, (system.independent, system.dependent), post,
+                         checks_events=True)
+
     def state_derivative(self, system, x: NDArray, t: float):
         """ẋ = (q̇, s̈) = (ṡ_tree, s̈_tree[independent]) of ``system`` at x = (q, ṡ) (q̇ = ṡ_tree:
         K = E, and no Baumgarte term where the kernel applies), or None where the kernel flags
@@ -1279,6 +1331,14 @@ def _compiled(elastic: bool = False, pinned: bool = False) -> dict:
     return dict(zip(rules, kernels.jit(partitioned, tangent, cut_joint_rows, callees=_HELPERS,
                                        kernels=_compiled_callees(elastic),
                                        names=tuple(prefix + rule for rule in rules), **replaced)))
+
+
+@functools.cache
+def _compiled_adapter(partitioned_kernel):
+    """:func:`partitioned_state_derivative` compiled by numba, calling the compiled ``partitioned_kernel``
+    (one of :func:`_compiled`'s) by name."""
+    return kernels.jit(partitioned_state_derivative, kernels={"partitioned": partitioned_kernel},
+                       names=(f"{partitioned_kernel.py_func.__name__}_state_derivative",))[0]
 
 
 def _interpreted(rule: str, pinned: bool):

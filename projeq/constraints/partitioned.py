@@ -968,6 +968,16 @@ class PartitionedEvaluator:
         q, s_dot = kernel_state("q", q, system.n_q), kernel_state("s_dot", s_dot, system.n_s)
         return self._tree(q, s_dot, t, self.method)[0][system.independent]
 
+    def loop_model(self):
+        """The system as the compiled integration loop takes it
+        (:meth:`projeq.constraints.compiled.CompiledClosure.loop_model`, made once), or None where its ẋ is
+        not one compiled call of coordinate partitioning."""
+        if not hasattr(self, "_loop_model"):
+            whole = getattr(self, "state_derivative", None) == self._state_derivative  # one compiled call
+            kernel = self.system.compiled_kernel() if whole else None
+            self._loop_model = None if kernel is None else kernel.loop_model(self.system)
+        return self._loop_model
+
     def _compiled_accelerations(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
         """s̈ by the system's compiled kernel at real arguments; by the numpy path at complex ones (a
         complex step) and where the kernel flags (which raises the error naming the cause)."""

@@ -403,7 +403,7 @@ class _Run:
         labels += [f"the model's event {callable_name(e)}" for e in self.model.events()]
         events = [_event_wrapper(e, n_q, label) for e, label in zip(self.events + list(self.model.events()), labels)]
         dense = self.dense_output or bool(events)
-        compiled = None if dense else self.compiled_loop()
+        compiled = None if self.dense_output or self.events else self.compiled_loop()
         if compiled is not None:
             segment = self._compiled_segment(compiled, a, b, inside)
             if segment is not None:
@@ -430,14 +430,17 @@ class _Run:
         (:func:`projeq.simulation.loop.loop`), or None where solve_ivp steps: a method the loop does not
         step (implicit, projected, an OdeSolver class: ``method=scipy.integrate.DOP853`` keeps scipy's),
         events, options besides max_step, or an evaluator without a compiled one-call ẋ."""
-        key = (id(self.ev), self.method)
+        key = (self.ev, self.method)  # the evaluator itself: an id could be a collected one's, after a re-partition
         if key not in self.loops:
-            ready = not (self.events or self.model.events() or set(self.options) - {"max_step"})
+            ready = not (self.events or set(self.options) - {"max_step"})
             provider = getattr(self.ev, "loop_model", None) if ready else None
             if provider is not None and self.fused is not None:
                 self.fused(self.reached, self.x)  # ẋ's kernel compiled or found (the default evaluator's tier)
+            model = None if provider is None else provider()
+            if model is not None and self.model.events() and not model.checks_events:
+                model = None  # the model's events located by solve_ivp
             try:
-                self.loops[key] = None if provider is None else loop.loop(provider(), self.method)
+                self.loops[key] = loop.loop(model, self.method)
             except compilation.NotCompiled:  # rented: solve_ivp steps, its CPU spent from the budget
                 self.loops[key], self.renting = None, True
         return self.loops[key]
@@ -446,7 +449,7 @@ class _Run:
         """One segment from the current state at a to b by the compiled loop, as solve_ivp's result
         (its output rows, status and message); None where an evaluation failed for a reason the
         checked evaluation does not raise (the segment then runs again by solve_ivp)."""
-        first = self._continued(b - a).get("first_step") or 0.0
+        first, step_size = self._continued(b - a).get("first_step") or 0.0, self.step_size
         self.reached = a
         stepped = compiled.run(
             self.model.n_q, a, self.x, b, first, float(self.options.get("max_step", np.inf)), self.rtol, self.atol,
@@ -455,6 +458,7 @@ class _Run:
             self.nfev + stepped.nfev, self.steps + stepped.steps, self.calls + stepped.nfev, stepped.h_abs, stepped.t)
         if stepped.status == loop.EVALUATION_FAILED:
             self.checked_rhs(stepped.t, stepped.x_failed)  # raises, naming why
+            self.step_size = step_size  # solve_ivp steps the segment again, as the compiled loop began it
             return None
         rows = stepped.rows
         segment = SimpleNamespace(t=inside[:len(rows)], y=rows.T, status=0, t_events=None, y_events=None,

@@ -368,7 +368,10 @@ def _specialised(model, method: str) -> tuple:
     if key not in _SPECIALISED:
         numba = kernels.numba_module()
         arguments = (*model.pre, 0.0, *model.tree, np.zeros(1), 0, *model.post, np.zeros(1))
-        kernel = _address(model.kernel, model.kernel.overloads[tuple(numba.typeof(a) for a in arguments)].signature)
+        signature = tuple(numba.typeof(a) for a in arguments)
+        if signature not in model.kernel.overloads:  # a kernel Python has not called yet: compiled (or loaded) now
+            model.kernel.compile(signature)
+        kernel = _address(model.kernel, model.kernel.overloads[signature].signature)
         compiled = _compiled(tuple(numba.typeof(a) for a in (
             kernel, model.pre, model.tree, model.post, 0, tableau(method), 0.0, 0.0, True, 0.0, 0.0, 0.0, 0.0, 0,
             np.zeros(1), 0, np.zeros((1, 1)), np.zeros(1), np.zeros(1), np.zeros(1))))

@@ -59,6 +59,48 @@ def test_the_compiled_loop_takes_scipys_steps(scene, method, calls):
     np.testing.assert_array_equal(compiled.t, reference.t)
 
 
+#: 10x the largest relative difference measured over the cases of test_closed_loops_step_in_the_compiled_loop
+#: (q: 2.1e-14, s_dot: 5.9e-14, the four-bar's DOP853; the bicycle's at most 6.7e-16 and 0)
+CLOSED_RTOL = (2.1e-13, 6e-13)
+
+
+@pytest.mark.parametrize("method", loop.METHODS)
+@pytest.mark.parametrize("scene", ["four_bar", "whipple_bicycle"])
+def test_closed_loops_step_in_the_compiled_loop(scene, method, calls):
+    """ConstrainedSystems (coordinate partitioning): a four-bar closed by Φ and the Whipple bicycle
+    (holonomic and Pfaffian rows, UserJoints from sympy) step every segment in the compiled loop, their
+    ẋ the closure's one compiled call, and equal scipy's run of the same method: the same evaluations
+    (DOP853 fewer: with the partition's event solve_ivp forms the interpolant at each segment's end),
+    q and ṡ to round-off."""
+    system = pq.scenes.SCENES[scene].build()
+    compiled = pq.simulate(system, 0.5, method=method, n_points=21)
+    assert calls["segments"] == 20
+    reference = pq.simulate(system, 0.5, method=getattr(scipy.integrate, method), n_points=21)
+    assert calls["segments"] == 20
+    assert compiled.nfev == reference.nfev if method != "DOP853" else compiled.nfev <= reference.nfev
+    dq, ds = _differences(compiled, reference)
+    assert dq <= CLOSED_RTOL[0] and ds <= CLOSED_RTOL[1], (dq, ds)
+
+
+def test_a_partition_degenerating_inside_a_compiled_segment(calls):
+    """The crank–rocker four-bar of tests/constraints/test_repivot.py (independent velocity the rocker's,
+    which degenerates at t ≈ 0.091 s): the compiled ẋ fails where κ reaches 0.999 of the partition's
+    limit, that segment is stepped again by solve_ivp, which locates the event κ − limit and
+    re-partitions; the switch lands where scipy's run puts it (measured 5e-16 s apart; bound 1e-13 s),
+    the rows within 10× the measured 3.4e-14 (RK45) and 7.7e-14 (DOP853) of scipy's."""
+    from projeq.scenes.mechanisms import four_bar
+
+    system = four_bar(a=0.3, b=1.0, c=0.8, d=1.0, m=(1.0, 2.0, 1.5), g=9.81, theta1=0.0, omega1=6.0) \
+        .with_independent([1], repivot=True)
+    for method, bound in (("RK45", 3.4e-13), ("DOP853", 7.7e-13)):
+        runs = [pq.simulate(system, 0.3, t_eval=np.linspace(0, 0.3, 31), rtol=1e-9, atol=1e-11, method=m)
+                for m in (method, getattr(scipy.integrate, method))]
+        assert [p[1] for p in runs[0].partitions] == [p[1] for p in runs[1].partitions] == [(1,), (2,)]
+        assert abs(runs[0].partitions[1][0] - runs[1].partitions[1][0]) < 1e-13
+        assert np.abs(runs[0].q - runs[1].q).max() < bound
+    assert calls["segments"] == 2 * 21  # the segment with the switch: the compiled loop up to κ, then again
+
+
 def test_output_times_and_the_largest_step(calls):
     """Unequal output times (the first at t_start, some at segments' ends, some between) and
     max_step: the rows scipy's run gives, at the same times (measured: 5.0e-16 relative in q, 1.1e-15
