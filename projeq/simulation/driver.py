@@ -6,9 +6,10 @@ non-finite state or Ctrl-C keeps everything computed up to the last finished seg
 each segment is one ``scipy.integrate.solve_ivp`` call with the user's method, tolerances
 and events, plus the model's own events (a ConstrainedSystem's degenerating partition),
 after which the run goes on with the model's :meth:`~projeq.system.Model.after_event` — or,
-for RK23, RK45 and DOP853 on a model whose evaluator has a compiled one-call ẋ and no events,
-one call of the compiled loop (:mod:`projeq.simulation.loop`: scipy's algorithm, the same steps
-to round-off, without Python between the steps).
+for RK23, RK45 and DOP853 on a model whose evaluator has a compiled one-call ẋ and no events of
+the user's, one call of the compiled loop (:mod:`projeq.simulation.loop`: scipy's algorithm, the
+same steps to round-off, without Python between the steps; a ConstrainedSystem's ẋ fails where its
+partition's event nears, and solve_ivp steps that segment again and locates it).
 Quaternions are normalised where the pose is evaluated and in the output.
 
 The steps: :class:`_Run` checks the arguments and holds the run's state, ``_Run.solve``
@@ -167,8 +168,9 @@ def simulate(
         to crawl at their stability limit goes on with Radau (``Result.method`` "DOP853, Radau
         from t = …", the evidence in ``Result.message``); ``Result.method`` names the choice. Or any method of
         ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...): by name, RK23, RK45
-        and DOP853 step in the compiled loop where the model has a compiled ẋ and no events
-        (:mod:`projeq.simulation.loop`; scipy's steps to round-off), and ``method=`` the scipy class
+        and DOP853 step in the compiled loop where the model has a compiled ẋ (a tree, or a loop
+        closed by coordinate partitioning) and no ``events`` (:mod:`projeq.simulation.loop`; scipy's
+        steps to round-off), and ``method=`` the scipy class
         (``scipy.integrate.DOP853``) keeps solve_ivp stepping;
         or ``"RK45-projected"`` / ``"DOP853-projected"``: that method with each step projected
         onto the initial energy, so that a conservative scleronomic system's energy error

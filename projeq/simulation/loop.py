@@ -16,10 +16,12 @@ the same number of evaluations:
   starting-step algorithm (§II.4) unless the segment continues the previous one's;
 - output rows at the requested times inside each step by the method's interpolant.
 
-The model enters as data: a first-class function (the compiled ẋ kernel,
-:meth:`projeq.assembly.fast.FastEvaluator.loop_model`) and the tuples of arrays it takes, so the
+The model enters as data: a first-class function (the compiled ẋ kernel of a tree,
+:meth:`projeq.assembly.fast.FastEvaluator.loop_model`, or of a loop closed by coordinate partitioning,
+:meth:`projeq.constraints.compiled.CompiledClosure.loop_model`) and the tuples of arrays it takes, so the
 loop is compiled once per signature of the ẋ kernel — once for every tree without joints of kind
-GIVEN, once for those with them — and never per model, chain length or set of force laws; the
+GIVEN, once for those with them, once per variant of the closures' kernel (rigid or elastic tree, Φ
+a user's function or cut joints) — and never per model, chain length or set of force laws; the
 method's tableau is data too. It returns to Python once per segment of ``simulate`` (a chunk of
 (t_end − t_start) / n_segments): there the rows are checked, progress is reported and Ctrl-C
 takes effect, keeping every finished segment.
