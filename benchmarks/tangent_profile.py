@@ -111,7 +111,7 @@ def profile(name: str, budget: float) -> dict:
     head = (closure.phi, closure.pins, closure.fields, closure.pfaffian, closure.joints, closure.tree)
     kept = np.array(system._tangent, dtype=float)
     args = (*head, q, s_dot, t, m_h, system.independent, n - k, system.separation, closure.constants[0], kept,
-            SINGULAR_PIVOT, closure._q_dot, closure._s_ddot_tree, closure._A, ws.M_all, ws.b_all)
+            SINGULAR_PIVOT, closure._q_dot, closure._s_ddot_tree, closure._A, ws.M_all, ws.b_all, closure._kappa)
     cycled = itertools.cycle(states)
     pieces = {  # name: (a call, how many s̈ pieces it times)
         "Φ_q (complex step)": (lambda: loops["jacobian_loop"](*head, Q, t, m_h, As[0].copy(), r), r * STATES),

@@ -496,11 +496,12 @@ class LoopModel:
     ``kernel(*pre, t, *tree, x, n_q, *post, x_dot)`` (as :meth:`FastEvaluator.state_derivative` calls
     it) with the arrays before t, the tree's and the workspace's; ``loops``, the loops compiled for it,
     by method; ``checks_events``: the kernel fails where the model's own events would fire (a
-    ConstrainedSystem's partition degenerating), so that simulate steps that segment by solve_ivp."""
+    ConstrainedSystem's partition degenerating), so that simulate steps that segment by solve_ivp;
+    ``before()``: called before each compiled segment (state the kernel keeps between calls)."""
 
-    def __init__(self, kernel, pre: tuple, tree: tuple, post: tuple, checks_events: bool = False):
+    def __init__(self, kernel, pre: tuple, tree: tuple, post: tuple, checks_events: bool = False, before=None):
         self.kernel, self.pre, self.tree, self.post, self.loops = kernel, pre, tree, post, {}
-        self.checks_events = checks_events
+        self.checks_events, self.before = checks_events, before
 
 
 class _Workspace:

@@ -714,13 +714,15 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
 
 
 def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept,
-            pivot, q_dot, s_ddot_tree, A, M, b):
+            pivot, q_dot, s_ddot_tree, A, M, b, kappa):
     """The constrained s̈ of :class:`~projeq.constraints.partitioned.TangentSystem`: F = N N_ind⁻¹ with
     N the null space of A_s = U Σ Vᵀ continued along the branch (``kept``: the tangent kept last,
     n × n_s, NaN where none; overwritten where the null space is separated, its rule), f̄ =
     x₀ − F x₀[independent] with x₀ = A_s⁺(−γ) over the ``rank`` largest singular values above
     ``acting`` σ_max, and ṡ_tree = F ṡ + f with f the same particular solution of A_s f = b_s;
-    otherwise as :func:`partitioned`. DEGENERATE where N_ind is singular or A_s not finite."""
+    otherwise as :func:`partitioned`; writes κ = 1/σ_min(N_ind) = ‖F‖₂ (N orthonormal; 1 without
+    independent velocities) into ``kappa[0]``.
+    DEGENERATE where N_ind is singular or A_s not finite."""
     n, m, k = q.shape[0], A.shape[0], independent.shape[0]
     _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
     U, sigma, Vt = _svd(A)
@@ -745,6 +747,7 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     F = _scaled(N, independent)
     if F.shape[0] == 0:
         return DEGENERATE
+    kappa[0] = np.linalg.svd(F)[1][0] if k else 1.0  # (no free motion: nothing to describe)
     s_dot_tree = _matvec(F, s_dot)
     if b_s.shape[0]:  # ṡ_tree = F ṡ + f, A_s f = b_s with f[independent] = 0
         f = _particular(U, sigma, Vt, -b_s, min(count, rank), F, independent)
@@ -765,10 +768,7 @@ def partitioned_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, i
     κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ reaches :data:`EVENT_MARGIN` · ``limit`` — the ConstrainedSystem's own event
     κ − limit, which solve_ivp then locates, stepping that segment again, and re-partitions there
     (solve_ivp looks for a sign change at the steps' ends, where this call is made: none is missed)."""
-    for i in range(n_q):
-        q[i] = x[i]
-    for i in range(s_dot.shape[0]):
-        s_dot[i] = x[n_q + i]
+    _split(x, n_q, q, s_dot)
     if partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
                    q_dot, s_ddot_tree, A, M, b) != DONE:
         return 0
@@ -776,9 +776,32 @@ def partitioned_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, i
     for r in range(dependent.shape[0]):
         for c in range(dependent.shape[0]):
             A_dep[r, c] = A[r, dependent[c]]
-    sigma = np.linalg.svd(A_dep)[1]
-    if not sigma[-1] * EVENT_MARGIN * limit > np.linalg.svd(A)[1][0]:
+    if not np.linalg.svd(A_dep)[1][-1] * EVENT_MARGIN * limit > np.linalg.svd(A)[1][0]:
         return 0
+    return _state_rates(q_dot, s_ddot_tree, independent, n_q, x_dot)
+
+
+def tangent_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, independent, x, n_q, m_h, rank, separation,
+                             acting, kept, pivot, limit, q, s_dot, q_dot, s_ddot_tree, A, M, b, kappa, x_dot):
+    """:func:`partitioned_state_derivative` for :func:`tangent` (the null-space form): 0 where its
+    κ = 1/σ_min(N_ind) reaches :data:`EVENT_MARGIN` · ``limit`` (the TangentSystem's event)."""
+    _split(x, n_q, q, s_dot)
+    if tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting,
+               kept, pivot, q_dot, s_ddot_tree, A, M, b, kappa) != DONE or not kappa[0] < EVENT_MARGIN * limit:
+        return 0
+    return _state_rates(q_dot, s_ddot_tree, independent, n_q, x_dot)
+
+
+def _split(x, n_q, q, s_dot):
+    """q and ṡ ← the parts of x = (q, ṡ)."""
+    for i in range(n_q):
+        q[i] = x[i]
+    for i in range(s_dot.shape[0]):
+        s_dot[i] = x[n_q + i]
+
+
+def _state_rates(q_dot, s_ddot_tree, independent, n_q, x_dot) -> int:
+    """x_dot ← (q̇, s̈_tree[independent]): −1, or 0 where an entry is not finite."""
     for i in range(n_q):
         x_dot[i] = q_dot[i]
     for i in range(independent.shape[0]):
@@ -1194,6 +1217,7 @@ class CompiledClosure:
         self._workspace = ev._real
         self.tree = tree_arrays(ev, float)
         self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
+        self._kappa = np.zeros(1)  # the tangent rule's κ
         self._kept = (None, None)  # (the system, the tangent it keeps) of the last call (_kept_tangent)
 
     def _call(self, system, q: NDArray, s_dot: NDArray, t: float) -> bool:
@@ -1209,7 +1233,7 @@ class CompiledClosure:
             flag = self.kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, q, s_dot, t,
                                self.m_h, system.independent, system.tree.n_s - system.n_s,
                                system.separation, self.constants[0], self._kept_tangent(system), SINGULAR_PIVOT,
-                               self._q_dot, self._s_ddot_tree, self._A, M, b)
+                               self._q_dot, self._s_ddot_tree, self._A, M, b, self._kappa)
         return flag == DONE
 
     def _kept_tangent(self, system) -> NDArray:
@@ -1236,20 +1260,34 @@ class CompiledClosure:
         return self._s_ddot_tree[system.independent] if self._call(system, q, s_dot, t) else None
 
     def loop_model(self, system):
-        """``system`` (a ConstrainedSystem of this closure, partitioned) as the compiled integration loop
-        takes it (:class:`~projeq.assembly.fast.LoopModel`: ẋ by :func:`partitioned_state_derivative`,
-        which checks the system's event itself); None for the tangent rule or an interpreted kernel."""
+        """``system`` (a ConstrainedSystem of this closure) as the compiled integration loop takes it
+        (:class:`~projeq.assembly.fast.LoopModel`: ẋ by :func:`partitioned_state_derivative` or
+        :func:`tangent_state_derivative`, which check the system's event themselves); None for an
+        interpreted kernel."""
         from projeq.assembly.fast import LoopModel  # (fast imports the package that imports this module)
 
-        if self.rule != "partitioned" or not isinstance(self.phi, int):
+        if not isinstance(self.phi, int):
             return None
-        n_s = system.tree.n_s
         pre = (self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree)
-        post = (self.m_h, float(self.constants[0]), float(SINGULAR_PIVOT), float(system.limit), np.zeros(system.n_q),
-                np.zeros(system.n_s), self._q_dot, self._s_ddot_tree, self._A, self._workspace.M_all,
-                self._workspace.b_all)
-        return LoopModel(_compiled_adapter(self.kernel), pre, (system.independent, system.dependent), post,
-                         checks_events=True)
+        buffers = (np.zeros(system.n_q), np.zeros(system.n_s), self._q_dot, self._s_ddot_tree, self._A,
+                   self._workspace.M_all, self._workspace.b_all)
+        if self.rule == "partitioned":
+            return LoopModel(_compiled_adapter(self.kernel, self.rule), pre, (system.independent, system.dependent),
+                             (self.m_h, float(self.constants[0]), float(SINGULAR_PIVOT), float(system.limit),
+                              *buffers), checks_events=True)
+        kept = self._kept_tangent(system)
+        return LoopModel(_compiled_adapter(self.kernel, self.rule), pre, (system.independent,),
+                         (self.m_h, system.tree.n_s - system.n_s, float(system.separation), float(self.constants[0]),
+                          kept, float(SINGULAR_PIVOT), float(system.limit), *buffers, self._kappa),
+                         checks_events=True, before=lambda: self._keep_tangent(system, kept))
+
+    def _keep_tangent(self, system, kept: NDArray) -> None:
+        """The tangent ``system`` keeps, in the array ``kept`` the compiled loop's ẋ reads and writes
+        (the numpy path between segments may have kept another)."""
+        found = self._kept_tangent(system)
+        if found is not kept:
+            kept[:, :] = found
+            system._tangent, self._kept = kept, (weakref.ref(system), kept)
 
     def state_derivative(self, system, x: NDArray, t: float):
         """ẋ = (q̇, s̈) = (ṡ_tree, s̈_tree[independent]) of ``system`` at x = (q, ṡ) (q̇ = ṡ_tree:
@@ -1334,11 +1372,12 @@ def _compiled(elastic: bool = False, pinned: bool = False) -> dict:
 
 
 @functools.cache
-def _compiled_adapter(partitioned_kernel):
-    """:func:`partitioned_state_derivative` compiled by numba, calling the compiled ``partitioned_kernel``
-    (one of :func:`_compiled`'s) by name."""
-    return kernels.jit(partitioned_state_derivative, kernels={"partitioned": partitioned_kernel},
-                       names=(f"{partitioned_kernel.py_func.__name__}_state_derivative",))[0]
+def _compiled_adapter(kernel, rule: str):
+    """:func:`partitioned_state_derivative` or :func:`tangent_state_derivative` (``rule``) compiled by
+    numba, calling the compiled ``kernel`` (one of :func:`_compiled`'s) by the rule's name."""
+    adapter = partitioned_state_derivative if rule == "partitioned" else tangent_state_derivative
+    return kernels.jit(adapter, callees=(_split, _state_rates), kernels={rule: kernel},
+                       names=(f"{kernel.py_func.__name__}_state_derivative",))[0]
 
 
 def _interpreted(rule: str, pinned: bool):

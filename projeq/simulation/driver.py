@@ -168,8 +168,8 @@ def simulate(
         to crawl at their stability limit goes on with Radau (``Result.method`` "DOP853, Radau
         from t = …", the evidence in ``Result.message``); ``Result.method`` names the choice. Or any method of
         ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...): by name, RK23, RK45
-        and DOP853 step in the compiled loop where the model has a compiled ẋ (a tree, or a loop
-        closed by coordinate partitioning) and no ``events`` (:mod:`projeq.simulation.loop`; scipy's
+        and DOP853 step in the compiled loop where the model has a compiled ẋ (a tree, or a closed
+        loop's one compiled call) and no ``events`` (:mod:`projeq.simulation.loop`; scipy's
         steps to round-off), and ``method=`` the scipy class
         (``scipy.integrate.DOP853``) keeps solve_ivp stepping;
         or ``"RK45-projected"`` / ``"DOP853-projected"``: that method with each step projected

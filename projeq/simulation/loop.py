@@ -17,8 +17,8 @@ the same number of evaluations:
 - output rows at the requested times inside each step by the method's interpolant.
 
 The model enters as data: a first-class function (the compiled ẋ kernel of a tree,
-:meth:`projeq.assembly.fast.FastEvaluator.loop_model`, or of a loop closed by coordinate partitioning,
-:meth:`projeq.constraints.compiled.CompiledClosure.loop_model`) and the tuples of arrays it takes, so the
+:meth:`projeq.assembly.fast.FastEvaluator.loop_model`, or of a closed loop, partitioned or in the
+null-space form, :meth:`projeq.constraints.compiled.CompiledClosure.loop_model`) and the tuples of arrays it takes, so the
 loop is compiled once per signature of the ẋ kernel — once for every tree without joints of kind
 GIVEN, once for those with them, once per variant of the closures' kernel (rigid or elastic tree, Φ
 a user's function or cut joints) — and never per model, chain length or set of force laws; the
@@ -332,6 +332,8 @@ class CompiledLoop:
         rows, rate, x_failed = np.empty((len(t_eval), len(state))), np.empty(len(state)), np.empty(len(state))
         status, n_rows, nfev, steps, known, stopped_by = PAUSED, 0, 0, 0, False, None
         model = self.model
+        if model.before is not None:
+            model.before()
         while status == PAUSED:
             with _signals_held():  # the arguments of the types compiled for (the entry point checks none)
                 status, n_rows, more, taken, t, h_abs = self.compiled(

@@ -82,6 +82,29 @@ def test_closed_loops_step_in_the_compiled_loop(scene, method, calls):
     assert dq <= CLOSED_RTOL[0] and ds <= CLOSED_RTOL[1], (dq, ds)
 
 
+#: 10x the largest relative difference measured over the cases of test_the_null_space_form_steps_in_the_compiled_loop
+#: (q: 1.35e-12, s_dot: 1.36e-12, A02's DOP853 through its singular positions; A01 at most 4.6e-13 and 2.9e-13,
+#: A04 6.1e-14 and 8.3e-14)
+TANGENT_RTOL = (1.4e-11, 1.4e-11)
+
+
+@pytest.mark.parametrize("method", ["RK45", "DOP853"])
+@pytest.mark.parametrize("scene", ["simple_pendulum", "n_four_bar", "bricard"])
+def test_the_null_space_form_steps_in_the_compiled_loop(scene, method, calls):
+    """TangentSystems (IFToMM A01, A02 through singular positions, A04 with a redundant row): the
+    compiled ẋ of the null-space form (its kept tangent the system's, between segments too) and its
+    event κ = 1/σ_min(N_ind) − limit: the runs re-partition where scipy's do (A01 once, at t = 0.5897 s:
+    measured 2.6e-15 s apart, bound 3e-14 s), q and ṡ to round-off."""
+    system = pq.scenes.SCENES[scene].build()
+    compiled = pq.simulate(system, 1.0, method=method, n_points=21)
+    assert calls["segments"] >= 20
+    reference = pq.simulate(system, 1.0, method=getattr(scipy.integrate, method), n_points=21)
+    assert [p[1:] for p in compiled.partitions] == [p[1:] for p in reference.partitions]
+    assert np.abs(np.subtract([p[0] for p in compiled.partitions], [p[0] for p in reference.partitions])).max() < 3e-14
+    dq, ds = _differences(compiled, reference)
+    assert dq <= TANGENT_RTOL[0] and ds <= TANGENT_RTOL[1], (dq, ds)
+
+
 def test_a_partition_degenerating_inside_a_compiled_segment(calls):
     """The crank–rocker four-bar of tests/constraints/test_repivot.py (independent velocity the rocker's,
     which degenerates at t ≈ 0.091 s): the compiled ẋ fails where κ reaches 0.999 of the partition's
