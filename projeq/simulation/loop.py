@@ -90,6 +90,16 @@ def _rhs(f, pre, tree, post, n_q, t, x, x_dot):
     return f(*pre, t, *tree, x, n_q, *post, x_dot)
 
 
+def _stage(f, pre, tree, post, n_q, K, a, s, h, t, y, x, x_failed):
+    """K[s] ← ẋ(t, x) at the stage x = y + h Σ_(j<s) a_j K[j] (:func:`_combine`); whether the kernel failed
+    there (x then copied into x_failed)."""
+    _combine(K, a, s, h, y, x)
+    if _rhs(f, pre, tree, post, n_q, t, x, K[s]) < 0:
+        return False
+    _copy(x, x_failed)
+    return True
+
+
 def _rms(v, scale):
     """scipy's norm of v / scale: the root mean square."""
     total = 0.0
@@ -248,17 +258,11 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
             h_abs = abs(h)
             _copy(rate, K[0])
             for s in range(1, n_stages):
-                _combine(K, A[s], s, h, y, work[1])
                 nfev += 1
-                failed = _rhs(f, pre, tree, post, n_q, t + C[s] * h, work[1], K[s])
-                if failed >= 0:
-                    _copy(work[1], x_failed)
+                if _stage(f, pre, tree, post, n_q, K, A[s], s, h, t + C[s] * h, y, work[1], x_failed):
                     return EVALUATION_FAILED, n_rows, nfev, steps, t + C[s] * h, h_abs
-            _combine(K, B, n_stages, h, y, y_new)
             nfev += 1
-            failed = _rhs(f, pre, tree, post, n_q, t + h, y_new, K[n_stages])
-            if failed >= 0:
-                _copy(y_new, x_failed)
+            if _stage(f, pre, tree, post, n_q, K, B, n_stages, h, t + h, y, y_new, x_failed):
                 return EVALUATION_FAILED, n_rows, nfev, steps, t + h, h_abs
             scale = work[0]
             for i in range(n):
@@ -279,11 +283,8 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
             last += 1
         if last > n_rows:
             for s in range(n_stages + 1, A.shape[0]):  # DOP853's extra stages of its dense output
-                _combine(K, A[s], s, h, y, work[1])
                 nfev += 1
-                failed = _rhs(f, pre, tree, post, n_q, t + C[s] * h, work[1], K[s])
-                if failed >= 0:
-                    _copy(work[1], x_failed)
+                if _stage(f, pre, tree, post, n_q, K, A[s], s, h, t + C[s] * h, y, work[1], x_failed):
                     return EVALUATION_FAILED, n_rows, nfev, steps, t + C[s] * h, h_abs
             _dense_rows(method, K, t, h, y, y_new, K[n_stages], t_eval, n_rows, last, rows, work)
             n_rows = last
@@ -297,7 +298,7 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
     return FINISHED, n_rows, nfev, steps, t, h_abs
 
 
-_CALLEES = (_rhs, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows)
+_CALLEES = (_rhs, _stage, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows)
 
 
 @functools.cache
