@@ -408,8 +408,9 @@ class _Run:
         compiled = None if self.dense_output or self.events else self.compiled_loop()
         if compiled is not None:
             segment = self._compiled_segment(compiled, a, b, inside)
-            if segment is not None:
+            if not isinstance(segment, float):
                 return segment
+            a, inside = segment, inside[inside > segment]  # solve_ivp goes on where the compiled loop stopped
         extra = not dense and not (len(inside) and inside[-1] == b)  # b as an output time
         started = _time.process_time()
         segment = solve_ivp(self.rhs, (a, b), self.x, method=_counted(self.solver, self),
@@ -449,24 +450,29 @@ class _Run:
 
     def _compiled_segment(self, compiled, a: float, b: float, inside: NDArray):
         """One segment from the current state at a to b by the compiled loop, as solve_ivp's result
-        (its output rows, status and message); None where an evaluation failed for a reason the
-        checked evaluation does not raise (the segment then runs again by solve_ivp)."""
-        first, step_size = self._continued(b - a).get("first_step") or 0.0, self.step_size
+        (its output rows, status and message); where an evaluation failed for a reason the checked
+        evaluation does not raise (a closed loop's partition nearing its event), the rows up to the last
+        accepted step kept and the time of that step, from where solve_ivp goes on."""
+        first = self._continued(b - a).get("first_step") or 0.0
         self.reached = a
         stepped = compiled.run(
             self.model.n_q, a, self.x, b, first, float(self.options.get("max_step", np.inf)), self.rtol, self.atol,
             np.ascontiguousarray(inside, dtype=float), self._paused, MONITOR_EVERY if self.may_be_singular else 0)
         self.nfev, self.steps, self.calls, self.step_size, self.reached = (
-            self.nfev + stepped.nfev, self.steps + stepped.steps, self.calls + stepped.nfev, stepped.h_abs, stepped.t)
+            self.nfev + stepped.nfev, self.steps + stepped.steps, self.calls + stepped.nfev, stepped.h_abs,
+            stepped.t_failed)
         if stepped.status == loop.EVALUATION_FAILED:
-            self.checked_rhs(stepped.t, stepped.x_failed)  # raises, naming why
-            self.step_size = step_size  # solve_ivp steps the segment again, as the compiled loop began it
-            return None
+            self.checked_rhs(stepped.t_failed, stepped.x_failed)  # raises, naming why
         rows = stepped.rows
         segment = SimpleNamespace(t=inside[:len(rows)], y=rows.T, status=0, t_events=None, y_events=None,
                                   sol=SimpleNamespace(ts=np.array([a, b if stepped.status == loop.FINISHED
                                                                    else stepped.t])),
                                   message="The solver successfully reached the end of the integration interval.")
+        if stepped.status == loop.EVALUATION_FAILED:
+            self._keep(segment)
+            self.check_rows(np.vstack((rows, stepped.state)), stepped.t)
+            self.x, self.reached = stepped.state, stepped.t
+            return float(stepped.t)
         if stepped.status == loop.TOO_SMALL_STEP:
             segment.status, segment.message = -1, "Required step size is less than spacing between numbers."
         elif stepped.status == loop.FINISHED:

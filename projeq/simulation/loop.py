@@ -52,15 +52,17 @@ FINISHED, TOO_SMALL_STEP, EVALUATION_FAILED, PAUSED, STOPPED = 0, 1, 2, 3, 4
 
 
 class Stepped(NamedTuple):
-    """What :meth:`CompiledLoop.run` did: how it ended (``status``), the time ``t`` and ``state`` reached, the
-    ``rows`` at the output times passed, the state where an evaluation failed (``x_failed``), the
-    evaluations and steps taken, the next step size and the monitor's exception (status STOPPED)."""
+    """What :meth:`CompiledLoop.run` did: how it ended (``status``), the time ``t`` and ``state`` reached (on
+    EVALUATION_FAILED, of the last accepted step), the ``rows`` at the output times passed, the state
+    and time where an evaluation failed (``x_failed``, ``t_failed``), the evaluations and steps taken,
+    the next step size and the monitor's exception (status STOPPED)."""
 
     status: int
     t: float
     rows: NDArray
     state: NDArray
     x_failed: NDArray
+    t_failed: float
     nfev: int
     steps: int
     h_abs: float
@@ -221,11 +223,12 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
     there where ``known`` (else evaluated); h_abs > 0 the next step (else HNW's first step). Writes
     the rows at the output times t_eval[first_row:] (increasing, inside [t, t_bound]) into rows, and
     leaves in state and rate the state and ẋ where it stopped. Returns (status, rows written,
-    evaluations, steps, time reached, next step size), the status FINISHED; PAUSED after the first
+    evaluations, steps, time reached, next step size, time of x_failed), the status FINISHED; PAUSED after the first
     step that brings the evaluations to ``pause`` (> 0; the caller checks the state and goes on with
     ``known`` True: the same steps as without the pause); TOO_SMALL_STEP (scipy's failure: the step
     size fell below the spacing of the numbers near t); or EVALUATION_FAILED, the state evaluated in
-    x_failed (the caller's checked evaluation names why)."""
+    x_failed (the caller's checked evaluation names why), the state and time reached those of the last
+    accepted step (the caller may go on from there)."""
     dop853, A, B, C, E, E3, dense, n_stages, exponent = method
     n = state.shape[0]
     K = np.empty((max(A.shape[0], n_stages + 1), n))
@@ -242,7 +245,7 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
         h_abs = _first_choice(rate, work[2], work[0], h0, d1, abs(t_bound - t), max_step, exponent)
     if failed >= 0:
         _copy(y, x_failed)
-        return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs
+        return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t
     while t != t_bound:
         min_step = 10 * abs(np.nextafter(t, np.inf) - t)
         h_abs = max_step if h_abs > max_step else (min_step if h_abs < min_step else h_abs)
@@ -250,7 +253,7 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
         while not accepted:
             if h_abs < min_step:
                 _copy(y, state)
-                return TOO_SMALL_STEP, n_rows, nfev, steps, t, h_abs
+                return TOO_SMALL_STEP, n_rows, nfev, steps, t, h_abs, t
             t_new = t + h_abs
             if t_new - t_bound > 0:
                 t_new = t_bound
@@ -260,10 +263,12 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
             for s in range(1, n_stages):
                 nfev += 1
                 if _stage(f, pre, tree, post, n_q, K, A[s], s, h, t + C[s] * h, y, work[1], x_failed):
-                    return EVALUATION_FAILED, n_rows, nfev, steps, t + C[s] * h, h_abs
+                    _copy(y, state)
+                    return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t + C[s] * h
             nfev += 1
             if _stage(f, pre, tree, post, n_q, K, B, n_stages, h, t + h, y, y_new, x_failed):
-                return EVALUATION_FAILED, n_rows, nfev, steps, t + h, h_abs
+                _copy(y, state)
+                return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t + h
             scale = work[0]
             for i in range(n):
                 scale[i] = atol + max(abs(y[i]), abs(y_new[i])) * rtol
@@ -285,7 +290,8 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
             for s in range(n_stages + 1, A.shape[0]):  # DOP853's extra stages of its dense output
                 nfev += 1
                 if _stage(f, pre, tree, post, n_q, K, A[s], s, h, t + C[s] * h, y, work[1], x_failed):
-                    return EVALUATION_FAILED, n_rows, nfev, steps, t + C[s] * h, h_abs
+                    _copy(y, state)
+                    return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t + C[s] * h
             _dense_rows(method, K, t, h, y, y_new, K[n_stages], t_eval, n_rows, last, rows, work)
             n_rows = last
         t = t_new
@@ -293,9 +299,9 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
         _copy(K[n_stages], rate)
         if pause > 0 and nfev >= pause and t != t_bound:
             _copy(y, state)
-            return PAUSED, n_rows, nfev, steps, t, h_abs
+            return PAUSED, n_rows, nfev, steps, t, h_abs, t
     _copy(y, state)
-    return FINISHED, n_rows, nfev, steps, t, h_abs
+    return FINISHED, n_rows, nfev, steps, t, h_abs, t
 
 
 _CALLEES = (_rhs, _stage, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows)
@@ -337,7 +343,7 @@ class CompiledLoop:
             model.before()
         while status == PAUSED:
             with _signals_held():  # the arguments of the types compiled for (the entry point checks none)
-                status, n_rows, more, taken, t, h_abs = self.compiled(
+                status, n_rows, more, taken, t, h_abs, t_failed = self.compiled(
                     self.kernel, model.pre, model.tree, model.post, int(n_q), self.method, float(t), float(t_bound),
                     known, float(h_abs), float(max_step), float(rtol), float(atol), int(every), t_eval, n_rows, rows,
                     state, rate, x_failed)
@@ -347,7 +353,7 @@ class CompiledLoop:
                     monitor(t, state)
                 except Exception as exc:  # noqa: BLE001 - the caller raises it, keeping the rows
                     status, stopped_by = STOPPED, exc
-        return Stepped(status, t, rows[:n_rows], state, x_failed, nfev, steps, h_abs, stopped_by)
+        return Stepped(status, t, rows[:n_rows], state, x_failed, t_failed, nfev, steps, h_abs, stopped_by)
 
 
 def _layout(value):

@@ -108,7 +108,7 @@ def test_the_null_space_form_steps_in_the_compiled_loop(scene, method, calls):
 def test_a_partition_degenerating_inside_a_compiled_segment(calls):
     """The crank–rocker four-bar of tests/constraints/test_repivot.py (independent velocity the rocker's,
     which degenerates at t ≈ 0.091 s): the compiled ẋ fails where κ reaches 0.999 of the partition's
-    limit, that segment is stepped again by solve_ivp, which locates the event κ − limit and
+    limit, solve_ivp goes on from the compiled loop's last step, locates the event κ − limit and
     re-partitions; the switch lands where scipy's run puts it (measured 5e-16 s apart; bound 1e-13 s),
     the rows within 10× the measured 3.4e-14 (RK45) and 7.7e-14 (DOP853) of scipy's."""
     from projeq.scenes.mechanisms import four_bar
@@ -121,7 +121,7 @@ def test_a_partition_degenerating_inside_a_compiled_segment(calls):
         assert [p[1] for p in runs[0].partitions] == [p[1] for p in runs[1].partitions] == [(1,), (2,)]
         assert abs(runs[0].partitions[1][0] - runs[1].partitions[1][0]) < 1e-13
         assert np.abs(runs[0].q - runs[1].q).max() < bound
-    assert calls["segments"] == 2 * 21  # the segment with the switch: the compiled loop up to κ, then again
+    assert calls["segments"] == 2 * 21  # the segment with the switch: the compiled loop up to κ, after it too
 
 
 def test_output_times_and_the_largest_step(calls):
