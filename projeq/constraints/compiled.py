@@ -766,7 +766,7 @@ def partitioned_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, i
     integration loop calls a model's ẋ (:mod:`projeq.simulation.loop`; ``q``, ``s_dot``: buffers of the
     state's parts): −1, or 0 where the kernel flags, ẋ is not finite or the partition's condition
     κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ reaches :data:`EVENT_MARGIN` · ``limit`` — the ConstrainedSystem's own event
-    κ − limit, which solve_ivp then locates, stepping that segment again, and re-partitions there
+    κ − limit, which solve_ivp then locates, going on from the loop's last step, and re-partitions there
     (solve_ivp looks for a sign change at the steps' ends, where this call is made: none is missed)."""
     _split(x, n_q, q, s_dot)
     if partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,

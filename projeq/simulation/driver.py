@@ -9,7 +9,7 @@ after which the run goes on with the model's :meth:`~projeq.system.Model.after_e
 for RK23, RK45 and DOP853 on a model whose evaluator has a compiled one-call ẋ and no events of
 the user's, one call of the compiled loop (:mod:`projeq.simulation.loop`: scipy's algorithm, the
 same steps to round-off, without Python between the steps; a ConstrainedSystem's ẋ fails where its
-partition's event nears, and solve_ivp steps that segment again and locates it).
+partition's event nears, and solve_ivp goes on from the loop's last step and locates it).
 Quaternions are normalised where the pose is evaluated and in the output.
 
 The steps: :class:`_Run` checks the arguments and holds the run's state, ``_Run.solve``
