@@ -343,7 +343,7 @@ class _Run:
         self.out_of_range = False  # warned that a subsystem left the range of its model
         self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
-        self.loops, self.renting = {}, False  # the compiled loop (or None) per evaluator and method: compiled_loop
+        self.loops, self.renting = {}, False  # (evaluator, its compiled loop or None) per evaluator and method
 
     def rhs(self, t: float, x: NDArray) -> NDArray:
         """ẋ = (q̇, s̈) of the current model: by the evaluator's ``state_derivative`` where it
@@ -433,8 +433,8 @@ class _Run:
         (:func:`projeq.simulation.loop.loop`), or None where solve_ivp steps: a method the loop does not
         step (implicit, projected, an OdeSolver class: ``method=scipy.integrate.DOP853`` keeps scipy's),
         events, options besides max_step, or an evaluator without a compiled one-call ẋ."""
-        key = (self.ev, self.method)  # the evaluator itself: an id could be a collected one's, after a re-partition
-        if key not in self.loops:
+        key = (id(self.ev), self.method)
+        if self.loops.get(key, (None,))[0] is not self.ev:  # (kept with its evaluator: an id is reused once freed)
             ready = not (self.events or set(self.options) - {"max_step"})
             provider = getattr(self.ev, "loop_model", None) if ready else None
             if provider is not None and self.fused is not None:
@@ -443,10 +443,10 @@ class _Run:
             if model is not None and self.model.events() and not model.checks_events:
                 model = None  # the model's events located by solve_ivp
             try:
-                self.loops[key] = loop.loop(model, self.method)
+                self.loops[key] = self.ev, loop.loop(model, self.method)
             except compilation.NotCompiled:  # rented: solve_ivp steps, its CPU spent from the budget
-                self.loops[key], self.renting = None, True
-        return self.loops[key]
+                self.loops[key], self.renting = (self.ev, None), True
+        return self.loops[key][1]
 
     def _compiled_segment(self, compiled, a: float, b: float, inside: NDArray):
         """One segment from the current state at a to b by the compiled loop, as solve_ivp's result
