@@ -83,6 +83,7 @@ PRINTS = {
                       "four-bar (crank-rocker)", "rocker, repivot"),
     "loop_overhead.py": ("per evaluation", "scipy's loop", "rolling_disk"),
     "nonholonomic_effort.py": ("| car |", "| knife_edge_disc |", "| rolling_disk |"),
+    "loop_vs_cyrk.py": ("CyRK/projeq", "projeq run", "chain(3)"),
     "output_rows.py": ("before/after", "simple_pendulum"),
     "peers.py": ("chain",),
     "pin_closures.py": ("PinClosure, compiled kernel", "PinClosure, numpy path", "hand-written Φ",
