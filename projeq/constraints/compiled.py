@@ -671,15 +671,15 @@ def _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree):
 
 
 def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
-                q_dot, s_ddot_tree, A, M, b):
+                q_dot, s_ddot_tree, A, M, b, kappa):
     """The constrained s̈ of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (module
     docstring) from Φ (``phi``: :func:`phi_into`; ``m_h`` rows) and the Pfaffian rows A(q)
     (``pfaffian``), the tree's packed arrays and workspace (``tree``: those of
     :func:`projeq.assembly.kernels.chain_terms`) with its joints of kind GIVEN (``joints``:
     :func:`given_motions`), q, ṡ, t and the partition; ṡ_tree = F ṡ + f with f = [0; A_dep⁻¹ b_s]
     (b_s = −∂Φ/∂t of cut joints across joints prescribed in time, else 0); writes q̇ = ṡ_tree (K = E), s̈_tree,
-    A_s = [Φ_q; A], M and b; returns DONE, SINGULAR (:func:`_projected`) or DEGENERATE where
-    ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) is not below ``bound``."""
+    A_s = [Φ_q; A], M and b, and ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) into ``kappa[0]``; returns DONE, SINGULAR
+    (:func:`_projected`) or DEGENERATE where that bound is not below ``bound``."""
     n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
     _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
     A_dep = np.empty((m, m))
@@ -687,7 +687,8 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
         for c in range(m):
             A_dep[r, c] = A[r, dependent[c]]
     inv = _inverse(A_dep)
-    if not np.sqrt(np.sum(A * A)) * np.sqrt(np.sum(inv * inv)) < bound:
+    kappa[0] = np.sqrt(np.sum(A * A)) * np.sqrt(np.sum(inv * inv))
+    if not kappa[0] < bound:
         return DEGENERATE
     F = np.zeros((n, k))  # F = [E; −A_dep⁻¹ A_ind]
     for c in range(k):
@@ -761,17 +762,21 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
 
 
 def partitioned_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, independent, dependent, x, n_q, m_h,
-                                 bound, pivot, limit, q, s_dot, q_dot, s_ddot_tree, A, M, b, x_dot):
+                                 bound, pivot, limit, q, s_dot, q_dot, s_ddot_tree, A, M, b, kappa, x_dot):
     """ẋ = (q̇, s̈_tree[independent]) of :func:`partitioned` at x = (q, ṡ) into ``x_dot``, as the compiled
     integration loop calls a model's ẋ (:mod:`projeq.simulation.loop`; ``q``, ``s_dot``: buffers of the
     state's parts): −1, or 0 where the kernel flags, ẋ is not finite or the partition's condition
     κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ reaches :data:`EVENT_MARGIN` · ``limit`` — the ConstrainedSystem's own event
     κ − limit, which solve_ivp then locates, going on from the loop's last step, and re-partitions there
-    (solve_ivp looks for a sign change at the steps' ends, where this call is made: none is missed)."""
+    (solve_ivp looks for a sign change at the steps' ends, where this call is made: none is missed). κ by
+    two SVDs only where the kernel's bound ‖A_s‖_F ‖A_dep⁻¹‖_F ≥ κ reaches the margin (the SVDs cost a
+    third of the four-bar's evaluation)."""
     _split(x, n_q, q, s_dot)
     if partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
-                   q_dot, s_ddot_tree, A, M, b) != DONE:
+                   q_dot, s_ddot_tree, A, M, b, kappa) != DONE:
         return 0
+    if kappa[0] < EVENT_MARGIN * limit:  # κ ≤ the bound: far from the event
+        return _state_rates(q_dot, s_ddot_tree, independent, n_q, x_dot)
     A_dep = np.empty((dependent.shape[0], dependent.shape[0]))
     for r in range(dependent.shape[0]):
         for c in range(dependent.shape[0]):
@@ -1217,7 +1222,7 @@ class CompiledClosure:
         self._workspace = ev._real
         self.tree = tree_arrays(ev, float)
         self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
-        self._kappa = np.zeros(1)  # the tangent rule's κ
+        self._kappa = np.zeros(1)  # κ (the tangent rule) or its bound (partitioning), written by the kernel
         self._kept = (None, None)  # (the system, the tangent it keeps) of the last call (_kept_tangent)
 
     def _call(self, system, q: NDArray, s_dot: NDArray, t: float) -> bool:
@@ -1228,7 +1233,8 @@ class CompiledClosure:
         if self.rule == "partitioned":
             flag = self.kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, q, s_dot, t,
                                self.m_h, system.independent, system.dependent,
-                               self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b)
+                               self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b,
+                               self._kappa)
         else:
             flag = self.kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, q, s_dot, t,
                                self.m_h, system.independent, system.tree.n_s - system.n_s,
@@ -1274,7 +1280,7 @@ class CompiledClosure:
         if self.rule == "partitioned":
             return LoopModel(_compiled_adapter(self.kernel, self.rule), pre, (system.independent, system.dependent),
                              (self.m_h, float(self.constants[0]), float(SINGULAR_PIVOT), float(system.limit),
-                              *buffers), checks_events=True)
+                              *buffers, self._kappa), checks_events=True)
         kept = self._kept_tangent(system)
         return LoopModel(_compiled_adapter(self.kernel, self.rule), pre, (system.independent,),
                          (self.m_h, system.tree.n_s - system.n_s, float(system.separation), float(self.constants[0]),

@@ -405,7 +405,7 @@ class _Run:
         labels += [f"the model's event {callable_name(e)}" for e in self.model.events()]
         events = [_event_wrapper(e, n_q, label) for e, label in zip(self.events + list(self.model.events()), labels)]
         dense = self.dense_output or bool(events)
-        compiled = None if self.dense_output or self.events else self.compiled_loop()
+        compiled = None if self.dense_output else self.compiled_loop()
         if compiled is not None:
             segment = self._compiled_segment(compiled, a, b, inside)
             if not isinstance(segment, float):
