@@ -247,6 +247,13 @@ class Model(ABC):
         model with constraint equations, (rank, mobility) of its constraint matrix (else None)."""
         return self.energy(q, s_dot, t), self.constraint_residual(q, self.q_dot(q, s_dot, t), t), None
 
+    def rows(self, x_rows: NDArray, times: NDArray) -> tuple | None:
+        """:meth:`output_row` of many output rows x = (q, ṡ) at ``times`` at once, q normalised first:
+        (q normalised (k, n_q), energies (k, 2), residuals (k, n_c), (rank, mobility) (k, 2) or None),
+        where the model computes them together; None (the default) where it does not (then row by
+        row, which names a row that fails)."""
+        return None
+
     # -- events ---------------------------------------------------------------------------
     def events(self) -> tuple:
         """The model's own terminal events ``event(t, q, s_dot)`` (none by default); where
@@ -714,6 +721,13 @@ class System(Model):
         residuals = [self.constraint_residual(q, self.q_dot(q, s_dot, t), t) for q, s_dot, t in
                      zip(q_rows, s_rows, times)] if self._constrained else np.zeros((len(times), 0))
         return energies, np.reshape(residuals, (len(times), self.n_c))
+
+    def rows(self, x_rows: NDArray, times: NDArray) -> tuple | None:
+        """:meth:`Model.rows`: :meth:`normalized_rows`, then :meth:`output_rows` (no rank)."""
+        x_rows = np.asarray(x_rows, dtype=float)
+        q = self.normalized_rows(x_rows[:, :self.n_q])
+        values = self.output_rows(q, x_rows[:, self.n_q:], times)
+        return None if values is None else (q, values[0], values[1], None)
 
     def potential_energy(self, kin, q: NDArray):
         """V at the poses ``kin`` (R_n, r_n, twists, ẏ_n; the ground's last) and q: each

@@ -202,20 +202,23 @@ def selected_chain_terms(system, prep: Plan, F6, T_aug6, P_aug) -> tuple[list, l
     (with [0; E] columns for internal velocities) and T̃_np = S̃_n T̃⁶ S̃_pᵀ (composed with
     P̃ for joints on a deforming parent)."""
     N = len(F6)
-    T_aug, F = [None] * N + [np.ones((1, 1))], [None] * N
+    T_aug, F = [None] * N + [np.ones((1, 1))], [selected_F(system, n, F6[n]) for n in range(N)]
     for n in range(N):
-        S = system.S[n]
-        F[n] = F6[n] if S is None else S @ F6[n]
         if prep.plain[n]:
             T_aug[n] = T_aug6[n]
         elif prep.port[n]:
             T_aug[n] = prep.S_aug[n] @ T_aug6[n] @ P_aug[n]
         else:
             T_aug[n] = prep.S_aug[n] @ T_aug6[n] @ prep.S_aug[system.parent[n]].T
-    for n in prep.internal:  # F_n = [S F⁶, [0; E]]
-        n_e = system.e_s_slice[n].stop - system.e_s_slice[n].start
-        F[n] = np.hstack((F[n], np.eye(F[n].shape[0])[:, -n_e:]))
     return T_aug, F
+
+
+def selected_F(system, n: int, F6: NDArray) -> NDArray:
+    """F_n = S_n F⁶ of subsystem n from its joint's spatial F⁶, with [0; E] columns for its internal
+    velocities ṡ_e (if any)."""
+    S, n_e = system.S[n], system.e_s_slice[n].stop - system.e_s_slice[n].start
+    F = F6 if S is None else S @ F6
+    return np.hstack((F, np.eye(F.shape[0])[:, -n_e:])) if n_e else F
 
 
 def gauss_terms(system, kin: Kinematics, q: NDArray, s_dot: NDArray, t: float) -> tuple[list, list]:

@@ -78,6 +78,7 @@ from projeq.assembly.linalg import SINGULAR_PIVOT
 from projeq.checks import depends_on_t
 from projeq.constraints.batched import NODES, WEIGHTS
 from projeq.constraints.cut_joints import point_rows
+from projeq.constraints.matrices import RANK_TOLERANCE
 
 #: flags of the kernels (:func:`partitioned`, :func:`tangent`): done; partition bound reached (or
 #: A_dep, N_ind singular, or A_s not finite); FᵀMF not positive definite; a force law without a value
@@ -680,16 +681,32 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
     (b_s = −∂Φ/∂t of cut joints across joints prescribed in time, else 0); writes q̇ = ṡ_tree (K = E), s̈_tree,
     A_s = [Φ_q; A], M and b, and ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) into ``kappa[0]``; returns DONE, SINGULAR
     (:func:`_projected`) or DEGENERATE where that bound is not below ``bound``."""
-    n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
+    n, m = q.shape[0], dependent.shape[0]
     _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
+    F, inv, s_dot_tree = _partition(pins, joints, fields, tree, q, s_dot, m_h, A, independent, dependent, kappa)
+    if not kappa[0] < bound:
+        return DEGENERATE
+    q_dot[:] = s_dot_tree
+    gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
+    f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
+    minus_gamma = _matvec(inv, -gamma)
+    for r in range(m):
+        f_bar[dependent[r]] = minus_gamma[r]
+    given_motions(joints, q, s_dot_tree, t, tree[4])
+    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+
+
+def _partition(pins, joints, fields, tree, q, s_dot, m_h, A, independent, dependent, kappa):
+    """(F, A_dep⁻¹, ṡ_tree = F ṡ + f) of coordinate partitioning from A_s (``A``, at q, with the
+    workspace :func:`_constraint_rows` leaves): F = [E; −A_dep⁻¹ A_ind], f = [0; A_dep⁻¹ b_s]; writes
+    ‖A_s‖_F ‖A_dep⁻¹‖_F (≥ κ) into ``kappa[0]`` (F not finite where A_dep is singular)."""
+    n, m, k = q.shape[0], dependent.shape[0], independent.shape[0]
     A_dep = np.empty((m, m))
     for r in range(m):
         for c in range(m):
             A_dep[r, c] = A[r, dependent[c]]
     inv = _inverse(A_dep)
     kappa[0] = np.sqrt(np.sum(A * A)) * np.sqrt(np.sum(inv * inv))
-    if not kappa[0] < bound:
-        return DEGENERATE
     F = np.zeros((n, k))  # F = [E; −A_dep⁻¹ A_ind]
     for c in range(k):
         F[independent[c], c] = 1.0
@@ -704,14 +721,83 @@ def partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, ind
         f = _matvec(inv, b_s)
         for r in range(m):
             s_dot_tree[dependent[r]] += f[r]
-    q_dot[:] = s_dot_tree
-    gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
-    f_bar = np.zeros(n)  # f̄ = [0; −A_dep⁻¹ γ]
-    minus_gamma = _matvec(inv, -gamma)
-    for r in range(m):
-        f_bar[dependent[r]] = minus_gamma[r]
-    given_motions(joints, q, s_dot_tree, t, tree[4])
-    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+    return F, inv, s_dot_tree
+
+
+def partitioned_rows(phi, pins, fields, pfaffian, joints, tree, q_rows, s_rows, times, m_h, independent, dependent,
+                     bound, tolerance, rank_tolerance, max_iter, q_out, s_tree_out, residuals, ranks):
+    """The output rows of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (its
+    ``output_row`` after ``normalized``, K = E) at the states (``q_rows``, ``s_rows``) and ``times``:
+    q moved onto Φ(q, t) = 0 by minimum-norm Gauss–Newton steps q ← q − Φ_q⁺ Φ (singular values below
+    ``rank_tolerance`` σ_max dropped; converged where |Φ| ≤ ``tolerance`` · max(1, |q|), at most
+    ``max_iter`` evaluations), ṡ_tree = F ṡ + f there (:func:`_partition`), the residuals
+    (Φ(q, t), A q̇) and the rank of A_s (its singular values above ``rank_tolerance`` σ_max), into
+    ``q_out``, ``s_tree_out``, ``residuals``, ``ranks`` (:func:`_write_row`). Returns the number of rows
+    done: fewer where a row's projection does not converge or its partition reaches ``bound`` (the numpy
+    path then names why)."""
+    A, values, kappa = np.zeros((residuals.shape[1], q_rows.shape[1])), np.zeros(m_h), np.zeros(1)
+    for row in range(q_rows.shape[0]):
+        q, t = q_rows[row].copy(), times[row]
+        if not _projected_onto(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, tolerance, rank_tolerance,
+                               max_iter, A, values):
+            return row
+        _, _, s_dot_tree = _partition(pins, joints, fields, tree, q, s_rows[row], m_h, A, independent, dependent,
+                                      kappa)
+        if not kappa[0] < bound:
+            return row
+        _write_row(row, q, A, np.linalg.svd(A)[1], values, s_dot_tree, m_h, rank_tolerance, q_out, s_tree_out,
+                   residuals, ranks)
+    return q_rows.shape[0]
+
+
+def tangent_rows(phi, pins, fields, pfaffian, joints, tree, q_rows, s_rows, times, m_h, independent, rank, separation,
+                 acting, kept, tolerance, rank_tolerance, max_iter, q_out, s_tree_out, residuals, ranks):
+    """:func:`partitioned_rows` of :class:`~projeq.constraints.partitioned.TangentSystem`: ṡ_tree = F ṡ + f
+    by the null-space rule (:func:`_tangent_velocities`), the tangent ``kept`` continued from row to row
+    in their order as the numpy path's rows continue it; rows up to one where N_ind is singular."""
+    A, values, kappa = np.zeros((residuals.shape[1], q_rows.shape[1])), np.zeros(m_h), np.zeros(1)
+    for row in range(q_rows.shape[0]):
+        q, t = q_rows[row].copy(), times[row]
+        if not _projected_onto(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, tolerance, rank_tolerance,
+                               max_iter, A, values):
+            return row
+        _, sigma, _, _, F, s_dot_tree = _tangent_velocities(phi, pins, fields, pfaffian, joints, tree, q, s_rows[row],
+                                                            t, m_h, independent, rank, separation, acting, kept, A,
+                                                            kappa)
+        if F.shape[0] == 0:
+            return row
+        _write_row(row, q, A, sigma, values, s_dot_tree, m_h, rank_tolerance, q_out, s_tree_out, residuals, ranks)
+    return q_rows.shape[0]
+
+
+def _write_row(row, q, A, sigma, values, s_dot_tree, m_h, rank_tolerance, q_out, s_tree_out, residuals, ranks):
+    """Row ``row`` of the output: q, ṡ_tree, the residuals (Φ(q, t), A q̇ − b) with q̇ = ṡ_tree and b = 0
+    (the Pfaffian rows of A_s, ``A[m_h:]``), and the rank of A_s from its singular values ``sigma``."""
+    q_out[row], s_tree_out[row] = q, s_dot_tree
+    residuals[row, :m_h] = values
+    residuals[row, m_h:] = _matvec(A[m_h:], s_dot_tree)
+    ranks[row] = np.sum(sigma > rank_tolerance * sigma[0])
+
+
+def _projected_onto(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, tolerance, rank_tolerance, max_iter, A,
+                    values) -> bool:
+    """q moved onto Φ(q, t) = 0 in place (:func:`partitioned_rows`), leaving A_s (``A``) and Φ (``values``) at
+    the point reached; whether it converged (|Φ| ≤ ``tolerance`` · max(1, |q|) of the q given)."""
+    scale = max(1.0, np.max(np.abs(q)))
+    for _ in range(max_iter):
+        _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
+        _constraint_values(phi, pins, fields, tree, q, t, values)
+        if not (np.all(np.isfinite(A)) and np.all(np.isfinite(values))):
+            return False
+        if m_h == 0 or np.max(np.abs(values)) <= tolerance * scale:
+            return True
+        U, sigma, Vt = np.linalg.svd(A[:m_h], full_matrices=False)
+        for j in range(sigma.shape[0]):
+            if sigma[j] > rank_tolerance * sigma[0]:
+                weight = np.sum(U[:, j] * values) / sigma[j]
+                for i in range(q.shape[0]):
+                    q[i] -= Vt[j, i] * weight
+    return False
 
 
 def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting, kept,
@@ -724,17 +810,35 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
     otherwise as :func:`partitioned`; writes κ = 1/σ_min(N_ind) = ‖F‖₂ (N orthonormal; 1 without
     independent velocities) into ``kappa[0]``.
     DEGENERATE where N_ind is singular or A_s not finite."""
-    n, m, k = q.shape[0], A.shape[0], independent.shape[0]
     _constraint_rows(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, A)
+    U, sigma, Vt, count, F, s_dot_tree = _tangent_velocities(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t,
+                                                             m_h, independent, rank, separation, acting, kept, A,
+                                                             kappa)
+    if F.shape[0] == 0:
+        return DEGENERATE
+    q_dot[:] = s_dot_tree
+    gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, A.shape[0])
+    f_bar = _particular(U, sigma, Vt, gamma, count, F, independent)
+    given_motions(joints, q, s_dot_tree, t, tree[4])
+    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+
+
+def _tangent_velocities(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation,
+                        acting, kept, A, kappa):
+    """(U, σ, Vᵀ of A_s, the count of its singular values that act, F, ṡ_tree = F ṡ + f) of the null-space
+    rule (:func:`tangent`) from A_s (``A``, at q, with the workspace :func:`_constraint_rows` leaves); the
+    tangent ``kept`` continued and κ written as there; F empty (0 rows) where N_ind is singular or A_s
+    not finite."""
+    n, m, k = q.shape[0], A.shape[0], independent.shape[0]
     U, sigma, Vt = _svd(A)
     count = 0  # the singular values above acting σ_max, at most rank
     for value in sigma:
         count += value > acting * sigma[0]
+    count = min(count, rank)
     b_s = _constraint_rates(pins, joints, fields, tree, q, m_h, m)  # from the workspace at q, before q*
-    sigma_star, Vt_star = _on_manifold(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, U, sigma, Vt,
-                                       min(count, rank))
+    sigma_star, Vt_star = _on_manifold(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, U, sigma, Vt, count)
     if not np.all(np.isfinite(Vt_star)):  # A_s not finite: the numpy path names the cause
-        return DEGENERATE
+        return U, sigma, Vt, count, np.empty((0, k)), s_dot.copy()
     near = 0  # the singular values below separation σ_max, at least k
     for value in sigma_star:
         near += value < separation * sigma_star[0]
@@ -747,18 +851,14 @@ def tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, indepen
         N = np.linalg.qr(_matmul(V_near.T, _matmul(V_near, kept)))[0]
     F = _scaled(N, independent)
     if F.shape[0] == 0:
-        return DEGENERATE
+        return U, sigma, Vt, count, F, s_dot.copy()
     kappa[0] = np.linalg.svd(F)[1][0] if k else 1.0  # (no free motion: nothing to describe)
     s_dot_tree = _matvec(F, s_dot)
     if b_s.shape[0]:  # ṡ_tree = F ṡ + f, A_s f = b_s with f[independent] = 0
-        f = _particular(U, sigma, Vt, -b_s, min(count, rank), F, independent)
+        f = _particular(U, sigma, Vt, -b_s, count, F, independent)
         for i in range(n):
             s_dot_tree[i] += f[i]
-    q_dot[:] = s_dot_tree
-    gamma = _constraint_gamma(phi, pins, fields, pfaffian, joints, tree, q, s_dot_tree, t, m_h, m)
-    f_bar = _particular(U, sigma, Vt, gamma, min(count, rank), F, independent)
-    given_motions(joints, q, s_dot_tree, t, tree[4])
-    return _projected(tree, q, s_dot_tree, t, F, f_bar, pivot, M, b, s_ddot_tree)
+    return U, sigma, Vt, count, F, s_dot_tree
 
 
 def partitioned_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, independent, dependent, x, n_q, m_h,
@@ -1103,7 +1203,7 @@ _HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _constraint_
             _pin_constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame, _port_chain, _pin_values, _pin_rates,
             _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, given_motions, _matvec, _matmul, _svd,
             _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms, _projected,
-            _inverse)
+            _inverse, _partition, _projected_onto, _tangent_velocities, _write_row)
 
 
 def compiled_partition(system, bound: float) -> "CompiledClosure | None":
@@ -1214,10 +1314,12 @@ class CompiledClosure:
         self.pins, self.fields = pin_table(None, 0) if pins is None else pins
         self._callbacks = [pfaffian] + [joint_callback(tree.joints[n]) if compiled else None for n in ev._given]
         if compiled:
-            self.kernel = _compiled(ev._width > 6, bool(len(self.pins)))[rule]
+            found = _compiled(ev._width > 6, bool(len(self.pins)))
+            self.kernel, self.rows_kernel = found[rule], found[f"{rule}_rows"]
             self.phi, self.pfaffian = callback.address, 0 if pfaffian is None else pfaffian.address
         else:
             self.kernel, self.phi, self.pfaffian = _interpreted(rule, bool(len(self.pins))), callback, pfaffian
+            self.rows_kernel = _interpreted(f"{rule}_rows", bool(len(self.pins)))
         self.joints = joint_table(ev._given_plan, self._callbacks[1:], compiled)
         self._workspace = ev._real
         self.tree = tree_arrays(ev, float)
@@ -1264,6 +1366,27 @@ class CompiledClosure:
         """s̈ = s̈_tree[independent] of ``system`` at (q, ṡ, t) (the evaluator's s̈, without copies of
         A_s, M and b), or None (flagged)."""
         return self._s_ddot_tree[system.independent] if self._call(system, q, s_dot, t) else None
+
+    def rows(self, system, q_rows: NDArray, s_rows: NDArray, times: NDArray, tolerance: float,
+             steps: int) -> tuple | None:
+        """(q on Φ = 0, ṡ_tree, residuals, ranks of A_s) of ``system``'s output rows at the states
+        (``q_rows``, ``s_rows``) and ``times`` by :func:`partitioned_rows` or :func:`tangent_rows` (the
+        projection of ``normalized``, converged at |Φ| ≤ ``tolerance`` · max(1, |q|) within ``steps``
+        evaluations, then ``output_row``'s pieces but the energy; the null-space rule continues the
+        system's kept tangent through the rows, as the numpy path does), or None where the kernel does
+        not finish a row (the numpy path names why)."""
+        k, (m, n) = len(times), self._A.shape
+        q_out, s_tree, residuals, ranks = np.empty((k, system.n_q)), np.empty((k, n)), np.empty((k, m)), \
+            np.empty(k, np.intp)
+        head = (self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, kernels.kernel_array(q_rows),
+                kernels.kernel_array(s_rows), kernels.kernel_array(times), self.m_h, system.independent)
+        tail = (float(tolerance), RANK_TOLERANCE, int(steps), q_out, s_tree, residuals, ranks)
+        if self.rule == "partitioned":
+            done = self.rows_kernel(*head, system.dependent, self.constants[0], *tail)
+        else:
+            done = self.rows_kernel(*head, system.tree.n_s - system.n_s, system.separation, self.constants[0],
+                                    self._kept_tangent(system), *tail)
+        return (q_out, s_tree, residuals, ranks) if done == k else None
 
     def loop_model(self, system):
         """``system`` (a ConstrainedSystem of this closure) as the compiled integration loop takes it
@@ -1360,7 +1483,8 @@ _PINNED = {"_constraint_rows": _pin_constraint_rows, "_constraint_gamma": _pin_c
 
 @functools.cache
 def _compiled(elastic: bool = False, pinned: bool = False) -> dict:
-    """{"partitioned": …, "tangent": …, "cut_joint_rows": …}: the kernels compiled by numba (cached on
+    """{"partitioned": …, "tangent": …, "cut_joint_rows": …, and the rows of the two rules}: the kernels compiled by
+    numba (cached on
     disk) as :func:`projeq.assembly.kernels.jit` compiles another module's kernels, calling the
     compiled kernels of :mod:`projeq.assembly.kernels` (the Gauss form's rigid variant, n_y = 6 a
     constant, or for trees with ``elastic`` bodies the one that reads each body's n_y), the force
@@ -1369,10 +1493,11 @@ def _compiled(elastic: bool = False, pinned: bool = False) -> dict:
     made of cut joints (``pinned``) the same source with the helpers of :data:`_PINNED` under the
     names of :func:`_constraint_rows`, :func:`_constraint_gamma` and :func:`_constraint_rates` (as
     the rigid passes take ``_six`` for ``_rows``): the other closures' kernels hold no code of theirs."""
-    rules = ("partitioned", "tangent", "cut_joint_rows")
+    rules = ("partitioned", "tangent", "cut_joint_rows", "partitioned_rows", "tangent_rows")
     prefix = ("elastic_" if elastic else "") + ("pinned_" if pinned else "")
     replaced = _PINNED if pinned else {}
-    return dict(zip(rules, kernels.jit(partitioned, tangent, cut_joint_rows, callees=_HELPERS,
+    return dict(zip(rules, kernels.jit(partitioned, tangent, cut_joint_rows, partitioned_rows, tangent_rows,
+                                       callees=_HELPERS,
                                        kernels=_compiled_callees(elastic),
                                        names=tuple(prefix + rule for rule in rules), **replaced)))
 

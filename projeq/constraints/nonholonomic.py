@@ -86,27 +86,30 @@ def near_singularity(system, q, t: float) -> None:
                          f"velocities grow without bound and the steps shrink to nothing: {exc}") from None
 
 
+def _joint_F(system, n: int, q_n: NDArray, n_s: int, t: float) -> NDArray | None:
+    """F_n(q) of joint n alone (its ``n_s`` minimal velocities at rest: F⁶ depends on its own coordinates
+    and t; :func:`projeq.assembly.kinematics.selected_F`), None where it cannot be evaluated there."""
+    from projeq.assembly.kinematics import selected_F
+
+    try:
+        return selected_F(system, n, system.joints[n].relative(q_n, np.zeros(n_s), t).F)
+    except (FloatingPointError, ZeroDivisionError, ValueError):
+        return None
+
+
 def check_configuration(system, q, t: float = 0.0, max_condition: float = SINGULAR_CONDITION) -> None:
     """Raise ValueError if some joint's K(q) or F(q) is singular at q (non-finite entries,
-    or condition number above ``max_condition``), naming the joint and the coordinates."""
-    from projeq.assembly.kinematics import forward
-
+    or condition number above ``max_condition``), naming the joint and the coordinates: each joint that
+    :func:`may_lose_rank` on its own (its K and F depend on its coordinates and t alone)."""
     q = state_vector("q", q, system.n_q)
-    if not may_be_singular(system):
-        return
-    with np.errstate(all="ignore"):
-        K = system.K(q, t)
-        try:
-            kin = forward(system, q, np.zeros(system.n_s), t)
-            F_all = kin.F
-        except (FloatingPointError, ZeroDivisionError, ValueError):
-            F_all = [None] * len(system.joints)
     for n, joint in enumerate(system.joints):
         if not may_lose_rank(joint):
             continue
         rows, cols = _joint_rows(system, n)
         where = f"joint of {system.names[n]!r} at q = {np.round(q[rows], 6).tolist()}"
-        for label, M in (("K(q) of q̇ = K ṡ", K[rows, cols]), ("F(q)", F_all[n])):
+        with np.errstate(all="ignore"):
+            K, F = joint.K(q[rows], t), _joint_F(system, n, q[rows], cols.stop - cols.start, t)
+        for label, M in (("K(q) of q̇ = K ṡ", K), ("F(q)", F)):
             if M is None:
                 continue
             if not np.all(np.isfinite(M)):

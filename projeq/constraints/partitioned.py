@@ -103,6 +103,8 @@ FORMULATIONS = ("auto", "partitioned", "null_space")
 PARTITION_CONDITION = 1e8
 # |Φ| (relative to the largest coordinate, at least 1) accepted as on the manifold: 1e4 × round-off
 POSITION_TOLERANCE = 1e-12
+# Gauss–Newton evaluations of Φ that project may take onto Φ = 0
+PROJECTION_STEPS = 20
 
 
 class RedundantRowWarning(UserWarning):
@@ -698,7 +700,7 @@ class ConstrainedSystem(Model):
         q = self.tree.normalized(q)
         return self.project(q, t) if self.correction == "projection" else q
 
-    def project(self, q: NDArray, t: float = 0.0, max_iter: int = 20) -> NDArray:
+    def project(self, q: NDArray, t: float = 0.0, max_iter: int = PROJECTION_STEPS) -> NDArray:
         """q moved onto Φ(q, t) = 0 by minimum-norm Gauss–Newton steps (redundant rows: singular
         values of ∂Φ/∂q below RANK_TOLERANCE σ_max dropped); ValueError if it fails.
 
@@ -746,6 +748,34 @@ class ConstrainedSystem(Model):
         s_dot_tree = self.tree_velocities(q, s_dot, t, (A_s, b_s))
         residual = self.constraint_residual(q, self._q_dot(q, s_dot_tree, t), t)
         return self.tree._energy(q, s_dot_tree, float(t)), residual, self._rank_and_mobility(A_s)
+
+    def rows(self, x_rows: NDArray, times: NDArray) -> tuple | None:
+        """:meth:`Model.rows <projeq.system.Model.rows>` by the system's compiled kernel, partitioned or in
+        the null-space form (:meth:`~projeq.constraints.compiled.CompiledClosure.rows`: the projection of
+        :meth:`normalized`, ṡ_tree, the residuals and the rank of A_s) and the tree's energies together
+        (:meth:`projeq.System.output_rows`); None where it does not apply (no compiled kernel built, a
+        subclass's own rows or normalisation, a tree that normalises q) or a row is not finished there. The energies
+        row by row where the tree's are not computed together (elastic bodies, springs)."""
+        kernel = self._compiled  # only where the run built it (the numpy path's runs compile nothing)
+        if not kernel or not self._rows_of_this_class() or self.tree._normalizing:
+            return None
+        x_rows = np.asarray(x_rows, dtype=float)
+        found = kernel.rows(self, x_rows[:, :self.n_q], x_rows[:, self.n_q:], times, POSITION_TOLERANCE,
+                            PROJECTION_STEPS)
+        if found is None:
+            return None
+        q, s_dot_tree, residuals, ranks = found
+        values = self.tree.output_rows(q, s_dot_tree, times)
+        energies = np.reshape([self.tree._energy(*row, float(t)) for *row, t in zip(q, s_dot_tree, times)],
+                              (len(times), 2)) if values is None else values[0]
+        return q, energies, residuals, np.column_stack((ranks, self.tree.n_s - ranks))
+
+    def _rows_of_this_class(self) -> bool:
+        """Whether the output rows are those of this module's classes: normalized, output_row and rows not
+        a subclass's (the kernel's F rule is checked by :meth:`compiled_kernel`)."""
+        cls = type(self)
+        return all(getattr(cls, name) is getattr(ConstrainedSystem, name) for name in ("normalized", "output_row",
+                                                                                      "project", "rows"))
 
     # -- dynamics ---------------------------------------------------------------------------
     def gamma(self, q: NDArray, s_dot_tree: NDArray, t: float = 0.0, C=None) -> NDArray:

@@ -378,9 +378,11 @@ class _Run:
         return x_dot
 
     def model_rhs(self, t: float, x: NDArray) -> NDArray:
-        """ẋ of the current model (:func:`projeq.analysis.jacobians.state_derivative`) without the
-        run's counters and monitor of :meth:`rhs`: the stiffness check differentiates it."""
-        return state_derivative(self.model, x, t)
+        """ẋ of the current model without the run's counters and monitor of :meth:`rhs`: the stiffness
+        check differentiates it. By the evaluator's one-call ẋ where it has one (None: not finite), else
+        :func:`projeq.analysis.jacobians.state_derivative`."""
+        x_dot = None if self.fused is None else self.fused(t, x)
+        return state_derivative(self.model, x, t) if x_dot is None else x_dot
 
     def jacobian(self, t: float, x: NDArray) -> NDArray:
         """∂ẋ/∂x of the current model by the complex step (:func:`projeq.analysis.jacobians.state_jacobian`:
@@ -591,9 +593,14 @@ HIGH_ORDER_RTOL = 1e-7  # at rtol this tight or tighter the eighth order of DOP8
 
 def measured_mode(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float) -> tuple[float, bool]:
     """(ρ, decays) of the model's fastest mode at the initial state
-    (:func:`~projeq.simulation.integrators.fastest_mode` of ẋ = (q̇, s̈) by ``evaluator``)."""
+    (:func:`~projeq.simulation.integrators.fastest_mode` of ẋ = (q̇, s̈) by ``evaluator``: its one-call ẋ
+    where it has one, as the integration loop calls it)."""
+    one_call = getattr(evaluator, "state_derivative", None)
 
     def rhs(t, x):
+        x_dot = None if one_call is None else one_call(t, x)
+        if x_dot is not None:
+            return x_dot
         q, s_dot = x[: model.n_q], x[model.n_q :]
         return np.concatenate((model.q_dot(q, s_dot, t), evaluator.accelerations(q, s_dot, t)))
 
@@ -844,15 +851,33 @@ def _rank_history(rows: list, ranks: list) -> dict:
 
 def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, NDArray, list]:
     """Normalised q, (T, V), constraint residuals (Φ, A q̇ − b) and (rank, mobility) of each
-    output row in its own model (:meth:`projeq.system.Model.output_row`), up to the first row
+    output row in its own model (:meth:`projeq.system.Model.output_row`), the rows of each model's
+    stretch together where it computes them so (:meth:`projeq.system.Model.rows`), up to the first row
     where a user function raises (a constraint or residual
     function that fails only late in the run, evaluated here for the first time at that
     row): the run is then a failure at that row's time (status, message naming the
     function, cause) and keeps the rows before it."""
     system, n_q = run.user_model, run.user_model.n_q
-    together = _rows_together(rows, x, n_q)
-    if together is not None:
-        return together
+    q, energies, residual, ranks = [], [], [], []
+    start = 0
+    while start < len(rows):
+        model = rows[start][0]
+        end = next((i for i in range(start, len(rows)) if rows[i][0] is not model), len(rows))
+        values = _rows_together(model, [t for _, t in rows[start:end]], x[start:end])
+        if values is None:
+            values = _rows_one_by_one(run, rows[start:end], x[start:end], n_q)
+        for kept, new in zip((q, energies, residual, ranks), values):
+            kept.extend(new)
+        if len(values[0]) < end - start:
+            break
+        start = end
+    n = len(q)
+    return (np.reshape(q, (n, n_q)), np.reshape(energies, (n, 2)), np.reshape(residual, (n, system.n_c)), ranks)
+
+
+def _rows_one_by_one(run: _Run, rows: list, x: NDArray, n_q: int) -> tuple[list, list, list, list]:
+    """:func:`_row_values` of ``rows`` one by one, up to the first that fails (the run's status and
+    message then name it)."""
     q, energies, residual, ranks = [], [], [], []
     for (model, t), xi in zip(rows, x):
         try:
@@ -870,26 +895,21 @@ def _row_values(run: _Run, rows: list, x: NDArray) -> tuple[NDArray, NDArray, ND
         energies.append(values[0])
         residual.append(values[1])
         ranks.append(values[2])
-    n = len(q)
-    return (np.reshape(q, (n, n_q)), np.reshape(energies, (n, 2)), np.reshape(residual, (n, system.n_c)), ranks)
+    return q, energies, residual, ranks
 
 
-def _rows_together(rows: list, x: NDArray, n_q: int) -> tuple | None:
-    """:func:`_row_values` of rows all in one model that computes them together
-    (:meth:`projeq.System.output_rows`) where every energy is finite; None where they are in several
-    models, the model does not, or a row fails (then row by row, which names the row)."""
-    model = rows[0][0] if rows else None
-    if model is None or not hasattr(model, "output_rows") or any(m is not model for m, _ in rows):
-        return None
-    times = np.array([t for _, t in rows])
+def _rows_together(model, times: list, x: NDArray) -> tuple | None:
+    """The rows (q, energies, residuals, ranks) at ``times`` and states ``x`` of one model that
+    computes them together (:meth:`projeq.system.Model.rows`) where every energy is finite; None where
+    the model does not, or a row fails (then row by row, which names the row)."""
     try:
-        q = model.normalized_rows(x[:len(rows), :n_q])
-        values = model.output_rows(q, x[:len(rows), n_q:], times)
+        values = model.rows(x, np.array(times, dtype=float))
     except Exception:  # noqa: BLE001 - a user's function: row by row names it with its time
         return None
-    if values is None or not np.isfinite(values[0]).all():
+    if values is None or not np.isfinite(values[1]).all():
         return None
-    return q, values[0], values[1], [None] * len(rows)
+    q, energies, residuals, ranks = values
+    return q, energies, residuals, [None] * len(times) if ranks is None else [tuple(row) for row in ranks]
 
 
 def _failure(run: _Run, result: Result) -> SimulationError:
