@@ -5,7 +5,9 @@ chooses, 501 output rows with their energies and residuals), warm (compilation e
 alternately: as it runs by default (the compiled integration loop, :mod:`projeq.simulation.loop`,
 where the model has a compiled one-call ẋ) and with scipy's ``solve_ivp`` stepping the same method
 (``method=`` the scipy class). *CPU per evaluation* = the run's CPU ÷ its ẋ evaluations ÷ the CPU
-of one compiled ẋ of the same model called alone in a loop (issue 34's definition; its bound 1.5).
+of one compiled ẋ of the same model called alone in a loop (issue 34's definition; its bound 1.5);
+"without rows" the same of a run with two output rows (``n_points=2``: the same steps and evaluations,
+the output rows' energies, residuals and projections left out), to tell the loop's share from the rows'.
 Each run's CPU is the least of ``--repeats`` alternating rounds.
 
     PYTHONPATH=. python benchmarks/loop_overhead.py [--t-end 2] [--repeats 3]
@@ -44,27 +46,30 @@ def x_dot_cpu(system, seconds: float = 0.3) -> float:
     return (time.process_time() - started) / repeats
 
 
-def run_cpu(system, t_end: float, method) -> tuple[float, object]:
+def run_cpu(system, t_end: float, method, **options) -> tuple[float, object]:
     """(CPU seconds, Result) of one run."""
     started = time.process_time()
-    result = simulate(system, t_end, method=method)
+    result = simulate(system, t_end, method=method, **options)
     return time.process_time() - started, result
 
 
 def row(name: str, t_end: float, repeats: int) -> list:
-    """[scene, method, evaluations, ẋ µs, per evaluation (default), per evaluation (scipy), scipy / default]."""
+    """[scene, method, evaluations, ẋ µs, per evaluation (default), the same without its output rows,
+    per evaluation (scipy), scipy / default]."""
     system = getattr(scenes, name)()
     chosen = simulate(system, t_end).method  # warm: compiles (or loads) the model and the loop
     scipy_method = getattr(scipy.integrate, chosen.split(",")[0])
-    best = {"default": np.inf, "scipy": np.inf}
+    best = {"default": np.inf, "scipy": np.inf, "no rows": np.inf}
     nfev = {}
     for _ in range(repeats):
-        for label, method in (("default", None), ("scipy", scipy_method)):
-            cpu, result = run_cpu(system, t_end, method)
+        for label, method, options in (("default", None, {}), ("scipy", scipy_method, {}),
+                                       ("no rows", None, {"n_points": 2})):
+            cpu, result = run_cpu(system, t_end, method, **options)
             best[label], nfev[label] = min(best[label], cpu), result.nfev
     x_dot = x_dot_cpu(system)
     default, scipy_ = best["default"] / nfev["default"] / x_dot, best["scipy"] / nfev["scipy"] / x_dot
-    return [name, chosen, nfev["default"], x_dot * 1e6, default, scipy_, scipy_ / default]
+    return [name, chosen, nfev["default"], x_dot * 1e6, default, best["no rows"] / nfev["no rows"] / x_dot, scipy_,
+            scipy_ / default]
 
 
 def main(argv=None) -> Table:
@@ -75,9 +80,10 @@ def main(argv=None) -> Table:
     args = parser.parse_args(argv)
     names, t_end, repeats = (("chain", "rolling_disk"), 0.2, 1) if args.quick else (SCENES, args.t_end, args.repeats)
     rows = [row(name, t_end, repeats) for name in names]
-    table = Table(["scene", "method", "evaluations", "ẋ", "per evaluation", "scipy's loop", "scipy / default"], rows,
-                  units={"ẋ": "µs"}, formats={"ẋ": ".1f", "per evaluation": ".2f", "scipy's loop": ".2f",
-                                              "scipy / default": ".2f"},
+    table = Table(["scene", "method", "evaluations", "ẋ", "per evaluation", "without rows", "scipy's loop",
+                   "scipy / default"], rows,
+                  units={"ẋ": "µs"}, formats={"ẋ": ".1f", "per evaluation": ".2f", "without rows": ".2f",
+                                              "scipy's loop": ".2f", "scipy / default": ".2f"},
                   title=f"simulate(scene, {t_end:g}) at its defaults, warm: CPU per evaluation (run CPU / evaluations / "
                         "one compiled ẋ alone; issue 34's bound 1.5), by default and with scipy's solve_ivp stepping")
     print(table.to_text())
