@@ -724,47 +724,37 @@ def _partition(pins, joints, fields, tree, q, s_dot, m_h, A, independent, depend
     return F, inv, s_dot_tree
 
 
-def partitioned_rows(phi, pins, fields, pfaffian, joints, tree, q_rows, s_rows, times, m_h, independent, dependent,
-                     bound, tolerance, rank_tolerance, max_iter, q_out, s_tree_out, residuals, ranks):
-    """The output rows of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (its
-    ``output_row`` after ``normalized``, K = E) at the states (``q_rows``, ``s_rows``) and ``times``:
-    q moved onto Φ(q, t) = 0 by minimum-norm Gauss–Newton steps q ← q − Φ_q⁺ Φ (singular values below
+def closure_rows(phi, pins, fields, pfaffian, joints, tree, q_rows, s_rows, times, m_h, independent, partitioned,
+                 dependent, bound, rank, separation, acting, kept, tolerance, rank_tolerance, max_iter, q_out,
+                 s_tree_out, residuals, ranks):
+    """The output rows of :class:`~projeq.constraints.partitioned.ConstrainedSystem` (its ``output_row``
+    after ``normalized``, K = E) at the states (``q_rows``, ``s_rows``) and ``times``: q moved onto
+    Φ(q, t) = 0 by minimum-norm Gauss–Newton steps q ← q − Φ_q⁺ Φ (singular values below
     ``rank_tolerance`` σ_max dropped; converged where |Φ| ≤ ``tolerance`` · max(1, |q|), at most
-    ``max_iter`` evaluations), ṡ_tree = F ṡ + f there (:func:`_partition`), the residuals
-    (Φ(q, t), A q̇) and the rank of A_s (its singular values above ``rank_tolerance`` σ_max), into
-    ``q_out``, ``s_tree_out``, ``residuals``, ``ranks`` (:func:`_write_row`). Returns the number of rows
-    done: fewer where a row's projection does not converge or its partition reaches ``bound`` (the numpy
-    path then names why)."""
+    ``max_iter`` evaluations, :func:`_projected_onto`), ṡ_tree = F ṡ + f there — ``partitioned``: by
+    :func:`_partition` (``dependent``, ``bound``), else by the null-space rule of
+    :class:`~projeq.constraints.partitioned.TangentSystem` (:func:`_tangent_velocities`: ``rank``,
+    ``separation``, ``acting``, the tangent ``kept`` continued from row to row in their order, as the
+    numpy path's rows continue it) —, the residuals (Φ(q, t), A q̇) and the rank of A_s, into ``q_out``,
+    ``s_tree_out``, ``residuals``, ``ranks`` (:func:`_write_row`). Returns the number of rows done: fewer
+    where a row's projection does not converge, its partition reaches ``bound`` or its N_ind is singular
+    (the numpy path then names why)."""
     A, values, kappa = np.zeros((residuals.shape[1], q_rows.shape[1])), np.zeros(m_h), np.zeros(1)
     for row in range(q_rows.shape[0]):
         q, t = q_rows[row].copy(), times[row]
         if not _projected_onto(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, tolerance, rank_tolerance,
                                max_iter, A, values):
             return row
-        _, _, s_dot_tree = _partition(pins, joints, fields, tree, q, s_rows[row], m_h, A, independent, dependent,
-                                      kappa)
-        if not kappa[0] < bound:
-            return row
-        _write_row(row, q, A, np.linalg.svd(A)[1], values, s_dot_tree, m_h, rank_tolerance, q_out, s_tree_out,
-                   residuals, ranks)
-    return q_rows.shape[0]
-
-
-def tangent_rows(phi, pins, fields, pfaffian, joints, tree, q_rows, s_rows, times, m_h, independent, rank, separation,
-                 acting, kept, tolerance, rank_tolerance, max_iter, q_out, s_tree_out, residuals, ranks):
-    """:func:`partitioned_rows` of :class:`~projeq.constraints.partitioned.TangentSystem`: ṡ_tree = F ṡ + f
-    by the null-space rule (:func:`_tangent_velocities`), the tangent ``kept`` continued from row to row
-    in their order as the numpy path's rows continue it; rows up to one where N_ind is singular."""
-    A, values, kappa = np.zeros((residuals.shape[1], q_rows.shape[1])), np.zeros(m_h), np.zeros(1)
-    for row in range(q_rows.shape[0]):
-        q, t = q_rows[row].copy(), times[row]
-        if not _projected_onto(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, tolerance, rank_tolerance,
-                               max_iter, A, values):
-            return row
-        _, sigma, _, _, F, s_dot_tree = _tangent_velocities(phi, pins, fields, pfaffian, joints, tree, q, s_rows[row],
-                                                            t, m_h, independent, rank, separation, acting, kept, A,
-                                                            kappa)
-        if F.shape[0] == 0:
+        if partitioned:
+            _, _, s_dot_tree = _partition(pins, joints, fields, tree, q, s_rows[row], m_h, A, independent,
+                                          dependent, kappa)
+            done, sigma = kappa[0] < bound, np.linalg.svd(A)[1]
+        else:
+            _, sigma, _, _, F, s_dot_tree = _tangent_velocities(phi, pins, fields, pfaffian, joints, tree, q,
+                                                                s_rows[row], t, m_h, independent, rank, separation,
+                                                                acting, kept, A, kappa)
+            done = F.shape[0] > 0
+        if not done:
             return row
         _write_row(row, q, A, sigma, values, s_dot_tree, m_h, rank_tolerance, q_out, s_tree_out, residuals, ranks)
     return q_rows.shape[0]
@@ -781,7 +771,7 @@ def _write_row(row, q, A, sigma, values, s_dot_tree, m_h, rank_tolerance, q_out,
 
 def _projected_onto(phi, pins, fields, pfaffian, joints, tree, q, t, m_h, tolerance, rank_tolerance, max_iter, A,
                     values) -> bool:
-    """q moved onto Φ(q, t) = 0 in place (:func:`partitioned_rows`), leaving A_s (``A``) and Φ (``values``) at
+    """q moved onto Φ(q, t) = 0 in place (:func:`closure_rows`), leaving A_s (``A``) and Φ (``values``) at
     the point reached; whether it converged (|Φ| ≤ ``tolerance`` · max(1, |q|) of the q given)."""
     scale = max(1.0, np.max(np.abs(q)))
     for _ in range(max_iter):
@@ -1242,6 +1232,9 @@ def _closure(system, rule: str, constant: float) -> "CompiledClosure | None":
                            pfaffian=pieces.get("the Pfaffian rows A"), pins=pins)
 
 
+#: the arguments of the other rule in :func:`closure_rows` (unread): no dependent velocities, no kept tangent
+_NO_INDICES, _NO_TANGENT = np.zeros(0, np.intp), np.zeros((1, 1))
+
 #: the Φ "callback" of a closure made of cut joints: the kernels evaluate them themselves
 #: (:func:`_pin_jacobian`, :func:`_pin_gamma`) and never call it
 _NO_CALLBACK = types.SimpleNamespace(address=0)
@@ -1315,11 +1308,11 @@ class CompiledClosure:
         self._callbacks = [pfaffian] + [joint_callback(tree.joints[n]) if compiled else None for n in ev._given]
         if compiled:
             found = _compiled(ev._width > 6, bool(len(self.pins)))
-            self.kernel, self.rows_kernel = found[rule], found[f"{rule}_rows"]
+            self.kernel, self.rows_kernel = found[rule], found["closure_rows"]
             self.phi, self.pfaffian = callback.address, 0 if pfaffian is None else pfaffian.address
         else:
             self.kernel, self.phi, self.pfaffian = _interpreted(rule, bool(len(self.pins))), callback, pfaffian
-            self.rows_kernel = _interpreted(f"{rule}_rows", bool(len(self.pins)))
+            self.rows_kernel = _interpreted("closure_rows", bool(len(self.pins)))
         self.joints = joint_table(ev._given_plan, self._callbacks[1:], compiled)
         self._workspace = ev._real
         self.tree = tree_arrays(ev, float)
@@ -1370,7 +1363,7 @@ class CompiledClosure:
     def rows(self, system, q_rows: NDArray, s_rows: NDArray, times: NDArray, tolerance: float,
              steps: int) -> tuple | None:
         """(q on Φ = 0, ṡ_tree, residuals, ranks of A_s) of ``system``'s output rows at the states
-        (``q_rows``, ``s_rows``) and ``times`` by :func:`partitioned_rows` or :func:`tangent_rows` (the
+        (``q_rows``, ``s_rows``) and ``times`` by :func:`closure_rows` (the
         projection of ``normalized``, converged at |Φ| ≤ ``tolerance`` · max(1, |q|) within ``steps``
         evaluations, then ``output_row``'s pieces but the energy; the null-space rule continues the
         system's kept tangent through the rows, as the numpy path does), or None where the kernel does
@@ -1378,14 +1371,14 @@ class CompiledClosure:
         k, (m, n) = len(times), self._A.shape
         q_out, s_tree, residuals, ranks = np.empty((k, system.n_q)), np.empty((k, n)), np.empty((k, m)), \
             np.empty(k, np.intp)
-        head = (self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, kernels.kernel_array(q_rows),
-                kernels.kernel_array(s_rows), kernels.kernel_array(times), self.m_h, system.independent)
-        tail = (float(tolerance), RANK_TOLERANCE, int(steps), q_out, s_tree, residuals, ranks)
-        if self.rule == "partitioned":
-            done = self.rows_kernel(*head, system.dependent, self.constants[0], *tail)
-        else:
-            done = self.rows_kernel(*head, system.tree.n_s - system.n_s, system.separation, self.constants[0],
-                                    self._kept_tangent(system), *tail)
+        partitioned = self.rule == "partitioned"
+        rule = (True, system.dependent, float(self.constants[0]), 0, 0.0, 0.0, _NO_TANGENT) if partitioned else \
+            (False, _NO_INDICES, 0.0, system.tree.n_s - system.n_s, float(system.separation),
+             float(self.constants[0]), self._kept_tangent(system))
+        done = self.rows_kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree,
+                                kernels.kernel_array(q_rows), kernels.kernel_array(s_rows), kernels.kernel_array(times),
+                                self.m_h, system.independent, *rule, float(tolerance), RANK_TOLERANCE, int(steps),
+                                q_out, s_tree, residuals, ranks)
         return (q_out, s_tree, residuals, ranks) if done == k else None
 
     def loop_model(self, system):
@@ -1483,8 +1476,7 @@ _PINNED = {"_constraint_rows": _pin_constraint_rows, "_constraint_gamma": _pin_c
 
 @functools.cache
 def _compiled(elastic: bool = False, pinned: bool = False) -> dict:
-    """{"partitioned": …, "tangent": …, "cut_joint_rows": …, and the rows of the two rules}: the kernels compiled by
-    numba (cached on
+    """{"partitioned": …, "tangent": …, "cut_joint_rows": …, "closure_rows": …}: the kernels compiled by numba (cached on
     disk) as :func:`projeq.assembly.kernels.jit` compiles another module's kernels, calling the
     compiled kernels of :mod:`projeq.assembly.kernels` (the Gauss form's rigid variant, n_y = 6 a
     constant, or for trees with ``elastic`` bodies the one that reads each body's n_y), the force
@@ -1493,11 +1485,10 @@ def _compiled(elastic: bool = False, pinned: bool = False) -> dict:
     made of cut joints (``pinned``) the same source with the helpers of :data:`_PINNED` under the
     names of :func:`_constraint_rows`, :func:`_constraint_gamma` and :func:`_constraint_rates` (as
     the rigid passes take ``_six`` for ``_rows``): the other closures' kernels hold no code of theirs."""
-    rules = ("partitioned", "tangent", "cut_joint_rows", "partitioned_rows", "tangent_rows")
+    rules = ("partitioned", "tangent", "cut_joint_rows", "closure_rows")
     prefix = ("elastic_" if elastic else "") + ("pinned_" if pinned else "")
     replaced = _PINNED if pinned else {}
-    return dict(zip(rules, kernels.jit(partitioned, tangent, cut_joint_rows, partitioned_rows, tangent_rows,
-                                       callees=_HELPERS,
+    return dict(zip(rules, kernels.jit(partitioned, tangent, cut_joint_rows, closure_rows, callees=_HELPERS,
                                        kernels=_compiled_callees(elastic),
                                        names=tuple(prefix + rule for rule in rules), **replaced)))
 
