@@ -431,11 +431,13 @@ class _Run:
     def compiled_loop(self):
         """The compiled integration loop of the run's method on the current model
         (:func:`projeq.simulation.loop.loop`), or None where solve_ivp steps: a method the loop does not
-        step (implicit, projected, an OdeSolver class: ``method=scipy.integrate.DOP853`` keeps scipy's),
-        events, options besides max_step, or an evaluator without a compiled one-call ẋ."""
+        step (BDF, LSODA, projected, an OdeSolver class: ``method=scipy.integrate.DOP853`` keeps scipy's),
+        events, options besides max_step, the user's own Jacobian (Radau's loop differentiates the compiled
+        ẋ), or an evaluator without a compiled one-call ẋ."""
         key = (id(self.ev), self.method)
         if self.loops.get(key, (None,))[0] is not self.ev:  # (kept with its evaluator: an id is reused once freed)
-            ready = not (self.events or set(self.options) - {"max_step"})
+            ready = not (self.events or set(self.options) - {"max_step"}) and (self.jac is None or isinstance(
+                self.jac, str))
             provider = getattr(self.ev, "loop_model", None) if ready else None
             if provider is not None and self.fused is not None:
                 self.fused(self.reached, self.x)  # ẋ's kernel compiled or found (the default evaluator's tier)
@@ -458,9 +460,9 @@ class _Run:
         stepped = compiled.run(
             self.model.n_q, a, self.x, b, first, float(self.options.get("max_step", np.inf)), self.rtol, self.atol,
             np.ascontiguousarray(inside, dtype=float), self._paused, MONITOR_EVERY if self.may_be_singular else 0)
-        self.nfev, self.steps, self.calls, self.step_size, self.reached = (
-            self.nfev + stepped.nfev, self.steps + stepped.steps, self.calls + stepped.nfev, stepped.h_abs,
-            stepped.t_failed)
+        self.nfev, self.njev, self.steps, self.calls, self.step_size, self.reached = (
+            self.nfev + stepped.nfev, self.njev + stepped.njev, self.steps + stepped.steps, self.calls + stepped.nfev,
+            stepped.h_abs, stepped.t_failed)
         if stepped.status == loop.EVALUATION_FAILED:
             self.checked_rhs(stepped.t_failed, stepped.x_failed)  # raises, naming why
         rows = stepped.rows
