@@ -170,7 +170,9 @@ def simulate(
         ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...): by name, RK23, RK45
         and DOP853 step in the compiled loop where the model has a compiled ẋ (a tree, or a closed
         loop's one compiled call) and no ``events`` (:mod:`projeq.simulation.loop`; scipy's
-        steps to round-off), and ``method=`` the scipy class
+        steps to round-off), and so does Radau (scipy's algorithm, its Jacobian by forward differences
+        of the compiled ẋ: n_x evaluations each, counted in ``Result.nfev`` and ``Result.njev``; with the
+        user's own ``jac``, solve_ivp steps), and ``method=`` the scipy class
         (``scipy.integrate.DOP853``) keeps solve_ivp stepping;
         or ``"RK45-projected"`` / ``"DOP853-projected"``: that method with each step projected
         onto the initial energy, so that a conservative scleronomic system's energy error
@@ -195,7 +197,9 @@ def simulate(
     jac : "exact", "differences", callable or matrix
         For Radau, BDF and LSODA: ∂ẋ/∂x by the complex step through the model ("exact",
         the default; exact to round-off, n complex evaluations per Jacobian, counted in
-        ``Result.njev``), by scipy's finite differences ("differences"), or the user's.
+        ``Result.njev``), by scipy's finite differences ("differences"), or the user's. Radau in
+        the compiled loop takes the forward differences of the compiled ẋ for "exact" and
+        "differences" alike.
     out_of_range : "warn" or "stop"
         What a subsystem leaving the range its model describes (a beam beyond moderate
         deflections, :meth:`projeq.subsystems.base.Subsystem.out_of_range`, checked on the output
@@ -626,7 +630,8 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
     with |x_s| its stability interval (:func:`~projeq.simulation.integrators.stability_limit`:
     RK45 3.31, DOP853 6.39). ``mode``: (ρ, decays) measured already (:func:`measured_mode`).
 
-    * "Radau" (exact Jacobian) when even DOP853 would need more than ``STIFF_STEPS`` steps
+    * "Radau" (the compiled loop's where the model has a compiled ẋ, else solve_ivp's with the exact
+      Jacobian) when even DOP853 would need more than ``STIFF_STEPS`` steps
       for stability alone, or when the fastest mode decays without oscillating (a real
       eigenvalue −ρ: a stiff damper) and would force more than ``FAST_MODE_STEPS`` RK45 steps —
       such a mode dies out, so only stability limits an explicit step (IFToMM A05, the stiff
