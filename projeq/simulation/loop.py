@@ -328,16 +328,16 @@ def radau_tableau() -> tuple:
 
 def radau_memory(n: int) -> tuple:
     """What a Radau run keeps from step to step (and over the pauses of :meth:`CompiledLoop.run`): ∂ẋ/∂x
-    J, the inverses of μ_real/h − J and μ_complex/h − J, the last step's interpolant (its coefficients Q
+    J, the LU factorisations (LU, pivots) of μ_real/h − J and μ_complex/h − J, the last step's interpolant (its coefficients Q
     and its start y_old) and the numbers ``RADAU_*`` (``scalars``); a fresh one: no Jacobian yet."""
     scalars = np.zeros(RADAU_SCALARS)
     scalars[RADAU_H_OLD] = scalars[RADAU_ERROR_OLD] = -1.0  # scipy's None
-    return (np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n), np.complex128), np.zeros((3, n)), np.zeros(n),
-            scalars)
+    return (np.zeros((n, n)), (np.zeros((n, n)), np.zeros(n, np.int32)),
+            (np.zeros((n, n), np.complex128), np.zeros(n, np.int32)), np.zeros((3, n)), np.zeros(n), scalars)
 
 
 #: the entries of a Radau run's scalars: the last step's start and size (its interpolant's), the previous
-#: step size and error norm (−1: none, scipy's None), whether the interpolant, the inverses and J exist,
+#: step size and error norm (−1: none, scipy's None), whether the interpolant, the factorisations and J exist,
 #: whether J is the current one (at the step's start), and the Jacobians formed
 (RADAU_T_OLD, RADAU_STEP, RADAU_H_OLD, RADAU_ERROR_OLD, RADAU_HAS_SOL, RADAU_HAS_LU, RADAU_HAS_J,
  RADAU_CURRENT_J, RADAU_NJEV, RADAU_SCALARS) = range(10)
@@ -362,28 +362,57 @@ def _jacobian(f, pre, tree, post, n_q, t, y, rate, J, x, column, x_failed):
     return False
 
 
-def _inverses(J, h, mu_real, mu_complex, inverse_real, inverse_complex):
-    """The inverses of μ_real/h I − J and μ_complex/h I − J (numba's np.linalg.inv: LAPACK's getrf and
-    getri) for the simplified Newton iteration's real and complex systems."""
+def _factorise(J, h, mu_real, mu_complex, real, complex_):
+    """LU factorisations of μ_real/h I − J and μ_complex/h I − J into ``real`` and ``complex_`` (each (LU,
+    pivots)) by LAPACK's dgetrf and zgetrf (scipy's ``cython_lapack``, :func:`_lapack`), for the simplified
+    Newton iteration's real and complex systems. LAPACK reads the C-ordered matrix as its transpose:
+    :func:`_solve` solves with the transpose of that (``trans = 'T'``)."""
     n = J.shape[0]
-    M_real, M_complex = np.empty((n, n)), np.empty((n, n), np.complex128)
+    M_real, M_complex = real[0], complex_[0]
     for i in range(n):
         for j in range(n):
             M_real[i, j] = -J[i, j]
             M_complex[i, j] = -J[i, j]
         M_real[i, i] += mu_real / h
         M_complex[i, i] += mu_complex / h
-    inverse_real[:, :] = np.linalg.inv(M_real)
-    inverse_complex[:, :] = np.linalg.inv(M_complex)
+    sizes = np.array([n, 1, 0], np.int32)  # n (also the leading dimension), right-hand sides, LAPACK's info
+    DGETRF(sizes.ctypes, sizes.ctypes, M_real.ctypes, sizes.ctypes, real[1].ctypes, sizes[2:].ctypes)
+    ZGETRF(sizes.ctypes, sizes.ctypes, M_complex.ctypes, sizes.ctypes, complex_[1].ctypes, sizes[2:].ctypes)
 
 
-def _apply(inverse, v, out):
-    """out ← inverse · v (a solve by the factorised matrix's inverse)."""
-    for i in range(v.shape[0]):
-        total = inverse[i, 0] * v[0]
-        for j in range(1, v.shape[0]):
-            total += inverse[i, j] * v[j]
-        out[i] = total
+def _solve(factorised, b, out):
+    """out ← M⁻¹ b by the factorisation (LU, pivots) of :func:`_factorise` (LAPACK's dgetrs or zgetrs, by
+    the dtype: the transpose of LAPACK's column-major view of the C-ordered LU)."""
+    _copy(b, out)
+    sizes, trans = np.array([b.shape[0], 1, 0], np.int32), np.array([84], np.uint8)  # 84: 'T'
+    if out.itemsize == 8:  # float64 (complex128: 16)
+        DGETRS(trans.ctypes, sizes.ctypes, sizes[1:].ctypes, factorised[0].ctypes, sizes.ctypes, factorised[1].ctypes,
+               out.ctypes, sizes.ctypes, sizes[2:].ctypes)
+    else:
+        ZGETRS(trans.ctypes, sizes.ctypes, sizes[1:].ctypes, factorised[0].ctypes, sizes.ctypes, factorised[1].ctypes,
+               out.ctypes, sizes.ctypes, sizes[2:].ctypes)
+
+
+#: LAPACK's dgetrf, dgetrs, zgetrf and zgetrs as numba's external functions (:func:`_lapack`; None until the
+#: Radau segment is compiled: its namespace holds them)
+DGETRF = DGETRS = ZGETRF = ZGETRS = None
+
+
+@functools.cache
+def _lapack() -> dict:
+    """LAPACK's LU factorisation and solve, real and complex, as numba external functions by symbol name:
+    scipy's ``scipy.linalg.cython_lapack`` entry points registered with LLVM under projeq's names (per
+    process, so that a Radau segment cached on disk links to this process's addresses)."""
+    import llvmlite.binding as llvm
+
+    numba = kernels.numba_module()
+    pointer, functions = numba.types.voidptr, {}
+    for name, n_args in (("dgetrf", 6), ("dgetrs", 9), ("zgetrf", 6), ("zgetrs", 9)):
+        llvm.add_symbol(f"projeq_{name}",
+                        numba.extending.get_cython_function_address("scipy.linalg.cython_lapack", name))
+        functions[name.upper()] = numba.types.ExternalFunction(f"projeq_{name}",
+                                                               numba.types.void(*(pointer,) * n_args))
+    return functions
 
 
 def _transformed(M, Z, W):
@@ -393,11 +422,11 @@ def _transformed(M, Z, W):
             W[a, i] = M[a, 0] * Z[0, i] + M[a, 1] * Z[1, i] + M[a, 2] * Z[2, i]
 
 
-def _collocation(f, pre, tree, post, n_q, radau, t, y, h, Z, scale, tol, inverse_real, inverse_complex, work,
+def _collocation(f, pre, tree, post, n_q, radau, t, y, h, Z, scale, tol, real, complex_, work,
                  x_failed):
     """scipy's ``solve_collocation_system``: the simplified Newton iteration on the collocation system of
     the step (t, y, h), the stage increments Z (3 × n) starting from the given guess, by the real and the
-    complex system of :func:`_inverses` (Hairer & Wanner, *Solving ODEs II*, §IV.8); at most
+    complex system factorised by :func:`_factorise` (Hairer & Wanner, *Solving ODEs II*, §IV.8); at most
     NEWTON_MAXITER iterations, stopped early where the convergence rate θ predicts failure (θ ≥ 1, or
     θ^(k_max − k)/(1 − θ) ‖ΔW‖ > tol). Returns (converged, iterations, θ (−1: none), the time of a
     failed evaluation or NaN: its state in x_failed)."""
@@ -419,8 +448,8 @@ def _collocation(f, pre, tree, post, n_q, radau, t, y, h, Z, scale, tol, inverse
             f_real[i] = F[0, i] * TI[0, 0] + F[1, i] * TI[0, 1] + F[2, i] * TI[0, 2] - M_real * W[0, i]
             f_complex[i] = (F[0, i] * (TI[1, 0] + 1j * TI[2, 0]) + F[1, i] * (TI[1, 1] + 1j * TI[2, 1])
                             + F[2, i] * (TI[1, 2] + 1j * TI[2, 2]) - M_complex * (W[1, i] + 1j * W[2, i]))
-        _apply(inverse_real, f_real, dW[0])
-        _apply(inverse_complex, f_complex, dW_complex)
+        _solve(real, f_real, dW[0])
+        _solve(complex_, f_complex, dW_complex)
         total = 0.0
         for i in range(n):
             dW[1, i], dW[2, i] = dW_complex[i].real, dW_complex[i].imag
@@ -476,7 +505,7 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
     order 3; the stage guess: the last step's collocation polynomial extrapolated."""
     radau, memory = method
     C, E, _, _, P, mu_real, mu_complex = radau
-    J, inverse_real, inverse_complex, Q, y_old, scalars = memory
+    J, real, complex_, Q, y_old, scalars = memory
     n = state.shape[0]
     work = (np.empty((3, n)), np.empty((3, n)), np.empty((3, n)), np.empty(n), np.empty(n),
             np.empty(n, np.complex128), np.empty(n, np.complex128))
@@ -532,10 +561,10 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
             converged = False
             while not converged:
                 if scalars[RADAU_HAS_LU] == 0.0:
-                    _inverses(J, h, mu_real, mu_complex, inverse_real, inverse_complex)
+                    _factorise(J, h, mu_real, mu_complex, real, complex_)
                     scalars[RADAU_HAS_LU] = 1.0
                 converged, n_iter, rate_newton, t_failed = _collocation(
-                    f, pre, tree, post, n_q, radau, t, y, h, Z, scale, newton_tol, inverse_real, inverse_complex,
+                    f, pre, tree, post, n_q, radau, t, y, h, Z, scale, newton_tol, real, complex_,
                     work, x_failed)
                 nfev += 3 * n_iter
                 if not np.isnan(t_failed):
@@ -559,7 +588,7 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
                 y_new[i] = y[i] + Z[2, i]
                 ZE[i] = (Z[0, i] * E[0] + Z[1, i] * E[1] + Z[2, i] * E[2]) / h
                 f_new[i] = rate[i] + ZE[i]
-            _apply(inverse_real, f_new, error)
+            _solve(real, f_new, error)
             for i in range(n):
                 scale[i] = atol + max(abs(y[i]), abs(y_new[i])) * rtol
             error_norm = _rms(error, scale)
@@ -574,7 +603,7 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
                     return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t
                 for i in range(n):
                     f_new[i] += ZE[i]
-                _apply(inverse_real, f_new, error)
+                _solve(real, f_new, error)
                 error_norm = _rms(error, scale)
             if error_norm > 1:
                 factor = _predict_factor(h_abs, h_abs_old, error_norm, error_norm_old)
@@ -623,7 +652,7 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
 
 
 _CALLEES = (_rhs, _stage, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows,
-            _jacobian, _inverses, _apply, _transformed, _collocation, _predict_factor, _interpolated)
+            _jacobian, _factorise, _solve, _transformed, _collocation, _predict_factor, _interpolated)
 
 
 @functools.cache
@@ -632,7 +661,7 @@ def _compiled(signature, implicit: bool):
     ``signature`` (the ẋ kernel's as a first-class function type first), cached on disk; its callees
     compiled with it."""
     numba = kernels.numba_module()
-    namespace = dict(globals())
+    namespace = {**globals(), **(_lapack() if implicit else {})}
 
     def rebound(function):
         return types.FunctionType(function.__code__, namespace, function.__name__, function.__defaults__)
