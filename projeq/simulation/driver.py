@@ -171,8 +171,8 @@ def simulate(
         and DOP853 step in the compiled loop where the model has a compiled ẋ (a tree, or a closed
         loop's one compiled call) and no ``events`` (:mod:`projeq.simulation.loop`; scipy's
         steps to round-off), and so does Radau (scipy's algorithm, its Jacobian by forward differences
-        of the compiled ẋ: n_x evaluations each, counted in ``Result.nfev`` and ``Result.njev``; with the
-        user's own ``jac``, solve_ivp steps), and ``method=`` the scipy class
+        of the compiled ẋ: n_x evaluations each, counted in ``Result.nfev`` and ``Result.njev``; with
+        ``jac`` "differences" or the user's own, solve_ivp steps), and ``method=`` the scipy class
         (``scipy.integrate.DOP853``) keeps solve_ivp stepping;
         or ``"RK45-projected"`` / ``"DOP853-projected"``: that method with each step projected
         onto the initial energy, so that a conservative scleronomic system's energy error
@@ -198,8 +198,8 @@ def simulate(
         For Radau, BDF and LSODA: ∂ẋ/∂x by the complex step through the model ("exact",
         the default; exact to round-off, n complex evaluations per Jacobian, counted in
         ``Result.njev``), by scipy's finite differences ("differences"), or the user's. Radau in
-        the compiled loop takes the forward differences of the compiled ẋ for "exact" and
-        "differences" alike.
+        the compiled loop (``jac="exact"``) differentiates the compiled ẋ by forward differences
+        instead (it takes real states only): n_x evaluations per Jacobian in ``Result.nfev``.
     out_of_range : "warn" or "stop"
         What a subsystem leaving the range its model describes (a beam beyond moderate
         deflections, :meth:`projeq.subsystems.base.Subsystem.out_of_range`, checked on the output
@@ -436,12 +436,12 @@ class _Run:
         """The compiled integration loop of the run's method on the current model
         (:func:`projeq.simulation.loop.loop`), or None where solve_ivp steps: a method the loop does not
         step (BDF, LSODA, projected, an OdeSolver class: ``method=scipy.integrate.DOP853`` keeps scipy's),
-        events, options besides max_step, the user's own Jacobian (Radau's loop differentiates the compiled
-        ẋ), or an evaluator without a compiled one-call ẋ."""
+        events, options besides max_step, a Radau run whose ``jac`` is not "exact" (the default: the loop
+        differentiates the compiled ẋ itself), or an evaluator without a compiled one-call ẋ."""
         key = (id(self.ev), self.method)
         if self.loops.get(key, (None,))[0] is not self.ev:  # (kept with its evaluator: an id is reused once freed)
-            ready = not (self.events or set(self.options) - {"max_step"}) and (self.jac is None or isinstance(
-                self.jac, str))
+            ready = not (self.events or set(self.options) - {"max_step"}) and (
+                self.method not in IMPLICIT or isinstance(self.jac, str))  # Radau: jac "exact", the default
             provider = getattr(self.ev, "loop_model", None) if ready else None
             if provider is not None and self.fused is not None:
                 self.fused(self.reached, self.x)  # ẋ's kernel compiled or found (the default evaluator's tier)
