@@ -14,7 +14,12 @@ the same number of evaluations:
   (≤ 1 after a rejection), h ← h · max(0.2, 0.9 · err^(−1/(p+1))) after a rejected one, with err the
   RMS norm of the error estimate over atol + rtol · max(|y|, |y_new|); the first step by HNW's
   starting-step algorithm (§II.4) unless the segment continues the previous one's;
-- output rows at the requested times inside each step by the method's interpolant.
+- output rows at the requested times inside each step by the method's interpolant;
+- and the implicit Radau IIA of order 5 (:func:`radau_segment`: scipy's ``Radau._step_impl``,
+  ``solve_collocation_system``, ``predict_factor`` and ``RadauDenseOutput``; Hairer & Wanner, *Solving
+  Ordinary Differential Equations II*, 2nd ed., §IV.8), whose ∂ẋ/∂x comes by forward differences of
+  the model's compiled ẋ (scipy's Radau in projeq takes the exact one: the steps may differ slightly)
+  and whose two Newton matrices are factorised by LAPACK (dgetrf/zgetrf, scipy's ``cython_lapack``).
 
 The model enters as data: a first-class function (the compiled ẋ kernel of a tree,
 :meth:`projeq.assembly.fast.FastEvaluator.loop_model`, or of a closed loop, partitioned or in the
