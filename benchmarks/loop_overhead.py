@@ -3,14 +3,15 @@
 For each scene of issue 34's list, ``simulate(scene, t_end)`` at its defaults (the method it
 chooses, 501 output rows with their energies and residuals), warm (compilation excluded), twice
 alternately: as it runs by default (the compiled integration loop, :mod:`projeq.simulation.loop`,
-where the model has a compiled one-call ẋ) and with scipy's ``solve_ivp`` stepping the same method
+where the model has a compiled one-call ẋ; Radau's Jacobian columns, n_x evaluations each, counted as
+evaluations) and with scipy's ``solve_ivp`` stepping the same method
 (``method=`` the scipy class). *CPU per evaluation* = the run's CPU ÷ its ẋ evaluations ÷ the CPU
 of one compiled ẋ of the same model called alone in a loop (issue 34's definition; its bound 1.5);
 "without rows" the same of a run with two output rows (``n_points=2``: the same steps and evaluations,
 the output rows' energies, residuals and projections left out), to tell the loop's share from the rows'.
 Each run's CPU is the least of ``--repeats`` alternating rounds.
 
-    PYTHONPATH=. python benchmarks/loop_overhead.py [--t-end 2] [--repeats 3]
+    PYTHONPATH=. python benchmarks/loop_overhead.py [--t-end 2] [--repeats 3] [--scenes flyball_governor]
     PYTHONPATH=. python benchmarks/loop_overhead.py --quick     # chain and rolling disk, 0.2 s, one round
 """
 
@@ -76,9 +77,11 @@ def main(argv=None) -> Table:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--t-end", type=float, default=2.0, help="simulated seconds (default 2)")
     parser.add_argument("--repeats", type=int, default=3, help="alternating rounds per scene (default 3)")
+    parser.add_argument("--scenes", nargs="+", choices=SCENES, default=SCENES, help="the scenes (default all)")
     parser.add_argument("--quick", action="store_true", help="chain and rolling disk, 0.2 s, one round")
     args = parser.parse_args(argv)
-    names, t_end, repeats = (("chain", "rolling_disk"), 0.2, 1) if args.quick else (SCENES, args.t_end, args.repeats)
+    names, t_end, repeats = ((("chain", "rolling_disk"), 0.2, 1) if args.quick
+                             else (tuple(args.scenes), args.t_end, args.repeats))
     rows = [row(name, t_end, repeats) for name in names]
     table = Table(["scene", "method", "evaluations", "ẋ", "per evaluation", "without rows", "scipy's loop",
                    "scipy / default"], rows,

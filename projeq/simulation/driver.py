@@ -170,7 +170,9 @@ def simulate(
         ``scipy.integrate.solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA, ...): by name, RK23, RK45
         and DOP853 step in the compiled loop where the model has a compiled ẋ (a tree, or a closed
         loop's one compiled call) and no ``events`` (:mod:`projeq.simulation.loop`; scipy's
-        steps to round-off), and ``method=`` the scipy class
+        steps to round-off), and so does Radau (scipy's algorithm, its Jacobian by forward differences
+        of the compiled ẋ: n_x evaluations each, counted in ``Result.nfev`` and ``Result.njev``; with
+        ``jac`` "differences" or the user's own, solve_ivp steps), and ``method=`` the scipy class
         (``scipy.integrate.DOP853``) keeps solve_ivp stepping;
         or ``"RK45-projected"`` / ``"DOP853-projected"``: that method with each step projected
         onto the initial energy, so that a conservative scleronomic system's energy error
@@ -195,7 +197,9 @@ def simulate(
     jac : "exact", "differences", callable or matrix
         For Radau, BDF and LSODA: ∂ẋ/∂x by the complex step through the model ("exact",
         the default; exact to round-off, n complex evaluations per Jacobian, counted in
-        ``Result.njev``), by scipy's finite differences ("differences"), or the user's.
+        ``Result.njev``), by scipy's finite differences ("differences"), or the user's. Radau in
+        the compiled loop (``jac="exact"``) differentiates the compiled ẋ by forward differences
+        instead (it takes real states only): n_x evaluations per Jacobian in ``Result.nfev``.
     out_of_range : "warn" or "stop"
         What a subsystem leaving the range its model describes (a beam beyond moderate
         deflections, :meth:`projeq.subsystems.base.Subsystem.out_of_range`, checked on the output
@@ -433,11 +437,13 @@ class _Run:
     def compiled_loop(self):
         """The compiled integration loop of the run's method on the current model
         (:func:`projeq.simulation.loop.loop`), or None where solve_ivp steps: a method the loop does not
-        step (implicit, projected, an OdeSolver class: ``method=scipy.integrate.DOP853`` keeps scipy's),
-        events, options besides max_step, or an evaluator without a compiled one-call ẋ."""
+        step (BDF, LSODA, projected, an OdeSolver class: ``method=scipy.integrate.DOP853`` keeps scipy's),
+        events, options besides max_step, a Radau run whose ``jac`` is not "exact" (the default: the loop
+        differentiates the compiled ẋ itself), or an evaluator without a compiled one-call ẋ."""
         key = (id(self.ev), self.method)
         if self.loops.get(key, (None,))[0] is not self.ev:  # (kept with its evaluator: an id is reused once freed)
-            ready = not (self.events or set(self.options) - {"max_step"})
+            ready = not (self.events or set(self.options) - {"max_step"}) and (
+                self.method not in IMPLICIT or isinstance(self.jac, str))  # Radau: jac "exact", the default
             provider = getattr(self.ev, "loop_model", None) if ready else None
             if provider is not None and self.fused is not None:
                 self.fused(self.reached, self.x)  # ẋ's kernel compiled or found (the default evaluator's tier)
@@ -460,9 +466,9 @@ class _Run:
         stepped = compiled.run(
             self.model.n_q, a, self.x, b, first, float(self.options.get("max_step", np.inf)), self.rtol, self.atol,
             np.ascontiguousarray(inside, dtype=float), self._paused, MONITOR_EVERY if self.may_be_singular else 0)
-        self.nfev, self.steps, self.calls, self.step_size, self.reached = (
-            self.nfev + stepped.nfev, self.steps + stepped.steps, self.calls + stepped.nfev, stepped.h_abs,
-            stepped.t_failed)
+        self.nfev, self.njev, self.steps, self.calls, self.step_size, self.reached = (
+            self.nfev + stepped.nfev, self.njev + stepped.njev, self.steps + stepped.steps, self.calls + stepped.nfev,
+            stepped.h_abs, stepped.t_failed)
         if stepped.status == loop.EVALUATION_FAILED:
             self.checked_rhs(stepped.t_failed, stepped.x_failed)  # raises, naming why
         rows = stepped.rows
@@ -631,7 +637,8 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
     with |x_s| its stability interval (:func:`~projeq.simulation.integrators.stability_limit`:
     RK45 3.31, DOP853 6.39). ``mode``: (ρ, decays) measured already (:func:`measured_mode`).
 
-    * "Radau" (exact Jacobian) when even DOP853 would need more than ``STIFF_STEPS`` steps
+    * "Radau" (the compiled loop's where the model has a compiled ẋ, else solve_ivp's with the exact
+      Jacobian) when even DOP853 would need more than ``STIFF_STEPS`` steps
       for stability alone, or when the fastest mode decays without oscillating (a real
       eigenvalue −ρ: a stiff damper) and would force more than ``FAST_MODE_STEPS`` RK45 steps —
       such a mode dies out, so only stability limits an explicit step (IFToMM A05, the stiff

@@ -14,7 +14,12 @@ the same number of evaluations:
   (≤ 1 after a rejection), h ← h · max(0.2, 0.9 · err^(−1/(p+1))) after a rejected one, with err the
   RMS norm of the error estimate over atol + rtol · max(|y|, |y_new|); the first step by HNW's
   starting-step algorithm (§II.4) unless the segment continues the previous one's;
-- output rows at the requested times inside each step by the method's interpolant.
+- output rows at the requested times inside each step by the method's interpolant;
+- and the implicit Radau IIA of order 5 (:func:`radau_segment`: scipy's ``Radau._step_impl``,
+  ``solve_collocation_system``, ``predict_factor`` and ``RadauDenseOutput``; Hairer & Wanner, *Solving
+  Ordinary Differential Equations II*, 2nd ed., §IV.8), whose ∂ẋ/∂x comes by forward differences of
+  the model's compiled ẋ (scipy's Radau in projeq takes the exact one: the steps may differ slightly)
+  and whose two Newton matrices are factorised by LAPACK (dgetrf/zgetrf, scipy's ``cython_lapack``).
 
 The model enters as data: a first-class function (the compiled ẋ kernel of a tree,
 :meth:`projeq.assembly.fast.FastEvaluator.loop_model`, or of a closed loop, partitioned or in the
@@ -41,8 +46,9 @@ from numpy.typing import NDArray
 
 from projeq.assembly import compilation, kernels
 
-#: the methods the compiled loop steps (scipy's names)
-METHODS = ("RK23", "RK45", "DOP853")
+#: the explicit methods the compiled loop steps (scipy's names), and all of them (Radau IIA the implicit one)
+EXPLICIT = ("RK23", "RK45", "DOP853")
+METHODS = (*EXPLICIT, "Radau")
 
 #: scipy's step-size control constants (``scipy.integrate._ivp.rk``)
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -55,7 +61,8 @@ class Stepped(NamedTuple):
     """What :meth:`CompiledLoop.run` did: how it ended (``status``), the time ``t`` and ``state`` reached (on
     EVALUATION_FAILED, of the last accepted step), the ``rows`` at the output times passed, the state
     and time where an evaluation failed (``x_failed``, ``t_failed``), the evaluations and steps taken,
-    the next step size and the monitor's exception (status STOPPED)."""
+    the next step size, the monitor's exception (status STOPPED) and the Jacobians formed (Radau; their
+    n_x evaluations each counted in nfev)."""
 
     status: int
     t: float
@@ -67,6 +74,7 @@ class Stepped(NamedTuple):
     steps: int
     h_abs: float
     stopped_by: Exception | None
+    njev: int = 0
 
 
 @functools.cache
@@ -304,30 +312,377 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
     return FINISHED, n_rows, nfev, steps, t, h_abs, t
 
 
-_CALLEES = (_rhs, _stage, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows)
+# -- Radau IIA of order 5 (scipy.integrate._ivp.radau, compiled) --------------------------------------------
+
+#: scipy's Newton iteration limit of the collocation system (``radau.NEWTON_MAXITER``)
+NEWTON_MAXITER = 6
 
 
 @functools.cache
-def _compiled(signature):
-    """:func:`segment` compiled by numba for the argument types ``signature`` (the ẋ kernel's as a
-    first-class function type first), cached on disk; its callees compiled with it."""
+def radau_tableau() -> tuple:
+    """(C, E, T, TI, P, μ_real, μ_complex) of scipy's Radau IIA of order 5 (Hairer & Wanner, *Solving
+    Ordinary Differential Equations II*, 2nd ed., §IV.8): the nodes C, the embedded error weights E, the
+    eigen-decomposition A⁻¹ = T diag(μ_real, μ_complex, μ̄_complex) T⁻¹ (TI = T⁻¹) that splits the
+    simplified Newton iteration into one real and one complex system of size n (eq. IV.8.16–8.18), and
+    the collocation polynomial's coefficients P of the dense output."""
+    from scipy.integrate._ivp import radau as r
+
+    return (np.asarray(r.C, float), np.asarray(r.E, float), np.asarray(r.T, float), np.asarray(r.TI, float),
+            np.asarray(r.P, float), float(r.MU_REAL), complex(r.MU_COMPLEX))
+
+
+def radau_memory(n: int) -> tuple:
+    """What a Radau run keeps from step to step (and over the pauses of :meth:`CompiledLoop.run`): ∂ẋ/∂x
+    J, the LU factorisations (LU, pivots) of μ_real/h − J and μ_complex/h − J, the last step's interpolant (its coefficients Q
+    and its start y_old) and the numbers ``RADAU_*`` (``scalars``); a fresh one: no Jacobian yet."""
+    scalars = np.zeros(RADAU_SCALARS)
+    scalars[RADAU_H_OLD] = scalars[RADAU_ERROR_OLD] = -1.0  # scipy's None
+    return (np.zeros((n, n)), (np.zeros((n, n)), np.zeros(n, np.int32)),
+            (np.zeros((n, n), np.complex128), np.zeros(n, np.int32)), np.zeros((3, n)), np.zeros(n), scalars)
+
+
+#: the entries of a Radau run's scalars: the last step's start and size (its interpolant's), the previous
+#: step size and error norm (−1: none, scipy's None), whether the interpolant, the factorisations and J exist,
+#: whether J is the current one (at the step's start), and the Jacobians formed
+(RADAU_T_OLD, RADAU_STEP, RADAU_H_OLD, RADAU_ERROR_OLD, RADAU_HAS_SOL, RADAU_HAS_LU, RADAU_HAS_J,
+ RADAU_CURRENT_J, RADAU_NJEV, RADAU_SCALARS) = range(10)
+
+
+def _jacobian(f, pre, tree, post, n_q, t, y, rate, J, x, column, x_failed):
+    """J ← ∂ẋ/∂x at (t, y) by forward differences of the kernel f column by column, ẋ(t, y) = rate given,
+    the increment δ_j = √(ε max(10⁻⁵, |y_j|)) of Hairer & Wanner's RADAU5 (*Solving ODEs II*, §IV.8):
+    n evaluations; whether one failed (its state in x_failed)."""
+    n = y.shape[0]
+    eps = np.finfo(np.float64).eps
+    _copy(y, x)
+    for j in range(n):
+        delta = np.sqrt(eps * max(1e-5, abs(y[j])))
+        x[j] = y[j] + delta
+        if _rhs(f, pre, tree, post, n_q, t, x, column) >= 0:
+            _copy(x, x_failed)
+            return True
+        for i in range(n):
+            J[i, j] = (column[i] - rate[i]) / delta
+        x[j] = y[j]
+    return False
+
+
+def _factorise(J, h, mu_real, mu_complex, real, complex_):
+    """LU factorisations of μ_real/h I − J and μ_complex/h I − J into ``real`` and ``complex_`` (each (LU,
+    pivots)) by LAPACK's dgetrf and zgetrf (scipy's ``cython_lapack``, :func:`_lapack`), for the simplified
+    Newton iteration's real and complex systems. LAPACK reads the C-ordered matrix as its transpose:
+    :func:`_solve` solves with the transpose of that (``trans = 'T'``)."""
+    n = J.shape[0]
+    M_real, M_complex = real[0], complex_[0]
+    for i in range(n):
+        for j in range(n):
+            M_real[i, j] = -J[i, j]
+            M_complex[i, j] = -J[i, j]
+        M_real[i, i] += mu_real / h
+        M_complex[i, i] += mu_complex / h
+    sizes = np.array([n, 1, 0], np.int32)  # n (also the leading dimension), right-hand sides, LAPACK's info
+    DGETRF(sizes.ctypes, sizes.ctypes, M_real.ctypes, sizes.ctypes, real[1].ctypes, sizes[2:].ctypes)
+    ZGETRF(sizes.ctypes, sizes.ctypes, M_complex.ctypes, sizes.ctypes, complex_[1].ctypes, sizes[2:].ctypes)
+
+
+def _solve(factorised, b, out):
+    """out ← M⁻¹ b by the factorisation (LU, pivots) of :func:`_factorise` (LAPACK's dgetrs or zgetrs, by
+    the dtype: the transpose of LAPACK's column-major view of the C-ordered LU)."""
+    _copy(b, out)
+    sizes, trans = np.array([b.shape[0], 1, 0], np.int32), np.array([84], np.uint8)  # 84: 'T'
+    if out.itemsize == 8:  # float64 (complex128: 16)
+        DGETRS(trans.ctypes, sizes.ctypes, sizes[1:].ctypes, factorised[0].ctypes, sizes.ctypes, factorised[1].ctypes,
+               out.ctypes, sizes.ctypes, sizes[2:].ctypes)
+    else:
+        ZGETRS(trans.ctypes, sizes.ctypes, sizes[1:].ctypes, factorised[0].ctypes, sizes.ctypes, factorised[1].ctypes,
+               out.ctypes, sizes.ctypes, sizes[2:].ctypes)
+
+
+#: LAPACK's dgetrf, dgetrs, zgetrf and zgetrs as numba's external functions (:func:`_lapack`; None until the
+#: Radau segment is compiled: its namespace holds them)
+DGETRF = DGETRS = ZGETRF = ZGETRS = None
+
+
+@functools.cache
+def _lapack() -> dict:
+    """LAPACK's LU factorisation and solve, real and complex, as numba external functions by symbol name:
+    scipy's ``scipy.linalg.cython_lapack`` entry points registered with LLVM under projeq's names (per
+    process, so that a Radau segment cached on disk links to this process's addresses)."""
+    import llvmlite.binding as llvm
+
     numba = kernels.numba_module()
-    namespace = dict(globals())
+    pointer, functions = numba.types.voidptr, {}
+    for name, n_args in (("dgetrf", 6), ("dgetrs", 9), ("zgetrf", 6), ("zgetrs", 9)):
+        llvm.add_symbol(f"projeq_{name}",
+                        numba.extending.get_cython_function_address("scipy.linalg.cython_lapack", name))
+        functions[name.upper()] = numba.types.ExternalFunction(f"projeq_{name}",
+                                                               numba.types.void(*(pointer,) * n_args))
+    return functions
+
+
+def _transformed(M, Z, W):
+    """W ← M Z for a 3 × 3 M and 3 × n Z (scipy's ``TI.dot(Z)``, ``T.dot(W)``)."""
+    for a in range(3):
+        for i in range(Z.shape[1]):
+            W[a, i] = M[a, 0] * Z[0, i] + M[a, 1] * Z[1, i] + M[a, 2] * Z[2, i]
+
+
+def _collocation(f, pre, tree, post, n_q, radau, t, y, h, Z, scale, tol, real, complex_, work,
+                 x_failed):
+    """scipy's ``solve_collocation_system``: the simplified Newton iteration on the collocation system of
+    the step (t, y, h), the stage increments Z (3 × n) starting from the given guess, by the real and the
+    complex system factorised by :func:`_factorise` (Hairer & Wanner, *Solving ODEs II*, §IV.8); at most
+    NEWTON_MAXITER iterations, stopped early where the convergence rate θ predicts failure (θ ≥ 1, or
+    θ^(k_max − k)/(1 − θ) ‖ΔW‖ > tol). Returns (converged, iterations, θ (−1: none), the time of a
+    failed evaluation or NaN: its state in x_failed)."""
+    C, _, T, TI, _, mu_real, mu_complex = radau
+    n = y.shape[0]
+    W, F, dW, x = work[0], work[1], work[2], work[3]
+    f_real, f_complex, dW_complex = work[4], work[5], work[6]
+    M_real, M_complex = mu_real / h, mu_complex / h
+    _transformed(TI, Z, W)
+    dW_norm_old, rate, converged, k = -1.0, -1.0, False, 0
+    while k < NEWTON_MAXITER:
+        for s in range(3):
+            for i in range(n):
+                x[i] = y[i] + Z[s, i]
+            if _rhs(f, pre, tree, post, n_q, t + C[s] * h, x, F[s]) >= 0:
+                _copy(x, x_failed)
+                return False, k + 1, rate, t + C[s] * h
+        for i in range(n):
+            f_real[i] = F[0, i] * TI[0, 0] + F[1, i] * TI[0, 1] + F[2, i] * TI[0, 2] - M_real * W[0, i]
+            f_complex[i] = (F[0, i] * (TI[1, 0] + 1j * TI[2, 0]) + F[1, i] * (TI[1, 1] + 1j * TI[2, 1])
+                            + F[2, i] * (TI[1, 2] + 1j * TI[2, 2]) - M_complex * (W[1, i] + 1j * W[2, i]))
+        _solve(real, f_real, dW[0])
+        _solve(complex_, f_complex, dW_complex)
+        total = 0.0
+        for i in range(n):
+            dW[1, i], dW[2, i] = dW_complex[i].real, dW_complex[i].imag
+            total += (dW[0, i] / scale[i]) ** 2 + (dW[1, i] / scale[i]) ** 2 + (dW[2, i] / scale[i]) ** 2
+        dW_norm = np.sqrt(total / (3 * n))
+        if dW_norm_old >= 0.0:
+            rate = dW_norm / dW_norm_old
+        if rate >= 0.0 and (rate >= 1 or rate ** (NEWTON_MAXITER - k) / (1 - rate) * dW_norm > tol):
+            break
+        for a in range(3):
+            for i in range(n):
+                W[a, i] += dW[a, i]
+        _transformed(T, W, Z)
+        if dW_norm == 0 or rate >= 0.0 and rate / (1 - rate) * dW_norm < tol:
+            converged = True
+            break
+        dW_norm_old = dW_norm
+        k += 1
+    return converged, min(k, NEWTON_MAXITER - 1) + 1, rate, np.nan
+
+
+def _predict_factor(h_abs, h_abs_old, error_norm, error_norm_old):
+    """scipy's ``predict_factor``: Gustafsson's predictive step-size control (Hairer & Wanner, *Solving
+    ODEs II*, §IV.8, eq. 8.25) where the previous step is known (h_abs_old, error_norm_old ≥ 0), else
+    the classical err^(−1/4)."""
+    if error_norm == 0:
+        return np.inf
+    multiplier = 1.0
+    if error_norm_old >= 0 and h_abs_old >= 0:
+        multiplier = h_abs / h_abs_old * (error_norm_old / error_norm) ** 0.25
+    return min(1.0, multiplier) * error_norm ** -0.25
+
+
+def _interpolated(Q, t_old, step, y_old, time, out):
+    """out ← the collocation polynomial of the step from t_old of size ``step`` at ``time``: y_old + Σ_k
+    Q_k θ^(k+1), θ = (time − t_old) / step (scipy's ``RadauDenseOutput``)."""
+    theta = (time - t_old) / step
+    for i in range(y_old.shape[0]):
+        out[i] = y_old[i] + theta * (Q[0, i] + theta * (Q[1, i] + theta * Q[2, i]))
+
+
+def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step, rtol, atol, pause,
+                  t_eval, first_row, rows, state, rate, x_failed):
+    """:func:`segment` by scipy's Radau IIA of order 5 (``scipy.integrate.Radau._step_impl``, step by
+    step): ``method`` = (:func:`radau_tableau`, :func:`radau_memory`), the memory kept over pauses.
+    Each step solves the collocation system by :func:`_collocation`; a step whose Newton iteration
+    fails is retried with a fresh Jacobian (if J is not current) or halved; the error estimate
+    (HNW IV.8, eq. 8.19–8.20: (μ_real/h − J)⁻¹ (ẋ + Zᵀ E / h), once more through ẋ after a rejection)
+    drives Gustafsson's predictive control (:func:`_predict_factor`, safety 0.9 (2 k_max + 1) /
+    (2 k_max + iterations)); the step size is kept (and the factorisation reused) when it would grow by
+    less than 1.2; J is formed again (:func:`_jacobian`, n evaluations) when the Newton iteration took
+    more than two iterations at a rate above 10⁻³. The first step: HNW's starting-step algorithm for
+    order 3; the stage guess: the last step's collocation polynomial extrapolated."""
+    radau, memory = method
+    C, E, _, _, P, mu_real, mu_complex = radau
+    J, real, complex_, Q, y_old, scalars = memory
+    n = state.shape[0]
+    work = (np.empty((3, n)), np.empty((3, n)), np.empty((3, n)), np.empty(n), np.empty(n),
+            np.empty(n, np.complex128), np.empty(n, np.complex128))
+    Z, scale, error, ZE, f_new = np.empty((3, n)), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    y, y_new = state.copy(), np.empty(n)
+    nfev, steps, n_rows, failed = 0, 0, first_row, -1
+    newton_tol = max(10 * np.finfo(np.float64).eps / rtol, min(0.03, rtol ** 0.5))
+    if not known:
+        nfev += 1
+        failed = _rhs(f, pre, tree, post, n_q, t, y, rate)
+    if failed < 0 and h_abs <= 0.0:  # scipy's select_initial_step, for the error estimator's order 3
+        h0, d1 = _first_guess(y, rate, abs(t_bound - t), rtol, atol, scale, error)
+        nfev += 1
+        failed = _rhs(f, pre, tree, post, n_q, t + h0, error, ZE)
+        h_abs = _first_choice(rate, ZE, scale, h0, d1, abs(t_bound - t), max_step, -0.25)
+    if failed >= 0:
+        _copy(y, x_failed)
+        return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t
+    if scalars[RADAU_HAS_J] == 0.0:
+        nfev += n
+        scalars[RADAU_NJEV] += 1
+        if _jacobian(f, pre, tree, post, n_q, t, y, rate, J, error, ZE, x_failed):
+            _copy(y, state)
+            return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t
+        scalars[RADAU_HAS_J], scalars[RADAU_CURRENT_J] = 1.0, 1.0
+    while t != t_bound:
+        min_step = 10 * abs(np.nextafter(t, np.inf) - t)
+        h_abs_old, error_norm_old, h_abs_start = scalars[RADAU_H_OLD], scalars[RADAU_ERROR_OLD], h_abs
+        if h_abs > max_step or h_abs < min_step:
+            h_abs = max_step if h_abs > max_step else min_step
+            h_abs_old, error_norm_old = -1.0, -1.0
+        current_jac = scalars[RADAU_CURRENT_J] != 0.0
+        rejected, accepted, n_iter, rate_newton, error_norm, safety = False, False, 0, -1.0, 0.0, 0.0
+        while not accepted:
+            if h_abs < min_step:
+                _copy(y, state)
+                return TOO_SMALL_STEP, n_rows, nfev, steps, t, h_abs, t
+            t_new = t + h_abs
+            if t_new - t_bound > 0:
+                t_new = t_bound
+            h = t_new - t
+            h_abs = abs(h)
+            for s in range(3):
+                if scalars[RADAU_HAS_SOL] != 0.0:
+                    _interpolated(Q, scalars[RADAU_T_OLD], scalars[RADAU_STEP], y_old, t + h * C[s], Z[s])
+                    for i in range(n):
+                        Z[s, i] -= y[i]
+                else:
+                    for i in range(n):
+                        Z[s, i] = 0.0
+            for i in range(n):
+                scale[i] = atol + abs(y[i]) * rtol
+            converged = False
+            while not converged:
+                if scalars[RADAU_HAS_LU] == 0.0:
+                    _factorise(J, h, mu_real, mu_complex, real, complex_)
+                    scalars[RADAU_HAS_LU] = 1.0
+                converged, n_iter, rate_newton, t_failed = _collocation(
+                    f, pre, tree, post, n_q, radau, t, y, h, Z, scale, newton_tol, real, complex_,
+                    work, x_failed)
+                nfev += 3 * n_iter
+                if not np.isnan(t_failed):
+                    _copy(y, state)
+                    return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t_failed
+                if not converged:
+                    if current_jac:
+                        break
+                    nfev += n
+                    scalars[RADAU_NJEV] += 1
+                    if _jacobian(f, pre, tree, post, n_q, t, y, rate, J, work[3], work[4], x_failed):
+                        _copy(y, state)
+                        return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t
+                    current_jac = True
+                    scalars[RADAU_HAS_LU] = 0.0
+            if not converged:
+                h_abs *= 0.5
+                scalars[RADAU_HAS_LU] = 0.0
+                continue
+            for i in range(n):
+                y_new[i] = y[i] + Z[2, i]
+                ZE[i] = (Z[0, i] * E[0] + Z[1, i] * E[1] + Z[2, i] * E[2]) / h
+                f_new[i] = rate[i] + ZE[i]
+            _solve(real, f_new, error)
+            for i in range(n):
+                scale[i] = atol + max(abs(y[i]), abs(y_new[i])) * rtol
+            error_norm = _rms(error, scale)
+            safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter)
+            if rejected and error_norm > 1:
+                for i in range(n):
+                    work[3][i] = y[i] + error[i]
+                nfev += 1
+                if _rhs(f, pre, tree, post, n_q, t, work[3], f_new) >= 0:
+                    _copy(work[3], x_failed)
+                    _copy(y, state)
+                    return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t
+                for i in range(n):
+                    f_new[i] += ZE[i]
+                _solve(real, f_new, error)
+                error_norm = _rms(error, scale)
+            if error_norm > 1:
+                factor = _predict_factor(h_abs, h_abs_old, error_norm, error_norm_old)
+                h_abs *= max(MIN_FACTOR, safety * factor)
+                scalars[RADAU_HAS_LU] = 0.0
+                rejected = True
+            else:
+                accepted = True
+        recompute_jac = n_iter > 2 and rate_newton > 1e-3
+        factor = min(MAX_FACTOR, safety * _predict_factor(h_abs, h_abs_old, error_norm, error_norm_old))
+        if not recompute_jac and factor < 1.2:
+            factor = 1.0
+        else:
+            scalars[RADAU_HAS_LU] = 0.0
+        nfev += 1
+        if _rhs(f, pre, tree, post, n_q, t_new, y_new, f_new) >= 0:
+            _copy(y_new, x_failed)
+            _copy(y, state)
+            return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t_new
+        if recompute_jac:
+            nfev += n
+            scalars[RADAU_NJEV] += 1
+            if _jacobian(f, pre, tree, post, n_q, t_new, y_new, f_new, J, work[3], work[4], x_failed):
+                _copy(y, state)
+                return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t_new
+        scalars[RADAU_CURRENT_J] = 1.0 if recompute_jac else 0.0
+        scalars[RADAU_H_OLD], scalars[RADAU_ERROR_OLD] = h_abs_start, error_norm
+        h_abs *= factor
+        for i in range(n):  # the step's collocation polynomial: Q = Zᵀ P (scipy's _compute_dense_output)
+            for k in range(3):
+                Q[k, i] = Z[0, i] * P[0, k] + Z[1, i] * P[1, k] + Z[2, i] * P[2, k]
+        _copy(y, y_old)
+        scalars[RADAU_T_OLD], scalars[RADAU_STEP], scalars[RADAU_HAS_SOL] = t, h, 1.0
+        steps += 1
+        while n_rows < t_eval.shape[0] and t_eval[n_rows] <= t_new:  # solve_ivp's searchsorted(side="right")
+            _interpolated(Q, t, h, y_old, t_eval[n_rows], rows[n_rows])
+            n_rows += 1
+        t = t_new
+        y, y_new = y_new, y
+        _copy(f_new, rate)
+        if pause > 0 and nfev >= pause and t != t_bound:
+            _copy(y, state)
+            return PAUSED, n_rows, nfev, steps, t, h_abs, t
+    _copy(y, state)
+    return FINISHED, n_rows, nfev, steps, t, h_abs, t
+
+
+_CALLEES = (_rhs, _stage, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows,
+            _jacobian, _factorise, _solve, _transformed, _collocation, _predict_factor, _interpolated)
+
+
+@functools.cache
+def _compiled(signature, implicit: bool):
+    """:func:`segment` (``implicit``: :func:`radau_segment`) compiled by numba for the argument types
+    ``signature`` (the ẋ kernel's as a first-class function type first), cached on disk; its callees
+    compiled with it."""
+    numba = kernels.numba_module()
+    namespace = {**globals(), **(_lapack() if implicit else {})}
 
     def rebound(function):
         return types.FunctionType(function.__code__, namespace, function.__name__, function.__defaults__)
 
     for callee in _CALLEES:
         namespace[callee.__name__] = numba.extending.register_jitable(rebound(callee))
-    return numba.njit([signature], cache=True)(rebound(segment))
+    return numba.njit([signature], cache=True)(rebound(radau_segment if implicit else segment))
 
 
 class CompiledLoop:
-    """The compiled :func:`segment` for one model's ẋ kernel (``model``: the evaluator's ``loop_model``)
-    and one method of :data:`METHODS`; :meth:`run` steps a segment."""
+    """The compiled :func:`segment` (Radau: :func:`radau_segment`) for one model's ẋ kernel (``model``: the
+    evaluator's ``loop_model``) and one method of :data:`METHODS`; :meth:`run` steps a segment."""
 
     def __init__(self, model, method: str):
-        self.model, self.method = model, tableau(method)
+        self.model, self.implicit = model, method not in EXPLICIT
+        self.method = radau_tableau() if self.implicit else tableau(method)
         self.kernel, self.compiled = _specialised(model, method)
 
     def run(self, n_q: int, t: float, x: NDArray, t_bound: float, h_abs: float, max_step: float, rtol: float,
@@ -338,13 +693,15 @@ class CompiledLoop:
         t_eval, state = np.ascontiguousarray(t_eval, dtype=float).ravel(), np.array(x, dtype=float).ravel()
         rows, rate, x_failed = np.empty((len(t_eval), len(state))), np.empty(len(state)), np.empty(len(state))
         status, n_rows, nfev, steps, known, stopped_by = PAUSED, 0, 0, 0, False, None
-        model = self.model
+        model, method = self.model, self.method
+        if self.implicit:  # a fresh Radau run: its Jacobian formed at t (solve_ivp's, too, per segment)
+            method = (method, radau_memory(len(state)))
         if model.before is not None:
             model.before()
         while status == PAUSED:
             with _signals_held():  # the arguments of the types compiled for (the entry point checks none)
                 status, n_rows, more, taken, t, h_abs, t_failed = self.compiled(
-                    self.kernel, model.pre, model.tree, model.post, int(n_q), self.method, float(t), float(t_bound),
+                    self.kernel, model.pre, model.tree, model.post, int(n_q), method, float(t), float(t_bound),
                     known, float(h_abs), float(max_step), float(rtol), float(atol), int(every), t_eval, n_rows, rows,
                     state, rate, x_failed)
             nfev, steps, known = nfev + more, steps + taken, True
@@ -353,7 +710,8 @@ class CompiledLoop:
                     monitor(t, state)
                 except Exception as exc:  # noqa: BLE001 - the caller raises it, keeping the rows
                     status, stopped_by = STOPPED, exc
-        return Stepped(status, t, rows[:n_rows], state, x_failed, t_failed, nfev, steps, h_abs, stopped_by)
+        njev = int(method[1][-1][RADAU_NJEV]) if self.implicit else 0
+        return Stepped(status, t, rows[:n_rows], state, x_failed, t_failed, nfev, steps, h_abs, stopped_by, njev)
 
 
 def _layout(value):
@@ -383,9 +741,11 @@ def _specialised(model, method: str) -> tuple:
         if signature not in model.kernel.overloads:  # a kernel Python has not called yet: compiled (or loaded) now
             model.kernel.compile(signature)
         kernel = _address(model.kernel, model.kernel.overloads[signature].signature)
+        implicit = method not in EXPLICIT
+        data = (radau_tableau(), radau_memory(1)) if implicit else tableau(method)
         compiled = _compiled(tuple(numba.typeof(a) for a in (
-            kernel, model.pre, model.tree, model.post, 0, tableau(method), 0.0, 0.0, True, 0.0, 0.0, 0.0, 0.0, 0,
-            np.zeros(1), 0, np.zeros((1, 1)), np.zeros(1), np.zeros(1), np.zeros(1))))
+            kernel, model.pre, model.tree, model.post, 0, data, 0.0, 0.0, True, 0.0, 0.0, 0.0, 0.0, 0,
+            np.zeros(1), 0, np.zeros((1, 1)), np.zeros(1), np.zeros(1), np.zeros(1))), implicit)
         _SPECIALISED[key] = kernel, compiled.overloads[compiled.signatures[0]].entry_point
     return _SPECIALISED[key]
 
