@@ -495,13 +495,16 @@ class LoopModel:
     """A model as the compiled integration loop (:mod:`projeq.simulation.loop`) takes it: its ẋ kernel
     ``kernel(*pre, t, *tree, x, n_q, *post, x_dot)`` (as :meth:`FastEvaluator.state_derivative` calls
     it) with the arrays before t, the tree's and the workspace's; ``loops``, the loops compiled for it,
-    by method; ``checks_events``: the kernel fails where the model's own events would fire (a
-    ConstrainedSystem's partition degenerating), so that simulate steps that segment by solve_ivp;
-    ``before()``: called before each compiled segment (state the kernel keeps between calls)."""
+    by method; ``event``: the model's own terminal event where it has one (a ConstrainedSystem's
+    partition degenerating, κ − limit rising), as (an array whose first entry the kernel writes at each
+    evaluation, the limit that value rises through), which the explicit methods locate in the loop
+    (``checks_events``: it has one); ``before()``: called before each compiled segment (state the kernel
+    keeps between calls)."""
 
-    def __init__(self, kernel, pre: tuple, tree: tuple, post: tuple, checks_events: bool = False, before=None):
+    def __init__(self, kernel, pre: tuple, tree: tuple, post: tuple, event: tuple | None = None, before=None):
         self.kernel, self.pre, self.tree, self.post, self.loops = kernel, pre, tree, post, {}
-        self.checks_events, self.before = checks_events, before
+        self.checks_events, self.before = event is not None, before
+        self.event = (np.zeros(1), np.inf) if event is None else event
 
 
 class _Workspace:

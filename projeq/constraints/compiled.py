@@ -85,8 +85,8 @@ from projeq.constraints.matrices import RANK_TOLERANCE
 #: (a spring-damper whose two points coincide) — the numpy path then raises the error naming it
 DONE, DEGENERATE, SINGULAR, UNLOADED = 0, 1, 2, 3
 
-#: the share of a partition's event limit at which the compiled loop's ẋ (:func:`partitioned_state_derivative`)
-#: gives the segment back to solve_ivp: below 1, so that round-off between two SVDs of A_s cannot miss it
+#: the share of a partition's event limit from which the compiled loop's ẋ (:func:`partitioned_state_derivative`)
+#: writes κ itself, not its bound: below 1, so that round-off between the bound and κ cannot miss the event
 EVENT_MARGIN = 0.999
 
 
@@ -842,7 +842,8 @@ def _tangent_velocities(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, 
     F = _scaled(N, independent)
     if F.shape[0] == 0:
         return U, sigma, Vt, count, F, s_dot.copy()
-    kappa[0] = np.linalg.svd(F)[1][0] if k else 1.0  # (no free motion: nothing to describe)
+    # ‖F‖₂: a column's Euclidean norm (one free motion), else its largest singular value (1 without free motion)
+    kappa[0] = np.sqrt(np.sum(F * F)) if k == 1 else np.linalg.svd(F)[1][0] if k else 1.0
     s_dot_tree = _matvec(F, s_dot)
     if b_s.shape[0]:  # ṡ_tree = F ṡ + f, A_s f = b_s with f[independent] = 0
         f = _particular(U, sigma, Vt, -b_s, count, F, independent)
@@ -855,34 +856,33 @@ def partitioned_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, i
                                  bound, pivot, limit, q, s_dot, q_dot, s_ddot_tree, A, M, b, kappa, x_dot):
     """ẋ = (q̇, s̈_tree[independent]) of :func:`partitioned` at x = (q, ṡ) into ``x_dot``, as the compiled
     integration loop calls a model's ẋ (:mod:`projeq.simulation.loop`; ``q``, ``s_dot``: buffers of the
-    state's parts): −1, or 0 where the kernel flags, ẋ is not finite or the partition's condition
-    κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ reaches :data:`EVENT_MARGIN` · ``limit`` — the ConstrainedSystem's own event
-    κ − limit, which solve_ivp then locates, going on from the loop's last step, and re-partitions there
-    (solve_ivp looks for a sign change at the steps' ends, where this call is made: none is missed). κ by
-    two SVDs only where the kernel's bound ‖A_s‖_F ‖A_dep⁻¹‖_F ≥ κ reaches the margin (the SVDs cost a
-    third of the four-bar's evaluation)."""
+    state's parts): −1, or 0 where the kernel flags (``kappa[0]`` then ∞) or ẋ is not finite. Writes into
+    ``kappa[0]`` the value of the ConstrainedSystem's event κ − limit plus its limit: the partition's
+    condition κ = ‖A_s‖₂ ‖A_dep⁻¹‖₂ by two SVDs where the kernel's bound ‖A_s‖_F ‖A_dep⁻¹‖_F ≥ κ reaches
+    :data:`EVENT_MARGIN` · ``limit``, the bound elsewhere (below the limit: the event's sign is right
+    everywhere, its value exact near its root; the SVDs cost a third of the four-bar's evaluation)."""
     _split(x, n_q, q, s_dot)
     if partitioned(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, dependent, bound, pivot,
                    q_dot, s_ddot_tree, A, M, b, kappa) != DONE:
+        kappa[0] = np.inf
         return 0
-    if kappa[0] < EVENT_MARGIN * limit:  # κ ≤ the bound: far from the event
-        return _state_rates(q_dot, s_ddot_tree, independent, n_q, x_dot)
-    A_dep = np.empty((dependent.shape[0], dependent.shape[0]))
-    for r in range(dependent.shape[0]):
-        for c in range(dependent.shape[0]):
-            A_dep[r, c] = A[r, dependent[c]]
-    if not np.linalg.svd(A_dep)[1][-1] * EVENT_MARGIN * limit > np.linalg.svd(A)[1][0]:
-        return 0
+    if not kappa[0] < EVENT_MARGIN * limit:  # near the event: κ itself
+        A_dep = np.empty((dependent.shape[0], dependent.shape[0]))
+        for r in range(dependent.shape[0]):
+            for c in range(dependent.shape[0]):
+                A_dep[r, c] = A[r, dependent[c]]
+        kappa[0] = np.linalg.svd(A)[1][0] / np.linalg.svd(A_dep)[1][-1]
     return _state_rates(q_dot, s_ddot_tree, independent, n_q, x_dot)
 
 
 def tangent_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, independent, x, n_q, m_h, rank, separation,
                              acting, kept, pivot, limit, q, s_dot, q_dot, s_ddot_tree, A, M, b, kappa, x_dot):
-    """:func:`partitioned_state_derivative` for :func:`tangent` (the null-space form): 0 where its
-    κ = 1/σ_min(N_ind) reaches :data:`EVENT_MARGIN` · ``limit`` (the TangentSystem's event)."""
+    """:func:`partitioned_state_derivative` for :func:`tangent` (the null-space form), its event's
+    κ = 1/σ_min(N_ind) = ‖F‖₂ the kernel's own."""
     _split(x, n_q, q, s_dot)
     if tangent(phi, pins, fields, pfaffian, joints, tree, q, s_dot, t, m_h, independent, rank, separation, acting,
-               kept, pivot, q_dot, s_ddot_tree, A, M, b, kappa) != DONE or not kappa[0] < EVENT_MARGIN * limit:
+               kept, pivot, q_dot, s_ddot_tree, A, M, b, kappa) != DONE:
+        kappa[0] = np.inf
         return 0
     return _state_rates(q_dot, s_ddot_tree, independent, n_q, x_dot)
 
@@ -1393,15 +1393,16 @@ class CompiledClosure:
         pre = (self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree)
         buffers = (np.zeros(system.n_q), np.zeros(system.n_s), self._q_dot, self._s_ddot_tree, self._A,
                    self._workspace.M_all, self._workspace.b_all)
+        event = (self._kappa, float(system.limit))  # κ − limit, rising: the system's event
         if self.rule == "partitioned":
             return LoopModel(_compiled_adapter(self.kernel, self.rule), pre, (system.independent, system.dependent),
                              (self.m_h, float(self.constants[0]), float(SINGULAR_PIVOT), float(system.limit),
-                              *buffers, self._kappa), checks_events=True)
+                              *buffers, self._kappa), event=event)
         kept = self._kept_tangent(system)
         return LoopModel(_compiled_adapter(self.kernel, self.rule), pre, (system.independent,),
                          (self.m_h, system.tree.n_s - system.n_s, float(system.separation), float(self.constants[0]),
                           kept, float(SINGULAR_PIVOT), float(system.limit), *buffers, self._kappa),
-                         checks_events=True, before=lambda: self._keep_tangent(system, kept))
+                         event=event, before=lambda: self._keep_tangent(system, kept))
 
     def _keep_tangent(self, system, kept: NDArray) -> None:
         """The tangent ``system`` keeps, in the array ``kept`` the compiled loop's ẋ reads and writes

@@ -458,9 +458,10 @@ class _Run:
 
     def _compiled_segment(self, compiled, a: float, b: float, inside: NDArray):
         """One segment from the current state at a to b by the compiled loop, as solve_ivp's result
-        (its output rows, status and message); where an evaluation failed for a reason the checked
-        evaluation does not raise (a closed loop's partition nearing its event), the rows up to the last
-        accepted step kept and the time of that step, from where solve_ivp goes on."""
+        (its output rows, status and message; where the model's own event fired, its time and state as
+        solve_ivp gives a terminal event's); where an evaluation failed for a reason the checked
+        evaluation does not raise (a closed loop's partition flagged by its kernel), the rows up to the
+        last accepted step kept and the time of that step, from where solve_ivp goes on."""
         first = self._continued(b - a).get("first_step") or 0.0
         self.reached = a
         stepped = compiled.run(
@@ -483,6 +484,10 @@ class _Run:
             return float(stepped.t)
         if stepped.status == loop.TOO_SMALL_STEP:
             segment.status, segment.message = -1, "Required step size is less than spacing between numbers."
+        elif stepped.status == loop.MODEL_EVENT:  # the model's own terminal event, located where it fired
+            segment.status, segment.message = 1, "A termination event occurred."
+            segment.t_events = [np.zeros(0)] * len(self.events) + [np.array([stepped.t])]
+            segment.y_events = [np.zeros((0, len(stepped.state)))] * len(self.events) + [stepped.state[None].copy()]
         elif stepped.status == loop.FINISHED:
             self.x_end = stepped.state
         self._keep(segment)

@@ -53,8 +53,14 @@ METHODS = (*EXPLICIT, "Radau")
 #: scipy's step-size control constants (``scipy.integrate._ivp.rk``)
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 
-#: what a compiled segment ended with (STOPPED: the monitor raised where the segment paused)
-FINISHED, TOO_SMALL_STEP, EVALUATION_FAILED, PAUSED, STOPPED = 0, 1, 2, 3, 4
+#: what a compiled segment ended with (STOPPED: the monitor raised where the segment paused; MODEL_EVENT: the
+#: model's own terminal event, located where it fired)
+FINISHED, TOO_SMALL_STEP, EVALUATION_FAILED, PAUSED, STOPPED, MODEL_EVENT = 0, 1, 2, 3, 4, 5
+
+#: scipy's tolerances of an event's root (``solve_ivp``'s ``solve_event_equation``: brentq's xtol and rtol)
+EVENT_XTOL = EVENT_RTOL = 4 * np.finfo(float).eps
+#: brentq's iteration limit (scipy's default maxiter)
+EVENT_MAXITER = 100
 
 
 class Stepped(NamedTuple):
@@ -225,7 +231,7 @@ def _dense_rows(method, K, t_old, h, y_old, y, f_new, t_eval, first, last, rows,
 
 
 def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step, rtol, atol, pause, t_eval, first_row,
-            rows, state, rate, x_failed):
+            rows, state, rate, x_failed, event):
     """Steps from (t, state) towards t_bound by the explicit method ``method`` (:func:`tableau`) on the ẋ
     kernel f (``f(*pre, t, *tree, x, n_q, *post, x_dot)``, −1 or a failure index), with ``rate`` its ẋ
     there where ``known`` (else evaluated); h_abs > 0 the next step (else HNW's first step). Writes
@@ -236,16 +242,20 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
     ``known`` True: the same steps as without the pause); TOO_SMALL_STEP (scipy's failure: the step
     size fell below the spacing of the numbers near t); or EVALUATION_FAILED, the state evaluated in
     x_failed (the caller's checked evaluation names why), the state and time reached those of the last
-    accepted step (the caller may go on from there)."""
+    accepted step (the caller may go on from there); or MODEL_EVENT: the model's own terminal event
+    ``event`` (:func:`_event_fired`) located inside the last step, the state and time reached its root's,
+    the rows up to it written."""
     dop853, A, B, C, E, E3, dense, n_stages, exponent = method
     n = state.shape[0]
     K = np.empty((max(A.shape[0], n_stages + 1), n))
-    work = (np.empty(n), np.empty(n), np.empty(n), np.empty((max(dense.shape[1], dense.shape[0] + 3), n)))
+    work = (np.empty(n), np.empty(n), np.empty(n), np.empty((max(dense.shape[1], dense.shape[0] + 3), n)),
+            np.empty((1, n)))
     y, y_new = state.copy(), np.empty(n)
     nfev, steps, n_rows, failed = 0, 0, first_row, -1
     if not known:
         nfev += 1
         failed = _rhs(f, pre, tree, post, n_q, t, y, rate)
+        event[2][0] = event[0][0] - event[1]  # the event's value where the segment starts
     if failed < 0 and h_abs <= 0.0:  # scipy's select_initial_step
         h0, d1 = _first_guess(y, rate, abs(t_bound - t), rtol, atol, work[0], work[1])
         nfev += 1
@@ -291,17 +301,28 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
                 h_abs *= max(MIN_FACTOR, SAFETY * error_norm ** exponent)
                 rejected = True
         steps += 1
+        fired = _event_fired(event)  # at y_new: the step's last stage was evaluated there
+        t_end = t_new
+        if fired:
+            t_end = _event_root(f, pre, tree, post, n_q, method, K, t, h, y, y_new, work, event)
         last = n_rows
-        while last < t_eval.shape[0] and t_eval[last] <= t_new:  # solve_ivp's searchsorted(side="right")
+        while last < t_eval.shape[0] and t_eval[last] <= t_end:  # solve_ivp's searchsorted(side="right")
             last += 1
-        if last > n_rows:
+        if fired:  # the root's search formed the dense output (DOP853: its extra stages, which scipy counts)
+            nfev += A.shape[0] - n_stages - 1
+        elif last > n_rows:
             for s in range(n_stages + 1, A.shape[0]):  # DOP853's extra stages of its dense output
                 nfev += 1
                 if _stage(f, pre, tree, post, n_q, K, A[s], s, h, t + C[s] * h, y, work[1], x_failed):
                     _copy(y, state)
                     return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t + C[s] * h
+        if last > n_rows:
             _dense_rows(method, K, t, h, y, y_new, K[n_stages], t_eval, n_rows, last, rows, work)
             n_rows = last
+        if fired:  # solve_ivp's terminal event: the rows up to its root, the state there
+            _dense_rows(method, K, t, h, y, y_new, K[n_stages], np.array([t_end]), 0, 1, work[4], work)
+            _copy(work[4][0], state)
+            return MODEL_EVENT, n_rows, nfev, steps, t_end, h_abs, t_end
         t = t_new
         y, y_new = y_new, y
         _copy(K[n_stages], rate)
@@ -310,6 +331,73 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
             return PAUSED, n_rows, nfev, steps, t, h_abs, t
     _copy(y, state)
     return FINISHED, n_rows, nfev, steps, t, h_abs, t
+
+
+def _event_fired(event) -> bool:
+    """Whether the model's terminal event g = value − limit (``event`` = (the model's value array, its
+    limit, [g where the last step started]), rising, as a ConstrainedSystem's κ − limit; limit ∞: none)
+    rose through zero over the last step, from the value its last evaluation wrote; keeps the new g
+    (scipy's ``find_active_events``: g_old ≤ 0 ≤ g_new)."""
+    value, limit, kept = event
+    if limit == np.inf:
+        return False
+    g_old, g_new = kept[0], value[0] - limit
+    kept[0] = g_new
+    return g_old <= 0.0 and g_new >= 0.0
+
+
+def _event_root(f, pre, tree, post, n_q, method, K, t_old, h, y_old, y_new, work, event) -> float:
+    """The time of the event's root inside the step (t_old, t_old + h) by scipy's brentq (its C code, step
+    by step: Brent's inverse quadratic interpolation and bisection, xtol = rtol = 4 ε) on g(τ) = the value
+    the kernel writes at the step's interpolant at τ, minus the limit (scipy's ``solve_event_equation``);
+    DOP853's dense stages computed first (their evaluations are the caller's to count)."""
+    dop853, A, _, C, _, _, _, n_stages, _ = method
+    for s in range(n_stages + 1, A.shape[0]):
+        _stage(f, pre, tree, post, n_q, K, A[s], s, h, t_old + C[s] * h, y_old, work[1], work[2])
+    x_pre, x_cur = t_old, t_old + h
+    f_pre = _event_at(f, pre, tree, post, n_q, method, K, t_old, h, y_old, y_new, work, event, x_pre)
+    f_cur = _event_at(f, pre, tree, post, n_q, method, K, t_old, h, y_old, y_new, work, event, x_cur)
+    if f_pre == 0.0:
+        return x_pre
+    if f_cur == 0.0:
+        return x_cur
+    x_blk, f_blk, s_pre, s_cur = 0.0, 0.0, 0.0, 0.0
+    for _ in range(EVENT_MAXITER):
+        if f_pre != 0.0 and f_cur != 0.0 and (f_pre < 0.0) != (f_cur < 0.0):
+            x_blk, f_blk = x_pre, f_pre
+            s_pre = s_cur = x_cur - x_pre
+        if abs(f_blk) < abs(f_cur):
+            x_pre, x_cur, x_blk = x_cur, x_blk, x_cur
+            f_pre, f_cur, f_blk = f_cur, f_blk, f_cur
+        delta = (EVENT_XTOL + EVENT_RTOL * abs(x_cur)) / 2
+        s_bis = (x_blk - x_cur) / 2
+        if f_cur == 0.0 or abs(s_bis) < delta:
+            return x_cur
+        if abs(s_pre) > delta and abs(f_cur) < abs(f_pre):
+            if x_pre == x_blk:  # interpolate
+                s_try = -f_cur * (x_cur - x_pre) / (f_cur - f_pre)
+            else:  # extrapolate
+                d_pre = (f_pre - f_cur) / (x_pre - x_cur)
+                d_blk = (f_blk - f_cur) / (x_blk - x_cur)
+                s_try = -f_cur * (f_blk * d_blk - f_pre * d_pre) / (d_blk * d_pre * (f_blk - f_pre))
+            if 2 * abs(s_try) < min(abs(s_pre), 3 * abs(s_bis) - delta):  # a good short step
+                s_pre, s_cur = s_cur, s_try
+            else:
+                s_pre = s_cur = s_bis
+        else:
+            s_pre = s_cur = s_bis
+        x_pre, f_pre = x_cur, f_cur
+        x_cur += s_cur if abs(s_cur) > delta else (delta if s_bis > 0 else -delta)
+        f_cur = _event_at(f, pre, tree, post, n_q, method, K, t_old, h, y_old, y_new, work, event, x_cur)
+    return x_cur
+
+
+def _event_at(f, pre, tree, post, n_q, method, K, t_old, h, y_old, y_new, work, event, time) -> float:
+    """g at ``time`` inside the step: the kernel evaluated at the step's interpolant there (into scratch),
+    its written value minus the limit (∞ where the kernel flags: the kernels write an infinite value)."""
+    _dense_rows(method, K, t_old, h, y_old, y_new, K[method[7]], np.array([time]), 0, 1, work[4], work)
+    _rhs(f, pre, tree, post, n_q, time, work[4][0], work[2])
+    return event[0][0] - event[1]
 
 
 # -- Radau IIA of order 5 (scipy.integrate._ivp.radau, compiled) --------------------------------------------
@@ -497,7 +585,7 @@ def _interpolated(Q, t_old, step, y_old, time, out):
 
 
 def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step, rtol, atol, pause,
-                  t_eval, first_row, rows, state, rate, x_failed):
+                  t_eval, first_row, rows, state, rate, x_failed, event):
     """:func:`segment` by scipy's Radau IIA of order 5 (``scipy.integrate.Radau._step_impl``, step by
     step): ``method`` = (:func:`radau_tableau`, :func:`radau_memory`), the memory kept over pauses.
     Each step solves the collocation system by :func:`_collocation`; a step whose Newton iteration
@@ -656,8 +744,9 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
     return FINISHED, n_rows, nfev, steps, t, h_abs, t
 
 
-_CALLEES = (_rhs, _stage, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows,
-            _jacobian, _factorise, _solve, _transformed, _collocation, _predict_factor, _interpolated)
+_CALLEES = (_rhs, _stage, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows, _event_fired,
+            _event_root, _event_at, _jacobian, _factorise, _solve, _transformed, _collocation, _predict_factor,
+            _interpolated)
 
 
 @functools.cache
@@ -696,6 +785,7 @@ class CompiledLoop:
         model, method = self.model, self.method
         if self.implicit:  # a fresh Radau run: its Jacobian formed at t (solve_ivp's, too, per segment)
             method = (method, radau_memory(len(state)))
+        event = (model.event[0], float(model.event[1]), np.zeros(1))  # (value, limit, g kept over pauses)
         if model.before is not None:
             model.before()
         while status == PAUSED:
@@ -703,7 +793,7 @@ class CompiledLoop:
                 status, n_rows, more, taken, t, h_abs, t_failed = self.compiled(
                     self.kernel, model.pre, model.tree, model.post, int(n_q), method, float(t), float(t_bound),
                     known, float(h_abs), float(max_step), float(rtol), float(atol), int(every), t_eval, n_rows, rows,
-                    state, rate, x_failed)
+                    state, rate, x_failed, event)
             nfev, steps, known = nfev + more, steps + taken, True
             if status == PAUSED:
                 try:
@@ -745,7 +835,8 @@ def _specialised(model, method: str) -> tuple:
         data = (radau_tableau(), radau_memory(1)) if implicit else tableau(method)
         compiled = _compiled(tuple(numba.typeof(a) for a in (
             kernel, model.pre, model.tree, model.post, 0, data, 0.0, 0.0, True, 0.0, 0.0, 0.0, 0.0, 0,
-            np.zeros(1), 0, np.zeros((1, 1)), np.zeros(1), np.zeros(1), np.zeros(1))), implicit)
+            np.zeros(1), 0, np.zeros((1, 1)), np.zeros(1), np.zeros(1), np.zeros(1),
+            (np.zeros(1), 0.0, np.zeros(1)))), implicit)
         _SPECIALISED[key] = kernel, compiled.overloads[compiled.signatures[0]].entry_point
     return _SPECIALISED[key]
 
@@ -803,7 +894,8 @@ def loop(model, method) -> CompiledLoop | None:
     the cold-start policy of :mod:`projeq.assembly.compilation` (its budget not spent) a loop numba
     would have to compile raises :class:`~projeq.assembly.compilation.NotCompiled` instead: the caller
     steps with solve_ivp (the same steps) and spends that CPU from the budget."""
-    if model is None or not isinstance(method, str) or method not in METHODS:
+    if model is None or not isinstance(method, str) or method not in METHODS or \
+            method not in EXPLICIT and model.event[1] < np.inf:  # Radau locates no model event: solve_ivp's
         return None
     if method not in model.loops:
         if compilation.compile_now():
