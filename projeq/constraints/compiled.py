@@ -1360,6 +1360,13 @@ class CompiledClosure:
         A_s, M and b), or None (flagged)."""
         return self._s_ddot_tree[system.independent] if self._call(system, q, s_dot, t) else None
 
+    def tree_velocities(self, system, q: NDArray, s_dot: NDArray, t: float) -> NDArray | None:
+        """ṡ_tree = F ṡ + f of ``system`` at (q, ṡ, t) (q̇ = ṡ_tree: K = E) by one kernel call, or None
+        (flagged, or complex arguments: the numpy path's)."""
+        if np.iscomplexobj(q) or np.iscomplexobj(s_dot):
+            return None
+        return self._q_dot.copy() if self._call(system, q, s_dot, t) else None
+
     def rows(self, system, q_rows: NDArray, s_rows: NDArray, times: NDArray, tolerance: float,
              steps: int) -> tuple | None:
         """(q on Φ = 0, ṡ_tree, residuals, ranks of A_s) of ``system``'s output rows at the states

@@ -515,8 +515,15 @@ class ConstrainedSystem(Model):
             raise self._singular_position(q, t)
         dependent = pivoted_columns(self.constraint_matrix(q, t)[0], self.n_c)
         new = self._in_partition(np.setdiff1d(np.arange(self.tree.n_s), dependent), q, t)
-        new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
+        new.s_dot0 = self._tree_velocities_now(q, s_dot, t)[new.independent]
         return new, new.s_dot0.copy()
+
+    def _tree_velocities_now(self, q: NDArray, s_dot: NDArray, t: float) -> NDArray:
+        """ṡ_tree = F ṡ + f at (q, t) where the partition changes: by the compiled kernel where the run built
+        it (:meth:`~projeq.constraints.compiled.CompiledClosure.tree_velocities`, one call), else by
+        :meth:`tree_velocities` (also where the kernel flags: it names why)."""
+        found = self._compiled.tree_velocities(self, q, s_dot, t) if self._compiled else None
+        return self.tree_velocities(q, s_dot, t) if found is None else found
 
     def _in_null_space(self, q: NDArray, s_dot: NDArray, t: float) -> tuple["TangentSystem", NDArray]:
         """(system, s_dot) going on from a singular position in the null-space form: a copy that is a

@@ -166,7 +166,7 @@ class NullSpaceForm(Model):
             self.check_configuration(q, t)
         chosen = pivoted_columns(self._null_space(self.constraint_matrix(q, t)[0]).T, self.n_s)
         new = self._in_partition(chosen, q, t)
-        new.s_dot0 = self.tree_velocities(q, s_dot, t)[new.independent]
+        new.s_dot0 = self._tree_velocities_now(q, s_dot, t)[new.independent]
         return new, new.s_dot0.copy()
 
     def with_independent(self, independent, repivot: bool | None = None) -> "NullSpaceForm":
