@@ -192,7 +192,6 @@ def _power_balance(tree):
     P_ref = np.abs(s_dot) @ (np.abs(M @ s_ddot) + np.abs(b)) if system.n_s else 0.0
     T, V = system.energy(q, s_dot, t)
     tol = 1e-7 * P_ref + 50 * np.finfo(float).eps * (abs(T) + abs(V)) / h
-    open("/tmp/h39t/pb.log", "a").write(f"{abs(rate - power):.4g} {P_ref:.4g} {np.finfo(float).eps * (abs(T) + abs(V)) / h:.4g} {tol:.4g}\n")
     return rate, power, tol
 
 
