@@ -29,6 +29,7 @@ from projeq.assembly.kinematics import forward
 from projeq.spatial import chain_matrix
 
 seeds = st.integers(0, 2**32 - 1)
+EPS = np.finfo(float).eps
 KINDS = sorted(set(S.SPATIAL_KINDS) | {"car_sympy", "prescribed_prismatic", "planar_xz"})
 
 
@@ -233,11 +234,12 @@ def test_chain_matrices_equal_those_of_the_absolute_poses(planar, data):
         S_p = np.eye(6) if system.S[p] is None else system.S[p]
         expected = S_n @ chain_matrix(A_np, r_pn) @ S_p.T
         scale = max(1.0, np.abs(expected).max(initial=0.0))
-        assert np.abs(kin.T[n] - expected).max(initial=0.0) <= 1e-12 * scale, f"T of {system.names[n]}"
+        # measured ≤ 1.1e-15 and 3.5e-16 of the scale (was 1e-12)
+        assert np.abs(kin.T[n] - expected).max(initial=0.0) <= 100 * EPS * scale, f"T of {system.names[n]}"
         joint = system.joints[n]
         f = joint.relative(system._q_get[n](tree.q), np.zeros(joint.n_s), tree.t).w
         chain = kin.T[n] @ kin.y_dot[p] + kin.F[n] @ system._s_get[n](tree.s_dot) + S_n @ f
-        assert np.abs(kin.y_dot[n] - chain).max() <= 1e-12 * max(1.0, np.abs(kin.y_dot[n]).max()), (
+        assert np.abs(kin.y_dot[n] - chain).max() <= 100 * EPS * max(1.0, np.abs(kin.y_dot[n]).max()), (
             system.names[n]
         )
 
@@ -254,7 +256,7 @@ def test_a_prescribed_motion_takes_the_complex_step():
     joint = pq.Prescribed(pq.Revolute(axis="z"), spin_up_motion(4.0, 15.0))
     for t in (3.0, 20.0):
         stepped, exact = joint.angles(complex(t, 1e-30)), joint.angles(t)
-        assert np.imag(stepped[0]) / 1e-30 == pytest.approx(exact[1], rel=1e-14)
+        assert np.imag(stepped[0]) / 1e-30 == pytest.approx(exact[1], rel=1e-14, abs=0)  # measured 1.9e-16
         assert np.imag(stepped[1]) / 1e-30 == pytest.approx(exact[2], rel=1e-14, abs=1e-15)
     system = pq.scenes.spin_up_beam()
     with warnings.catch_warnings():
