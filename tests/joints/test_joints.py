@@ -63,20 +63,23 @@ def test_twist_is_the_derivative_of_the_pose(kind, seed):
     """F ṡ + f = (Aᵀ ṙ, (Aᵀ Ȧ)^∨) along q̇ = K ṡ + k (``pose_twist_mismatch``).
 
     pose_twist_mismatch uses central differences of step 1e-7: truncation ~1e-14, round-off
-    ~ε (|A| + |r|)/1e-7 ≈ 4e-9 for |r| ≤ 2; 1e-7 (1 + |w|) bounds it with margin and any
-    wrong K or F (an O(1) error) fails."""
+    ~ε (|A| + |r|)/1e-7 ≈ 4e-9 for |r| ≤ 2. Measured ≤ 2.7e-9 (1 + |w|) over 13000 examples (1000 of the
+    "thorough" profile per kind); the bound 2.7e-8 (1 + |w|) is 10 times that (was 1e-7), and any wrong
+    K or F (an O(1) error) fails."""
     rng = np.random.default_rng(seed)
     joint = _joint(kind, rng)
     q, s_dot, t = _state(joint, rng)
     w = joint.relative(q, s_dot, t).w
-    assert pose_twist_mismatch(joint, q, s_dot, t) <= 1e-7 * (1.0 + np.abs(w).max())
+    assert pose_twist_mismatch(joint, q, s_dot, t) <= 2.7e-8 * (1.0 + np.abs(w).max())
 
 
 @pytest.mark.parametrize("kind", KINDS)
 @given(seed=seeds)
 def test_zeta_is_the_derivative_of_the_twist_at_fixed_velocities(kind, seed):
     """ζ = Ḟ ṡ + ḟ = d/dt (F(q, t) ṡ + f(q, t)) along (q̇, 1) with ṡ held fixed (docs/theory.md §4),
-    by the fourth-order difference of ``_d_dt`` along q(τ) = normalized(q + τ q̇), t + τ."""
+    by the fourth-order difference of ``_d_dt`` along q(τ) = normalized(q + τ q̇), t + τ: measured ≤ 6.2e-12
+    of the scale over 13000 examples (1000 of the "thorough" profile per kind); the bound is 10 times
+    that (was 1e-9)."""
     rng = np.random.default_rng(seed)
     joint = _joint(kind, rng)
     q, s_dot, t = _state(joint, rng)
@@ -84,7 +87,7 @@ def test_zeta_is_the_derivative_of_the_twist_at_fixed_velocities(kind, seed):
     rel = joint.relative(q, s_dot, t)
     numeric = _d_dt(lambda tau: joint.relative(joint.normalized(q + tau * q_dot), s_dot, t + tau).w)
     scale = max(1.0, np.abs(rel.w).max(), np.abs(rel.zeta).max())
-    assert np.abs(rel.zeta - numeric).max() <= 1e-9 * scale
+    assert np.abs(rel.zeta - numeric).max() <= 6.2e-11 * scale
 
 
 @pytest.mark.parametrize("kind", KINDS)
