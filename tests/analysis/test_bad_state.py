@@ -172,11 +172,12 @@ def test_a_complex_state_is_refused_not_cast(chain, entry):
 
 def test_energy_of_a_complex_state_is_the_complex_step(chain):
     """Passes if energy at a complex state is complex (the complex step of the energy gradient,
-    documented): its imaginary part over h is dT/dṡ₀ · 1 = (M ṡ)₀, to 1e-12 relative, not dropped."""
+    documented): its imaginary part over h is dT/dṡ₀ · 1 = (M ṡ)₀, to 100 ε relative (measured 1.8e-16;
+    was 1e-12), not dropped."""
     q, s_dot = _state(chain)
     kinetic, _ = chain.energy(q.astype(complex), s_dot + np.eye(chain.n_s)[0] * 1e-20j)
     expected = (chain.mass_matrix(q) @ s_dot)[0]
-    assert abs(kinetic.imag / 1e-20 - expected) <= 1e-12 * abs(expected)
+    assert abs(kinetic.imag / 1e-20 - expected) <= 100 * np.finfo(float).eps * abs(expected)
 
 
 @pytest.mark.parametrize("entry", PUBLIC)

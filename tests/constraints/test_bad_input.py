@@ -146,7 +146,9 @@ def test_time_dependence_that_vanishes_at_q0_is_seen(tree):
     would be wrong wherever x ≠ 0.6)."""
     system = ConstrainedSystem(tree, phi=lambda q, t: [np.hypot(q[0], q[1]) - 1.0 + 0.1 * t * (q[0] - 0.6)])
     assert system.rheonomic
-    assert abs(system.velocity_constraints(np.array([0.8, -0.6]), 0.0)[1][0] + 0.1 * 0.2) <= 1e-15
+    # measured 6.9e-18 (was 1e-15): 100 ε of ∂Φ/∂t = 0.02
+    phi_t = system.velocity_constraints(np.array([0.8, -0.6]), 0.0)[1][0]
+    assert abs(phi_t + 0.1 * 0.2) <= 100 * np.finfo(float).eps * 0.02
 
 
 def test_reactions_of_a_tree(tree):
@@ -232,7 +234,8 @@ def test_joint_reactions_with_cuts_that_are_not_phi(four_bar_pin, cut):
     (with the right cut: 3e-15)."""
     system, pin = four_bar_pin
     right = joint_reactions(system, system.q0, [3.0], cuts={"pin": pin})
-    assert abs(right["crank"][2]) < 1e-13 * np.abs(right["pin"]).max()  # the reference: F_nᵀ W_n = 0
+    # the reference: F_nᵀ W_n = 0 (measured 2.1e-16 of the pin's largest reaction; was 1e-13)
+    assert abs(right["crank"][2]) < 100 * np.finfo(float).eps * np.abs(right["pin"]).max()
     with pytest.raises(ValueError, match=r"^cuts: the cut joints \['pin'\] are not the system's Φ \(at q = .*"
                                          r"give the closures Φ was built from, in the order of its rows"):
         joint_reactions(system, system.q0, [3.0], cuts={"pin": cut})

@@ -24,7 +24,8 @@ def test_factors_and_solutions_are_scipys_bit_for_bit(dtype):
     assert lu.tobytes() == reference[0].tobytes() and np.array_equal(pivots, reference[1])
     x = lu_solved((lu, pivots), b.copy())
     assert x.tobytes() == lu_solve(reference, b.copy(), overwrite_b=True).tobytes()
-    assert np.abs(A @ x - b).max() < 1e3 * np.finfo(float).eps * np.abs(A).sum(axis=1).max() * np.abs(x).max()
+    # the residual of a backward-stable solve: measured 0.32 ε ‖A‖∞ ‖x‖∞ (was 1000 ε)
+    assert np.abs(A @ x - b).max() < 100 * np.finfo(float).eps * np.abs(A).sum(axis=1).max() * np.abs(x).max()
 
 
 def test_non_finite_and_singular_input_as_scipy():

@@ -42,7 +42,8 @@ def test_universal_joint_through_a_massless_frame(method):
         q, s_dot = rng.uniform(-1, 1, 2), rng.uniform(-2, 2, 2)
         a = by_frame.accelerations(q, s_dot, method=method)
         b = by_joint.accelerations(q, s_dot, method=method)
-        assert np.abs(a - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
+        # measured 1.2e-16 of the scale (was 1e-12)
+        assert np.abs(a - b).max() <= 100 * np.finfo(float).eps * max(1.0, np.abs(b).max())
 
 
 def test_a_frame_that_moves_no_mass_is_singular():

@@ -73,18 +73,19 @@ def test_internal_coordinates_are_laid_out_after_the_joints():
     """q_n = (joint coordinates, internal coordinates): arm θ, arm x_a, tip φ."""
     system = _pendulum_with_absorber()
     assert system.n_q == 3 and system.n_s == 3
-    assert np.allclose(system.q_dot(system.q0, np.array([1.0, 2.0, 3.0])), [1.0, 2.0, 3.0])
+    assert np.array_equal(system.q_dot(system.q0, np.array([1.0, 2.0, 3.0])), [1.0, 2.0, 3.0])  # measured 0
 
 
 @pytest.mark.parametrize("seed", range(5))
 def test_recursive_equals_dense(seed):
-    """docs/theory.md §5 = §6 for a subsystem with its own minimal velocity (round-off: 1e-12)."""
+    """docs/theory.md §5 = §6 for a subsystem with its own minimal velocity (round-off: 100 ε of the
+    scale, measured 1.2e-16 over the five seeds; was 1e-12)."""
     system = _pendulum_with_absorber()
     rng = np.random.default_rng(seed)
     q, s_dot = rng.uniform(-1, 1, 3), rng.uniform(-2, 2, 3)
     a = system.accelerations(q, s_dot, method="recursive")
     b = system.accelerations(q, s_dot, method="dense")
-    assert np.abs(a - b).max() <= 1e-12 * max(1.0, np.abs(b).max())
+    assert np.abs(a - b).max() <= 100 * np.finfo(float).eps * max(1.0, np.abs(b).max())
 
 
 def test_energy_is_conserved():

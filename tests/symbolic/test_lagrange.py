@@ -72,16 +72,18 @@ def test_disc_multiplier_forms_follow_the_projection_equation(form):
 def test_barhorst_particle_multiplier_forms_follow_the_projection_equation(form, alpha):
     """Barhorst's particle (Barhorst §3.1, L = ½(ẋ² + ẏ²) − 10 y, ẏ − y² ẋ = 0). From (2, 2) with
     ẋ = 0.5: the multiplier forms (with and without Baumgarte, α = 10/s) match projeq's
-    scene ``barhorst_particle`` to 1000 × rtol over 0.3 s (the particle reaches y ≈ 4 before the curve
-    y = 1/(2.5 − x) steepens), and conserve E = ½(ẋ² + ẏ²) + 10 y (the constraint force does no work)."""
+    scene ``barhorst_particle`` over 0.3 s (the particle reaches y ≈ 4 before the curve y = 1/(2.5 − x)
+    steepens), and conserve E = ½(ẋ² + ẏ²) + 10 y (the constraint force does no work). Measured, largest
+    over the three forms: q 5.4e-12, E 1.8e-12 relative; the bounds 5 and 1.8 × rtol are 10 times those
+    (were 1000 × rtol)."""
     system = barhorst_particle(s_dot0=(0.5,))
     reference = simulate(system, 0.3, t_eval=np.linspace(0, 0.3, 16), rtol=RTOL, atol=ATOL, method="DOP853")
     q_dot0 = system.q_dot(system.q0, system.s_dot0)
     sol = particle().simulate(system.q0, q_dot0, (0, 0.3), form=form, alpha=alpha,
                               t_eval=reference.t, rtol=RTOL, atol=ATOL)
-    assert np.abs(sol.q.T - reference.q).max() < 1000 * RTOL
+    assert np.abs(sol.q.T - reference.q).max() < 5 * RTOL
     energy = 0.5 * (sol.q_dot**2).sum(axis=0) + 10 * sol.q[1]
-    assert np.abs(energy - energy[0]).max() < 1000 * RTOL * abs(energy[0])
+    assert np.abs(energy - energy[0]).max() < 1.8 * RTOL * abs(energy[0])
 
 
 def test_lagrange_equations_are_the_lecture_form():
