@@ -144,8 +144,10 @@ def table(systems: dict, repeat: int) -> None:
 
 
 def flyball(runs: int, t_end: float = 10.0) -> None:
-    """The flyball governor's default run (module docstring) to ``t_end``, one-call vs per-column Jacobians:
-    the CPU time of the whole run and of its Jacobians (simulate's ``_Run.jacobian``, timed)."""
+    """The flyball governor's default run (module docstring) to ``t_end`` stepped by solve_ivp with the exact
+    Jacobians this study times (the compiled loop switched off here: its Radau forms ∂ẋ/∂x by differences
+    inside the loop), one-call vs per-column Jacobians: the CPU time of the whole run and of its
+    Jacobians (simulate's ``_Run.jacobian``, timed)."""
     from projeq.simulation import driver
 
     system = pq.scenes.flyball_governor()
@@ -160,6 +162,7 @@ def flyball(runs: int, t_end: float = 10.0) -> None:
         return J
 
     driver._Run.jacobian = timed
+    compiled_loop, driver._Run.compiled_loop = driver._Run.compiled_loop, lambda run: None
     results = {}
     for _ in range(runs):
         for label, way in (("one call", one_call), ("per column", lambda t, x: None)):
@@ -169,7 +172,7 @@ def flyball(runs: int, t_end: float = 10.0) -> None:
             cpu = time.process_time() - start
             if label not in results or cpu < results[label][0]:
                 results[label] = (cpu, spent[0], r)
-    evaluator.state_jacobian, driver._Run.jacobian = one_call, jacobian
+    evaluator.state_jacobian, driver._Run.jacobian, driver._Run.compiled_loop = one_call, jacobian, compiled_loop
     print(f"{'Jacobians':12} {'method':>7} {'CPU s':>7} {'of which ∂ẋ/∂x':>15} {'nfev':>7} {'njev':>6}  final state")
     for label, (cpu, in_jacobians, r) in results.items():
         print(f"{label:12} {r.method:>7} {cpu:7.2f} {in_jacobians:15.2f} {r.nfev:7d} {r.njev:6d}  "
