@@ -116,6 +116,15 @@ def _stage(f, pre, tree, post, n_q, K, a, s, h, t, y, x, x_failed):
     return True
 
 
+def _step_to(t, h_abs, t_bound):
+    """(t_new, h, |h|) of the next step of size h_abs from t, cut at t_bound (scipy's ``_step_impl``)."""
+    t_new = t + h_abs
+    if t_new - t_bound > 0:
+        t_new = t_bound
+    h = t_new - t
+    return t_new, h, abs(h)
+
+
 def _rms(v, scale):
     """scipy's norm of v / scale: the root mean square."""
     total = 0.0
@@ -272,11 +281,7 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
             if h_abs < min_step:
                 _copy(y, state)
                 return TOO_SMALL_STEP, n_rows, nfev, steps, t, h_abs, t
-            t_new = t + h_abs
-            if t_new - t_bound > 0:
-                t_new = t_bound
-            h = t_new - t
-            h_abs = abs(h)
+            t_new, h, h_abs = _step_to(t, h_abs, t_bound)
             _copy(rate, K[0])
             for s in range(1, n_stages):
                 nfev += 1
@@ -636,11 +641,7 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
             if h_abs < min_step:
                 _copy(y, state)
                 return TOO_SMALL_STEP, n_rows, nfev, steps, t, h_abs, t
-            t_new = t + h_abs
-            if t_new - t_bound > 0:
-                t_new = t_bound
-            h = t_new - t
-            h_abs = abs(h)
+            t_new, h, h_abs = _step_to(t, h_abs, t_bound)
             for s in range(3):
                 if scalars[RADAU_HAS_SOL] != 0.0:
                     _interpolated(Q, scalars[RADAU_T_OLD], scalars[RADAU_STEP], y_old, t + h * C[s], Z[s])
@@ -744,7 +745,7 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
     return FINISHED, n_rows, nfev, steps, t, h_abs, t
 
 
-_CALLEES = (_rhs, _stage, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows, _event_fired,
+_CALLEES = (_rhs, _stage, _step_to, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows, _event_fired,
             _event_root, _event_at, _jacobian, _factorise, _solve, _transformed, _collocation, _predict_factor,
             _interpolated)
 

@@ -154,16 +154,17 @@ def test_one_compiled_loop_for_every_tree():
     assert loop._compiled.cache_info().currsize == before
 
 
-def test_a_failing_evaluation_is_named(calls):
-    """A load that turns NaN after t = 0.35 s inside a compiled segment (a callable numba compiles) ends
-    the run as solve_ivp's run ends it: the same error naming the law and the time, the same status,
-    the rows of the segments before kept."""
+@pytest.mark.parametrize("method", ["RK45", "Radau"])
+def test_a_failing_evaluation_is_named(method, calls):
+    """A load that turns NaN after t = 0.35 s inside a compiled segment (a callable numba compiles), an
+    explicit method's or Radau's, ends the run as solve_ivp's run of the same method ends it: the same
+    error naming the law and the time, the same status, the rows of the segments before kept."""
     system = pq.scenes.chain(2)
     system = pq.System(dict(zip(system.names, system.subsystems)), dict(zip(system.names, system.joints)),
                        gravity=system.gravity,
                        forces=[pq.JointForce(system.names[0], lambda t, q, s_dot: np.nan if t > 0.35 else 0.0)])
     failures = []
-    for method in ("RK45", scipy.integrate.RK45):
+    for method in (method, getattr(scipy.integrate, method)):
         with pytest.raises(pq.SimulationError, match=r"failed at t = 0\.3\d* s .*tau of joint 'link1': non-finite") as failed:
             pq.simulate(system, 1.0, method=method, n_segments=10)
         failures.append(failed.value)
