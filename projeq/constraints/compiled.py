@@ -876,7 +876,7 @@ def partitioned_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, i
 
 
 def tangent_state_derivative(phi, pins, fields, pfaffian, joints, tree, t, independent, x, n_q, m_h, rank, separation,
-                             acting, kept, pivot, limit, q, s_dot, q_dot, s_ddot_tree, A, M, b, kappa, x_dot):
+                             acting, kept, pivot, q, s_dot, q_dot, s_ddot_tree, A, M, b, kappa, x_dot):
     """:func:`partitioned_state_derivative` for :func:`tangent` (the null-space form), its event's
     κ = 1/σ_min(N_ind) = ‖F‖₂ the kernel's own."""
     _split(x, n_q, q, s_dot)
@@ -1408,7 +1408,7 @@ class CompiledClosure:
         kept = self._kept_tangent(system)
         return LoopModel(_compiled_adapter(self.kernel, self.rule), pre, (system.independent,),
                          (self.m_h, system.tree.n_s - system.n_s, float(system.separation), float(self.constants[0]),
-                          kept, float(SINGULAR_PIVOT), float(system.limit), *buffers, self._kappa),
+                          kept, float(SINGULAR_PIVOT), *buffers, self._kappa),
                          event=event, before=lambda: self._keep_tangent(system, kept))
 
     def _keep_tangent(self, system, kept: NDArray) -> None:
