@@ -11,7 +11,7 @@ and the compiled chain(k)'s, all timed alternately in one run
 
     python benchmarks/tangent_profile.py                       # Andrews' squeezer, Bricard
     python benchmarks/tangent_profile.py n_four_bar            # another TangentSystem scene
-    python benchmarks/tangent_profile.py --quick               # Andrews' squeezer, 0.05 s (a test runs it)
+    python benchmarks/tangent_profile.py --quick               # Andrews' squeezer, 0.05 s of timing
 """
 
 from __future__ import annotations

@@ -48,6 +48,8 @@ OPT_IN = {
     "run_profile.py": "two fresh processes (8 s)",
     "beam_convergence.py": "projeq bench's quick study: seven 20 s spin-ups (8 s)",
     "scene_builds.py": "a fresh process (4 s)",
+    "tangent_profile.py": "its six profiling loops compiled by numba at every run with an empty cache, each "
+                          "linking the closure kernels' helpers (40 s of the 42 s it took in CI)",
 }
 
 #: script → texts its quick run prints (table heads and row labels, no numbers)
