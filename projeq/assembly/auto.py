@@ -78,8 +78,8 @@ class AutoEvaluator:
     Attributes: ``name`` (of the picked evaluator: "fast", "hub_beam", "dense" or
     "recursive"), ``reason`` (why; and whether it runs interpreted until compiled), ``interpreting``,
     ``evaluator`` (the picked evaluator, which counts the calls);
-    ``accelerations`` and, where the picked one has them, ``state_derivative``, ``state_jacobian`` and
-    ``energy``: the picked evaluator's own, through a :class:`Tier` where it is compiled (module
+    ``accelerations`` and, where the picked one has them, ``state_derivative``, ``state_jacobian``,
+    ``energy`` and ``gauss_form``: the picked evaluator's own, through a :class:`Tier` where it is compiled (module
     docstring), else called without a layer between.
     """
 
@@ -93,6 +93,8 @@ class AutoEvaluator:
             self.state_derivative = self.evaluator.state_derivative
         if hasattr(self.evaluator, "state_jacobian"):  # ∂ẋ/∂x in one call (projeq.analysis.jacobians)
             self.state_jacobian = self.evaluator.state_jacobian
+        if hasattr(self.evaluator, "gauss_form"):  # M, b of a closed loop's tree (its numpy path)
+            self.gauss_form = self.evaluator.gauss_form
         if getattr(self.evaluator, "compiled", False):
             self._tiered(system)
         if self.name in ("dense", "recursive"):
@@ -119,6 +121,8 @@ class AutoEvaluator:
         if hasattr(picked, "state_jacobian"):  # None: the caller's complex step through s̈
             self.state_jacobian = Tier(picked.state_jacobian, _none, model, 1)
         self.energy = Tier(picked.energy, lambda q, s_dot, t: system._energy(q, s_dot, t, "recursive"), model, 0)
+        if hasattr(picked, "gauss_form"):
+            self.gauss_form = Tier(picked.gauss_form, system.evaluator("dense").gauss_form, model, 0)
 
     def loop_model(self) -> "LoopModel | None":
         """The picked evaluator's model for the compiled integration loop

@@ -14,9 +14,10 @@ numba compiles projeq's kernels on their first use and keeps them in its disk ca
   :class:`CacheWarning` naming it, and the kernel is compiled and cached anew;
 - under :func:`cached_only` a kernel numba would compile raises :class:`NotCompiled` before
   its compilation starts (a kernel in memory or in the disk cache runs): the default evaluator
-  (:mod:`projeq.assembly.auto`) evaluates interpreted instead, until :data:`BUDGET` seconds of
-  CPU are spent so over the runs of the same numba cache, then compiles (:func:`spend`,
-  :func:`compile_now`).
+  (:mod:`projeq.assembly.auto`) evaluates interpreted instead, a closed loop by its numpy path
+  (:class:`projeq.constraints.compiled.Deferred`), the integration loop by solve_ivp, until
+  :data:`BUDGET` seconds of CPU are spent so over the runs of the same numba cache, then compiles
+  (:func:`spend`, :func:`compile_now`).
 
 All three apply to projeq's own functions only (their module's name starts with ``projeq``: the
 package and the modules it generates, :func:`projeq.assembly.given.generated_module`).

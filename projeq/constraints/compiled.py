@@ -62,6 +62,7 @@ from __future__ import annotations
 
 import functools
 import re
+import time
 import types
 import warnings
 import weakref
@@ -70,7 +71,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.analysis.differentiation import COMPLEX_STEP
-from projeq.assembly import kernels, loads
+from projeq.assembly import compilation, kernels, loads
 from projeq.assembly.given import generated_module, given_motions, intrinsics, joint_callback, joint_table
 from projeq.assembly.kernels import (N_COLS, N_Y, PARENT, S_INDEX, add_cross, add_motion_cross, bias_rates,
                                      chain_matrix_into, cholesky, cholesky_solve, dot6, port_motion)
@@ -82,8 +83,9 @@ from projeq.constraints.matrices import RANK_TOLERANCE
 
 #: flags of the kernels (:func:`partitioned`, :func:`tangent`): done; partition bound reached (or
 #: A_dep, N_ind singular, or A_s not finite); FᵀMF not positive definite; a force law without a value
-#: (a spring-damper whose two points coincide) — the numpy path then raises the error naming it
-DONE, DEGENERATE, SINGULAR, UNLOADED = 0, 1, 2, 3
+#: (a spring-damper whose two points coincide) — the numpy path then raises the error naming it; not
+#: compiled yet (:class:`Deferred`: the numpy path evaluates)
+DONE, DEGENERATE, SINGULAR, UNLOADED, NOT_COMPILED = 0, 1, 2, 3, -1
 
 #: the share of a partition's event limit from which the compiled loop's ẋ (:func:`partitioned_state_derivative`)
 #: writes κ itself, not its bound: below 1, so that round-off between the bound and κ cannot miss the event
@@ -1289,6 +1291,25 @@ def compiled_cut_joints(system) -> "CutJointRows | None":
     return None if None in callbacks else CutJointRows(ev, pin_table(system._phi, system.m_h), callbacks)
 
 
+class Deferred:
+    """The interpreted tier of a closed loop's kernels (:class:`projeq.assembly.auto.Tier`) while numba
+    has not compiled them and the cold-start budget lasts (:mod:`projeq.assembly.compilation`): it
+    flags NOT_COMPILED, so that the caller evaluates by the numpy path, and spends from the budget the
+    CPU since the last call it answered — that evaluation and the integrator's work around it. A
+    four-bar's first run, with an empty numba cache: a few seconds instead of about 90 s of
+    compilation, which its kernels pay once the budget is spent."""
+
+    def __init__(self):
+        self.at = None
+
+    def __call__(self, *args) -> int:
+        now = time.process_time()
+        if self.at is not None:
+            compilation.spend(now - self.at, "the closed loop")
+        self.at = now
+        return NOT_COMPILED
+
+
 class CompiledClosure:
     """s̈_tree, A_s, M and b of a constrained model by one call of a compiled kernel
     (:func:`partitioned` or :func:`tangent`) with the C callbacks of Φ, of the Pfaffian rows A
@@ -1306,9 +1327,12 @@ class CompiledClosure:
         self.callback, self.rule, self.constants, self.m_h = callback, rule, constants, m if m_h is None else m_h
         self.pins, self.fields = pin_table(None, 0) if pins is None else pins
         self._callbacks = [pfaffian] + [joint_callback(tree.joints[n]) if compiled else None for n in ev._given]
-        if compiled:
-            found = _compiled(ev._width > 6, bool(len(self.pins)))
-            self.kernel, self.rows_kernel = found[rule], found["closure_rows"]
+        if compiled:  # each kernel in tiers: the numpy path until numba has it or the budget is spent
+            from projeq.assembly.auto import Tier  # (auto imports the package that imports this module)
+
+            found, deferred = _compiled(ev._width > 6, bool(len(self.pins))), Deferred()
+            self.kernel, self.rows_kernel = (Tier(found[name], deferred, "the closed loop", state=6)
+                                             for name in (rule, "closure_rows"))
             self.phi, self.pfaffian = callback.address, 0 if pfaffian is None else pfaffian.address
         else:
             self.kernel, self.phi, self.pfaffian = _interpreted(rule, bool(len(self.pins))), callback, pfaffian
@@ -1402,11 +1426,11 @@ class CompiledClosure:
                    self._workspace.M_all, self._workspace.b_all)
         event = (self._kappa, float(system.limit))  # κ − limit, rising: the system's event
         if self.rule == "partitioned":
-            return LoopModel(_compiled_adapter(self.kernel, self.rule), pre, (system.independent, system.dependent),
+            return LoopModel(_compiled_adapter(self.kernel.compiled, self.rule), pre, (system.independent, system.dependent),
                              (self.m_h, float(self.constants[0]), float(SINGULAR_PIVOT), float(system.limit),
                               *buffers, self._kappa), event=event)
         kept = self._kept_tangent(system)
-        return LoopModel(_compiled_adapter(self.kernel, self.rule), pre, (system.independent,),
+        return LoopModel(_compiled_adapter(self.kernel.compiled, self.rule), pre, (system.independent,),
                          (self.m_h, system.tree.n_s - system.n_s, float(system.separation), float(self.constants[0]),
                           kept, float(SINGULAR_PIVOT), *buffers, self._kappa),
                          event=event, before=lambda: self._keep_tangent(system, kept))

@@ -845,12 +845,13 @@ class ConstrainedSystem(Model):
     def tree_gauss_form(self, q: NDArray, s_dot_tree: NDArray, t: float,
                         method: str | None = None) -> tuple[NDArray, NDArray]:
         """M and b of the tree's Gauss form M s̈_tree + b = 0 at ṡ_tree, compiled where the tree's
-        default evaluator is, else (and for ``method="dense"`` or complex arguments) the dense
-        reference; b from the free accelerations of ``method`` = "recursive" or "fast"
-        (module docstring)."""
+        default evaluator is (through its tier: the dense reference while its kernels are not
+        compiled, :class:`projeq.assembly.auto.Tier`), else (and for ``method="dense"`` or complex
+        arguments) the dense reference; b from the free accelerations of ``method`` = "recursive" or
+        "fast" (module docstring)."""
         tree = self.tree
         compiled = self.compiled_tree(method) and not (np.iscomplexobj(q) or np.iscomplexobj(s_dot_tree))
-        M, b = tree.evaluator("fast" if compiled else "dense").gauss_form(q, s_dot_tree, t)
+        M, b = (tree.evaluator("auto") if compiled else tree.evaluator("dense")).gauss_form(q, s_dot_tree, t)
         if method not in (None, "dense"):  # M s̈_free + b = 0
             b = -M @ tree.evaluator(method).accelerations(q, s_dot_tree, t)
         return M, b
