@@ -67,7 +67,8 @@ class _Announcer:
     :func:`cached_only`, :class:`NotCompiled` before a top-level kernel compiles."""
 
     def __init__(self):
-        self.announced, self.depth, self.started = False, 0, None
+        self.announced, self.depth, self.started, self.cpu = False, 0, None, 0.0
+        self.seconds = 0.0  # CPU of the top-level compilations of projeq's kernels in this process
         self.deferring = threading.local()
 
     def on_start(self, event):
@@ -78,7 +79,7 @@ class _Announcer:
         self.started = None
         if getattr(self.deferring, "on", False):
             raise NotCompiled(function.__qualname__)  # before numba compiles anything
-        self.started = time.perf_counter()
+        self.started, self.cpu = time.perf_counter(), time.process_time()
         if not self.announced:
             self.announced = True
             print("projeq: compiling the compiled kernels — first use, cached afterwards (up to a minute or two on "
@@ -88,6 +89,8 @@ class _Announcer:
         self.depth -= 1
         function = getattr(event.data.get("dispatcher"), "py_func", None)
         compiled = self.started is not None  # not the kernel cached_only stopped
+        if self.depth == 0 and _ours(function) and compiled:
+            self.seconds += time.process_time() - self.cpu
         if self.depth == 0 and _ours(function) and compiled and time.perf_counter() - self.started > SLOW:
             print(f"projeq:   compiled {function.__qualname__} "
                   f"({time.perf_counter() - self.started:.0f} s)", file=sys.stderr, flush=True)
@@ -173,6 +176,11 @@ _BUDGET = _Budget()
 def compile_now() -> bool:
     """Whether kernels compile at their next use: :data:`BUDGET` is spent, or ``PROJEQ_COMPILE=now``."""
     return _BUDGET.exhausted()
+
+
+def compiling_seconds() -> float:
+    """CPU seconds this process has spent compiling projeq's kernels (top-level compilations)."""
+    return _ANNOUNCER.seconds
 
 
 def spend(seconds: float, what: str) -> None:

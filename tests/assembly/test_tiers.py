@@ -167,3 +167,19 @@ def test_a_new_cache_runs_a_closed_loop_by_its_numpy_path(tmp_path):
     # (|q| ≤ 1.9), 1.7e-12 in ṡ (|ṡ| = 5.3); bounds 10×
     assert np.abs(np.array(child["q"]) - compiled.q[-1]).max() < 1.1e-11, np.array(child["q"]) - compiled.q[-1]
     assert np.abs(np.array(child["s_dot"]) - compiled.s_dot[-1]).max() < 1.7e-11
+
+
+def test_a_closed_loops_stand_in_spends_the_cpu_between_its_calls_less_compiling(budget, monkeypatch):
+    """:class:`projeq.constraints.compiled.Deferred` flags NOT_COMPILED and spends the CPU since its last
+    call from the budget, less the CPU that compiling other kernels took meanwhile (which would
+    otherwise spend the budget at once: the cut joints' rows compile at first use)."""
+    from projeq.constraints.compiled import NOT_COMPILED, Deferred
+
+    compiling = [0.0]
+    monkeypatch.setattr(compilation, "compiling_seconds", lambda: compiling[0])
+    stand_in = Deferred()
+    assert stand_in() == NOT_COMPILED and compilation._BUDGET.spent == 0.0  # the clock starts
+    _interpreted(1.0), _interpreted(1.0), _interpreted(1.0)  # 30 ms of CPU
+    compiling[0] += 0.02  # 20 ms of it "compiling"
+    assert stand_in() == NOT_COMPILED
+    assert 0.005 < compilation._BUDGET.spent < 0.02, compilation._BUDGET.spent
