@@ -851,7 +851,7 @@ class ConstrainedSystem(Model):
         "fast" (module docstring)."""
         tree = self.tree
         compiled = self.compiled_tree(method) and not (np.iscomplexobj(q) or np.iscomplexobj(s_dot_tree))
-        M, b = (tree.evaluator("auto") if compiled else tree.evaluator("dense")).gauss_form(q, s_dot_tree, t)
+        M, b = tree.evaluator("auto" if compiled else "dense").gauss_form(q, s_dot_tree, t)
         if method not in (None, "dense"):  # M s̈_free + b = 0
             b = -M @ tree.evaluator(method).accelerations(q, s_dot_tree, t)
         return M, b

@@ -37,8 +37,9 @@ class Result:
     kinetic, potential : (n,) energies (``energy`` is their sum)
     constraint_residual : (n, m) residuals of velocity constraints (m = 0 without any)
     nfev : right-hand-side evaluations; wall_time : seconds
-    njev : Jacobians of an implicit method: by the complex step through solve_ivp (each n_q + n_s complex
-        evaluations), by forward differences in the compiled loop's Radau (each n_q + n_s evaluations, counted in nfev)
+    njev : Jacobians of an implicit method, each n_q + n_s evaluations
+        by the complex step through solve_ivp (complex ones), by forward differences in the compiled
+        loop's Radau (counted in nfev)
     status : 0 finished, 1 stopped by an event, -1 failed, 2 interrupted, 3 out of range, 4 non-finite
     (:data:`STATUSES`; 3: stopped where a subsystem left the range its model describes, 4: the solution blew up)
     message : the integrator's message

@@ -164,9 +164,9 @@ def test_a_failing_evaluation_is_named(method, calls):
                        gravity=system.gravity,
                        forces=[pq.JointForce(system.names[0], lambda t, q, s_dot: np.nan if t > 0.35 else 0.0)])
     failures = []
-    for method in (method, getattr(scipy.integrate, method)):
+    for way in (method, getattr(scipy.integrate, method)):  # the compiled loop's, solve_ivp's
         with pytest.raises(pq.SimulationError, match=r"failed at t = 0\.3\d* s .*tau of joint 'link1': non-finite") as failed:
-            pq.simulate(system, 1.0, method=method, n_segments=10)
+            pq.simulate(system, 1.0, method=way, n_segments=10)
         failures.append(failed.value)
     assert calls["segments"] == 4
     assert str(failures[0]) == str(failures[1]) and failures[0].result.status == failures[1].result.status
