@@ -28,6 +28,7 @@ OWN_TESTS = {
     "closure_linalg.py": "tests/constraints/test_compiled_closures.py",
     "effort_growth.py": "tests/studies/test_effort_growth.py",
     "iftomm.py": "tests/studies/test_iftomm_benchmark.py",
+    "mutation.py": "tests/studies/test_mutation_benchmark.py",
     "spinning_beam_frequencies.py": "tests/symbolic/test_spinning_beam.py",
     "statements.py": "tests/studies/test_statements_benchmark.py",
     "time_loads.py": "tests/assembly/test_time_loads.py",
