@@ -88,5 +88,6 @@ def test_two_masses_released_upper_mass():
     # of the request; 5 as in scipy's solve_ivp tests
     assert in_request_units(res.q[:, 0], y0[0] + xi1, rtol, atol).max() < 5
     assert in_request_units(res.q[:, 1], y2_seed, rtol, atol).max() < 5
-    # energy is quadratic in the state: state errors of 5 request units change it by ≤ 10 rtol
-    assert res.energy_drift < 10 * rtol
+    # energy drift: 0.031 rtol measured here; the largest over rtol 3e-11 … 1e-9 and one to three slow
+    # periods 0.18 rtol (rtol 1e-9, three periods), so 2 rtol (was 10 rtol)
+    assert res.energy_drift < 2 * rtol
