@@ -28,13 +28,14 @@ def _terms(beam, scale, seed=0):
 @pytest.mark.parametrize("scale", [0.0, 0.05, 0.5])
 def test_precomputed_equals_quadrature_at_any_deformation(stiffening, scale):
     """Undeformed, small (v/L ~ 3 %) and large (v/L ~ 30 %, far beyond the first-order
-    mode this replaces) deformations, with axial and rotary terms: equal to 1e-12 of the
+    mode this replaces) deformations, with axial and rotary terms: equal to 100 ε of the
     terms' scale (the quadrature's own round-off; the moments are the same Gauss sums
-    reordered)."""
+    reordered; measured ≤ 3.5e-16 for M, 2.2e-16 for h; was 1e-12)."""
     quadrature, precomputed = _pair(stiffening=stiffening)
     (Ma, ha), (Mb, hb) = _terms(quadrature, scale), _terms(precomputed, scale)
-    assert np.abs(Ma - Mb).max() <= 1e-12 * np.abs(Ma).max()
-    assert np.abs(ha - hb).max() <= 1e-12 * np.abs(ha).max()
+    exact = 100 * np.finfo(float).eps
+    assert np.abs(Ma - Mb).max() <= exact * np.abs(Ma).max()
+    assert np.abs(ha - hb).max() <= exact * np.abs(ha).max()
 
 
 def test_monomial_derivatives():
@@ -54,7 +55,8 @@ def test_monomial_derivatives():
 
 
 def test_recursive_equals_dense_in_the_precomputed_mode():
-    """docs/theory.md §5 = §6 hold for either mode (both assemblers call the same terms): 1e-10."""
+    """docs/theory.md §5 = §6 hold for either mode (both assemblers call the same terms): 6e-12 of |s̈|
+    (measured 4.8e-13; at most 5.8e-13 over 12 random states, κ(M) ≈ 6e4; was 1e-10)."""
     _, beam = _pair()
     system = pq.System(
         {"hub": pq.RigidBody(1.0, (0, 0, 0), np.diag([0.5, 0.5, 0.2])), "beam": beam},
@@ -65,7 +67,7 @@ def test_recursive_equals_dense_in_the_precomputed_mode():
     q, s_dot = rng.uniform(-0.05, 0.05, system.n_q), rng.uniform(-1, 1, system.n_s)
     a = system.accelerations(q, s_dot, method="recursive")
     b = system.accelerations(q, s_dot, method="dense")
-    assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max()
+    assert np.abs(a - b).max() <= 6e-12 * np.abs(b).max(), np.abs(a - b).max() / np.abs(b).max()
 
 
 def test_spin_up_tip_deflection_of_both_modes():
