@@ -70,26 +70,28 @@ def rotated(tensor, R):
 def test_equivalent_shape_inverts_the_inertia_formulas():
     """Box, cylinder (about each axis), sphere from projeq.subsystems.inertia, turned by a random
     rotation: the solid found has the same sizes, and its inertia by the forward formula turned by
-    its rotation is I_c again (measured 5.5e-16 relative; bound 1e-14, 45 ε)."""
+    its rotation is I_c again (measured 5.5e-16 relative; bound 1e-14, 45 ε); the sizes to 100 ε relative
+    (measured ≤ 3.1e-15 over three rotations, 0 for the sphere and the disk; were rel 1e-14 and 1e-9 with
+    pytest's absolute 1e-12, up to 6.7e-11 of the disk's thickness)."""
     from scipy.spatial.transform import Rotation
 
     R = Rotation.from_rotvec([0.3, -1.1, 0.7]).as_matrix()
     box = equivalent_shape(3.0, rotated(inertia.box(3.0, 0.2, 0.5, 1.3), R))
-    assert box.kind == "box" and sorted(box.size) == pytest.approx([0.2, 0.5, 1.3], rel=1e-14)
+    assert box.kind == "box" and sorted(box.size) == pytest.approx([0.2, 0.5, 1.3], rel=ROUND_OFF, abs=0)
     I_box = rotated(inertia.box(3.0, *box.size), box.rotation)
     assert np.abs(I_box - rotated(inertia.box(3.0, 0.2, 0.5, 1.3), R)).max() < 1e-14 * np.abs(I_box).max()
     for axis in "xyz":
         I_c = rotated(inertia.cylinder(2.0, 0.1, 0.9, axis=axis), R)
         cylinder = equivalent_shape(2.0, I_c)
-        assert cylinder.kind == "cylinder" and cylinder.size == pytest.approx((0.1, 0.9), rel=1e-14)
+        assert cylinder.kind == "cylinder" and cylinder.size == pytest.approx((0.1, 0.9), rel=ROUND_OFF, abs=0)
         assert np.linalg.det(cylinder.rotation) == pytest.approx(1.0, abs=ROUND_OFF)  # measured 2.2e-16
         # three.js's cylinder has its axis along y
         I_back = rotated(inertia.cylinder(2.0, *cylinder.size, axis="y"), cylinder.rotation)
         assert np.abs(I_back - I_c).max() < 1e-14 * np.abs(I_c).max()
     sphere = equivalent_shape(5.0, inertia.sphere(5.0, 0.25))
-    assert sphere.kind == "sphere" and sphere.size == pytest.approx((0.25,), rel=1e-14)
+    assert sphere.kind == "sphere" and sphere.size == pytest.approx((0.25,), rel=ROUND_OFF, abs=0)
     disk = equivalent_shape(1.0, inertia.disk(1.0, 0.3, axis="y"))  # no thickness: drawn 5 % of r thick
-    assert disk.kind == "cylinder" and disk.size == pytest.approx((0.3, 0.015), rel=1e-9)
+    assert disk.kind == "cylinder" and disk.size == pytest.approx((0.3, 0.015), rel=ROUND_OFF, abs=0)
     with pytest.raises(ValueError, match="I_c"):
         equivalent_shape(1.0, np.diag([1.0, -2.0, 1.0]))
     with pytest.raises(ValueError, match="I_c"):
