@@ -83,7 +83,8 @@ def test_equivalent_shape_inverts_the_inertia_formulas():
     for axis in "xyz":
         I_c = rotated(inertia.cylinder(2.0, 0.1, 0.9, axis=axis), R)
         cylinder = equivalent_shape(2.0, I_c)
-        assert cylinder.kind == "cylinder" and cylinder.size == pytest.approx((0.1, 0.9), rel=ROUND_OFF, abs=0)
+        assert cylinder.kind == "cylinder"
+        assert cylinder.size == pytest.approx((0.1, 0.9), rel=ROUND_OFF, abs=0)
         assert np.linalg.det(cylinder.rotation) == pytest.approx(1.0, abs=ROUND_OFF)  # measured 2.2e-16
         # three.js's cylinder has its axis along y
         I_back = rotated(inertia.cylinder(2.0, *cylinder.size, axis="y"), cylinder.rotation)
