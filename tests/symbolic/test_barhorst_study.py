@@ -96,9 +96,10 @@ def test_eq_38_particle_energy_is_conserved(form):
 def test_eq_38_rolling_disk_with_and_without_drag(disk_forms):
     """§3.2: without drag eq. 38 vanishes at random states (round-off); with his air-drag torque (104),
     −T_f u_i |u_i| about C's axes, the rate equals its power −T_f Σ |u_i|³. The equations keep T_f
-    as a symbol (its value enters only when compiled), so the form of the fixture serves. Round-off: without
-    drag at most 9.3e-20 Σ u² (bound 1e-18 Σ u², was 1e-15), with drag 5.5e-15 relative (bound 5.5e-14, atol 0;
-    was rtol 1e-9 with np.isclose's atol 1e-8, 8e-7 of the power), both the largest over 63 random states."""
+    as a symbol (its value enters only when compiled), so the form of the fixture serves. Round-off:
+    without drag at most 9.3e-20 Σ u² (bound 1e-18 Σ u², was 1e-15), with drag 5.5e-15 relative (bound
+    5.5e-14, atol 0; was rtol 1e-9 with np.isclose's atol 1e-8, 8e-7 of the power), both the largest
+    over 63 random states."""
     example, form, _ = disk_forms
     rate = energy_rate(form, _energy_in_u(example, form))
     numbers = {k: sp.Float(v) for k, v in example.values.items() if k != bx.T_f}
