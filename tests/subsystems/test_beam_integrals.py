@@ -73,15 +73,20 @@ def test_recursive_equals_dense_in_the_precomputed_mode():
 def test_spin_up_tip_deflection_of_both_modes():
     """A fast spin-up (Ωs = 4 rad/s in Ts = 5 s, 2 eigenfunctions per plane, 8 s) bends
     the tip by v(L) ≈ 1.2 m (v/L = 12 %, where the former first-order mode was 1.5 % off):
-    both modes integrate the same equations, so their tip deflections agree to the
-    integration tolerance (rtol 1e-6 of the peak)."""
+    both modes integrate the same equations, so their tip deflections agree to round-off, 100 ε of
+    the peak (measured 1.0e-15; 5.4e-16 and 4.9e-16 at rtol 2e-6 and 5e-7: the steps coincide). The
+    recursive evaluator calls each mode's own terms; the compiled hub_beam kernel, which this test
+    took before, evaluates the beam's fields itself and gave both runs the same numbers (difference
+    exactly 0 against the bound 1e-6 of the peak then: a test that could not fail)."""
     tips = []
     for precomputed in (False, True):
         system = spin_up_beam(
             omega_s=4.0, t_s=5.0, n_shapes=2, family="clamped_free", precomputed_integrals=precomputed
         )
-        result = pq.simulate(system, 8.0, method="RK45", rtol=1e-6, atol=1e-8, n_points=41, evaluator="hub_beam")
+        result = pq.simulate(system, 8.0, method="RK45", rtol=1e-6, atol=1e-8, n_points=41,
+                             evaluator="recursive")
         tips.append(system.subsystem("beam").deflection(result, 10.0)[:, 1])
     peak = np.abs(tips[0]).max()
     assert peak > 0.5  # a large deflection indeed
-    assert np.abs(tips[0] - tips[1]).max() < 1e-6 * peak
+    difference = np.abs(tips[0] - tips[1]).max()
+    assert difference < 100 * np.finfo(float).eps * peak, difference / peak
