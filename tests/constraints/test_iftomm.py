@@ -36,7 +36,8 @@ def double_four_bar():  # ~10 s CPU
 def test_double_four_bar_runs_through_its_singular_positions(double_four_bar):
     """A02 with N = 2, all bars 1 m and 1 kg, B0 starting at 1 m/s: over 2 s the cranks pass the
     horizontal (rank 2 of 4 rows, 3 degrees of freedom) twice (θ0 from π/2 to −4.8 rad), and B0's
-    position and velocity stay within 1e-6 of the parallelogram motion (achieved 1.9e-7 at rtol 1e-9)."""
+    position and velocity stay within 4e-7 of the parallelogram motion (measured 1.65e-8 at rtol 1e-9;
+    3.8e-8 and 8.1e-9 at 2e-9 and 5e-10, bound 10× the largest; was 1e-6, with 1.9e-7 stated)."""
     system, full = double_four_bar
     assert full.status == 0 and full.t[-1] == 10.0
     first = full.t <= 2.0
@@ -48,7 +49,7 @@ def test_double_four_bar_runs_through_its_singular_positions(double_four_bar):
     assert system.rank(horizontal) == 2 and system.mobility(horizontal) == 3
     assert system.mobility(system.q0) == 1
     error = np.abs(point_b0(system, r.q, r.s_dot) - parallelogram_motion(r.t, 2))
-    assert error.max() < 1e-6, error.max(axis=0)
+    assert error.max() < 4e-7, error.max(axis=0)
     assert np.abs(r.constraint_residual).max() < 1e-13, "measured 9.2e-15"
 
 

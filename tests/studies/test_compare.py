@@ -89,7 +89,8 @@ def test_car_constraint_inserted_too_early_loses_both_terms(car_table):
     assert all(sp.expand(d - e) == 0 for d, e in zip(row["difference"], expected))
     assert sp.expand(v_x * row["difference"][0] + omega_z * row["difference"][1]) == 0
     assert "before the derivation" in row["why"] and "v_y = 0" in row["why"]
-    assert row["energy_drift"] < 1e-7  # as every row: rtol 1e-9 over 0.2 s
+    # constant v_x and ω_z: T stays exactly constant (measured 0; was 1e-7)
+    assert row["energy_drift"] < 100 * np.finfo(float).eps, row["energy_drift"]
     # over 0.2 s the heading alone departs by ~1e-2 rad (ω_z decays at m c v_x / C° = 4.5/s in B(9),
     # stays 0.2 rad/s here); integration errors are ~1e-9
     gap = float(re.search(r"max \|Δq\| = (\S+)", row["note"]).group(1))
@@ -296,7 +297,8 @@ def test_bad_name():
 def test_a_users_system_is_compared():
     """A user's System (here the double pendulum built as a System): the numeric Projection
     Equation, recursive and dense, and its sympy derivation (gauss_form) agree at random states
-    (measured 1.3e-15 and 6.6e-16 relative, bound 1.3e-14) and conserve energy; with a load given
+    (measured 1.3e-15 and 6.6e-16 relative, bound 1.3e-14) and conserve energy (measured ≤ 1.1e-14 at
+    rtol 1e-9 over 0.1 s, 3.3e-15 over 0.2 s; bound 1.1e-13, was 1e-7); with a load given
     as a function gauss_form refuses, the symbolic row is "not available" naming why; a
     ConstrainedSystem is refused."""
     from projeq import Force, scenes
@@ -308,7 +310,7 @@ def test_a_users_system_is_compared():
     for row in table.rows[1:]:
         assert row["identical"] == "yes", row
         assert float(row["check"].rsplit(" ", 1)[1]) < 1.3e-14, row["check"]
-    assert all(row["energy_drift"] < 1e-7 for row in table.rows)
+    assert all(row["energy_drift"] < 1.1e-13 for row in table.rows), [row["energy_drift"] for row in table.rows]
     pendulum = scenes.double_pendulum()
     parts = dict(zip(pendulum.names, pendulum.subsystems)), dict(zip(pendulum.names, pendulum.joints))
     pushed = System(*parts, forces=[Force("bob2", lambda t, q, s_dot: (0.1 * t, 0.0, 0.0))])

@@ -105,20 +105,22 @@ def _free_hub_with_beam(stiffening=True):
     )
 
 
-def _assert_recursive_equals_dense(system, seed, q_range):
-    """docs/theory.md §5 = §6 at three random states (round-off relative to |s̈|: 1e-10)."""
+def _assert_recursive_equals_dense(system, seed, q_range, bound):
+    """docs/theory.md §5 = §6 at three random states, to ``bound`` relative to |s̈| (round-off of two
+    evaluations of an ill-conditioned M)."""
     rng = np.random.default_rng(seed)
     for _ in range(3):
         q, s_dot = rng.uniform(-q_range, q_range, system.n_q), rng.uniform(-1, 1, system.n_s)
         a = system.accelerations(q, s_dot, method="recursive")
         b = system.accelerations(q, s_dot, method="dense")
-        assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max()
+        assert np.abs(a - b).max() <= bound * np.abs(b).max(), np.abs(a - b).max() / np.abs(b).max()
 
 
 @pytest.mark.parametrize("stiffening", [True, False])
 def test_recursive_equals_dense_with_a_beam(stiffening):
-    """docs/theory.md §5 = §6 with an elastic subsystem."""
-    _assert_recursive_equals_dense(_free_hub_with_beam(stiffening), seed=7, q_range=0.05)
+    """docs/theory.md §5 = §6 with an elastic subsystem: 3e-11 of |s̈| (measured ≤ 1.95e-12, at most 2.9e-12
+    over 30 random states; was 1e-10)."""
+    _assert_recursive_equals_dense(_free_hub_with_beam(stiffening), seed=7, q_range=0.05, bound=3e-11)
 
 
 def test_energy_of_a_freely_spinning_beam_is_conserved():
@@ -216,8 +218,9 @@ def _arm_with_offset_tip_body():
 
 
 def test_body_on_a_beam_station_recursive_equals_dense():
-    """docs/theory.md §5 = §6 when T_np depends on the parent's elastic coordinates."""
-    _assert_recursive_equals_dense(_arm_with_offset_tip_body(), seed=1, q_range=0.1)
+    """docs/theory.md §5 = §6 when T_np depends on the parent's elastic coordinates: 1e-10 of |s̈|
+    (measured ≤ 1.1e-12, at most 9.5e-12 over 30 random states)."""
+    _assert_recursive_equals_dense(_arm_with_offset_tip_body(), seed=1, q_range=0.1, bound=1e-10)
 
 
 @pytest.mark.parametrize(
@@ -271,14 +274,16 @@ def test_spinning_shaft_frequencies_split_by_the_spin(omega):
 def test_probes_along_a_trajectory():
     """deflection, slope and bending moment at a station, one row per time point; at the
     clamped root all vanish except the moment, and the tip moment of a cantilever vanishes
-    only for exact eigenfunctions (Ritz moments are approximate): check root and shape."""
+    only for exact eigenfunctions (Ritz moments are approximate): check root and shape. At the root the
+    deflection and slope are 0 to 100 ε of the tip's (measured exactly 0; was allclose's atol 1e-8)."""
     system = spin_up_beam(n_shapes=3, t_s=2.0)
     result = pq.simulate(system, 1.0, method="RK45", rtol=1e-6, atol=1e-8, n_points=11)
     beam = system.subsystem("beam")
     tip = beam.deflection(result, L)
     assert tip.shape == (11, 3)
-    assert np.allclose(beam.deflection(result, 0.0), 0.0)
-    assert np.allclose(beam.slope(result, 0.0), 0.0)
+    exact = 100 * np.finfo(float).eps
+    assert np.allclose(beam.deflection(result, 0.0), 0.0, rtol=0, atol=exact * np.abs(tip).max())
+    assert np.allclose(beam.slope(result, 0.0), 0.0, rtol=0, atol=exact * np.abs(beam.slope(result, L)).max())
     assert beam.bending_moment(result, 0.5 * L).shape == (11, 2)
     # the deflection agrees with displacement() on the raw coordinates
     q_e = result.q[:, system.e_q_slice[system.index("beam")]]

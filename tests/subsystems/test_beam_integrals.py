@@ -28,13 +28,14 @@ def _terms(beam, scale, seed=0):
 @pytest.mark.parametrize("scale", [0.0, 0.05, 0.5])
 def test_precomputed_equals_quadrature_at_any_deformation(stiffening, scale):
     """Undeformed, small (v/L ~ 3 %) and large (v/L ~ 30 %, far beyond the first-order
-    mode this replaces) deformations, with axial and rotary terms: equal to 1e-12 of the
+    mode this replaces) deformations, with axial and rotary terms: equal to 100 ε of the
     terms' scale (the quadrature's own round-off; the moments are the same Gauss sums
-    reordered)."""
+    reordered; measured ≤ 3.5e-16 for M, 2.2e-16 for h; was 1e-12)."""
     quadrature, precomputed = _pair(stiffening=stiffening)
     (Ma, ha), (Mb, hb) = _terms(quadrature, scale), _terms(precomputed, scale)
-    assert np.abs(Ma - Mb).max() <= 1e-12 * np.abs(Ma).max()
-    assert np.abs(ha - hb).max() <= 1e-12 * np.abs(ha).max()
+    exact = 100 * np.finfo(float).eps
+    assert np.abs(Ma - Mb).max() <= exact * np.abs(Ma).max()
+    assert np.abs(ha - hb).max() <= exact * np.abs(ha).max()
 
 
 def test_monomial_derivatives():
@@ -54,7 +55,8 @@ def test_monomial_derivatives():
 
 
 def test_recursive_equals_dense_in_the_precomputed_mode():
-    """docs/theory.md §5 = §6 hold for either mode (both assemblers call the same terms): 1e-10."""
+    """docs/theory.md §5 = §6 hold for either mode (both assemblers call the same terms): 6e-12 of |s̈|
+    (measured 4.8e-13; at most 5.8e-13 over 12 random states, κ(M) ≈ 6e4; was 1e-10)."""
     _, beam = _pair()
     system = pq.System(
         {"hub": pq.RigidBody(1.0, (0, 0, 0), np.diag([0.5, 0.5, 0.2])), "beam": beam},
@@ -65,21 +67,26 @@ def test_recursive_equals_dense_in_the_precomputed_mode():
     q, s_dot = rng.uniform(-0.05, 0.05, system.n_q), rng.uniform(-1, 1, system.n_s)
     a = system.accelerations(q, s_dot, method="recursive")
     b = system.accelerations(q, s_dot, method="dense")
-    assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max()
+    assert np.abs(a - b).max() <= 6e-12 * np.abs(b).max(), np.abs(a - b).max() / np.abs(b).max()
 
 
 def test_spin_up_tip_deflection_of_both_modes():
     """A fast spin-up (Ωs = 4 rad/s in Ts = 5 s, 2 eigenfunctions per plane, 8 s) bends
     the tip by v(L) ≈ 1.2 m (v/L = 12 %, where the former first-order mode was 1.5 % off):
-    both modes integrate the same equations, so their tip deflections agree to the
-    integration tolerance (rtol 1e-6 of the peak)."""
+    both modes integrate the same equations, so their tip deflections agree to round-off, 100 ε of
+    the peak (measured 1.0e-15; 5.4e-16 and 4.9e-16 at rtol 2e-6 and 5e-7: the steps coincide). The
+    recursive evaluator calls each mode's own terms; the compiled hub_beam kernel, which this test
+    took before, evaluates the beam's fields itself and gave both runs the same numbers (difference
+    exactly 0 against the bound 1e-6 of the peak then: a test that could not fail)."""
     tips = []
     for precomputed in (False, True):
         system = spin_up_beam(
             omega_s=4.0, t_s=5.0, n_shapes=2, family="clamped_free", precomputed_integrals=precomputed
         )
-        result = pq.simulate(system, 8.0, method="RK45", rtol=1e-6, atol=1e-8, n_points=41, evaluator="hub_beam")
+        result = pq.simulate(system, 8.0, method="RK45", rtol=1e-6, atol=1e-8, n_points=41,
+                             evaluator="recursive")
         tips.append(system.subsystem("beam").deflection(result, 10.0)[:, 1])
     peak = np.abs(tips[0]).max()
     assert peak > 0.5  # a large deflection indeed
-    assert np.abs(tips[0] - tips[1]).max() < 1e-6 * peak
+    difference = np.abs(tips[0] - tips[1]).max()
+    assert difference < 100 * np.finfo(float).eps * peak, difference / peak
