@@ -19,16 +19,21 @@ package's tests (and its modules' doctests) on the unmutated source under covera
 test: a mutant's tests are the passing ones that run one of its lines (all of its package's where
 only the import runs them), fastest first up to ``--budget`` seconds; a mutant on lines no passing
 test runs survives unrun ("not run"). OUT/baseline.json lists each mutant's tests and their times.
+Hypothesis draws the same examples in every run (``--hypothesis-seed=0``, its database cleared before
+each), so a property test kills a mutant only where the mutant changes what it checks.
 
-Each worker mutates its own copy of the source (``projeq``, ``tests``, ``pyproject.toml`` in a
-temporary folder) and runs the mutant's tests with ``pytest -x`` (the first failure kills the mutant; a
-run longer than ``--timeout-factor`` times the baseline's, plus 30 s, kills it too). The results go to
-the session database as they arrive: Ctrl-C stops, and the same command continues with the mutants
-still pending. The survivors are written to OUT/survivors.md with their diffs; ``--again OUT`` runs
-a session's survivors again against the tests as they are now (the "after" of a round of new tests).
+Each worker mutates its own copy of the source (``projeq``, ``tests``, ``benchmarks``, ``examples``,
+``pyproject.toml`` in a temporary folder) and runs the mutant's tests with ``pytest -x`` (the first
+failure kills the mutant; a run longer than ``--timeout-factor`` times the baseline's, plus 30 s, kills
+it too). The results go to the session database as they arrive: Ctrl-C stops, and the same command
+continues with the mutants still pending. The survivors are written to OUT/survivors.md with their
+diffs; ``--again OUT`` runs a session's survivors again against the tests as they are now (the "after"
+of a round of new tests); ``--compiled`` runs its not-run mutants with numba's JIT on against the test
+files of :data:`COMPILED_TESTS`, an empty numba cache each (minutes per mutant).
 
     python benchmarks/mutation.py [--mutants 200] [--seed 37] [--workers 2] [--out DIR]
     python benchmarks/mutation.py --again OUT --out OUT2   # OUT's survivors against the tests of today
+    python benchmarks/mutation.py --compiled --out OUT   # OUT's not-run mutants against the compiled tests
     python benchmarks/mutation.py --quick     # 3 mutants of assembly/linalg.py against its test file
 """
 
@@ -63,6 +68,17 @@ QUICK = {"assembly": ("projeq/assembly/linalg.py", ("tests/assembly/test_linalg.
 BITWISE = ("_RShift", "_LShift", "_BitOr", "_BitAnd", "_BitXor")
 #: the outcome's note for a mutant on lines that no passing test runs (it survives, unrun)
 NOT_RUN = "no test that passes interpreted runs these lines"
+#: ``--compiled``: the test files that run a module's compiled-only code (numba's JIT on)
+COMPILED_TESTS = {
+    "projeq/assembly/generated.py": ("tests/assembly/test_stated_loads.py", "tests/assembly/test_time_loads.py"),
+    "projeq/assembly/given.py": ("tests/assembly/test_given.py",),
+    "projeq/assembly/kernels.py": ("tests/assembly/test_fast_beams.py", "tests/assembly/test_fast_energy.py"),
+    "projeq/constraints/compiled.py": ("tests/constraints/test_compiled_closures.py",
+                                       "tests/constraints/test_compiled_pins.py",
+                                       "tests/constraints/test_compiled_pfaffian.py"),
+    "projeq/subsystems/beam/beam.py": ("tests/subsystems/test_beam_bad_input.py",),
+    "projeq/subsystems/beam/slice_chain.py": ("tests/subsystems/test_beam_slice_chain.py",),
+}
 
 #: the baseline's pytest plugin: each test's outcome and time to a log, the lines of projeq each test runs
 #: to coverage's data (one context per test); a test running longer than the limit is stopped by an alarm
@@ -163,26 +179,32 @@ def sample(cr, module_paths: list[str], count: int, seed: int) -> list:
 
 
 def copy_source(target: Path) -> Path:
-    """A copy of the package, its tests and pyproject.toml in ``target`` (made anew)."""
+    """A copy of the package, its tests, the scripts they run (benchmarks, examples) and pyproject.toml
+    in ``target`` (made anew)."""
     shutil.rmtree(target, ignore_errors=True)
     target.mkdir(parents=True)
-    ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".hypothesis")
-    for name in ("projeq", "tests"):
+    ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".hypothesis", "results")
+    for name in ("projeq", "tests", "benchmarks", "examples"):
         shutil.copytree(ROOT / name, target / name, ignore=ignore)
     shutil.copy2(ROOT / "pyproject.toml", target / "pyproject.toml")
     return target
 
 
-def environment(copy: Path) -> dict:
-    """The tests' environment: the copy's projeq first on the path, numba's JIT off, no bytecode
-    written (a mutant and the original may share a time stamp)."""
+def environment(copy: Path, cache: Path | None = None) -> dict:
+    """The tests' environment: the copy's projeq first on the path, no bytecode written (a mutant and
+    the original may share a time stamp), numba's JIT off, or on with the empty numba ``cache``."""
     env = dict(os.environ, NUMBA_DISABLE_JIT="1", PYTHONDONTWRITEBYTECODE="1", PYTHONPATH=str(copy))
     env.pop("PYTEST_ADDOPTS", None)
+    if cache is not None:
+        env.update(NUMBA_DISABLE_JIT="0", NUMBA_CACHE_DIR=str(cache), PROJEQ_COMPILE="now")
     return env
 
 
 def pytest_command(arguments) -> list[str]:
-    return [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-W", "ignore", *arguments]
+    """pytest with hypothesis's draws fixed (the baseline's examples are each mutant's: a property test
+    whose random draws reach code that fails interpreted would kill mutants by chance)."""
+    return [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-W", "ignore", "--hypothesis-seed=0",
+            *arguments]
 
 
 def check_copy_is_imported(copy: Path) -> None:
@@ -193,9 +215,10 @@ def check_copy_is_imported(copy: Path) -> None:
         raise RuntimeError(f"the tests in {copy} import projeq from {found}, not the copy being mutated")
 
 
-def baseline(copy: Path, packages: dict, module_paths: list[str], test_seconds: float) -> dict:
+def baseline(copy: Path, packages: dict, module_paths: list[str], test_seconds: float, processes: int) -> dict:
     """package → {"seconds": {node id: seconds} of the tests that pass on the unmutated source within
-    ``test_seconds`` each, "lines": {module: {line: [node ids of those that run it]}}}."""
+    ``test_seconds`` each, "lines": {module: {line: [node ids of those that run it]}}}; the tests run in
+    ``processes`` pytest-xdist workers (0: in pytest's own)."""
     found = {}
     for name, (_, tests) in packages.items():
         log, data = copy / f"baseline-{name}.jsonl", copy / f"coverage-{name}"
@@ -207,8 +230,8 @@ def baseline(copy: Path, packages: dict, module_paths: list[str], test_seconds: 
         started = time.perf_counter()
         env = dict(environment(copy), MUTATION_BASELINE_LOG=str(log), MUTATION_TEST_SECONDS=str(test_seconds),
                    MUTATION_COVERAGE=str(data / ".coverage"))
-        subprocess.run(pytest_command(["-p", "mutation_baseline", "-n", "2", *tests, *modules_here]), cwd=copy, env=env,
-                       capture_output=True, check=False)  # its failures are the tests left out
+        subprocess.run(pytest_command(["-p", "mutation_baseline", "-n", str(processes), *tests, *modules_here]),
+                       cwd=copy, env=env, capture_output=True, check=False)  # its failures are the tests left out
         seconds = passing_tests(log, test_seconds)
         found[name] = {"seconds": seconds, "lines": covered_lines(copy, data, modules_here, set(seconds))}
         print(f"baseline {name}: {len(seconds)} tests pass interpreted within {test_seconds:g} s each "
@@ -282,10 +305,13 @@ def run_mutant(cr, copy: Path, item, tests: list[str], timeout: float):
     return result, reason
 
 
-def run_tests(cr, copy: Path, tests: list[str], timeout: float):
-    """(outcome, output, the first failing test or the timeout) of ``tests`` run in ``copy`` with ``-x``."""
+def run_tests(cr, copy: Path, tests: list[str], timeout: float, cache: Path | None = None):
+    """(outcome, output, the first failing test or the timeout) of ``tests`` run in ``copy`` with ``-x``
+    (numba's JIT on with the empty ``cache`` where given); hypothesis's database of earlier failures
+    (another mutant's) cleared first."""
+    shutil.rmtree(copy / ".hypothesis", ignore_errors=True)
     try:
-        done = subprocess.run(pytest_command(["-x", *tests]), cwd=copy, env=environment(copy),
+        done = subprocess.run(pytest_command(["-x", *tests]), cwd=copy, env=environment(copy, cache),
                               capture_output=True, text=True, timeout=timeout, check=False)
     except subprocess.TimeoutExpired:
         return cr.work_item.TestOutcome.KILLED, "timeout", f"timeout ({timeout:.0f} s)"
@@ -293,6 +319,33 @@ def run_tests(cr, copy: Path, tests: list[str], timeout: float):
     reason = failed.group(1) if failed else ("" if done.returncode == 0 else f"exit {done.returncode}")
     outcome = cr.work_item.TestOutcome.SURVIVED if done.returncode == 0 else cr.work_item.TestOutcome.KILLED
     return outcome, done.stdout[-1500:] + done.stderr[-500:], reason
+
+
+def compiled(cr, out: Path, copy: Path, timeout: float) -> dict:
+    """The session's "not run" mutants against :data:`COMPILED_TESTS` with numba's JIT on and an empty
+    cache each (minutes per mutant: the kernels compile anew): job id → (outcome, why, seconds), kept in
+    OUT/compiled.json as they arrive."""
+    record_file = out / "compiled.json"
+    found = json.loads(record_file.read_text()) if record_file.exists() else {}
+    with cr.work_db.use_db(out / "session.sqlite", cr.work_db.WorkDB.Mode.open) as db:
+        unrun = [item for item, result in sorted(db.completed_work_items, key=lambda pair: pair[0].job_id)
+                 if outcome_of(result) == "not run" and item.job_id not in found]
+    for item in unrun:
+        mutation = item.mutations[0]
+        tests = COMPILED_TESTS.get(str(mutation.module_path))
+        started = time.perf_counter()
+        if tests is None:
+            found[item.job_id] = ("no compiled tests named", "", 0.0)
+        else:
+            operator = cr.plugins.get_operator(mutation.operator_name)()
+            with cr.mutating.use_mutation(copy / mutation.module_path, operator, mutation.occurrence), \
+                    tempfile.TemporaryDirectory() as cache:
+                outcome, _, reason = run_tests(cr, copy, list(tests), timeout, Path(cache))
+            found[item.job_id] = (outcome.value, reason, time.perf_counter() - started)
+        record_file.write_text(json.dumps(found, indent=1))
+        print(f"compiled {item.job_id} {found[item.job_id][0]:<9} {mutation.module_path}:{mutation.start_pos[0]} "
+              f"{found[item.job_id][1]} ({found[item.job_id][2]:.0f} s)", flush=True)
+    return found
 
 
 def outcome_of(result) -> str:
@@ -339,6 +392,9 @@ def main(argv=None) -> dict:
     parser.add_argument("--out", type=Path, default=None, help="session folder (default: a new temporary one)")
     parser.add_argument("--again", type=Path, default=None,
                         help="run the survivors of the session in this folder again, against the tests as they are now")
+    parser.add_argument("--compiled", action="store_true",
+                        help="run the session's not-run mutants against the compiled tests (COMPILED_TESTS), "
+                             "numba's JIT on, an empty cache each")
     parser.add_argument("--quick", action="store_true", help="3 mutants of assembly/linalg.py, one test file")
     args = parser.parse_args(argv)
     if args.mutants < 1 or args.workers < 1 or min(args.test_seconds, args.budget) <= 0 \
@@ -357,6 +413,8 @@ def main(argv=None) -> dict:
     scratch = Path(tempfile.mkdtemp(prefix="projeq-mutants-"))
     try:
         copies = [copy_source(scratch / f"worker-{k}") for k in range(workers)]
+        if args.compiled:
+            return compiled(cr, out, copies[0], 1800.0)
         return run(cr, args, packages, module_paths, count, out, copies, settings)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
@@ -373,7 +431,7 @@ def start(cr, args, packages, module_paths, count, out, copy, settings) -> None:
     """A new session in ``out``: the mutants (drawn, or the survivors of ``--again``), the baseline,
     each mutant's tests (OUT/baseline.json: job id → tests, test → seconds)."""
     items = survivors_of(cr, args.again) if args.again else sample(cr, module_paths, count, args.seed)
-    found = baseline(copy, packages, module_paths, args.test_seconds)
+    found = baseline(copy, packages, module_paths, args.test_seconds, 0 if args.quick else 2)
     chosen = {}
     for item in items:
         mutation = item.mutations[0]

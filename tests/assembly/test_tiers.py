@@ -83,6 +83,18 @@ def test_the_budget_counts_over_the_runs_of_one_cache(budget):
     assert compilation._BUDGET.total() == compilation._BUDGET.spent  # a damaged ledger: a new budget
 
 
+def test_the_ledger_makes_its_folders_on_a_new_cache(budget, monkeypatch):
+    """A first run on a new NUMBA_CACHE_DIR spends interpreted seconds before numba has made its cache
+    folder (nothing compiled yet): saving them makes the folder, parents included, so that the next run
+    of that cache counts them (a mutant that made the last folder alone survived every other test:
+    issue 37, item 8)."""
+    ledger = budget.parent / "new" / "numba cache" / budget.name
+    monkeypatch.setattr(compilation, "_ledger", lambda: ledger)
+    compilation.spend(0.02, "the model")
+    compilation._BUDGET.save()
+    assert float(ledger.read_text()) == 0.02
+
+
 def test_a_kernel_in_numba_cache_runs_at_once(budget):
     kernel = _Kernel()
     kernel.compiled = True  # as if loaded from the disk cache

@@ -169,6 +169,9 @@ MODELS = {
     "spatial loop, spherical cut joint": spatial_loop,
     "tangent four-bar": lambda: four_bar(kind=TangentSystem),
     "tangent four-bar, redundant z row": lambda: four_bar(kind=TangentSystem, axes="xyz"),
+    # one row: mobility 2, the only model whose null-space basis F has two columns (issue 37, item 8: a
+    # mutant of its off-diagonal entries survived the others)
+    "tangent four-bar pinned along x alone": lambda: four_bar(kind=TangentSystem, axes="x"),
     "four-bar with springs and gravity": lambda: four_bar(forces=_springs(), independent=[0]),
     "four-bar on a sympy UserJoint (kind GIVEN, F(q))": cam_four_bar,
 }

@@ -94,6 +94,23 @@ def test_knife_edge_disc_near_flat_tilt_is_singular(distance):
         pq.scenes.knife_edge_disc(q0=(0.0, 0.0, 0.0, np.pi / 2 - distance, 0.0))
 
 
+def test_a_singular_joint_behind_another_is_refused_by_name():
+    """check_configuration evaluates each joint's F(q) with that joint's own minimal velocities: the
+    knife-edge disc 1e-11 rad from flat (cond F 2.8e11, slide 29) beside a pendulum whose revolute joint
+    comes first (the disc's ṡ start at index 1) is refused naming 'disc', as the disc alone is. A mutant
+    that sized the disc's ṡ by stop + start instead of stop − start survived the disc alone (issue 37,
+    item 8)."""
+    from projeq.constraints.nonholonomic import check_configuration
+
+    disc = pq.scenes.knife_edge_disc()
+    system = pq.System({"pendulum": pq.PointMass(1.0), "disc": disc.subsystems[0]},
+                       {"pendulum": pq.Revolute(axis="y"), "disc": disc.joints[0]}, gravity=(0, 0, -9.81))
+    q = np.zeros(system.n_q)
+    q[1 + 3] = np.pi / 2 - 1e-11  # the disc's tilt ϕ
+    with pytest.raises(ValueError, match=r"F\(q\) loses rank \(condition number 2.8\de\+11\) for the joint of 'disc'"):
+        check_configuration(system, q)
+
+
 def test_knife_edge_disc_started_near_flat_stops_within_few_evaluations():
     """Passes if the disc started 1e-4 rad from flat (issue 20: 460k evaluations, never finished
     its first segment) stops with a SimulationError naming the coordinate singularity within a few

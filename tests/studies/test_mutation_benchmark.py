@@ -34,6 +34,9 @@ def test_quick_mode_runs_three_mutants_in_a_copy(tmp_path, capsys):
     out = capsys.readouterr().out
     assert digest(target) == before, "the package's own source was mutated"
     assert sum(counts["assembly"].values()) == 3 and set(counts["assembly"]) <= {"killed", "survived", "not run"}, counts
+    # the tests ran against the mutated copy, not the installed package: some mutant dies (3 of 3 measured:
+    # a pivot threshold and two comparisons of solve_spd, each caught by tests/assembly/test_linalg.py)
+    assert counts["assembly"].get("killed", 0) >= 1, counts
     assert "3 drawn (seed 37)" in out and "[3/3]" in out and (tmp_path / "survivors.md").exists()
     from cosmic_ray.work_db import WorkDB, use_db
 
