@@ -31,7 +31,7 @@ diffs; ``--again OUT`` runs a session's survivors again against the tests as the
 of a round of new tests); ``--compiled`` runs its not-run mutants with numba's JIT on against the test
 files of :data:`COMPILED_TESTS`, an empty numba cache each (minutes per mutant).
 
-    python benchmarks/mutation.py [--mutants 200] [--seed 37] [--workers 2] [--out DIR]
+    python benchmarks/mutation.py [--mutants 200] [--seed=37] [--workers 2] [--out DIR]
     python benchmarks/mutation.py --again OUT --out OUT2   # OUT's survivors against the tests of today
     python benchmarks/mutation.py --compiled --out OUT   # OUT's not-run mutants against the compiled tests
     python benchmarks/mutation.py --quick     # 3 mutants of assembly/linalg.py against its test file
@@ -167,7 +167,7 @@ def sample(cr, module_paths: list[str], count: int, seed: int) -> list:
         mutations = sorted((item.mutations[0] for item in db.work_items if item.mutations[0].operator_name in wanted),
                            key=lambda m: (str(m.module_path), m.operator_name, m.occurrence))
     chosen = sorted(random.Random(seed).sample(range(len(mutations)), min(count, len(mutations))))
-    print(f"{len(mutations)} mutants of {len(module_paths)} modules; {len(chosen)} drawn (seed {seed})", flush=True)
+    print(f"{len(mutations)} mutants of {len(module_paths)} modules; {len(chosen)} drawn (seed={seed})", flush=True)
     items = []
     for number, index in enumerate(chosen):
         m = mutations[index]

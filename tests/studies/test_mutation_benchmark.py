@@ -37,7 +37,7 @@ def test_quick_mode_runs_three_mutants_in_a_copy(tmp_path, capsys):
     # the tests ran against the mutated copy, not the installed package: some mutant dies (3 of 3 measured:
     # a pivot threshold and two comparisons of solve_spd, each caught by tests/assembly/test_linalg.py)
     assert counts["assembly"].get("killed", 0) >= 1, counts
-    assert "3 drawn (seed 37)" in out and "[3/3]" in out and (tmp_path / "survivors.md").exists()
+    assert "3 drawn (seed=37)" in out and "[3/3]" in out and (tmp_path / "survivors.md").exists()
     from cosmic_ray.work_db import WorkDB, use_db
 
     with use_db(tmp_path / "session.sqlite", WorkDB.Mode.open) as db:
