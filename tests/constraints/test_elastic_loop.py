@@ -196,8 +196,8 @@ def test_a_cut_joint_off_the_beams_axis_is_the_numpy_paths(scene):
     kernel's own s̈_tree and λ (the station's frame from the slice field, kernels.port_motion) equal the
     numpy path's (the port's position by the beam's own terms, RitzBeam.port_at, differentiated by the
     complex step) at three projected states (measured 3.0e-13 and 2.1e-13 relative; bound 3e-12). Every
-    other elastic cut joint sits on the beam's axis, where the station's rotation does not enter: a
-    mutant that read the displacement columns for the rotation ones survived them (issue 37, item 8)."""
+    other elastic cut joint sits on the beam's axis, where the station's rotation does not enter (written
+    for a mutant of the station's columns that survived them, issue 37, item 8; it survives this too)."""
     tree = scene.tree
     pin = pq.PinClosure(tree, "coupler", (B, 0.05, 0.0), "rocker", (C, 0.0, 0.0), axes="xy")
     system = pq.ConstrainedSystem(tree, phi=pin, independent=[0, 3, 4], q0=scene.q0, project_q0=True)
