@@ -288,9 +288,9 @@ def tests_of(mutation, found: dict, budget: float) -> list[str]:
     return chosen
 
 
-def run_mutant(cr, copy: Path, item, tests: list[str], timeout: float):
-    """Apply ``item``'s mutation to ``copy``, run ``tests`` there (none: it survives unrun), put the
-    file back: (WorkResult, why it ended)."""
+def run_mutant(cr, copy: Path, item, tests: list[str], timeout: float, cache: Path | None = None):
+    """Apply ``item``'s mutation to ``copy``, run ``tests`` there (none: it survives unrun; numba's JIT on
+    with the empty ``cache`` where given), put the file back: (WorkResult, why it ended)."""
     mutation = item.mutations[0]
     operator = cr.plugins.get_operator(mutation.operator_name)()
     with cr.mutating.use_mutation(copy / mutation.module_path, operator, mutation.occurrence) as (before, after):
@@ -298,7 +298,7 @@ def run_mutant(cr, copy: Path, item, tests: list[str], timeout: float):
             return cr.work_item.WorkResult(worker_outcome=cr.work_item.WorkerOutcome.NO_TEST), ""
         diff = "".join(difflib.unified_diff(before.splitlines(True), after.splitlines(True),
                                             f"a/{mutation.module_path}", f"b/{mutation.module_path}"))
-        outcome, output, reason = run_tests(cr, copy, tests, timeout) if tests else \
+        outcome, output, reason = run_tests(cr, copy, tests, timeout, cache) if tests else \
             (cr.work_item.TestOutcome.SURVIVED, NOT_RUN, NOT_RUN)
     result = cr.work_item.WorkResult(worker_outcome=cr.work_item.WorkerOutcome.NORMAL, output=output,
                                      test_outcome=outcome, diff=diff)
@@ -328,7 +328,7 @@ def compiled(cr, out: Path, copy: Path, timeout: float) -> dict:
     record_file = out / "compiled.json"
     found = json.loads(record_file.read_text()) if record_file.exists() else {}
     with cr.work_db.use_db(out / "session.sqlite", cr.work_db.WorkDB.Mode.open) as db:
-        unrun = [item for item, result in sorted(db.completed_work_items, key=lambda pair: pair[0].job_id)
+        unrun = [item for item, result in by_job(db.completed_work_items)
                  if outcome_of(result) == "not run" and item.job_id not in found]
     for item in unrun:
         mutation = item.mutations[0]
@@ -337,15 +337,18 @@ def compiled(cr, out: Path, copy: Path, timeout: float) -> dict:
         if tests is None:
             found[item.job_id] = ("no compiled tests named", "", 0.0)
         else:
-            operator = cr.plugins.get_operator(mutation.operator_name)()
-            with cr.mutating.use_mutation(copy / mutation.module_path, operator, mutation.occurrence), \
-                    tempfile.TemporaryDirectory() as cache:
-                outcome, _, reason = run_tests(cr, copy, list(tests), timeout, Path(cache))
-            found[item.job_id] = (outcome.value, reason, time.perf_counter() - started)
+            with tempfile.TemporaryDirectory() as cache:
+                result, reason = run_mutant(cr, copy, item, list(tests), timeout, Path(cache))
+            found[item.job_id] = (outcome_of(result), reason, time.perf_counter() - started)
         record_file.write_text(json.dumps(found, indent=1))
         print(f"compiled {item.job_id} {found[item.job_id][0]:<9} {mutation.module_path}:{mutation.start_pos[0]} "
               f"{found[item.job_id][1]} ({found[item.job_id][2]:.0f} s)", flush=True)
     return found
+
+
+def by_job(completed) -> list:
+    """cosmic-ray's (work item, result) pairs in the order of their job ids (the sample's order)."""
+    return sorted(completed, key=lambda pair: pair[0].job_id)
 
 
 def outcome_of(result) -> str:
@@ -359,7 +362,7 @@ def report(out: Path, completed) -> dict:
     """Counts per package and outcome; the survivors (run and not run) with their diffs in OUT/survivors.md."""
     counts: dict[str, dict[str, int]] = {}
     lines = {"survived": ["# Survivors", ""], "not run": ["# Not run (no passing test runs these lines)", ""]}
-    for item, result in sorted(completed, key=lambda pair: pair[0].job_id):
+    for item, result in by_job(completed):
         mutation, outcome = item.mutations[0], outcome_of(result)
         package = package_of(str(mutation.module_path), PACKAGES)
         counts.setdefault(package, {}).setdefault(outcome, 0)
@@ -412,7 +415,8 @@ def main(argv=None) -> dict:
         raise SystemExit(f"{out} holds a session with other settings ({out / 'settings.json'}): give another --out")
     scratch = Path(tempfile.mkdtemp(prefix="projeq-mutants-"))
     try:
-        copies = [copy_source(scratch / f"worker-{k}") for k in range(workers)]
+        copies = [copy_source(scratch / f"worker-{k}") for k in range(1 if args.compiled else workers)]
+        check_copy_is_imported(copies[0])
         if args.compiled:
             return compiled(cr, out, copies[0], 1800.0)
         return run(cr, args, packages, module_paths, count, out, copies, settings)
@@ -423,7 +427,7 @@ def main(argv=None) -> dict:
 def survivors_of(cr, old: Path) -> list:
     """The mutants that survived in the session in ``old`` (the same job ids and mutations)."""
     with cr.work_db.use_db(old / "session.sqlite", cr.work_db.WorkDB.Mode.open) as db:
-        return [item for item, result in sorted(db.completed_work_items, key=lambda pair: pair[0].job_id)
+        return [item for item, result in by_job(db.completed_work_items)
                 if result.test_outcome == cr.work_item.TestOutcome.SURVIVED]
 
 
@@ -448,7 +452,6 @@ def start(cr, args, packages, module_paths, count, out, copy, settings) -> None:
 
 def run(cr, args, packages, module_paths, count, out, copies, settings) -> dict:
     """The session in ``out`` (started if new): its pending mutants on ``copies``, then the report."""
-    check_copy_is_imported(copies[0])
     if not (out / "session.sqlite").exists():
         start(cr, args, packages, module_paths, count, out, copies[0], settings)
     tests = json.loads((out / "baseline.json").read_text())
