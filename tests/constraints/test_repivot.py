@@ -10,7 +10,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import projeq as pq
-from projeq.constraints.partitioned import POSITION_TOLERANCE, ConstrainedSystem
+from projeq.constraints.partitioned import POSITION_TOLERANCE, ConstrainedSystem, TangentSystem
 from projeq.constraints.reactions import reactions
 from projeq.scenes.mechanisms import four_bar
 
@@ -116,3 +116,22 @@ def test_energy_projection_follows_the_new_partition():
     # the loop-closure projection that follows the energy projection moves q by up to
     # POSITION_TOLERANCE (1e-12), E by |∇_q E| times that (measured 1.7e-13; RK45: 9e-7)
     assert r.energy_drift < 2e-12, r.energy_drift
+
+
+def test_the_condition_of_a_turning_constraint_is_taken_at_the_time_asked():
+    """A bead on a rod through the origin that turns at ω in the x–z plane, Φ = −x sin ωt + z cos ωt:
+    A_s = (−sin ωt, cos ωt), its null space N = (cos ωt, sin ωt), and with x the independent velocity
+    (chosen at q0 = (1, 0), t = 0) κ = 1/σ_min(N_ind) = 1/|cos ωt| in closed form. ``condition(q)``
+    is taken at t = 0, the time q0 is given at (it sets the repivoting limit); measured exact at ωt = 0,
+    0.5 and ±1 (bound 100 ε)."""
+    tree = pq.System({"x": pq.Frame(), "bead": pq.PointMass(1.0)},
+                     {"x": pq.Prismatic(axis="x"), "bead": pq.Prismatic(parent="x", axis="z")},
+                     gravity=(0, 0, 0))
+    omega = 1.0
+    rod = lambda q, t: [-q[0] * np.sin(omega * t) + q[1] * np.cos(omega * t)]
+    system = TangentSystem(tree, phi=rod, q0=[1.0, 0.0])
+    assert system.independent.tolist() == [0]
+    assert system.condition(system.q0) == 1.0
+    for t in (0.5, 1.0, -1.0):
+        expected = 1.0 / abs(np.cos(omega * t))
+        assert abs(system.condition(system.q0, t) - expected) <= 100 * np.finfo(float).eps * expected
