@@ -70,7 +70,8 @@ BITWISE = ("_RShift", "_LShift", "_BitOr", "_BitAnd", "_BitXor")
 NOT_RUN = "no test that passes interpreted runs these lines"
 #: ``--compiled``: the test files that run a module's compiled-only code (numba's JIT on)
 COMPILED_TESTS = {
-    "projeq/assembly/generated.py": ("tests/assembly/test_stated_loads.py", "tests/assembly/test_time_loads.py"),
+    "projeq/assembly/generated.py": ("tests/assembly/test_stated_loads.py", "tests/assembly/test_time_loads.py",
+                                     "tests/assembly/test_given.py"),
     "projeq/assembly/given.py": ("tests/assembly/test_given.py",),
     "projeq/assembly/kernels.py": ("tests/assembly/test_fast_beams.py", "tests/assembly/test_fast_energy.py"),
     "projeq/constraints/compiled.py": ("tests/constraints/test_compiled_closures.py",
