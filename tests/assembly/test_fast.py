@@ -489,3 +489,16 @@ def test_kernels_are_specialised_once_per_dtype():
     states = {(signature[4].layout, signature[4].mutable, signature[5].mutable) for signature in chain_terms.signatures}
     assert states == {("C", True, True)}, states
     assert len(chain_terms.signatures) <= 2, chain_terms.signatures
+
+
+@pytest.mark.parametrize("name", ["fast", "recursive", "dense"])
+def test_an_evaluator_counts_each_call(name):
+    """``n_calls`` (the evaluations that benchmarks/jacobians.py and the trade-off study count) rises by
+    one for each accelerations or gauss_form call."""
+    system = pq.scenes.chain(3)
+    evaluator = system.evaluator(name)
+    evaluator.accelerations(system.q0, system.s_dot0, 0.0)
+    assert evaluator.n_calls == 1
+    if hasattr(evaluator, "gauss_form"):
+        evaluator.gauss_form(system.q0, system.s_dot0, 0.0)
+        assert evaluator.n_calls == 2

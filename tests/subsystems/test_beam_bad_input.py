@@ -53,11 +53,15 @@ SQUARE = (lambda x: x**2, lambda x: 2 * x, lambda x: 2 + 0 * x)  # Φ, Φ′, Φ
         ({"rho_I": (1e-3, 1e-3, 2e-3)}, r"rho_I: expected ρI or \(ρI_y, ρI_z\)"),
         ({"quadrature_order": 0}, "quadrature_order: expected an integer >= 1"),
         ({"quadrature_order": 7.5}, "quadrature_order: expected an integer"),
+        # four functions reach degree 2·4 + 2 = 10, which 6 Gauss points integrate exactly (2·6 − 1 = 11)
+        ({"n_v": 4, "quadrature_order": 5}, r"quadrature_order: 5 Gauss points .* up to degree 9 .* reach degree 10; "
+                                            r"give at least 6 \(default 14\)"),
     ],
     ids=[
         "pinned-root", "axial-root", "family-count", "family-not-a-tuple", "family-signature",
         "family-dict", "family-non-finite",
         "EI-not-a-number", "rho_A-wrong-shape", "rho_I-three", "quadrature-zero", "quadrature-fraction",
+        "quadrature-too-few",
     ],
 )
 def test_bad_beam_input_names_parameter_and_function(kwargs, match):
