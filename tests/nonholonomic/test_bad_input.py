@@ -132,7 +132,9 @@ def test_knife_edge_disc_started_near_flat_stops_within_few_evaluations():
 def test_initial_rates_violating_the_constraints():
     """Slide 30's rolling constraints and Barhorst's ẏ − y² ẋ = 0: rates that violate them
     are refused with the residual; rates that satisfy them give the minimal velocities."""
-    with pytest.raises(ValueError, match=r"^q_dot: the initial rates violate the velocity constraints: residual \[1\. 0\.\]"):
+    # the tolerance is relative to the rates: 1e-8 (1 + max |q̇|) = 2e-8
+    with pytest.raises(ValueError, match=r"^q_dot: the initial rates violate the velocity constraints: residual \[1\. 0\.\] "
+                                         r"\(tolerance 2e-08\)"):
         pq.scenes.knife_edge_disc(q_dot0=(1.0, 0.0, 0.0, 0.0, 0.0))
     with pytest.raises(ValueError, match=r"residual \[-4\.\]"):
         pq.scenes.barhorst_particle(q_dot0=(1.0, 0.0))  # ẏ − y² ẋ = 0 − 4·1 at (2, 2)
