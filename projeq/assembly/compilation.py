@@ -12,6 +12,9 @@ numba compiles projeq's kernels on their first use and keeps them in its disk ca
 - a cache entry numba cannot read back (a truncated or corrupted index or data file: an
   ``EOFError`` or ``UnpicklingError`` from its loader) is discarded with one
   :class:`CacheWarning` naming it, and the kernel is compiled and cached anew;
+- one process compiles a kernel at a time, the others wait for it and load it from the cache
+  (:func:`_one_at_a_time`): processes that start together on an empty cache — a sweep's workers,
+  the test suite's — compile each kernel once, not once each;
 - under :func:`cached_only` a kernel numba would compile raises :class:`NotCompiled` before
   its compilation starts (a kernel in memory or in the disk cache runs): the default evaluator
   (:mod:`projeq.assembly.auto`) evaluates interpreted instead, a closed loop by its numpy path
@@ -19,7 +22,7 @@ numba compiles projeq's kernels on their first use and keeps them in its disk ca
   :data:`BUDGET` seconds of CPU are spent so over the runs of the same numba cache, then compiles
   (:func:`spend`, :func:`compile_now`).
 
-All three apply to projeq's own functions only (their module's name starts with ``projeq``: the
+All four apply to projeq's own functions only (their module's name starts with ``projeq``: the
 package and the modules it generates, :func:`projeq.assembly.given.generated_module`).
 """
 
@@ -34,6 +37,11 @@ import threading
 import time
 import warnings
 from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:  # Windows: no compile lock (_one_at_a_time)
+    fcntl = None
 
 #: seconds after which a top-level kernel's compilation is reported by name
 SLOW = 5.0
@@ -114,6 +122,44 @@ def _safe_load(load):
 
     load_overload.projeq_safe = True
     return load_overload
+
+
+def _one_at_a_time(compile):
+    """numba's ``Dispatcher.compile``, for a top-level projeq kernel under an exclusive lock on a file
+    beside its cache entries (``fcntl.flock``, released by the system if the process dies): a process
+    that finds another compiling the same kernel waits, and numba's compile then finds the entry the
+    other wrote and loads it (it looks in the disk cache before compiling); under :func:`cached_only` it
+    does not wait: :class:`NotCompiled`. Kernels compiled inside
+    another's compilation are not locked (a process holding a lock never waits for one: no deadlock);
+    without ``fcntl`` (Windows) or a disk cache, unchanged."""
+
+    @functools.wraps(compile)
+    def locked_compile(self, sig):
+        folder = getattr(self._cache, "_cache_path", None)
+        if fcntl is None or folder is None or getattr(_LOCKING, "held", False) or not _ours(self.py_func):
+            return compile(self, sig)
+        try:
+            os.makedirs(folder, exist_ok=True)
+            lock = open(os.path.join(folder, f"{self.py_func.__qualname__}.projeq-lock"), "a")  # noqa: SIM115
+        except OSError:  # a cache folder numba cannot lock: compile as numba does
+            return compile(self, sig)
+        with lock:
+            try:
+                fcntl.flock(lock, fcntl.LOCK_EX | (fcntl.LOCK_NB if getattr(_ANNOUNCER.deferring, "on", False) else 0))
+            except BlockingIOError:  # under cached_only: being compiled elsewhere is not cached yet
+                raise NotCompiled(self.py_func.__qualname__) from None
+            _LOCKING.held = True
+            try:
+                return compile(self, sig)
+            finally:
+                _LOCKING.held = False
+                fcntl.flock(lock, fcntl.LOCK_UN)
+
+    locked_compile.projeq_locked = True
+    return locked_compile
+
+
+_LOCKING = threading.local()  # .held: this thread compiles a top-level kernel under its lock
 
 
 @contextlib.contextmanager
@@ -197,8 +243,9 @@ def spend(seconds: float, what: str) -> None:
 
 @functools.cache
 def prepare() -> None:
-    """Install the compilation notice and the safe cache loading (once per process; needs numba)."""
-    from numba.core import caching, event
+    """Install the compilation notice, the safe cache loading and the compile lock (once per process;
+    needs numba)."""
+    from numba.core import caching, dispatcher, event
 
     class Listener(event.Listener):
         def on_start(self, found):
@@ -210,6 +257,8 @@ def prepare() -> None:
     event.register("numba:compile", Listener())
     if not getattr(caching.Cache.load_overload, "projeq_safe", False):
         caching.Cache.load_overload = _safe_load(caching.Cache.load_overload)
+    if not getattr(dispatcher.Dispatcher.compile, "projeq_locked", False):
+        dispatcher.Dispatcher.compile = _one_at_a_time(dispatcher.Dispatcher.compile)
 
 
 _ANNOUNCER = _Announcer()

@@ -9,6 +9,7 @@ not the minute of the tree kernels; the mechanism is the same for every projeq k
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -47,3 +48,30 @@ def test_first_compilation_is_announced_and_a_damaged_cache_is_rebuilt(tmp_path)
     assert "Traceback" not in damaged.stderr
     rebuilt = _run(tmp_path)
     assert rebuilt.returncode == 0 and rebuilt.stderr == "", rebuilt.stderr
+
+
+TOGETHER = '''import os, pathlib, time
+from projeq.assembly import kernels; kernels.numba_module()
+import projeq_generated_probe as m
+pathlib.Path(f"ready-{os.getpid()}").touch()
+while not pathlib.Path("go").exists():
+    time.sleep(0.002)
+print(m.twice(1.5))
+'''
+
+
+def test_processes_that_start_together_compile_a_kernel_once(tmp_path):
+    """Two processes on an empty cache call the kernel at the same moment: one compiles it (announced)
+    and the other waits for its lock and loads it from the cache (silent). Without the lock both
+    compiled, as a sweep's workers or the test suite's processes each compiled every kernel."""
+    (tmp_path / "projeq_generated_probe.py").write_text(KERNEL)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT)]))
+    runs = [subprocess.Popen([sys.executable, "-c", TOGETHER], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    deadline = time.monotonic() + 60
+    while len(list(tmp_path.glob("ready-*"))) < 2 and time.monotonic() < deadline and all(r.poll() is None for r in runs):
+        time.sleep(0.01)
+    (tmp_path / "go").touch()
+    outputs = [run.communicate(timeout=120) for run in runs]
+    assert [out.strip() for out, _ in outputs] == ["3.0", "3.0"], [err for _, err in outputs]
+    assert sum(err.count("projeq: compiling the compiled kernels") for _, err in outputs) == 1, outputs
