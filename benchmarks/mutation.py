@@ -70,13 +70,15 @@ BITWISE = ("_RShift", "_LShift", "_BitOr", "_BitAnd", "_BitXor")
 NOT_RUN = "no test that passes interpreted runs these lines"
 #: ``--compiled``: the test files that run a module's compiled-only code (numba's JIT on)
 COMPILED_TESTS = {
+    "projeq/assembly/fast.py": ("tests/assembly/test_fast.py",),
     "projeq/assembly/generated.py": ("tests/assembly/test_stated_loads.py", "tests/assembly/test_time_loads.py",
                                      "tests/assembly/test_given.py"),
     "projeq/assembly/given.py": ("tests/assembly/test_given.py",),
     "projeq/assembly/kernels.py": ("tests/assembly/test_fast_beams.py", "tests/assembly/test_fast_energy.py"),
     "projeq/constraints/compiled.py": ("tests/constraints/test_compiled_closures.py",
                                        "tests/constraints/test_compiled_pins.py",
-                                       "tests/constraints/test_compiled_pfaffian.py"),
+                                       "tests/constraints/test_compiled_pfaffian.py",
+                                       "tests/simulation/test_output_rows.py"),
     "projeq/subsystems/beam/beam.py": ("tests/subsystems/test_beam_bad_input.py",),
     "projeq/subsystems/beam/slice_chain.py": ("tests/subsystems/test_beam_slice_chain.py",),
 }
