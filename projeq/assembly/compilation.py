@@ -141,13 +141,15 @@ def _one_at_a_time(compile):
         try:
             os.makedirs(folder, exist_ok=True)
             lock = open(os.path.join(folder, f"{self.py_func.__qualname__}.projeq-lock"), "a")  # noqa: SIM115
-        except OSError:  # a cache folder numba cannot lock: compile as numba does
+        except OSError:  # no file can be made in the cache folder: compile as numba does
             return compile(self, sig)
         with lock:
             try:
                 fcntl.flock(lock, fcntl.LOCK_EX | (fcntl.LOCK_NB if getattr(_ANNOUNCER.deferring, "on", False) else 0))
             except BlockingIOError:  # under cached_only: being compiled elsewhere is not cached yet
                 raise NotCompiled(self.py_func.__qualname__) from None
+            except OSError:  # a file system without locks (some network ones): compile as numba does
+                return compile(self, sig)
             _LOCKING.held = True
             try:
                 return compile(self, sig)
