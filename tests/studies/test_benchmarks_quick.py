@@ -64,6 +64,7 @@ PRINTS = {
     "closures.py": ("default/chain", "four_bar", "andrews_squeezer"),
     "cold_start.py": ("projeq run --t-end 1", "default", "exit codes"),
     "code_size.py": ("compiled path:", "interpreted path:", "ratio compiled / interpreted"),
+    "compile_lock.py": ("CPU s (both)", "without", "CPU with / without the lock"),
     "compiled_jacobians.py": ("forward diff.", "chain(10)", "spin-up beam", "per column / one call"),
     "default_integrator.py": ("StiffnessWarning", "spin_up_beam", "Radau", "BDF"),
     "derivation.py": ("projeq_s", "lagrange_s"),
