@@ -1,10 +1,11 @@
 """Cut joints (PinClosure) in the compiled closure kernels (projeq.constraints.compiled: A_s rows from
-the chain's body Jacobians, γ from the points' accelerations at s̈ = 0), checked against independent
-statements: the numpy path of the same model (Φ's complex-step derivatives, numpy's linear algebra on
-the dense Gauss form, docs/theory.md §7); the four-bar's loop closure differentiated by sympy and the
-KKT system [M A_sᵀ; A_s 0] solved by numpy; the work–energy theorem (the cut joints' forces do no
-work, so a conservative mechanism keeps dE/dt = 0); and the refusal of a ``phi`` list that is not
-made of one tree's cut joints. The models: planar four-bars (partitioned and tangent, with force
+the chain's body Jacobians, γ from the points' accelerations at s̈ = 0), checked against: the numpy path
+of the same model (numpy's linear algebra on the dense Gauss form, docs/theory.md §7; a PinClosure's
+rows Φ, A_s and γ there are the kernels' own ``cut_joint_rows``, so this checks the kernels' algebra,
+not the rows); the rows against independent statements: the four-bar's loop closure differentiated by
+sympy and the KKT system [M A_sᵀ; A_s 0] solved by numpy, and the work–energy theorem (the cut joints'
+forces do no work, so a conservative mechanism keeps dE/dt = 0); and the refusal of a ``phi`` list that
+is not made of one tree's cut joints. The models: planar four-bars (partitioned and tangent, with force
 laws, on a sympy UserJoint), a rod pinned to the ground, two loops on one crank, and a spatial loop
 on skew axes whose terms the planar ones cannot see (ω̇ at s̈ = 0, ζ̄ carried down a chain, z
 components)."""
@@ -215,8 +216,9 @@ def test_the_kernels_two_column_null_space_basis_is_the_numpy_paths():
     """The four-bar pinned along x alone: one row, mobility 2, the only model here whose null-space
     basis F has two columns (a mutant of F's off-diagonal entries survived the other models, issue
     37, item 8). The tangent kernel's own source, run interpreted (compiled, this model would be a
-    specialization of its own, 27 s of compilation), against the numpy path at three projected
-    states: measured s̈_tree 9.8e-15 and λ 2.5e-14 relative, bound 1e-13 as above."""
+    specialization of its own, 27 s of compilation), against the numpy path (the same rows, numpy's SVD
+    and F) at three projected states: measured s̈_tree 9.8e-15 and λ 2.5e-14 relative, bound 1e-13 as
+    above."""
     system = four_bar(kind=TangentSystem, axes="x")
     assert system.n_s == 2
     kernel = CompiledClosure(system.tree, system.n_c, system._phi, "tangent", (ACTING,), compiled=False,
