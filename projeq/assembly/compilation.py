@@ -129,9 +129,10 @@ def _one_at_a_time(compile):
     beside its cache entries (``fcntl.flock``, released by the system if the process dies): a process
     that finds another compiling the same kernel waits, and numba's compile then finds the entry the
     other wrote and loads it (it looks in the disk cache before compiling); under :func:`cached_only` it
-    does not wait: :class:`NotCompiled`. Kernels compiled inside
-    another's compilation are not locked (a process holding a lock never waits for one: no deadlock);
-    without ``fcntl`` (Windows) or a disk cache, unchanged."""
+    does not wait: :class:`NotCompiled`; a stopped or hung holder is waited for :data:`LOCK_WAIT` seconds
+    at most (:func:`_acquired`). Kernels compiled inside another's compilation are not locked (a process
+    holding a lock never waits for one: no deadlock); without ``fcntl`` (Windows) or a disk cache,
+    unchanged."""
 
     @functools.wraps(compile)
     def locked_compile(self, sig):
@@ -145,9 +146,8 @@ def _one_at_a_time(compile):
             return compile(self, sig)
         with lock:
             try:
-                fcntl.flock(lock, fcntl.LOCK_EX | (fcntl.LOCK_NB if getattr(_ANNOUNCER.deferring, "on", False) else 0))
-            except BlockingIOError:  # under cached_only: being compiled elsewhere is not cached yet
-                raise NotCompiled(self.py_func.__qualname__) from None
+                if not _acquired(lock, self.py_func.__qualname__):
+                    return compile(self, sig)
             except OSError:  # a file system without locks (some network ones): compile as numba does
                 return compile(self, sig)
             _LOCKING.held = True
@@ -162,6 +162,39 @@ def _one_at_a_time(compile):
 
 
 _LOCKING = threading.local()  # .held: this thread compiles a top-level kernel under its lock
+
+#: seconds a process waits for another that compiles the same kernel, then compiles it itself (the other
+#: may be stopped or hung; the longest of projeq's compilations takes about 3 minutes on a slow machine)
+LOCK_WAIT = 600.0
+_WAITED = threading.Event()  # set once this process has said that it waits for another's compilation
+
+
+def _acquired(lock, name: str) -> bool:
+    """Whether this process holds ``lock`` (the compile lock of kernel ``name``): at once, or after waiting
+    for the process that holds it (said once per process on standard error) up to :data:`LOCK_WAIT`
+    seconds (False: compile without it, said). Under :func:`cached_only`, a held lock is
+    :class:`NotCompiled` (being compiled elsewhere is not cached yet)."""
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return True
+    except BlockingIOError:
+        if getattr(_ANNOUNCER.deferring, "on", False):
+            raise NotCompiled(name) from None
+    if not _WAITED.is_set():
+        _WAITED.set()
+        print(f"projeq: another process is compiling {name}; waiting for it, then loading it from numba's cache",
+              file=sys.stderr, flush=True)
+    deadline = time.monotonic() + LOCK_WAIT
+    while time.monotonic() < deadline:
+        time.sleep(0.05)
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return True
+        except BlockingIOError:
+            continue
+    print(f"projeq: waited {LOCK_WAIT:.0f} s for another process compiling {name}; compiling it here",
+          file=sys.stderr, flush=True)
+    return False
 
 
 @contextlib.contextmanager

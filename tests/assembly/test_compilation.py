@@ -64,6 +64,7 @@ def test_processes_that_start_together_compile_a_kernel_once(tmp_path):
     """Two processes on an empty cache call the kernel at the same moment: one compiles it (announced)
     and the other waits for its lock and loads it from the cache (silent). Without the lock both
     compiled, as a sweep's workers or the test suite's processes each compiled every kernel."""
+    pytest.importorskip("fcntl")  # POSIX: the lock is fcntl.flock
     (tmp_path / "projeq_generated_probe.py").write_text(KERNEL)
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT)]))
     runs = [subprocess.Popen([sys.executable, "-c", TOGETHER], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
@@ -75,3 +76,25 @@ def test_processes_that_start_together_compile_a_kernel_once(tmp_path):
     outputs = [run.communicate(timeout=120) for run in runs]
     assert [out.strip() for out, _ in outputs] == ["3.0", "3.0"], [err for _, err in outputs]
     assert sum(err.count("projeq: compiling the compiled kernels") for _, err in outputs) == 1, outputs
+
+
+def test_a_process_holding_the_lock_too_long_is_not_waited_for_forever(tmp_path):
+    """A process that holds a kernel's compile lock and does not finish (stopped, hung: here this test
+    holds it) is waited for LOCK_WAIT seconds (1 s here), saying so, then the kernel is compiled
+    without it: the run goes on, it never hangs."""
+    fcntl = pytest.importorskip("fcntl")  # POSIX: the lock is fcntl.flock
+    (tmp_path / "projeq_generated_probe.py").write_text(KERNEL)
+    assert _run(tmp_path).returncode == 0  # compiled once: the lock file exists beside the cache entries
+    (lock_file,) = (tmp_path / "cache").rglob("*.projeq-lock")
+    for path in (tmp_path / "cache").rglob("*"):
+        if path.suffix in (".nbi", ".nbc"):
+            path.unlink()  # not cached any more: the next process must compile
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT)]))
+    with open(lock_file, "a") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)
+        found = subprocess.run([sys.executable, "-c", "from projeq.assembly import compilation; compilation.LOCK_WAIT = 1.0; "
+                                + RUN], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    assert found.returncode == 0 and found.stdout.strip() == "3.0", found.stderr
+    assert "projeq: another process is compiling twice; waiting for it" in found.stderr
+    assert "projeq: waited 1 s for another process compiling twice; compiling it here" in found.stderr
+    assert "projeq: compiling the compiled kernels" in found.stderr
