@@ -26,9 +26,14 @@ def twice(x):
 RUN = "from projeq.assembly import kernels; kernels.numba_module(); import projeq_generated_probe as m; print(m.twice(1.5))"
 
 
-def _run(folder: Path) -> subprocess.CompletedProcess:
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(folder / "cache"), PYTHONPATH=os.pathsep.join([str(folder), str(ROOT)]))
-    return subprocess.run([sys.executable, "-c", RUN], cwd=folder, env=env, capture_output=True, text=True, timeout=120)
+def _environment(folder: Path) -> dict:
+    """numba's cache in ``folder``/cache; the probe module in ``folder`` and this checkout's projeq importable."""
+    return dict(os.environ, NUMBA_CACHE_DIR=str(folder / "cache"), PYTHONPATH=os.pathsep.join([str(folder), str(ROOT)]))
+
+
+def _run(folder: Path, prelude: str = "") -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", prelude + RUN], cwd=folder, env=_environment(folder),
+                          capture_output=True, text=True, timeout=120, check=False)
 
 
 def test_first_compilation_is_announced_and_a_damaged_cache_is_rebuilt(tmp_path):
@@ -66,8 +71,7 @@ def test_processes_that_start_together_compile_a_kernel_once(tmp_path):
     compiled, as a sweep's workers or the test suite's processes each compiled every kernel."""
     pytest.importorskip("fcntl")  # POSIX: the lock is fcntl.flock
     (tmp_path / "projeq_generated_probe.py").write_text(KERNEL)
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT)]))
-    runs = [subprocess.Popen([sys.executable, "-c", TOGETHER], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
+    runs = [subprocess.Popen([sys.executable, "-c", TOGETHER], cwd=tmp_path, env=_environment(tmp_path), stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
     deadline = time.monotonic() + 60
     while len(list(tmp_path.glob("ready-*"))) < 2 and time.monotonic() < deadline and all(r.poll() is None for r in runs):
@@ -89,11 +93,9 @@ def test_a_process_holding_the_lock_too_long_is_not_waited_for_forever(tmp_path)
     for path in (tmp_path / "cache").rglob("*"):
         if path.suffix in (".nbi", ".nbc"):
             path.unlink()  # not cached any more: the next process must compile
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT)]))
     with open(lock_file, "a") as held:
         fcntl.flock(held, fcntl.LOCK_EX)
-        found = subprocess.run([sys.executable, "-c", "from projeq.assembly import compilation; compilation.LOCK_WAIT = 1.0; "
-                                + RUN], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+        found = _run(tmp_path, "from projeq.assembly import compilation; compilation.LOCK_WAIT = 1.0; ")
     assert found.returncode == 0 and found.stdout.strip() == "3.0", found.stderr
     assert "projeq: another process is compiling twice; waiting for it" in found.stderr
     assert "projeq: waited 1 s for another process compiling twice; compiling it here" in found.stderr
