@@ -174,27 +174,26 @@ def _acquired(lock, name: str) -> bool:
     for the process that holds it (said once per process on standard error) up to :data:`LOCK_WAIT`
     seconds (False: compile without it, said). Under :func:`cached_only`, a held lock is
     :class:`NotCompiled` (being compiled elsewhere is not cached yet)."""
-    try:
-        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        return True
-    except BlockingIOError:
-        if getattr(_ANNOUNCER.deferring, "on", False):
-            raise NotCompiled(name) from None
-    if not _WAITED.is_set():
-        _WAITED.set()
-        print(f"projeq: another process is compiling {name}; waiting for it, then loading it from numba's cache",
-              file=sys.stderr, flush=True)
-    deadline = time.monotonic() + LOCK_WAIT
-    while time.monotonic() < deadline:
-        time.sleep(0.05)
+    deadline = None  # of the wait, once it has begun
+    while True:
         try:
             fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
             return True
         except BlockingIOError:
-            continue
-    print(f"projeq: waited {LOCK_WAIT:.0f} s for another process compiling {name}; compiling it here",
-          file=sys.stderr, flush=True)
-    return False
+            pass
+        if getattr(_ANNOUNCER.deferring, "on", False):
+            raise NotCompiled(name)
+        if deadline is None:
+            deadline = time.monotonic() + LOCK_WAIT
+            if not _WAITED.is_set():
+                _WAITED.set()
+                print(f"projeq: another process is compiling {name}; waiting for it, then loading it from numba's "
+                      "cache", file=sys.stderr, flush=True)
+        elif time.monotonic() > deadline:
+            print(f"projeq: waited {LOCK_WAIT:.0f} s for another process compiling {name}; compiling it here",
+                  file=sys.stderr, flush=True)
+            return False
+        time.sleep(0.05)
 
 
 @contextlib.contextmanager
