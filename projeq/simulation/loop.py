@@ -53,6 +53,9 @@ METHODS = (*EXPLICIT, "Radau")
 #: scipy's step-size control constants (``scipy.integrate._ivp.rk``)
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 
+#: failed stages in a row an explicit step retries (h × 0.2 each: 0.2⁸ ≈ 2.6e-6) before the segment ends there
+STAGE_RETRIES = 8
+
 #: what a compiled segment ended with (STOPPED: the monitor raised where the segment paused; MODEL_EVENT: the
 #: model's own terminal event, located where it fired)
 FINISHED, TOO_SMALL_STEP, EVALUATION_FAILED, PAUSED, STOPPED, MODEL_EVENT = 0, 1, 2, 3, 4, 5
@@ -67,8 +70,9 @@ class Stepped(NamedTuple):
     """What :meth:`CompiledLoop.run` did: how it ended (``status``), the time ``t`` and ``state`` reached (on
     EVALUATION_FAILED, of the last accepted step), the ``rows`` at the output times passed, the state
     and time where an evaluation failed (``x_failed``, ``t_failed``), the evaluations and steps taken,
-    the next step size, the monitor's exception (status STOPPED) and the Jacobians formed (Radau; their
-    n_x evaluations each counted in nfev)."""
+    the next step size, the monitor's exception (status STOPPED), the Jacobians formed (Radau; their
+    n_x evaluations each counted in nfev) and, where it paused past ``t_pause``, what the next run
+    takes to go on with the same steps (:class:`Carried`)."""
 
     status: int
     t: float
@@ -81,6 +85,20 @@ class Stepped(NamedTuple):
     h_abs: float
     stopped_by: Exception | None
     njev: int = 0
+    carried: Carried | None = None
+
+
+class Carried(NamedTuple):
+    """Where a run paused past ``t_pause`` (:meth:`CompiledLoop.run`), what the next run from there keeps:
+    the time and state it paused at, ẋ there, the next step size, the method's data (Radau's memory:
+    ∂ẋ/∂x, its factorisations, the last step's interpolant) and the model event's value."""
+
+    t: float
+    state: NDArray
+    rate: NDArray
+    h_abs: float
+    method: tuple
+    event: tuple
 
 
 @functools.cache
@@ -239,21 +257,24 @@ def _dense_rows(method, K, t_old, h, y_old, y, f_new, t_eval, first, last, rows,
             rows[r, i] = value + y_old[i]
 
 
-def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step, rtol, atol, pause, t_eval, first_row,
-            rows, state, rate, x_failed, event):
+def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step, rtol, atol, pause, t_pause, retries,
+            t_eval, first_row, rows, state, rate, x_failed, event):
     """Steps from (t, state) towards t_bound by the explicit method ``method`` (:func:`tableau`) on the ẋ
     kernel f (``f(*pre, t, *tree, x, n_q, *post, x_dot)``, −1 or a failure index), with ``rate`` its ẋ
     there where ``known`` (else evaluated); h_abs > 0 the next step (else HNW's first step). Writes
     the rows at the output times t_eval[first_row:] (increasing, inside [t, t_bound]) into rows, and
-    leaves in state and rate the state and ẋ where it stopped. Returns (status, rows written,
-    evaluations, steps, time reached, next step size, time of x_failed), the status FINISHED; PAUSED after the first
-    step that brings the evaluations to ``pause`` (> 0; the caller checks the state and goes on with
-    ``known`` True: the same steps as without the pause); TOO_SMALL_STEP (scipy's failure: the step
-    size fell below the spacing of the numbers near t); or EVALUATION_FAILED, the state evaluated in
-    x_failed (the caller's checked evaluation names why), the state and time reached those of the last
-    accepted step (the caller may go on from there); or MODEL_EVENT: the model's own terminal event
-    ``event`` (:func:`_event_fired`) located inside the last step, the state and time reached its root's,
-    the rows up to it written."""
+    leaves in state and rate the state and ẋ where it stopped. A step with a stage the kernel cannot
+    evaluate (a trial state far off: a step past a stiff mode's stability limit) is rejected as one of
+    infinite error (h × 0.2), ``retries`` times in a row at most. Returns (status, rows written,
+    evaluations, steps, time reached, next step size, time of x_failed), the status FINISHED; PAUSED
+    after the first step that brings the evaluations to ``pause`` (> 0), or after the first step that
+    reaches ``t_pause`` (the end of a segment of :func:`projeq.simulate`; the caller checks the state and
+    goes on with ``known`` True: the same steps as without the pause); TOO_SMALL_STEP (scipy's failure:
+    the step size fell below the spacing of the numbers near t); or EVALUATION_FAILED (a stage failed
+    more than ``retries`` times in a row), the state evaluated in x_failed (the caller's checked
+    evaluation names why), the state and time reached those of the last accepted step (the caller may
+    go on from there); or MODEL_EVENT: the model's own terminal event ``event`` (:func:`_event_fired`)
+    located inside the last step, the state and time reached its root's, the rows up to it written."""
     dop853, A, B, C, E, E3, dense, n_stages, exponent = method
     n = state.shape[0]
     K = np.empty((max(A.shape[0], n_stages + 1), n))
@@ -276,22 +297,30 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
     while t != t_bound:
         min_step = 10 * abs(np.nextafter(t, np.inf) - t)
         h_abs = max_step if h_abs > max_step else (min_step if h_abs < min_step else h_abs)
-        accepted, rejected = False, False
+        accepted, rejected, failures, t_failed = False, False, 0, t
         while not accepted:
-            if h_abs < min_step:
+            if h_abs < min_step:  # (where a stage failed, it is the cause: named by the caller)
                 _copy(y, state)
-                return TOO_SMALL_STEP, n_rows, nfev, steps, t, h_abs, t
+                return (EVALUATION_FAILED if failures else TOO_SMALL_STEP), n_rows, nfev, steps, t, h_abs, t_failed
             t_new, h, h_abs = _step_to(t, h_abs, t_bound)
             _copy(rate, K[0])
-            for s in range(1, n_stages):
+            stage_failed = False
+            for s in range(1, n_stages + 1):
                 nfev += 1
-                if _stage(f, pre, tree, post, n_q, K, A[s], s, h, t + C[s] * h, y, work[1], x_failed):
+                last = s == n_stages  # the stage at the step's end, of weights B
+                t_failed = t + h if last else t + C[s] * h
+                if _stage(f, pre, tree, post, n_q, K, B if last else A[s], s, h, t_failed, y,
+                          y_new if last else work[1], x_failed):
+                    stage_failed = True
+                    break
+            if stage_failed:  # rejected as a step of infinite error, or the run stops where it keeps failing
+                failures += 1
+                if failures > retries:
                     _copy(y, state)
-                    return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t + C[s] * h
-            nfev += 1
-            if _stage(f, pre, tree, post, n_q, K, B, n_stages, h, t + h, y, y_new, x_failed):
-                _copy(y, state)
-                return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t + h
+                    return EVALUATION_FAILED, n_rows, nfev, steps, t, h_abs, t_failed
+                h_abs *= MIN_FACTOR
+                rejected = True
+                continue
             scale = work[0]
             for i in range(n):
                 scale[i] = atol + max(abs(y[i]), abs(y_new[i])) * rtol
@@ -331,7 +360,7 @@ def segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step,
         t = t_new
         y, y_new = y_new, y
         _copy(K[n_stages], rate)
-        if pause > 0 and nfev >= pause and t != t_bound:
+        if (pause > 0 and nfev >= pause or t >= t_pause) and t != t_bound:
             _copy(y, state)
             return PAUSED, n_rows, nfev, steps, t, h_abs, t
     _copy(y, state)
@@ -590,7 +619,7 @@ def _interpolated(Q, t_old, step, y_old, time, out):
 
 
 def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step, rtol, atol, pause,
-                  t_eval, first_row, rows, state, rate, x_failed, event):
+                  t_pause, retries, t_eval, first_row, rows, state, rate, x_failed, event):
     """:func:`segment` by scipy's Radau IIA of order 5 (``scipy.integrate.Radau._step_impl``, step by
     step): ``method`` = (:func:`radau_tableau`, :func:`radau_memory`), the memory kept over pauses.
     Each step solves the collocation system by :func:`_collocation`; a step whose Newton iteration
@@ -600,7 +629,8 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
     (2 k_max + iterations)); the step size is kept (and the factorisation reused) when it would grow by
     less than 1.2; J is formed again (:func:`_jacobian`, n evaluations) when the Newton iteration took
     more than two iterations at a rate above 10⁻³. The first step: HNW's starting-step algorithm for
-    order 3; the stage guess: the last step's collocation polynomial extrapolated."""
+    order 3; the stage guess: the last step's collocation polynomial extrapolated. ``retries`` is the
+    explicit methods' (:func:`segment`); here a failed evaluation ends the segment."""
     radau, memory = method
     C, E, _, _, P, mu_real, mu_complex = radau
     J, real, complex_, Q, y_old, scalars = memory
@@ -738,7 +768,7 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
         t = t_new
         y, y_new = y_new, y
         _copy(f_new, rate)
-        if pause > 0 and nfev >= pause and t != t_bound:
+        if (pause > 0 and nfev >= pause or t >= t_pause) and t != t_bound:
             _copy(y, state)
             return PAUSED, n_rows, nfev, steps, t, h_abs, t
     _copy(y, state)
@@ -776,33 +806,48 @@ class CompiledLoop:
         self.kernel, self.compiled = _specialised(model, method)
 
     def run(self, n_q: int, t: float, x: NDArray, t_bound: float, h_abs: float, max_step: float, rtol: float,
-            atol: float, t_eval: NDArray, monitor=None, every: int = 0) -> Stepped:
-        """One segment from (t, x) to t_bound; ``monitor(t, x)`` called after the first step past each
-        ``every`` evaluations (``every`` > 0), as :func:`segment` pauses: where it raises, the segment
-        ends there (status STOPPED) with the rows computed so far."""
+            atol: float, t_eval: NDArray, monitor=None, every: int = 0, t_pause: float = np.inf,
+            carried: Carried | None = None) -> Stepped:
+        """One segment from (t, x) to t_bound, or to the end of the first step that reaches ``t_pause``
+        (status PAUSED, with ``Stepped.carried``); ``monitor(t, x)`` called after the first step past each
+        ``every`` evaluations (``every`` > 0), as :func:`segment` pauses: where it raises, the segment ends
+        there (status STOPPED) with the rows computed so far. With ``carried`` (the last run's, paused at
+        t) the run goes on with the steps one run without the pause would take: its step size, Radau's
+        memory and the event's value kept, and ẋ too where x is the state it paused at (not where the
+        caller normalised it: then ẋ is evaluated again)."""
         t_eval, state = np.ascontiguousarray(t_eval, dtype=float).ravel(), np.array(x, dtype=float).ravel()
-        rows, rate, x_failed = np.empty((len(t_eval), len(state))), np.empty(len(state)), np.empty(len(state))
-        status, n_rows, nfev, steps, known, stopped_by = PAUSED, 0, 0, 0, False, None
-        model, method = self.model, self.method
-        if self.implicit:  # a fresh Radau run: its Jacobian formed at t (solve_ivp's, too, per segment)
-            method = (method, radau_memory(len(state)))
-        event = (model.event[0], float(model.event[1]), np.zeros(1))  # (value, limit, g kept over pauses)
+        rows, x_failed = np.empty((len(t_eval), len(state))), np.empty(len(state))
+        status, n_rows, nfev, steps, stopped_by = PAUSED, 0, 0, 0, None
+        model = self.model
+        if carried is not None and carried.t == t and carried.state.shape == state.shape:
+            known, rate, h_abs = bool(np.array_equal(carried.state, state)), carried.rate, carried.h_abs
+            method, event = carried.method, carried.event
+        else:  # a fresh run (Radau: its Jacobian formed at t, as solve_ivp's per segment)
+            known, rate, method = False, np.empty(len(state)), self.method
+            if self.implicit:
+                method = (method, radau_memory(len(state)))
+            event = (model.event[0], float(model.event[1]), np.zeros(1))  # (value, limit, g kept over pauses)
+        njev = int(method[1][-1][RADAU_NJEV]) if self.implicit else 0  # (a carried memory's count so far)
+        retries = 0 if self.implicit or model.checks_events else STAGE_RETRIES  # a closed loop's kernel fails on purpose
         if model.before is not None:
             model.before()
         while status == PAUSED:
             with _signals_held():  # the arguments of the types compiled for (the entry point checks none)
                 status, n_rows, more, taken, t, h_abs, t_failed = self.compiled(
                     self.kernel, model.pre, model.tree, model.post, int(n_q), method, float(t), float(t_bound),
-                    known, float(h_abs), float(max_step), float(rtol), float(atol), int(every), t_eval, n_rows, rows,
-                    state, rate, x_failed, event)
+                    known, float(h_abs), float(max_step), float(rtol), float(atol), int(every), float(t_pause),
+                    retries, t_eval, n_rows, rows, state, rate, x_failed, event)
             nfev, steps, known = nfev + more, steps + taken, True
+            if status == PAUSED and t >= t_pause:
+                break
             if status == PAUSED:
                 try:
                     monitor(t, state)
                 except Exception as exc:  # noqa: BLE001 - the caller raises it, keeping the rows
                     status, stopped_by = STOPPED, exc
-        njev = int(method[1][-1][RADAU_NJEV]) if self.implicit else 0
-        return Stepped(status, t, rows[:n_rows], state, x_failed, t_failed, nfev, steps, h_abs, stopped_by, njev)
+        njev = int(method[1][-1][RADAU_NJEV]) - njev if self.implicit else 0
+        carry = Carried(t, state.copy(), rate, h_abs, method, event) if status == PAUSED else None
+        return Stepped(status, t, rows[:n_rows], state, x_failed, t_failed, nfev, steps, h_abs, stopped_by, njev, carry)
 
 
 def _layout(value):
@@ -835,7 +880,7 @@ def _specialised(model, method: str) -> tuple:
         implicit = method not in EXPLICIT
         data = (radau_tableau(), radau_memory(1)) if implicit else tableau(method)
         compiled = _compiled(tuple(numba.typeof(a) for a in (
-            kernel, model.pre, model.tree, model.post, 0, data, 0.0, 0.0, True, 0.0, 0.0, 0.0, 0.0, 0,
+            kernel, model.pre, model.tree, model.post, 0, data, 0.0, 0.0, True, 0.0, 0.0, 0.0, 0.0, 0, 0.0, 0,
             np.zeros(1), 0, np.zeros((1, 1)), np.zeros(1), np.zeros(1), np.zeros(1),
             (np.zeros(1), 0.0, np.zeros(1)))), implicit)
         _SPECIALISED[key] = kernel, compiled.overloads[compiled.signatures[0]].entry_point

@@ -4,6 +4,7 @@ a file, ParaView files of a saved run."""
 
 import csv
 import json
+import re
 
 import numpy as np
 import pytest
@@ -60,8 +61,8 @@ def test_the_summary_names_the_state_and_says_why_energy_changes(tmp_path, capsy
     w amplitudes (the spin is about the beam's normal, it bends in v only) left out and
     counted, and the energy caveat; the double pendulum (conservative) has no caveat. run.json
     reports the spin-up's energy as not conserved (no drift figure: the hub's drive changes E by
-    its work) with its change, the pendulum's drift as a number (over 0.05 s: measured 6.2e-14,
-    bound 6e-13)."""
+    its work) with its change, the pendulum's drift as a number (over 0.05 s at rtol 1e-8: measured
+    9.8e-12, bound 9.8e-11; 6.2e-14 while the steps were cut at the 20 segments' ends, 2.5 ms apart)."""
     assert main(["run", "spin_up_beam", "--t-end", "0.05", "--out", str(tmp_path / "beam")]) == 0
     out = capsys.readouterr().out
     assert "final q: beam.v[0] = " in out and "beam.w[0]" not in out and "(4 zero throughout: not shown)" in out
@@ -73,7 +74,7 @@ def test_the_summary_names_the_state_and_says_why_energy_changes(tmp_path, capsy
     assert main(["run", "double_pendulum", "--t-end", "0.05", "--out", str(tmp_path / "dp")]) == 0
     assert "not conserved" not in capsys.readouterr().out
     energy = json.loads((run_folder(tmp_path / "dp") / "run.json").read_text())["energy"]
-    assert energy["conserved"] is True and 0.0 <= energy["drift"] < 6e-13, energy
+    assert energy["conserved"] is True and 0.0 <= energy["drift"] < 9.8e-11, energy
 
 
 def test_list_describes_a_scenes_parameters(capsys):
@@ -238,8 +239,8 @@ def test_run_uses_the_scenes_settings_then_simulates_defaults(tmp_path, capsys):
 
 def test_a_run_out_of_range_exits_3_and_records_every_warning(tmp_path, capsys):
     """Passes if `projeq run spin_up_beam --set omega_s=200 --set t_s=2 --t-end 3 --json` (issue 37:
-    exit 0, "finished", q ≈ 1e88 m, energy NaN) stops at t = 0.3 s, where the beam's tip passes its
-    moderate-deflection range, with exit code 3, status "out of range" in run.json and the NPZ,
+    exit 0, "finished", q ≈ 1e88 m, energy NaN) stops at the end of the step past t = 0.3 s (0.309 s),
+    where the beam's tip has passed its moderate-deflection range, with exit code 3, status "out of range" in run.json and the NPZ,
     the ValidityWarning in run.json's warnings, and every warning on stderr as one line
     "projeq run: <Category>: <message>" (no Python source lines)."""
     argv = ["run", "spin_up_beam", "--set", "omega_s=200", "--set", "t_s=2", "--t-end", "3", "--json",
@@ -248,13 +249,14 @@ def test_a_run_out_of_range_exits_3_and_records_every_warning(tmp_path, capsys):
     said = capsys.readouterr()
     record = json.loads((run_folder(tmp_path) / "run.json").read_text())
     assert json.loads(said.out)["status"] == record["status"] == "out of range" and record["exit_code"] == 3
-    assert record["t_reached"] == pytest.approx(0.3) and np.isfinite(record["energy"]["final"])
+    assert 0.3 <= record["t_reached"] < 0.31 and np.isfinite(record["energy"]["final"])
     validity = [w for w in record["warnings"] if w["category"] == "ValidityWarning"]
-    assert len(validity) == 1 and validity[0]["message"].startswith("'beam' by t = 0.3 s: lateral deflection 0.33")
+    assert len(validity) == 1 and re.match(r"'beam' by t = 0\.30\d* s: lateral deflection 0\.3\d* L", validity[0]["message"])
     lines = said.err.splitlines()
     assert [line for line in lines if line.startswith("projeq run: ")] == [f"projeq run: {w['category']}: {w['message']}"
                                                              for w in record["warnings"]]
-    assert "projeq: stopped at t = 0.3 s: a subsystem left the range" in said.err and "warnings.warn" not in said.err
+    assert re.search(r"projeq: stopped at t = 0\.30\d* s: a subsystem left the range", said.err)
+    assert "warnings.warn" not in said.err
     assert pq.Result.load(run_folder(tmp_path) / "spin_up_beam.npz").status == 3
 
 
