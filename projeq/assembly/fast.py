@@ -28,7 +28,8 @@ such joint has them (:mod:`projeq.assembly.given`: UserJoints from sympy, Planar
 Prescribed motions in sympy or as callables numba compiles), else by its own
 ``relative_values``. Coupled joints (gears, ropes: shared minimal velocities) are evaluated in
 every joint's own velocities ṡ_all = P ṡ and projected, M = Pᵀ M_all P, b = Pᵀ b_all (B(14)
-with ∂ṡ_all/∂ṡ = P), by the compiled Gauss form. Under gravity and any force laws: between the compiled kinematics and the compiled passes
+with ∂ṡ_all/∂ṡ = P), by the compiled Gauss form.
+Under gravity and any force laws: between the compiled kinematics and the compiled passes
 the laws add their loads to the kernel's h_n — those with constant loads or stated terms
 (every law of :mod:`projeq.forces` without a callable load) in compiled code, by the
 statement their ``add_to`` calls (:mod:`projeq.assembly.loads`); any other (a callable
@@ -148,8 +149,8 @@ class FastEvaluator:
         # callbacks, given.py): without joints of kind GIVEN every joint has q̇ = ṡ (K = E)
         self._given_motions = given.motions_kernel() if self._given and not self._python_joints and self.compiled \
             else None
-        self.interpreted = [f"joint {system.names[n]!r} ({type(system.joints[n]).__name__}{f': {why}' if why else ''})"
-                            for n, why in zip(self._python_joints, self._python_joint_why)] \
+        self.interpreted = [f"joint {system.names[n]!r} ({type(system.joints[n]).__name__}"
+                            f"{f': {why}' if why else ''})" for n, why in zip(self._python_joints, self._python_joint_why)] \
             + [f"force law {type(law).__name__} ({why})"
                for law, why in zip(self._python_laws, self._python_why)]
         if self.interpreted and self.compiled:
