@@ -10,6 +10,7 @@ contract.
 
 from __future__ import annotations
 
+import functools
 import math
 
 from typing import Callable, NamedTuple
@@ -396,13 +397,22 @@ def moved_row(joint: Prescribed):
     :func:`projeq.joints.user_compiler.row_expressions`) with θ(t) and its rates as arguments, printed
     as scalar numpy code (:func:`projeq.symbolic.codegen.numeric_function`): the inner joint's
     kinematics at a function θ(t) (:meth:`Prescribed.symbolic_relative`), ζ = ḟ derived, then θ̈, θ̇,
-    θ put in for d²θ/dt², dθ/dt and θ(t)."""
+    θ put in for d²θ/dt², dθ/dt and θ(t); printed once per kinematics in a process (a scene built
+    again, a sweep of its motion's numbers)."""
+    t = sp.Symbol("t")
+    form = joint.symbolic_relative([], [], t, sp.Function("theta")(t))
+    return _printed_row(*(sp.ImmutableMatrix(e) for e in form))
+
+
+@functools.lru_cache(maxsize=64)
+def _printed_row(A, r, F, f, K, k):
+    """:func:`moved_row` of the sympy form (A, r, F, f, K, k) at θ(t)."""
     from projeq.joints.user_compiler import joint_symbols, row_expressions
     from projeq.symbolic import codegen
 
     t, angles = sp.Symbol("t"), sp.symbols("theta theta_dot theta_ddot")
     theta = sp.Function("theta")(t)
-    symbols = joint_symbols((), (), t, *joint.symbolic_relative([], [], t, theta))
+    symbols = joint_symbols((), (), t, A, r, F, f, K, k)
     rates = {theta.diff(t, 2): angles[2], theta.diff(t): angles[1], theta: angles[0]}
     expressions = [e.xreplace(rates) for e in row_expressions(symbols)]
     return codegen.numeric_function("moved_row", [(str(a), a) for a in angles], expressions)()
