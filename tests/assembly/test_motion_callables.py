@@ -93,7 +93,7 @@ def _python_pieces(motion) -> tuple:
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         ev = system.evaluator()
-    for t, q, s_dot in _states():  # the joint in Python: still the reference's s̈, measured 0, bound 100 ε
+    for t, q, s_dot in _states():  # the joint in Python: the reference's s̈, measured ≤ 8.2e-16, bound 100 ε
         reference = system.accelerations(q, s_dot, t, method="recursive")
         error = np.abs(ev.accelerations(q, s_dot, t) - reference).max()
         assert error <= 100 * np.finfo(float).eps * (1 + np.abs(reference).max()), (t, error)
