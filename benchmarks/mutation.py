@@ -72,8 +72,8 @@ NOT_RUN = "no test that passes interpreted runs these lines"
 COMPILED_TESTS = {
     "projeq/assembly/fast.py": ("tests/assembly/test_fast.py",),
     "projeq/assembly/generated.py": ("tests/assembly/test_stated_loads.py", "tests/assembly/test_time_loads.py",
-                                     "tests/assembly/test_given.py"),
-    "projeq/assembly/given.py": ("tests/assembly/test_given.py",),
+                                     "tests/assembly/test_given.py", "tests/assembly/test_motion_callables.py"),
+    "projeq/assembly/given.py": ("tests/assembly/test_given.py", "tests/assembly/test_motion_callables.py"),
     "projeq/assembly/kernels.py": ("tests/assembly/test_fast_beams.py", "tests/assembly/test_fast_energy.py"),
     "projeq/constraints/compiled.py": ("tests/constraints/test_compiled_closures.py",
                                        "tests/constraints/test_compiled_pins.py",

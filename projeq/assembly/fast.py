@@ -24,10 +24,11 @@ computes the relative motion of the joints whose ``compiled_kind`` it has
 other joint (Planar, Free, Spherical, Screw, Prescribed, UserJoint — non-holonomic ones
 too) states it before each call, which the kernel reads (kind ``GIVEN``, 0–6 minimal
 velocities): by the C callbacks of its ``compiled_values`` in one compiled call where every
-such joint has them (:mod:`projeq.assembly.given`: UserJoints from sympy, Prescribed motions
-in sympy, Planar, Free), else by its own ``relative_values``. Coupled joints (gears, ropes: shared minimal
-velocities) are evaluated in every joint's own velocities ṡ_all = P ṡ and projected,
-M = Pᵀ M_all P, b = Pᵀ b_all (B(14) with ∂ṡ_all/∂ṡ = P), by the compiled Gauss form.
+such joint has them (:mod:`projeq.assembly.given`: UserJoints from sympy, Planar, Free,
+Prescribed motions in sympy or as callables numba compiles), else by its own
+``relative_values``. Coupled joints (gears, ropes: shared minimal velocities) are evaluated in
+every joint's own velocities ṡ_all = P ṡ and projected, M = Pᵀ M_all P, b = Pᵀ b_all (B(14)
+with ∂ṡ_all/∂ṡ = P), by the compiled Gauss form.
 Under gravity and any force laws: between the compiled kinematics and the compiled passes
 the laws add their loads to the kernel's h_n — those with constant loads or stated terms
 (every law of :mod:`projeq.forces` without a callable load) in compiled code, by the
@@ -77,6 +78,7 @@ from projeq.assembly.kinematics import Kinematics, describing_velocities, select
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, column_scales, mass_scales
 from projeq.checks import kernel_state
 from projeq.forces import ForceLaw
+from projeq.joints.standard import MotionValues
 from projeq.subsystems.rigid import gravity_potential, rigid_mass_matrix
 
 
@@ -97,7 +99,8 @@ class PythonPieceWarning(UserWarning):
 #: how to keep a joint and a force law on the compiled path (:class:`PythonPieceWarning`)
 HOW_TO_COMPILE = {
     "joint": "state a joint's motion once as statement(q_n, t, m) (docs/architecture.md, 'Adding a joint') or in "
-             "sympy (UserJoint.from_sympy; a Prescribed motion as an expression in t)",
+             "sympy (UserJoint.from_sympy; a Prescribed motion as an expression in t, or as a callable t -> "
+             "(θ, θ̇, θ̈) written with numpy and math on numbers and arrays, which numba compiles)",
     "force law": "build the loads from the laws of projeq.forces, a load that varies as a callable "
                  "(t, q, s_dot) written with numpy and math on numbers and arrays (numba compiles it), or "
                  "state a load on a body once as a projeq.BodyLoad (docs/architecture.md, 'Adding a force law')",
@@ -146,7 +149,8 @@ class FastEvaluator:
         # callbacks, given.py): without joints of kind GIVEN every joint has q̇ = ṡ (K = E)
         self._given_motions = given.motions_kernel() if self._given and not self._python_joints and self.compiled \
             else None
-        self.interpreted = [f"joint {system.names[n]!r} ({type(system.joints[n]).__name__})" for n in self._python_joints] \
+        self.interpreted = [f"joint {system.names[n]!r} ({type(system.joints[n]).__name__}"
+                            f"{f': {why}' if why else ''})" for n, why in zip(self._python_joints, self._python_joint_why)] \
             + [f"force law {type(law).__name__} ({why})"
                for law, why in zip(self._python_laws, self._python_why)]
         if self.interpreted and self.compiled:
@@ -168,10 +172,15 @@ class FastEvaluator:
         joints, bodies = system.joints, system.subsystems
         kind = [kernels.KINDS.get(j.compiled_kind, kernels.GIVEN) for j in joints]
         self._given = [n for n in range(N) if kind[n] == kernels.GIVEN]
-        # the joints of kind GIVEN without compiled values (given.py), stated in Python; where there are
-        # none, their C callbacks' tables of each dtype are built on first use (None where numba cannot
-        # compile one)
-        self._python_joints = [n for n in self._given if joints[n].compiled_values() is None]
+        # the joints of kind GIVEN without compiled values, or moved by a callable numba cannot compile
+        # (given.python_reason), stated in Python; where there are none, their C callbacks' tables of each
+        # dtype are built on first use (None where numba cannot compile one)
+        python = [(n, given.python_reason(joints[n], self.compiled)) for n in self._given]
+        self._python_joints = [n for n, why in python if why is not None]
+        self._python_joint_why = [why for _, why in python if why is not None]
+        # joints moved by a callable the kernels call compiled (given.motion_callbacks): where s̈ is not
+        # finite, the reference evaluator names a motion that is not (Prescribed.angles), as in Python
+        self._moved = any(isinstance(joints[n].compiled_values(), MotionValues) for n, why in python if why is None)
         self._tables, self._loop_model = {}, None
         n_cols = [j.n_s + b.n_e for j, b in zip(joints, bodies)]
         # every joint's own coordinates and velocities (and a body's internal ones after them), in
@@ -406,6 +415,8 @@ class FastEvaluator:
                 f"D_n = F_nᵀ M̂_n F_n of joint {self.system.names[failed]!r} is singular: "
                 "it moves no mass or inertia"
             )
+        if self._moved and not np.isfinite(s_ddot).all():
+            self.system.evaluator("recursive").accelerations(q, s_dot, t)  # raises naming a motion not finite
         return s_ddot
 
     def state_derivative(self, t: float, x: NDArray) -> NDArray | None:

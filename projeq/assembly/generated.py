@@ -3,12 +3,14 @@
 A plug-in's statement, traced with sympy and printed as scalar code (:mod:`projeq.symbolic.codegen`),
 is compiled by numba into a C callback — a joint's relative motion (:mod:`projeq.assembly.given`), a
 force law's body wrench (:func:`law_callback`), a constraint Φ (:mod:`projeq.constraints.compiled`) —
-in a module written once per printed source (:func:`generated_module`) and cached on disk; a load
-given as a callable of (t, q, ṡ) is printed from its source with the numbers it reads as data, or
-compiled by ``numba.njit`` in memory with them frozen (:func:`load_callbacks`); the
-numbers of the plug-in (its parameters) are data, passed by the address of an array
-(:func:`parameters`); the compiled kernels call the callbacks through their addresses by the
-intrinsics of :func:`intrinsics`.
+in a module written once per printed source (:func:`generated_module`) and cached on disk; a
+plug-in given as a Python callable — a load of (t, q, ṡ) (:func:`load_callbacks`), a prescribed
+motion t ↦ (θ, θ̇, θ̈) (:func:`projeq.assembly.given.motion_callbacks`) — is printed from its source
+with the numbers it reads as data, or compiled by ``numba.njit`` in memory with them frozen, and
+its compiled values checked against its own (:func:`callable_callbacks`); the numbers of the
+plug-in (its parameters) are data, passed by the address of an array (:func:`parameters`); the
+compiled kernels call the callbacks through their addresses by the intrinsics of
+:func:`intrinsics`.
 """
 
 from __future__ import annotations
@@ -44,24 +46,32 @@ def parameters(f) -> np.ndarray:
     return _PARAMETERS[f]
 
 
+#: the imports every generated module starts with
+HEADER = "import numba\nimport numpy\nfrom numba import types as nb\n"
+
+
 def generated_module(f, into: str, parameters: bool = False):
     """A module of ``f``'s printed source (``f.source``) compiled by ``numba.njit(cache=True)`` as
-    ``function``, and the C callback ``into`` (``cache=True``): written once to a file named by its
-    digest in numba's cache directory (or ~/.cache/projeq) and imported, so that numba's disk cache,
-    which needs a file, keeps both across processes (a temporary directory where that is not
-    writable: compiled anew each process). ``f``'s constants (``f.constants``) are, with
-    ``parameters``, the entries of a last argument p of ``function`` (one module for all their
-    values), else module globals holding their values (``f.values``)."""
+    ``function`` (:func:`printed_source`), and the C callback ``into`` (``cache=True``): written once to
+    a file named by its digest in numba's cache directory (or ~/.cache/projeq) and imported, so that
+    numba's disk cache, which needs a file, keeps both across processes (a temporary directory where
+    that is not writable: compiled anew each process)."""
+    return source_module("\n".join([HEADER, printed_source(f, "function", parameters), into]))
+
+
+def printed_source(f, name: str, parameters: bool = False) -> str:
+    """The source of ``f``'s printed function (``f.source``) as ``name``, under ``numba.njit(cache=True)``:
+    ``f``'s constants (``f.constants``) are, with ``parameters``, the entries of a last argument p
+    (one module for all their values), else module globals holding their values (``f.values``)."""
     header = f.source.split("\n", 1)
     if parameters:
-        signature = header[0].replace(f"def {f.__name__}(", "def function(", 1).replace("):", ", p):", 1)
-        unpacked = [f"    {name} = p[{i}]" for i, name in enumerate(f.constants)]
+        signature = header[0].replace(f"def {f.__name__}(", f"def {name}(", 1).replace("):", ", p):", 1)
+        unpacked = [f"    {constant} = p[{i}]" for i, constant in enumerate(f.constants)]
         constants, body = [], "\n".join([signature, *unpacked, header[1]])
     else:
-        constants = [f"{name} = {float(value)!r}" for name, value in sorted(zip(f.constants, f.values))]
-        body = f.source.replace(f"def {f.__name__}(", "def function(", 1)
-    return source_module("\n".join(["import numba", "import numpy", "from numba import types as nb", "", *constants,
-                                     "", "@numba.njit(cache=True)", body, into]))
+        constants = [f"{constant} = {float(value)!r}" for constant, value in sorted(zip(f.constants, f.values))]
+        body = f.source.replace(f"def {f.__name__}(", f"def {name}(", 1)
+    return "\n".join([*constants, "", "@numba.njit(cache=True)", body])
 
 
 def source_module(source: str):
@@ -147,10 +157,10 @@ def law_callback(values, dtype=float):
                     UncompiledLawWarning)
 
 
-_LOADS: dict = {}  # (load_key(function), size, n_q, n_s) -> (callbacks, parameters), or (None, why not)
+_CALLABLES: dict = {}  # (callable_key(function), *key) -> (callbacks, parameters), or (None, why not)
 
 
-def load_key(function):
+def callable_key(function):
     """A hashable key of a callable's code and the values it reads (its closure's cells, the numbers
     of its module it names, arrays by their bytes, and its defaults): one check of closures of the
     same source and numbers (a scene built twice); the callable itself where they do not hash."""
@@ -180,28 +190,95 @@ def _frozen(value):
     return (value.dtype.str, value.shape, value.tobytes()) if isinstance(value, np.ndarray) else value
 
 
+def callable_callbacks(function, key: tuple, samples: list, size: int, stated_into, frozen_into) -> tuple:
+    """((float64, complex128) C callbacks, parameters p) of a plug-in given as a Python callable
+    ``function`` (a load of (t, q, ṡ), :func:`load_callbacks`; a prescribed motion of t,
+    :func:`projeq.assembly.given.motion_callbacks`), or (None, why) where numba cannot compile it or
+    its compiled values differ from its own at the arguments ``samples`` (:func:`check_values`, ``size``
+    entries). A lambda or function whose source reads numbers (scalars, real arrays) from its closure
+    or module is printed as ``function(*arguments, p)`` with those numbers as the data p
+    (:func:`stated_callable`), followed by the callbacks' source ``stated_into(len(p))`` (defining
+    ``into`` and ``complex_into``): one compiled module per source, cached on disk, for every value of
+    its numbers; any other is compiled by ``numba.njit`` in memory with its captured values frozen
+    and its callbacks are ``frozen_into(jitted)`` (p empty). One attempt per callable's code, numbers
+    and ``key`` in a process."""
+    key = (callable_key(function), *key)
+    if key not in _CALLABLES:
+        try:
+            _CALLABLES[key] = _compiled_callable(function, samples, size, stated_into, frozen_into)
+        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
+            lines = [line.strip() for line in re.sub(r"\x1b\[[0-9;]*m", "", str(exc)).splitlines()]
+            _CALLABLES[key] = None, f"{type(exc).__name__}: {' '.join(filter(None, lines))[:200]}"
+    return _CALLABLES[key]
+
+
+def _compiled_callable(function, samples: list, size: int, stated_into, frozen_into) -> tuple:
+    """:func:`callable_callbacks`' (callbacks, parameters); raises where numba refuses the callable or
+    its values differ."""
+    stated = stated_callable(function, len(samples[0]))
+    if stated is not None:
+        try:
+            source, p = stated
+            module = source_module(source + stated_into(len(p)))
+            check_values(function, lambda *arguments: module.function(*arguments, p), samples, size)
+            return (module.into, module.complex_into), p
+        except Exception:  # noqa: BLE001 — compiled with its numbers frozen instead
+            pass
+    numba = kernels.numba_module()
+    jitted = function if isinstance(function, numba.core.dispatcher.Dispatcher) else numba.njit(function)
+    check_values(function, jitted, samples, size)
+    return frozen_into(jitted), np.zeros(0)
+
+
+def check_values(function, jitted, samples: list, size: int) -> None:
+    """ValueError unless the compiled ``jitted`` gives ``function``'s values at each argument tuple of
+    ``samples`` (t first): ``size`` entries, their real and imaginary parts (a complex step) each to
+    1e-13 relative, NaN where its own are NaN."""
+    for arguments in samples:
+        t = arguments[0]
+        try:
+            want = np.ravel(np.asarray(function(*arguments), dtype=complex))
+        except Exception as exc:  # noqa: BLE001 — a user's callable raises what it raises
+            raise ValueError(f"calling it at t = {t} raised {type(exc).__name__}: {exc}") from exc
+        got = np.ravel(np.asarray(jitted(*arguments), dtype=complex))
+        if got.shape != want.shape or not np.array_equal(np.isnan(got), np.isnan(want)):
+            raise ValueError(f"its compiled values {got} differ from its own {want} at t = {t}")
+        got, want = np.nan_to_num(got), np.nan_to_num(want)  # a NaN where its own is NaN: the loop names it
+        scale = max(1.0, np.abs(want.real).max(initial=0.0))
+        rate = max(1.0, np.abs(want.imag / 1e-30).max(initial=0.0))
+        if not (want.shape == (size,) and np.all(np.abs(got.real - want.real) <= 1e-13 * scale)
+                and np.all(np.abs(got.imag - want.imag) / 1e-30 <= 1e-13 * rate)):
+            raise ValueError(f"its compiled values {got} differ from its own {want} at t = {t}")
+
+
+def frozen_callbacks(into, signature) -> tuple:
+    """The C callbacks of float64 and complex128 (``signature(kind)``, the kind of their arrays) of
+    ``into``, compiled by ``numba.cfunc`` in memory, the numbers it reads frozen
+    (:func:`callable_callbacks`)."""
+    numba = kernels.numba_module()
+    from numba import types as nb
+
+    return tuple(numba.cfunc(signature(kind))(into) for kind in (nb.float64, nb.complex128))
+
+
 def load_callbacks(function, size: int, n_q: int, n_s: int) -> tuple:
     """((float64, complex128) C callbacks ``into(t, q, n_q, s_dot, n_s, p, load)``, parameters p) of a
     load given as a callable ``function(t, q, s_dot)`` of ``size`` entries (a scalar where ``size``
     is 1), or (None, why) where numba cannot compile it or its compiled values differ from its own
-    (real and imaginary parts, a complex step, each to 1e-13 relative at three states of n_q
-    coordinates and n_s velocities). A lambda or function whose source reads numbers (scalars,
-    real arrays) from its closure or module is printed with those numbers as the data p
-    (:func:`stated_load`): one compiled module per source, cached on disk, for every value of its
-    numbers; any other is compiled by ``numba.njit`` in memory with its captured values frozen
-    (p empty). A load of another size is written as NaN (the loop then names the law,
-    :func:`projeq.assembly.loads.add_loads`)."""
-    key = (load_key(function), size, n_q, n_s)
-    if key not in _LOADS:
-        try:
-            _LOADS[key] = _compiled_load(function, size, n_q, n_s)
-        except Exception as exc:  # noqa: BLE001 — numba's typing and lowering errors have no common base
-            lines = [line.strip() for line in re.sub(r"\x1b\[[0-9;]*m", "", str(exc)).splitlines()]
-            _LOADS[key] = None, f"{type(exc).__name__}: {' '.join(filter(None, lines))[:200]}"
-    return _LOADS[key]
+    at three states of n_q coordinates and n_s velocities (real and imaginary parts, a complex step):
+    :func:`callable_callbacks`. A load of another size is written as NaN (the loop then names the
+    law, :func:`projeq.assembly.loads.add_loads`)."""
+    rng = np.random.default_rng(7)
+    samples = [(t, *(rng.uniform(-1, 1, n) + 1j * 1e-30 * rng.standard_normal(n) for n in (n_q, n_s)))
+               for t in (0.0, 0.37, 1.9)]
+    return callable_callbacks(
+        function, ("load", size, n_q, n_s), samples, size,
+        lambda n_p: "".join(LOAD_INTO.format(n_p=n_p, size=size, dtype=dtype, name=name)
+                            for dtype, name in (("float64", "into"), ("complex128", "complex_into"))),
+        lambda jitted: _frozen_load(jitted, size))
 
 
-#: a C callback of a stated load (:func:`stated_load`) of one dtype
+#: a C callback of a stated load (:func:`stated_callable`) of one dtype
 LOAD_INTO = """
 @numba.cfunc(nb.void(nb.float64, nb.CPointer(nb.{dtype}), nb.int64, nb.CPointer(nb.{dtype}), nb.int64,
                      nb.CPointer(nb.float64), nb.CPointer(nb.{dtype})), cache=True)
@@ -214,47 +291,7 @@ def {name}(t, q_pointer, n_q, s_pointer, n_s, p_pointer, load_pointer):
 """
 
 
-def _compiled_load(function, size: int, n_q: int, n_s: int) -> tuple:
-    """:func:`load_callbacks`' (callbacks, parameters); raises where numba refuses the callable or its
-    values differ."""
-    stated = stated_load(function)
-    if stated is not None:
-        try:
-            source, p = stated
-            module = source_module(source + "".join(
-                LOAD_INTO.format(n_p=len(p), size=size, dtype=dtype, name=name)
-                for dtype, name in (("float64", "into"), ("complex128", "complex_into"))))
-            _check_load(function, lambda t, q, s_dot: module.function(t, q, s_dot, p), size, n_q, n_s)
-            return (module.into, module.complex_into), p
-        except Exception:  # noqa: BLE001 — compiled with its numbers frozen instead
-            pass
-    numba = kernels.numba_module()
-    jitted = function if isinstance(function, numba.core.dispatcher.Dispatcher) else numba.njit(function)
-    _check_load(function, jitted, size, n_q, n_s)
-    return _frozen_callbacks(jitted, size), np.zeros(0)
-
-
-def _check_load(function, jitted, size: int, n_q: int, n_s: int) -> None:
-    """ValueError unless the compiled ``jitted`` gives ``function``'s values (:func:`load_callbacks`)."""
-    rng = np.random.default_rng(7)
-    for t in (0.0, 0.37, 1.9):
-        q, s_dot = (rng.uniform(-1, 1, n) + 1j * 1e-30 * rng.standard_normal(n) for n in (n_q, n_s))
-        try:
-            want = np.ravel(np.asarray(function(t, q, s_dot), dtype=complex))
-        except Exception as exc:  # noqa: BLE001 — a user's callable raises what it raises
-            raise ValueError(f"calling it at t = {t} raised {type(exc).__name__}: {exc}") from exc
-        got = np.ravel(np.asarray(jitted(t, q, s_dot), dtype=complex))
-        if got.shape != want.shape or not np.array_equal(np.isnan(got), np.isnan(want)):
-            raise ValueError(f"its compiled values {got} differ from its own {want} at t = {t}")
-        got, want = np.nan_to_num(got), np.nan_to_num(want)  # a NaN where its own is NaN: the loop names it
-        scale = max(1.0, np.abs(want.real).max(initial=0.0))
-        rate = max(1.0, np.abs(want.imag / 1e-30).max(initial=0.0))
-        if not (want.shape == (size,) and np.all(np.abs(got.real - want.real) <= 1e-13 * scale)
-                and np.all(np.abs(got.imag - want.imag) / 1e-30 <= 1e-13 * rate)):
-            raise ValueError(f"its compiled values {got} differ from its own {want} at t = {t}")
-
-
-def _frozen_callbacks(jitted, size: int) -> tuple:
+def _frozen_load(jitted, size: int) -> tuple:
     """The C callbacks of :func:`load_callbacks` around a compiled callable (its numbers frozen, p unread)."""
     numba = kernels.numba_module()
     from numba import types as nb
@@ -265,28 +302,28 @@ def _frozen_callbacks(jitted, size: int) -> tuple:
         for i in range(size):
             load[i] = found[i] if found.shape[0] == size else np.nan
 
-    return tuple(numba.cfunc(nb.void(nb.float64, nb.CPointer(kind), nb.int64, nb.CPointer(kind), nb.int64,
-                                     nb.CPointer(nb.float64), nb.CPointer(kind)))(into)
-                 for kind in (nb.float64, nb.complex128))
+    return frozen_callbacks(into, lambda kind: nb.void(nb.float64, nb.CPointer(kind), nb.int64, nb.CPointer(kind),
+                                                       nb.int64, nb.CPointer(nb.float64), nb.CPointer(kind)))
 
 
-def stated_load(function) -> tuple[str, np.ndarray] | None:
-    """(source, p): a lambda or function of (t, q, s_dot) printed as ``function(t, q, s_dot, p)``, the
-    numbers it reads from its closure and its module (scalars and real arrays) unpacked from p at
-    its start and the modules it reads imported by their names; None where its source cannot be
-    found (one lambda or def of its arguments on its first line) or it reads anything else."""
+def stated_callable(function, n_arguments: int) -> tuple[str, np.ndarray] | None:
+    """(source, p): a lambda or function of ``n_arguments`` positional arguments (a load's t, q,
+    s_dot; a motion's t) printed as ``function(*arguments, p)``, the numbers it reads from its
+    closure and its module (scalars and real arrays) unpacked from p at its start and the modules it
+    reads imported by their names; None where its source cannot be found (one lambda or def of its
+    arguments on its first line) or it reads anything else."""
     import ast
     import inspect
     import linecache
 
     code = getattr(function, "__code__", None)
-    if code is None or code.co_argcount != 3 or function.__defaults__ or code.co_kwonlyargcount:
+    if code is None or code.co_argcount != n_arguments or function.__defaults__ or code.co_kwonlyargcount:
         return None
     try:
         tree = ast.parse("".join(linecache.getlines(inspect.getsourcefile(function))))
     except (OSError, TypeError, SyntaxError):
         return None
-    arguments = list(code.co_varnames[:3])
+    arguments = list(code.co_varnames[:n_arguments])
     found = [node for node in ast.walk(tree) if isinstance(node, (ast.Lambda, ast.FunctionDef))
              and min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])]) == code.co_firstlineno
              and [a.arg for a in node.args.args] == arguments
@@ -318,8 +355,7 @@ def stated_load(function) -> tuple[str, np.ndarray] | None:
         [f"    {line}" for statement in node.body for line in ast.unparse(statement).splitlines()]
     signature = f"def function({', '.join(arguments)}, projeq_p):"
     source = "\n".join([*imports, "", "", "@numba.njit(cache=True)", signature, *lines, *body, ""])
-    return "\n".join(["import numba", "import numpy", "from numba import types as nb", source]), \
-        np.concatenate(p) if p else np.zeros(0)
+    return HEADER + source, np.concatenate(p) if p else np.zeros(0)
 
 
 @functools.cache

@@ -9,7 +9,10 @@ same code is compiled by numba as a C callback ``into(q_n, ṡ_n, t, row)`` (:fu
 float64, or complex128 for the complex step of :mod:`projeq.analysis.jacobians`; built once per
 expressions in a process and cached on disk, :func:`generated_module`), which compiled kernels call
 through its address (:func:`intrinsics`) for every joint of kind GIVEN of a tree
-(:func:`given_motions`, one row per joint of :func:`joint_table`). The fast evaluator's one-call
+(:func:`given_motions`, one row per joint of :func:`joint_table`). A Prescribed joint moved by a
+callable t ↦ (θ, θ̇, θ̈) has its row printed at θ, θ̇, θ̈ and the callable compiled as a load's is,
+its values checked against its own (:func:`motion_callbacks`); one numba cannot compile is stated
+in Python, and the fast evaluator names it (:func:`python_reason`). The fast evaluator's one-call
 kernels (:func:`given_state_derivative`, :func:`given_jacobian`) then take such trees: ẋ = (q̇, s̈)
 with q̇ of those joints from their rows (:func:`given_rates`), and ∂ẋ/∂x, ∂q̇/∂x included, by the
 complex step (Squire & Trapp, "Using complex variables to estimate derivatives of real functions",
@@ -21,12 +24,21 @@ from __future__ import annotations
 
 import functools
 import types
-import warnings
+from typing import NamedTuple
 
 import numpy as np
 
 from projeq.assembly import kernels, loads
-from projeq.assembly.generated import DTYPES, callback, generated_module, intrinsics, parameters
+from projeq.assembly.generated import (
+    DTYPES,
+    callable_callbacks,
+    callback,
+    frozen_callbacks,
+    generated_module,
+    intrinsics,
+    parameters,
+    printed_source,
+)
 from projeq.assembly.kernels import (
     GIVEN,
     GIVEN_F,
@@ -37,6 +49,7 @@ from projeq.assembly.kernels import (
     tree_accelerations,
     tree_state_derivative,
 )
+from projeq.joints.standard import MotionValues
 
 
 class UncompiledJointWarning(UserWarning):
@@ -57,39 +70,121 @@ def into(q_pointer, s_pointer, t, p_pointer, row_pointer):
 
 
 
+#: the C callbacks of a Prescribed joint moved by a callable (:func:`motion_callbacks`): its printed row
+#: ``moved_row`` at the values (θ, θ̇, θ̈) at t of the callable printed as ``function(t, p)``
+MOTION_INTO = """
+@numba.cfunc(nb.void(nb.CPointer(nb.{dtype}), nb.CPointer(nb.{dtype}), nb.float64, nb.CPointer(nb.float64),
+                     nb.CPointer(nb.{dtype})), cache=True)
+def {name}(q_pointer, s_pointer, t, p_pointer, row_pointer):
+    theta, theta_dot, theta_ddot = function(t, numba.carray(p_pointer, ({n_p},)))
+    found, row = moved_row(theta, theta_dot, theta_ddot), numba.carray(row_pointer, ({width},))
+    for i in range({width}):
+        row[i] = found[i]
+"""
+
+#: the times at which a motion's compiled values are checked against its own (:func:`motion_callbacks`)
+MOTION_TIMES = (0.0, 0.37, 1.9)
+
+
+class JointCallback(NamedTuple):
+    """A joint's C callback as the compiled kernels call it (:func:`joint_table`): its ``address`` and
+    its ``parameters`` p (float64, kept alive by the caches that built them), whose address it reads."""
+
+    address: int
+    parameters: np.ndarray
+
+
 def row_width(joint) -> int:
     """The entries of a joint's compiled row: A, r, w, ζ, F⁶ (:data:`projeq.assembly.kernels.GIVEN_F`
     + 6 n_s), then q̇ (n_q)."""
     return GIVEN_F + 6 * joint.n_s + joint.n_q
 
 
-def joint_callback(joint, dtype=float):
+def joint_callback(joint, dtype=float) -> JointCallback | None:
     """The joint's ``compiled_values()`` (its row, :func:`row_width` entries) compiled as a C callback
     ``into(q_n, ṡ_n, t, p, row)`` at q_n, ṡ_n and row of ``dtype`` (float or complex), t float64 and
     the values p of its constants (:func:`parameters`: data, not code, so joints that differ only in
     their parameters' values share one callback), built once per printed source and dtype in a process
-    and cached on disk (:func:`generated_module`); None for a joint without compiled values, or (after
-    one :class:`UncompiledJointWarning`) where numba cannot compile them."""
+    and cached on disk (:func:`generated_module`), or of a Prescribed joint moved by a callable
+    (:func:`motion_callbacks`); None for a joint without compiled values, where numba cannot compile
+    its motion (:func:`python_reason` says why), or (after one :class:`UncompiledJointWarning`) where
+    numba cannot compile its printed row."""
     values = joint.compiled_values()
     if values is None:
         return None
+    if isinstance(values, MotionValues):
+        callbacks, p = motion_callbacks(values)
+        complex_step = np.dtype(dtype).kind == "c"
+        return None if callbacks is None else JointCallback(callbacks[1 if complex_step else 0].address, p)
     into = JOINT_INTO.format(dtype=DTYPES[np.dtype(dtype)], n_q=joint.n_q, n_s=joint.n_s, width=row_width(joint),
                              n_p=len(values.constants))
-    return callback(values, into, f"joint: numba cannot compile the relative motion of {joint!r} for {np.dtype(dtype)}",
+    back = callback(values, into, f"joint: numba cannot compile the relative motion of {joint!r} for {np.dtype(dtype)}",
                     UncompiledJointWarning)
+    return None if back is None else JointCallback(back.address, parameters(values))
+
+
+def python_reason(joint, compiled: bool = True) -> str | None:
+    """Why a joint of kind GIVEN is stated in Python at every evaluation: "" where it has no compiled
+    values (a UserJoint from callables), the reason numba cannot compile the callable moving a
+    Prescribed joint (``compiled``: :func:`motion_callbacks`); None where the kernels state it."""
+    values = joint.compiled_values()
+    if values is None:
+        return ""
+    if compiled and isinstance(values, MotionValues):
+        callbacks, why = motion_callbacks(values)
+        if callbacks is None:
+            name = getattr(values.motion, "__qualname__", type(values.motion).__name__)
+            return f"numba cannot compile its motion {name} ({why})"
+    return None
+
+
+def motion_callbacks(values: MotionValues) -> tuple:
+    """((float64, complex128) C callbacks ``into(q_n, ṡ_n, t, p, row)``, p) of a Prescribed joint moved
+    by a callable (``values``: :class:`projeq.joints.standard.MotionValues`): its printed row
+    ``moved_row`` at the callable's (θ, θ̇, θ̈) at t, the callable compiled as a load's is and its
+    values checked against its own at :data:`MOTION_TIMES` (:func:`projeq.assembly.generated.callable_callbacks`:
+    printed from its source with the numbers it reads as the data p, one module per source cached on
+    disk, or by ``numba.njit`` with them frozen); or (None, why) where numba cannot compile it."""
+    row = values.row
+    width = len(row(0.0, 0.0, 0.0))
+
+    def stated_into(n_p: int) -> str:
+        return "\n".join([printed_source(row, "moved_row"), *(
+            MOTION_INTO.format(dtype=dtype, name=name, n_p=n_p, width=width)
+            for dtype, name in (("float64", "into"), ("complex128", "complex_into")))])
+
+    return callable_callbacks(values.motion, ("motion", row.source), [(t,) for t in MOTION_TIMES], 3, stated_into,
+                              lambda jitted: _frozen_motion(jitted, row, width))
+
+
+def _frozen_motion(jitted, row, width: int) -> tuple:
+    """The C callbacks of :func:`motion_callbacks` around a compiled callable (its numbers frozen, p
+    unread) and its printed row (compiled on its own, :func:`generated_module`)."""
+    import numba
+    from numba import types as nb
+
+    moved_row = generated_module(row, "").function
+
+    def into(q_pointer, s_pointer, t, p_pointer, row_pointer):
+        theta, theta_dot, theta_ddot = jitted(t)
+        found, values = moved_row(theta, theta_dot, theta_ddot), numba.carray(row_pointer, (width,))
+        for i in range(width):
+            values[i] = found[i]
+
+    return frozen_callbacks(into, lambda kind: nb.void(nb.CPointer(kind), nb.CPointer(kind), nb.float64,
+                                                       nb.CPointer(nb.float64), nb.CPointer(kind)))
 
 
 def joint_table(plan, callbacks, compiled: bool = True) -> np.ndarray:
     """One row (n, first coordinate, n_q, first velocity, n_s, callback, parameters) per joint of kind
     GIVEN of a fast evaluator's ``plan`` (its (n, joint, q slice, ṡ slice, width) rows), as
-    :func:`given_motions` reads them: its C callback's address (``callbacks``) and that of its
-    parameters' values (:func:`parameters`), or interpreted (``compiled=False``) its
+    :func:`given_motions` reads them: the addresses of its C callback and of its parameters' values
+    (``callbacks``: :class:`JointCallback`), or interpreted (``compiled=False``) its
     ``compiled_values`` function (its constants in its closure) and None."""
     rows = []
     for (n, joint, q_n, s_n, _), back in zip(plan, callbacks):
-        values = joint.compiled_values()
-        rows.append([n, q_n.start, joint.n_q, s_n.start, joint.n_s, back.address, parameters(values).ctypes.data]
-                    if compiled else [n, q_n.start, joint.n_q, s_n.start, joint.n_s, values, None])
+        rows.append([n, q_n.start, joint.n_q, s_n.start, joint.n_s, back.address, back.parameters.ctypes.data]
+                    if compiled else [n, q_n.start, joint.n_q, s_n.start, joint.n_s, joint.compiled_values(), None])
     return np.array(rows, dtype=np.int64 if compiled else object).reshape(len(rows), 7)
 
 

@@ -139,7 +139,8 @@ def _tree_piece(tree) -> str | None:
     if python:
         n = python[0]
         return (f"joint {tree.names[n]!r} ({type(tree.joints[n]).__name__}) states its own relative motion in "
-                "Python (no compiled values: a UserJoint from callables, a Prescribed motion that is a callable)")
+                "Python (no compiled values: a UserJoint from callables, a Prescribed motion that is a callable numba "
+                "cannot compile)")
     if ev._expansion is not None:
         return "coupled joints (shared minimal velocities)"
     for law, why in zip(ev._python_laws, ev._python_why):

@@ -10,9 +10,10 @@ contract.
 
 from __future__ import annotations
 
+import functools
 import math
 
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -315,7 +316,8 @@ class Prescribed(Joint):
         The joint whose coordinate θ is prescribed (its parent and placement are used).
     motion : sympy expression in ``t`` or callable
         θ(t) as an expression in the symbol ``t`` (θ̇, θ̈ by differentiation), or a callable
-        ``t -> (θ, θ̇, θ̈)``.
+        ``t -> (θ, θ̇, θ̈)``; either runs compiled, a callable where numba compiles it (written with
+        numpy and math on numbers and arrays; else it runs in Python, named once).
     """
 
     symbolic_parameters = {"motion": "its motion θ(t) as a sympy expression"}
@@ -360,15 +362,60 @@ class Prescribed(Joint):
                                 sp.zeros(0, 1))
 
     def compiled_values(self):
-        """``values(q_n, ṡ_n, t)`` -> :meth:`relative_values` (A, r, w, ζ = ḟ) of a motion given in
-        sympy, printed as scalar code that numba compiles, as a UserJoint's
-        (:func:`projeq.joints.user_compiler.printed_values`; one function per kinematics in a
-        process); None for a callable motion (its relative motion is stated in Python)."""
+        """``values(q_n, ṡ_n, t)`` -> :meth:`relative_values` (A, r, w, ζ = ḟ), built once per joint: of
+        a motion given in sympy, printed as scalar code that numba compiles, as a UserJoint's
+        (:func:`projeq.joints.user_compiler.printed_values`); of a callable motion, its
+        :class:`MotionValues` (the row printed at the callable's θ, θ̇, θ̈, which the compiled kernels
+        take from the callable compiled, :func:`projeq.assembly.given.motion_callbacks`)."""
+        if "_printed" in self.__dict__:
+            return self._printed
         if self.expression is None:
-            return None
-        t = sp.Symbol("t")
-        inner = self.symbolic_relative([], [], t, self.expression)
-        return statement.printed_form((), (), t, *(sp.ImmutableMatrix(e) for e in inner))()
+            self._printed = MotionValues(moved_row(self), self.motion)
+        else:
+            t = sp.Symbol("t")
+            inner = self.symbolic_relative([], [], t, self.expression)
+            self._printed = statement.printed_form((), (), t, *(sp.ImmutableMatrix(e) for e in inner))()
+        return self._printed
+
+
+class MotionValues(NamedTuple):
+    """The compiled values of a :class:`Prescribed` joint moved by a callable: ``row(θ, θ̇, θ̈)``, its
+    row A, r, w = F⁶ θ̇, ζ = Ḟ⁶ θ̇ + F⁶ θ̈ (docs/theory.md §4) printed as scalar code that numba compiles
+    (:func:`moved_row`), and ``motion``, the callable t -> (θ, θ̇, θ̈), which the compiled kernels call
+    compiled (:func:`projeq.assembly.given.motion_callbacks`); called as ``values(q_n, ṡ_n, t)``, the
+    row at the motion's values at t, in Python (the kernels interpreted)."""
+
+    row: Callable
+    motion: Callable
+
+    def __call__(self, q_n, s_dot_n, t):
+        return self.row(*self.motion(t))
+
+
+def moved_row(joint: Prescribed):
+    """``row(theta, theta_dot, theta_ddot)``: the row of ``joint``'s compiled values (A, r, w, ζ;
+    :func:`projeq.joints.user_compiler.row_expressions`) with θ(t) and its rates as arguments, printed
+    as scalar numpy code (:func:`projeq.symbolic.codegen.numeric_function`): the inner joint's
+    kinematics at a function θ(t) (:meth:`Prescribed.symbolic_relative`), ζ = ḟ derived, then θ̈, θ̇,
+    θ put in for d²θ/dt², dθ/dt and θ(t); printed once per kinematics in a process (a scene built
+    again, a sweep of its motion's numbers)."""
+    t = sp.Symbol("t")
+    form = joint.symbolic_relative([], [], t, sp.Function("theta")(t))
+    return _printed_row(*(sp.ImmutableMatrix(e) for e in form))
+
+
+@functools.lru_cache(maxsize=64)
+def _printed_row(A, r, F, f, K, k):
+    """:func:`moved_row` of the sympy form (A, r, F, f, K, k) at θ(t)."""
+    from projeq.joints.user_compiler import joint_symbols, row_expressions
+    from projeq.symbolic import codegen
+
+    t, angles = sp.Symbol("t"), sp.symbols("theta theta_dot theta_ddot")
+    theta = sp.Function("theta")(t)
+    symbols = joint_symbols((), (), t, A, r, F, f, K, k)
+    rates = {theta.diff(t, 2): angles[2], theta.diff(t): angles[1], theta: angles[0]}
+    expressions = [e.xreplace(rates) for e in row_expressions(symbols)]
+    return codegen.numeric_function("moved_row", [(str(a), a) for a in angles], expressions)()
 
 
 def _label(motion) -> str:

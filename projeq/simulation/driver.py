@@ -536,10 +536,12 @@ class _Run:
         (:func:`projeq.simulation.loop.loop`), or None where solve_ivp steps: a method the loop does not
         step (BDF, LSODA, projected, an OdeSolver class: ``method=scipy.integrate.DOP853`` keeps scipy's),
         events, options besides max_step, a Radau run whose ``jac`` is not "exact" (the default: the loop
-        differentiates the compiled ẋ itself), or an evaluator without a compiled one-call ẋ."""
+        differentiates the compiled ẋ itself), an evaluator without a compiled one-call ẋ, or an empty state
+        (n_q = n_s = 0, only prescribed motion: nothing to integrate, whose error norm the loop would divide
+        by zero entries)."""
         key = (id(self.ev), self.method)
         if self.loops.get(key, (None,))[0] is not self.ev:  # (kept with its evaluator: an id is reused once freed)
-            ready = not (self.events or set(self.options) - {"max_step"}) and (
+            ready = len(self.x) and not (self.events or set(self.options) - {"max_step"}) and (
                 self.method not in IMPLICIT or isinstance(self.jac, str))  # Radau: jac "exact", the default
             provider = getattr(self.ev, "loop_model", None) if ready else None
             if provider is not None and self.fused is not None:

@@ -201,10 +201,19 @@ def _planar_pendulum():
                              independent=[1, 2])
 
 
+class _Shaker:
+    """A Python object numba cannot read: its method gives the base's motion."""
+
+    def motion(self, t):
+        return 0.1 * np.sin(t), 0.1 * np.cos(t), -0.1 * np.sin(t)
+
+
 def _shaken_pendulum():
-    """The pendulum of :func:`_pendulum` on a base shaken along y by a Prescribed joint (a joint
-    that states its own relative motion, with no coordinate of its own)."""
-    shake = pq.Prescribed(pq.Prismatic(axis="y"), lambda t: (0.1 * np.sin(t), 0.1 * np.cos(t), -0.1 * np.sin(t)))
+    """The pendulum of :func:`_pendulum` on a base shaken along y by a Prescribed joint whose motion
+    calls a Python object's method (numba cannot compile it: the joint states its own relative motion
+    in Python, with no coordinate of its own)."""
+    shaker = _Shaker()
+    shake = pq.Prescribed(pq.Prismatic(axis="y"), lambda t: shaker.motion(t))
     tree = pq.System({"base": pq.Frame(), "x": pq.Frame(), "bob": pq.PointMass(1.0)},
                      {"base": shake, "x": pq.Prismatic(parent="base", axis="x"),
                       "bob": pq.Prismatic(parent="x", axis="z")}, gravity=(0, 0, -9.81))

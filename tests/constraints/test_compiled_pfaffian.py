@@ -133,9 +133,18 @@ def test_rheonomic_pfaffian_rows_keep_the_numpy_path_saying_why(constraints, why
     assert model.compiled_kernel() is None
 
 
+class _Turn:
+    """A Python object numba cannot read: its method gives the hub's motion."""
+
+    def motion(self, t):
+        return 0.3 * t, 0.3, 0.0
+
+
 def test_a_joint_stating_its_motion_in_python_keeps_the_numpy_path_saying_why():
-    """A Prescribed joint (kind GIVEN, its motion a callable of t) has no compiled form."""
-    hub = pq.Prescribed(pq.Revolute(axis="z"), lambda t: (0.3 * t, 0.3, 0.0))
+    """A Prescribed joint (kind GIVEN) whose motion calls a Python object's method, which numba cannot
+    compile, has no compiled form."""
+    turn = _Turn()
+    hub = pq.Prescribed(pq.Revolute(axis="z"), lambda t: turn.motion(t))
     tree = pq.System({"hub": pq.RigidBody(1.0, (0, 0, 0), np.eye(3)), "x": pq.PointMass(1.0), "y": pq.PointMass(1.0)},
                      {"hub": hub, "x": pq.Prismatic(parent="hub", axis="x"), "y": pq.Prismatic(parent="x", axis="y")})
     model = ConstrainedSystem(tree, phi=lambda q, t: [q[0] - q[1] ** 2 - 0.5], q0=[0.5, 0.0])

@@ -2,8 +2,9 @@
 in time, :class:`projeq.Prescribed`) and is closed by a cut joint (:class:`projeq.PinClosure`),
 so that Φ(q, t) depends on t through the crank: with the motion in sympy the closure kernel
 evaluates it (−∂Φ/∂t and γ from the chain's twists and accelerations, the prescribed joint's
-relative motion a compiled callback: exact), with a callable motion the numpy path (complex steps
-through the poses, stencils for Φ″). Checked against independent statements: the
+relative motion a compiled callback: exact), with a callable motion too (the callable compiled), and
+with a callable numba cannot compile the numpy path (complex steps through the poses, stencils for
+Φ″). Checked against independent statements: the
 loop's closed form (the rocker and coupler angles by intersecting the circles about the crank pin
 and the rocker pivot, differentiated symbolically by sympy for the rates and accelerations), and
 the power balance — the only force that works on the mechanism is the driving torque τ of the
@@ -62,17 +63,22 @@ def _callable_motion(t):
             -4 * AMPLITUDE * np.sin(2 * t))
 
 
+def _python_motion(t):
+    """The same motion through a Python function numba does not compile (the joint in Python)."""
+    return _callable_motion(t)
+
+
 def _driven(coupler=None, motion=None, kind=pq.ConstrainedSystem):
     """The driven four-bar (default: a rigid coupler, the sympy motion) as a ``kind`` of constrained
-    model, and its pin; a callable motion takes the numpy path (warned: not tested here)."""
+    model, and its pin; a callable numba cannot compile takes the numpy path (warned: not tested here)."""
     tree = _tree(slender_rod(2.0, B) if coupler is None else coupler, _motion() if motion is None else motion)
     pin = pq.PinClosure(tree, "coupler", (B, 0.0, 0.0), "rocker", (C, 0.0, 0.0), axes="xy")
     theta2, theta3 = four_bar_angles(THETA0, A, B, C, D)
     q0 = (theta3, theta2 - THETA0) + (0.0,) * (tree.n_q - 2)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore" if motion is _callable_motion else "error", UncompiledClosureWarning)
+        warnings.simplefilter("ignore" if motion is _python_motion else "error", UncompiledClosureWarning)
         system = kind(tree, phi=pin, q0=q0)
-        assert (system.compiled_kernel() is None) == (motion is _callable_motion)
+        assert (system.compiled_kernel() is None) == (motion is _python_motion)
     return system, pin
 
 
@@ -84,8 +90,9 @@ def exact():
 @pytest.mark.parametrize("motion, kind, bound", [
     (None, pq.ConstrainedSystem, 1e-14),  # the kernel: measured 1.1e-15
     (None, TangentSystem, 1e-14),  # the tangent kernel (f the particular solution by the SVD): 1.1e-15
-    (_callable_motion, pq.ConstrainedSystem, 1e-11),  # the numpy path: 1.4e-12 (1.4e-10 unscaled)
-], ids=["compiled", "compiled-tangent", "numpy"])
+    (_callable_motion, pq.ConstrainedSystem, 1e-14),  # the kernel, the callable compiled: 1.1e-15
+    (_python_motion, pq.ConstrainedSystem, 1e-11),  # the numpy path: 1.4e-12 (1.4e-10 unscaled)
+], ids=["compiled", "compiled-tangent", "compiled-callable", "numpy"])
 def test_a_driven_four_bar_follows_the_closed_form(exact, motion, kind, bound):
     """The default correction (projection onto Φ(q, t) = 0 at each output's time) keeps q on the
     closed form to round-off, and the velocities (f = A_dep⁻¹ b_s, b_s = −∂Φ/∂t: no minimal

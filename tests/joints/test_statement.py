@@ -81,14 +81,15 @@ def _interpreted_row(joint, q, s_dot, t):
 
 
 def _compiled_row(joint, q, s_dot, t):
-    """The row of the joint's C callback (given.joint_callback), called through ctypes."""
+    """The row of the joint's C callback (given.joint_callback: its address and parameters), called through
+    ctypes."""
     callback = given_joints.joint_callback(joint)
     row = np.zeros(given_joints.row_width(joint))
     pointer = ctypes.POINTER(ctypes.c_double)
+    into = ctypes.CFUNCTYPE(None, pointer, pointer, ctypes.c_double, pointer, pointer)(callback.address)
     q, s_dot = np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(s_dot, dtype=float)
-    p = given_joints.parameters(joint.compiled_values())
-    callback.ctypes(q.ctypes.data_as(pointer), s_dot.ctypes.data_as(pointer), t, p.ctypes.data_as(pointer),
-                    row.ctypes.data_as(pointer))
+    into(q.ctypes.data_as(pointer), s_dot.ctypes.data_as(pointer), t, callback.parameters.ctypes.data_as(pointer),
+         row.ctypes.data_as(pointer))
     return row
 
 

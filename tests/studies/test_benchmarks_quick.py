@@ -88,6 +88,8 @@ PRINTS = {
     "loop_overhead.py": ("per evaluation", "scipy's loop", "rolling_disk"),
     "nonholonomic_effort.py": ("| car |", "| knife_edge_disc |", "| rolling_disk |"),
     "loop_vs_cyrk.py": ("CyRK/projeq", "projeq run", "chain(3)"),
+    "motion_callables.py": ("rotating_blade: µs per evaluation", "hub chain", "spin_up_beam",
+                            "median ratio before / after"),
     "output_rows.py": ("before/after", "simple_pendulum"),
     "peers.py": ("chain",),
     "pin_closures.py": ("PinClosure, compiled kernel", "PinClosure, numpy path", "hand-written Φ",
