@@ -5,7 +5,9 @@ Per evaluation of the default evaluator's s̈ (``accelerations``) and of simulat
 ẋ = (q̇, s̈) — the evaluator's one compiled call (``state_derivative``) where it has one, else q̇ and
 its s̈ —, on ``scenes.rotating_blade()`` (a massless hub turned at Ω t, a RitzBeam of 8 coordinates:
 the fast evaluator), on a hub turned by θ = Ω t + a sin ωt carrying two links under gravity, and on
-``scenes.spin_up_beam()`` (the hub-beam path, whose kernel took the Python motion's θ, θ̇, θ̈ before). Before: the same joint with
+``scenes.spin_up_beam()`` (the hub-beam path, whose kernel takes a callable motion's θ, θ̇, θ̈ from
+Python both times: printing its row would cost ``projeq run`` the import of sympy; the ratio there is
+about 1). Before: the same joint with
 no compiled values (what projeq did for every callable motion until the callable was compiled, its row
 by its Python ``relative_values`` at every evaluation; ``PythonMotion`` below); after: the callable
 compiled (:func:`projeq.assembly.given.motion_callbacks`). Timed in alternating rounds (ratio =

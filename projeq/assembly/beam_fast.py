@@ -20,9 +20,9 @@ Compiled by default: a RitzBeam, rotary inertia and torsion included (its slice 
 fields, which the compiled kernel evaluates, :func:`projeq.assembly.kernels.elastic_body` and
 :func:`~projeq.assembly.kernels.rotary_body`, the same statement of the beam's terms as the
 order-n kernel's elastic block) on a Prescribed Revolute or Prismatic, a Fixed joint or any
-joint without coordinates (read by its ``relative_values``; a motion given in sympy, or as a
-callable numba compiles, by the C callback of its printed row, :mod:`projeq.assembly.given`, in
-one compiled call) is one call of
+joint without coordinates (read by its ``relative_values``; a motion given in sympy by the C
+callback of its printed row, :mod:`projeq.assembly.given`, in one compiled call; a callable
+motion's angles in Python) is one call of
 :func:`projeq.assembly.kernels.hub_beam` per s̈. Any other subsystem with internal
 coordinates and the beam's layout ẏ = (twist, q̇_e) (a user's subsystem, a RitzBeam that
 restates its terms) takes the interpreted path through its ``elastic_terms``
@@ -136,10 +136,12 @@ class HubBeamEvaluator:
         inner = joint.joint if isinstance(joint, Prescribed) else joint
         kind = kernels.KINDS.get(getattr(inner, "compiled_kind", None), kernels.GIVEN)
         self._kind = kind if isinstance(joint, Prescribed) or kind == kernels.FIXED else kernels.GIVEN
-        # a hub whose motion is compiled (a Prescribed motion in sympy, or a callable numba compiles): its row
-        # by its C callback in one compiled call (projeq.assembly.given), in place of the motion's Python per
-        # evaluation
-        callback = given.joint_callback(joint) if self._kind != kernels.FIXED else None
+        # a hub whose motion is printed (a Prescribed motion in sympy): its row by its C callback in one compiled
+        # call (projeq.assembly.given), in place of the motion's Python per evaluation; a callable motion keeps
+        # its angles in Python here (its row printed by sympy would cost `projeq run` the import of sympy, for
+        # 1.04-1.12x of the spin-up's evaluation)
+        printed = not (isinstance(joint, Prescribed) and joint.expression is None)
+        callback = given.joint_callback(joint) if self._kind != kernels.FIXED and printed else None
         self._kind = kernels.GIVEN if callback is not None else self._kind
         self._axis = np.array(inner.axis if self._kind in (kernels.REVOLUTE, kernels.PRISMATIC) else np.zeros(3),
                               dtype=float)
