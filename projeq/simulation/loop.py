@@ -28,8 +28,9 @@ loop is compiled once per signature of the ẋ kernel — once for every tree wi
 GIVEN, once for those with them, once per variant of the closures' kernel (rigid or elastic tree, Φ
 a user's function or cut joints) — and never per model, chain length or set of force laws; the
 method's tableau is data too. It returns to Python once per segment of ``simulate`` (a chunk of
-(t_end − t_start) / n_segments): there the rows are checked, progress is reported and Ctrl-C
-takes effect, keeping every finished segment.
+(t_end − t_start) / n_segments), after the first step that reaches the segment's end — no step is
+cut short there, and the next segment goes on with the same steps (:class:`Carried`) —: there the
+rows are checked, progress is reported and Ctrl-C takes effect, keeping every finished segment.
 """
 
 from __future__ import annotations
@@ -822,7 +823,7 @@ class CompiledLoop:
         if carried is not None and carried.t == t and carried.state.shape == state.shape:
             known, rate, h_abs = bool(np.array_equal(carried.state, state)), carried.rate, carried.h_abs
             method, event = carried.method, carried.event
-        else:  # a fresh run (Radau: its Jacobian formed at t, as solve_ivp's per segment)
+        else:  # a fresh run (Radau: its Jacobian formed at t)
             known, rate, method = False, np.empty(len(state)), self.method
             if self.implicit:
                 method = (method, radau_memory(len(state)))

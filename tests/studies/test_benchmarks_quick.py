@@ -103,6 +103,7 @@ PRINTS = {
     "scene_costs.py": ("chain", "four_bar", "ratio"),
     "simulate_share.py": ("ẋ share", "rows share", "DOP853"),
     "spinning_beam_chain.py": ("1. Ritz-constrained chain", "2. spin-up", "RitzBeam"),
+    "short_runs.py": ("CPU per run", "evaluations", "double_pendulum"),
     "sweep_points.py": ("CPU per point", "sweep (one thread)", "simulate, a new System"),
     "tangent_profile.py": ("andrews_squeezer: µs per call", "SVD of A_s", "evaluator.accelerations"),
 }
