@@ -86,8 +86,10 @@ class AutoEvaluator:
     def __init__(self, system):
         self.name, self._reason = pick(system)
         self.evaluator = system.evaluator(self.name)
-        if getattr(self.evaluator, "interpreted", None):  # the compiled kernel with pieces in Python (it warned)
-            self._reason = f"the compiled order-n kernel, with {', '.join(self.evaluator.interpreted)} in Python"
+        pieces = getattr(self.evaluator, "interpreted", None)
+        if pieces:  # a compiled kernel with pieces in Python (the order-n kernel's warned)
+            kernel = "the compiled order-n kernel" if self.name == "fast" else f"{self._reason}: the compiled kernel"
+            self._reason = f"{kernel}, with {', '.join(pieces)} in Python"
         self.accelerations = self.evaluator.accelerations  # the picked one's, called directly (one layer less per s̈)
         if hasattr(self.evaluator, "state_derivative"):  # ẋ in one call (projeq.simulate's right-hand side)
             self.state_derivative = self.evaluator.state_derivative

@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 from projeq.analysis.differentiation import COMPLEX_STEP
 from projeq.assembly import given, kernels
 from projeq.assembly.linalg import SINGULAR_PIVOT, SingularMassError, mass_scale
-from projeq.checks import kernel_state
+from projeq.checks import callable_name, kernel_state
 from projeq.joints import Prescribed
 
 
@@ -110,7 +110,8 @@ class HubBeamEvaluator:
         (:func:`compiled_unsupported` says why not; then interpreted); False: interpreted.
 
     Attributes: ``name`` ("hub_beam"), ``compiled`` (whether real arguments take the compiled
-    kernel), ``interpreted_reason`` (why not, or None), ``n_calls``.
+    kernel), ``interpreted_reason`` (why not, or None), ``interpreted`` (what the compiled kernel takes
+    from Python at every evaluation, by name: a callable hub motion's angles), ``n_calls``.
     """
 
     name = "hub_beam"
@@ -124,7 +125,7 @@ class HubBeamEvaluator:
         self._empty = np.zeros(0)
         self.n_calls = 0
         self.interpreted_reason = compiled_unsupported(system) if compiled else "compiled=False"
-        self.compiled = self.interpreted_reason is None
+        self.compiled, self.interpreted = self.interpreted_reason is None, []
         if self.compiled:
             self._pack(system)
 
@@ -142,6 +143,8 @@ class HubBeamEvaluator:
         # 1.04-1.12x of the spin-up's evaluation)
         printed = not (isinstance(joint, Prescribed) and joint.expression is None)
         callback = given.joint_callback(joint) if self._kind != kernels.FIXED and printed else None
+        if not printed:
+            self.interpreted = [f"the hub's motion {callable_name(joint.motion)} (θ, θ̇, θ̈ once per evaluation)"]
         self._kind = kernels.GIVEN if callback is not None else self._kind
         self._axis = np.array(inner.axis if self._kind in (kernels.REVOLUTE, kernels.PRISMATIC) else np.zeros(3),
                               dtype=float)

@@ -117,3 +117,20 @@ def test_compiled_values_that_differ_from_the_callables_own_are_caught():
     and the joint runs in Python, named once."""
     said, _ = _python_pieces(lambda t: (1e-20 * int(1e10 * t) ** 2, 2 * t, 2.0))
     assert len(said) == 1 and "differ from its own" in said[0], said
+
+
+def test_the_hub_beam_path_names_a_callable_hub_motion_it_takes_from_python():
+    """The hub-beam path (one RitzBeam on a Prescribed hub) keeps a callable motion's θ, θ̇, θ̈ in Python
+    (printing its row would load sympy into ``projeq run``); the default evaluator's reason says so by the
+    callable's name, without a warning; a motion in sympy is printed and compiled, and nothing is named."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        callable_hub = pq.scenes.spin_up_beam().evaluator()
+    assert callable_hub.name == "hub_beam" and callable_hub.evaluator.interpreted, callable_hub.reason
+    assert callable_hub.reason.startswith("one RitzBeam on a prescribed or fixed hub: the compiled kernel, with "
+                                          "the hub's motion ") and callable_hub.reason.endswith(" in Python")
+    system = pq.scenes.spin_up_beam()
+    hub = system.joints[0]
+    printed = pq.System(dict(zip(system.names, system.subsystems)),
+                        {system.names[0]: pq.Prescribed(hub.joint, "0.5*t**2")})
+    assert printed.evaluator().evaluator.interpreted == [] and "in Python" not in printed.evaluator().reason
