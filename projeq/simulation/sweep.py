@@ -139,7 +139,9 @@ def _exit_with_parent(parent: int) -> None:
 
 def run_point(scene: Scene, parameters: dict, outputs, t_end: float, options: dict):
     """Simulate one point; returns (status, output values, error message). Runs on a worker.
-    A SimulationError keeps its Result's status (−1 failed, 4 non-finite state)."""
+    A SimulationError keeps its Result's status (−1 failed, 4 non-finite state); Ctrl-C before the
+    integration started (building the scene, simulate's checks and choice of method, which
+    simulate does not turn into a partial result) is status 2 too, with no outputs."""
     from projeq.simulation.driver import simulate
 
     global _simulating
@@ -147,6 +149,8 @@ def run_point(scene: Scene, parameters: dict, outputs, t_end: float, options: di
         _simulating = True
         result = simulate(scene.build(**parameters), t_end, **options)
         return result.status, [output_value(result, o) for o in outputs], ""
+    except KeyboardInterrupt:
+        return 2, [np.nan] * len(outputs), "interrupted before its integration started"
     except Exception as exc:  # noqa: BLE001 - a failed point is reported in the table, never dropped
         status = exc.result.status if isinstance(exc, SimulationError) else -1
         return status, [np.nan] * len(outputs), _one_line(exc)

@@ -223,3 +223,18 @@ def test_a_scene_that_cannot_reach_the_workers_is_refused_before_any_work():
 def test_more_bad_input(kwargs, match):
     with pytest.raises(ValueError, match=match):
         sweep("atwood", **kwargs)
+
+
+def test_a_point_interrupted_before_its_integration_started_is_status_2():
+    """Ctrl-C on a worker while it builds the scene or simulate checks and chooses (before the run's
+    segments, which turn it into a partial result): the point is interrupted (status 2, no outputs),
+    as one stopped mid-run; before, the KeyboardInterrupt escaped and the point was marked not run."""
+    from projeq.scenes import SCENES
+
+    class Interrupted:
+        def build(self, **parameters):
+            raise KeyboardInterrupt
+
+    status, values, message = sweep_module.run_point(Interrupted(), {}, ["q0"], 1.0, {})
+    assert status == 2 and np.isnan(values).all() and message == "interrupted before its integration started"
+    assert sweep_module.run_point(SCENES["atwood"], {}, ["q0"], 0.01, {})[0] == 0
