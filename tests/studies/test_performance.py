@@ -34,9 +34,12 @@ def _timings(calls: list, clock=time.process_time) -> dict:
     return time_per_call(funcs, None, None, BUDGET * len(SIZES), clock)
 
 
-def test_order_n_evaluators_beat_dense_at_100_bodies():
-    """Wall time: CPU time would count the spinning threads of the dense evaluator's BLAS."""
-    calls = [(m, 100) for m in ("recursive", "fast", "dense") if m != "fast" or has_numba()]
+def test_order_n_evaluators_beat_dense_at_200_bodies():
+    """Wall time: CPU time would count the spinning threads of the dense evaluator's BLAS. The
+    interpreted recursive evaluator and the dense one (numpy's BLAS) cost the same at 100 bodies
+    (measured 4.4 and 4.4 ms, 4.2 and 4.2 ms: a comparison there fails on a loaded machine) and 8.0
+    against 13.5 ms at 200, 11.8 against 31 ms at 300 (the order-n pass against the n³ factorisation)."""
+    calls = [(m, 200) for m in ("recursive", "fast", "dense") if m != "fast" or has_numba()]
     seconds = {m: t for (m, _), t in _timings(calls, time.perf_counter).items()}
     assert seconds["recursive"] < seconds["dense"], seconds
     if has_numba():  # method="fast" is the compiled kernel, which needs numba
