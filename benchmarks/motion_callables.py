@@ -28,7 +28,7 @@ import numpy as np
 
 import projeq as pq
 from projeq.assembly import given
-from projeq.studies.timing import per_call
+from projeq.studies.timing import per_call, right_hand_side
 
 OMEGA, A, W = 2.0, 0.3, 5.0  # the chain's hub: θ = Ω t + a sin ωt
 
@@ -62,20 +62,6 @@ def hub_chain() -> pq.System:
                      {"hub": hub, "a": pq.Revolute("hub", axis="x", r_pn=(0.5, 0.0, 0.0)),
                       "b": pq.Revolute("a", axis="y", r_pn=(0.0, 0.0, -1.0))},
                      gravity=(0.0, 0.0, -9.81), q0=(0.4, -0.3))
-
-
-def right_hand_side(system: pq.System, ev):
-    """simulate's ẋ(t, x): the evaluator's one-call ẋ, else q̇ and its s̈ (as projeq.simulate)."""
-    fused = getattr(ev, "state_derivative", None)
-    n_q = system.n_q
-
-    def x_dot(t, x):
-        found = None if fused is None else fused(t, x)
-        if found is None:
-            found = np.concatenate((system.q_dot(x[:n_q], x[n_q:], t), ev.accelerations(x[:n_q], x[n_q:], t)))
-        return found
-
-    return x_dot
 
 
 def main(argv=None) -> dict:

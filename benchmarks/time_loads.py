@@ -29,7 +29,7 @@ import warnings
 import numpy as np
 
 import projeq as pq
-from projeq.studies.timing import per_call
+from projeq.studies.timing import per_call, right_hand_side
 
 A, OMEGA = 1.5, 3.0  # τ(t) = A sin(OMEGA t)
 
@@ -64,22 +64,6 @@ def models() -> dict:
             "BodyLoad of t": with_forces(base, [Push(body, 2.0, 3.0)]),
         }
     return found
-
-
-def right_hand_side(system: pq.System):
-    """simulate's ẋ(t, x): the default evaluator's one-call ẋ, else q̇ and its s̈ (as projeq.simulate)."""
-    ev = system.evaluator()
-    fused = getattr(ev, "state_derivative", None)
-    n_q = system.n_q
-
-    def x_dot(t, x):
-        found = None if fused is None else fused(t, x)
-        if found is None:
-            found = np.concatenate((system.q_dot(x[:n_q], x[n_q:], t), ev.accelerations(x[:n_q], x[n_q:], t)))
-        return found
-
-    return x_dot
-
 
 
 def main(argv=None) -> dict:

@@ -10,6 +10,23 @@ import timeit
 import numpy as np
 
 
+def right_hand_side(system, evaluator=None):
+    """simulate's ẋ(t, x) of ``system`` as a benchmark times it: the evaluator's one-call ẋ
+    (``state_derivative``; ``evaluator`` None: the system's default one), else q̇ and its s̈, as
+    :meth:`projeq.simulation.driver._Run.rhs` takes them."""
+    ev = system.evaluator() if evaluator is None else evaluator
+    fused = getattr(ev, "state_derivative", None)
+    n_q = system.n_q
+
+    def x_dot(t, x):
+        found = None if fused is None else fused(t, x)
+        if found is None:
+            found = np.concatenate((system.q_dot(x[:n_q], x[n_q:], t), ev.accelerations(x[:n_q], x[n_q:], t)))
+        return found
+
+    return x_dot
+
+
 def per_call(f, seconds: float) -> float:
     """µs per call of ``f()`` over about ``seconds`` (after one call that compiles or warms it),
     by :func:`timeit.timeit`: wall time, for the alternating rounds of a benchmark."""
