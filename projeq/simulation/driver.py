@@ -366,7 +366,7 @@ class _Run:
         # first step past b)
         self.dense_output, self.x_end, self.t_x_end = flag("dense_output", dense_output), None, t_start
         self.out_of_range = False  # warned that a subsystem left the range of its model
-        self.status, self.message = 0, "The solver successfully reached the end of the integration interval."
+        self.status, self.message = 0, FINISHED_MESSAGE
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
         self.loops, self.renting = {}, False  # (evaluator, its compiled loop or None) per evaluator and method
 
@@ -495,18 +495,12 @@ class _Run:
             self.nfev += solver.nfev - nfev
             if self.renting:
                 compilation.spend(_time.process_time() - started, "the integration loop")
-            sol = OdeSolution(steps, interpolants) if interpolants else SimpleNamespace(ts=np.array([a, solver.t]))
-            segment = SimpleNamespace(t=np.concatenate(times or [np.zeros(0)]),
-                                      y=np.vstack(rows or [np.zeros((0, len(self.x)))]).T, status=0, t_events=None,
-                                      y_events=None, sol=sol,
-                                      message="The solver successfully reached the end of the integration interval.")
+            segment = _segment(np.concatenate(times or [np.zeros(0)]), np.vstack(rows or [np.zeros((0, len(self.x)))]),
+                               a, solver.t if fired is None else fired[1])
+            if interpolants:
+                segment.sol = OdeSolution(steps, interpolants)
             if fired is not None:  # the model's event: solve_ivp's terminal event, its time and state
-                k, t_fired, x_fired = fired
-                segment.status, segment.message = 1, "A termination event occurred."
-                segment.t_events = [np.array([t_fired]) if i == k else np.zeros(0) for i in range(len(events))]
-                segment.y_events = [x_fired[None] if i == k else np.zeros((0, len(x_fired))) for i in range(len(events))]
-                if not interpolants:
-                    segment.sol = SimpleNamespace(ts=np.array([a, t_fired]))
+                _terminated(segment, fired[0], len(events), *fired[1:])
             self._keep(segment)
         if fired is not None:
             return segment
@@ -576,9 +570,7 @@ class _Run:
             self.nfev + stepped.nfev, self.njev + stepped.njev, self.steps + stepped.steps, self.calls + stepped.nfev,
             stepped.h_abs, stepped.t_failed)
         rows = stepped.rows
-        segment = SimpleNamespace(t=ahead[:len(rows)], y=rows.T, status=0, t_events=None, y_events=None,
-                                  sol=SimpleNamespace(ts=np.array([a, stepped.t])),
-                                  message="The solver successfully reached the end of the integration interval.")
+        segment = _segment(ahead[:len(rows)], rows, a, stepped.t)
         if stepped.status == loop.EVALUATION_FAILED:
             self._keep(segment)  # the rows up to the last accepted step
             self.checked_rhs(stepped.t_failed, stepped.x_failed)  # raises, naming why
@@ -588,9 +580,7 @@ class _Run:
         if stepped.status == loop.TOO_SMALL_STEP:
             segment.status, segment.message = -1, "Required step size is less than spacing between numbers."
         elif stepped.status == loop.MODEL_EVENT:  # the model's own terminal event, located where it fired
-            segment.status, segment.message = 1, "A termination event occurred."
-            segment.t_events = [np.zeros(0)] * len(self.events) + [np.array([stepped.t])]
-            segment.y_events = [np.zeros((0, len(stepped.state)))] * len(self.events) + [stepped.state[None].copy()]
+            _terminated(segment, len(self.events), len(self.events) + 1, stepped.t, stepped.state.copy())
         elif stepped.status in (loop.FINISHED, loop.PAUSED):
             self.x_end, self.t_x_end = stepped.state, stepped.t
             self.carried = None if stepped.carried is None else (compiled, stepped.carried)
@@ -801,6 +791,24 @@ def default_method(evaluator, model, q0: NDArray, s_dot0: NDArray, t0: float, t_
         return "Radau"
     high_order = rtol <= HIGH_ORDER_RTOL and not hasattr(model, "mobility")  # no constraint equations
     return "DOP853" if explicit_steps > FAST_MODE_STEPS or high_order else "RK45"
+
+
+FINISHED_MESSAGE = "The solver successfully reached the end of the integration interval."  # scipy's, status 0
+
+
+def _segment(t: NDArray, rows: NDArray, a: float, reached: float) -> SimpleNamespace:
+    """A segment stepped by the compiled loop or scipy's solver in the shape of solve_ivp's result: the
+    output times ``t`` and ``rows`` (one state per row), status 0, from a to the time ``reached``."""
+    return SimpleNamespace(t=t, y=rows.T, status=0, t_events=None, y_events=None,
+                           sol=SimpleNamespace(ts=np.array([a, reached])), message=FINISHED_MESSAGE)
+
+
+def _terminated(segment: SimpleNamespace, k: int, n_events: int, t: float, x: NDArray) -> None:
+    """``segment`` ended by event k of ``n_events`` (all terminal) at time t in the state x, as
+    solve_ivp gives a terminal event: status 1, its time and state in t_events and y_events."""
+    segment.status, segment.message = 1, "A termination event occurred."
+    segment.t_events = [np.array([t]) if i == k else np.zeros(0) for i in range(n_events)]
+    segment.y_events = [x[None] if i == k else np.zeros((0, len(x))) for i in range(n_events)]
 
 
 class _Interpolant:
