@@ -49,6 +49,7 @@ from projeq.assembly.kernels import (
     tree_accelerations,
     tree_state_derivative,
 )
+from projeq.checks import callable_name
 from projeq.joints.standard import MotionValues
 
 
@@ -133,8 +134,7 @@ def python_reason(joint, compiled: bool = True) -> str | None:
     if compiled and isinstance(values, MotionValues):
         callbacks, why = motion_callbacks(values)
         if callbacks is None:
-            name = getattr(values.motion, "__qualname__", type(values.motion).__name__)
-            return f"numba cannot compile its motion {name} ({why})"
+            return f"numba cannot compile its motion {callable_name(values.motion)} ({why})"
     return None
 
 
