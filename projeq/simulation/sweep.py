@@ -673,9 +673,11 @@ class _Run:
             process.join(1.0)
 
 
-def _finished(running: dict) -> set:
-    """The futures among ``running`` that are done, waiting for at least one."""
-    return cf.wait(running, return_when=cf.FIRST_COMPLETED)[0]
+def _finished(running: dict) -> list:
+    """The futures among ``running`` (future -> point index) that are done, waiting for at least one,
+    in their points' order: points that finished together are recorded, and appended to the table's
+    file, in input order (a set's order was arbitrary)."""
+    return sorted(cf.wait(running, return_when=cf.FIRST_COMPLETED)[0], key=running.get)
 
 
 def _workers(pool) -> list:
