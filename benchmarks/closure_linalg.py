@@ -4,14 +4,16 @@ the sizes used).
 
 :func:`projeq.constraints.compiled.tangent` takes the SVD of A_s (at q and at q moved onto the
 constraint manifold, :func:`~projeq.constraints.compiled._on_manifold`) and N_ind⁻¹,
-:func:`~projeq.constraints.compiled.partitioned` A_dep⁻¹, by the library's hand-written routines:
-one-sided Jacobi rotations preconditioned by a QR with column pivoting
-(:func:`~projeq.constraints.compiled._svd`; Drmač & Veselić, "New fast and accurate Jacobi SVD
-algorithm I", SIAM J. Matrix Anal. Appl. 29, 2008) and Gauss–Jordan elimination
-(:func:`~projeq.constraints.compiled._inverse`). Here the same kernels are compiled a second time with
-LAPACK's in their place (:func:`lapack_svd`: gesdd, as the numpy path; :func:`lapack_inverse`:
-getrf/getri; numba's ``np.linalg``, under the names the kernels call: the replacements of
-:func:`projeq.assembly.kernels.jit`), and both run in one process.
+:func:`~projeq.constraints.compiled.partitioned` A_dep⁻¹. The library's SVD
+(:func:`~projeq.constraints.compiled._svd`) is LAPACK's gesdd (:func:`~projeq.constraints.compiled._lapack_svd`,
+numba's ``np.linalg.svd``, as the numpy path) from ``LAPACK_SVD_SIZE`` entries of A_s on and below that the
+hand-written one-sided Jacobi rotations preconditioned by a QR with column pivoting
+(:func:`~projeq.constraints.compiled._jacobi_svd`; Drmač & Veselić, "New fast and accurate Jacobi SVD
+algorithm I", SIAM J. Matrix Anal. Appl. 29, 2008); its inverse is Gauss–Jordan elimination
+(:func:`~projeq.constraints.compiled._inverse`). Here the kernels are compiled twice, once with LAPACK's
+routines at every size (:func:`lapack_inverse`: getrf/getri, numba's ``np.linalg.inv``) and once with the
+hand-written ones, under the names the kernels call (the replacements of :func:`projeq.assembly.kernels.jit`),
+and both run in one process.
 
 Printed per model — the closed-loop scenes: the four-bar and the Whipple bicycle partitioned (A_dep
 2 × 2 and 5 × 5); the simple pendulum, the double four-bar (IFToMM A02, N = 2), Bricard's mechanism,
@@ -32,8 +34,8 @@ its first call (CPU seconds of each step).
     python benchmarks/closure_linalg.py --quick         # both variants interpreted, small models (the test)
 
 OPENBLAS_NUM_THREADS=1 unless set (single-threaded CPU times): with BLAS threads on a loaded machine
-(``OPENBLAS_NUM_THREADS=2 … --models "A02 N=40"``) the 80 × 81 SVDs slow down up to 100-fold, as
-benchmarks/iftomm.py says — the reason the kernels keep the hand-written SVD there too. ``--quick`` runs
+(``OPENBLAS_NUM_THREADS=2 … --models "A02 N=40"``) the 80 × 81 SVDs slow down up to 10-fold: the library
+holds BLAS to one thread around the kernels that call LAPACK (:func:`projeq.assembly.linalg.one_blas_thread`). ``--quick`` runs
 both variants' kernels interpreted (plain Python on numpy: nothing to compile) on the three smallest
 models: it checks that the script runs and that both give the same s̈, not their speed.
 """
@@ -86,21 +88,6 @@ STATES = 4  # moving states per model, taken in turn
 COMPILED_FIRST = {"partitioned": pq.scenes.four_bar, "tangent": n_four_bar}
 
 
-def lapack_svd(A):
-    """(U, σ, Vᵀ) of A (m × n) by LAPACK (numba's ``np.linalg.svd``: gesdd, as the numpy path's
-    NullSpaceForm._decomposition) in the form the kernels read (:func:`~projeq.constraints.compiled._svd`):
-    U m × m, Vᵀ n × n, σ with all n singular values, those beyond the m rows zero (as
-    NullSpaceForm._branch pads them); NaN where LAPACK refuses A (not finite: the kernel flags it)."""
-    m, n = A.shape
-    try:
-        U, values, Vt = np.linalg.svd(A)
-    except Exception:  # noqa: BLE001 — numba raises LinAlgError, catchable only as Exception
-        return np.full((m, m), np.nan), np.full(n, np.nan), np.full((n, n), np.nan)
-    sigma = np.zeros(n)
-    sigma[:values.shape[0]] = values
-    return U, sigma, Vt
-
-
 def lapack_inverse(A):
     """A⁻¹ by LAPACK (numba's ``np.linalg.inv``: getrf, getri), ∞ entries where A is singular or not
     finite, as :func:`~projeq.constraints.compiled._inverse` gives them (the kernel flags them)."""
@@ -110,22 +97,21 @@ def lapack_inverse(A):
         return np.full(A.shape, np.inf)
 
 
-#: the two variants of the kernels' linear algebra: the routines under the names the kernels call
-#: (the hand-written ones are the library's)
-VARIANTS = {"lapack": {"_svd": lapack_svd, "_inverse": lapack_inverse}, "hand": {}}
+#: the two variants of the kernels' linear algebra: the routines under the names the kernels call (the
+#: library's _svd calls LAPACK's from LAPACK_SVD_SIZE entries on, the hand-written one below; its _inverse
+#: is the hand-written one)
+VARIANTS = {"lapack": {"_svd": compiled._lapack_svd, "_inverse": lapack_inverse},
+            "hand": {"_svd": compiled._jacobi_svd}}
 
 
 def variant_kernels(variant: str) -> dict:
     """{"partitioned": …, "tangent": …}: the closure kernels of rigid trees with a Φ of their own (the
-    models here) with the routines of ``variant``: the library's own
-    (:func:`projeq.constraints.compiled._compiled`), or compiled as it compiles them with LAPACK's in
-    their place (cached on disk under names of their own)."""
-    if not VARIANTS[variant]:
-        return compiled._compiled(False, False)
+    models here) compiled as :func:`projeq.constraints.compiled._compiled` compiles them with the routines
+    of ``variant`` in their place (cached on disk under names of their own)."""
     rules = ("partitioned", "tangent")
     functions = [getattr(compiled, rule) for rule in rules]
     names = tuple(f"{variant}_{rule}" for rule in rules)
-    callees = compiled._HELPERS + (lapack_svd, lapack_inverse)  # in the digest of the names
+    callees = compiled._HELPERS + (lapack_inverse,)  # in the digest of the names
     return dict(zip(rules, kernels.jit(*functions, callees=callees, names=names,
                                        kernels=compiled._compiled_callees(False), **VARIANTS[variant])))
 

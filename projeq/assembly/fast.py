@@ -510,11 +510,13 @@ class LoopModel:
     partition degenerating, κ − limit rising), as (an array whose first entry the kernel writes at each
     evaluation, the limit that value rises through), which the explicit methods locate in the loop
     (``checks_events``: it has one); ``before()``: called before each compiled segment (state the kernel
-    keeps between calls)."""
+    keeps between calls); ``lapack``: the kernel calls LAPACK on matrices large enough that the loop holds
+    BLAS to one thread (:func:`projeq.assembly.linalg.one_blas_thread`)."""
 
-    def __init__(self, kernel, pre: tuple, tree: tuple, post: tuple, event: tuple | None = None, before=None):
+    def __init__(self, kernel, pre: tuple, tree: tuple, post: tuple, event: tuple | None = None, before=None,
+                 lapack: bool = False):
         self.kernel, self.pre, self.tree, self.post, self.loops = kernel, pre, tree, post, {}
-        self.checks_events, self.before = event is not None, before
+        self.checks_events, self.before, self.lapack = event is not None, before, lapack
         self.event = (np.zeros(1), np.inf) if event is None else event
 
 

@@ -1,7 +1,10 @@
-"""Small symmetric positive definite solves with errors that say which matrix failed."""
+"""Small symmetric positive definite solves with errors that say which matrix failed, and BLAS held to
+one thread around the compiled calls of LAPACK."""
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import warnings
 
 import numpy as np
@@ -17,6 +20,30 @@ class AccuracyWarning(UserWarning):
 
 class SingularMassError(ValueError):
     """A mass matrix (system M or a recursive pivot D_n) is singular or indefinite."""
+
+
+@contextlib.contextmanager
+def one_blas_thread(needed: bool = True):
+    """BLAS held to one thread while the block runs (where ``needed``; threadpoolctl's limit, process-wide,
+    restored after): the compiled closures call LAPACK's SVD on matrices of at most a few hundred rows,
+    where OpenBLAS's threads only contend — an 80 × 81 SVD 6.4–6.9 ms with them against 0.87–0.91 ms
+    without, two processes timing it beside a third busy one on two cores
+    (:func:`projeq.constraints.compiled._lapack_svd`). Entering costs about 20 µs."""
+    if not needed:
+        yield
+        return
+    with _blas_controller().limit(limits=1, user_api="blas"):
+        yield
+
+
+@functools.cache
+def _blas_controller():
+    """threadpoolctl's controller of the BLAS libraries loaded (scipy's, which numba's LAPACK calls, and
+    numpy's), found once."""
+    import scipy.linalg  # noqa: F401 - its BLAS loaded before the controller looks for it
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
 
 
 def mass_scale(system) -> float:

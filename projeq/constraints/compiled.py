@@ -75,7 +75,7 @@ from projeq.assembly import compilation, kernels, loads
 from projeq.assembly.given import generated_module, given_motions, intrinsics, joint_callback, joint_table
 from projeq.assembly.kernels import (N_COLS, N_Y, PARENT, S_INDEX, add_cross, add_motion_cross, bias_rates,
                                      chain_matrix_into, cholesky, cholesky_solve, dot6, port_motion)
-from projeq.assembly.linalg import SINGULAR_PIVOT
+from projeq.assembly.linalg import SINGULAR_PIVOT, one_blas_thread
 from projeq.checks import depends_on_t
 from projeq.constraints.batched import NODES, WEIGHTS
 from projeq.constraints.cut_joints import point_rows
@@ -90,6 +90,9 @@ DONE, DEGENERATE, SINGULAR, UNLOADED, NOT_COMPILED = 0, 1, 2, 3, -1
 #: the share of a partition's event limit from which the compiled loop's ẋ (:func:`partitioned_state_derivative`)
 #: writes κ itself, not its bound: below 1, so that round-off between the bound and κ cannot miss the event
 EVENT_MARGIN = 0.999
+
+#: the entries of A_s (m · n) from which :func:`_svd` calls LAPACK (faster from 14 × 15 on, its docstring)
+LAPACK_SVD_SIZE = 200
 
 
 class UncompiledClosureWarning(UserWarning):
@@ -1000,21 +1003,47 @@ def _particular(U: NDArray, sigma: NDArray, Vt: NDArray, gamma: NDArray, count: 
 
 
 def _svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-    """(U, σ, Vᵀ) of A (m × n) with all n singular values, descending (those beyond m zero to
-    round-off), V n × n and U m × n (column j = A v_j / σ_j, zero where σ_j = 0), for the few rows
-    and columns of a loop's A_s, without LAPACK's calls and workspace: the QR decomposition with
+    """(U, σ, Vᵀ) of A (m × n) with all n singular values, descending (those beyond m zero), V n × n
+    and U m × n (its first min(m, n) columns the left singular vectors): by LAPACK
+    (:func:`_lapack_svd`) from LAPACK_SVD_SIZE entries on, below that by the hand-written
+    :func:`_jacobi_svd`, which is faster there. benchmarks/closure_linalg.py times them alone
+    (single-threaded BLAS, µs per SVD of an m × (m + 1) A_s, LAPACK's over Jacobi's): 7.4 / 4.7 at
+    6 × 7, 15.1 / 11.6 at 10 × 11, 21.1 / 17.7 at 12 × 13, 26.8 / 28.3 at 14 × 15, 52 / 65 at
+    20 × 21, 182 / 457 at 40 × 41, 690 / 3500 at 80 × 81 (the IFToMM A02 N-four-bar with N = 40)."""
+    if A.shape[0] * A.shape[1] >= LAPACK_SVD_SIZE:
+        return _lapack_svd(A)
+    return _jacobi_svd(A)
+
+
+def _lapack_svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """:func:`_svd` by LAPACK's gesdd (numba's ``np.linalg.svd``, as the numpy path's
+    NullSpaceForm._decomposition); NaN where LAPACK refuses A (not finite, or no convergence: the
+    kernel then flags it, as the hand-written SVD's NaN do). Its callers hold the BLAS threads to one
+    (:func:`projeq.assembly.linalg.one_blas_thread`): with OpenBLAS's threads on a loaded two-core
+    machine one 80 × 81 SVD took 6.4–6.9 ms against 0.87–0.91 ms single-threaded (two processes
+    each timing it beside a third busy one)."""
+    m, n = A.shape
+    U, sigma = np.zeros((m, n)), np.zeros(n)
+    if not np.all(np.isfinite(A)):
+        return U + np.nan, sigma + np.nan, np.full((n, n), np.nan)
+    try:
+        U_full, values, Vt = np.linalg.svd(A)
+    except Exception:  # noqa: BLE001 — numba raises LinAlgError, catchable only as Exception
+        return U + np.nan, sigma + np.nan, np.full((n, n), np.nan)
+    p = values.shape[0]
+    sigma[:p] = values
+    U[:, :p] = U_full[:, :p]
+    return U, sigma, Vt
+
+
+def _jacobi_svd(A: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """:func:`_svd` for the few rows and columns of a small loop's A_s, without LAPACK's calls and
+    workspace (U's column j = A v_j / σ_j, zero where σ_j = 0): the QR decomposition with
     column pivoting of Aᵀ (:func:`_transposed_qr`, A[order] Q = [L 0]) as the preconditioner of
     Drmač & Veselić ("New fast and accurate Jacobi SVD algorithm I", SIAM J. Matrix Anal. Appl. 29,
     2008, §3: the one-sided Jacobi method on Rᵀ = L converges in fewer sweeps than on A), then
     one-sided Jacobi rotations of the columns of L (:func:`_jacobi` of [L; E]ᵀ): L W = Ũ Σ, so that
-    V = Q diag(W, E) and U[order] = Ũ. Not LAPACK's gesdd (numba's ``np.linalg.svd``, as the numpy path),
-    which benchmarks/closure_linalg.py times against it in the same kernels — LAPACK's time over this
-    one's per tangent s̈: 1.28 with A_s 1 × 2, 1.31 at 4 × 5, 1.34 at 5 × 5 and 6 × 7, 0.99 at 20 × 21,
-    0.31 at 80 × 81 (the IFToMM A02 N-four-bar, N = 10 and 40) with single-threaded BLAS; but with
-    BLAS threads on a loaded machine (tests in two processes on two cores) one 80 × 81 SVD takes
-    430 ms against 7 ms single-threaded, and the A02 N = 40 reference test
-    (tests/constraints/test_iftomm_references.py) ran 162 s by LAPACK (35 s single-threaded) against
-    22 s by this SVD."""
+    V = Q diag(W, E) and U[order] = Ũ."""
     m, n = A.shape
     X, Qt, order = _transposed_qr(A)  # X = [L; E]ᵀ
     p = X.shape[0]
@@ -1195,6 +1224,7 @@ _HELPERS = (_jacobian, _gamma, _constraint_rows, _constraint_gamma, _constraint_
             _pin_constraint_values, _on_manifold, _pin_constraint_rows,
             _pin_constraint_gamma, _pfaffian_rows, _pfaffian_gamma, _pin_frame, _port_chain, _pin_values, _pin_rates,
             _body_jacobians, _inertial_axis, _pin_jacobian, _pin_gamma, given_motions, _matvec, _matmul, _svd,
+            _lapack_svd, _jacobi_svd,
             _transposed_qr, _reflect, _jacobi, _row_square, _scaled, _particular, _chain_terms, _projected,
             _inverse, _partition, _projected_onto, _tangent_velocities, _write_row)
 
@@ -1349,6 +1379,7 @@ class CompiledClosure:
         self._workspace = ev._real
         self.tree = tree_arrays(ev, float)
         self._A, self._s_ddot_tree, self._q_dot = np.zeros((m, tree.n_s)), np.zeros(tree.n_s), np.zeros(tree.n_s)
+        self.lapack = m * tree.n_s >= LAPACK_SVD_SIZE  # its calls hold BLAS to one thread (:func:`_lapack_svd`)
         self._kappa = np.zeros(1)  # κ (the tangent rule) or its bound (partitioning), written by the kernel
         self._kept = (None, None)  # (the system, the tangent it keeps) of the last call (_kept_tangent)
 
@@ -1357,17 +1388,22 @@ class CompiledClosure:
         which the call updates as the numpy path does) into the workspace; whether it is done."""
         M, b = self._workspace.M_all, self._workspace.b_all
         q, s_dot, t = kernels.kernel_array(q), kernels.kernel_array(s_dot), float(t)
+        if not self.lapack:  # (no context per call of a small loop's s̈: about 1 µs)
+            return self._kernel_call(system, q, s_dot, t, M, b) == DONE
+        with one_blas_thread():
+            return self._kernel_call(system, q, s_dot, t, M, b) == DONE
+
+    def _kernel_call(self, system, q: NDArray, s_dot: NDArray, t: float, M: NDArray, b: NDArray) -> int:
+        """The kernel's flag at (q, ṡ, t) (:meth:`_call`)."""
         if self.rule == "partitioned":
-            flag = self.kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, q, s_dot, t,
+            return self.kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, q, s_dot, t,
                                self.m_h, system.independent, system.dependent,
                                self.constants[0], SINGULAR_PIVOT, self._q_dot, self._s_ddot_tree, self._A, M, b,
                                self._kappa)
-        else:
-            flag = self.kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, q, s_dot, t,
-                               self.m_h, system.independent, system.tree.n_s - system.n_s,
-                               system.separation, self.constants[0], self._kept_tangent(system), SINGULAR_PIVOT,
-                               self._q_dot, self._s_ddot_tree, self._A, M, b, self._kappa)
-        return flag == DONE
+        return self.kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree, q, s_dot, t,
+                           self.m_h, system.independent, system.tree.n_s - system.n_s,
+                           system.separation, self.constants[0], self._kept_tangent(system), SINGULAR_PIVOT,
+                           self._q_dot, self._s_ddot_tree, self._A, M, b, self._kappa)
 
     def _kept_tangent(self, system) -> NDArray:
         """The tangent ``system`` keeps (TangentSystem._tangent) as the array the kernel reads and
@@ -1414,10 +1450,11 @@ class CompiledClosure:
         rule = (True, system.dependent, float(self.constants[0]), 0, 0.0, 0.0, _NO_TANGENT) if partitioned else \
             (False, _NO_INDICES, 0.0, system.tree.n_s - system.n_s, float(system.separation),
              float(self.constants[0]), self._kept_tangent(system))
-        done = self.rows_kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree,
-                                kernels.kernel_array(q_rows), kernels.kernel_array(s_rows), kernels.kernel_array(times),
-                                self.m_h, system.independent, *rule, float(tolerance), RANK_TOLERANCE, int(steps),
-                                q_out, s_tree, residuals, ranks)
+        with one_blas_thread(self.lapack):
+            done = self.rows_kernel(self.phi, self.pins, self.fields, self.pfaffian, self.joints, self.tree,
+                                    kernels.kernel_array(q_rows), kernels.kernel_array(s_rows),
+                                    kernels.kernel_array(times), self.m_h, system.independent, *rule, float(tolerance),
+                                    RANK_TOLERANCE, int(steps), q_out, s_tree, residuals, ranks)
         return (q_out, s_tree, residuals, ranks) if done == k else None
 
     def loop_model(self, system):
@@ -1436,12 +1473,12 @@ class CompiledClosure:
         if self.rule == "partitioned":
             return LoopModel(_compiled_adapter(self.kernel.compiled, self.rule), pre, (system.independent, system.dependent),
                              (self.m_h, float(self.constants[0]), float(SINGULAR_PIVOT), float(system.limit),
-                              *buffers, self._kappa), event=event)
+                              *buffers, self._kappa), event=event, lapack=self.lapack)
         kept = self._kept_tangent(system)
         return LoopModel(_compiled_adapter(self.kernel.compiled, self.rule), pre, (system.independent,),
                          (self.m_h, system.tree.n_s - system.n_s, float(system.separation), float(self.constants[0]),
                           kept, float(SINGULAR_PIVOT), *buffers, self._kappa),
-                         event=event, before=lambda: self._keep_tangent(system, kept))
+                         event=event, before=lambda: self._keep_tangent(system, kept), lapack=self.lapack)
 
     def _keep_tangent(self, system, kept: NDArray) -> None:
         """The tangent ``system`` keeps, in the array ``kept`` the compiled loop's ẋ reads and writes

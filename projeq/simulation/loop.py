@@ -46,6 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from projeq.assembly import compilation, kernels
+from projeq.assembly.linalg import one_blas_thread
 
 #: the explicit methods the compiled loop steps (scipy's names), and all of them (Radau IIA the implicit one)
 EXPLICIT = ("RK23", "RK45", "DOP853")
@@ -833,8 +834,8 @@ class CompiledLoop:
         if model.before is not None:
             model.before()
         while status == PAUSED:
-            with _signals_held():  # the arguments of the types compiled for (the entry point checks none)
-                status, n_rows, more, taken, t, h_abs, t_failed = self.compiled(
+            with _signals_held(), one_blas_thread(model.lapack):  # the arguments of the types compiled for
+                status, n_rows, more, taken, t, h_abs, t_failed = self.compiled(  # (the entry point checks none)
                     self.kernel, model.pre, model.tree, model.post, int(n_q), method, float(t), float(t_bound),
                     known, float(h_abs), float(max_step), float(rtol), float(atol), int(every), float(t_pause),
                     retries, t_eval, n_rows, rows, state, rate, x_failed, event)

@@ -349,18 +349,19 @@ def _svd_cases():
         yield f"{m}x{n} rank 0", np.zeros((m, n))
 
 
-def test_the_kernels_svd_gives_lapacks_singular_values_null_space_and_pseudo_inverse():
-    """The kernel's SVD (QR-preconditioned one-sided Jacobi, Drmač & Veselić 2008; norms updated
-    by the rotations, de Rijk 1989) against numpy's LAPACK SVD on matrices of the sizes of a loop's
-    A_s: the same singular values, the same null space (its orthogonal projector: the basis of a
-    null space of dimension > 1 is not unique) and the same pseudo-inverse V Σ⁺ Uᵀ over the
-    nonzero singular values (unique, also where singular values repeat), each to 3e-14 of its
-    size; U Σ Vᵀ = A and V orthogonal (measured at most 2.7e-15 of the size, V's orthogonality; the
-    bound was 1e-13)."""
+@pytest.mark.parametrize("svd", [compiled._jacobi_svd, compiled._lapack_svd], ids=["jacobi", "lapack"])
+def test_the_kernels_svd_gives_lapacks_singular_values_null_space_and_pseudo_inverse(svd):
+    """Both of the kernels' SVDs — QR-preconditioned one-sided Jacobi (Drmač & Veselić 2008; norms
+    updated by the rotations, de Rijk 1989), and LAPACK's in the form the kernels read — against
+    numpy's LAPACK SVD on matrices of the sizes of a loop's A_s: the same singular values, the same
+    null space (its orthogonal projector: the basis of a null space of dimension > 1 is not unique)
+    and the same pseudo-inverse V Σ⁺ Uᵀ over the nonzero singular values (unique, also where
+    singular values repeat), each to 3e-14 of its size; U Σ Vᵀ = A and V orthogonal (Jacobi's
+    measured at most 2.7e-15 of the size, V's orthogonality; the bound was 1e-13)."""
     tol = 3e-14
     for name, A in _svd_cases():
         m, n = A.shape
-        U, sigma, Vt = compiled._svd(A)
+        U, sigma, Vt = svd(A)
         expected = np.linalg.svd(A, compute_uv=False)
         scale = max(expected.max(initial=0.0), 1e-300)
         rank = int(np.sum(expected > 1e-10 * scale))
@@ -375,6 +376,47 @@ def test_the_kernels_svd_gives_lapacks_singular_values_null_space_and_pseudo_inv
         pseudo_inverse = (Vt[:rank].T / sigma[:rank]) @ U[:, :rank].T
         expected_inverse = np.linalg.pinv(A, rcond=1e-10)
         assert np.abs(pseudo_inverse - expected_inverse).max() <= tol * max(1.0, np.abs(expected_inverse).max()), name
+
+
+def test_the_kernels_svd_is_lapacks_from_its_size_on_and_nan_where_lapack_refuses():
+    """_svd takes LAPACK's from LAPACK_SVD_SIZE entries on (the A02 N-four-bar's 80 × 81 with N = 40:
+    the same factors as _lapack_svd's, bit for bit) and Jacobi's below (12 × 13); the two agree at
+    80 × 81 to 1e-13 in σ and the null space (measured 7.7e-15 and 3.3e-16); A with a NaN gives NaN
+    factors, which the kernel flags, not LAPACK's error."""
+    rng = np.random.default_rng(80)
+    large, small = rng.standard_normal((80, 81)), rng.standard_normal((12, 13))
+    assert large.size >= compiled.LAPACK_SVD_SIZE > small.size
+    for A, routine in ((large, compiled._lapack_svd), (small, compiled._jacobi_svd)):
+        assert all(np.array_equal(a, b) for a, b in zip(compiled._svd(A), routine(A)))
+    (_, sigma_l, Vt_l), (_, sigma_j, Vt_j) = compiled._lapack_svd(large), compiled._jacobi_svd(large)
+    assert np.abs(sigma_l - sigma_j).max() <= 1e-13 * sigma_l[0]
+    assert np.abs(np.outer(Vt_l[-1], Vt_l[-1]) - np.outer(Vt_j[-1], Vt_j[-1])).max() <= 1e-13
+    large[3, 4] = np.nan
+    assert all(np.isnan(factor).all() for factor in compiled._lapack_svd(large))
+
+
+def test_a_closure_that_calls_lapack_holds_blas_to_one_thread_while_its_kernel_runs():
+    """The A02 N-four-bar with N = 10 (A_s 20 × 21: LAPACK's SVD) runs its kernel with every BLAS library at
+    one thread and gives the threads back after (on a machine of one core both are 1: then only the latter
+    is shown); its loop model says so to the compiled loop, which holds them the same way. The four-bar
+    (A_s 2 × 3: Jacobi's) leaves them alone."""
+    from threadpoolctl import threadpool_info
+
+    from projeq.scenes.iftomm import n_four_bar
+
+    def blas_threads():
+        return [info["num_threads"] for info in threadpool_info() if info["user_api"] == "blas"]
+
+    before = blas_threads()
+    model, small = n_four_bar(10), pq.scenes.four_bar()
+    closure = model.compiled_kernel()
+    assert closure.lapack and not small.compiled_kernel().lapack
+    assert closure.loop_model(model).lapack
+    seen, call = [], closure._kernel_call
+    closure._kernel_call = lambda *arguments: (seen.append(blas_threads()), call(*arguments))[1]
+    closure.minimal_accelerations(model, model.q0, model.s_dot0, 0.0)
+    assert seen[0] == [1] * len(before)
+    assert blas_threads() == before
 
 
 def test_the_closure_linalg_benchmark_runs_and_both_variants_give_the_same_accelerations(capsys):
