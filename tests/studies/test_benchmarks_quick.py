@@ -75,6 +75,7 @@ PRINTS = {
     "exudyn_spin_up.py": ("max |v − ref| m", "projeq "),
     "fastest_mode.py": ("ρ exact", "double_pendulum", "four_bar"),
     "flexible_arm.py": ("rigid last link", "RitzBeam, 4 functions", "Radau"),
+    "flexible_arm_alpha.py": ("generalized-α, fixed steps", "h = 0.01 s, ρ∞ 0.9", "per-component error estimate"),
     "flexible_arm_integrators.py": ("DOP853 compiled", "exprb43", "ETDRK4", "costs inside a compiled loop"),
     "flexible_arm_exudyn.py": ("cheapest run of each code per error level", "the issue's targets",
                                "simulate(rtol=1e-04)"),
