@@ -50,7 +50,6 @@ import numpy as np
 
 import projeq as pq
 from projeq.constraints.augmented import AugmentedSystem
-from projeq.constraints.partitioned import ConstrainedSystem
 from projeq.scenes.bicycle import whipple_bicycle
 from projeq.scenes.iftomm import (
     ANDREWS_REFERENCE, _flyball_geometry, andrews_balance, andrews_error, andrews_squeezer, bricard, flyball_balance,
@@ -217,7 +216,7 @@ def references(args) -> None:
     """A01 over its 2000 s and A02 (N = 40) over its 20 s against the published files: the largest
     distance of the output point from the file's rows (A01's file mirrored, x → −x: it starts at
     x = −1, the specification's text at +1) and from the closed form, per rtol, with CPU time."""
-    print(f"\nagainst the published reference files (benchmark criterion: 1e-3 over the whole horizon)")
+    print("\nagainst the published reference files (benchmark criterion: 1e-3 over the whole horizon)")
     print(f"{'problem':<22}{'t_end':>7}{'rtol':>7}{'CPU s':>8}{'nfev':>8}{'file error m':>14}{'exact error m':>15}")
     a01 = reference("A01")
     if a01 is not None:
