@@ -17,7 +17,10 @@ first step that reaches it and the next segment goes on from there with the same
 takes the steps of one segment (bit for bit on a tree; a closed loop's state is projected onto
 Φ = 0 where a segment ends) — on short runs up to 40 % fewer evaluations (the double pendulum over
 0.5 s: 203 instead of 351) — and a step that passes several ends finishes those segments together
-(``progress`` is called once, with the time reached). With events of the user's each segment is a
+(``progress`` is called once, with the time reached). On a tree whose segment ends change nothing (no
+quaternion to normalise) one call of the compiled loop takes as many segments as it reaches within
+``CHUNK_EVALUATIONS`` at the last call's pace (``_Run.chunk_end``: fewer returns to Python; the checks,
+``progress`` and Ctrl-C then act at the end of such a chunk). With events of the user's each segment is a
 solve_ivp call that ends at the segment's end.
 Quaternions are normalised where the pose is evaluated and in the output.
 
@@ -208,7 +211,8 @@ def simulate(
         Right-hand side (default: the model's, :meth:`projeq.system.Model.evaluator`).
     progress : callable ``progress(t)``, optional
         Called after each segment with the time reached (the end of the integrator's first step past
-        the segment's end; once for the segments one step passes; with events, the segment's end).
+        the segment's end; once for the segments one step passes, or one call of the compiled loop joins
+        on a tree; with events, the segment's end).
     jac : "exact", "differences", callable or matrix
         For Radau, BDF and LSODA: ∂ẋ/∂x by the complex step through the model ("exact",
         the default; exact to round-off, n complex evaluations per Jacobian, counted in
@@ -256,6 +260,7 @@ def simulate(
             a, b = segments.popleft()
             if b <= run.t_x:  # the compiled loop's last step went past this segment's end: its rows are kept
                 continue
+            b = run.chunk_end(b, segments)
             segment = run.solve(run.t_x, b)
             if run.model_event_fired(segment):  # a ConstrainedSystem's partition degenerates
                 a = run.after_model_event(segment)
@@ -369,6 +374,7 @@ class _Run:
         self.status, self.message = 0, FINISHED_MESSAGE
         self.fired = [([], [], []) for _ in self.events]  # the user's events: times, q, ṡ
         self.loops, self.renting = {}, False  # (evaluator, its compiled loop or None) per evaluator and method
+        self.chunk_rate = None  # evaluations per simulated second of the last compiled call that may join segments
 
     def rhs(self, t: float, x: NDArray) -> NDArray:
         """ẋ = (q̇, s̈) of the current model: by the evaluator's ``state_derivative`` where it
@@ -566,6 +572,8 @@ class _Run:
             self.model.n_q, a, self.x, self.t_end, first, float(self.options.get("max_step", np.inf)), self.rtol,
             self.atol, np.ascontiguousarray(ahead, dtype=float), self._paused,
             MONITOR_EVERY if self.may_be_singular else 0, b, carried)
+        joins = self.model.tree is self.model and not self.model.tree._normalizing and stepped.t > a
+        self.chunk_rate = stepped.nfev / (stepped.t - a) if joins else None
         self.nfev, self.njev, self.steps, self.calls, self.step_size, self.reached = (
             self.nfev + stepped.nfev, self.njev + stepped.njev, self.steps + stepped.steps, self.calls + stepped.nfev,
             stepped.h_abs, stepped.t_failed)
@@ -588,6 +596,20 @@ class _Run:
         if stepped.stopped_by is not None:  # the monitor's verdict, the rows before it kept
             raise stepped.stopped_by
         return segment
+
+    def chunk_end(self, b: float, segments: deque) -> float:
+        """The end of the next call of the compiled loop: b, or the end of the last of the following
+        ``segments`` (taken from it) that the loop reaches within ``CHUNK_EVALUATIONS`` at the last call's
+        evaluations per simulated second, where that call stepped a tree whose segment ends change nothing
+        (no joint whose coordinates are normalised: the same steps, bit for bit): each return to Python
+        costs about 0.1 ms, a tenth of a short run's CPU (the double pendulum over 0.5 s: 9 calls, 2 now).
+        Counted in evaluations, not seconds, so that a run's calls, and where its checks of the rows fall
+        (progress, a subsystem out of range), do not depend on the machine's load; such a chunk lasts a
+        few milliseconds to a second (1 µs to 0.5 ms per evaluation), as a segment may."""
+        while self.chunk_rate is not None and segments and \
+                (segments[0][1] - self.t_x) * self.chunk_rate < CHUNK_EVALUATIONS:
+            b = segments.popleft()[1]
+        return b
 
     def _paused(self, t: float, x: NDArray) -> None:
         """The check of :meth:`_monitor` where a compiled segment pauses (every ``MONITOR_EVERY``
@@ -694,6 +716,7 @@ class _Run:
             self.message, self.cause = _described(exc), exc
 
 
+CHUNK_EVALUATIONS = 2000  # evaluations of a compiled call that joins the segments of a tree (_Run.chunk_end)
 FAST_MODE_STEPS = 500  # RK45 steps forced by stability alone beyond which DOP853 is the default
 STIFF_STEPS = 100_000  # DOP853 steps forced by stability alone beyond which Radau is the default
 HIGH_ORDER_RTOL = 1e-7  # at rtol this tight or tighter the eighth order of DOP853 pays on every model measured

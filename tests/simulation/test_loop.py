@@ -52,16 +52,17 @@ STEPS_RTOL = (1.1e-12, 1.5e-11)
 @pytest.mark.parametrize("scene", ["chain", "rolling_disk"])
 def test_the_compiled_loop_takes_scipys_steps(scene, method, calls):
     """A tree without (chain) and with (rolling disk: the rolling joint's C callbacks) joints of kind
-    GIVEN: the compiled loop runs every segment, with the steps of its own run in one segment (bit for
-    bit), and equals scipy's run of the same method in one segment (same evaluations, q and ṡ to
-    round-off)."""
+    GIVEN: the compiled loop runs the 20 segments in calls that join them (driver.CHUNK_EVALUATIONS: 2 to
+    10 here), with the steps of its own run in one segment (bit for bit), and equals scipy's run of the
+    same method in one segment (same evaluations, q and ṡ to round-off)."""
     system = getattr(pq.scenes, scene)()
     compiled = pq.simulate(system, 1.0, method=method, n_points=101)
-    assert calls["segments"] == 20
+    joined = calls["segments"]
+    assert 2 <= joined < 20  # the first segment alone, then as many as CHUNK_EVALUATIONS reach
     one = pq.simulate(system, 1.0, method=method, n_points=101, n_segments=1)  # the same steps, bit for bit
     assert compiled.nfev == one.nfev and np.array_equal(compiled.q, one.q) and np.array_equal(compiled.s_dot, one.s_dot)
     reference = pq.simulate(system, 1.0, method=getattr(scipy.integrate, method), n_points=101, n_segments=1)
-    assert calls["segments"] == 21  # scipy's class: solve_ivp steps
+    assert calls["segments"] == joined + 1  # scipy's class: solve_ivp steps
     assert compiled.nfev == reference.nfev
     dq, ds = _differences(compiled, reference)
     assert dq <= STEPS_RTOL[0] and ds <= STEPS_RTOL[1], (dq, ds)
@@ -133,15 +134,30 @@ def test_a_partition_degenerating_inside_a_compiled_segment(calls):
     assert calls["segments"] == 2 * 2  # the compiled loop up to κ, and after the switch
 
 
+def test_segments_join_only_where_their_ends_change_nothing(calls):
+    """The compiled loop joins a tree's segments (driver.CHUNK_EVALUATIONS: the double pendulum's 20 in
+    two calls) but not those of a top on a Spherical joint, whose quaternion is normalised at each
+    segment's end, nor a closed loop's (q projected onto Φ = 0 there): both keep a call per segment."""
+    pq.simulate(pq.scenes.double_pendulum(), 0.5, method="RK45")
+    assert calls["segments"] == 2
+    top = pq.System({"top": pq.RigidBody(1.0, (0.0, 0.0, 0.1), np.diag([0.01, 0.01, 0.02]))}, {"top": pq.Spherical()},
+                    gravity=(0.0, 0.0, -9.81), s_dot0=(0.1, 0.0, 5.0))
+    for system in (top, pq.scenes.four_bar()):
+        calls["segments"] = 0
+        pq.simulate(system, 0.5, method="RK45")
+        assert calls["segments"] == 20
+
+
 def test_output_times_and_the_largest_step(calls):
     """Unequal output times (the first at t_start, some at segments' ends, some between) and
-    max_step: the compiled loop's four segments give the rows scipy's run in one segment gives, at the
-    same times (measured: 8.8e-16 relative in q, 1.6e-15 in ṡ), with as many evaluations."""
+    max_step: the compiled loop's four segments (in two calls: the first, then the three that
+    driver.CHUNK_EVALUATIONS joins) give the rows scipy's run in one segment gives, at the same times
+    (measured: 8.8e-16 relative in q, 1.6e-15 in ṡ), with as many evaluations."""
     system = pq.scenes.double_pendulum()
     t_eval = np.unique(np.concatenate(([0.0, 0.001, 0.5, 1.0], np.sort(np.random.default_rng(3).uniform(0, 1, 37)))))
     runs = [pq.simulate(system, 1.0, method=m, t_eval=t_eval, max_step=0.01, n_segments=n)
             for m, n in (("DOP853", 4), (scipy.integrate.DOP853, 1))]
-    assert calls["segments"] == 4
+    assert calls["segments"] == 2
     np.testing.assert_array_equal(runs[0].t, t_eval)
     assert runs[0].nfev == runs[1].nfev
     dq, ds = _differences(*runs)
@@ -178,7 +194,7 @@ def test_a_failing_evaluation_is_named(method, calls):
         with pytest.raises(pq.SimulationError, match=r"failed at t = 0\.\d+ s .*tau of joint 'link1': non-finite") as failed:
             pq.simulate(system, 1.0, method=way, n_segments=10)
         failures.append(failed.value)
-    assert calls["segments"] == (4 if method == "RK45" else 2)  # the segments up to the failing one
+    assert calls["segments"] == 2  # the first segment, then the rest joined up to the failure
     assert str(failures[0]) == str(failures[1]) and failures[0].result.status == failures[1].result.status
     assert re.search(r"failed at t = (\S+) s", str(failures[0])).group(1) == ("0.35" if method == "RK45" else "0.684399")
     np.testing.assert_array_equal(failures[0].result.t, failures[1].result.t)

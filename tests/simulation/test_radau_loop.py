@@ -63,7 +63,7 @@ def test_a_stiff_linear_oscillator_against_its_closed_form(calls):
     system = two_masses()
     t_eval = np.sort(np.random.default_rng(1).uniform(0.0, 5.0, 37))
     result = pq.simulate(system, 5.0, method="Radau", rtol=1e-6, atol=1e-9, t_eval=t_eval)
-    assert calls["segments"] == 20
+    assert calls["segments"] == 2  # the first of its 20 segments, then the rest joined (driver.CHUNK_EVALUATIONS)
     np.testing.assert_array_equal(result.t, t_eval)
     error = np.abs(result.q - closed_form(t_eval, system.q0)).max() / 0.1
     assert error <= 1.5e-6, error
@@ -73,11 +73,11 @@ def test_a_stiff_linear_oscillator_against_its_closed_form(calls):
 def test_the_flyball_governor_against_a_converged_run(calls):
     """The flyball governor (stiff: ρ ≈ 8e3 1/s) over 0.2 s at rtol 1e-6 against DOP853 at rtol 1e-12: q
     within 10× the measured 9.4e-9 (relative to its largest entry; 1.9e-10 when each of the 20 segments
-    cut its last step short). The compiled loop runs 15 of the 20 segments: five of its steps pass two
-    segments' ends."""
+    cut its last step short). The compiled loop runs the 20 segments in three calls (the first, then as
+    many as driver.CHUNK_EVALUATIONS joins)."""
     system = pq.scenes.flyball_governor()
     result = pq.simulate(system, 0.2, method="Radau", rtol=1e-6, n_points=21)
-    assert calls["segments"] == 15
+    assert calls["segments"] == 3
     reference = pq.simulate(system, 0.2, method="DOP853", rtol=1e-12, atol=1e-13, n_points=21)
     error = np.abs(result.q - reference.q).max() / np.abs(reference.q).max()
     assert error <= 9.4e-8, error
@@ -98,7 +98,7 @@ def test_counts_close_to_scipys_radau(calls):
         return pq.analysis.jacobians.state_jacobian(system, x, t)[0]
 
     reference = pq.simulate(system, 0.2, method="Radau", jac=exact, rtol=1e-6, n_points=21, n_segments=1)
-    assert calls["segments"] == 15  # the user's jac: solve_ivp stepped the reference
+    assert calls["segments"] == 3  # the user's jac: solve_ivp stepped the reference
     own = compiled.nfev - (system.n_q + system.n_s) * compiled.njev
     assert abs(own - reference.nfev) <= 0.02 * reference.nfev, (own, reference.nfev)
     assert abs(compiled.njev - len(jacobians)) <= 0.2 * len(jacobians), (compiled.njev, len(jacobians))
