@@ -9,7 +9,8 @@ angles (0.3, −0.4, 0.2) rad, the beam straight, from rest.
 
 projeq: ``simulate(system, 0.5, rtol=…)`` with the default method at rtol = 1e-2, 1e-3, …, 1e-10
 (atol at its default), n_v = 4 bending functions (``--n-v`` adds coarser beams, each a numba
-compilation the first time), and ``--methods`` besides. Exudyn: links 1 and 2 as
+compilation the first time), and ``--methods`` besides; and projeq's generalized-α at fixed steps
+(``simulate(method="GeneralizedAlpha", step=h)``, ρ∞ 0.9, h in ``--alpha-steps``), Exudyn's method. Exudyn: links 1 and 2 as
 ``ObjectRigidBody2D`` joined by ``RevoluteJoint2D``; the beam as n ``ObjectANCFCable2D`` elements,
 EA = 1e8 N (nearly inextensible, exact curvature), its first node *pinned* to link 2's tip (its
 slope free: projeq's beam is clamped to the massless frame of the third revolute joint, which
@@ -187,15 +188,19 @@ def main(argv=None) -> dict:
                         help="projeq's methods besides the default, every rtol")
     parser.add_argument("--repeat", type=int, default=3,
                         help="runs of each setting, in turn; the least CPU counts")
+    parser.add_argument("--alpha-steps", type=float, nargs="*", default=[1e-2, 5e-3, 2e-3, 1e-3],
+                        help="steps of projeq's GeneralizedAlpha runs (n_v = 4, ρ∞ 0.9, as Exudyn's)")
     parser.add_argument("--quick", action="store_true",
-                        help="0.05 s, rtol 1e-2 and 1e-4, one Exudyn run, one repeat")
+                        help="0.05 s, rtol 1e-2 and 1e-4, one GeneralizedAlpha and one Exudyn run, one repeat")
     args = parser.parse_args(argv)
     rtols, exudyn_runs = RTOLS, EXUDYN_RUNS
     if args.quick:
         args.t_end, args.repeat, rtols, exudyn_runs = 0.05, 1, (1e-2, 1e-4), EXUDYN_RUNS[:1]
+        args.alpha_steps = args.alpha_steps[:1]
     times = np.linspace(0.0, args.t_end, round(args.t_end / OUTPUT_STEP) + 1)
     for n_v in set(args.n_v) | {4}:
         projeq_tip({}, times[:2], n_v)  # compile or load the kernels outside the timings
+    projeq_tip({"method": "GeneralizedAlpha", "step": OUTPUT_STEP}, times[:2])  # and the exact ∂ẋ/∂x's
     reference, reference_cpu, _ = projeq_tip(REFERENCE, times)
     jobs = {}  # name → a call giving (tip, CPU, how)
     for n_v in args.n_v:
@@ -204,6 +209,9 @@ def main(argv=None) -> dict:
                 options = {"rtol": rtol} if method is None else {"rtol": rtol, "method": method}
                 jobs[f"projeq n_v={n_v} {method or 'default'} rtol={rtol:.0e}"] = (
                     lambda options=options, n_v=n_v: projeq_run(options, times, n_v))
+    for h in args.alpha_steps:  # fixed steps, Newton to simulate's default tolerances
+        jobs[f"projeq n_v=4 GeneralizedAlpha h={h:g}"] = (
+            lambda h=h: projeq_run({"method": "GeneralizedAlpha", "step": h}, times, 4))
     if importlib.util.find_spec("exudyn") is None:
         print("exudyn is not installed (pip install 'projeq[bench]'): its runs left out, the ratios are nan")
     else:
