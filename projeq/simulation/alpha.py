@@ -1,5 +1,7 @@
 """The generalized-α method with fixed steps, as scipy's ``OdeSolver``: ``simulate(system, t_end,
-method="GeneralizedAlpha", step=h)``.
+method="GeneralizedAlpha", step=h)`` — stepped by the compiled loop where the model has a compiled ẋ
+(:func:`projeq.simulation.loop.alpha_segment`, the same steps: the double pendulum's q to 1e-15), by this
+class through solve_ivp otherwise (events of the user's, a dense output, ``jac`` not "exact").
 
 For first-order systems ẏ = f(t, y) (Jansen, Whiting & Hulbert, "A generalized-α method for integrating
 the filtered Navier–Stokes equations with a stabilized finite element method", Comput. Methods Appl.
@@ -80,14 +82,16 @@ class GeneralizedAlpha(OdeSolver):
             raise ValueError(f"rho_inf: the spectral radius at infinity must lie in [0, 1], got {rho_inf!r}")
 
     def _jacobian(self, t: float, y: np.ndarray) -> None:
-        """J at (t, y): the user's ``jac`` or forward differences (n evaluations of f)."""
+        """J at (t, y): the user's ``jac`` or forward differences (n evaluations of f) with the increments
+        √(ε max(10⁻⁵, |y_j|)) of Hairer & Wanner's RADAU5, as the compiled loop's
+        (:func:`projeq.simulation.loop._jacobian`)."""
         self.njev += 1
         if self.jac is not None:
             self.J = np.asarray(self.jac(t, y), dtype=float)
             return
         f0, J = self.fun(t, y), np.empty((self.n, self.n))
         for j in range(self.n):
-            delta = np.sqrt(np.finfo(float).eps) * max(1.0, abs(y[j]))
+            delta = np.sqrt(np.finfo(float).eps * max(1e-5, abs(y[j])))
             shifted = y.copy()
             shifted[j] += delta
             J[:, j] = (self.fun(t, shifted) - f0) / delta
@@ -130,14 +134,11 @@ class GeneralizedAlpha(OdeSolver):
         t, span = self.t, abs(self.t_bound - self.t)
         done = abs(t - self.t_start) / self.h_abs  # steps of the grid t_0 + k h passed (a halved step's rest first)
         h = min((np.floor(done + 1e-9) + 1 - done) * self.h_abs, span)
-        if self.J is None:
+        fresh = self.J is None
+        if fresh:
             self._jacobian(t, self.y)
             self.factorised_for = None
-        found, fresh = None, False
-        while found is None:
-            found = self._newton(h * self.direction)
-            if found is not None:
-                break
+        while (found := self._newton(h * self.direction)) is None:
             if not fresh:  # a stale J: formed again at the step's start
                 self._jacobian(t, self.y)
                 self.factorised_for, fresh = None, True

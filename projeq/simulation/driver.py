@@ -205,9 +205,10 @@ def simulate(
         suggesting Radau or BDF. Or ``"GeneralizedAlpha"`` with the option ``step`` (and ``rho_inf``,
         default 0.9): the generalized-α method at fixed steps, damping the modes a step does not
         resolve, as Exudyn and Chrono integrate elastic models
-        (:class:`projeq.simulation.alpha.GeneralizedAlpha`; its Jacobian as Radau's, ``jac``; rtol and
-        atol set only its Newton iteration): the flexible arm's tip within 3.2e-4 of the converged run
-        over 0.5 s with ``step=1e-2``, where a step chosen by a tolerance resolves the bending modes.
+        (:class:`projeq.simulation.alpha.GeneralizedAlpha`; in the compiled loop as Radau, its J by
+        differences of the compiled ẋ; rtol and atol set only its Newton iteration): the flexible arm's
+        tip within 3.2e-4 of the converged run over 0.5 s with ``step=1e-2``, where a step chosen by a
+        tolerance resolves the bending modes.
     rtol, atol : float
         Tolerances passed to the integrator.
     events : callable or list of callables ``event(t, q, s_dot)``
@@ -553,7 +554,8 @@ class _Run:
         by zero entries)."""
         key = (id(self.ev), self.method)
         if self.loops.get(key, (None,))[0] is not self.ev:  # (kept with its evaluator: an id is reused once freed)
-            ready = len(self.x) and not (self.events or set(self.options) - {"max_step"}) and (
+            taken = {"max_step"} | (set(SOLVER_OPTIONS["GeneralizedAlpha"]) if self.method == "GeneralizedAlpha" else set())
+            ready = len(self.x) and not (self.events or set(self.options) - taken) and (
                 self.method not in IMPLICIT or isinstance(self.jac, str))  # Radau: jac "exact", the default
             provider = getattr(self.ev, "loop_model", None) if ready else None
             if provider is not None and self.fused is not None:
@@ -580,10 +582,11 @@ class _Run:
         first = self._continued(self.t_end - a).get("first_step") or 0.0
         carried = self.carried[1] if self.carried is not None and self.carried[0] is compiled else None
         self.reached, self.carried = a, None
+        alpha = (float(self.options.get("rho_inf", 0.9)), float(self.options.get("step", 0.0)), self.bounds[0])
         stepped = compiled.run(
             self.model.n_q, a, self.x, self.t_end, first, float(self.options.get("max_step", np.inf)), self.rtol,
             self.atol, np.ascontiguousarray(ahead, dtype=float), self._paused,
-            MONITOR_EVERY if self.may_be_singular else 0, b, carried)
+            MONITOR_EVERY if self.may_be_singular else 0, b, carried, alpha)
         self._pace(stepped.nfev, a, stepped.t)
         self.nfev, self.njev, self.steps, self.calls, self.step_size, self.reached = (
             self.nfev + stepped.nfev, self.njev + stepped.njev, self.steps + stepped.steps, self.calls + stepped.nfev,

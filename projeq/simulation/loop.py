@@ -19,7 +19,10 @@ the same number of evaluations:
   ``solve_collocation_system``, ``predict_factor`` and ``RadauDenseOutput``; Hairer & Wanner, *Solving
   Ordinary Differential Equations II*, 2nd ed., §IV.8), whose ∂ẋ/∂x comes by forward differences of
   the model's compiled ẋ (scipy's Radau in projeq takes the exact one: the steps may differ slightly)
-  and whose two Newton matrices are factorised by LAPACK (dgetrf/zgetrf, scipy's ``cython_lapack``).
+  and whose two Newton matrices are factorised by LAPACK (dgetrf/zgetrf, scipy's ``cython_lapack``);
+- and the generalized-α method at fixed steps (:func:`alpha_segment`: the steps of
+  :class:`projeq.simulation.alpha.GeneralizedAlpha`, Jansen, Whiting & Hulbert 2000), its Newton matrix
+  factorised the same way and its J by the same differences.
 
 The model enters as data: a first-class function (the compiled ẋ kernel of a tree,
 :meth:`projeq.assembly.fast.FastEvaluator.loop_model`, or of a closed loop, partitioned or in the
@@ -28,9 +31,10 @@ loop is compiled once per signature of the ẋ kernel — once for every tree wi
 GIVEN, once for those with them, once per variant of the closures' kernel (rigid or elastic tree, Φ
 a user's function or cut joints) — and never per model, chain length or set of force laws; the
 method's tableau is data too. It returns to Python once per segment of ``simulate`` (a chunk of
-(t_end − t_start) / n_segments), after the first step that reaches the segment's end — no step is
-cut short there, and the next segment goes on with the same steps (:class:`Carried`) —: there the
-rows are checked, progress is reported and Ctrl-C takes effect, keeping every finished segment.
+(t_end − t_start) / n_segments; on a tree, as many segments as about ``driver.CHUNK_EVALUATIONS``
+evaluations reach), after the first step that reaches the chunk's end — no step is cut short there,
+and the next chunk goes on with the same steps (:class:`Carried`) —: there the rows are checked,
+progress is reported and Ctrl-C takes effect, keeping every finished chunk.
 """
 
 from __future__ import annotations
@@ -48,9 +52,10 @@ from numpy.typing import NDArray
 from projeq.assembly import compilation, kernels
 from projeq.assembly.linalg import one_blas_thread
 
-#: the explicit methods the compiled loop steps (scipy's names), and all of them (Radau IIA the implicit one)
+#: the explicit methods the compiled loop steps (scipy's names), and all of them (Radau IIA and the
+#: generalized-α method the implicit ones)
 EXPLICIT = ("RK23", "RK45", "DOP853")
-METHODS = (*EXPLICIT, "Radau")
+METHODS = (*EXPLICIT, "Radau", "GeneralizedAlpha")
 
 #: scipy's step-size control constants (``scipy.integrate._ivp.rk``)
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -493,20 +498,25 @@ def _jacobian(f, pre, tree, post, n_q, t, y, rate, J, x, column, x_failed):
 
 def _factorise(J, h, mu_real, mu_complex, real, complex_):
     """LU factorisations of μ_real/h I − J and μ_complex/h I − J into ``real`` and ``complex_`` (each (LU,
-    pivots)) by LAPACK's dgetrf and zgetrf (scipy's ``cython_lapack``, :func:`_lapack`), for the simplified
-    Newton iteration's real and complex systems. LAPACK reads the C-ordered matrix as its transpose:
-    :func:`_solve` solves with the transpose of that (``trans = 'T'``)."""
-    n = J.shape[0]
-    M_real, M_complex = real[0], complex_[0]
+    pivots)), for the simplified Newton iteration's real and complex systems (:func:`_shifted_lu`)."""
+    _shifted_lu(J, mu_real / h, real)
+    _shifted_lu(J, mu_complex / h, complex_)
+
+
+def _shifted_lu(J, shift, factorised):
+    """The LU factorisation (LU, pivots) of shift I − J into ``factorised`` by LAPACK's dgetrf or zgetrf (by
+    the dtype; scipy's ``cython_lapack``, :func:`_lapack`). LAPACK reads the C-ordered matrix as its
+    transpose: :func:`_solve` solves with the transpose of that (``trans = 'T'``)."""
+    n, M = J.shape[0], factorised[0]
     for i in range(n):
         for j in range(n):
-            M_real[i, j] = -J[i, j]
-            M_complex[i, j] = -J[i, j]
-        M_real[i, i] += mu_real / h
-        M_complex[i, i] += mu_complex / h
+            M[i, j] = -J[i, j]
+        M[i, i] += shift
     sizes = np.array([n, 1, 0], np.int32)  # n (also the leading dimension), right-hand sides, LAPACK's info
-    DGETRF(sizes.ctypes, sizes.ctypes, M_real.ctypes, sizes.ctypes, real[1].ctypes, sizes[2:].ctypes)
-    ZGETRF(sizes.ctypes, sizes.ctypes, M_complex.ctypes, sizes.ctypes, complex_[1].ctypes, sizes[2:].ctypes)
+    if M.itemsize == 8:  # float64 (complex128: 16)
+        DGETRF(sizes.ctypes, sizes.ctypes, M.ctypes, sizes.ctypes, factorised[1].ctypes, sizes[2:].ctypes)
+    else:
+        ZGETRF(sizes.ctypes, sizes.ctypes, M.ctypes, sizes.ctypes, factorised[1].ctypes, sizes[2:].ctypes)
 
 
 def _solve(factorised, b, out):
@@ -777,25 +787,166 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
     return FINISHED, n_rows, nfev, steps, t, h_abs, t
 
 
+def alpha_constants(rho_inf: float, step: float, t_start: float) -> NDArray:
+    """(α_m, α_f, γ, the step, the grid's start t_0) of a run of :func:`alpha_segment`
+    (:func:`projeq.simulation.alpha.coefficients` of ρ∞)."""
+    from projeq.simulation.alpha import coefficients
+
+    return np.array([*coefficients(rho_inf), step, t_start])
+
+
+def alpha_memory(n: int) -> tuple:
+    """What a generalized-α run keeps from step to step (and over pauses): ∂ẋ/∂x J, the LU factorisation
+    (LU, pivots) of μ/h I − J and the numbers ``ALPHA_*`` (``scalars``); a fresh one: no Jacobian yet."""
+    return np.zeros((n, n)), (np.zeros((n, n)), np.zeros(n, np.int32)), np.zeros(ALPHA_SCALARS)
+
+
+#: the entries of a generalized-α run's scalars: whether J exists, the step its factorisation is for (0:
+#: none), the Jacobians formed
+ALPHA_HAS_J, ALPHA_FACTORED, ALPHA_NJEV, ALPHA_SCALARS = range(4)
+
+
+def _alpha_newton(f, pre, tree, post, n_q, constants, real, t, y, rate, h, scale, tol, work, x_failed):
+    """The step of size h from (t, y, ẏ_n = ``rate``) of :class:`projeq.simulation.alpha.GeneralizedAlpha`
+    (its ``_newton``: the iteration matrix α_m E − α_f γ h J = α_f γ h (μ/h E − J), μ = α_m/(α_f γ),
+    factorised in ``real``) into work[0] (y_{n+1}) and work[1] (ẏ_{n+1}): (converged, evaluations, the time
+    of a failed evaluation or NaN: its state in x_failed)."""
+    alpha_m, alpha_f, gamma = constants[0], constants[1], constants[2]
+    n = y.shape[0]
+    y_new, v, x, residual, dv = work[0], work[1], work[2], work[3], work[4]
+    _copy(rate, v)
+    norm_old, theta = -1.0, -1.0
+    for k in range(NEWTON_MAXITER):
+        for i in range(n):
+            y_new[i] = y[i] + h * rate[i] + gamma * h * (v[i] - rate[i])
+            x[i] = y[i] + alpha_f * (y_new[i] - y[i])
+        if _rhs(f, pre, tree, post, n_q, t + alpha_f * h, x, residual) >= 0:
+            _copy(x, x_failed)
+            return False, k + 1, t + alpha_f * h
+        for i in range(n):
+            residual[i] = (residual[i] - rate[i] - alpha_m * (v[i] - rate[i])) / (alpha_f * gamma * h)
+        _solve(real, residual, dv)  # dv = −W⁻¹ (ẏ_{n+α_m} − f)
+        total = 0.0
+        for i in range(n):
+            total += (gamma * h * dv[i] / scale[i]) ** 2
+        norm = np.sqrt(total / n)
+        if not np.isfinite(norm):
+            return False, k + 1, np.nan
+        if norm_old >= 0.0:
+            theta = norm / norm_old
+            if theta >= 1 or theta ** (NEWTON_MAXITER - k) / (1 - theta) * norm > tol:
+                return False, k + 1, np.nan
+        for i in range(n):
+            v[i] += dv[i]
+        if norm == 0 or theta >= 0.0 and theta / (1 - theta) * norm < tol:
+            for i in range(n):
+                y_new[i] = y[i] + h * rate[i] + gamma * h * (v[i] - rate[i])
+            return True, k + 1, np.nan
+        norm_old = norm
+    return False, NEWTON_MAXITER, np.nan
+
+
+def alpha_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max_step, rtol, atol, pause,
+                  t_pause, retries, t_eval, first_row, rows, state, rate, x_failed, event):
+    """:func:`segment` by the generalized-α method at fixed steps on the grid t_0 + k h, as
+    :class:`projeq.simulation.alpha.GeneralizedAlpha` steps (``method`` = (:func:`alpha_constants`,
+    :func:`alpha_memory`), the memory kept over pauses; ``rate`` the method's own ẏ_n): J by forward
+    differences of the kernel (:func:`_jacobian`, n evaluations and one at the step's start) formed again
+    only where an iteration fails, then the step halved where it fails with a fresh J; the rows by the
+    cubic Hermite interpolant of (y, ẏ). ``h_abs``, ``max_step`` and ``retries`` are the other methods'."""
+    constants, memory = method
+    J, real, scalars = memory
+    step, t_start = constants[3], constants[4]
+    n = state.shape[0]
+    work = (np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n))
+    scale, f0, column = np.empty(n), np.empty(n), np.empty(n)
+    y = state.copy()
+    nfev, steps, n_rows = 0, 0, first_row
+    tol = max(10 * np.finfo(np.float64).eps / rtol, min(0.03, rtol ** 0.5))
+    if not known:
+        nfev += 1
+        if _rhs(f, pre, tree, post, n_q, t, y, rate) >= 0:
+            _copy(y, x_failed)
+            return EVALUATION_FAILED, n_rows, nfev, steps, t, step, t
+    while t != t_bound:
+        done = abs(t - t_start) / step  # grid steps passed (a halved step's rest first)
+        h = min((np.floor(done + 1e-9) + 1 - done) * step, abs(t_bound - t))
+        for i in range(n):
+            scale[i] = atol + abs(y[i]) * rtol
+        fresh = scalars[ALPHA_HAS_J] == 0.0
+        while True:
+            if fresh and scalars[ALPHA_HAS_J] == 0.0:
+                nfev += n + 1
+                scalars[ALPHA_NJEV] += 1
+                failed = _rhs(f, pre, tree, post, n_q, t, y, f0) >= 0
+                if failed or _jacobian(f, pre, tree, post, n_q, t, y, f0, J, work[2], column, x_failed):
+                    if failed:
+                        _copy(y, x_failed)
+                    _copy(y, state)
+                    return EVALUATION_FAILED, n_rows, nfev, steps, t, step, t
+                scalars[ALPHA_HAS_J], scalars[ALPHA_FACTORED] = 1.0, 0.0
+            if scalars[ALPHA_FACTORED] != h:
+                _shifted_lu(J, constants[0] / (constants[1] * constants[2] * h), real)
+                scalars[ALPHA_FACTORED] = h
+            converged, evaluations, t_failed = _alpha_newton(f, pre, tree, post, n_q, constants, real, t, y, rate,
+                                                             h, scale, tol, work, x_failed)
+            nfev += evaluations
+            if not np.isnan(t_failed):
+                _copy(y, state)
+                return EVALUATION_FAILED, n_rows, nfev, steps, t, step, t_failed
+            if converged:
+                break
+            if not fresh:  # a stale J: formed again at the step's start
+                fresh, scalars[ALPHA_HAS_J] = True, 0.0
+                continue
+            h *= 0.5
+            if h < 10 * abs(np.nextafter(t, np.inf) - t):
+                _copy(y, state)
+                return TOO_SMALL_STEP, n_rows, nfev, steps, t, step, t
+        t_new = t + h if h < abs(t_bound - t) else t_bound
+        y_new, v = work[0], work[1]
+        while n_rows < t_eval.shape[0] and t_eval[n_rows] <= t_new:  # the cubic Hermite interpolant
+            theta = (t_eval[n_rows] - t) / (t_new - t)
+            h00, h10 = (2 * theta - 3) * theta * theta + 1, ((theta - 2) * theta + 1) * theta
+            h01, h11 = (3 - 2 * theta) * theta * theta, (theta - 1) * theta * theta
+            for i in range(n):
+                rows[n_rows, i] = (h00 * y[i] + h10 * (t_new - t) * rate[i] + h01 * y_new[i]
+                                   + h11 * (t_new - t) * v[i])
+            n_rows += 1
+        _copy(y_new, y)
+        _copy(v, rate)
+        t = t_new
+        steps += 1
+        if (pause > 0 and nfev >= pause or t >= t_pause) and t != t_bound:
+            _copy(y, state)
+            return PAUSED, n_rows, nfev, steps, t, step, t
+    _copy(y, state)
+    return FINISHED, n_rows, nfev, steps, t, step, t
+
+
 _CALLEES = (_rhs, _stage, _step_to, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows, _event_fired,
-            _event_root, _event_at, _jacobian, _factorise, _solve, _transformed, _collocation, _predict_factor,
-            _interpolated)
+            _event_root, _event_at, _jacobian, _factorise, _shifted_lu, _solve, _transformed, _collocation,
+            _predict_factor, _interpolated, _alpha_newton)
+
+
+#: the segment function of each kind of method :func:`_compiled` compiles
+SEGMENTS = {"explicit": segment, "Radau": radau_segment, "GeneralizedAlpha": alpha_segment}
 
 
 @functools.cache
-def _compiled(signature, implicit: bool):
-    """:func:`segment` (``implicit``: :func:`radau_segment`) compiled by numba for the argument types
-    ``signature`` (the ẋ kernel's as a first-class function type first), cached on disk; its callees
-    compiled with it."""
+def _compiled(signature, kind: str):
+    """The segment function of ``kind`` (:data:`SEGMENTS`: :func:`segment` of the explicit methods,
+    :func:`radau_segment`, :func:`alpha_segment`) compiled by numba for the argument types ``signature``
+    (the ẋ kernel's as a first-class function type first), cached on disk; its callees compiled with it."""
     numba = kernels.numba_module()
-    namespace = {**globals(), **(_lapack() if implicit else {})}
+    namespace = {**globals(), **(_lapack() if kind != "explicit" else {})}
 
     def rebound(function):
         return types.FunctionType(function.__code__, namespace, function.__name__, function.__defaults__)
 
     for callee in _CALLEES:
         namespace[callee.__name__] = numba.extending.register_jitable(rebound(callee))
-    return numba.njit([signature], cache=True)(rebound(radau_segment if implicit else segment))
+    return numba.njit([signature], cache=True)(rebound(SEGMENTS[kind]))
 
 
 class CompiledLoop:
@@ -803,20 +954,21 @@ class CompiledLoop:
     evaluator's ``loop_model``) and one method of :data:`METHODS`; :meth:`run` steps a segment."""
 
     def __init__(self, model, method: str):
-        self.model, self.implicit = model, method not in EXPLICIT
-        self.method = radau_tableau() if self.implicit else tableau(method)
+        self.model, self.implicit, self.alpha = model, method not in EXPLICIT, method == "GeneralizedAlpha"
+        self.method = None if self.alpha else radau_tableau() if self.implicit else tableau(method)
         self.kernel, self.compiled = _specialised(model, method)
 
     def run(self, n_q: int, t: float, x: NDArray, t_bound: float, h_abs: float, max_step: float, rtol: float,
             atol: float, t_eval: NDArray, monitor=None, every: int = 0, t_pause: float = np.inf,
-            carried: Carried | None = None) -> Stepped:
+            carried: Carried | None = None, alpha: tuple = ()) -> Stepped:
         """One segment from (t, x) to t_bound, or to the end of the first step that reaches ``t_pause``
         (status PAUSED, with ``Stepped.carried``); ``monitor(t, x)`` called after the first step past each
         ``every`` evaluations (``every`` > 0), as :func:`segment` pauses: where it raises, the segment ends
         there (status STOPPED) with the rows computed so far. With ``carried`` (the last run's, paused at
         t) the run goes on with the steps one run without the pause would take: its step size, Radau's
         memory and the event's value kept, and ẋ too where x is the state it paused at (not where the
-        caller normalised it: then ẋ is evaluated again)."""
+        caller normalised it: then ẋ is evaluated again). The generalized-α method takes ``alpha`` = (ρ∞, the
+        step, the grid's start) (:func:`alpha_constants`)."""
         t_eval, state = np.ascontiguousarray(t_eval, dtype=float).ravel(), np.array(x, dtype=float).ravel()
         rows, x_failed = np.empty((len(t_eval), len(state))), np.empty(len(state))
         status, n_rows, nfev, steps, stopped_by = PAUSED, 0, 0, 0, None
@@ -826,10 +978,13 @@ class CompiledLoop:
             method, event = carried.method, carried.event
         else:  # a fresh run (Radau: its Jacobian formed at t)
             known, rate, method = False, np.empty(len(state)), self.method
-            if self.implicit:
+            if self.alpha:
+                method = (alpha_constants(*alpha), alpha_memory(len(state)))
+            elif self.implicit:
                 method = (method, radau_memory(len(state)))
             event = (model.event[0], float(model.event[1]), np.zeros(1))  # (value, limit, g kept over pauses)
-        njev = int(method[1][-1][RADAU_NJEV]) if self.implicit else 0  # (a carried memory's count so far)
+        counted = ALPHA_NJEV if self.alpha else RADAU_NJEV
+        njev = int(method[1][-1][counted]) if self.implicit else 0  # (a carried memory's count so far)
         retries = 0 if self.implicit or model.checks_events else STAGE_RETRIES  # a closed loop's kernel fails on purpose
         if model.before is not None:
             model.before()
@@ -847,7 +1002,7 @@ class CompiledLoop:
                     monitor(t, state)
                 except Exception as exc:  # noqa: BLE001 - the caller raises it, keeping the rows
                     status, stopped_by = STOPPED, exc
-        njev = int(method[1][-1][RADAU_NJEV]) - njev if self.implicit else 0
+        njev = int(method[1][-1][counted]) - njev if self.implicit else 0
         carry = Carried(t, state.copy(), rate, h_abs, method, event) if status == PAUSED else None
         return Stepped(status, t, rows[:n_rows], state, x_failed, t_failed, nfev, steps, h_abs, stopped_by, njev, carry)
 
@@ -879,12 +1034,12 @@ def _specialised(model, method: str) -> tuple:
         if signature not in model.kernel.overloads:  # a kernel Python has not called yet: compiled (or loaded) now
             model.kernel.compile(signature)
         kernel = _address(model.kernel, model.kernel.overloads[signature].signature)
-        implicit = method not in EXPLICIT
-        data = (radau_tableau(), radau_memory(1)) if implicit else tableau(method)
+        data = tableau(method) if method in EXPLICIT else (alpha_constants(0.9, 1.0, 0.0), alpha_memory(1)) \
+            if method == "GeneralizedAlpha" else (radau_tableau(), radau_memory(1))
         compiled = _compiled(tuple(numba.typeof(a) for a in (
             kernel, model.pre, model.tree, model.post, 0, data, 0.0, 0.0, True, 0.0, 0.0, 0.0, 0.0, 0, 0.0, 0,
             np.zeros(1), 0, np.zeros((1, 1)), np.zeros(1), np.zeros(1), np.zeros(1),
-            (np.zeros(1), 0.0, np.zeros(1)))), implicit)
+            (np.zeros(1), 0.0, np.zeros(1)))), method if method not in EXPLICIT else "explicit")
         _SPECIALISED[key] = kernel, compiled.overloads[compiled.signatures[0]].entry_point
     return _SPECIALISED[key]
 

@@ -78,7 +78,7 @@ PRINTS = {
     "flexible_arm_alpha.py": ("generalized-α, fixed steps", "h = 0.01 s, ρ∞ 0.9", "per-component error estimate"),
     "flexible_arm_integrators.py": ("DOP853 compiled", "exprb43", "ETDRK4", "costs inside a compiled loop"),
     "flexible_arm_exudyn.py": ("cheapest run of each code per error level", "the issue's targets",
-                               "simulate(rtol=1e-04)"),
+                               "simulate(rtol=1e-04)", "GeneralizedAlpha h=0.01"),
     "flexible_four_bar_exudyn.py": ("projeq n_v=2 defaults", "projeq n_v=4 tight"),
     "formulations.py": ("knife-edge disc", "formulation"),
     "four_bar_mujoco.py": ("projeq/MuJoCo", "MuJoCo RK4 dt", "rtol=1e-6"),
