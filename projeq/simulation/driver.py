@@ -17,8 +17,8 @@ first step that reaches it and the next segment goes on from there with the same
 takes the steps of one segment (bit for bit on a tree; a closed loop's state is projected onto
 Φ = 0 where a segment ends) — on short runs up to 40 % fewer evaluations (the double pendulum over
 0.5 s: 203 instead of 351) — and a step that passes several ends finishes those segments together
-(``progress`` is called once, with the time reached). On a tree whose segment ends change nothing (no
-quaternion to normalise) one call of the compiled loop takes as many segments as it reaches within
+(``progress`` is called once, with the time reached). On a tree of rigid bodies whose segment ends change
+nothing (no quaternion to normalise) one call of the compiled loop takes as many segments as it reaches within
 ``CHUNK_EVALUATIONS`` at the last call's pace (``_Run.chunk_end``: fewer returns to Python; the checks,
 ``progress`` and Ctrl-C then act at the end of such a chunk). With events of the user's each segment is a
 solve_ivp call that ends at the segment's end.
@@ -224,7 +224,7 @@ def simulate(
     progress : callable ``progress(t)``, optional
         Called after each segment with the time reached (the end of the integrator's first step past
         the segment's end; once for the segments one step passes, or one call of the compiled loop joins
-        on a tree; with events, the segment's end).
+        on a tree of rigid bodies; with events, the segment's end).
     jac : "exact", "differences", callable or matrix
         For Radau, BDF and LSODA: ∂ẋ/∂x by the complex step through the model ("exact",
         the default; exact to round-off, n complex evaluations per Jacobian, counted in
@@ -613,16 +613,20 @@ class _Run:
 
     def _pace(self, evaluations: int, a: float, t: float) -> None:
         """The evaluations per simulated second of a segment from a to t that :meth:`chunk_end` reads, where
-        the run's model is a tree whose segment ends change nothing (else None: no segments joined)."""
-        joins = self.model.tree is self.model and not self.model.tree._normalizing and t > a
+        the run's model is a tree of rigid bodies whose segment ends change nothing (else None: no segments
+        joined): no joint whose coordinates are normalised there, no subsystem of coordinates of its own,
+        whose range each segment's rows are checked against (a beam found beyond moderate deflections at
+        the end of a joined chunk would have gone far beyond)."""
+        tree = self.model.tree
+        joins = tree is self.model and not tree._normalizing and t > a and not any(sub.n_e for sub in tree.subsystems)
         self.chunk_rate = evaluations / (t - a) if joins else None
 
     def chunk_end(self, b: float, segments: deque) -> float:
         """The end of the next call of the compiled loop (or of scipy's solver stepped over the run,
         :meth:`_stepped_segment`): b, or the end of the last of the following ``segments`` (taken from it)
         that it reaches within ``CHUNK_EVALUATIONS`` at the last call's evaluations per simulated second
-        (:meth:`_pace`), where that call stepped a tree whose segment ends change nothing (no joint whose
-        coordinates are normalised: the same steps, bit for bit): each return to Python costs about 0.1 ms,
+        (:meth:`_pace`), where that call stepped a tree of rigid bodies whose segment ends change nothing
+        (the same steps, bit for bit): each return to Python costs about 0.1 ms,
         a tenth of a short run's CPU (the double pendulum over 0.5 s: 9 calls, 2 now).
         Counted in evaluations, not seconds, so that a run's calls, and where its checks of the rows fall
         (progress, a subsystem out of range), do not depend on the machine's load; such a chunk lasts a

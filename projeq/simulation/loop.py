@@ -31,8 +31,8 @@ loop is compiled once per signature of the ẋ kernel — once for every tree wi
 GIVEN, once for those with them, once per variant of the closures' kernel (rigid or elastic tree, Φ
 a user's function or cut joints) — and never per model, chain length or set of force laws; the
 method's tableau is data too. It returns to Python once per segment of ``simulate`` (a chunk of
-(t_end − t_start) / n_segments; on a tree, as many segments as about ``driver.CHUNK_EVALUATIONS``
-evaluations reach), after the first step that reaches the chunk's end — no step is cut short there,
+(t_end − t_start) / n_segments; on a tree of rigid bodies, as many segments as about
+``driver.CHUNK_EVALUATIONS`` evaluations reach), after the first step that reaches the chunk's end — no step is cut short there,
 and the next chunk goes on with the same steps (:class:`Carried`) —: there the rows are checked,
 progress is reported and Ctrl-C takes effect, keeping every finished chunk.
 """
