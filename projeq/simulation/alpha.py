@@ -40,6 +40,8 @@ GETRF, GETRS = scipy.linalg.get_lapack_funcs(("getrf", "getrs"), (np.zeros(1),))
 
 #: Newton iterations per step at most (scipy's Radau's)
 NEWTON_MAXITER = 6
+#: the spectral radius at infinity by default (Exudyn's)
+RHO_INF = 0.9
 
 
 def coefficients(rho_inf: float) -> tuple[float, float, float]:
@@ -56,7 +58,7 @@ class GeneralizedAlpha(OdeSolver):
     ``jac`` a callable jac(t, y) or None (forward differences). ``first_step`` and ``max_step`` are
     taken for scipy's interface and do not change the steps."""
 
-    def __init__(self, fun, t0, y0, t_bound, step=None, rho_inf=0.9, jac=None, rtol=1e-3, atol=1e-6,
+    def __init__(self, fun, t0, y0, t_bound, step=None, rho_inf=RHO_INF, jac=None, rtol=1e-3, atol=1e-6,
                  first_step=None, max_step=np.inf, vectorized=False, **extraneous):
         if extraneous:
             raise ValueError(f"GeneralizedAlpha: unknown options {sorted(extraneous)}; it takes step, rho_inf")
@@ -74,7 +76,7 @@ class GeneralizedAlpha(OdeSolver):
     @staticmethod
     def check_options(options: dict) -> None:
         """ValueError naming ``step`` (missing, or not a positive number) or ``rho_inf`` (outside [0, 1])."""
-        step, rho_inf = options.get("step"), options.get("rho_inf", 0.9)
+        step, rho_inf = options.get("step"), options.get("rho_inf", RHO_INF)
         if isinstance(step, bool) or not isinstance(step, (int, float, np.number)) or not 0 < step < np.inf:
             raise ValueError(f"step: GeneralizedAlpha takes fixed steps: give step=h, a positive number of "
                              f"seconds, got {step!r}")

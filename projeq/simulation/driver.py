@@ -51,7 +51,7 @@ from projeq.analysis.jacobians import state_derivative, state_jacobian
 from projeq.assembly import EVALUATORS, compilation
 from projeq.checks import callable_name, closest, count, finite_array, flag, non_negative, positive, state_vector
 from projeq.simulation import loop
-from projeq.simulation.alpha import GeneralizedAlpha
+from projeq.simulation.alpha import RHO_INF, GeneralizedAlpha
 from projeq.simulation.integrators import (
     EXPLICIT, PROJECTED, fastest_mode, projected_solver, stability_limit, stiff_steps, warn_stiff, with_direct_lu,
 )
@@ -554,7 +554,7 @@ class _Run:
         by zero entries)."""
         key = (id(self.ev), self.method)
         if self.loops.get(key, (None,))[0] is not self.ev:  # (kept with its evaluator: an id is reused once freed)
-            taken = {"max_step"} | (set(SOLVER_OPTIONS["GeneralizedAlpha"]) if self.method == "GeneralizedAlpha" else set())
+            taken = {"max_step", *(SOLVER_OPTIONS[self.method] if self.method in OWN_SOLVERS else ())}
             ready = len(self.x) and not (self.events or set(self.options) - taken) and (
                 self.method not in IMPLICIT or isinstance(self.jac, str))  # Radau: jac "exact", the default
             provider = getattr(self.ev, "loop_model", None) if ready else None
@@ -582,7 +582,7 @@ class _Run:
         first = self._continued(self.t_end - a).get("first_step") or 0.0
         carried = self.carried[1] if self.carried is not None and self.carried[0] is compiled else None
         self.reached, self.carried = a, None
-        alpha = (float(self.options.get("rho_inf", 0.9)), float(self.options.get("step", 0.0)), self.bounds[0])
+        alpha = (float(self.options.get("rho_inf", RHO_INF)), float(self.options.get("step", 0.0)), self.bounds[0])
         stepped = compiled.run(
             self.model.n_q, a, self.x, self.t_end, first, float(self.options.get("max_step", np.inf)), self.rtol,
             self.atol, np.ascontiguousarray(ahead, dtype=float), self._paused,
