@@ -43,14 +43,19 @@ def simulation_options(parser: argparse.ArgumentParser, out: str = "projeq-out")
     sweep``): scene settings, end time, integrator, tolerances, evaluator, output directory,
     quiet, JSON; :func:`simulate_options` turns them into :func:`projeq.simulate`'s keywords."""
     from projeq.assembly import EVALUATORS
-    from projeq.simulation.driver import INTEGRATORS
+    from projeq.simulation.driver import INTEGRATORS, OWN_SOLVERS
     from projeq.simulation.integrators import PROJECTED
 
+    methods = [*INTEGRATORS, *OWN_SOLVERS, *PROJECTED]
     scene_settings_option(parser)
     parser.add_argument("--t-end", type=float, default=None, help="end time in s (default: the scene's)")
-    parser.add_argument("--method", default=None, choices=[*INTEGRATORS, *PROJECTED], metavar="METHOD",
-                        help=f"integrator: {', '.join([*INTEGRATORS, *PROJECTED])} (default: the scene's setting, "
+    parser.add_argument("--method", default=None, choices=methods, metavar="METHOD",
+                        help=f"integrator: {', '.join(methods)} (default: the scene's setting, "
                              "else projeq.simulate's choice)")
+    parser.add_argument("--step", type=float, default=None,
+                        help="the fixed step in s of --method GeneralizedAlpha (it takes no other)")
+    parser.add_argument("--rho-inf", type=float, default=None,
+                        help="GeneralizedAlpha's spectral radius at infinity in [0, 1] (default 0.9)")
     parser.add_argument("--rtol", type=float, default=None,
                         help="relative tolerance (default: the scene's setting, else projeq.simulate's)")
     parser.add_argument("--atol", type=float, default=None,
@@ -67,7 +72,8 @@ def simulate_options(args, scene) -> dict:
     scene's own settings (:class:`projeq.scenes.Scene` ``settings``); what neither gives is
     left to ``simulate``'s defaults, except that a run leaving its model's range stops there
     (``out_of_range="stop"``: status "out of range", exit code 3 of ``projeq run``)."""
-    given = {name: getattr(args, name) for name in ("method", "rtol", "atol", "evaluator") if getattr(args, name) is not None}
+    given = {name: getattr(args, name) for name in ("method", "rtol", "atol", "evaluator", "step", "rho_inf")
+             if getattr(args, name) is not None}
     return (scene.settings or {}) | given | {"out_of_range": "stop"}  # a run leaving its model's range ends
 
 

@@ -78,8 +78,8 @@ class GeneralizedAlpha(OdeSolver):
         """ValueError naming ``step`` (missing, or not a positive number) or ``rho_inf`` (outside [0, 1])."""
         step, rho_inf = options.get("step"), options.get("rho_inf", RHO_INF)
         if isinstance(step, bool) or not isinstance(step, (int, float, np.number)) or not 0 < step < np.inf:
-            raise ValueError(f"step: GeneralizedAlpha takes fixed steps: give step=h, a positive number of "
-                             f"seconds, got {step!r}")
+            raise ValueError(f"step: GeneralizedAlpha takes fixed steps: give step=h (projeq run: --step H), a "
+                             f"positive number of seconds, got {step!r}")
         if isinstance(rho_inf, bool) or not isinstance(rho_inf, (int, float, np.number)) or not 0 <= rho_inf <= 1:
             raise ValueError(f"rho_inf: the spectral radius at infinity must lie in [0, 1], got {rho_inf!r}")
 
