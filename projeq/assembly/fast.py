@@ -345,18 +345,26 @@ class FastEvaluator:
         if self._expansion is not None:  # every joint's own coordinates and velocities
             q_rows, s_rows = q_rows @ self._expansion[0].T, s_rows @ self._expansion[1].T
         rows_kinematics = kernels.rows_kernel(self.compiled)
+        # joints of kind GIVEN: their relative motions at each row's time, in the compiled rows kernel where
+        # their callbacks are (given.rows_kernel), else from Python a row at a time
+        table = self._joint_table(float) if self._given and self._given_motions is not None else None
         chunk = max(1, ROWS_BYTES // (8 * 6 * ws.twist.size))  # rows stacked at once: R, r and the twists
         energies = np.zeros((len(times), 2))
         for start in range(0, len(times), chunk):
             rows = range(start, min(start + chunk, len(times)))
             twists, R, r = (np.empty((len(rows), *a.shape)) for a in (ws.twist[:-1], ws.R[rigid], ws.r[rigid]))
-            for block in ([slice(k, k + 1) for k in range(len(rows))] if self._given else [slice(0, len(rows))]):
+            by_row = self._given and table is None
+            for block in ([slice(k, k + 1) for k in range(len(rows))] if by_row else [slice(0, len(rows))]):
                 q_all, s_all = (np.ascontiguousarray(a[start:][block]) for a in (q_rows, s_rows))
-                if self._given:  # the relative motions of joints of kind GIVEN at the row's time
+                arguments = (self._index, self._geometry, self._inertia, self._gravity, q_all, s_all,
+                             ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat,
+                             ws.R, ws.r, ws.twist, rigid, twists[block], R[block], r[block])
+                if table is not None:
+                    given.rows_kernel()(table, np.ascontiguousarray(times[start:][block], dtype=float), *arguments)
+                    continue
+                if by_row:  # the relative motions of joints of kind GIVEN at the row's time
                     self._relative_motions(ws, q_all[0], s_all[0], float(times[start + block.start]))
-                rows_kinematics(self._index, self._geometry, self._inertia, self._gravity, q_all, s_all,
-                                ws.given_values, self._elastic, self._ports, ws.T, ws.zeta, ws.F, ws.M_n, ws.h_hat,
-                                ws.R, ws.r, ws.twist, rigid, twists[block], R[block], r[block])
+                rows_kinematics(*arguments)
             energies[rows, 0] = 0.5 * np.einsum("kni,nij,knj->k", twists, ws.M_n[:, :6, :6], twists)  # rigid M_n
             if len(rigid):
                 energies[rows, 1] = gravity_potential(m, r_c, R, r, system.gravity)

@@ -46,6 +46,7 @@ from projeq.assembly.kernels import (
     N_COLS,
     Q_INDEX,
     S_INDEX,
+    rows_kinematics,
     tree_accelerations,
     tree_state_derivative,
 )
@@ -277,6 +278,26 @@ def _compiled(rigid: bool) -> tuple:
                                 given_state_derivative),
                        kernels=callees, names=(prefix + "given_state_derivative", prefix + "given_jacobian"),
                        _rates=given_rates)
+
+
+def given_rows_kinematics(joints, times, index, geometry, inertia, gravity, q_rows, s_rows, given, elastic, port, T,
+                          zeta, F, M, h, R, r_O, twist, bodies, twists, R_rows, r_rows):
+    """:func:`projeq.assembly.kernels.rows_kinematics` of a tree with joints of kind GIVEN: at each row,
+    their relative motions at the row's time (:func:`given_motions`) first, so that a run's output rows
+    take one compiled call, not a Python step per row (the Whipple bicycle's 501 rows: 7 ms of its 13.5 ms
+    run over 2 s)."""
+    for k in range(q_rows.shape[0]):
+        given_motions(joints, q_rows[k], s_rows[k], times[k], given)
+        rows_kinematics(index, geometry, inertia, gravity, q_rows[k:k + 1], s_rows[k:k + 1], given, elastic, port,
+                        T, zeta, F, M, h, R, r_O, twist, bodies, twists[k:k + 1], R_rows[k:k + 1], r_rows[k:k + 1])
+
+
+@functools.cache
+def rows_kernel():
+    """:func:`given_rows_kinematics` compiled (cached on disk), calling the compiled rows kernel."""
+    kernels.kernel(True)
+    return kernels.jit(given_rows_kinematics, callees=(given_motions,),
+                       kernels={"rows_kinematics": kernels.rows_kernel(), **intrinsics()})[0]
 
 
 @functools.cache

@@ -229,3 +229,24 @@ def test_a_hub_beam_on_a_motion_in_sympy_reads_it_by_its_callback():
         assert np.abs(ev.accelerations(q, s_dot, t) - want).max() <= 100 * EPS * scale
         x_dot = ev.state_derivative(t, np.concatenate((q, s_dot)))
         assert np.abs(x_dot - np.concatenate((s_dot, want))).max() <= 100 * EPS * scale
+
+
+@pytest.mark.parametrize("scene", ["whipple_bicycle", "car"])
+def test_output_rows_energies_in_one_compiled_call(scene, monkeypatch):
+    """The energies of a run's output rows on a tree with joints of kind GIVEN (the bicycle's rear frame,
+    the car's rolling joint) take one compiled call per chunk of rows (given.rows_kernel: each row's
+    relative motions by their callbacks, then its kinematics), equal bit for bit (measured 0.0) to the
+    rows one at a time with the joints' relative motions from Python."""
+    from projeq.assembly import given
+
+    system = getattr(pq.scenes, scene)()
+    ev = system.tree.evaluator("fast")
+    result = pq.simulate(system, 1.0, n_points=51)
+    s_tree = np.array([system.tree_velocities(q, s, t) if hasattr(system, "tree_velocities") else s
+                       for q, s, t in zip(result.q, result.s_dot, result.t)])
+    calls, kernel = [], given.rows_kernel
+    monkeypatch.setattr(given, "rows_kernel", lambda: (calls.append(1), kernel())[1])
+    together = ev.energies(result.q, s_tree, result.t)
+    assert calls
+    monkeypatch.setattr(ev, "_given_motions", None)  # the joints' relative_values, a row at a time
+    assert np.array_equal(together, ev.energies(result.q, s_tree, result.t))
