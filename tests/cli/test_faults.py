@@ -150,7 +150,8 @@ def test_sigterm_to_a_sweep_keeps_the_finished_points_and_stops_the_workers(tmp_
     assert table["status"][1] == 2 and table["error"][1] == ""  # stopped, with its partial result (maybe no step)
     # finished, running (stopped in its integration, or told before it started it: a CI run met that), or not started
     for status, error in zip(table["status"][2:], table["error"][2:]):
-        assert (status, error) in ((0, ""), (2, ""), (2, "interrupted before its integration started"), (-1, "interrupted"))
+        assert (status, error) in ((0, ""), (2, ""), (2, "interrupted before its integration started"),
+                                   (-1, "interrupted"))
 
 
 def test_a_killed_sweep_keeps_its_finished_points_and_resume_runs_the_rest(tmp_path, monkeypatch, capsys):
