@@ -35,6 +35,8 @@ import numpy as np
 import scipy.linalg
 from scipy.integrate import DenseOutput, OdeSolver
 
+from projeq.simulation.loop import grid_step, hermite_weights, newton_tolerance
+
 #: LAPACK's LU factorisation and solve of real matrices
 GETRF, GETRS = scipy.linalg.get_lapack_funcs(("getrf", "getrs"), (np.zeros(1),))
 
@@ -68,7 +70,7 @@ class GeneralizedAlpha(OdeSolver):
         self.alpha_m, self.alpha_f, self.gamma = coefficients(self.rho_inf)
         self.jac, self.njev, self.nlu = jac, 0, 0
         self.rtol, self.atol = rtol, atol
-        self.newton_tol = max(10 * np.finfo(float).eps / rtol, min(0.03, rtol ** 0.5))
+        self.newton_tol = newton_tolerance(rtol)
         self.f = self.fun(self.t, self.y)  # ẏ_0
         self.J, self.lu, self.factorised_for = None, None, None
         self.t_old = self.y_old = self.f_old = None
@@ -134,8 +136,7 @@ class GeneralizedAlpha(OdeSolver):
 
     def _step_impl(self):
         t, span = self.t, abs(self.t_bound - self.t)
-        done = abs(t - self.t_start) / self.h_abs  # steps of the grid t_0 + k h passed (a halved step's rest first)
-        h = min((np.floor(done + 1e-9) + 1 - done) * self.h_abs, span)
+        h = grid_step(t, self.t_start, self.h_abs, self.t_bound)
         fresh = self.J is None
         if fresh:
             self._jacobian(t, self.y)
@@ -167,8 +168,6 @@ class HermiteOutput(DenseOutput):
 
     def _call_impl(self, t):
         h = self.t - self.t_old
-        s = (np.asarray(t, dtype=float) - self.t_old) / h
-        h00, h10 = 2 * s ** 3 - 3 * s ** 2 + 1, s ** 3 - 2 * s ** 2 + s
-        h01, h11 = 3 * s ** 2 - 2 * s ** 3, s ** 3 - s ** 2
+        h00, h10, h01, h11 = hermite_weights((np.asarray(t, dtype=float) - self.t_old) / h)
         return (np.multiply.outer(self.y_old, h00) + np.multiply.outer(h * self.f_old, h10)
                 + np.multiply.outer(self.y_new, h01) + np.multiply.outer(h * self.f_new, h11))

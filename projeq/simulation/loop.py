@@ -652,7 +652,7 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
     Z, scale, error, ZE, f_new = np.empty((3, n)), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     y, y_new = state.copy(), np.empty(n)
     nfev, steps, n_rows, failed = 0, 0, first_row, -1
-    newton_tol = max(10 * np.finfo(np.float64).eps / rtol, min(0.03, rtol ** 0.5))
+    newton_tol = newton_tolerance(rtol)
     if not known:
         nfev += 1
         failed = _rhs(f, pre, tree, post, n_q, t, y, rate)
@@ -787,6 +787,26 @@ def radau_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
     return FINISHED, n_rows, nfev, steps, t, h_abs, t
 
 
+def newton_tolerance(rtol):
+    """scipy's Radau's tolerance of the simplified Newton iteration, relative to atol + rtol |y|:
+    max(10 ε / rtol, min(0.03, √rtol)) (its ``newton_tol``; :func:`radau_segment`, :func:`alpha_segment`)."""
+    return max(10 * np.finfo(np.float64).eps / rtol, min(0.03, rtol ** 0.5))
+
+
+def grid_step(t, t_start, step, t_bound):
+    """The next step of the generalized-α method from t on the grid t_0 + k h (``t_start``, ``step``): to
+    the next grid point (the rest of a step halved before it), cut at t_bound."""
+    done = abs(t - t_start) / step  # grid steps passed
+    return min((np.floor(done + 1e-9) + 1 - done) * step, abs(t_bound - t))
+
+
+def hermite_weights(theta):
+    """(h₀₀, h₁₀, h₀₁, h₁₁) of the cubic Hermite interpolant at θ ∈ [0, 1] of a step of size h:
+    y(θ) = h₀₀ y_old + h₁₀ h ẏ_old + h₀₁ y_new + h₁₁ h ẏ_new (θ a number, or an array of them)."""
+    return ((2 * theta - 3) * theta * theta + 1, ((theta - 2) * theta + 1) * theta,
+            (3 - 2 * theta) * theta * theta, (theta - 1) * theta * theta)
+
+
 def alpha_constants(rho_inf: float, step: float, t_start: float) -> NDArray:
     """(α_m, α_f, γ, the step, the grid's start t_0) of a run of :func:`alpha_segment`
     (:func:`projeq.simulation.alpha.coefficients` of ρ∞)."""
@@ -862,15 +882,14 @@ def alpha_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
     scale, f0, column = np.empty(n), np.empty(n), np.empty(n)
     y = state.copy()
     nfev, steps, n_rows = 0, 0, first_row
-    tol = max(10 * np.finfo(np.float64).eps / rtol, min(0.03, rtol ** 0.5))
+    tol = newton_tolerance(rtol)
     if not known:
         nfev += 1
         if _rhs(f, pre, tree, post, n_q, t, y, rate) >= 0:
             _copy(y, x_failed)
             return EVALUATION_FAILED, n_rows, nfev, steps, t, step, t
     while t != t_bound:
-        done = abs(t - t_start) / step  # grid steps passed (a halved step's rest first)
-        h = min((np.floor(done + 1e-9) + 1 - done) * step, abs(t_bound - t))
+        h = grid_step(t, t_start, step, t_bound)
         for i in range(n):
             scale[i] = atol + abs(y[i]) * rtol
         fresh = scalars[ALPHA_HAS_J] == 0.0
@@ -906,9 +925,7 @@ def alpha_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
         t_new = t + h if h < abs(t_bound - t) else t_bound
         y_new, v = work[0], work[1]
         while n_rows < t_eval.shape[0] and t_eval[n_rows] <= t_new:  # the cubic Hermite interpolant
-            theta = (t_eval[n_rows] - t) / (t_new - t)
-            h00, h10 = (2 * theta - 3) * theta * theta + 1, ((theta - 2) * theta + 1) * theta
-            h01, h11 = (3 - 2 * theta) * theta * theta, (theta - 1) * theta * theta
+            h00, h10, h01, h11 = hermite_weights((t_eval[n_rows] - t) / (t_new - t))
             for i in range(n):
                 rows[n_rows, i] = (h00 * y[i] + h10 * (t_new - t) * rate[i] + h01 * y_new[i]
                                    + h11 * (t_new - t) * v[i])
@@ -926,7 +943,7 @@ def alpha_segment(f, pre, tree, post, n_q, method, t, t_bound, known, h_abs, max
 
 _CALLEES = (_rhs, _stage, _step_to, _rms, _copy, _combine, _first_guess, _first_choice, _error_norm, _dense_rows, _event_fired,
             _event_root, _event_at, _jacobian, _factorise, _shifted_lu, _solve, _transformed, _collocation,
-            _predict_factor, _interpolated, _alpha_newton)
+            _predict_factor, _interpolated, _alpha_newton, newton_tolerance, grid_step, hermite_weights)
 
 
 #: the segment function of each kind of method :func:`_compiled` compiles
