@@ -35,7 +35,7 @@ import numpy as np
 import scipy.linalg
 from scipy.integrate import DenseOutput, OdeSolver
 
-from projeq.simulation.loop import grid_step, hermite_weights, newton_tolerance
+from projeq.simulation.loop import coefficients, grid_step, hermite_weights, newton_tolerance
 
 #: LAPACK's LU factorisation and solve of real matrices
 GETRF, GETRS = scipy.linalg.get_lapack_funcs(("getrf", "getrs"), (np.zeros(1),))
@@ -44,13 +44,6 @@ GETRF, GETRS = scipy.linalg.get_lapack_funcs(("getrf", "getrs"), (np.zeros(1),))
 NEWTON_MAXITER = 6
 #: the spectral radius at infinity by default (Exudyn's)
 RHO_INF = 0.9
-
-
-def coefficients(rho_inf: float) -> tuple[float, float, float]:
-    """(α_m, α_f, γ) of the first-order generalized-α method for the spectral radius at infinity ρ∞
-    (Jansen, Whiting & Hulbert 2000, eq. (18), (20))."""
-    alpha_m, alpha_f = 0.5 * (3.0 - rho_inf) / (1.0 + rho_inf), 1.0 / (1.0 + rho_inf)
-    return alpha_m, alpha_f, 0.5 + alpha_m - alpha_f
 
 
 class GeneralizedAlpha(OdeSolver):

@@ -807,11 +807,16 @@ def hermite_weights(theta):
             (3 - 2 * theta) * theta * theta, (theta - 1) * theta * theta)
 
 
+def coefficients(rho_inf: float) -> tuple[float, float, float]:
+    """(α_m, α_f, γ) of the first-order generalized-α method for the spectral radius at infinity ρ∞
+    (Jansen, Whiting & Hulbert 2000, eq. (18), (20))."""
+    alpha_m, alpha_f = 0.5 * (3.0 - rho_inf) / (1.0 + rho_inf), 1.0 / (1.0 + rho_inf)
+    return alpha_m, alpha_f, 0.5 + alpha_m - alpha_f
+
+
 def alpha_constants(rho_inf: float, step: float, t_start: float) -> NDArray:
     """(α_m, α_f, γ, the step, the grid's start t_0) of a run of :func:`alpha_segment`
-    (:func:`projeq.simulation.alpha.coefficients` of ρ∞)."""
-    from projeq.simulation.alpha import coefficients
-
+    (:func:`coefficients` of ρ∞)."""
     return np.array([*coefficients(rho_inf), step, t_start])
 
 
